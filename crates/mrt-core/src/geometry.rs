@@ -1,0 +1,193 @@
+//! 2D geometry used across MRT: vectors, points, poses and angles.
+//!
+//! Built on `nalgebra` (no hand-written linear algebra). A [`Pose2`] is a robot posture
+//! `(x, y, θ)` on the field: position in metres, heading in radians, counter-clockwise from +x.
+
+use nalgebra::{Isometry2, Vector2};
+use serde::{Deserialize, Serialize};
+use std::f64::consts::{PI, TAU};
+
+/// A 2D vector (displacement, velocity) in metres or metres per second.
+pub type Vec2 = Vector2<f64>;
+
+/// A 2D point (position) in metres.
+pub type Point2 = nalgebra::Point2<f64>;
+
+/// Normalizes an angle in radians to `(-π, π]`. Non-finite input is returned unchanged.
+///
+/// ```
+/// # use mrt_core::normalize_angle;
+/// use std::f64::consts::PI;
+/// assert!((normalize_angle(3.0 * PI) - PI).abs() < 1e-12);
+/// assert!((normalize_angle(-PI) - PI).abs() < 1e-12);
+/// ```
+pub fn normalize_angle(a: f64) -> f64 {
+    if !a.is_finite() {
+        return a;
+    }
+    let r = a.rem_euclid(TAU); // [0, 2π)
+    if r > PI {
+        r - TAU
+    } else {
+        r
+    }
+}
+
+/// Normalizes an angle in radians to `[0, 2π)`. Non-finite input is returned unchanged.
+pub fn normalize_angle_positive(a: f64) -> f64 {
+    if !a.is_finite() {
+        return a;
+    }
+    let r = a.rem_euclid(TAU);
+    // rem_euclid can round up to exactly TAU for tiny negative inputs.
+    if r >= TAU {
+        0.0
+    } else {
+        r
+    }
+}
+
+/// The signed shortest rotation from `from` to `to`, in `(-π, π]`.
+pub fn angle_diff(to: f64, from: f64) -> f64 {
+    normalize_angle(to - from)
+}
+
+/// A posture on the plane: position `(x, y)` and heading `theta` (radians, in `(-π, π]`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Pose2 {
+    /// x coordinate, metres.
+    pub x: f64,
+    /// y coordinate, metres.
+    pub y: f64,
+    /// Heading, radians, normalized to `(-π, π]` by the constructors.
+    pub theta: f64,
+}
+
+impl Pose2 {
+    /// A pose; `theta` is normalized to `(-π, π]`.
+    pub fn new(x: f64, y: f64, theta: f64) -> Self {
+        Self {
+            x,
+            y,
+            theta: normalize_angle(theta),
+        }
+    }
+
+    /// The pose at the origin, facing +x.
+    pub const fn identity() -> Self {
+        Self {
+            x: 0.0,
+            y: 0.0,
+            theta: 0.0,
+        }
+    }
+
+    /// The position part.
+    pub fn position(&self) -> Point2 {
+        Point2::new(self.x, self.y)
+    }
+
+    /// The unit vector of the heading.
+    pub fn heading(&self) -> Vec2 {
+        Vec2::new(self.theta.cos(), self.theta.sin())
+    }
+
+    /// As an `nalgebra` isometry (rotation then translation).
+    pub fn to_isometry(&self) -> Isometry2<f64> {
+        Isometry2::new(Vec2::new(self.x, self.y), self.theta)
+    }
+
+    /// From an `nalgebra` isometry.
+    pub fn from_isometry(iso: &Isometry2<f64>) -> Self {
+        Self::new(iso.translation.x, iso.translation.y, iso.rotation.angle())
+    }
+
+    /// `self ⊕ other`: the pose `other`, expressed in the frame of `self`, seen in `self`'s
+    /// parent frame. E.g. field pose of a robot ⊕ a displacement measured by the robot.
+    pub fn compose(&self, other: &Pose2) -> Pose2 {
+        Self::from_isometry(&(self.to_isometry() * other.to_isometry()))
+    }
+
+    /// The inverse pose: `p.compose(&p.inverse())` is the identity.
+    pub fn inverse(&self) -> Pose2 {
+        Self::from_isometry(&self.to_isometry().inverse())
+    }
+
+    /// `self` expressed in the frame of `reference` (`reference⁻¹ ⊕ self`).
+    pub fn relative_to(&self, reference: &Pose2) -> Pose2 {
+        reference.inverse().compose(self)
+    }
+
+    /// A point given in this pose's frame (e.g. the robot's), in the parent frame (the field).
+    pub fn transform_point(&self, p: Point2) -> Point2 {
+        self.to_isometry() * p
+    }
+
+    /// A point given in the parent frame (the field), in this pose's frame (the robot's).
+    pub fn inverse_transform_point(&self, p: Point2) -> Point2 {
+        self.to_isometry().inverse_transform_point(&p)
+    }
+
+    /// Euclidean distance between the positions of two poses.
+    pub fn distance(&self, other: &Pose2) -> f64 {
+        (self.x - other.x).hypot(self.y - other.y)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+    use std::f64::consts::FRAC_PI_2;
+
+    fn close(a: f64, b: f64) -> bool {
+        (a - b).abs() < 1e-9
+    }
+
+    #[test]
+    fn normalize_angle_edges() {
+        assert!(close(normalize_angle(0.0), 0.0));
+        assert!(close(normalize_angle(PI), PI));
+        assert!(close(normalize_angle(-PI), PI));
+        assert!(close(normalize_angle(3.0 * FRAC_PI_2), -FRAC_PI_2));
+        assert!(close(normalize_angle_positive(-FRAC_PI_2), 3.0 * FRAC_PI_2));
+        assert!(normalize_angle(f64::NAN).is_nan());
+        assert!(close(angle_diff(-3.0, 3.0), TAU - 6.0));
+    }
+
+    #[test]
+    fn compose_and_points_by_hand() {
+        // Robot at (1, 2) facing +y; 1 m ahead and 1 m to its left is (0, 3).
+        let robot = Pose2::new(1.0, 2.0, FRAC_PI_2);
+        let p = robot.transform_point(Point2::new(1.0, 1.0));
+        assert!(close(p.x, 0.0) && close(p.y, 3.0));
+        let back = robot.inverse_transform_point(p);
+        assert!(close(back.x, 1.0) && close(back.y, 1.0));
+        // Moving 1 m forward and turning left by 90° from there.
+        let moved = robot.compose(&Pose2::new(1.0, 0.0, FRAC_PI_2));
+        assert!(close(moved.x, 1.0) && close(moved.y, 3.0) && close(moved.theta, PI));
+        assert!(close(robot.distance(&moved), 1.0));
+        assert!(close(robot.heading().y, 1.0));
+    }
+
+    proptest! {
+        #[test]
+        fn normalize_angle_is_in_range_and_equivalent(a in -1e4f64..1e4) {
+            let n = normalize_angle(a);
+            prop_assert!(n > -PI - 1e-12 && n <= PI + 1e-12);
+            prop_assert!(close(n.sin(), a.sin()) && close(n.cos(), a.cos()));
+            let p = normalize_angle_positive(a);
+            prop_assert!((0.0..TAU).contains(&p));
+        }
+
+        #[test]
+        fn pose_inverse_composes_to_identity(x in -10.0f64..10.0, y in -10.0f64..10.0, t in -7.0f64..7.0) {
+            let p = Pose2::new(x, y, t);
+            let id = p.compose(&p.inverse());
+            prop_assert!(close(id.x, 0.0) && close(id.y, 0.0) && close(id.theta.sin(), 0.0));
+            let r = Pose2::new(1.0, -2.0, 0.3);
+            let back = r.compose(&p.relative_to(&r));
+            prop_assert!(close(back.x, p.x) && close(back.y, p.y) && close(angle_diff(back.theta, p.theta), 0.0));
+        }
+    }
+}

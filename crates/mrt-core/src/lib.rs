@@ -1,0 +1,51 @@
+//! # mrt-core: the types every MRT crate shares
+//!
+//! MRT (Modular Robotic Toolkit) is built of small modules that talk over one message bus
+//! (DCDT, MRT manual chapter 3). This crate holds what all of them agree on:
+//!
+//! - **identifiers** of the DCDT vocabulary: [`AgoraId`], [`MemberId`], [`MsgType`];
+//! - **time**: the [`Clock`] trait with a [`WallClock`] for real robots and a manually advanced
+//!   [`SimClock`] for the simulator. Everything in DCDT reads time only through a `Clock`, so a
+//!   simulated match runs as fast as the CPU allows and is reproducible;
+//! - **2D geometry** on top of `nalgebra`: [`Vec2`], [`Point2`], [`Pose2`] and angle helpers
+//!   ([`normalize_angle`], [`angle_diff`]).
+//!
+//! ```
+//! use mrt_core::{Clock, Pose2, SimClock, Time, Vec2};
+//! use std::f64::consts::FRAC_PI_2;
+//! use std::time::Duration;
+//!
+//! // A simulated clock only moves when told to.
+//! let clock = SimClock::new();
+//! clock.advance(Duration::from_millis(20));
+//! assert_eq!(clock.now(), Time::from_millis(20));
+//!
+//! // A robot at (1, 0) facing +y sees a point 2 m ahead at (1, 2) in the field frame.
+//! let robot = Pose2::new(1.0, 0.0, FRAC_PI_2);
+//! let p = robot.transform_point(Vec2::new(2.0, 0.0).into());
+//! assert!((p.x - 1.0).abs() < 1e-12 && (p.y - 2.0).abs() < 1e-12);
+//! ```
+//!
+//! | seed name (MRT manual ch. 3) | Rust type |
+//! |---|---|
+//! | Agora ID | [`AgoraId`] |
+//! | Member ID | [`MemberId`] |
+//! | Message type | [`MsgType`] |
+//! | `DCDT_TIME` | [`Time`] |
+#![deny(missing_docs)]
+
+mod geometry;
+mod ids;
+mod time;
+
+pub use geometry::{angle_diff, normalize_angle, normalize_angle_positive, Point2, Pose2, Vec2};
+pub use ids::{AgoraId, MemberId, MsgType};
+pub use time::{Clock, SharedClock, SimClock, Time, WallClock};
+
+/// The names most MRT code needs, for `use mrt_core::prelude::*`.
+pub mod prelude {
+    pub use crate::{
+        AgoraId, Clock, MemberId, MsgType, Point2, Pose2, SharedClock, SimClock, Time, Vec2,
+        WallClock,
+    };
+}

@@ -1,0 +1,1349 @@
+//! Self-describing messages (MRT manual §3.2).
+//!
+//! The manual: "our modules communicate through XML messages whose structure is defined by a
+//! shared DTD. Each message contains some general information, such as the time-stamp, and a
+//! list of objects characterized by a name and its membership class. For each object may be
+//! defined a number of attributes, that are tuples of name, value, variability, and
+//! reliability. In order to correctly parse the content of the messages, modules share a
+//! common ontology that defines the semantic of the used symbols."
+//!
+//! In MRT such a message is the standard typed message [`SelfDescribing`]. On the bus it
+//! travels like any other [`Message`] (postcard on the wire); its XML text form, described by
+//! [`DTD`], is for tools and logs: [`SelfDescribing::to_xml`] writes it and
+//! [`SelfDescribing::from_xml`] reads it back exactly (timestamps to the nanosecond, numbers
+//! bit for bit).
+//!
+//! ```
+//! use mrt_core::Time;
+//! use mrt_dcdt::describe::{Attribute, Object, SelfDescribing};
+//!
+//! let msg = SelfDescribing::new(Time(12_500_000_000)).with_object(
+//!     Object::new("ball", "Ball")
+//!         .with(Attribute::number("distance", 2.4, 0.1, 0.9))
+//!         .with(Attribute::symbol("colour", "orange", 0.0, 1.0)),
+//! );
+//! let xml = msg.to_xml();
+//! println!("{xml}");
+//! assert_eq!(
+//!     xml,
+//!     r#"<message timestamp="12.500000000">
+//!   <object name="ball" class="Ball">
+//!     <attribute name="distance" value="2.4" variability="0.1" reliability="0.9"/>
+//!     <attribute name="colour" symbol="orange" variability="0" reliability="1"/>
+//!   </object>
+//! </message>"#
+//! );
+//! assert_eq!(SelfDescribing::from_xml(&xml)?, msg);
+//! # Ok::<(), mrt_dcdt::describe::XmlError>(())
+//! ```
+
+use crate::msg::{Message, RESERVED_TYPES_START};
+use mrt_core::{MsgType, Time};
+use quick_xml::errors::{Error as QxError, IllFormedError, SyntaxError};
+use quick_xml::escape::EscapeError;
+use quick_xml::events::attributes::{AttrError, Attribute as XmlAttr};
+use quick_xml::events::{BytesEnd, BytesStart, Event};
+use quick_xml::name::QName;
+use quick_xml::{Reader, Writer};
+use serde::{Deserialize, Serialize};
+use std::borrow::Cow;
+use std::fmt::Write as _;
+
+/// The DTD of the XML form.
+///
+/// [`SelfDescribing::to_xml`] does not embed it; [`SelfDescribing::from_xml`] accepts (and
+/// skips) a `<!DOCTYPE ...>` declaration, with or without this DTD as internal subset.
+/// A DTD cannot say it, but each `<attribute>` carries exactly one of `value` (a number) and
+/// `symbol` (a symbol of the shared ontology).
+pub const DTD: &str = r#"<!ELEMENT message (object*)>
+<!ATTLIST message
+  timestamp CDATA #REQUIRED>
+<!ELEMENT object (attribute*)>
+<!ATTLIST object
+  name CDATA #REQUIRED
+  class CDATA #REQUIRED>
+<!ELEMENT attribute EMPTY>
+<!ATTLIST attribute
+  name CDATA #REQUIRED
+  value CDATA #IMPLIED
+  symbol CDATA #IMPLIED
+  variability CDATA #REQUIRED
+  reliability CDATA #REQUIRED>
+"#;
+
+/// One self-describing message (§3.2): a time-stamp and a list of objects.
+#[derive(Clone, Debug, PartialEq, Default, Serialize, Deserialize)]
+pub struct SelfDescribing {
+    /// When the described state was observed.
+    pub timestamp: Time,
+    /// The described objects, in order.
+    pub objects: Vec<Object>,
+}
+
+impl Message for SelfDescribing {
+    const TYPE: MsgType = MsgType(RESERVED_TYPES_START + 1);
+    const NAME: &'static str = "SelfDescribing";
+}
+
+/// An object of a [`SelfDescribing`] message: a name, its membership class, and attributes.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Object {
+    /// The object's name, e.g. `"ball"`.
+    pub name: String,
+    /// The class the object belongs to, a symbol of the shared ontology, e.g. `"Ball"`.
+    pub class: String,
+    /// The object's attributes, in order.
+    pub attributes: Vec<Attribute>,
+}
+
+/// An attribute of an [`Object`]: a tuple of name, value, variability and reliability.
+///
+/// [`SelfDescribing::from_xml`] accepts only a `variability` ≥ 0 (infinity included) and a
+/// `reliability` in [0, 1]; the constructors do not check.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Attribute {
+    /// The attribute's name, e.g. `"distance"`.
+    pub name: String,
+    /// The attribute's value.
+    pub value: AttrValue,
+    /// How much the value varies (e.g. a standard deviation, in the value's unit); ≥ 0.
+    pub variability: f64,
+    /// How far the value can be trusted, from 0 (not at all) to 1 (fully).
+    pub reliability: f64,
+}
+
+/// The value of an [`Attribute`].
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub enum AttrValue {
+    /// A number (`value="..."` in XML).
+    Number(f64),
+    /// A symbol of the shared ontology, e.g. `"yellow"` (`symbol="..."` in XML).
+    Symbol(String),
+}
+
+/// Why [`SelfDescribing::from_xml`] rejected a text.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum XmlError {
+    /// The text is not well-formed XML or does not follow [`DTD`] and the rules of the form.
+    #[error("line {line}, column {column}: {message}")]
+    Syntax {
+        /// 1-based line of the offending markup.
+        line: usize,
+        /// 1-based column (in characters) of the offending markup.
+        column: usize,
+        /// What was expected, in lower case.
+        message: String,
+    },
+}
+
+impl SelfDescribing {
+    /// An empty message stamped `timestamp`.
+    pub fn new(timestamp: Time) -> Self {
+        SelfDescribing {
+            timestamp,
+            objects: Vec::new(),
+        }
+    }
+
+    /// The message with `obj` appended to its objects.
+    pub fn with_object(mut self, obj: Object) -> Self {
+        self.objects.push(obj);
+        self
+    }
+
+    /// The first object named `name`.
+    pub fn object(&self, name: &str) -> Option<&Object> {
+        self.objects.iter().find(|o| o.name == name)
+    }
+
+    /// The XML form, indented by 2 spaces, without XML declaration, DOCTYPE or final newline.
+    ///
+    /// The timestamp is written in seconds with 9 decimals, numbers with Rust's shortest
+    /// round-trip formatting (`NaN`, `inf` and `-inf` for non-finite ones). In names, classes
+    /// and symbols, `<`, `>`, `&`, `"` and control characters are escaped (the latter as
+    /// character references); a NUL character, which XML cannot carry, is written as is.
+    pub fn to_xml(&self) -> String {
+        let mut writer = Writer::new_with_indent(Vec::new(), b' ', 2);
+        // Writing into a `Vec` cannot fail.
+        let _ = self.write_xml(&mut writer);
+        match String::from_utf8(writer.into_inner()) {
+            Ok(text) => text,
+            Err(e) => String::from_utf8_lossy(e.as_bytes()).into_owned(),
+        }
+    }
+
+    fn write_xml(&self, w: &mut Writer<Vec<u8>>) -> std::io::Result<()> {
+        let mut root = BytesStart::new("message");
+        root.push_attribute(xml_attr("timestamp", format_timestamp(self.timestamp)));
+        if self.objects.is_empty() {
+            return w.write_event(Event::Empty(root));
+        }
+        w.write_event(Event::Start(root))?;
+        for obj in &self.objects {
+            let mut tag = BytesStart::new("object");
+            tag.push_attribute(xml_attr("name", escape(&obj.name)));
+            tag.push_attribute(xml_attr("class", escape(&obj.class)));
+            if obj.attributes.is_empty() {
+                w.write_event(Event::Empty(tag))?;
+                continue;
+            }
+            w.write_event(Event::Start(tag))?;
+            for attr in &obj.attributes {
+                let mut tag = BytesStart::new("attribute");
+                tag.push_attribute(xml_attr("name", escape(&attr.name)));
+                match &attr.value {
+                    AttrValue::Number(v) => tag.push_attribute(xml_attr("value", v.to_string())),
+                    AttrValue::Symbol(s) => tag.push_attribute(xml_attr("symbol", escape(s))),
+                }
+                tag.push_attribute(xml_attr("variability", attr.variability.to_string()));
+                tag.push_attribute(xml_attr("reliability", attr.reliability.to_string()));
+                w.write_event(Event::Empty(tag))?;
+            }
+            w.write_event(Event::End(BytesEnd::new("object")))?;
+        }
+        w.write_event(Event::End(BytesEnd::new("message")))
+    }
+
+    /// Reads the XML form written by [`to_xml`](Self::to_xml).
+    ///
+    /// An XML declaration, a `<!DOCTYPE ...>`, comments, processing instructions and
+    /// whitespace between elements are skipped; anything else that [`DTD`] does not allow is
+    /// an error, as are a timestamp that is not non-negative seconds with at most 9 decimals,
+    /// an attribute with neither or both of `value` and `symbol`, a negative variability and a
+    /// reliability outside [0, 1]. Errors give the line and column of the offending element.
+    pub fn from_xml(text: &str) -> Result<SelfDescribing, XmlError> {
+        Parser::new(text).parse()
+    }
+}
+
+impl Object {
+    /// An object without attributes.
+    pub fn new(name: impl Into<String>, class: impl Into<String>) -> Self {
+        Object {
+            name: name.into(),
+            class: class.into(),
+            attributes: Vec::new(),
+        }
+    }
+
+    /// The object with `attr` appended to its attributes.
+    pub fn with(mut self, attr: Attribute) -> Self {
+        self.attributes.push(attr);
+        self
+    }
+
+    /// The first attribute named `name`.
+    pub fn attribute(&self, name: &str) -> Option<&Attribute> {
+        self.attributes.iter().find(|a| a.name == name)
+    }
+}
+
+impl Attribute {
+    /// A numeric attribute.
+    pub fn number(name: impl Into<String>, value: f64, variability: f64, reliability: f64) -> Self {
+        Attribute {
+            name: name.into(),
+            value: AttrValue::Number(value),
+            variability,
+            reliability,
+        }
+    }
+
+    /// A symbolic attribute: `value` is a symbol of the shared ontology.
+    pub fn symbol(
+        name: impl Into<String>,
+        value: impl Into<String>,
+        variability: f64,
+        reliability: f64,
+    ) -> Self {
+        Attribute {
+            name: name.into(),
+            value: AttrValue::Symbol(value.into()),
+            variability,
+            reliability,
+        }
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Writing
+
+/// An XML attribute whose value is already escaped.
+fn xml_attr(key: &str, escaped: String) -> XmlAttr<'_> {
+    XmlAttr {
+        key: QName(key.as_bytes()),
+        value: Cow::Owned(escaped.into_bytes()),
+    }
+}
+
+/// Escapes `s` for a double-quoted attribute value. Tabs, newlines and other control
+/// characters become character references, so that they survive attribute-value
+/// normalization.
+fn escape(s: &str) -> String {
+    let mut out = String::with_capacity(s.len());
+    for c in s.chars() {
+        match c {
+            '<' => out.push_str("&lt;"),
+            '>' => out.push_str("&gt;"),
+            '&' => out.push_str("&amp;"),
+            '"' => out.push_str("&quot;"),
+            '\0' => out.push(c),
+            c if c.is_ascii_control() && c != '\u{7f}' => {
+                let _ = write!(out, "&#{};", u32::from(c));
+            }
+            c => out.push(c),
+        }
+    }
+    out
+}
+
+const NANOS_PER_SEC: u64 = 1_000_000_000;
+
+fn format_timestamp(t: Time) -> String {
+    let n = t.as_nanos();
+    format!("{}.{:09}", n / NANOS_PER_SEC, n % NANOS_PER_SEC)
+}
+
+// ---------------------------------------------------------------------------------------------
+// Reading
+
+fn is_xml_space(b: u8) -> bool {
+    matches!(b, b' ' | b'\t' | b'\r' | b'\n')
+}
+
+fn trim_xml_space(s: &str) -> &str {
+    s.trim_matches(|c: char| c.is_ascii() && is_xml_space(c as u8))
+}
+
+/// Parses `{secs}` or `{secs}.{decimals}` (1 to 9 decimals) into nanoseconds, exactly.
+fn parse_timestamp(s: &str) -> Result<Time, &'static str> {
+    const MALFORMED: &str = "as non-negative seconds with at most 9 decimals";
+    let s = trim_xml_space(s);
+    let (secs, frac) = match s.split_once('.') {
+        Some((secs, frac)) => (secs, Some(frac)),
+        None => (s, None),
+    };
+    let all_digits = |d: &str| !d.is_empty() && d.bytes().all(|b| b.is_ascii_digit());
+    if !all_digits(secs) {
+        return Err(MALFORMED);
+    }
+    let mut nanos = 0u64;
+    if let Some(frac) = frac {
+        if !all_digits(frac) || frac.len() > 9 {
+            return Err(MALFORMED);
+        }
+        for b in frac.bytes() {
+            nanos = nanos * 10 + u64::from(b - b'0');
+        }
+        for _ in frac.len()..9 {
+            nanos *= 10;
+        }
+    }
+    const RANGE: &str = "of at most 18446744073.709551615 seconds";
+    let secs: u64 = secs.parse().map_err(|_| RANGE)?;
+    secs.checked_mul(NANOS_PER_SEC)
+        .and_then(|n| n.checked_add(nanos))
+        .map(Time)
+        .ok_or(RANGE)
+}
+
+fn parse_number(s: &str) -> Option<f64> {
+    trim_xml_space(s).parse().ok()
+}
+
+/// 1-based line and column (in characters) of byte `pos` of `text`.
+fn line_column(text: &str, pos: u64) -> (usize, usize) {
+    let bytes = text.as_bytes();
+    let pos = usize::try_from(pos).unwrap_or(usize::MAX).min(bytes.len());
+    let before = bytes.get(..pos).unwrap_or(bytes);
+    let line = 1 + before.iter().filter(|&&b| b == b'\n').count();
+    let line_start = before
+        .iter()
+        .rposition(|&b| b == b'\n')
+        .map_or(0, |i| i + 1);
+    let column = 1 + before
+        .get(line_start..)
+        .unwrap_or_default()
+        .iter()
+        .filter(|&&b| b & 0xC0 != 0x80)
+        .count();
+    (line, column)
+}
+
+fn lossy(bytes: &[u8]) -> Cow<'_, str> {
+    String::from_utf8_lossy(bytes)
+}
+
+/// A structural event: what is left once whitespace, comments and the like are skipped.
+enum Item<'a> {
+    Open(BytesStart<'a>, bool),
+    Close(BytesEnd<'a>),
+    Eof,
+}
+
+impl Item<'_> {
+    /// How the item is named in "found ..." messages.
+    fn describe(&self) -> String {
+        match self {
+            Item::Open(tag, _) => format!("<{}>", lossy(tag.name().as_ref())),
+            Item::Close(tag) => format!("</{}>", lossy(tag.name().as_ref())),
+            Item::Eof => "end of input".to_owned(),
+        }
+    }
+}
+
+/// The XML attributes of one element, unescaped.
+struct Fields {
+    pairs: Vec<(String, String)>,
+}
+
+impl Fields {
+    fn take(&mut self, key: &str) -> Option<String> {
+        let i = self.pairs.iter().position(|(k, _)| k == key)?;
+        Some(self.pairs.remove(i).1)
+    }
+
+    /// The first key left over after all known keys were taken.
+    fn unknown(&self) -> Option<&str> {
+        self.pairs.first().map(|(k, _)| k.as_str())
+    }
+}
+
+struct Parser<'a> {
+    text: &'a str,
+    reader: Reader<&'a [u8]>,
+}
+
+impl<'a> Parser<'a> {
+    fn new(text: &'a str) -> Self {
+        let mut reader = Reader::from_str(text);
+        let config = reader.config_mut();
+        config.check_end_names = true;
+        config.expand_empty_elements = false;
+        config.trim_text(false);
+        Parser { text, reader }
+    }
+
+    fn error_at(&self, pos: u64, message: impl Into<String>) -> XmlError {
+        let (line, column) = line_column(self.text, pos);
+        XmlError::Syntax {
+            line,
+            column,
+            message: message.into(),
+        }
+    }
+
+    /// An error of the XML reader itself, at the position it reports.
+    fn reader_error(&self, e: &QxError) -> XmlError {
+        let message = match e {
+            QxError::Syntax(s) => match s {
+                SyntaxError::InvalidBangMarkup => {
+                    "expected a comment, cdata section or doctype after `<!`".to_owned()
+                }
+                SyntaxError::UnclosedPIOrXmlDecl => {
+                    "expected `?>` to close the processing instruction, found end of input"
+                        .to_owned()
+                }
+                SyntaxError::UnclosedComment => {
+                    "expected `-->` to close the comment, found end of input".to_owned()
+                }
+                SyntaxError::UnclosedDoctype => {
+                    "expected `>` to close the doctype, found end of input".to_owned()
+                }
+                SyntaxError::UnclosedCData => {
+                    "expected `]]>` to close the cdata section, found end of input".to_owned()
+                }
+                SyntaxError::UnclosedTag => {
+                    "expected `>` to close the tag, found end of input".to_owned()
+                }
+            },
+            QxError::IllFormed(f) => match f {
+                IllFormedError::MismatchedEndTag { expected, found } => {
+                    format!("expected </{expected}>, found </{found}>")
+                }
+                IllFormedError::UnmatchedEndTag(tag) => {
+                    format!("expected a start tag before </{tag}>")
+                }
+                IllFormedError::MissingEndTag(tag) => {
+                    format!("expected </{tag}>, found end of input")
+                }
+                IllFormedError::MissingDeclVersion(_) => {
+                    "expected `version` first in the xml declaration".to_owned()
+                }
+                IllFormedError::MissingDoctypeName => "expected a name in the doctype".to_owned(),
+                IllFormedError::DoubleHyphenInComment => {
+                    "expected no `--` inside a comment".to_owned()
+                }
+            },
+            other => format!("malformed xml: {}", other.to_string().to_lowercase()),
+        };
+        self.error_at(self.reader.error_position(), message)
+    }
+
+    /// The next structural item and its byte position, skipping whitespace, comments and
+    /// processing instructions (and, in the prolog, the XML declaration and the DOCTYPE).
+    /// `expected` says what is expected in place of anything else.
+    fn next(&mut self, prolog: bool, expected: &str) -> Result<(u64, Item<'a>), XmlError> {
+        loop {
+            let pos = self.reader.buffer_position();
+            let event = match self.reader.read_event() {
+                Ok(event) => event,
+                Err(e) => return Err(self.reader_error(&e)),
+            };
+            let found = match event {
+                Event::Start(tag) => return Ok((pos, Item::Open(tag, false))),
+                Event::Empty(tag) => return Ok((pos, Item::Open(tag, true))),
+                Event::End(tag) => return Ok((pos, Item::Close(tag))),
+                Event::Eof => return Ok((pos, Item::Eof)),
+                Event::Comment(_) | Event::PI(_) => continue,
+                Event::Decl(_) | Event::DocType(_) if prolog => continue,
+                Event::Text(text) if text.iter().copied().all(is_xml_space) => continue,
+                Event::Text(_) | Event::CData(_) => "text",
+                Event::Decl(_) => "an xml declaration",
+                Event::DocType(_) => "a doctype",
+            };
+            return Err(self.error_at(pos, format!("expected {expected}, found {found}")));
+        }
+    }
+
+    /// The XML attributes of the element `tag` at `pos`; `what` names it in errors.
+    fn fields(&self, pos: u64, tag: &BytesStart<'_>, what: &str) -> Result<Fields, XmlError> {
+        let mut pairs = Vec::new();
+        for attr in tag.attributes() {
+            let attr = attr.map_err(|e| self.attr_error(pos, tag, what, &e))?;
+            let key = lossy(attr.key.as_ref()).into_owned();
+            let value = match attr.unescape_value() {
+                Ok(value) => value.into_owned(),
+                Err(e) => {
+                    let problem = match &e {
+                        QxError::Escape(EscapeError::UnrecognizedEntity(_, name)) => {
+                            format!("a predefined entity, found `&{name};`")
+                        }
+                        QxError::Escape(EscapeError::UnterminatedEntity(_)) => {
+                            "`;` to end the entity".to_owned()
+                        }
+                        QxError::Escape(EscapeError::InvalidCharRef(_)) => {
+                            "a valid character reference".to_owned()
+                        }
+                        other => format!("valid text ({})", other.to_string().to_lowercase()),
+                    };
+                    return Err(
+                        self.error_at(pos, format!("{what}: in `{key}`, expected {problem}"))
+                    );
+                }
+            };
+            pairs.push((key, value));
+        }
+        Ok(Fields { pairs })
+    }
+
+    fn attr_error(&self, pos: u64, tag: &BytesStart<'_>, what: &str, e: &AttrError) -> XmlError {
+        // Positions of attribute errors count from the byte after `<`.
+        let (at, message) = match e {
+            AttrError::ExpectedEq(p) => (*p, "expected `=` after the attribute name".to_owned()),
+            AttrError::ExpectedValue(p) => (*p, "expected a quoted attribute value".to_owned()),
+            AttrError::UnquotedValue(p) => (
+                *p,
+                "expected a quoted attribute value, found an unquoted one".to_owned(),
+            ),
+            AttrError::ExpectedQuote(p, q) => (
+                *p,
+                format!(
+                    "expected a closing `{}` after the attribute value",
+                    char::from(*q)
+                ),
+            ),
+            AttrError::Duplicated(p, _) => {
+                let content: &[u8] = tag;
+                let key: Vec<u8> = content
+                    .get(*p..)
+                    .unwrap_or_default()
+                    .iter()
+                    .copied()
+                    .take_while(|&b| !is_xml_space(b) && !matches!(b, b'=' | b'/' | b'>'))
+                    .collect();
+                (
+                    *p,
+                    format!(
+                        "expected each attribute once, found a second `{}`",
+                        lossy(&key)
+                    ),
+                )
+            }
+        };
+        let at = pos.saturating_add(1).saturating_add(at as u64);
+        self.error_at(at, format!("{what}: {message}"))
+    }
+
+    fn parse(mut self) -> Result<SelfDescribing, XmlError> {
+        let (pos, item) = self.next(true, "<message>")?;
+        let (tag, empty) = match item {
+            Item::Open(tag, empty) if tag.name().as_ref() == b"message" => (tag, empty),
+            other => {
+                let found = other.describe();
+                return Err(self.error_at(pos, format!("expected <message>, found {found}")));
+            }
+        };
+        let mut fields = self.fields(pos, &tag, "<message>")?;
+        let timestamp = fields.take("timestamp");
+        if let Some(key) = fields.unknown() {
+            return Err(self.error_at(
+                pos,
+                format!("<message>: expected only `timestamp`, found `{key}`"),
+            ));
+        }
+        let Some(timestamp) = timestamp else {
+            return Err(self.error_at(pos, "<message>: expected `timestamp`"));
+        };
+        let timestamp = parse_timestamp(&timestamp).map_err(|want| {
+            self.error_at(
+                pos,
+                format!("<message>: expected `timestamp` {want}, found {timestamp:?}"),
+            )
+        })?;
+        let mut msg = SelfDescribing::new(timestamp);
+        if !empty {
+            loop {
+                let (pos, item) = self.next(false, "<object> or </message>")?;
+                match item {
+                    Item::Open(tag, empty) if tag.name().as_ref() == b"object" => {
+                        let obj = self.object(pos, &tag, empty)?;
+                        msg.objects.push(obj);
+                    }
+                    Item::Close(tag) if tag.name().as_ref() == b"message" => break,
+                    Item::Open(..) => {
+                        let found = item.describe();
+                        return Err(self.error_at(pos, format!("expected <object>, found {found}")));
+                    }
+                    other => {
+                        let found = other.describe();
+                        return Err(
+                            self.error_at(pos, format!("expected </message>, found {found}"))
+                        );
+                    }
+                }
+            }
+        }
+        let (pos, item) = self.next(false, "end of input")?;
+        if let Item::Eof = item {
+            return Ok(msg);
+        }
+        let found = item.describe();
+        Err(self.error_at(pos, format!("expected end of input, found {found}")))
+    }
+
+    fn object(&mut self, pos: u64, tag: &BytesStart<'_>, empty: bool) -> Result<Object, XmlError> {
+        let mut fields = self.fields(pos, tag, "<object>")?;
+        let name = fields.take("name");
+        let class = fields.take("class");
+        let what = match &name {
+            Some(name) => format!("object {name:?}"),
+            None => "<object>".to_owned(),
+        };
+        if let Some(key) = fields.unknown() {
+            return Err(self.error_at(
+                pos,
+                format!("{what}: expected only `name` and `class`, found `{key}`"),
+            ));
+        }
+        let Some(name) = name else {
+            return Err(self.error_at(pos, format!("{what}: expected `name`")));
+        };
+        let Some(class) = class else {
+            return Err(self.error_at(pos, format!("{what}: expected `class`")));
+        };
+        let mut obj = Object::new(name, class);
+        if empty {
+            return Ok(obj);
+        }
+        loop {
+            let (pos, item) = self.next(false, "<attribute> or </object>")?;
+            match item {
+                Item::Open(tag, empty) if tag.name().as_ref() == b"attribute" => {
+                    let attr = self.attribute(pos, &tag, empty, &obj.name)?;
+                    obj.attributes.push(attr);
+                }
+                Item::Close(tag) if tag.name().as_ref() == b"object" => return Ok(obj),
+                Item::Open(..) => {
+                    let found = item.describe();
+                    return Err(self.error_at(pos, format!("expected <attribute>, found {found}")));
+                }
+                other => {
+                    let found = other.describe();
+                    return Err(self.error_at(pos, format!("expected </object>, found {found}")));
+                }
+            }
+        }
+    }
+
+    fn attribute(
+        &mut self,
+        pos: u64,
+        tag: &BytesStart<'_>,
+        empty: bool,
+        object: &str,
+    ) -> Result<Attribute, XmlError> {
+        let mut fields = self.fields(pos, tag, &format!("<attribute> of object {object:?}"))?;
+        let name = fields.take("name");
+        let value = fields.take("value");
+        let symbol = fields.take("symbol");
+        let variability = fields.take("variability");
+        let reliability = fields.take("reliability");
+        let what = match &name {
+            Some(name) => format!("attribute {name:?} of object {object:?}"),
+            None => format!("<attribute> of object {object:?}"),
+        };
+        let fail = |message: String| Err(self.error_at(pos, format!("{what}: {message}")));
+        if let Some(key) = fields.unknown() {
+            return fail(format!(
+                "expected only `name`, `value`, `symbol`, `variability` and `reliability`, \
+                 found `{key}`"
+            ));
+        }
+        let Some(name) = name else {
+            return fail("expected `name`".to_owned());
+        };
+        let value = match (value, symbol) {
+            (Some(value), None) => match parse_number(&value) {
+                Some(v) => AttrValue::Number(v),
+                None => return fail(format!("expected a number in `value`, found {value:?}")),
+            },
+            (None, Some(symbol)) => AttrValue::Symbol(symbol),
+            (Some(_), Some(_)) => return fail("expected `value` or `symbol`, not both".to_owned()),
+            (None, None) => return fail("expected `value` or `symbol`".to_owned()),
+        };
+        let Some(variability_text) = variability else {
+            return fail("expected `variability`".to_owned());
+        };
+        let variability = match parse_number(&variability_text) {
+            Some(v) if v >= 0.0 => v,
+            _ => {
+                return fail(format!(
+                    "expected `variability` to be a non-negative number, found {variability_text:?}"
+                ))
+            }
+        };
+        let Some(reliability_text) = reliability else {
+            return fail("expected `reliability`".to_owned());
+        };
+        let reliability = match parse_number(&reliability_text) {
+            Some(r) if (0.0..=1.0).contains(&r) => r,
+            _ => {
+                return fail(format!(
+                    "expected `reliability` between 0 and 1, found {reliability_text:?}"
+                ))
+            }
+        };
+        let attr = Attribute {
+            name,
+            value,
+            variability,
+            reliability,
+        };
+        if !empty {
+            let (pos, item) = self.next(false, "</attribute>")?;
+            match item {
+                Item::Close(tag) if tag.name().as_ref() == b"attribute" => {}
+                other => {
+                    let found = other.describe();
+                    return Err(self.error_at(pos, format!("expected </attribute>, found {found}")));
+                }
+            }
+        }
+        Ok(attr)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    const EXAMPLE: &str = r#"<message timestamp="12.500000000">
+  <object name="ball" class="Ball">
+    <attribute name="distance" value="2.4" variability="0.1" reliability="0.9"/>
+    <attribute name="colour" symbol="orange" variability="0" reliability="1"/>
+  </object>
+</message>"#;
+
+    fn example() -> SelfDescribing {
+        SelfDescribing::new(Time(12_500_000_000)).with_object(
+            Object::new("ball", "Ball")
+                .with(Attribute::number("distance", 2.4, 0.1, 0.9))
+                .with(Attribute::symbol("colour", "orange", 0.0, 1.0)),
+        )
+    }
+
+    /// The error message `from_xml` gives for `text`, which must be rejected.
+    fn err(text: &str) -> String {
+        match SelfDescribing::from_xml(text) {
+            Ok(m) => panic!("accepted {text:?} as {m:?}"),
+            Err(e) => e.to_string(),
+        }
+    }
+
+    /// `EXAMPLE` with `from` (which must occur) replaced by `to`.
+    fn example_with(from: &str, to: &str) -> String {
+        assert!(EXAMPLE.contains(from), "{from:?} not in the example");
+        EXAMPLE.replacen(from, to, 1)
+    }
+
+    #[test]
+    fn hand_written_xml_parses_to_the_expected_message() -> Result<(), XmlError> {
+        let expected = SelfDescribing {
+            timestamp: Time(12_500_000_000),
+            objects: vec![Object {
+                name: "ball".to_owned(),
+                class: "Ball".to_owned(),
+                attributes: vec![
+                    Attribute {
+                        name: "distance".to_owned(),
+                        value: AttrValue::Number(2.4),
+                        variability: 0.1,
+                        reliability: 0.9,
+                    },
+                    Attribute {
+                        name: "colour".to_owned(),
+                        value: AttrValue::Symbol("orange".to_owned()),
+                        variability: 0.0,
+                        reliability: 1.0,
+                    },
+                ],
+            }],
+        };
+        assert_eq!(SelfDescribing::from_xml(EXAMPLE)?, expected);
+        assert_eq!(example(), expected);
+        Ok(())
+    }
+
+    #[test]
+    fn to_xml_writes_the_exact_form() {
+        assert_eq!(example().to_xml(), EXAMPLE);
+    }
+
+    #[test]
+    fn module_doc_example() -> Result<(), XmlError> {
+        // The module's doctest, with the scratch paths.
+        let msg = example();
+        let xml = msg.to_xml();
+        assert_eq!(xml, EXAMPLE);
+        assert_eq!(SelfDescribing::from_xml(&xml)?, msg);
+        Ok(())
+    }
+
+    #[test]
+    fn empty_message_and_object_use_empty_elements() -> Result<(), XmlError> {
+        let empty = SelfDescribing::default();
+        assert_eq!(empty.to_xml(), r#"<message timestamp="0.000000000"/>"#);
+        assert_eq!(SelfDescribing::from_xml(&empty.to_xml())?, empty);
+
+        let msg = SelfDescribing::new(Time(1)).with_object(Object::new("a", "B"));
+        let xml = msg.to_xml();
+        assert_eq!(
+            xml,
+            "<message timestamp=\"0.000000001\">\n  <object name=\"a\" class=\"B\"/>\n</message>"
+        );
+        assert_eq!(SelfDescribing::from_xml(&xml)?, msg);
+        Ok(())
+    }
+
+    #[test]
+    fn special_characters_are_escaped() -> Result<(), XmlError> {
+        let msg = SelfDescribing::new(Time(0)).with_object(
+            Object::new("a<b>&\"c'", "tab\there\nnew line")
+                .with(Attribute::symbol("s", "x&y", 0.0, 1.0)),
+        );
+        let xml = msg.to_xml();
+        assert_eq!(
+            xml,
+            "<message timestamp=\"0.000000000\">\n  \
+             <object name=\"a&lt;b&gt;&amp;&quot;c'\" class=\"tab&#9;here&#10;new line\">\n    \
+             <attribute name=\"s\" symbol=\"x&amp;y\" variability=\"0\" reliability=\"1\"/>\n  \
+             </object>\n</message>"
+        );
+        assert_eq!(SelfDescribing::from_xml(&xml)?, msg);
+        Ok(())
+    }
+
+    #[test]
+    fn lookups_and_message_identity() {
+        let msg = example();
+        let ball = msg.object("ball");
+        assert_eq!(ball.map(|o| o.class.as_str()), Some("Ball"));
+        assert!(msg.object("goal").is_none());
+        assert_eq!(
+            ball.and_then(|o| o.attribute("colour")).map(|a| &a.value),
+            Some(&AttrValue::Symbol("orange".to_owned()))
+        );
+        assert!(ball.and_then(|o| o.attribute("speed")).is_none());
+        assert_eq!(SelfDescribing::TYPE, MsgType(0xFFFF_0001));
+        assert_eq!(SelfDescribing::NAME, "SelfDescribing");
+    }
+
+    #[test]
+    fn non_finite_numbers_round_trip() -> Result<(), XmlError> {
+        let msg = SelfDescribing::new(Time(5)).with_object(
+            Object::new("o", "C")
+                .with(Attribute::number("nan", f64::NAN, f64::INFINITY, 0.5))
+                .with(Attribute::number("inf", f64::INFINITY, 0.0, 0.5))
+                .with(Attribute::number("-inf", f64::NEG_INFINITY, 0.0, 0.5)),
+        );
+        let xml = msg.to_xml();
+        assert!(xml.contains(r#"value="NaN" variability="inf""#), "{xml}");
+        assert!(xml.contains(r#"value="inf""#), "{xml}");
+        assert!(xml.contains(r#"value="-inf""#), "{xml}");
+        let back = SelfDescribing::from_xml(&xml)?;
+        let attrs = &back.objects[0].attributes;
+        assert!(matches!(attrs[0].value, AttrValue::Number(v) if v.is_nan()));
+        assert_eq!(attrs[0].variability, f64::INFINITY);
+        assert_eq!(attrs[1].value, AttrValue::Number(f64::INFINITY));
+        assert_eq!(attrs[2].value, AttrValue::Number(f64::NEG_INFINITY));
+        // Written by hand, too.
+        let back = SelfDescribing::from_xml(&example_with(r#"value="2.4""#, r#"value="NaN""#))?;
+        let value = &back.objects[0].attributes[0].value;
+        assert!(matches!(value, AttrValue::Number(v) if v.is_nan()));
+        Ok(())
+    }
+
+    #[test]
+    fn timestamps_are_exact() -> Result<(), XmlError> {
+        for (text, nanos) in [
+            ("12.500000000", 12_500_000_000),
+            ("12.5", 12_500_000_000),
+            ("12", 12_000_000_000),
+            ("0.000000001", 1),
+            ("007.000000010", 7_000_000_010),
+            (" 3.25 ", 3_250_000_000),
+            ("18446744073.709551615", u64::MAX),
+        ] {
+            let xml = format!(r#"<message timestamp="{text}"/>"#);
+            assert_eq!(
+                SelfDescribing::from_xml(&xml)?.timestamp,
+                Time(nanos),
+                "{text}"
+            );
+        }
+        for nanos in [
+            0,
+            1,
+            999_999_999,
+            1_000_000_000,
+            123_456_789_012_345_678,
+            u64::MAX,
+        ] {
+            let msg = SelfDescribing::new(Time(nanos));
+            assert_eq!(SelfDescribing::from_xml(&msg.to_xml())?, msg);
+        }
+        assert_eq!(
+            SelfDescribing::new(Time(u64::MAX)).to_xml(),
+            r#"<message timestamp="18446744073.709551615"/>"#
+        );
+        Ok(())
+    }
+
+    #[test]
+    fn bad_timestamps_are_rejected() {
+        for bad in [
+            "-1.0",
+            "+1.0",
+            "1.5e3",
+            "abc",
+            "",
+            "1.",
+            ".5",
+            "1.0000000001",
+            "1,5",
+            "NaN",
+            "inf",
+            "1 .5",
+        ] {
+            assert_eq!(
+                err(&format!(r#"<message timestamp="{bad}"/>"#)),
+                format!(
+                    "line 1, column 1: <message>: expected `timestamp` as non-negative seconds \
+                     with at most 9 decimals, found {bad:?}"
+                ),
+            );
+        }
+        for bad in ["18446744073.709551616", "99999999999999999999999"] {
+            assert_eq!(
+                err(&format!(r#"<message timestamp="{bad}"/>"#)),
+                format!(
+                    "line 1, column 1: <message>: expected `timestamp` of at most \
+                     18446744073.709551615 seconds, found {bad:?}"
+                ),
+            );
+        }
+        assert_eq!(
+            err("\n\n  <message/>"),
+            "line 3, column 3: <message>: expected `timestamp`"
+        );
+        assert_eq!(
+            err(&example_with(
+                "timestamp=\"12.500000000\"",
+                "timestamp=\"12.5x\""
+            )),
+            "line 1, column 1: <message>: expected `timestamp` as non-negative seconds with at \
+             most 9 decimals, found \"12.5x\""
+        );
+    }
+
+    #[test]
+    fn missing_reliability() {
+        assert_eq!(
+            err(&example_with(r#" reliability="0.9""#, "")),
+            "line 3, column 5: attribute \"distance\" of object \"ball\": expected `reliability`"
+        );
+    }
+
+    #[test]
+    fn reliability_out_of_range() {
+        for bad in ["1.5", "-0.1", "NaN", "high"] {
+            assert_eq!(
+                err(&example_with(
+                    r#"reliability="1""#,
+                    &format!(r#"reliability="{bad}""#)
+                )),
+                format!(
+                    "line 4, column 5: attribute \"colour\" of object \"ball\": expected \
+                     `reliability` between 0 and 1, found {bad:?}"
+                )
+            );
+        }
+    }
+
+    #[test]
+    fn variability_must_be_non_negative() {
+        assert_eq!(
+            err(&example_with(
+                r#"variability="0.1""#,
+                r#"variability="-0.1""#
+            )),
+            "line 3, column 5: attribute \"distance\" of object \"ball\": expected `variability` \
+             to be a non-negative number, found \"-0.1\""
+        );
+        assert_eq!(
+            err(&example_with(r#" variability="0.1""#, "")),
+            "line 3, column 5: attribute \"distance\" of object \"ball\": expected `variability`"
+        );
+    }
+
+    #[test]
+    fn value_xor_symbol() {
+        assert_eq!(
+            err(&example_with(
+                r#"value="2.4""#,
+                r#"value="2.4" symbol="far""#
+            )),
+            "line 3, column 5: attribute \"distance\" of object \"ball\": expected `value` or \
+             `symbol`, not both"
+        );
+        assert_eq!(
+            err(&example_with(r#" value="2.4""#, "")),
+            "line 3, column 5: attribute \"distance\" of object \"ball\": expected `value` or \
+             `symbol`"
+        );
+        assert_eq!(
+            err(&example_with(r#"value="2.4""#, r#"value="far""#)),
+            "line 3, column 5: attribute \"distance\" of object \"ball\": expected a number in \
+             `value`, found \"far\""
+        );
+    }
+
+    #[test]
+    fn missing_or_unknown_xml_attributes() {
+        assert_eq!(
+            err(&example_with(r#"<attribute name="distance""#, "<attribute")),
+            "line 3, column 5: <attribute> of object \"ball\": expected `name`"
+        );
+        assert_eq!(
+            err(&example_with(r#"name="ball" "#, "")),
+            "line 2, column 3: <object>: expected `name`"
+        );
+        assert_eq!(
+            err(&example_with(r#" class="Ball""#, "")),
+            "line 2, column 3: object \"ball\": expected `class`"
+        );
+        assert_eq!(
+            err(&example_with(
+                r#"class="Ball""#,
+                r#"class="Ball" colour="red""#
+            )),
+            "line 2, column 3: object \"ball\": expected only `name` and `class`, found `colour`"
+        );
+        assert_eq!(
+            err(&example_with(
+                r#"reliability="1""#,
+                r#"reliability="1" unit="m""#
+            )),
+            "line 4, column 5: attribute \"colour\" of object \"ball\": expected only `name`, \
+             `value`, `symbol`, `variability` and `reliability`, found `unit`"
+        );
+        assert_eq!(
+            err(&example_with("<message ", "<message version=\"2\" ")),
+            "line 1, column 1: <message>: expected only `timestamp`, found `version`"
+        );
+        assert_eq!(
+            err(&example_with(
+                r#"class="Ball""#,
+                r#"class="Ball" name="bat""#
+            )),
+            "line 2, column 36: <object>: expected each attribute once, found a second `name`"
+        );
+    }
+
+    #[test]
+    fn unknown_elements() {
+        assert_eq!(
+            err(&example_with(
+                r#"<attribute name="colour" symbol="orange" variability="0" reliability="1"/>"#,
+                "<foo/>"
+            )),
+            "line 4, column 5: expected <attribute>, found <foo>"
+        );
+        assert_eq!(
+            err(&example_with("<object", "<thing")),
+            "line 2, column 3: expected <object>, found <thing>"
+        );
+        assert_eq!(
+            err(r#"<msg timestamp="1"/>"#),
+            "line 1, column 1: expected <message>, found <msg>"
+        );
+        assert_eq!(
+            err(&format!("{EXAMPLE}\n<message timestamp=\"1\"/>")),
+            "line 7, column 1: expected end of input, found <message>"
+        );
+        assert_eq!(
+            err(&example_with(
+                "<attribute name=\"colour\"",
+                "text <attribute name=\"colour\""
+            )),
+            "line 3, column 81: expected <attribute> or </object>, found text"
+        );
+    }
+
+    #[test]
+    fn malformed_xml() {
+        // An unclosed tag: the input ends inside `<object ...`.
+        let cut = EXAMPLE.find(" class").unwrap_or_default();
+        assert_eq!(
+            err(&EXAMPLE[..cut]),
+            "line 2, column 3: expected `>` to close the tag, found end of input"
+        );
+        // Elements left open at the end of the input.
+        let cut = EXAMPLE.rfind("\n</message>").unwrap_or_default();
+        assert_eq!(
+            err(&EXAMPLE[..cut]),
+            "line 5, column 12: expected </message>, found end of input"
+        );
+        let cut = EXAMPLE.find("\n  </object>").unwrap_or_default();
+        assert_eq!(
+            err(&EXAMPLE[..cut]),
+            "line 4, column 79: expected </object>, found end of input"
+        );
+        // A mismatched end tag.
+        assert_eq!(
+            err(&example_with("</object>", "</objet>")),
+            "line 5, column 3: expected </object>, found </objet>"
+        );
+        assert_eq!(
+            err(""),
+            "line 1, column 1: expected <message>, found end of input"
+        );
+        assert_eq!(
+            err("hello"),
+            "line 1, column 1: expected <message>, found text"
+        );
+        assert_eq!(
+            err(&example_with(r#"value="2.4""#, "value=2.4")),
+            "line 3, column 38: <attribute> of object \"ball\": expected a quoted attribute \
+             value, found an unquoted one"
+        );
+        assert_eq!(
+            err(&example_with(r#"symbol="orange""#, r#"symbol="&orange;""#)),
+            "line 4, column 5: <attribute> of object \"ball\": in `symbol`, expected a \
+             predefined entity, found `&orange;`"
+        );
+        assert_eq!(
+            err("<!-- open\n<message/>"),
+            "line 1, column 1: expected `-->` to close the comment, found end of input"
+        );
+    }
+
+    #[test]
+    fn columns_count_characters() {
+        assert_eq!(line_column("ab\ncd", 4), (2, 2));
+        assert_eq!(line_column("é\né€x", 8), (2, 3));
+        assert_eq!(line_column("abc", 99), (1, 4));
+        assert_eq!(line_column("", 0), (1, 1));
+        assert_eq!(
+            err("<message timestamp=\"1\">\n<!--é€--><obj/>"),
+            "line 2, column 10: expected <object>, found <obj>"
+        );
+    }
+
+    #[test]
+    fn prolog_doctype_comments_and_open_attribute_elements_are_accepted() -> Result<(), XmlError> {
+        let with_dtd = format!(
+            "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n<!DOCTYPE message [\n{DTD}]>\n\
+             <!-- a comment -->\n{EXAMPLE}\n<!-- the end -->\n"
+        );
+        assert_eq!(SelfDescribing::from_xml(&with_dtd)?, example());
+        let with_system = format!("<!DOCTYPE message SYSTEM \"describe.dtd\">{EXAMPLE}");
+        assert_eq!(SelfDescribing::from_xml(&with_system)?, example());
+        let open = example_with(
+            r#"reliability="1"/>"#,
+            "reliability=\"1\">\n      <!-- nothing -->\n    </attribute>",
+        );
+        assert_eq!(SelfDescribing::from_xml(&open)?, example());
+        assert_eq!(
+            err(&format!("{EXAMPLE}<!DOCTYPE message>")),
+            "line 6, column 11: expected end of input, found a doctype"
+        );
+        assert_eq!(
+            err(&example_with(
+                r#"reliability="1"/>"#,
+                r#"reliability="1">x</attribute>"#
+            )),
+            "line 4, column 78: expected </attribute>, found text"
+        );
+        Ok(())
+    }
+
+    #[test]
+    fn postcard_round_trip() -> Result<(), postcard::Error> {
+        let msg = example().with_object(
+            Object::new("robot", "Robot").with(Attribute::number("x", -1e-300, 1e300, 0.0)),
+        );
+        let bytes = postcard::to_stdvec(&msg)?;
+        let back: SelfDescribing = postcard::from_bytes(&bytes)?;
+        assert_eq!(back, msg);
+        Ok(())
+    }
+
+    fn text() -> impl Strategy<Value = String> {
+        prop_oneof![
+            "[a-zA-Z0-9 _<>&\"'\t\n\r=/;#\u{e9}\u{4e2d}\u{1F916}-]{0,12}",
+            any::<String>(),
+        ]
+    }
+
+    fn number() -> impl Strategy<Value = f64> {
+        prop_oneof![
+            any::<f64>().prop_filter("NaN is never equal", |v| !v.is_nan()),
+            -1e6..1e6f64,
+            prop::sample::select(vec![
+                0.0,
+                -0.0,
+                -2.5,
+                1e300,
+                -1e300,
+                5e-324,
+                -5e-324,
+                f64::MAX,
+                f64::MIN,
+                f64::MIN_POSITIVE,
+                f64::EPSILON,
+                f64::INFINITY,
+                f64::NEG_INFINITY,
+            ]),
+        ]
+    }
+
+    fn attribute() -> impl Strategy<Value = Attribute> {
+        let value = prop_oneof![
+            number().prop_map(AttrValue::Number),
+            text().prop_map(AttrValue::Symbol)
+        ];
+        let variability = prop_oneof![
+            0.0..1e3f64,
+            number().prop_map(f64::abs),
+            Just(f64::INFINITY)
+        ];
+        let reliability = prop_oneof![0.0..=1.0f64, Just(0.0), Just(1.0)];
+        (text(), value, variability, reliability).prop_map(
+            |(name, value, variability, reliability)| Attribute {
+                name,
+                value,
+                variability,
+                reliability,
+            },
+        )
+    }
+
+    fn message() -> impl Strategy<Value = SelfDescribing> {
+        let object = (text(), text(), prop::collection::vec(attribute(), 0..4)).prop_map(
+            |(name, class, attributes)| Object {
+                name,
+                class,
+                attributes,
+            },
+        );
+        (any::<u64>(), prop::collection::vec(object, 0..4)).prop_map(|(nanos, objects)| {
+            SelfDescribing {
+                timestamp: Time(nanos),
+                objects,
+            }
+        })
+    }
+
+    fn xml_like() -> impl Strategy<Value = String> {
+        "(<|</|/>|>|=|\"|'| |\n|&|&amp;|&#|;|<!--|-->|<!DOCTYPE|<\\?|\\?>|]>|message|object\
+         |attribute|name|class|value|symbol|variability|reliability|timestamp|[0-9.e+-]|é|x){0,60}"
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(512))]
+
+        #[test]
+        fn xml_round_trip(m in message()) {
+            let xml = m.to_xml();
+            let back = SelfDescribing::from_xml(&xml)
+                .map_err(|e| TestCaseError::fail(format!("{e}\n{xml}")))?;
+            prop_assert_eq!(back, m);
+        }
+
+        #[test]
+        fn postcard_round_trip_any(m in message()) {
+            let bytes = postcard::to_stdvec(&m).map_err(|e| TestCaseError::fail(e.to_string()))?;
+            let back: SelfDescribing =
+                postcard::from_bytes(&bytes).map_err(|e| TestCaseError::fail(e.to_string()))?;
+            prop_assert_eq!(back, m);
+        }
+
+        #[test]
+        fn arbitrary_strings_never_panic(text in any::<String>()) {
+            let _ = SelfDescribing::from_xml(&text);
+        }
+
+        #[test]
+        fn arbitrary_bytes_never_panic(bytes in prop::collection::vec(any::<u8>(), 0..512)) {
+            let _ = SelfDescribing::from_xml(&String::from_utf8_lossy(&bytes));
+        }
+
+        #[test]
+        fn xml_like_text_never_panics(text in xml_like()) {
+            let _ = SelfDescribing::from_xml(&text);
+        }
+
+        #[test]
+        fn damaged_messages_never_panic(
+            m in message(),
+            cut in any::<prop::sample::Index>(),
+            at in any::<prop::sample::Index>(),
+            insert in "[<>/=\"'&;! a-z]{0,3}",
+        ) {
+            let xml = m.to_xml();
+            let chars: Vec<char> = xml.chars().collect();
+            let cut = cut.index(chars.len() + 1);
+            let truncated: String = chars[..cut].iter().collect();
+            let _ = SelfDescribing::from_xml(&truncated);
+            let at = at.index(chars.len() + 1);
+            let mut damaged: String = chars[..at].iter().collect();
+            damaged.push_str(&insert);
+            damaged.extend(&chars[at..]);
+            let _ = SelfDescribing::from_xml(&damaged);
+        }
+    }
+}
