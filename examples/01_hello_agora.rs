@@ -6,6 +6,8 @@
 //!
 //! Run: `cargo run -p mrt-examples --example 01_hello_agora` (or `mrt demo`).
 
+#![allow(clippy::print_stdout)] // examples talk to the user
+
 use mrt_dcdt::prelude::*;
 use mrt_dcdt::{DcdtError, RunReport};
 use serde::{Deserialize, Serialize};
@@ -35,10 +37,7 @@ pub struct Greeter {
 impl Member for Greeter {
     fn do_your_job(&mut self, ctx: &mut Context<'_>) -> Result<(), MemberError> {
         self.sent += 1;
-        let reached = ctx.publish(Greeting {
-            n: self.sent,
-            text: format!("hello #{}", self.sent),
-        });
+        let reached = ctx.publish(Greeting { n: self.sent, text: format!("hello #{}", self.sent) });
         if self.verbose {
             println!(
                 "[{}] Greeter   sent greeting {} to {reached} subscriber(s)",
@@ -97,21 +96,9 @@ impl Member for Listener {
 /// Builds the Agora and lets it work until the Listener shuts it down.
 pub fn run(count: u32, period: Duration, verbose: bool) -> Result<RunReport, DcdtError> {
     let mut agora = Agora::standalone();
-    let greeter = agora.add_member(
-        Greeter {
-            sent: 0,
-            count,
-            verbose,
-        },
-        Activation::Periodic(period),
-    );
-    let listener = agora.add_member(
-        Listener {
-            expected: count,
-            verbose,
-        },
-        Activation::OnMessage,
-    );
+    let greeter =
+        agora.add_member(Greeter { sent: 0, count, verbose }, Activation::Periodic(period));
+    let listener = agora.add_member(Listener { expected: count, verbose }, Activation::OnMessage);
     agora.activate_member(greeter)?;
     agora.activate_member(listener)?;
     agora.lets_work() // blocks until shutdown or every Member terminated

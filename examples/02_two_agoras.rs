@@ -8,6 +8,8 @@
 //!
 //! Run: `cargo run -p mrt-examples --example 02_two_agoras` (or `mrt demo two-agoras`).
 
+#![allow(clippy::print_stdout)] // examples talk to the user
+
 use mrt_core::SimClock;
 use mrt_dcdt::prelude::*;
 use mrt_dcdt::{DcdtError, InnerLinkManager};
@@ -35,9 +37,7 @@ pub struct Camera {
 impl Member for Camera {
     fn do_your_job(&mut self, ctx: &mut Context<'_>) -> Result<(), MemberError> {
         self.distance -= 0.1;
-        ctx.publish(BallSeen {
-            distance: self.distance,
-        });
+        ctx.publish(BallSeen { distance: self.distance });
         Ok(())
     }
 }
@@ -73,10 +73,7 @@ impl Member for Listener {
                     msg.agora_id()
                 );
             }
-            self.heard
-                .lock()
-                .map_err(|_| "log poisoned")?
-                .push(msg.agora_id().0);
+            self.heard.lock().map_err(|_| "log poisoned")?.push(msg.agora_id().0);
         }
         Ok(())
     }
@@ -101,10 +98,8 @@ pub fn run(duration: Duration, verbose: bool) -> Result<Heard, DcdtError> {
     let own = Arc::new(Mutex::new(Vec::new()));
     let teammates = Arc::new(Mutex::new(Vec::new()));
     let ids = [
-        robot1.add_member(
-            Camera { distance: 3.0 },
-            Activation::Periodic(Duration::from_millis(20)),
-        ),
+        robot1
+            .add_member(Camera { distance: 3.0 }, Activation::Periodic(Duration::from_millis(20))),
         robot1.add_member(
             Listener {
                 label: "own-ball",
@@ -127,10 +122,8 @@ pub fn run(duration: Duration, verbose: bool) -> Result<Heard, DcdtError> {
     for id in ids {
         robot1.activate_member(id)?;
     }
-    let cam2 = robot2.add_member(
-        Camera { distance: 5.0 },
-        Activation::Periodic(Duration::from_millis(30)),
-    );
+    let cam2 = robot2
+        .add_member(Camera { distance: 5.0 }, Activation::Periodic(Duration::from_millis(30)));
     robot2.activate_member(cam2)?;
 
     exec.add_agora(robot1)?;
@@ -139,10 +132,7 @@ pub fn run(duration: Duration, verbose: bool) -> Result<Heard, DcdtError> {
     exec.finish();
 
     let take = |v: &Arc<Mutex<Vec<u32>>>| v.lock().map(|g| g.clone()).unwrap_or_default();
-    Ok(Heard {
-        own: take(&own),
-        teammates: take(&teammates),
-    })
+    Ok(Heard { own: take(&own), teammates: take(&teammates) })
 }
 
 /// Entry point of the example.

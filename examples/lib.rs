@@ -16,11 +16,7 @@ mod tests {
     fn hello_agora_delivers_every_greeting_and_shuts_down() {
         let report = super::hello_agora::run(5, Duration::from_millis(1), false).unwrap();
         assert_eq!(report.exit, ExitReason::Shutdown);
-        let names: Vec<_> = report
-            .members
-            .iter()
-            .map(|m| (m.name.as_str(), m.cycles))
-            .collect();
+        let names: Vec<_> = report.members.iter().map(|m| (m.name.as_str(), m.cycles)).collect();
         assert_eq!(names[0], ("Greeter", 5));
         assert_eq!(names[1].0, "Listener");
         assert!(names[1].1 >= 1 && names[1].1 <= 5);

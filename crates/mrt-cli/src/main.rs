@@ -11,7 +11,6 @@ use anyhow::{Context as _, Result};
 use clap::{Parser, Subcommand, ValueEnum};
 use mrt_dcdt::config::AgoraConfig;
 use std::path::PathBuf;
-use std::time::Duration;
 
 #[derive(Parser)]
 #[command(name = "mrt", version, about = "MRT: Modular Robotic Toolkit")]
@@ -53,23 +52,11 @@ fn main() -> Result<()> {
         .with_writer(std::io::stderr)
         .init();
     match Cli::parse().command {
-        Command::Demo {
-            which: Demo::HelloAgora,
-        } => {
+        Command::Demo { which: Demo::HelloAgora } => {
             println!("MRT demo 01_hello_agora: a Greeter (periodic, 100 ms) and a Listener (on-message)\n");
-            let report = mrt_examples::hello_agora::run(10, Duration::from_millis(100), true)
-                .context("the hello-agora demo failed")?;
-            println!("\nthe Agora stopped: {:?}", report.exit);
-            for m in &report.members {
-                println!(
-                    "  {:<9} {} cycles, {} panics, final state {:?}",
-                    m.name, m.cycles, m.panics, m.state
-                );
-            }
+            mrt_examples::hello_agora::main().context("the hello-agora demo failed")?;
         }
-        Command::Demo {
-            which: Demo::TwoAgoras,
-        } => {
+        Command::Demo { which: Demo::TwoAgoras } => {
             mrt_examples::two_agoras::main().context("the two-agoras demo failed")?;
         }
         Command::Check { files } => {
@@ -84,10 +71,7 @@ fn main() -> Result<()> {
                 }
             }
             if failed > 0 {
-                anyhow::bail!(
-                    "{failed} of {} configuration files have errors",
-                    files.len()
-                );
+                anyhow::bail!("{failed} of {} configuration files have errors", files.len());
             }
         }
     }

@@ -66,20 +66,12 @@ pub struct Pose2 {
 impl Pose2 {
     /// A pose; `theta` is normalized to `(-π, π]`.
     pub fn new(x: f64, y: f64, theta: f64) -> Self {
-        Self {
-            x,
-            y,
-            theta: normalize_angle(theta),
-        }
+        Self { x, y, theta: normalize_angle(theta) }
     }
 
     /// The pose at the origin, facing +x.
     pub const fn identity() -> Self {
-        Self {
-            x: 0.0,
-            y: 0.0,
-            theta: 0.0,
-        }
+        Self { x: 0.0, y: 0.0, theta: 0.0 }
     }
 
     /// The position part.

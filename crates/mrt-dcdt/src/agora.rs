@@ -34,11 +34,7 @@ pub(crate) struct AgoraShared {
 
 impl AgoraShared {
     pub(crate) fn waker(&self, member: MemberId) -> Option<Arc<Waker>> {
-        self.wakers
-            .read()
-            .unwrap_or_else(|e| e.into_inner())
-            .get(member.0 as usize)
-            .cloned()
+        self.wakers.read().unwrap_or_else(|e| e.into_inner()).get(member.0 as usize).cloned()
     }
 
     pub(crate) fn is_shutting_down(&self) -> bool {
@@ -95,10 +91,8 @@ impl AgoraBuilder {
 
     /// Builds the Agora. Fails when the community already has an Agora with this id.
     pub fn build(self) -> Result<Agora, DcdtError> {
-        let policy = self
-            .policy
-            .or_else(|| self.config.as_ref().and_then(|c| c.policy))
-            .unwrap_or_default();
+        let policy =
+            self.policy.or_else(|| self.config.as_ref().and_then(|c| c.policy)).unwrap_or_default();
         let post_office = Arc::new(PostOffice::new(self.id, policy));
         let route = match &self.inner_link {
             Some(ilm) => {
@@ -123,13 +117,7 @@ impl AgoraBuilder {
             Some(c) => AgoraMode::Network(Box::new(c)),
             None => AgoraMode::Standalone,
         };
-        Agora {
-            shared,
-            mode,
-            inner_link: self.inner_link,
-            slots: Vec::new(),
-            next_member: 0,
-        }
+        Agora { shared, mode, inner_link: self.inner_link, slots: Vec::new(), next_member: 0 }
     }
 }
 
@@ -173,13 +161,7 @@ pub struct Agora {
 impl Agora {
     /// Starts building an Agora with this id.
     pub fn builder(id: impl Into<AgoraId>) -> AgoraBuilder {
-        AgoraBuilder {
-            id: id.into(),
-            clock: None,
-            policy: None,
-            inner_link: None,
-            config: None,
-        }
+        AgoraBuilder { id: id.into(), clock: None, policy: None, inner_link: None, config: None }
     }
 
     /// A STANDALONE Agora with id 0, a wall clock and the default policy.
@@ -220,11 +202,7 @@ impl Agora {
         self.next_member += 1;
         let waker = Arc::new(Waker::default());
         self.shared.post_office.register(id, waker.clone());
-        let mut wakers = self
-            .shared
-            .wakers
-            .write()
-            .unwrap_or_else(|e| e.into_inner());
+        let mut wakers = self.shared.wakers.write().unwrap_or_else(|e| e.into_inner());
         if wakers.len() <= id.0 as usize {
             wakers.resize_with(id.0 as usize + 1, Default::default);
         }
@@ -248,12 +226,7 @@ impl Agora {
         let state = SharedState::default();
         let endpoint = Endpoint::new(self.shared.clone(), id);
         let runner = Runner::new(member, endpoint, activation, state.clone());
-        self.slots.push(Slot {
-            id,
-            name: runner.name.clone(),
-            runner: Some(runner),
-            state,
-        });
+        self.slots.push(Slot { id, name: runner.name.clone(), runner: Some(runner), state });
         id
     }
 
@@ -270,10 +243,7 @@ impl Agora {
         self.slots
             .iter()
             .find(|s| s.id == id)
-            .ok_or(DcdtError::UnknownMember {
-                agora: self.shared.id,
-                member: id,
-            })
+            .ok_or(DcdtError::UnknownMember { agora: self.shared.id, member: id })
     }
 
     /// A Member's state.

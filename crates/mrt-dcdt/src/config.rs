@@ -105,13 +105,7 @@ impl AgoraConfig {
                 let prefix = std::str::from_utf8(valid).unwrap_or_default();
                 let prefix = prefix.strip_prefix('\u{feff}').unwrap_or(prefix);
                 let line = prefix.matches('\n').count() + 1;
-                let column = prefix
-                    .rsplit('\n')
-                    .next()
-                    .unwrap_or_default()
-                    .chars()
-                    .count()
-                    + 1;
+                let column = prefix.rsplit('\n').next().unwrap_or_default().chars().count() + 1;
                 let byte = bytes.get(error.valid_up_to()).copied().unwrap_or_default();
                 Err(ConfigError::Parse {
                     file,
@@ -128,10 +122,7 @@ impl AgoraConfig {
         let path = path.as_ref();
         match std::fs::read(path) {
             Ok(bytes) => Self::parse_bytes(&bytes, path),
-            Err(source) => Err(ConfigError::Io {
-                file: path.to_path_buf(),
-                source,
-            }),
+            Err(source) => Err(ConfigError::Io { file: path.to_path_buf(), source }),
         }
     }
 
@@ -172,12 +163,8 @@ pub enum PolicyKind {
 
 impl PolicyKind {
     /// Every policy, in the order of the manual (MRT's own `PMQ` last).
-    pub const ALL: [PolicyKind; 4] = [
-        PolicyKind::Slwb,
-        PolicyKind::Slwdwcv,
-        PolicyKind::Slwsm,
-        PolicyKind::Pmq,
-    ];
+    pub const ALL: [PolicyKind; 4] =
+        [PolicyKind::Slwb, PolicyKind::Slwdwcv, PolicyKind::Slwsm, PolicyKind::Pmq];
 
     /// The name used in configuration files, e.g. `"SLWB"`.
     pub fn name(self) -> &'static str {
@@ -282,22 +269,10 @@ impl fmt::Display for Channel {
     /// the line break).
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
-            Channel::Ip {
-                mode,
-                level,
-                local_addr,
-                local_port,
-                remote_addr,
-                remote_port,
-            } => write!(
-                f,
-                "ip {mode} {level} {local_addr} {local_port} {remote_addr} {remote_port}"
-            ),
-            Channel::Serial {
-                mode,
-                level,
-                device,
-            } => write!(f, "ser {mode} {level} {device}"),
+            Channel::Ip { mode, level, local_addr, local_port, remote_addr, remote_port } => {
+                write!(f, "ip {mode} {level} {local_addr} {local_port} {remote_addr} {remote_port}")
+            }
+            Channel::Serial { mode, level, device } => write!(f, "ser {mode} {level} {device}"),
         }
     }
 }
@@ -357,10 +332,7 @@ fn tokenize(text: &str) -> impl Iterator<Item = Line<'_>> {
             // A stray carriage return separates tokens like a space does.
             match (matches!(c, ' ' | '\t' | '\r'), start) {
                 (true, Some((from, at))) => {
-                    tokens.push(Token {
-                        column: at,
-                        text: &content[from..byte],
-                    });
+                    tokens.push(Token { column: at, text: &content[from..byte] });
                     start = None;
                 }
                 (false, None) => start = Some((byte, column)),
@@ -368,16 +340,9 @@ fn tokenize(text: &str) -> impl Iterator<Item = Line<'_>> {
             }
         }
         if let Some((from, at)) = start {
-            tokens.push(Token {
-                column: at,
-                text: &content[from..],
-            });
+            tokens.push(Token { column: at, text: &content[from..] });
         }
-        (!tokens.is_empty()).then_some(Line {
-            number: index + 1,
-            tokens,
-            end_column: column + 1,
-        })
+        (!tokens.is_empty()).then_some(Line { number: index + 1, tokens, end_column: column + 1 })
     })
 }
 
@@ -442,10 +407,7 @@ impl<'a> Cursor<'_, 'a> {
         let token = self.line.tokens.get(self.next).copied();
         self.next += 1;
         token.ok_or_else(|| {
-            self.error(
-                self.line.end_column,
-                format!("expected {what}, found end of line"),
-            )
+            self.error(self.line.end_column, format!("expected {what}, found end of line"))
         })
     }
 
@@ -457,10 +419,7 @@ impl<'a> Cursor<'_, 'a> {
     ) -> Result<T, ConfigError> {
         let token = self.next(what)?;
         convert(token.text).ok_or_else(|| {
-            self.error(
-                token.column,
-                format!("expected {what}, found {}", quote(token.text)),
-            )
+            self.error(token.column, format!("expected {what}, found {}", quote(token.text)))
         })
     }
 
@@ -470,10 +429,7 @@ impl<'a> Cursor<'_, 'a> {
             None => Ok(()),
             Some(extra) => Err(self.error(
                 extra.column,
-                format!(
-                    "expected end of line after {last}, found {}",
-                    quote(extra.text)
-                ),
+                format!("expected end of line after {last}, found {}", quote(extra.text)),
             )),
         }
     }
@@ -485,11 +441,7 @@ struct Parser {
 
 impl Parser {
     fn cursor<'p, 'a>(&'p self, line: &'p Line<'a>) -> Cursor<'p, 'a> {
-        Cursor {
-            file: &self.file,
-            line,
-            next: 0,
-        }
+        Cursor { file: &self.file, line, next: 0 }
     }
 
     fn parse(&self, text: &str) -> Result<AgoraConfig, ConfigError> {
@@ -498,12 +450,7 @@ impl Parser {
         let Some(network) = lines.next() else {
             let (line, column) = end_of_file(text);
             let message = format!("expected {NETWORK_LINE}, found end of file");
-            return Err(ConfigError::Parse {
-                file: self.file.clone(),
-                line,
-                column,
-                message,
-            });
+            return Err(ConfigError::Parse { file: self.file.clone(), line, column, message });
         };
         let (local_ip, multicast, port) = self.network_line(&network)?;
         let mut policy: Option<(PolicyKind, usize)> = None;
@@ -548,9 +495,8 @@ impl Parser {
             }
         }
         let local_ip = cursor.parse("a local IP address", parse_ip)?;
-        let multicast = cursor.parse(MULTICAST, |text| {
-            parse_ip(text).filter(IpAddr::is_multicast)
-        })?;
+        let multicast =
+            cursor.parse(MULTICAST, |text| parse_ip(text).filter(IpAddr::is_multicast))?;
         let port = cursor.parse("a port (1-65535)", parse_port)?;
         cursor.end("the port")?;
         Ok((local_ip, multicast, port))
@@ -565,16 +511,10 @@ impl Parser {
             cursor.next(&what)?
         } else {
             // `POST_OFFICE` is ASCII, so its length is also its width in characters.
-            Token {
-                column: keyword.column + POST_OFFICE.len(),
-                text: glued,
-            }
+            Token { column: keyword.column + POST_OFFICE.len(), text: glued }
         };
         let kind = name.text.parse().map_err(|UnknownPolicy(found)| {
-            cursor.error(
-                name.column,
-                format!("expected {what}, found {}", quote(&found)),
-            )
+            cursor.error(name.column, format!("expected {what}, found {}", quote(&found)))
         })?;
         cursor.end("the PostOffice policy")?;
         Ok(kind)
@@ -595,17 +535,9 @@ impl Parser {
             }
         } else {
             let device = cursor.next("a serial device path such as `/dev/ttyS0`")?;
-            Channel::Serial {
-                mode,
-                level,
-                device: device.text.to_owned(),
-            }
+            Channel::Serial { mode, level, device: device.text.to_owned() }
         };
-        cursor.end(if keyword == "ip" {
-            "the remote port"
-        } else {
-            "the device"
-        })?;
+        cursor.end(if keyword == "ip" { "the remote port" } else { "the device" })?;
         Ok(channel)
     }
 }
@@ -734,10 +666,7 @@ mod tests {
         let base = "1.2.3.4 225.0.0.1 2003\n";
         assert_eq!(parse(base).policy, None);
         assert_eq!(parse(base).policy_or_default(), PolicyKind::Pmq);
-        assert_eq!(
-            parse(&format!("{base}PostOffice:SLWSM\n")).policy,
-            Some(PolicyKind::Slwsm)
-        );
+        assert_eq!(parse(&format!("{base}PostOffice:SLWSM\n")).policy, Some(PolicyKind::Slwsm));
         assert_eq!(
             parse(&format!("{base}PostOffice:\tSLWDWCV\n")).policy,
             Some(PolicyKind::Slwdwcv)
@@ -781,30 +710,15 @@ mod tests {
         let base = "1.2.3.4 225.0.0.1 2003\n";
         let cases = [
             ("ip", "2:3: expected `link` or `bridge`, found end of line"),
-            (
-                "ip link -1",
-                "2:9: expected a level (an integer 0-4294967295), found `-1`",
-            ),
+            ("ip link -1", "2:9: expected a level (an integer 0-4294967295), found `-1`"),
             (
                 "ip link 4294967296",
                 "2:9: expected a level (an integer 0-4294967295), found `4294967296`",
             ),
-            (
-                "ip link 0",
-                "2:10: expected a local IP address, found end of line",
-            ),
-            (
-                "ip link 0 1.2.3",
-                "2:11: expected a local IP address, found `1.2.3`",
-            ),
-            (
-                "ip link 0 1.2.3.4 0",
-                "2:19: expected a local port (1-65535), found `0`",
-            ),
-            (
-                "ip link 0 1.2.3.4 1 x",
-                "2:21: expected a remote IP address, found `x`",
-            ),
+            ("ip link 0", "2:10: expected a local IP address, found end of line"),
+            ("ip link 0 1.2.3", "2:11: expected a local IP address, found `1.2.3`"),
+            ("ip link 0 1.2.3.4 0", "2:19: expected a local port (1-65535), found `0`"),
+            ("ip link 0 1.2.3.4 1 x", "2:21: expected a remote IP address, found `x`"),
             (
                 "ip link 0 1.2.3.4 1 ::1",
                 "2:24: expected a remote port (1-65535), found end of line",
@@ -825,21 +739,11 @@ mod tests {
                 "ser bridge 2 /dev/ttyS0 9600",
                 "2:25: expected end of line after the device, found `9600`",
             ),
-            (
-                "IP link 0 1.2.3.4 1 ::1 2",
-                "2:1: expected `ip`, `ser` or `PostOffice:`, found `IP`",
-            ),
-            (
-                "ser Link 0 /dev/ttyS0",
-                "2:5: expected `link` or `bridge`, found `Link`",
-            ),
+            ("IP link 0 1.2.3.4 1 ::1 2", "2:1: expected `ip`, `ser` or `PostOffice:`, found `IP`"),
+            ("ser Link 0 /dev/ttyS0", "2:5: expected `link` or `bridge`, found `Link`"),
         ];
         for (line, expected) in cases {
-            assert_eq!(
-                error(&format!("{base}{line}\n")),
-                format!("dcdt.cfg:{expected}"),
-                "{line}"
-            );
+            assert_eq!(error(&format!("{base}{line}\n")), format!("dcdt.cfg:{expected}"), "{line}");
         }
     }
 
@@ -847,10 +751,7 @@ mod tests {
     fn found_tokens_are_escaped_and_shortened() {
         let long = "x".repeat(100);
         let message = error(&format!("1.2.3.4 225.0.0.1 2003\n{long}\n"));
-        assert!(
-            message.ends_with(&format!("found `{}…`", "x".repeat(40))),
-            "{message}"
-        );
+        assert!(message.ends_with(&format!("found `{}…`", "x".repeat(40))), "{message}");
         let message = error("1.2.3.4 225.0.0.1 20\u{1b}03\n");
         assert!(message.ends_with("found `20\\u{1b}03`"), "{message}");
     }
@@ -874,11 +775,7 @@ mod tests {
         let config = parse("1.2.3.4\r225.0.0.1 2003\nser link 0 /dev/ttyS0\r\r\n");
         assert_eq!(
             config.channels[0],
-            Channel::Serial {
-                mode: ChannelMode::Link,
-                level: 0,
-                device: "/dev/ttyS0".into()
-            }
+            Channel::Serial { mode: ChannelMode::Link, level: 0, device: "/dev/ttyS0".into() }
         );
         // A comment-only line at any place, and a `#` glued to a token.
         let config = parse("1.2.3.4 225.0.0.1 2003#c\n#ip link 0\nser link 0 /dev/ttyUSB0#c\n");
@@ -906,10 +803,7 @@ mod tests {
                     ip link 1 10.0.0.1 3000 10.0.0.2 3001\n";
         let config = parse(text);
         assert_eq!(config.local_ip, ip("fe80::1"));
-        assert_eq!(
-            config.multicast,
-            IpAddr::V6(Ipv6Addr::new(0xff02, 0, 0, 0, 0, 0, 1, 2))
-        );
+        assert_eq!(config.multicast, IpAddr::V6(Ipv6Addr::new(0xff02, 0, 0, 0, 0, 0, 1, 2)));
         assert_eq!(config.port, 4000);
         assert_eq!(config.policy, None);
         assert_eq!(
@@ -928,11 +822,7 @@ mod tests {
                     remote_addr: ip("2001:db8::2"),
                     remote_port: 65535,
                 },
-                Channel::Serial {
-                    mode: ChannelMode::Link,
-                    level: 0,
-                    device: "COM3".into()
-                },
+                Channel::Serial { mode: ChannelMode::Link, level: 0, device: "COM3".into() },
                 Channel::Ip {
                     mode: ChannelMode::Link,
                     level: 1,
@@ -953,10 +843,7 @@ mod tests {
             Ok(config) => panic!("parsed {config:?}"),
             Err(error) => error.to_string(),
         };
-        assert_eq!(
-            message,
-            "dcdt.cfg:2:21: expected UTF-8 text, found the invalid byte 0xFF"
-        );
+        assert_eq!(message, "dcdt.cfg:2:21: expected UTF-8 text, found the invalid byte 0xFF");
         let config = AgoraConfig::parse_bytes(MANUAL_EXAMPLE.as_bytes(), "dcdt.cfg");
         assert_eq!(config.ok(), Some(parse(MANUAL_EXAMPLE)));
     }
@@ -974,10 +861,7 @@ mod tests {
 
         match AgoraConfig::from_file("/nonexistent/dcdt.cfg") {
             Err(error @ ConfigError::Io { .. }) => {
-                assert!(
-                    error.to_string().starts_with("/nonexistent/dcdt.cfg: "),
-                    "{error}"
-                );
+                assert!(error.to_string().starts_with("/nonexistent/dcdt.cfg: "), "{error}");
                 assert!(std::error::Error::source(&error).is_some());
             }
             other => panic!("expected an I/O error, got {other:?}"),
@@ -996,10 +880,8 @@ mod tests {
         assert_eq!(unknown, Err(UnknownPolicy("Slwb".into())));
         assert_eq!(
             unknown.map_err(|e| e.to_string()),
-            Err(
-                "unknown PostOffice policy `Slwb`, expected `SLWB`, `SLWDWCV`, `SLWSM` or `PMQ`"
-                    .into()
-            )
+            Err("unknown PostOffice policy `Slwb`, expected `SLWB`, `SLWDWCV`, `SLWSM` or `PMQ`"
+                .into())
         );
     }
 
@@ -1017,23 +899,14 @@ mod tests {
         assert!(matches!(
             gateway.channels.as_slice(),
             [
-                Channel::Ip {
-                    mode: ChannelMode::Bridge,
-                    ..
-                },
-                Channel::Serial {
-                    mode: ChannelMode::Link,
-                    ..
-                }
+                Channel::Ip { mode: ChannelMode::Bridge, .. },
+                Channel::Serial { mode: ChannelMode::Link, .. }
             ]
         ));
     }
 
     fn any_ip() -> impl Strategy<Value = IpAddr> {
-        prop_oneof![
-            any::<Ipv4Addr>().prop_map(IpAddr::V4),
-            any::<Ipv6Addr>().prop_map(IpAddr::V6),
-        ]
+        prop_oneof![any::<Ipv4Addr>().prop_map(IpAddr::V4), any::<Ipv6Addr>().prop_map(IpAddr::V6),]
     }
 
     fn multicast_ip() -> impl Strategy<Value = IpAddr> {
@@ -1054,31 +927,18 @@ mod tests {
 
     fn channel() -> impl Strategy<Value = Channel> {
         prop_oneof![
-            (
-                mode(),
-                any::<u32>(),
-                any_ip(),
-                1..=u16::MAX,
-                any_ip(),
-                1..=u16::MAX
-            )
-                .prop_map(
-                    |(mode, level, local_addr, local_port, remote_addr, remote_port)| Channel::Ip {
-                        mode,
-                        level,
-                        local_addr,
-                        local_port,
-                        remote_addr,
-                        remote_port,
-                    }
-                ),
-            (mode(), any::<u32>(), "[^ \t#\r\n]{1,12}").prop_map(|(mode, level, device)| {
-                Channel::Serial {
+            (mode(), any::<u32>(), any_ip(), 1..=u16::MAX, any_ip(), 1..=u16::MAX).prop_map(
+                |(mode, level, local_addr, local_port, remote_addr, remote_port)| Channel::Ip {
                     mode,
                     level,
-                    device,
+                    local_addr,
+                    local_port,
+                    remote_addr,
+                    remote_port,
                 }
-            }),
+            ),
+            (mode(), any::<u32>(), "[^ \t#\r\n]{1,12}")
+                .prop_map(|(mode, level, device)| { Channel::Serial { mode, level, device } }),
         ]
     }
 
@@ -1090,15 +950,13 @@ mod tests {
             proptest::option::of(proptest::sample::select(PolicyKind::ALL.to_vec())),
             proptest::collection::vec(channel(), 0..8),
         )
-            .prop_map(
-                |(local_ip, multicast, port, policy, channels)| AgoraConfig {
-                    local_ip,
-                    multicast,
-                    port,
-                    policy,
-                    channels,
-                },
-            )
+            .prop_map(|(local_ip, multicast, port, policy, channels)| AgoraConfig {
+                local_ip,
+                multicast,
+                port,
+                policy,
+                channels,
+            })
     }
 
     const ALPHABET: &[&str] = &[

@@ -140,10 +140,7 @@ pub enum XmlError {
 impl SelfDescribing {
     /// An empty message stamped `timestamp`.
     pub fn new(timestamp: Time) -> Self {
-        SelfDescribing {
-            timestamp,
-            objects: Vec::new(),
-        }
+        SelfDescribing { timestamp, objects: Vec::new() }
     }
 
     /// The message with `obj` appended to its objects.
@@ -220,11 +217,7 @@ impl SelfDescribing {
 impl Object {
     /// An object without attributes.
     pub fn new(name: impl Into<String>, class: impl Into<String>) -> Self {
-        Object {
-            name: name.into(),
-            class: class.into(),
-            attributes: Vec::new(),
-        }
+        Object { name: name.into(), class: class.into(), attributes: Vec::new() }
     }
 
     /// The object with `attr` appended to its attributes.
@@ -242,12 +235,7 @@ impl Object {
 impl Attribute {
     /// A numeric attribute.
     pub fn number(name: impl Into<String>, value: f64, variability: f64, reliability: f64) -> Self {
-        Attribute {
-            name: name.into(),
-            value: AttrValue::Number(value),
-            variability,
-            reliability,
-        }
+        Attribute { name: name.into(), value: AttrValue::Number(value), variability, reliability }
     }
 
     /// A symbolic attribute: `value` is a symbol of the shared ontology.
@@ -271,10 +259,7 @@ impl Attribute {
 
 /// An XML attribute whose value is already escaped.
 fn xml_attr(key: &str, escaped: String) -> XmlAttr<'_> {
-    XmlAttr {
-        key: QName(key.as_bytes()),
-        value: Cow::Owned(escaped.into_bytes()),
-    }
+    XmlAttr { key: QName(key.as_bytes()), value: Cow::Owned(escaped.into_bytes()) }
 }
 
 /// Escapes `s` for a double-quoted attribute value. Tabs, newlines and other control
@@ -342,10 +327,7 @@ fn parse_timestamp(s: &str) -> Result<Time, &'static str> {
     }
     const RANGE: &str = "of at most 18446744073.709551615 seconds";
     let secs: u64 = secs.parse().map_err(|_| RANGE)?;
-    secs.checked_mul(NANOS_PER_SEC)
-        .and_then(|n| n.checked_add(nanos))
-        .map(Time)
-        .ok_or(RANGE)
+    secs.checked_mul(NANOS_PER_SEC).and_then(|n| n.checked_add(nanos)).map(Time).ok_or(RANGE)
 }
 
 fn parse_number(s: &str) -> Option<f64> {
@@ -358,10 +340,7 @@ fn line_column(text: &str, pos: u64) -> (usize, usize) {
     let pos = usize::try_from(pos).unwrap_or(usize::MAX).min(bytes.len());
     let before = bytes.get(..pos).unwrap_or(bytes);
     let line = 1 + before.iter().filter(|&&b| b == b'\n').count();
-    let line_start = before
-        .iter()
-        .rposition(|&b| b == b'\n')
-        .map_or(0, |i| i + 1);
+    let line_start = before.iter().rposition(|&b| b == b'\n').map_or(0, |i| i + 1);
     let column = 1 + before
         .get(line_start..)
         .unwrap_or_default()
@@ -427,11 +406,7 @@ impl<'a> Parser<'a> {
 
     fn error_at(&self, pos: u64, message: impl Into<String>) -> XmlError {
         let (line, column) = line_column(self.text, pos);
-        XmlError::Syntax {
-            line,
-            column,
-            message: message.into(),
-        }
+        XmlError::Syntax { line, column, message: message.into() }
     }
 
     /// An error of the XML reader itself, at the position it reports.
@@ -543,17 +518,12 @@ impl<'a> Parser<'a> {
         let (at, message) = match e {
             AttrError::ExpectedEq(p) => (*p, "expected `=` after the attribute name".to_owned()),
             AttrError::ExpectedValue(p) => (*p, "expected a quoted attribute value".to_owned()),
-            AttrError::UnquotedValue(p) => (
-                *p,
-                "expected a quoted attribute value, found an unquoted one".to_owned(),
-            ),
-            AttrError::ExpectedQuote(p, q) => (
-                *p,
-                format!(
-                    "expected a closing `{}` after the attribute value",
-                    char::from(*q)
-                ),
-            ),
+            AttrError::UnquotedValue(p) => {
+                (*p, "expected a quoted attribute value, found an unquoted one".to_owned())
+            }
+            AttrError::ExpectedQuote(p, q) => {
+                (*p, format!("expected a closing `{}` after the attribute value", char::from(*q)))
+            }
             AttrError::Duplicated(p, _) => {
                 let content: &[u8] = tag;
                 let key: Vec<u8> = content
@@ -563,13 +533,7 @@ impl<'a> Parser<'a> {
                     .copied()
                     .take_while(|&b| !is_xml_space(b) && !matches!(b, b'=' | b'/' | b'>'))
                     .collect();
-                (
-                    *p,
-                    format!(
-                        "expected each attribute once, found a second `{}`",
-                        lossy(&key)
-                    ),
-                )
+                (*p, format!("expected each attribute once, found a second `{}`", lossy(&key)))
             }
         };
         let at = pos.saturating_add(1).saturating_add(at as u64);
@@ -588,10 +552,9 @@ impl<'a> Parser<'a> {
         let mut fields = self.fields(pos, &tag, "<message>")?;
         let timestamp = fields.take("timestamp");
         if let Some(key) = fields.unknown() {
-            return Err(self.error_at(
-                pos,
-                format!("<message>: expected only `timestamp`, found `{key}`"),
-            ));
+            return Err(
+                self.error_at(pos, format!("<message>: expected only `timestamp`, found `{key}`"))
+            );
         }
         let Some(timestamp) = timestamp else {
             return Err(self.error_at(pos, "<message>: expected `timestamp`"));
@@ -735,12 +698,7 @@ impl<'a> Parser<'a> {
                 ))
             }
         };
-        let attr = Attribute {
-            name,
-            value,
-            variability,
-            reliability,
-        };
+        let attr = Attribute { name, value, variability, reliability };
         if !empty {
             let (pos, item) = self.next(false, "</attribute>")?;
             match item {
@@ -918,20 +876,9 @@ mod tests {
             ("18446744073.709551615", u64::MAX),
         ] {
             let xml = format!(r#"<message timestamp="{text}"/>"#);
-            assert_eq!(
-                SelfDescribing::from_xml(&xml)?.timestamp,
-                Time(nanos),
-                "{text}"
-            );
+            assert_eq!(SelfDescribing::from_xml(&xml)?.timestamp, Time(nanos), "{text}");
         }
-        for nanos in [
-            0,
-            1,
-            999_999_999,
-            1_000_000_000,
-            123_456_789_012_345_678,
-            u64::MAX,
-        ] {
+        for nanos in [0, 1, 999_999_999, 1_000_000_000, 123_456_789_012_345_678, u64::MAX] {
             let msg = SelfDescribing::new(Time(nanos));
             assert_eq!(SelfDescribing::from_xml(&msg.to_xml())?, msg);
         }
@@ -975,15 +922,9 @@ mod tests {
                 ),
             );
         }
+        assert_eq!(err("\n\n  <message/>"), "line 3, column 3: <message>: expected `timestamp`");
         assert_eq!(
-            err("\n\n  <message/>"),
-            "line 3, column 3: <message>: expected `timestamp`"
-        );
-        assert_eq!(
-            err(&example_with(
-                "timestamp=\"12.500000000\"",
-                "timestamp=\"12.5x\""
-            )),
+            err(&example_with("timestamp=\"12.500000000\"", "timestamp=\"12.5x\"")),
             "line 1, column 1: <message>: expected `timestamp` as non-negative seconds with at \
              most 9 decimals, found \"12.5x\""
         );
@@ -1001,10 +942,7 @@ mod tests {
     fn reliability_out_of_range() {
         for bad in ["1.5", "-0.1", "NaN", "high"] {
             assert_eq!(
-                err(&example_with(
-                    r#"reliability="1""#,
-                    &format!(r#"reliability="{bad}""#)
-                )),
+                err(&example_with(r#"reliability="1""#, &format!(r#"reliability="{bad}""#))),
                 format!(
                     "line 4, column 5: attribute \"colour\" of object \"ball\": expected \
                      `reliability` between 0 and 1, found {bad:?}"
@@ -1016,10 +954,7 @@ mod tests {
     #[test]
     fn variability_must_be_non_negative() {
         assert_eq!(
-            err(&example_with(
-                r#"variability="0.1""#,
-                r#"variability="-0.1""#
-            )),
+            err(&example_with(r#"variability="0.1""#, r#"variability="-0.1""#)),
             "line 3, column 5: attribute \"distance\" of object \"ball\": expected `variability` \
              to be a non-negative number, found \"-0.1\""
         );
@@ -1032,10 +967,7 @@ mod tests {
     #[test]
     fn value_xor_symbol() {
         assert_eq!(
-            err(&example_with(
-                r#"value="2.4""#,
-                r#"value="2.4" symbol="far""#
-            )),
+            err(&example_with(r#"value="2.4""#, r#"value="2.4" symbol="far""#)),
             "line 3, column 5: attribute \"distance\" of object \"ball\": expected `value` or \
              `symbol`, not both"
         );
@@ -1066,17 +998,11 @@ mod tests {
             "line 2, column 3: object \"ball\": expected `class`"
         );
         assert_eq!(
-            err(&example_with(
-                r#"class="Ball""#,
-                r#"class="Ball" colour="red""#
-            )),
+            err(&example_with(r#"class="Ball""#, r#"class="Ball" colour="red""#)),
             "line 2, column 3: object \"ball\": expected only `name` and `class`, found `colour`"
         );
         assert_eq!(
-            err(&example_with(
-                r#"reliability="1""#,
-                r#"reliability="1" unit="m""#
-            )),
+            err(&example_with(r#"reliability="1""#, r#"reliability="1" unit="m""#)),
             "line 4, column 5: attribute \"colour\" of object \"ball\": expected only `name`, \
              `value`, `symbol`, `variability` and `reliability`, found `unit`"
         );
@@ -1085,10 +1011,7 @@ mod tests {
             "line 1, column 1: <message>: expected only `timestamp`, found `version`"
         );
         assert_eq!(
-            err(&example_with(
-                r#"class="Ball""#,
-                r#"class="Ball" name="bat""#
-            )),
+            err(&example_with(r#"class="Ball""#, r#"class="Ball" name="bat""#)),
             "line 2, column 36: <object>: expected each attribute once, found a second `name`"
         );
     }
@@ -1115,10 +1038,7 @@ mod tests {
             "line 7, column 1: expected end of input, found <message>"
         );
         assert_eq!(
-            err(&example_with(
-                "<attribute name=\"colour\"",
-                "text <attribute name=\"colour\""
-            )),
+            err(&example_with("<attribute name=\"colour\"", "text <attribute name=\"colour\"")),
             "line 3, column 81: expected <attribute> or </object>, found text"
         );
     }
@@ -1147,14 +1067,8 @@ mod tests {
             err(&example_with("</object>", "</objet>")),
             "line 5, column 3: expected </object>, found </objet>"
         );
-        assert_eq!(
-            err(""),
-            "line 1, column 1: expected <message>, found end of input"
-        );
-        assert_eq!(
-            err("hello"),
-            "line 1, column 1: expected <message>, found text"
-        );
+        assert_eq!(err(""), "line 1, column 1: expected <message>, found end of input");
+        assert_eq!(err("hello"), "line 1, column 1: expected <message>, found text");
         assert_eq!(
             err(&example_with(r#"value="2.4""#, "value=2.4")),
             "line 3, column 38: <attribute> of object \"ball\": expected a quoted attribute \
@@ -1202,10 +1116,7 @@ mod tests {
             "line 6, column 11: expected end of input, found a doctype"
         );
         assert_eq!(
-            err(&example_with(
-                r#"reliability="1"/>"#,
-                r#"reliability="1">x</attribute>"#
-            )),
+            err(&example_with(r#"reliability="1"/>"#, r#"reliability="1">x</attribute>"#)),
             "line 4, column 78: expected </attribute>, found text"
         );
         Ok(())
@@ -1223,10 +1134,7 @@ mod tests {
     }
 
     fn text() -> impl Strategy<Value = String> {
-        prop_oneof![
-            "[a-zA-Z0-9 _<>&\"'\t\n\r=/;#\u{e9}\u{4e2d}\u{1F916}-]{0,12}",
-            any::<String>(),
-        ]
+        prop_oneof!["[a-zA-Z0-9 _<>&\"'\t\n\r=/;#\u{e9}\u{4e2d}\u{1F916}-]{0,12}", any::<String>(),]
     }
 
     fn number() -> impl Strategy<Value = f64> {
@@ -1252,15 +1160,10 @@ mod tests {
     }
 
     fn attribute() -> impl Strategy<Value = Attribute> {
-        let value = prop_oneof![
-            number().prop_map(AttrValue::Number),
-            text().prop_map(AttrValue::Symbol)
-        ];
-        let variability = prop_oneof![
-            0.0..1e3f64,
-            number().prop_map(f64::abs),
-            Just(f64::INFINITY)
-        ];
+        let value =
+            prop_oneof![number().prop_map(AttrValue::Number), text().prop_map(AttrValue::Symbol)];
+        let variability =
+            prop_oneof![0.0..1e3f64, number().prop_map(f64::abs), Just(f64::INFINITY)];
         let reliability = prop_oneof![0.0..=1.0f64, Just(0.0), Just(1.0)];
         (text(), value, variability, reliability).prop_map(
             |(name, value, variability, reliability)| Attribute {
@@ -1273,19 +1176,10 @@ mod tests {
     }
 
     fn message() -> impl Strategy<Value = SelfDescribing> {
-        let object = (text(), text(), prop::collection::vec(attribute(), 0..4)).prop_map(
-            |(name, class, attributes)| Object {
-                name,
-                class,
-                attributes,
-            },
-        );
-        (any::<u64>(), prop::collection::vec(object, 0..4)).prop_map(|(nanos, objects)| {
-            SelfDescribing {
-                timestamp: Time(nanos),
-                objects,
-            }
-        })
+        let object = (text(), text(), prop::collection::vec(attribute(), 0..4))
+            .prop_map(|(name, class, attributes)| Object { name, class, attributes });
+        (any::<u64>(), prop::collection::vec(object, 0..4))
+            .prop_map(|(nanos, objects)| SelfDescribing { timestamp: Time(nanos), objects })
     }
 
     fn xml_like() -> impl Strategy<Value = String> {

@@ -53,11 +53,7 @@ pub struct Endpoint {
 
 impl Endpoint {
     pub(crate) fn new(shared: Arc<AgoraShared>, member: MemberId) -> Self {
-        Self {
-            shared,
-            member,
-            current: None,
-        }
+        Self { shared, member, current: None }
     }
 
     /// This endpoint's Member id.
@@ -82,10 +78,7 @@ impl Endpoint {
     /// Subscribes to a message type (`SubscribeMsgType`). Subscribing twice with different
     /// request types subscribes to both.
     pub fn subscribe(&self, ty: MsgType, req: RequestType) {
-        self.shared
-            .post_office
-            .policy
-            .subscribe(self.index(), ty, req.mask())
+        self.shared.post_office.policy.subscribe(self.index(), ty, req.mask())
     }
 
     /// Subscribes to the typed message `T`.
@@ -96,10 +89,7 @@ impl Endpoint {
     /// Unsubscribes from a message type (`UnSubscribeMsgType`); `RequestType::All` removes the
     /// whole subscription, `Local` or `Remote` only that half of it.
     pub fn unsubscribe(&self, ty: MsgType, req: RequestType) {
-        self.shared
-            .post_office
-            .policy
-            .unsubscribe(self.index(), ty, req.mask())
+        self.shared.post_office.policy.unsubscribe(self.index(), ty, req.mask())
     }
 
     /// Unsubscribes from every type (`UnSubscribeAll`).
@@ -131,10 +121,7 @@ impl Endpoint {
 
     /// Creates a raw message with a delivery warranty (`CreateMsg(type, warranty)`).
     pub fn create_msg_with(&self, ty: MsgType, warranty: DeliveryWarranty) -> MsgBuilder {
-        MsgBuilder {
-            header: self.header(ty, warranty, 0),
-            payload: Vec::new(),
-        }
+        MsgBuilder { header: self.header(ty, warranty, 0), payload: Vec::new() }
     }
 
     /// Shares a raw message with every subscriber of its type (`ShareMsg`); returns how many
@@ -185,10 +172,7 @@ impl Endpoint {
     /// elsewhere keeps its origin). Returns how many mailboxes it reached.
     pub fn share_ref(&self, msg: &MsgRef) -> usize {
         let origin = msg.agora_id();
-        let n = self
-            .shared
-            .route
-            .share(origin, msg.msg_type(), &mut || msg.clone());
+        let n = self.shared.route.share(origin, msg.msg_type(), &mut || msg.clone());
         self.shared.post_office.count_shared(n);
         n
     }

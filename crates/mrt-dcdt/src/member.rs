@@ -229,11 +229,8 @@ impl Runner {
         if self.cycles > 0 || self.consecutive_failures > 0 {
             self.restarts += 1;
         }
-        let mut ctx = Context {
-            endpoint: &mut self.endpoint,
-            cycle: self.cycles,
-            terminate: false,
-        };
+        let mut ctx =
+            Context { endpoint: &mut self.endpoint, cycle: self.cycles, terminate: false };
         let member = &mut self.member;
         match catch_unwind(AssertUnwindSafe(|| member.init(&mut ctx))) {
             Ok(Ok(())) => {
@@ -260,11 +257,8 @@ impl Runner {
         }
         let span = tracing::trace_span!("cycle", member = %self.name, cycle = self.cycles);
         let _enter = span.enter();
-        let mut ctx = Context {
-            endpoint: &mut self.endpoint,
-            cycle: self.cycles,
-            terminate: false,
-        };
+        let mut ctx =
+            Context { endpoint: &mut self.endpoint, cycle: self.cycles, terminate: false };
         let member = &mut self.member;
         let result = catch_unwind(AssertUnwindSafe(|| {
             let r = member.do_your_job(&mut ctx);
@@ -296,11 +290,8 @@ impl Runner {
     pub(crate) fn close(&mut self) {
         self.state.set(MemberState::Terminating);
         if !self.needs_init || self.cycles > 0 {
-            let mut ctx = Context {
-                endpoint: &mut self.endpoint,
-                cycle: self.cycles,
-                terminate: true,
-            };
+            let mut ctx =
+                Context { endpoint: &mut self.endpoint, cycle: self.cycles, terminate: true };
             let member = &mut self.member;
             if let Err(p) = catch_unwind(AssertUnwindSafe(|| member.close(&mut ctx))) {
                 self.panics += 1;
@@ -330,11 +321,7 @@ impl Runner {
     }
 
     pub(crate) fn has_mail(&self) -> bool {
-        self.endpoint
-            .shared
-            .post_office
-            .policy
-            .has_pending(self.endpoint.member.0 as usize)
+        self.endpoint.shared.post_office.policy.has_pending(self.endpoint.member.0 as usize)
     }
 
     pub(crate) fn report(&self) -> MemberReport {

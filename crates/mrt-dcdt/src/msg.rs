@@ -122,10 +122,8 @@ impl<T: Message> Payload for T {
         self
     }
     fn encode(&self) -> Result<Vec<u8>, DcdtError> {
-        postcard::to_stdvec(self).map_err(|e| DcdtError::Encode {
-            name: T::NAME,
-            reason: e.to_string(),
-        })
+        postcard::to_stdvec(self)
+            .map_err(|e| DcdtError::Encode { name: T::NAME, reason: e.to_string() })
     }
     fn len(&self) -> usize {
         std::mem::size_of::<T>()
@@ -148,10 +146,7 @@ pub struct RawPayload {
 impl RawPayload {
     /// A raw payload holding `bytes`.
     pub fn new(bytes: Vec<u8>) -> Self {
-        Self {
-            bytes,
-            decoded: OnceLock::new(),
-        }
+        Self { bytes, decoded: OnceLock::new() }
     }
 
     /// The bytes.
@@ -171,10 +166,7 @@ impl RawPayload {
                 expected: T::NAME,
                 found: "a value decoded as another Rust type",
             }),
-            Err(reason) => Err(DcdtError::Decode {
-                name: T::NAME,
-                reason: reason.clone(),
-            }),
+            Err(reason) => Err(DcdtError::Decode { name: T::NAME, reason: reason.clone() }),
         }
     }
 }
@@ -356,17 +348,11 @@ mod tests {
         let bytes = postcard::to_stdvec(&Odometry { dx: 0.5, dy: -1.0 }).unwrap();
         let m = Msg::new(header(Odometry::TYPE), RawPayload::new(bytes.clone())).into_ref();
         assert_eq!(m.bytes(), Some(&bytes[..]));
-        assert_eq!(
-            m.get::<Odometry>().unwrap(),
-            &Odometry { dx: 0.5, dy: -1.0 }
-        );
+        assert_eq!(m.get::<Odometry>().unwrap(), &Odometry { dx: 0.5, dy: -1.0 });
         let first: *const Odometry = m.get::<Odometry>().unwrap();
         let second: *const Odometry = m.get::<Odometry>().unwrap();
         assert_eq!(first, second, "decoded once and kept");
-        assert!(matches!(
-            m.get::<Other>(),
-            Err(DcdtError::TypeMismatch { .. })
-        ));
+        assert!(matches!(m.get::<Other>(), Err(DcdtError::TypeMismatch { .. })));
     }
 
     #[test]
@@ -377,11 +363,8 @@ mod tests {
 
     #[test]
     fn warranty_codes_round_trip() {
-        for w in [
-            DeliveryWarranty::None,
-            DeliveryWarranty::Retransmit,
-            DeliveryWarranty::Reliable,
-        ] {
+        for w in [DeliveryWarranty::None, DeliveryWarranty::Retransmit, DeliveryWarranty::Reliable]
+        {
             assert_eq!(DeliveryWarranty::from_code(w.code()), Some(w));
         }
         assert_eq!(DeliveryWarranty::from_code(3), None);

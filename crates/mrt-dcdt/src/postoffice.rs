@@ -69,10 +69,7 @@ impl PostOffice {
         let subs = self.policy.subscriptions();
         subs.iter()
             .filter(|(t, _)| *t == ty)
-            .flat_map(|(_, s)| {
-                s.iter()
-                    .map(|(m, mask)| (MemberId(*m as u32), request_type(*mask)))
-            })
+            .flat_map(|(_, s)| s.iter().map(|(m, mask)| (MemberId(*m as u32), request_type(*mask))))
             .collect()
     }
 
@@ -199,11 +196,7 @@ impl InnerLinkManager {
     }
 
     pub(crate) fn leave(&self, agora: AgoraId) {
-        self.post_offices.rcu(|list| {
-            list.iter()
-                .filter(|p| p.agora != agora)
-                .cloned()
-                .collect::<Vec<_>>()
-        });
+        self.post_offices
+            .rcu(|list| list.iter().filter(|p| p.agora != agora).cloned().collect::<Vec<_>>());
     }
 }

@@ -91,10 +91,7 @@ fn u32_at(b: &[u8], at: usize) -> u32 {
 /// Decodes one frame into a shared raw message. Never panics, whatever the bytes.
 pub fn decode(frame: &[u8]) -> Result<MsgRef, WireError> {
     if frame.len() < HEADER_LEN {
-        return Err(WireError::Truncated {
-            needed: HEADER_LEN,
-            got: frame.len(),
-        });
+        return Err(WireError::Truncated { needed: HEADER_LEN, got: frame.len() });
     }
     let (head, rest) = frame.split_at(HEADER_LEN);
     if head[0..4] != MAGIC {
@@ -111,10 +108,7 @@ pub fn decode(frame: &[u8]) -> Result<MsgRef, WireError> {
         return Err(WireError::TooLarge(len));
     }
     if rest.len() < len {
-        return Err(WireError::Truncated {
-            needed: HEADER_LEN + len,
-            got: frame.len(),
-        });
+        return Err(WireError::Truncated { needed: HEADER_LEN + len, got: frame.len() });
     }
     if rest.len() > len {
         return Err(WireError::Trailing(rest.len() - len));
@@ -159,25 +153,14 @@ mod tests {
 
     #[test]
     fn typed_message_crosses_the_wire_and_decodes_lazily() {
-        let m = Msg::new(
-            header(),
-            Sonar {
-                ranges: vec![1.0, 2.5],
-            },
-        )
-        .into_ref();
+        let m = Msg::new(header(), Sonar { ranges: vec![1.0, 2.5] }).into_ref();
         let frame = encode(&m).unwrap();
         // 32-byte header + postcard: 1-byte length + 2 × 4-byte floats.
         assert_eq!(frame.len(), 32 + 9);
         assert_eq!(&frame[..4], b"DCDT");
         let back = decode(&frame).unwrap();
         assert_eq!(back.header(), m.header());
-        assert_eq!(
-            back.get::<Sonar>().unwrap(),
-            &Sonar {
-                ranges: vec![1.0, 2.5]
-            }
-        );
+        assert_eq!(back.get::<Sonar>().unwrap(), &Sonar { ranges: vec![1.0, 2.5] });
     }
 
     #[test]
@@ -185,20 +168,8 @@ mod tests {
         let m = Msg::new(header(), RawPayload::new(vec![1, 2, 3])).into_ref();
         let frame = encode(&m).unwrap();
         assert_eq!(decode(&frame).unwrap().bytes(), Some(&[1u8, 2, 3][..]));
-        assert!(matches!(
-            decode(&frame[..10]),
-            Err(WireError::Truncated {
-                needed: 32,
-                got: 10
-            })
-        ));
-        assert!(matches!(
-            decode(&frame[..34]),
-            Err(WireError::Truncated {
-                needed: 35,
-                got: 34
-            })
-        ));
+        assert!(matches!(decode(&frame[..10]), Err(WireError::Truncated { needed: 32, got: 10 })));
+        assert!(matches!(decode(&frame[..34]), Err(WireError::Truncated { needed: 35, got: 34 })));
         let mut bad = frame.clone();
         bad[0] = b'X';
         assert!(matches!(decode(&bad), Err(WireError::BadMagic)));

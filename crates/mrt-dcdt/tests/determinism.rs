@@ -31,18 +31,8 @@ fn trace(policy: PolicyKind) -> Vec<Seen> {
     let log = log();
     let ilm = InnerLinkManager::new();
     let mut exec = SteppedExecutor::new(SimClock::new(), MS);
-    let mut r1 = exec
-        .agora_builder(1)
-        .policy(policy)
-        .inner_link(&ilm)
-        .build()
-        .unwrap();
-    let mut r2 = exec
-        .agora_builder(2)
-        .policy(policy)
-        .inner_link(&ilm)
-        .build()
-        .unwrap();
+    let mut r1 = exec.agora_builder(1).policy(policy).inner_link(&ilm).build().unwrap();
+    let mut r2 = exec.agora_builder(2).policy(policy).inner_link(&ilm).build().unwrap();
     let mut fast = Producer::new(0);
     fast.status_every = 3;
     let ids1 = [
@@ -50,10 +40,7 @@ fn trace(policy: PolicyKind) -> Vec<Seen> {
         r1.add_member(
             Recorder::new(
                 "r1-all",
-                &[
-                    (Count::TYPE, RequestType::All),
-                    (Status::TYPE, RequestType::All),
-                ],
+                &[(Count::TYPE, RequestType::All), (Status::TYPE, RequestType::All)],
                 &log,
             ),
             Activation::OnMessage,
@@ -120,16 +107,10 @@ fn trace_content_follows_the_schedule() {
     assert_eq!(r2_counts, 28);
     // r2-first runs before robot 2's relay and producer in the order: it sees robot 1's counts
     // in the tick they are created (robot 1 steps first) ...
-    let first = t
-        .iter()
-        .find(|s| s.receiver == "r2-first" && s.from_agora == 1)
-        .unwrap();
+    let first = t.iter().find(|s| s.receiver == "r2-first" && s.from_agora == 1).unwrap();
     assert_eq!(first.at_ns, first.created_ns);
     // ... and its own robot's counts one tick (1 ms) later, since the producer comes after it.
-    let own = t
-        .iter()
-        .find(|s| s.receiver == "r2-first" && s.from_agora == 2)
-        .unwrap();
+    let own = t.iter().find(|s| s.receiver == "r2-first" && s.from_agora == 2).unwrap();
     assert_eq!(own.at_ns, own.created_ns + 1_000_000);
     // Every count of robot 1 is relayed by robot 2 and seen by robot 2's cyclic recorder.
     let relayed = t

@@ -68,13 +68,8 @@ fn stepped_panicking_member_restarts_with_backoff_and_others_keep_their_rate() {
     let mut exec = SteppedExecutor::new(SimClock::new(), MS);
     let mut a = exec.agora_builder(1).build().unwrap();
     let steady = a.add_member(Producer::new(0), Activation::Periodic(10 * MS));
-    let flaky = a.add_member(
-        Flaky {
-            jobs: 0,
-            inits: inits.clone(),
-        },
-        Activation::Periodic(10 * MS),
-    );
+    let flaky =
+        a.add_member(Flaky { jobs: 0, inits: inits.clone() }, Activation::Periodic(10 * MS));
     let broken = a.add_member(Broken, Activation::Cyclic);
     let slow = a.add_member(SlowStart(0), Activation::Periodic(10 * MS));
     let grumpy = a.add_member(Grumpy, Activation::Periodic(100 * MS));
@@ -113,10 +108,7 @@ fn stepped_panicking_member_restarts_with_backoff_and_others_keep_their_rate() {
     // Errors are counted, the Member keeps running.
     let g = report.member(grumpy).unwrap();
     assert_eq!((g.cycles, g.errors, g.restarts), (20, 20, 0));
-    assert!(report
-        .members
-        .iter()
-        .all(|m| m.state == MemberState::Terminated));
+    assert!(report.members.iter().all(|m| m.state == MemberState::Terminated));
 }
 
 #[test]
@@ -124,15 +116,9 @@ fn threaded_panicking_member_is_isolated_and_the_agora_keeps_running() {
     let log = log();
     let mut a = mrt_dcdt::Agora::standalone();
     let inits = Arc::new(AtomicU32::new(0));
-    let producer = a.add_member(
-        Producer::new(200),
-        Activation::Periodic(Duration::from_millis(1)),
-    );
+    let producer = a.add_member(Producer::new(200), Activation::Periodic(Duration::from_millis(1)));
     let flaky = a.add_member(
-        Flaky {
-            jobs: 0,
-            inits: inits.clone(),
-        },
+        Flaky { jobs: 0, inits: inits.clone() },
         Activation::Periodic(Duration::from_millis(1)),
     );
     let rec = a.add_member(

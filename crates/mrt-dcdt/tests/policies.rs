@@ -23,10 +23,7 @@ fn run_one_agora(policy: PolicyKind, consumer: Activation) -> Log {
     let c = a.add_member(
         Recorder::new(
             "c",
-            &[
-                (Count::TYPE, RequestType::All),
-                (Status::TYPE, RequestType::All),
-            ],
+            &[(Count::TYPE, RequestType::All), (Status::TYPE, RequestType::All)],
             &log,
         ),
         consumer,
@@ -88,18 +85,8 @@ fn local_remote_and_all_across_agoras() {
         let log = log();
         let ilm = InnerLinkManager::new();
         let mut exec = SteppedExecutor::new(SimClock::new(), MS);
-        let mut r1 = exec
-            .agora_builder(1)
-            .policy(policy)
-            .inner_link(&ilm)
-            .build()
-            .unwrap();
-        let mut r2 = exec
-            .agora_builder(2)
-            .policy(policy)
-            .inner_link(&ilm)
-            .build()
-            .unwrap();
+        let mut r1 = exec.agora_builder(1).policy(policy).inner_link(&ilm).build().unwrap();
+        let mut r2 = exec.agora_builder(2).policy(policy).inner_link(&ilm).build().unwrap();
         let p1 = r1.add_member(Producer::new(1), Activation::Cyclic);
         let p2 = r2.add_member(Producer::new(2), Activation::Cyclic);
         let mut ids = vec![];
@@ -194,10 +181,7 @@ impl Message for Tracked {
 /// One allocation is shared by every subscriber and freed when the last one is done with it.
 #[test]
 fn a_message_is_shared_not_copied_and_freed_by_the_last_reader() {
-    let mut a = mrt_dcdt::Agora::builder(1)
-        .policy(PolicyKind::Slwb)
-        .build()
-        .unwrap();
+    let mut a = mrt_dcdt::Agora::builder(1).policy(PolicyKind::Slwb).build().unwrap();
     let tx = a.endpoint();
     let mut r1 = a.endpoint();
     let mut r2 = a.endpoint();
@@ -207,18 +191,11 @@ fn a_message_is_shared_not_copied_and_freed_by_the_last_reader() {
     assert_eq!(tx.publish(Tracked(5)), 2);
     let m1 = r1.receive_msg().unwrap();
     let m2 = r2.receive_msg().unwrap();
-    assert!(std::ptr::eq(
-        m1.get::<Tracked>().unwrap(),
-        m2.get::<Tracked>().unwrap()
-    ));
+    assert!(std::ptr::eq(m1.get::<Tracked>().unwrap(), m2.get::<Tracked>().unwrap()));
     drop(m1);
     r1.remove_curr_msg();
     drop(m2);
-    assert_eq!(
-        DROPS.load(Ordering::SeqCst),
-        before,
-        "r2 still holds it as its current message"
-    );
+    assert_eq!(DROPS.load(Ordering::SeqCst), before, "r2 still holds it as its current message");
     r2.remove_curr_msg();
     assert_eq!(DROPS.load(Ordering::SeqCst), before + 1);
 }
@@ -249,9 +226,7 @@ fn raw_messages_and_events() {
     let mut rx = a.endpoint();
     rx.subscribe(MsgType(500), RequestType::All);
     rx.subscribe(MsgType(501), RequestType::All);
-    let mut m = tx
-        .create_msg_with(MsgType(500), DeliveryWarranty::Reliable)
-        .with_priority(9);
+    let mut m = tx.create_msg_with(MsgType(500), DeliveryWarranty::Reliable).with_priority(9);
     m.payload_mut().extend_from_slice(b"hello");
     assert_eq!(tx.share_msg(m), 1);
     assert_eq!(tx.share_msg(tx.create_msg(MsgType(501))), 1);

@@ -24,10 +24,7 @@ impl Member for Collector {
         Ok(())
     }
     fn do_your_job(&mut self, ctx: &mut Context<'_>) -> Result<(), MemberError> {
-        self.threads
-            .lock()
-            .unwrap()
-            .push(std::thread::current().name().unwrap_or("?").to_string());
+        self.threads.lock().unwrap().push(std::thread::current().name().unwrap_or("?").to_string());
         while let Some(m) = ctx.receive_msg() {
             let n = m.get::<Count>()?.0;
             self.got.lock().unwrap().push(n);
@@ -59,17 +56,11 @@ fn every_policy_delivers_under_real_threads_and_shutdown_ends_everyone() {
         let mut a = mrt_dcdt::Agora::builder(1).policy(policy).build().unwrap();
         let p = a.add_member(Producer::new(2000), Activation::Cyclic);
         let c = a.add_member(
-            Collector {
-                got: got.clone(),
-                until: 2000,
-                threads: threads.clone(),
-            },
+            Collector { got: got.clone(), until: 2000, threads: threads.clone() },
             Activation::OnMessage,
         );
-        let s = a.add_member(
-            Sleeper(closed.clone()),
-            Activation::Periodic(Duration::from_secs(60)),
-        );
+        let s =
+            a.add_member(Sleeper(closed.clone()), Activation::Periodic(Duration::from_secs(60)));
         for id in [p, c, s] {
             a.activate_member(id).unwrap();
         }
@@ -79,11 +70,7 @@ fn every_policy_delivers_under_real_threads_and_shutdown_ends_everyone() {
         assert!(start.elapsed() < Duration::from_secs(20), "{policy}");
         assert_eq!(report.exit, ExitReason::Shutdown, "{policy}");
         assert!(*closed.lock().unwrap(), "{policy}: close ran");
-        assert_eq!(
-            report.member(s).unwrap().cycles,
-            1,
-            "{policy}: ran once at start"
-        );
+        assert_eq!(report.member(s).unwrap().cycles, 1, "{policy}: ran once at start");
         let got = got.lock().unwrap();
         if policy == PolicyKind::Slwsm {
             // Latest-only: strictly increasing, ending with the last one.
@@ -96,20 +83,14 @@ fn every_policy_delivers_under_real_threads_and_shutdown_ends_everyone() {
             threads.lock().unwrap().iter().all(|t| t == "mrt:Collector"),
             "{policy}: own thread"
         );
-        assert!(report
-            .members
-            .iter()
-            .all(|m| m.state == MemberState::Terminated));
+        assert!(report.members.iter().all(|m| m.state == MemberState::Terminated));
     }
 }
 
 #[test]
 fn lets_work_returns_when_every_member_terminated() {
     let mut a = mrt_dcdt::Agora::standalone();
-    let p1 = a.add_member(
-        Producer::new(3),
-        Activation::Periodic(Duration::from_millis(1)),
-    );
+    let p1 = a.add_member(Producer::new(3), Activation::Periodic(Duration::from_millis(1)));
     let p2 = a.add_member(Producer::new(5), Activation::Cyclic);
     let idle = a.add_member(Producer::new(1), Activation::Cyclic); // added, never activated
     a.activate_member(p1).unwrap();
@@ -159,30 +140,12 @@ fn ping_pong_between_two_agoras_on_threads() {
     let got_a = Arc::new(Mutex::new(Vec::new()));
     let got_b = Arc::new(Mutex::new(Vec::new()));
     let ilm = InnerLinkManager::new();
-    let mut a = mrt_dcdt::Agora::builder(1)
-        .inner_link(&ilm)
-        .build()
-        .unwrap();
-    let mut b = mrt_dcdt::Agora::builder(2)
-        .inner_link(&ilm)
-        .build()
-        .unwrap();
-    let pa = a.add_member(
-        Player {
-            got: got_a.clone(),
-            last: 1000,
-            serve: true,
-        },
-        Activation::Cyclic,
-    );
-    let pb = b.add_member(
-        Player {
-            got: got_b.clone(),
-            last: 1000,
-            serve: false,
-        },
-        Activation::OnMessage,
-    );
+    let mut a = mrt_dcdt::Agora::builder(1).inner_link(&ilm).build().unwrap();
+    let mut b = mrt_dcdt::Agora::builder(2).inner_link(&ilm).build().unwrap();
+    let pa =
+        a.add_member(Player { got: got_a.clone(), last: 1000, serve: true }, Activation::Cyclic);
+    let pb = b
+        .add_member(Player { got: got_b.clone(), last: 1000, serve: false }, Activation::OnMessage);
     a.activate_member(pa).unwrap();
     b.activate_member(pb).unwrap();
     let tb = std::thread::spawn(move || b.lets_work());
@@ -191,30 +154,15 @@ fn ping_pong_between_two_agoras_on_threads() {
     assert_eq!(ra.exit, ExitReason::AllTerminated);
     assert_eq!(rb.exit, ExitReason::AllTerminated);
     // Each robot saw exactly the other's numbers, in order, each once.
-    assert_eq!(
-        *got_b.lock().unwrap(),
-        (1..=999).step_by(2).collect::<Vec<_>>()
-    );
-    assert_eq!(
-        *got_a.lock().unwrap(),
-        (2..=1000).step_by(2).collect::<Vec<_>>()
-    );
-    assert_eq!(
-        ra.member(pa).unwrap().errors + rb.member(pb).unwrap().errors,
-        0
-    );
+    assert_eq!(*got_b.lock().unwrap(), (1..=999).step_by(2).collect::<Vec<_>>());
+    assert_eq!(*got_a.lock().unwrap(), (2..=1000).step_by(2).collect::<Vec<_>>());
+    assert_eq!(ra.member(pa).unwrap().errors + rb.member(pb).unwrap().errors, 0);
 }
 
 #[test]
 fn executors_refuse_the_wrong_clock() {
-    let a = mrt_dcdt::Agora::builder(1)
-        .clock(Arc::new(SimClock::new()))
-        .build()
-        .unwrap();
-    assert!(matches!(
-        a.lets_work(),
-        Err(DcdtError::ClockMismatch { .. })
-    ));
+    let a = mrt_dcdt::Agora::builder(1).clock(Arc::new(SimClock::new())).build().unwrap();
+    assert!(matches!(a.lets_work(), Err(DcdtError::ClockMismatch { .. })));
     let mut exec = SteppedExecutor::new(SimClock::new(), MS);
     let err = exec.add_agora(mrt_dcdt::Agora::standalone()).unwrap_err();
     assert!(err.to_string().contains("simulated clock"), "{err}");
@@ -223,17 +171,11 @@ fn executors_refuse_the_wrong_clock() {
 #[test]
 fn one_community_cannot_have_two_agoras_with_one_id() {
     let ilm = InnerLinkManager::new();
-    let _a = mrt_dcdt::Agora::builder(4)
-        .inner_link(&ilm)
-        .build()
-        .unwrap();
+    let _a = mrt_dcdt::Agora::builder(4).inner_link(&ilm).build().unwrap();
     assert!(matches!(
         mrt_dcdt::Agora::builder(4).inner_link(&ilm).build(),
         Err(DcdtError::DuplicateAgora(_))
     ));
     drop(_a);
-    assert!(
-        mrt_dcdt::Agora::builder(4).inner_link(&ilm).build().is_ok(),
-        "a dropped Agora leaves"
-    );
+    assert!(mrt_dcdt::Agora::builder(4).inner_link(&ilm).build().is_ok(), "a dropped Agora leaves");
 }

@@ -58,12 +58,7 @@ pub struct SteppedExecutor {
 impl SteppedExecutor {
     /// An executor on `clock`, advancing it by `tick` per step.
     pub fn new(clock: SimClock, tick: Duration) -> Self {
-        Self {
-            clock,
-            tick: tick.max(Duration::from_nanos(1)),
-            entries: Vec::new(),
-            started: false,
-        }
+        Self { clock, tick: tick.max(Duration::from_nanos(1)), entries: Vec::new(), started: false }
     }
 
     /// The simulated clock.
@@ -97,11 +92,7 @@ impl SteppedExecutor {
             });
         }
         let runners = agora.take_runners();
-        self.entries.push(Entry {
-            agora,
-            runners,
-            exit: None,
-        });
+        self.entries.push(Entry { agora, runners, exit: None });
         self.started = false;
         Ok(())
     }
@@ -170,10 +161,7 @@ impl SteppedExecutor {
                 e.exit = Some(ExitReason::AllTerminated);
             }
             if e.exit.is_some() {
-                e.runners
-                    .iter_mut()
-                    .filter(|r| !r.is_closed())
-                    .for_each(Runner::close);
+                e.runners.iter_mut().filter(|r| !r.is_closed()).for_each(Runner::close);
             }
         }
         self.clock.advance(self.tick);

@@ -51,10 +51,8 @@ impl ThreadedExecutor {
                     .name("mrt:MsgManager".into())
                     .spawn_scoped(s, move || po.policy.run_dispatcher(stop))
                     .map_err(|e| {
-                        spawn_error = Some(DcdtError::Spawn {
-                            what: "MsgManager".into(),
-                            source: e,
-                        })
+                        spawn_error =
+                            Some(DcdtError::Spawn { what: "MsgManager".into(), source: e })
                     })
                     .ok()
             } else {
@@ -74,10 +72,8 @@ impl ThreadedExecutor {
                 {
                     Ok(h) => handles.push(h),
                     Err(e) => {
-                        spawn_error = Some(DcdtError::Spawn {
-                            what: format!("member {name}"),
-                            source: e,
-                        })
+                        spawn_error =
+                            Some(DcdtError::Spawn { what: format!("member {name}"), source: e })
                     }
                 }
             }
@@ -108,11 +104,7 @@ impl ThreadedExecutor {
         } else {
             ExitReason::AllTerminated
         };
-        Ok(RunReport {
-            agora: shared.id,
-            exit,
-            members: reports,
-        })
+        Ok(RunReport { agora: shared.id, exit, members: reports })
     }
 }
 
@@ -165,10 +157,7 @@ struct StartGate {
 
 impl StartGate {
     fn new(n: usize) -> Self {
-        Self {
-            remaining: Mutex::new(n),
-            cv: Condvar::new(),
-        }
+        Self { remaining: Mutex::new(n), cv: Condvar::new() }
     }
 
     fn arrive(&self) {

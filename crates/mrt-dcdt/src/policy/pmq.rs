@@ -61,10 +61,7 @@ impl Pmq {
             if w.boxes.len() <= member {
                 w.boxes.resize_with(member + 1, Default::default);
             }
-            w.boxes[member] = Arc::new(Mailbox {
-                queue: SegQueue::new(),
-                waker,
-            });
+            w.boxes[member] = Arc::new(Mailbox { queue: SegQueue::new(), waker });
         })
     }
 
@@ -73,19 +70,11 @@ impl Pmq {
     }
 
     pub(crate) fn subscriptions(&self) -> Subscriptions {
-        self.writer
-            .lock()
-            .unwrap_or_else(|e| e.into_inner())
-            .subs
-            .clone()
+        self.writer.lock().unwrap_or_else(|e| e.into_inner()).subs.clone()
     }
 
     pub(crate) fn has_subscribers(&self, ty: MsgType, origin: u8) -> bool {
-        self.table
-            .load()
-            .by_type
-            .get(&ty)
-            .is_some_and(|s| s.iter().any(|(m, _)| m & origin != 0))
+        self.table.load().by_type.get(&ty).is_some_and(|s| s.iter().any(|(m, _)| m & origin != 0))
     }
 
     #[inline]
@@ -103,9 +92,7 @@ impl Pmq {
         let mut n = 0;
         for (mask, mailbox) in subs {
             if mask & origin != 0 {
-                mailbox
-                    .queue
-                    .push(msg.get_or_insert_with(&mut *make).clone());
+                mailbox.queue.push(msg.get_or_insert_with(&mut *make).clone());
                 mailbox.waker.wake();
                 n += 1;
             }
@@ -122,10 +109,7 @@ impl Pmq {
     }
 
     pub(crate) fn has_pending(&self, member: usize) -> bool {
-        self.boxes
-            .load()
-            .get(member)
-            .is_some_and(|b| !b.queue.is_empty())
+        self.boxes.load().get(member).is_some_and(|b| !b.queue.is_empty())
     }
 
     pub(crate) fn pending(&self, member: usize) -> usize {

@@ -42,11 +42,7 @@ pub(crate) struct SingleLock {
 
 impl SingleLock {
     pub(crate) fn new(kind: PolicyKind) -> Self {
-        Self {
-            kind,
-            state: Mutex::new(State::default()),
-            cv: Condvar::new(),
-        }
+        Self { kind, state: Mutex::new(State::default()), cv: Condvar::new() }
     }
 
     fn lock(&self) -> MutexGuard<'_, State> {
@@ -124,9 +120,7 @@ impl SingleLock {
 
     pub(crate) fn pending(&self, member: usize) -> usize {
         let s = self.lock();
-        s.boxes
-            .get(member)
-            .map_or(0, |b| b.queue.len() + b.fresh.len())
+        s.boxes.get(member).map_or(0, |b| b.queue.len() + b.fresh.len())
     }
 
     pub(crate) fn has_pending(&self, member: usize) -> bool {

@@ -48,11 +48,7 @@ pub struct Producer {
 
 impl Producer {
     pub fn new(limit: u32) -> Self {
-        Self {
-            n: 0,
-            limit,
-            status_every: 0,
-        }
+        Self { n: 0, limit, status_every: 0 }
     }
 }
 
@@ -79,11 +75,7 @@ pub struct Recorder {
 
 impl Recorder {
     pub fn new(name: &str, subs: &[(MsgType, RequestType)], log: &Log) -> Self {
-        Self {
-            name: name.into(),
-            subs: subs.to_vec(),
-            log: log.clone(),
-        }
+        Self { name: name.into(), subs: subs.to_vec(), log: log.clone() }
     }
 }
 
@@ -124,12 +116,7 @@ impl Member for Recorder {
 }
 
 pub fn whats(log: &Log, receiver: &str) -> Vec<String> {
-    log.lock()
-        .unwrap()
-        .iter()
-        .filter(|s| s.receiver == receiver)
-        .map(|s| s.what.clone())
-        .collect()
+    log.lock().unwrap().iter().filter(|s| s.receiver == receiver).map(|s| s.what.clone()).collect()
 }
 
 pub const MS: Duration = Duration::from_millis(1);
