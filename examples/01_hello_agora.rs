@@ -106,6 +106,13 @@ pub fn run(count: u32, period: Duration, verbose: bool) -> Result<RunReport, Dcd
 
 /// Entry point of the example.
 pub fn main() -> Result<(), DcdtError> {
+    // Show what MRT reports (crashes, restarts) through `tracing`; RUST_LOG overrides.
+    let _ = tracing_subscriber::fmt()
+        .with_env_filter(
+            tracing_subscriber::EnvFilter::try_from_default_env()
+                .unwrap_or_else(|_| tracing_subscriber::EnvFilter::new("warn")),
+        )
+        .try_init();
     let report = run(10, Duration::from_millis(100), true)?;
     println!("\nthe Agora stopped: {:?}", report.exit);
     for m in &report.members {

@@ -137,6 +137,13 @@ pub fn run(duration: Duration, verbose: bool) -> Result<Heard, DcdtError> {
 
 /// Entry point of the example.
 pub fn main() -> Result<(), DcdtError> {
+    // Show what MRT reports (crashes, restarts) through `tracing`; RUST_LOG overrides.
+    let _ = tracing_subscriber::fmt()
+        .with_env_filter(
+            tracing_subscriber::EnvFilter::try_from_default_env()
+                .unwrap_or_else(|_| tracing_subscriber::EnvFilter::new("warn")),
+        )
+        .try_init();
     let heard = run(Duration::from_millis(100), true)?;
     println!(
         "\nrobot 1 heard {} of its own sightings (Local) and {} of its teammate's (Remote)",

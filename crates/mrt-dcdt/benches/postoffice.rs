@@ -18,11 +18,6 @@ use std::sync::Arc;
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
-/// Messages are allocated on the producer's thread and freed on the consumers': a
-/// thread-caching allocator matters (see docs/performance.md for numbers with glibc malloc).
-#[global_allocator]
-static GLOBAL: mimalloc::MiMalloc = mimalloc::MiMalloc;
-
 #[derive(Clone, Copy, Serialize, Deserialize)]
 struct Sample {
     seq: u64,

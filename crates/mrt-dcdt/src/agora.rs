@@ -230,7 +230,8 @@ impl Agora {
         id
     }
 
-    /// Activates a Member (`ActivateMember`): it runs, on its own thread, when the Agora works.
+    /// Activates a Member (`ActivateMember`): it runs when an executor runs the Agora — on its
+    /// own thread under [`lets_work`](Self::lets_work), in turn under the [`SteppedExecutor`](crate::SteppedExecutor).
     pub fn activate_member(&mut self, id: MemberId) -> Result<(), DcdtError> {
         let slot = self.slot(id)?;
         if slot.state.get() == MemberState::Added {

@@ -6,7 +6,7 @@
 
 use crate::agora::AgoraShared;
 use crate::msg::{DeliveryWarranty, Message, Msg, MsgHeader, MsgRef, RawPayload};
-use crate::policy::RequestType;
+use crate::policy::{MailboxRef, RequestType};
 use mrt_core::{AgoraId, MemberId, MsgType, Time};
 use std::ops::{Deref, DerefMut};
 use std::sync::Arc;
@@ -48,12 +48,14 @@ impl MsgBuilder {
 pub struct Endpoint {
     pub(crate) shared: Arc<AgoraShared>,
     pub(crate) member: MemberId,
+    mailbox: MailboxRef,
     current: Option<MsgRef>,
 }
 
 impl Endpoint {
     pub(crate) fn new(shared: Arc<AgoraShared>, member: MemberId) -> Self {
-        Self { shared, member, current: None }
+        let mailbox = shared.post_office.policy.mailbox(member.0 as usize);
+        Self { shared, member, mailbox, current: None }
     }
 
     /// This endpoint's Member id.
@@ -125,7 +127,8 @@ impl Endpoint {
     }
 
     /// Shares a raw message with every subscriber of its type (`ShareMsg`); returns how many
-    /// mailboxes it reached. Nobody subscribed is not an error.
+    /// mailboxes it reached (under `SLWDWCV`: how many PostOffices queued it for their
+    /// dispatcher). Nobody subscribed is not an error.
     pub fn share_msg(&self, msg: MsgBuilder) -> usize {
         let MsgBuilder { header, payload } = msg;
         let mut payload = Some(payload);
@@ -135,7 +138,8 @@ impl Endpoint {
     }
 
     /// Publishes a typed message with warranty `None` and priority 0; returns how many
-    /// mailboxes it reached. When nobody subscribed, nothing is allocated.
+    /// mailboxes it reached, as [`share_msg`](Self::share_msg). When nobody subscribed,
+    /// nothing is allocated.
     #[inline]
     pub fn publish<T: Message>(&self, value: T) -> usize {
         self.publish_with(value, DeliveryWarranty::None, 0)
@@ -187,7 +191,7 @@ impl Endpoint {
     /// Takes the next message from this Member's mailbox (`ReceiveMsg`); it also becomes the
     /// current message until the next call or [`remove_curr_msg`](Self::remove_curr_msg).
     pub fn receive_msg(&mut self) -> Option<MsgRef> {
-        self.current = self.shared.post_office.policy.pop(self.index());
+        self.current = self.shared.post_office.policy.pop(&self.mailbox);
         self.current.clone()
     }
 
@@ -213,6 +217,12 @@ impl Endpoint {
         None
     }
 
+    /// Whether a message is waiting (cheaper than [`pending`](Self::pending)).
+    #[inline]
+    pub fn has_pending(&self) -> bool {
+        self.shared.post_office.policy.has_pending(&self.mailbox)
+    }
+
     /// Number of messages waiting in the mailbox.
     pub fn pending(&self) -> usize {
         self.shared.post_office.policy.pending(self.index())
@@ -224,11 +234,9 @@ impl Endpoint {
         let waker = self.shared.waker(self.member);
         if let Some(w) = &waker {
             w.bind_current();
-            let po = &self.shared.post_office;
-            let i = self.index();
-            w.wait(Some(timeout), &|| po.policy.has_pending(i));
+            w.wait(Some(timeout), &|| self.has_pending());
         }
-        self.shared.post_office.policy.has_pending(self.index())
+        self.has_pending()
     }
 
     /// Asks the whole Agora to shut down (`Shutdown()`): every Member ends within its current

@@ -48,7 +48,8 @@ pub trait Member: Send + 'static {
     /// a backoff while the rest of the Agora keeps running.
     fn do_your_job(&mut self, ctx: &mut Context<'_>) -> Result<(), MemberError>;
 
-    /// Cleans up (`Close()`), once, when the Member or the Agora terminates.
+    /// Cleans up (`Close()`), once, when the Member or the Agora terminates — provided `init`
+    /// succeeded at least once (a Member that never initialized has nothing to close).
     fn close(&mut self, _ctx: &mut Context<'_>) {}
 }
 
@@ -59,7 +60,9 @@ pub enum Activation {
     Periodic(Duration),
     /// "Cyclic Execution Member": again and again without delay.
     Cyclic,
-    /// Woken when a message it subscribed to arrives; runs while its mailbox is not empty.
+    /// Woken when a message it subscribed to arrives. The threaded executor wakes it on
+    /// arrival; the stepped executor runs it once in every tick that finds mail waiting.
+    /// Either way, drain the mailbox in `do_your_job`.
     OnMessage,
 }
 
@@ -144,6 +147,8 @@ pub(crate) struct Runner {
     pub(crate) state: SharedState,
     pub(crate) name: String,
     needs_init: bool,
+    /// `terminate` was called in `init`.
+    terminate_in_init: bool,
     consecutive_failures: u32,
     /// Not before this time (after a crash).
     pub(crate) resume_at: Time,
@@ -191,6 +196,7 @@ impl Runner {
             state,
             name,
             needs_init: true,
+            terminate_in_init: false,
             consecutive_failures: 0,
             resume_at: Time::ZERO,
             next_due: Time::ZERO,
@@ -234,6 +240,7 @@ impl Runner {
         let member = &mut self.member;
         match catch_unwind(AssertUnwindSafe(|| member.init(&mut ctx))) {
             Ok(Ok(())) => {
+                self.terminate_in_init |= ctx.terminate;
                 self.needs_init = false;
                 self.state.set(MemberState::Running);
                 true
@@ -254,6 +261,9 @@ impl Runner {
     pub(crate) fn step(&mut self) -> Step {
         if !self.init_if_needed() {
             return Step::Backoff;
+        }
+        if self.terminate_in_init {
+            return Step::Terminate;
         }
         let span = tracing::trace_span!("cycle", member = %self.name, cycle = self.cycles);
         let _enter = span.enter();
@@ -316,12 +326,17 @@ impl Runner {
         }
     }
 
+    /// The Member called `terminate` in `init`: it closes without running a job.
+    pub(crate) fn terminate_requested(&self) -> bool {
+        self.terminate_in_init
+    }
+
     pub(crate) fn is_closed(&self) -> bool {
         self.state.get() == MemberState::Terminated
     }
 
     pub(crate) fn has_mail(&self) -> bool {
-        self.endpoint.shared.post_office.policy.has_pending(self.endpoint.member.0 as usize)
+        self.endpoint.has_pending()
     }
 
     pub(crate) fn report(&self) -> MemberReport {

@@ -13,10 +13,9 @@ use std::sync::Arc;
 /// Counters of a PostOffice, for monitoring.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct PostOfficeStats {
-    /// Messages shared by Members of this Agora.
-    pub shared: u64,
     /// Messages shared by this Agora's Members that no Member anywhere subscribed to (these are
-    /// not even allocated).
+    /// not even allocated). Delivered messages are not counted: that would put an atomic
+    /// read-modify-write on every message's path.
     pub unsubscribed: u64,
 }
 
@@ -31,19 +30,12 @@ pub struct PostOffice {
     agora: AgoraId,
     kind: PolicyKind,
     pub(crate) policy: Policy,
-    shared: AtomicU64,
     unsubscribed: AtomicU64,
 }
 
 impl PostOffice {
     pub(crate) fn new(agora: AgoraId, kind: PolicyKind) -> Self {
-        Self {
-            agora,
-            kind,
-            policy: Policy::new(kind),
-            shared: AtomicU64::new(0),
-            unsubscribed: AtomicU64::new(0),
-        }
+        Self { agora, kind, policy: Policy::new(kind), unsubscribed: AtomicU64::new(0) }
     }
 
     /// The Agora this PostOffice belongs to.
@@ -58,10 +50,7 @@ impl PostOffice {
 
     /// Counters since the Agora was created.
     pub fn stats(&self) -> PostOfficeStats {
-        PostOfficeStats {
-            shared: self.shared.load(Ordering::Relaxed),
-            unsubscribed: self.unsubscribed.load(Ordering::Relaxed),
-        }
+        PostOfficeStats { unsubscribed: self.unsubscribed.load(Ordering::Relaxed) }
     }
 
     /// The subscriptions of one type: which Members, and for which [`RequestType`].
@@ -90,8 +79,8 @@ impl PostOffice {
         }
     }
 
+    #[inline]
     pub(crate) fn count_shared(&self, delivered: usize) {
-        self.shared.fetch_add(1, Ordering::Relaxed);
         if delivered == 0 {
             self.unsubscribed.fetch_add(1, Ordering::Relaxed);
         }
@@ -185,13 +174,18 @@ impl InnerLinkManager {
     }
 
     pub(crate) fn join(&self, po: Arc<PostOffice>) -> Result<(), crate::DcdtError> {
-        let current = self.post_offices.load();
-        if current.iter().any(|p| p.agora == po.agora) {
+        let mut duplicate = false;
+        self.post_offices.rcu(|list| {
+            duplicate = list.iter().any(|p| p.agora == po.agora);
+            let mut next = (**list).clone();
+            if !duplicate {
+                next.push(po.clone());
+            }
+            next
+        });
+        if duplicate {
             return Err(crate::DcdtError::DuplicateAgora(po.agora));
         }
-        let mut next = (**current).clone();
-        next.push(po);
-        self.post_offices.store(Arc::new(next));
         Ok(())
     }
 

@@ -57,6 +57,9 @@ pub enum WireError {
     /// The announced payload is larger than [`MAX_PAYLOAD`].
     #[error("payload of {0} bytes is larger than the {MAX_PAYLOAD}-byte limit")]
     TooLarge(usize),
+    /// The reserved header byte is not 0 (a frame of a newer, incompatible layout).
+    #[error("reserved header byte is {0}, expected 0")]
+    Reserved(u8),
     /// Bytes after the payload.
     #[error("{0} unexpected bytes after the payload")]
     Trailing(usize),
@@ -101,6 +104,9 @@ pub fn decode(frame: &[u8]) -> Result<MsgRef, WireError> {
         return Err(WireError::Version(head[4]));
     }
     let warranty = DeliveryWarranty::from_code(head[5]).ok_or(WireError::Warranty(head[5]))?;
+    if head[7] != 0 {
+        return Err(WireError::Reserved(head[7]));
+    }
     let mut t = [0u8; 8];
     t.copy_from_slice(&head[20..28]);
     let len = u32_at(head, 28) as usize;
@@ -179,6 +185,9 @@ mod tests {
         let mut bad = frame.clone();
         bad[5] = 9;
         assert!(matches!(decode(&bad), Err(WireError::Warranty(9))));
+        let mut bad = frame.clone();
+        bad[7] = 1;
+        assert!(matches!(decode(&bad), Err(WireError::Reserved(1))));
         let mut bad = frame.clone();
         bad[28..32].copy_from_slice(&u32::MAX.to_le_bytes());
         assert!(matches!(decode(&bad), Err(WireError::TooLarge(_))));

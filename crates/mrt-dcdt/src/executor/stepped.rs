@@ -12,6 +12,8 @@ struct Entry {
     agora: Agora,
     runners: Vec<Runner>,
     exit: Option<ExitReason>,
+    /// Whether its Members ran `init` (on the first step after the Agora was added).
+    started: bool,
 }
 
 /// Runs every Member of several Agoras on one thread, one at a time in a fixed order, on a
@@ -52,13 +54,12 @@ pub struct SteppedExecutor {
     clock: SimClock,
     tick: Duration,
     entries: Vec<Entry>,
-    started: bool,
 }
 
 impl SteppedExecutor {
     /// An executor on `clock`, advancing it by `tick` per step.
     pub fn new(clock: SimClock, tick: Duration) -> Self {
-        Self { clock, tick: tick.max(Duration::from_nanos(1)), entries: Vec::new(), started: false }
+        Self { clock, tick: tick.max(Duration::from_nanos(1)), entries: Vec::new() }
     }
 
     /// The simulated clock.
@@ -92,8 +93,7 @@ impl SteppedExecutor {
             });
         }
         let runners = agora.take_runners();
-        self.entries.push(Entry { agora, runners, exit: None });
-        self.started = false;
+        self.entries.push(Entry { agora, runners, exit: None, started: false });
         Ok(())
     }
 
@@ -116,13 +116,13 @@ impl SteppedExecutor {
     /// One tick. Returns `false` once every Agora has ended.
     pub fn step(&mut self) -> bool {
         let now = self.clock.now();
-        if !self.started {
-            self.started = true;
-            for i in 0..self.entries.len() {
+        // Members of newly added Agoras run `init` before any job of this tick.
+        for i in 0..self.entries.len() {
+            if !self.entries[i].started {
+                self.entries[i].started = true;
                 for r in &mut self.entries[i].runners {
-                    if r.init_if_needed() && r.next_due == Time::ZERO {
-                        r.next_due = now;
-                    }
+                    r.next_due = now;
+                    r.init_if_needed();
                 }
                 Self::dispatch_all(&self.entries);
             }
@@ -137,6 +137,10 @@ impl SteppedExecutor {
                     break;
                 }
                 if r.is_closed() || now < r.resume_at || !r.init_if_needed() {
+                    continue;
+                }
+                if r.terminate_requested() {
+                    r.close();
                     continue;
                 }
                 let due = match r.activation {

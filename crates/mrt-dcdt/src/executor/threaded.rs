@@ -5,6 +5,7 @@ use super::{ExitReason, RunReport};
 use crate::agora::{Agora, AgoraShared};
 use crate::error::DcdtError;
 use crate::member::{Activation, MemberReport, Runner, Step};
+use mrt_core::Time;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Condvar, Mutex};
 use std::thread;
@@ -117,16 +118,24 @@ fn run_member(mut r: Runner, shared: &Arc<AgoraShared>, gate: &StartGate) -> Mem
     r.init_if_needed();
     gate.arrive();
     r.next_due = clock.now();
-    while !shared.is_shutting_down() {
-        let now = clock.now();
-        if r.resume_at > now {
-            thread::park_timeout(r.resume_at - now);
-            continue;
+    // The clock is read only where a deadline matters: an on-message Member woken by a
+    // stream of messages goes straight from one job to the next.
+    while !shared.is_shutting_down() && !r.terminate_requested() {
+        if r.resume_at != Time::ZERO {
+            let now = clock.now();
+            if r.resume_at > now {
+                thread::park_timeout(r.resume_at - now);
+                continue;
+            }
+            r.resume_at = Time::ZERO;
         }
         match r.activation {
-            Activation::Periodic(_) if now < r.next_due => {
-                thread::park_timeout(r.next_due - now);
-                continue;
+            Activation::Periodic(_) => {
+                let now = clock.now();
+                if now < r.next_due {
+                    thread::park_timeout(r.next_due - now);
+                    continue;
+                }
             }
             Activation::OnMessage if !r.has_mail() => {
                 if r.init_if_needed() {
@@ -137,10 +146,13 @@ fn run_member(mut r: Runner, shared: &Arc<AgoraShared>, gate: &StartGate) -> Mem
                 continue;
             }
             Activation::Cyclic => thread::yield_now(),
-            _ => {}
+            Activation::OnMessage => {}
         }
         match r.step() {
-            Step::Ran => r.schedule_next(clock.now()),
+            Step::Ran if matches!(r.activation, Activation::Periodic(_)) => {
+                r.schedule_next(clock.now())
+            }
+            Step::Ran => {}
             Step::Backoff => {}
             Step::Terminate => break,
         }

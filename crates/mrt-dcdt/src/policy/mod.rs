@@ -102,6 +102,12 @@ impl Subscriptions {
     }
 }
 
+/// Where a Member's messages wait: its own queue under `PMQ`, a slot index otherwise.
+pub(crate) enum MailboxRef {
+    Pmq(Arc<pmq::Mailbox>),
+    Index(usize),
+}
+
 /// The policy behind a PostOffice, chosen by configuration.
 pub(crate) enum Policy {
     SingleLock(SingleLock),
@@ -150,11 +156,26 @@ impl Policy {
     ) -> usize {
         each!(self, p => p.deliver(ty, origin, make))
     }
-    pub(crate) fn pop(&self, member: usize) -> Option<MsgRef> {
-        each!(self, p => p.pop(member))
+    /// A handle on one Member's mailbox, for its endpoint to receive without looking it up.
+    pub(crate) fn mailbox(&self, member: usize) -> MailboxRef {
+        match self {
+            Policy::Pmq(p) => p.mailbox(member).map_or(MailboxRef::Index(member), MailboxRef::Pmq),
+            Policy::SingleLock(_) => MailboxRef::Index(member),
+        }
     }
-    pub(crate) fn has_pending(&self, member: usize) -> bool {
-        each!(self, p => p.has_pending(member))
+    pub(crate) fn pop(&self, mailbox: &MailboxRef) -> Option<MsgRef> {
+        match (self, mailbox) {
+            (_, MailboxRef::Pmq(b)) => b.pop(),
+            (Policy::SingleLock(p), MailboxRef::Index(i)) => p.pop(*i),
+            (Policy::Pmq(p), MailboxRef::Index(i)) => p.pop(*i),
+        }
+    }
+    pub(crate) fn has_pending(&self, mailbox: &MailboxRef) -> bool {
+        match (self, mailbox) {
+            (_, MailboxRef::Pmq(b)) => b.has_pending(),
+            (Policy::SingleLock(p), MailboxRef::Index(i)) => p.has_pending(*i),
+            (Policy::Pmq(p), MailboxRef::Index(i)) => p.has_pending(*i),
+        }
     }
     pub(crate) fn pending(&self, member: usize) -> usize {
         each!(self, p => p.pending(member))

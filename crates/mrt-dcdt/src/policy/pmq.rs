@@ -14,10 +14,29 @@ use mrt_core::MsgType;
 use rustc_hash::FxHashMap;
 use std::sync::{Arc, Mutex};
 
+/// One Member's mailbox. Endpoints keep an `Arc` to their own, so receiving reads no table.
 #[derive(Default)]
-struct Mailbox {
+pub(crate) struct Mailbox {
     queue: SegQueue<MsgRef>,
     waker: Arc<Waker>,
+}
+
+impl Mailbox {
+    #[inline]
+    fn push(&self, msg: MsgRef) {
+        self.queue.push(msg);
+        self.waker.wake();
+    }
+
+    #[inline]
+    pub(crate) fn pop(&self) -> Option<MsgRef> {
+        self.queue.pop()
+    }
+
+    #[inline]
+    pub(crate) fn has_pending(&self) -> bool {
+        !self.queue.is_empty()
+    }
 }
 
 /// What producers read: type → (origin mask, mailbox).
@@ -88,19 +107,24 @@ impl Pmq {
         let Some(subs) = table.by_type.get(&ty) else {
             return 0;
         };
-        let mut msg: Option<MsgRef> = None;
-        let mut n = 0;
-        for (mask, mailbox) in subs {
-            if mask & origin != 0 {
-                mailbox.queue.push(msg.get_or_insert_with(&mut *make).clone());
-                mailbox.waker.wake();
-                n += 1;
-            }
+        // The last matching mailbox gets the reference itself, the others a clone: one
+        // reference-count increment per extra subscriber, none for a single one.
+        let mut matching = subs.iter().filter(|(mask, _)| mask & origin != 0).map(|(_, b)| b);
+        let Some(mut target) = matching.next() else {
+            return 0;
+        };
+        let msg = make();
+        let mut n = 1;
+        for next in matching {
+            target.push(msg.clone());
+            target = next;
+            n += 1;
         }
+        target.push(msg);
         n
     }
 
-    fn mailbox(&self, member: usize) -> Option<Arc<Mailbox>> {
+    pub(crate) fn mailbox(&self, member: usize) -> Option<Arc<Mailbox>> {
         self.boxes.load().get(member).cloned()
     }
 
