@@ -7,6 +7,7 @@
 use crate::agora::AgoraShared;
 use crate::msg::{DeliveryWarranty, Message, Msg, MsgHeader, MsgRef, RawPayload};
 use crate::policy::{MailboxRef, RequestType};
+use crate::pool::MsgPool;
 use mrt_core::{AgoraId, MemberId, MsgType, Time};
 use std::ops::{Deref, DerefMut};
 use std::sync::Arc;
@@ -42,6 +43,9 @@ impl MsgBuilder {
 
 /// A Member's handle on its Agora's PostOffice.
 ///
+/// An endpoint belongs to one thread at a time (it is `Send`, not `Sync`): it recycles the
+/// blocks of the messages it published (see `pool`). Another thread gets its own endpoint.
+///
 /// Running Members get one through their [`Context`]. Code that is not a Member (a driver
 /// thread, a test, the simulator feeding sensor data) gets its own from
 /// [`Agora::endpoint`](crate::Agora::endpoint) and uses it from any thread.
@@ -50,12 +54,13 @@ pub struct Endpoint {
     pub(crate) member: MemberId,
     mailbox: MailboxRef,
     current: Option<MsgRef>,
+    pool: MsgPool,
 }
 
 impl Endpoint {
     pub(crate) fn new(shared: Arc<AgoraShared>, member: MemberId) -> Self {
         let mailbox = shared.post_office.policy.mailbox(member.0 as usize);
-        Self { shared, member, mailbox, current: None }
+        Self { shared, member, mailbox, current: None, pool: MsgPool::default() }
     }
 
     /// This endpoint's Member id.
@@ -155,6 +160,7 @@ impl Endpoint {
         let mut value = Some(value);
         let shared = &self.shared;
         let member = self.member;
+        let pool = &self.pool;
         self.route(T::TYPE, &mut || {
             let header = MsgHeader {
                 msg_type: T::TYPE,
@@ -165,7 +171,7 @@ impl Endpoint {
                 creation_time: shared.clock.now(),
             };
             match value.take() {
-                Some(v) => Msg::new(header, v).into_ref(),
+                Some(v) => pool.make(header, v),
                 // `make` is called at most once by every route; this arm is never reached.
                 None => Msg::new(header, RawPayload::new(Vec::new())).into_ref(),
             }

@@ -92,6 +92,7 @@ mod executor;
 mod member;
 mod msg;
 mod policy;
+mod pool;
 mod postoffice;
 mod waker;
 pub mod wire;

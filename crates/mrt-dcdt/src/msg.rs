@@ -3,7 +3,7 @@
 //! A message is created once and shared by reference ([`MsgRef`], an `Arc`): every subscriber
 //! in the process reads the same allocation, and it is freed when the last one is done with it.
 //! The payload is either a typed Rust value (a [`Message`]) or raw bytes (what
-//! [`create_msg`](crate::Context::create_msg) builds, and what arrives from another process).
+//! [`create_msg`](crate::Endpoint::create_msg) builds, and what arrives from another process).
 //! Typed payloads are serialized only when a message leaves the process ([`crate::wire`]).
 
 use crate::error::DcdtError;
@@ -135,7 +135,7 @@ impl<T: Message> Payload for T {
 
 /// A payload of plain bytes, as the manual's `GetPayload()` gives (§3.3.3).
 ///
-/// Raw payloads come from [`create_msg`](crate::Context::create_msg) and from the network. When
+/// Raw payloads come from [`create_msg`](crate::Endpoint::create_msg) and from the network. When
 /// a typed reader asks for a [`Message`] of the header's type, the bytes are decoded once and
 /// the value is kept, so every further reader of the same message gets it for free.
 pub struct RawPayload {
@@ -211,6 +211,12 @@ impl<P: Payload> Msg<P> {
     /// A message with this header and payload.
     pub fn new(header: MsgHeader, payload: P) -> Self {
         Self { header, payload }
+    }
+
+    /// Overwrites a message no one else holds (pool reuse).
+    pub(crate) fn reset(&mut self, header: MsgHeader, payload: P) {
+        self.header = header;
+        self.payload = payload;
     }
 
     /// Puts the message behind a shared reference, ready to be shared.
