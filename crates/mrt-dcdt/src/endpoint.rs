@@ -235,7 +235,9 @@ impl Endpoint {
     }
 
     /// Blocks the calling thread until a message is waiting or `timeout` passes (for
-    /// endpoints used outside an executor; Members are woken by their executor).
+    /// endpoints used outside an executor; Members are woken by their executor). The first
+    /// thread that waits on an endpoint is the one its arrivals wake: keep an endpoint on one
+    /// thread.
     pub fn wait_msg(&self, timeout: std::time::Duration) -> bool {
         let waker = self.shared.waker(self.member);
         if let Some(w) = &waker {
