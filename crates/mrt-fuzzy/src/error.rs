@@ -1,0 +1,44 @@
+//! The error type of `mrt-fuzzy`.
+
+use crate::lexer::Span;
+use std::path::{Path, PathBuf};
+
+/// What can go wrong when loading Mr. BRIAN files.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum BrianError {
+    /// A syntax or meaning error at a place in a file. Displayed as the manual's checker does
+    /// (§10.4.7), with the column added: `error in file <path> at line <n>, column <c>: ...`.
+    #[error("error in file {} at line {line}, column {column}: {message}", file.display())]
+    At {
+        /// The file.
+        file: PathBuf,
+        /// Line, from 1.
+        line: usize,
+        /// Column, from 1.
+        column: usize,
+        /// What was expected, or what is wrong.
+        message: String,
+    },
+    /// A file could not be read.
+    #[error("error in file {}: {source}", file.display())]
+    Io {
+        /// The file.
+        file: PathBuf,
+        /// The OS error.
+        #[source]
+        source: std::io::Error,
+    },
+}
+
+impl BrianError {
+    /// An error at `span` of `file`.
+    pub fn at(file: &Path, span: Span, message: impl Into<String>) -> BrianError {
+        BrianError::At {
+            file: file.to_path_buf(),
+            line: span.line,
+            column: span.column,
+            message: message.into(),
+        }
+    }
+}

@@ -1,0 +1,45 @@
+//! # mrt-fuzzy: fuzzy sets and the Mr. BRIAN behavior engine
+//!
+//! Mr. BRIAN (Multilevel Ruling BRIAN Reacts by Inferential ActioNs, MRT manual chapter 10)
+//! turns crisp sensor data into fuzzy predicates, lets behaviors propose fuzzy actions through
+//! rules, composes them by CANDO/WANT conditions in a hierarchy, and defuzzifies the result into
+//! crisp commands.
+//!
+//! This crate is being built bottom-up. It holds today the fuzzy core shared by Mr. BRIAN and
+//! ThinkingCap's HBM behaviors: the fuzzy sets of §10.4.1 ([`FuzzySet`]), the (value,
+//! reliability) fuzzy datum and its operators ([`FuzzyValue`]), the shape and association files
+//! of §10.4.1 and §10.4.6 ([`shapes`]) with fuzzification and singleton defuzzification.
+//!
+//! ```
+//! use mrt_fuzzy::shapes::{defuzzify, parse_shapes};
+//! use std::path::Path;
+//!
+//! let shapes = parse_shapes(
+//!     "(Distance (TRA (NEAREST 0 0.1 40 60)) (TRA (NEAR 40 60 100 120)) (TOR (FAR 100 120)))",
+//!     Path::new("shape_ctof.txt"),
+//! )?;
+//! let near: Vec<_> = shapes[0].fuzzify(45.0, 1.0).filter(|(_, v)| !v.is_dropped()).collect();
+//! assert_eq!(near.len(), 2); // NEAREST 0.75 and NEAR 0.25; FAR 0 is dropped
+//!
+//! // Formula 10.6: VERY_FAST(100) 0.8, FAST(75) 0.6, SLOW(25) 0.9 -> 64.13 cm/s.
+//! let speed = defuzzify([(100.0, 0.8), (75.0, 0.6), (25.0, 0.9)], false);
+//! assert!((speed.unwrap() - 64.1304).abs() < 1e-4);
+//! # Ok::<(), mrt_fuzzy::BrianError>(())
+//! ```
+//!
+//! | seed name (MRT manual ch. 10) | Rust |
+//! |---|---|
+//! | TRI, TOL, TOR, DIV, TRA, REC, SNG | [`FuzzySet`] |
+//! | fuzzy datum `<name, label, value, reliability>` | [`FuzzyValue`] |
+//! | `shape_ctof.txt`, `s_shape.txt` | [`shapes::parse_shapes`], [`shapes::Shape`] |
+//! | `ctof.txt`, `s_ftoc.txt` | [`shapes::parse_associations`] |
+//! | default (singleton) defuzzification, formula 10.6 | [`shapes::defuzzify`] |
+#![deny(missing_docs)]
+
+mod error;
+pub mod lexer;
+mod set;
+pub mod shapes;
+
+pub use error::BrianError;
+pub use set::{FuzzySet, FuzzyValue};

@@ -1,0 +1,348 @@
+//! Shape files and association files (MRT manual §10.4.1 and §10.4.6): `shape_ctof.txt` and
+//! `s_shape.txt` define shapes (named lists of labelled fuzzy sets); `ctof.txt` and
+//! `s_ftoc.txt` associate a crisp datum or an action with a shape.
+//!
+//! ```text
+//! (Distance
+//!  (TRA (NEAREST 0 0.1 40 60))
+//!  (TRA (NEAR 40 60 100 120))
+//!  (TOR (FAR 100 120))
+//! )
+//! (TargetDistance Distance)
+//! ```
+
+use crate::error::BrianError;
+use crate::lexer::{tokenize, Cursor, Span, Tok};
+use crate::set::{FuzzySet, FuzzyValue};
+use std::path::Path;
+
+/// A shape: a named list of labelled fuzzy sets.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Shape {
+    /// Its name.
+    pub name: String,
+    /// Its fuzzy sets, in file order.
+    pub sets: Vec<(String, FuzzySet)>,
+    /// Where it is defined.
+    pub span: Span,
+}
+
+impl Shape {
+    /// Fuzzifies a crisp datum (§10.3.1): one fuzzy value per set, each with the datum's
+    /// reliability. Values with membership 0 and reliability 1 are dropped by the caller
+    /// ([`FuzzyValue::is_dropped`]).
+    pub fn fuzzify(
+        &self,
+        crisp: f64,
+        reliability: f64,
+    ) -> impl Iterator<Item = (&str, FuzzyValue)> + '_ {
+        self.sets.iter().map(move |(label, set)| {
+            (label.as_str(), FuzzyValue::new(set.membership(crisp), reliability))
+        })
+    }
+
+    /// The set with this label.
+    pub fn set(&self, label: &str) -> Option<&FuzzySet> {
+        self.sets.iter().find(|(l, _)| l == label).map(|(_, s)| s)
+    }
+}
+
+/// An association line `(<data_or_action_name> <shape_name>)`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Association {
+    /// The crisp datum (or action) name.
+    pub name: String,
+    /// The shape's name.
+    pub shape: String,
+    /// Where it is written.
+    pub span: Span,
+}
+
+/// Parses a shape file.
+pub fn parse_shapes(text: &str, file: &Path) -> Result<Vec<Shape>, BrianError> {
+    let toks = tokenize(text, file)?;
+    let mut c = Cursor::new(&toks, file, text);
+    let mut shapes: Vec<Shape> = Vec::new();
+    while !c.at_end() {
+        c.punct(Tok::Open, "`(` to start a shape")?;
+        let (name, span) = c.word("a shape name")?;
+        if let Some(prev) = shapes.iter().find(|s| s.name == name) {
+            return Err(BrianError::at(
+                file,
+                span,
+                format!("shape `{name}` is already defined at line {}", prev.span.line),
+            ));
+        }
+        let mut sets: Vec<(String, FuzzySet)> = Vec::new();
+        while c.peek() == Some(&Tok::Open) {
+            c.punct(Tok::Open, "`(`")?;
+            let id_span = c.span();
+            let (id, _) = c.word("a fuzzy set identifier (TRI, TOL, TOR, DIV, TRA, REC or SNG)")?;
+            let Some(arity) = FuzzySet::arity(&id) else {
+                return Err(BrianError::at(
+                    file,
+                    id_span,
+                    format!("expected a fuzzy set identifier (TRI, TOL, TOR, DIV, TRA, REC or SNG), found `{id}`"),
+                ));
+            };
+            c.punct(Tok::Open, "`(` before the fuzzy set's label")?;
+            let (label, label_span) = c.word("a fuzzy set label")?;
+            let mut params = Vec::with_capacity(arity);
+            for k in 0..arity {
+                params.push(c.number(&format!(
+                    "value {} of {} of {id} `{label}` ({id} takes {arity})",
+                    k + 1,
+                    arity
+                ))?);
+            }
+            c.punct(Tok::Close, &format!("`)` after the {arity} values of {id} `{label}`"))?;
+            c.punct(Tok::Close, "`)` to close the fuzzy set")?;
+            let set = FuzzySet::from_parts(&id, &params).ok_or_else(|| {
+                BrianError::at(file, id_span, format!("{id} takes {arity} values"))
+            })?;
+            if !set.is_ordered() {
+                return Err(BrianError::at(
+                    file,
+                    label_span,
+                    format!("the values of {id} `{label}` must not decrease: {params:?}"),
+                ));
+            }
+            if sets.iter().any(|(l, _)| *l == label) {
+                return Err(BrianError::at(
+                    file,
+                    label_span,
+                    format!("label `{label}` appears twice in shape `{name}`"),
+                ));
+            }
+            sets.push((label, set));
+        }
+        c.punct(Tok::Close, &format!("`(` for another fuzzy set or `)` to close shape `{name}`"))?;
+        shapes.push(Shape { name, sets, span });
+    }
+    Ok(shapes)
+}
+
+/// Parses an association file.
+pub fn parse_associations(text: &str, file: &Path) -> Result<Vec<Association>, BrianError> {
+    let toks = tokenize(text, file)?;
+    let mut c = Cursor::new(&toks, file, text);
+    let mut out: Vec<Association> = Vec::new();
+    while !c.at_end() {
+        c.punct(Tok::Open, "`(` to start an association")?;
+        let (name, span) = c.word("a datum or action name")?;
+        let (shape, _) = c.word(&format!("the name of the shape for `{name}`"))?;
+        c.punct(Tok::Close, "`)` to close the association")?;
+        if let Some(prev) = out.iter().find(|a| a.name == name) {
+            return Err(BrianError::at(
+                file,
+                span,
+                format!("`{name}` is already associated at line {}", prev.span.line),
+            ));
+        }
+        out.push(Association { name, shape, span });
+    }
+    Ok(out)
+}
+
+/// Resolves associations against shapes: the index of each association's shape.
+pub fn resolve(
+    assocs: &[Association],
+    shapes: &[Shape],
+    file: &Path,
+) -> Result<Vec<usize>, BrianError> {
+    assocs
+        .iter()
+        .map(|a| {
+            shapes.iter().position(|s| s.name == a.shape).ok_or_else(|| {
+                let known: Vec<&str> = shapes.iter().map(|s| s.name.as_str()).collect();
+                BrianError::at(
+                    file,
+                    a.span,
+                    format!(
+                        "unknown shape `{}` for `{}` (known shapes: {})",
+                        a.shape,
+                        a.name,
+                        known.join(", ")
+                    ),
+                )
+            })
+        })
+        .collect()
+}
+
+/// Singleton defuzzification (formula 10.6): `Σ(w·v) / Σw` over the labels of one action, where
+/// `v` is the label's singleton. `None` when every weight is 0 (the action is absent).
+///
+/// With `circular`, values are angles in degrees averaged on the circle (for actions whose name
+/// contains `Angle`), giving `[0, 360)`.
+pub fn defuzzify(weighted: impl IntoIterator<Item = (f64, f64)>, circular: bool) -> Option<f64> {
+    let (mut sw, mut swv, mut sx, mut sy) = (0.0, 0.0, 0.0, 0.0);
+    for (value, weight) in weighted {
+        if weight.is_nan() || weight <= 0.0 || !value.is_finite() {
+            continue;
+        }
+        sw += weight;
+        if circular {
+            let r = value.to_radians();
+            sx += weight * r.cos();
+            sy += weight * r.sin();
+        } else {
+            swv += weight * value;
+        }
+    }
+    if sw <= 0.0 {
+        return None;
+    }
+    if circular {
+        // Opposite proposals of equal weight cancel out and the mean direction is undefined:
+        // atan2(0, 0) is 0, so the output is 0° then, still a number in [0, 360).
+        let deg = sy.atan2(sx).to_degrees();
+        let deg = if deg < 0.0 { deg + 360.0 } else { deg };
+        Some(if deg >= 360.0 { 0.0 } else { deg })
+    } else {
+        Some(swv / sw)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    const DISTANCE: &str = "(Distance\n (TRA (NEAREST 0 0.1 40 60))\n (TRA (NEAR 40 60 100 120))\n (TOR (FAR 100 120))\n )\n";
+
+    fn close(a: f64, b: f64) -> bool {
+        (a - b).abs() < 1e-9
+    }
+
+    /// MRT manual §10.4.1, the Distance shape fed `<TargetDistance, 45, 1>`. The manual prints
+    /// NEAREST 0.25 and NEAR 0.75: swapped. The shape decides: NEAREST = TRA(0 0.1 40 60) falls
+    /// from 1 at 40 to 0 at 60, so at 45 it is (60 − 45)/20 = 0.75; NEAR = TRA(40 60 100 120)
+    /// rises from 0 at 40 to 1 at 60, so (45 − 40)/20 = 0.25.
+    #[test]
+    fn manual_fuzzification_of_45_with_the_typo_fixed() {
+        let shapes = parse_shapes(DISTANCE, Path::new("shape_ctof.txt")).unwrap();
+        let got: Vec<(&str, FuzzyValue)> = shapes[0].fuzzify(45.0, 1.0).collect();
+        assert_eq!(got[0].0, "NEAREST");
+        assert!(close(got[0].1.value, 0.75));
+        assert!(close(got[1].1.value, 0.25));
+        assert_eq!(got[2], ("FAR", FuzzyValue::new(0.0, 1.0)));
+        assert!(got[2].1.is_dropped(), "FAR 0 with reliability 1 is not pushed");
+        assert!(!got[0].1.is_dropped() && !got[1].1.is_dropped());
+    }
+
+    /// §10.4.1 second example: `<TargetDistance, 80, 0.4>` gives NEAREST 0, NEAR 1, FAR 0, all
+    /// with reliability 0.4 and all kept (their reliability is not 1).
+    #[test]
+    fn manual_fuzzification_of_80_with_reliability_0_4() {
+        let shapes = parse_shapes(DISTANCE, Path::new("shape_ctof.txt")).unwrap();
+        let got: Vec<(&str, FuzzyValue)> = shapes[0].fuzzify(80.0, 0.4).collect();
+        assert_eq!(
+            got,
+            vec![
+                ("NEAREST", FuzzyValue::new(0.0, 0.4)),
+                ("NEAR", FuzzyValue::new(1.0, 0.4)),
+                ("FAR", FuzzyValue::new(0.0, 0.4))
+            ]
+        );
+        assert!(got.iter().all(|(_, v)| !v.is_dropped()));
+    }
+
+    /// §10.4.6: VERY_FAST 0.8, FAST 0.6, SLOW 0.9 on SPEEDMODULE give
+    /// (100·0.8 + 75·0.6 + 25·0.9) / (0.8 + 0.6 + 0.9) = 147.5 / 2.3 = 64.1304 cm/s.
+    /// The manual cites "Formula 10.7" there, which is the barycenter formula; the singleton
+    /// default it computes is formula 10.6.
+    #[test]
+    fn manual_defuzzification_64_13() {
+        let text = "(SPEEDMODULE\n(SNG (STEADY 0))\n(SNG (VERY_SLOW 10))\n(SNG (SLOW 25))\n(SNG (FAST 75))\n(SNG (VERY_FAST 100))\n)\n";
+        let shapes = parse_shapes(text, Path::new("s_shape.txt")).unwrap();
+        let s = &shapes[0];
+        let sng = |l: &str| match s.set(l) {
+            Some(FuzzySet::Sng { a }) => *a,
+            _ => f64::NAN,
+        };
+        let out =
+            defuzzify([(sng("VERY_FAST"), 0.8), (sng("FAST"), 0.6), (sng("SLOW"), 0.9)], false)
+                .unwrap();
+        assert!((out - 64.130_434_782_6).abs() < 1e-9, "{out}");
+        assert!((out - 147.5 / 2.3).abs() < 1e-12);
+        assert_eq!(defuzzify([(25.0, 0.0)], false), None, "all weights 0: absent, not 0");
+    }
+
+    #[test]
+    fn angles_average_on_the_circle() {
+        let out = defuzzify([(350.0, 1.0), (10.0, 1.0)], true).unwrap();
+        assert!(out.abs() < 1e-9 || (out - 360.0).abs() < 1e-9, "{out}");
+        let out = defuzzify([(340.0, 1.0), (20.0, 3.0)], true).unwrap();
+        // Unit vectors at −20° (w 1) and 20° (w 3): atan2(3 sin20 − sin20, 4 cos20).
+        let expect =
+            (2.0 * 20f64.to_radians().sin()).atan2(4.0 * 20f64.to_radians().cos()).to_degrees();
+        assert!((out - expect).abs() < 1e-9, "{out} vs {expect}");
+        let out = defuzzify([(270.0, 1.0)], true).unwrap();
+        assert!((out - 270.0).abs() < 1e-9);
+    }
+
+    #[test]
+    fn associations_resolve_or_say_which_shapes_exist() {
+        let shapes = parse_shapes(DISTANCE, Path::new("shape_ctof.txt")).unwrap();
+        let ok = parse_associations("(TargetDistance Distance) # comment\n", Path::new("ctof.txt"))
+            .unwrap();
+        assert_eq!(resolve(&ok, &shapes, Path::new("ctof.txt")).unwrap(), vec![0]);
+        let bad = parse_associations("\n  (TargetAngle Angle)\n", Path::new("ctof.txt")).unwrap();
+        let e = resolve(&bad, &shapes, Path::new("ctof.txt")).unwrap_err().to_string();
+        assert_eq!(e, "error in file ctof.txt at line 2, column 4: unknown shape `Angle` for `TargetAngle` (known shapes: Distance)");
+    }
+
+    #[test]
+    fn syntax_errors_name_file_line_and_column() {
+        let cases = [
+            ("(Distance\n (TRX (A 1 2 3)))", "at line 2, column 3: expected a fuzzy set identifier (TRI, TOL, TOR, DIV, TRA, REC or SNG), found `TRX`"),
+            ("(Distance\n (TRI (A 1 2)))", "at line 2, column 13: expected value 3 of 3 of TRI `A` (TRI takes 3), found `)`"),
+            ("(Distance\n (TRI (A 1 2 3 4)))", "at line 2, column 16: expected `)` after the 3 values of TRI `A`, found the number `4`"),
+            ("(Distance\n (TRI (A 3 2 1)))", "at line 2, column 8: the values of TRI `A` must not decrease: [3.0, 2.0, 1.0]"),
+            ("(Distance\n (SNG (A 1))\n (SNG (A 2)))", "at line 3, column 8: label `A` appears twice in shape `Distance`"),
+            ("(D (SNG (A 1)))\n(D (SNG (B 1)))", "at line 2, column 2: shape `D` is already defined at line 1"),
+            ("(Distance\n (SNG (A 1))", "at line 2, column 13: expected `(` for another fuzzy set or `)` to close shape `Distance`, found end of file"),
+            ("Distance", "at line 1, column 1: expected `(` to start a shape, found `Distance`"),
+        ];
+        for (text, want) in cases {
+            let e = parse_shapes(text, Path::new("s.txt")).unwrap_err().to_string();
+            assert_eq!(e, format!("error in file s.txt {want}"), "{text:?}");
+        }
+    }
+
+    #[test]
+    fn shared_bench_shapes_parse_when_present() {
+        let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/bench/brian40");
+        if !dir.exists() {
+            eprintln!("skipped: ../shared/bench/brian40 is absent (it is always there in CI)");
+            return;
+        }
+        for (shapes, assoc) in [("shape_ctof.txt", "ctof.txt"), ("s_shape.txt", "s_ftoc.txt")] {
+            let sp = dir.join(shapes);
+            let ap = dir.join(assoc);
+            let s = parse_shapes(&std::fs::read_to_string(&sp).unwrap(), &sp).unwrap();
+            let a = parse_associations(&std::fs::read_to_string(&ap).unwrap(), &ap).unwrap();
+            resolve(&a, &s, &ap).unwrap();
+            assert!(!s.is_empty() && !a.is_empty());
+        }
+    }
+
+    proptest! {
+        #[test]
+        fn random_bytes_never_panic(bytes in proptest::collection::vec(any::<u8>(), 0..256)) {
+            let text = String::from_utf8_lossy(&bytes);
+            let _ = parse_shapes(&text, Path::new("x"));
+            let _ = parse_associations(&text, Path::new("x"));
+        }
+
+        #[test]
+        fn token_soup_never_panics(parts in proptest::collection::vec(prop_oneof![
+            Just("("), Just(")"), Just("TRI"), Just("SNG"), Just("TRA"), Just("DIV"), Just("A"),
+            Just("1"), Just("-2.5"), Just("#c\n"), Just("\n"), Just(" "), Just("="), Just(";")], 0..40)) {
+            let text = parts.concat();
+            let _ = parse_shapes(&text, Path::new("x"));
+            let _ = parse_associations(&text, Path::new("x"));
+        }
+    }
+}
