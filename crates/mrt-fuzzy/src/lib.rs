@@ -36,7 +36,9 @@
 //! | default (singleton) defuzzification, formula 10.6 | [`shapes::defuzzify`] |
 #![deny(missing_docs)]
 
+pub mod brian;
 mod error;
+pub mod expr;
 pub mod lexer;
 mod set;
 pub mod shapes;

@@ -1,0 +1,599 @@
+//! The Mr. BRIAN engine (MRT manual chapter 10): loads a configuration directory, then turns
+//! crisp inputs into crisp commands every cycle.
+//!
+//! One cycle: fuzzify the inputs (`ctof.txt`) → predicates (`Predicate.ini`) → for each level in
+//! increasing order: re-fuzzify what lower levels proposed as `Proposed<Action>` data and
+//! evaluate `PredicateActions.ini`, then run the level's behaviors (alphabetically) whose CANDO
+//! is above the threshold, each rule proposing its actions with value = precondition value ×
+//! reliability, weighted once by the behavior's WANT; compose by max per (action, label); apply
+//! `&DEL` to lower levels → defuzzify each action (`s_ftoc.txt`, formula 10.6).
+
+use crate::error::BrianError;
+use crate::expr::{parse_definitions, parse_expr, Expr, RawExpr};
+use crate::lexer::{tokenize, Cursor, Span, Tok};
+use crate::set::{FuzzySet, FuzzyValue};
+use crate::shapes::{defuzzify, parse_associations, parse_shapes, resolve, Shape};
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+/// The default CANDO threshold (§10.4.4): a behavior runs when its CANDO value is above it.
+pub const DEFAULT_THRESHOLD: f64 = 0.49;
+/// A WANT value must exceed this to give a weight; below, the behavior's weight is 0.
+pub const WANT_THRESHOLD: f64 = 0.49;
+/// A rule whose precondition reliability is below this proposes nothing (§10.3.7).
+pub const MIN_RELIABILITY: f64 = 0.1;
+
+/// The file names of a configuration directory.
+#[derive(Clone, Debug)]
+pub struct BrianFiles {
+    /// Input shapes (`shape_ctof.txt`).
+    pub shape_ctof: PathBuf,
+    /// Crisp data → shape (`ctof.txt`).
+    pub ctof: PathBuf,
+    /// Predicates (`Predicate.ini`).
+    pub predicates: PathBuf,
+    /// Predicate actions (`PredicateActions.ini`); may be absent.
+    pub predicate_actions: PathBuf,
+    /// Activation conditions (`Cando.ini`).
+    pub cando: PathBuf,
+    /// Motivations (`want.txt`).
+    pub want: PathBuf,
+    /// Behavior list (`behavior.txt`).
+    pub behaviors: PathBuf,
+    /// Output shapes (`s_shape.txt`).
+    pub s_shape: PathBuf,
+    /// Action → output shape (`s_ftoc.txt`).
+    pub s_ftoc: PathBuf,
+}
+
+impl BrianFiles {
+    /// The standard names inside `dir`.
+    pub fn in_dir(dir: impl AsRef<Path>) -> Self {
+        let d = dir.as_ref();
+        Self {
+            shape_ctof: d.join("shape_ctof.txt"),
+            ctof: d.join("ctof.txt"),
+            predicates: d.join("Predicate.ini"),
+            predicate_actions: d.join("PredicateActions.ini"),
+            cando: d.join("Cando.ini"),
+            want: d.join("want.txt"),
+            behaviors: d.join("behavior.txt"),
+            s_shape: d.join("s_shape.txt"),
+            s_ftoc: d.join("s_ftoc.txt"),
+        }
+    }
+}
+
+fn read(path: &Path) -> Result<String, BrianError> {
+    std::fs::read_to_string(path)
+        .map_err(|source| BrianError::Io { file: path.to_path_buf(), source })
+}
+
+/// A crisp input of `ctof.txt`.
+#[derive(Clone, Debug)]
+struct Input {
+    name: String,
+    shape: Shape,
+    /// First index of its labels in the fuzzy data table.
+    offset: usize,
+    /// This cycle's value and reliability.
+    now: Option<(f64, f64)>,
+    /// The previous cycle's output of the same name, if any.
+    previous: Option<f64>,
+}
+
+/// An output action of `s_ftoc.txt`.
+#[derive(Clone, Debug)]
+struct Action {
+    name: String,
+    labels: Vec<(String, f64)>,
+    circular: bool,
+    /// The input slot `Proposed<name>` that re-fuzzifies this action for higher levels.
+    proposed: Option<usize>,
+    /// First index in the (action, label) accumulators.
+    offset: usize,
+}
+
+#[derive(Clone, Debug)]
+enum RuleAction {
+    Propose(usize),
+    Delete { action: usize, label: Option<usize> },
+}
+
+#[derive(Clone, Debug)]
+struct Rule {
+    precondition: Expr,
+    actions: Vec<RuleAction>,
+}
+
+#[derive(Clone, Debug)]
+struct Behavior {
+    name: String,
+    level: i64,
+    cando: Option<Expr>,
+    want: Option<Expr>,
+    rules: Vec<Rule>,
+}
+
+/// A loaded Mr. BRIAN configuration, ready to run cycles.
+///
+/// ```no_run
+/// use mrt_fuzzy::brian::Brian;
+/// let mut brian = Brian::from_dir("configs/brian/harvester")?;
+/// let commands = brian.run(&[("TargetDistance", 45.0, 1.0)]);
+/// println!("{commands:?}");
+/// # Ok::<(), mrt_fuzzy::BrianError>(())
+/// ```
+#[derive(Clone, Debug)]
+pub struct Brian {
+    inputs: Vec<Input>,
+    data: Vec<FuzzyValue>,
+    predicates: Vec<(String, Expr)>,
+    predicate_actions: Vec<(String, Expr)>,
+    behaviors: Vec<Behavior>,
+    actions: Vec<Action>,
+    threshold: f64,
+    pred_values: Vec<FuzzyValue>,
+    act_values: Vec<FuzzyValue>,
+    lower: Vec<f64>,
+    level_acc: Vec<f64>,
+}
+
+/// The crisp commands of one cycle: action name → value, sorted by name. An action every
+/// behavior left at weight 0 is absent.
+pub type Commands = BTreeMap<String, f64>;
+
+struct Names<'a> {
+    inputs: &'a [Input],
+    predicates: &'a [(String, Expr)],
+    predicate_actions: &'a [(String, Expr)],
+    file: &'a Path,
+}
+
+impl Names<'_> {
+    fn resolve(&self, e: &RawExpr) -> Result<Expr, BrianError> {
+        Ok(match e {
+            RawExpr::And(a, b) => Expr::And(Box::new(self.resolve(a)?), Box::new(self.resolve(b)?)),
+            RawExpr::Or(a, b) => Expr::Or(Box::new(self.resolve(a)?), Box::new(self.resolve(b)?)),
+            RawExpr::Not(a) => Expr::Not(Box::new(self.resolve(a)?)),
+            RawExpr::Data(d, l, span) => {
+                let Some(input) = self.inputs.iter().find(|i| i.name == *d) else {
+                    return Err(BrianError::at(
+                        self.file,
+                        *span,
+                        format!("unknown datum `{d}` (not in ctof.txt)"),
+                    ));
+                };
+                let Some(k) = input.shape.sets.iter().position(|(label, _)| label == l) else {
+                    let known: Vec<&str> =
+                        input.shape.sets.iter().map(|(l, _)| l.as_str()).collect();
+                    return Err(BrianError::at(
+                        self.file,
+                        *span,
+                        format!(
+                            "`{d}` (shape `{}`) has no label `{l}` (labels: {})",
+                            input.shape.name,
+                            known.join(", ")
+                        ),
+                    ));
+                };
+                Expr::Data(input.offset + k)
+            }
+            RawExpr::Pred(n, span) => {
+                if let Some(i) = self.predicates.iter().position(|(p, _)| p == n) {
+                    Expr::Pred(i)
+                } else if let Some(i) = self.predicate_actions.iter().position(|(p, _)| p == n) {
+                    Expr::Action(i)
+                } else {
+                    return Err(BrianError::at(
+                        self.file,
+                        *span,
+                        format!("unknown predicate `{n}` (predicates must be defined before use)"),
+                    ));
+                }
+            }
+        })
+    }
+}
+
+fn parse_file<T>(
+    path: &Path,
+    f: impl FnOnce(&mut Cursor<'_>) -> Result<T, BrianError>,
+) -> Result<T, BrianError> {
+    let text = read(path)?;
+    let toks = tokenize(&text, path)?;
+    let mut c = Cursor::new(&toks, path, &text);
+    f(&mut c)
+}
+
+impl Brian {
+    /// Loads the standard files of a configuration directory.
+    pub fn from_dir(dir: impl AsRef<Path>) -> Result<Brian, BrianError> {
+        Brian::from_files(&BrianFiles::in_dir(dir.as_ref()), dir.as_ref())
+    }
+
+    /// Loads from explicit file paths (the manual's `Brian(...)` constructor); behavior paths
+    /// in the behavior list are relative to `base`.
+    pub fn from_files(files: &BrianFiles, base: &Path) -> Result<Brian, BrianError> {
+        let shapes = parse_shapes(&read(&files.shape_ctof)?, &files.shape_ctof)?;
+        let assocs = parse_associations(&read(&files.ctof)?, &files.ctof)?;
+        let idx = resolve(&assocs, &shapes, &files.ctof)?;
+        let mut inputs = Vec::new();
+        let mut offset = 0;
+        for (a, i) in assocs.iter().zip(idx) {
+            let shape = shapes[i].clone();
+            let n = shape.sets.len();
+            inputs.push(Input { name: a.name.clone(), shape, offset, now: None, previous: None });
+            offset += n;
+        }
+
+        let mut predicates: Vec<(String, Expr)> = Vec::new();
+        for (name, _span, raw) in parse_file(&files.predicates, parse_definitions)? {
+            let e = Names {
+                inputs: &inputs,
+                predicates: &predicates,
+                predicate_actions: &[],
+                file: &files.predicates,
+            }
+            .resolve(&raw)?;
+            predicates.push((name, e));
+        }
+        let mut predicate_actions: Vec<(String, Expr)> = Vec::new();
+        if files.predicate_actions.exists() {
+            for (name, span, raw) in parse_file(&files.predicate_actions, parse_definitions)? {
+                if predicates.iter().any(|(p, _)| *p == name) {
+                    return Err(BrianError::at(
+                        &files.predicate_actions,
+                        span,
+                        format!("`{name}` is already a predicate"),
+                    ));
+                }
+                let e = Names {
+                    inputs: &inputs,
+                    predicates: &predicates,
+                    predicate_actions: &predicate_actions,
+                    file: &files.predicate_actions,
+                }
+                .resolve(&raw)?;
+                predicate_actions.push((name, e));
+            }
+        }
+
+        // Outputs.
+        let s_shapes = parse_shapes(&read(&files.s_shape)?, &files.s_shape)?;
+        let s_assocs = parse_associations(&read(&files.s_ftoc)?, &files.s_ftoc)?;
+        let s_idx = resolve(&s_assocs, &s_shapes, &files.s_ftoc)?;
+        let mut actions = Vec::new();
+        let mut offset = 0;
+        for (a, i) in s_assocs.iter().zip(s_idx) {
+            let mut labels = Vec::new();
+            for (label, set) in &s_shapes[i].sets {
+                match set {
+                    FuzzySet::Sng { a } => labels.push((label.clone(), *a)),
+                    other => {
+                        return Err(BrianError::at(
+                            &files.s_shape,
+                            s_shapes[i].span,
+                            format!("output shape `{}` set `{label}` is {}: defuzzification uses singletons (SNG) only", s_shapes[i].name, other.identifier()),
+                        ))
+                    }
+                }
+            }
+            let proposed = inputs.iter().position(|inp| inp.name == format!("Proposed{}", a.name));
+            let n = labels.len();
+            actions.push(Action {
+                name: a.name.clone(),
+                labels,
+                circular: a.name.contains("Angle"),
+                proposed,
+                offset,
+            });
+            offset += n;
+        }
+
+        let names = Names {
+            inputs: &inputs,
+            predicates: &predicates,
+            predicate_actions: &predicate_actions,
+            file: &files.cando,
+        };
+        let cando = parse_file(&files.cando, parse_definitions)?;
+        let want = parse_file(&files.want, parse_definitions)?;
+        let mut behaviors = Vec::new();
+        for (name, level, path, span) in parse_file(&files.behaviors, parse_behavior_list)? {
+            let rul = base.join(&path);
+            if behaviors.iter().any(|b: &Behavior| b.name == name) {
+                return Err(BrianError::at(
+                    &files.behaviors,
+                    span,
+                    format!("behavior `{name}` is listed twice"),
+                ));
+            }
+            let rules = parse_file(&rul, |c| {
+                parse_rules(c, &Names { file: &rul, ..names_ref(&names) }, &actions)
+            })?;
+            let cando = match cando.iter().find(|(n, _, _)| *n == name) {
+                Some((_, _, raw)) => {
+                    Some(Names { file: &files.cando, ..names_ref(&names) }.resolve(raw)?)
+                }
+                None => None,
+            };
+            let want = match want.iter().find(|(n, _, _)| *n == name) {
+                Some((_, _, raw)) => {
+                    Some(Names { file: &files.want, ..names_ref(&names) }.resolve(raw)?)
+                }
+                None => None,
+            };
+            behaviors.push(Behavior { name, level, cando, want, rules });
+        }
+        for (file, defs) in [(&files.cando, &cando), (&files.want, &want)] {
+            if let Some((n, span, _)) =
+                defs.iter().find(|(n, _, _)| !behaviors.iter().any(|b| b.name == *n))
+            {
+                return Err(BrianError::at(
+                    file,
+                    *span,
+                    format!("`{n}` is not a behavior of behavior.txt"),
+                ));
+            }
+        }
+        behaviors.sort_by(|a, b| (a.level, &a.name).cmp(&(b.level, &b.name)));
+
+        let slots = actions.iter().map(|a| a.labels.len()).sum();
+        Ok(Brian {
+            data: vec![FuzzyValue::MISSING; offset_of(&inputs)],
+            pred_values: vec![FuzzyValue::MISSING; predicates.len()],
+            act_values: vec![FuzzyValue::MISSING; predicate_actions.len()],
+            lower: vec![0.0; slots],
+            level_acc: vec![0.0; slots],
+            inputs,
+            predicates,
+            predicate_actions,
+            behaviors,
+            actions,
+            threshold: DEFAULT_THRESHOLD,
+        })
+    }
+
+    /// Sets the CANDO threshold (`threshold_filter`, default 0.49).
+    pub fn set_threshold(&mut self, t: f64) {
+        self.threshold = t;
+    }
+
+    /// The names of the crisp inputs (`ctof.txt`).
+    pub fn input_names(&self) -> impl Iterator<Item = &str> {
+        self.inputs.iter().map(|i| i.name.as_str())
+    }
+
+    /// Runs one cycle on `(name, value, reliability)` inputs. Unknown names are ignored; a
+    /// missing input reads as value 0, reliability 1 for every label, unless the previous
+    /// cycle produced an output of that name (then that value with reliability 1). A NaN value
+    /// belongs to no fuzzy set.
+    pub fn run(&mut self, inputs: &[(&str, f64, f64)]) -> Commands {
+        for input in &mut self.inputs {
+            input.now = None;
+        }
+        for (name, v, r) in inputs {
+            if let Some(i) = self.inputs.iter_mut().find(|i| i.name == *name) {
+                i.now = Some((*v, r.clamp(0.0, 1.0)));
+            }
+        }
+        self.cycle()
+    }
+
+    fn fuzzify(&mut self, slot: usize) {
+        let input = &self.inputs[slot];
+        let crisp = input.now.or(input.previous.map(|v| (v, 1.0)));
+        for (k, (_, set)) in input.shape.sets.iter().enumerate() {
+            self.data[input.offset + k] = match crisp {
+                Some((v, r)) => FuzzyValue::new(set.membership(v), r),
+                None => FuzzyValue::MISSING,
+            };
+        }
+    }
+
+    fn cycle(&mut self) -> Commands {
+        let proposed: Vec<usize> = self.actions.iter().filter_map(|a| a.proposed).collect();
+        for slot in 0..self.inputs.len() {
+            if proposed.contains(&slot) {
+                self.inputs[slot].now = None;
+                self.inputs[slot].previous = None;
+            }
+            self.fuzzify(slot);
+        }
+        for i in 0..self.predicates.len() {
+            self.pred_values[i] = self.predicates[i].1.eval(&self.data, &self.pred_values, &[]);
+        }
+        self.lower.iter_mut().for_each(|v| *v = 0.0);
+        let mut b = 0;
+        let mut first = true;
+        while b < self.behaviors.len() {
+            let level = self.behaviors[b].level;
+            if !first {
+                self.feed_proposals();
+            }
+            first = false;
+            for i in 0..self.predicate_actions.len() {
+                self.act_values[i] = self.predicate_actions[i].1.eval(
+                    &self.data,
+                    &self.pred_values,
+                    &self.act_values,
+                );
+            }
+            self.level_acc.iter_mut().for_each(|v| *v = 0.0);
+            while b < self.behaviors.len() && self.behaviors[b].level == level {
+                self.run_behavior(b);
+                b += 1;
+            }
+            for (l, v) in self.lower.iter_mut().zip(&self.level_acc) {
+                *l = l.max(*v);
+            }
+        }
+        let mut out = Commands::new();
+        for a in &self.actions {
+            let w = &self.lower[a.offset..a.offset + a.labels.len()];
+            if let Some(v) =
+                defuzzify(a.labels.iter().zip(w).map(|((_, s), w)| (*s, *w)), a.circular)
+            {
+                out.insert(a.name.clone(), v);
+            }
+        }
+        for input in &mut self.inputs {
+            input.previous = out.get(&input.name).copied();
+        }
+        out
+    }
+
+    /// Defuzzifies what the lower levels propose into `Proposed<Action>` data and fuzzifies it.
+    fn feed_proposals(&mut self) {
+        for ai in 0..self.actions.len() {
+            let a = &self.actions[ai];
+            let Some(slot) = a.proposed else { continue };
+            let w = &self.lower[a.offset..a.offset + a.labels.len()];
+            let crisp = defuzzify(a.labels.iter().zip(w).map(|((_, s), w)| (*s, *w)), a.circular);
+            self.inputs[slot].now = crisp.map(|v| (v, 1.0));
+            self.fuzzify(slot);
+        }
+    }
+
+    fn run_behavior(&mut self, b: usize) {
+        let beh = &self.behaviors[b];
+        let cando = beh.cando.as_ref().map_or(FuzzyValue::new(1.0, 1.0), |e| {
+            e.eval(&self.data, &self.pred_values, &self.act_values)
+        });
+        if cando.value <= self.threshold {
+            return;
+        }
+        let want = beh
+            .want
+            .as_ref()
+            .map_or(0.0, |e| e.eval(&self.data, &self.pred_values, &self.act_values).value);
+        let weight = if want > WANT_THRESHOLD { want } else { 0.0 };
+        for rule in &beh.rules {
+            let p = rule.precondition.eval(&self.data, &self.pred_values, &self.act_values);
+            if p.reliability < MIN_RELIABILITY {
+                continue;
+            }
+            let value = p.value * p.reliability;
+            for act in &rule.actions {
+                match *act {
+                    RuleAction::Propose(slot) => {
+                        let v = &mut self.level_acc[slot];
+                        *v = v.max(weight * value);
+                    }
+                    RuleAction::Delete { action, label } if value > 0.0 => {
+                        let a = &self.actions[action];
+                        match label {
+                            Some(k) => self.lower[a.offset + k] = 0.0,
+                            None => self.lower[a.offset..a.offset + a.labels.len()]
+                                .iter_mut()
+                                .for_each(|v| *v = 0.0),
+                        }
+                    }
+                    RuleAction::Delete { .. } => {}
+                }
+            }
+        }
+    }
+}
+
+fn offset_of(inputs: &[Input]) -> usize {
+    inputs.iter().map(|i| i.shape.sets.len()).sum()
+}
+
+fn names_ref<'a>(n: &Names<'a>) -> Names<'a> {
+    Names {
+        inputs: n.inputs,
+        predicates: n.predicates,
+        predicate_actions: n.predicate_actions,
+        file: n.file,
+    }
+}
+
+/// `(level <n> <name> <path>)` lines.
+fn parse_behavior_list(c: &mut Cursor<'_>) -> Result<Vec<(String, i64, String, Span)>, BrianError> {
+    let mut out = Vec::new();
+    while !c.at_end() {
+        c.punct(Tok::Open, "`(` to start a behavior line")?;
+        let (kw, span) = c.word("`level`")?;
+        if kw != "level" {
+            return Err(BrianError::at(c.file(), span, format!("expected `level`, found `{kw}`")));
+        }
+        let lspan = c.span();
+        let level = c.number("the level number")?;
+        if level.fract() != 0.0 || level < 1.0 {
+            return Err(BrianError::at(
+                c.file(),
+                lspan,
+                format!("the level must be a whole number from 1, found {level}"),
+            ));
+        }
+        let (name, nspan) = c.word("the behavior name")?;
+        let (path, _) = c.word("the path of the behavior's rule file")?;
+        c.punct(Tok::Close, "`)` to close the behavior line")?;
+        out.push((name, level as i64, path, nspan));
+    }
+    Ok(out)
+}
+
+/// `<precondition> => <action>+ ;` rules.
+fn parse_rules(
+    c: &mut Cursor<'_>,
+    names: &Names<'_>,
+    actions: &[Action],
+) -> Result<Vec<Rule>, BrianError> {
+    let mut rules = Vec::new();
+    while !c.at_end() {
+        let raw = parse_expr(c)?;
+        let precondition = names.resolve(&raw)?;
+        c.punct(Tok::Eq, "`=>` after the precondition")?;
+        match c.peek() {
+            Some(Tok::Word(w)) if w == ">" => {
+                c.word("`>`")?;
+            }
+            _ => return Err(c.expected("`=>` after the precondition")),
+        }
+        let mut acts = Vec::new();
+        while c.peek() == Some(&Tok::Open) {
+            c.punct(Tok::Open, "`(`")?;
+            let (name, span) = c.word("an action name or &DEL.<action>")?;
+            let (label, lspan) = c.word("a label")?;
+            c.punct(Tok::Close, "`)` to close the action")?;
+            let (target, delete) = match name.strip_prefix("&DEL.") {
+                Some(t) => (t, true),
+                None => (name.as_str(), false),
+            };
+            let Some(ai) = actions.iter().position(|a| a.name == target) else {
+                return Err(BrianError::at(
+                    c.file(),
+                    span,
+                    format!("unknown action `{target}` (not in s_ftoc.txt)"),
+                ));
+            };
+            let a = &actions[ai];
+            let k = a.labels.iter().position(|(l, _)| *l == label);
+            acts.push(match (delete, k) {
+                (true, _) if label == "ANY" => RuleAction::Delete { action: ai, label: None },
+                (true, Some(k)) => RuleAction::Delete { action: ai, label: Some(k) },
+                (false, Some(k)) => RuleAction::Propose(a.offset + k),
+                (_, None) => {
+                    let known: Vec<&str> = a.labels.iter().map(|(l, _)| l.as_str()).collect();
+                    return Err(BrianError::at(
+                        c.file(),
+                        lspan,
+                        format!(
+                            "action `{target}` has no label `{label}` (labels: {})",
+                            known.join(", ")
+                        ),
+                    ));
+                }
+            });
+        }
+        if acts.is_empty() {
+            return Err(c.expected("an action `(<action> <label>)` after `=>`"));
+        }
+        c.punct(Tok::Semi, "`;` at the end of the rule")?;
+        rules.push(Rule { precondition, actions: acts });
+    }
+    Ok(rules)
+}
