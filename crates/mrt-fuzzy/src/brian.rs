@@ -23,6 +23,56 @@ pub const WANT_THRESHOLD: f64 = 0.49;
 /// A rule whose precondition reliability is below this proposes nothing (§10.3.7).
 pub const MIN_RELIABILITY: f64 = 0.1;
 
+/// How proposals of the same (action, label) are combined (§10.3.8, §10.4.9), after each is
+/// multiplied by its behavior's weight.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Composer {
+    /// The maximum (formula 10.3): the default.
+    #[default]
+    Max,
+    /// The mean (`average_float_composer` of §10.4.9).
+    Average,
+}
+
+/// One (action, label) accumulator: enough for both composers.
+#[derive(Clone, Copy, Debug, Default)]
+struct Acc {
+    max: f64,
+    sum: f64,
+    n: u32,
+}
+
+impl Acc {
+    fn add(&mut self, v: f64) {
+        self.max = self.max.max(v);
+        self.sum += v;
+        self.n += 1;
+    }
+
+    fn merge(&mut self, o: &Acc) {
+        self.max = self.max.max(o.max);
+        self.sum += o.sum;
+        self.n += o.n;
+    }
+
+    fn weight(&self, c: Composer) -> f64 {
+        match c {
+            Composer::Max => self.max,
+            Composer::Average if self.n > 0 => self.sum / f64::from(self.n),
+            Composer::Average => 0.0,
+        }
+    }
+}
+
+impl Composer {
+    /// Combines weighted proposals of one (action, label); 0 when there are none.
+    pub fn combine(self, weighted: &[f64]) -> f64 {
+        let mut acc = Acc::default();
+        weighted.iter().for_each(|v| acc.add(*v));
+        acc.weight(self)
+    }
+}
+
 /// The file names of a configuration directory.
 #[derive(Clone, Debug)]
 pub struct BrianFiles {
@@ -133,10 +183,14 @@ pub struct Brian {
     behaviors: Vec<Behavior>,
     actions: Vec<Action>,
     threshold: f64,
+    composer: Composer,
     pred_values: Vec<FuzzyValue>,
     act_values: Vec<FuzzyValue>,
-    lower: Vec<f64>,
-    level_acc: Vec<f64>,
+    lower: Vec<Acc>,
+    level_acc: Vec<Acc>,
+    /// Inputs that carry `Proposed<Action>` data (set by the engine, not by callers).
+    is_proposed: Vec<bool>,
+    outputs: Vec<Option<f64>>,
 }
 
 /// The crisp commands of one cycle: action name → value, sorted by name. An action every
@@ -340,12 +394,17 @@ impl Brian {
         behaviors.sort_by(|a, b| (a.level, &a.name).cmp(&(b.level, &b.name)));
 
         let slots = actions.iter().map(|a| a.labels.len()).sum();
+        let is_proposed =
+            (0..inputs.len()).map(|i| actions.iter().any(|a| a.proposed == Some(i))).collect();
         Ok(Brian {
+            is_proposed,
+            outputs: vec![None; actions.len()],
+            composer: Composer::default(),
             data: vec![FuzzyValue::MISSING; offset_of(&inputs)],
             pred_values: vec![FuzzyValue::MISSING; predicates.len()],
             act_values: vec![FuzzyValue::MISSING; predicate_actions.len()],
-            lower: vec![0.0; slots],
-            level_acc: vec![0.0; slots],
+            lower: vec![Acc::default(); slots],
+            level_acc: vec![Acc::default(); slots],
             inputs,
             predicates,
             predicate_actions,
@@ -353,6 +412,11 @@ impl Brian {
             actions,
             threshold: DEFAULT_THRESHOLD,
         })
+    }
+
+    /// Chooses the composer (default [`Composer::Max`]).
+    pub fn set_composer(&mut self, c: Composer) {
+        self.composer = c;
     }
 
     /// Sets the CANDO threshold (`threshold_filter`, default 0.49).
@@ -365,20 +429,58 @@ impl Brian {
         self.inputs.iter().map(|i| i.name.as_str())
     }
 
+    /// The slot of a crisp input, for [`set_input`](Self::set_input).
+    pub fn input_slot(&self, name: &str) -> Option<usize> {
+        self.inputs.iter().position(|i| i.name == name)
+    }
+
+    /// Sets an input for the next [`step`](Self::step). Reliability is clamped to `[0, 1]`.
+    pub fn set_input(&mut self, slot: usize, value: f64, reliability: f64) {
+        if let Some(i) = self.inputs.get_mut(slot) {
+            i.now = Some((value, reliability.clamp(0.0, 1.0)));
+        }
+    }
+
+    /// Forgets every input set since the last step (missing inputs read as value 0,
+    /// reliability 1, or as the previous cycle's output of the same name).
+    pub fn clear_inputs(&mut self) {
+        self.inputs.iter_mut().for_each(|i| i.now = None);
+    }
+
+    /// The output action names, in `s_ftoc.txt` order (the order of [`output`](Self::output)).
+    pub fn output_names(&self) -> impl Iterator<Item = &str> {
+        self.actions.iter().map(|a| a.name.as_str())
+    }
+
+    /// Output `i` of the last step; `None` when every weight of that action was 0.
+    pub fn output(&self, i: usize) -> Option<f64> {
+        self.outputs.get(i).copied().flatten()
+    }
+
+    /// Runs one cycle on the inputs set with [`set_input`](Self::set_input), then clears them.
+    /// Allocates nothing.
+    pub fn step(&mut self) {
+        self.cycle();
+        self.clear_inputs();
+    }
+
     /// Runs one cycle on `(name, value, reliability)` inputs. Unknown names are ignored; a
     /// missing input reads as value 0, reliability 1 for every label, unless the previous
     /// cycle produced an output of that name (then that value with reliability 1). A NaN value
     /// belongs to no fuzzy set.
     pub fn run(&mut self, inputs: &[(&str, f64, f64)]) -> Commands {
-        for input in &mut self.inputs {
-            input.now = None;
-        }
+        self.clear_inputs();
         for (name, v, r) in inputs {
-            if let Some(i) = self.inputs.iter_mut().find(|i| i.name == *name) {
-                i.now = Some((*v, r.clamp(0.0, 1.0)));
+            if let Some(slot) = self.input_slot(name) {
+                self.set_input(slot, *v, *r);
             }
         }
-        self.cycle()
+        self.step();
+        self.actions
+            .iter()
+            .zip(&self.outputs)
+            .filter_map(|(a, o)| o.map(|v| (a.name.clone(), v)))
+            .collect()
     }
 
     fn fuzzify(&mut self, slot: usize) {
@@ -392,10 +494,9 @@ impl Brian {
         }
     }
 
-    fn cycle(&mut self) -> Commands {
-        let proposed: Vec<usize> = self.actions.iter().filter_map(|a| a.proposed).collect();
+    fn cycle(&mut self) {
         for slot in 0..self.inputs.len() {
-            if proposed.contains(&slot) {
+            if self.is_proposed[slot] {
                 self.inputs[slot].now = None;
                 self.inputs[slot].previous = None;
             }
@@ -404,7 +505,7 @@ impl Brian {
         for i in 0..self.predicates.len() {
             self.pred_values[i] = self.predicates[i].1.eval(&self.data, &self.pred_values, &[]);
         }
-        self.lower.iter_mut().for_each(|v| *v = 0.0);
+        self.lower.iter_mut().for_each(|v| *v = Acc::default());
         let mut b = 0;
         let mut first = true;
         while b < self.behaviors.len() {
@@ -420,28 +521,33 @@ impl Brian {
                     &self.act_values,
                 );
             }
-            self.level_acc.iter_mut().for_each(|v| *v = 0.0);
+            self.level_acc.iter_mut().for_each(|v| *v = Acc::default());
             while b < self.behaviors.len() && self.behaviors[b].level == level {
                 self.run_behavior(b);
                 b += 1;
             }
             for (l, v) in self.lower.iter_mut().zip(&self.level_acc) {
-                *l = l.max(*v);
+                l.merge(v);
             }
         }
-        let mut out = Commands::new();
-        for a in &self.actions {
-            let w = &self.lower[a.offset..a.offset + a.labels.len()];
-            if let Some(v) =
-                defuzzify(a.labels.iter().zip(w).map(|((_, s), w)| (*s, *w)), a.circular)
-            {
-                out.insert(a.name.clone(), v);
-            }
+        for (ai, a) in self.actions.iter().enumerate() {
+            self.outputs[ai] = self.crisp(a);
         }
+        // The previous cycle's outputs come back as inputs of the same name (§10.5).
         for input in &mut self.inputs {
-            input.previous = out.get(&input.name).copied();
+            input.previous = self
+                .actions
+                .iter()
+                .position(|a| a.name == input.name)
+                .and_then(|ai| self.outputs[ai]);
         }
-        out
+    }
+
+    /// Defuzzifies one action from the accumulated proposals.
+    fn crisp(&self, a: &Action) -> Option<f64> {
+        let w = &self.lower[a.offset..a.offset + a.labels.len()];
+        let c = self.composer;
+        defuzzify(a.labels.iter().zip(w).map(|((_, s), w)| (*s, w.weight(c))), a.circular)
     }
 
     /// Defuzzifies what the lower levels propose into `Proposed<Action>` data and fuzzifies it.
@@ -449,8 +555,7 @@ impl Brian {
         for ai in 0..self.actions.len() {
             let a = &self.actions[ai];
             let Some(slot) = a.proposed else { continue };
-            let w = &self.lower[a.offset..a.offset + a.labels.len()];
-            let crisp = defuzzify(a.labels.iter().zip(w).map(|((_, s), w)| (*s, *w)), a.circular);
+            let crisp = self.crisp(a);
             self.inputs[slot].now = crisp.map(|v| (v, 1.0));
             self.fuzzify(slot);
         }
@@ -477,17 +582,14 @@ impl Brian {
             let value = p.value * p.reliability;
             for act in &rule.actions {
                 match *act {
-                    RuleAction::Propose(slot) => {
-                        let v = &mut self.level_acc[slot];
-                        *v = v.max(weight * value);
-                    }
+                    RuleAction::Propose(slot) => self.level_acc[slot].add(weight * value),
                     RuleAction::Delete { action, label } if value > 0.0 => {
                         let a = &self.actions[action];
                         match label {
-                            Some(k) => self.lower[a.offset + k] = 0.0,
+                            Some(k) => self.lower[a.offset + k] = Acc::default(),
                             None => self.lower[a.offset..a.offset + a.labels.len()]
                                 .iter_mut()
-                                .for_each(|v| *v = 0.0),
+                                .for_each(|v| *v = Acc::default()),
                         }
                     }
                     RuleAction::Delete { .. } => {}
@@ -596,4 +698,27 @@ fn parse_rules(
         rules.push(Rule { precondition, actions: acts });
     }
     Ok(rules)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// §10.4.9 with `mult_weight_composer` and `average_float_composer`: GoToTarget (weight
+    /// 0.67) proposes FAST 0.56 and 0.478, SLOW 0.968; AvoidObstacle (weight 1) SLOW 0.354.
+    /// The manual prints the first FAST proposal as 0.57 but its weighted value as 0.3752,
+    /// which is 0.56 × 0.67 (0.57 × 0.67 = 0.3819): the proposal was 0.56. Then
+    /// FAST = (0.3752 + 0.32026) / 2 = 0.34773 and SLOW = (0.64856 + 0.354) / 2 = 0.50128.
+    #[test]
+    fn manual_average_composition_with_the_typo_fixed() {
+        let fast = Composer::Average.combine(&[0.56 * 0.67, 0.478 * 0.67]);
+        let slow = Composer::Average.combine(&[0.968 * 0.67, 0.354 * 1.0]);
+        assert!((fast - 0.34773).abs() < 1e-9, "{fast}");
+        assert!((slow - 0.50128).abs() < 1e-9, "{slow}");
+        let with_typo = Composer::Average.combine(&[0.57 * 0.67, 0.478 * 0.67]);
+        assert!((with_typo - 0.34773).abs() > 1e-3, "0.57 would not give the manual's result");
+        // The default composer takes the maximum (formula 10.3).
+        assert!((Composer::Max.combine(&[0.968 * 0.67, 0.354]) - 0.64856).abs() < 1e-9);
+        assert_eq!(Composer::Max.combine(&[]), 0.0);
+    }
 }
