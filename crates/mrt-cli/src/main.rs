@@ -7,6 +7,8 @@
 //! Logging goes through `tracing`; set `RUST_LOG` (e.g. `RUST_LOG=mrt_dcdt=debug`) for more.
 #![allow(clippy::print_stdout)]
 
+mod brian;
+
 use anyhow::{Context as _, Result};
 use clap::{Parser, Subcommand, ValueEnum};
 use mrt_dcdt::config::AgoraConfig;
@@ -27,11 +29,45 @@ enum Command {
         #[arg(value_enum, default_value_t = Demo::HelloAgora)]
         which: Demo,
     },
+    /// Mr. BRIAN fuzzy behaviors: check, evaluate or draw a configuration directory.
+    Brian {
+        #[command(subcommand)]
+        command: BrianCommand,
+    },
     /// Check DCDT Agora configuration files.
     Check {
         /// Configuration files.
         #[arg(required = true)]
         files: Vec<PathBuf>,
+    },
+}
+
+#[derive(Subcommand)]
+enum BrianCommand {
+    /// Check every file of a configuration (silent when correct; exit status 1 on an error).
+    Check {
+        /// The configuration directory.
+        dir: PathBuf,
+    },
+    /// Run cycles read as JSON Lines (`{"Name": value}` or `{"Name": [value, reliability]}`)
+    /// and print one JSON object of commands per cycle.
+    Eval {
+        /// The configuration directory.
+        dir: PathBuf,
+        /// Input cycles (default: standard input).
+        #[arg(long)]
+        input: Option<PathBuf>,
+        /// Add every predicate, predicate action, CANDO and WANT under `_trace`.
+        #[arg(long)]
+        trace: bool,
+    },
+    /// Draw every input and output shape as SVG.
+    Plot {
+        /// The configuration directory.
+        dir: PathBuf,
+        /// The SVG file to write.
+        #[arg(long, default_value = "shapes.svg")]
+        out: PathBuf,
     },
 }
 
@@ -59,6 +95,11 @@ fn main() -> Result<()> {
         Command::Demo { which: Demo::TwoAgoras } => {
             mrt_examples::two_agoras::main().context("the two-agoras demo failed")?;
         }
+        Command::Brian { command } => match command {
+            BrianCommand::Check { dir } => brian::check(&dir)?,
+            BrianCommand::Eval { dir, input, trace } => brian::eval(&dir, input.as_deref(), trace)?,
+            BrianCommand::Plot { dir, out } => brian::plot(&dir, &out)?,
+        },
         Command::Check { files } => {
             let mut failed = 0;
             for f in &files {

@@ -11,8 +11,11 @@ use mrt_fuzzy::brian::Brian;
 use std::path::PathBuf;
 use std::time::Duration;
 
-/// Loads a configuration and its cycles as (slot, value, reliability) lists.
-fn load(dir: &str, cycles: &str) -> Option<(Brian, Vec<Vec<(usize, f64, f64)>>)> {
+/// One cycle's inputs as (slot, value, reliability).
+type Cycle = Vec<(usize, f64, f64)>;
+
+/// Loads a configuration and its cycles.
+fn load(dir: &str, cycles: &str) -> Option<(Brian, Vec<Cycle>)> {
     let d = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/bench").join(dir);
     if !d.exists() {
         eprintln!("skipped: {} is absent", d.display());

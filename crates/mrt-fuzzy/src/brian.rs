@@ -188,9 +188,25 @@ pub struct Brian {
     act_values: Vec<FuzzyValue>,
     lower: Vec<Acc>,
     level_acc: Vec<Acc>,
+    /// Last cycle's (CANDO, WANT) of each behavior, in run order; `None` when it did not run.
+    activity: Vec<Option<Activity>>,
     /// Inputs that carry `Proposed<Action>` data (set by the engine, not by callers).
     is_proposed: Vec<bool>,
     outputs: Vec<Option<f64>>,
+}
+
+/// A behavior's (CANDO, WANT) in a cycle it ran.
+pub type Activity = (FuzzyValue, FuzzyValue);
+
+/// What one cycle computed; see [`Brian::trace`].
+#[derive(Clone, Debug)]
+pub struct Trace<'a> {
+    /// Predicates of `Predicate.ini`, in file order.
+    pub predicates: Vec<(&'a str, FuzzyValue)>,
+    /// Predicate actions of `PredicateActions.ini`, in file order.
+    pub predicate_actions: Vec<(&'a str, FuzzyValue)>,
+    /// Behaviors in run order: name, level, and (CANDO, WANT) when it ran.
+    pub behaviors: Vec<(&'a str, i64, Option<Activity>)>,
 }
 
 /// The crisp commands of one cycle: action name → value, sorted by name. An action every
@@ -397,6 +413,7 @@ impl Brian {
         let is_proposed =
             (0..inputs.len()).map(|i| actions.iter().any(|a| a.proposed == Some(i))).collect();
         Ok(Brian {
+            activity: vec![None; behaviors.len()],
             is_proposed,
             outputs: vec![None; actions.len()],
             composer: Composer::default(),
@@ -427,6 +444,43 @@ impl Brian {
     /// The names of the crisp inputs (`ctof.txt`).
     pub fn input_names(&self) -> impl Iterator<Item = &str> {
         self.inputs.iter().map(|i| i.name.as_str())
+    }
+
+    /// What the last cycle computed, for debugging rules: every predicate, every predicate
+    /// action (as evaluated for the highest level), and each behavior's CANDO and WANT (`None`
+    /// when its CANDO was not above the threshold and it did not run).
+    pub fn trace(&self) -> Trace<'_> {
+        Trace {
+            predicates: self
+                .predicates
+                .iter()
+                .map(|(n, _)| n.as_str())
+                .zip(self.pred_values.iter().copied())
+                .collect(),
+            predicate_actions: self
+                .predicate_actions
+                .iter()
+                .map(|(n, _)| n.as_str())
+                .zip(self.act_values.iter().copied())
+                .collect(),
+            behaviors: self
+                .behaviors
+                .iter()
+                .map(|b| (b.name.as_str(), b.level))
+                .zip(self.activity.iter().copied())
+                .map(|((n, l), a)| (n, l, a))
+                .collect(),
+        }
+    }
+
+    /// The input shapes, with the crisp datum each one fuzzifies.
+    pub fn input_shapes(&self) -> impl Iterator<Item = (&str, &Shape)> {
+        self.inputs.iter().map(|i| (i.name.as_str(), &i.shape))
+    }
+
+    /// The output actions with their singletons `(label, value)`.
+    pub fn output_singletons(&self) -> impl Iterator<Item = (&str, &[(String, f64)])> {
+        self.actions.iter().map(|a| (a.name.as_str(), a.labels.as_slice()))
     }
 
     /// The slot of a crisp input, for [`set_input`](Self::set_input).
@@ -567,13 +621,14 @@ impl Brian {
             e.eval(&self.data, &self.pred_values, &self.act_values)
         });
         if cando.value <= self.threshold {
+            self.activity[b] = None;
             return;
         }
-        let want = beh
-            .want
-            .as_ref()
-            .map_or(0.0, |e| e.eval(&self.data, &self.pred_values, &self.act_values).value);
-        let weight = if want > WANT_THRESHOLD { want } else { 0.0 };
+        let want = beh.want.as_ref().map_or(FuzzyValue::MISSING, |e| {
+            e.eval(&self.data, &self.pred_values, &self.act_values)
+        });
+        self.activity[b] = Some((cando, want));
+        let weight = if want.value > WANT_THRESHOLD { want.value } else { 0.0 };
         for rule in &beh.rules {
             let p = rule.precondition.eval(&self.data, &self.pred_values, &self.act_values);
             if p.reliability < MIN_RELIABILITY {

@@ -1,0 +1,156 @@
+//! `mrt brian check|eval|plot` on the shared brian40 configurations. Skipped, and said so, when
+//! `../shared` is absent (it is always there in CI).
+
+#![allow(clippy::unwrap_used, clippy::print_stderr)]
+
+use std::io::Write;
+use std::path::PathBuf;
+use std::process::{Command, Stdio};
+
+fn mrt() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_mrt"))
+}
+
+fn bench(name: &str) -> Option<PathBuf> {
+    let d = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/bench").join(name);
+    if d.exists() {
+        Some(d)
+    } else {
+        eprintln!("skipped: {} is absent", d.display());
+        None
+    }
+}
+
+fn copy_dir(from: &std::path::Path, to: &std::path::Path) {
+    std::fs::create_dir_all(to).unwrap();
+    for e in std::fs::read_dir(from).unwrap() {
+        let e = e.unwrap();
+        let target = to.join(e.file_name());
+        if e.file_type().unwrap().is_dir() {
+            copy_dir(&e.path(), &target);
+        } else {
+            std::fs::copy(e.path(), target).unwrap();
+        }
+    }
+}
+
+#[test]
+fn check_is_silent_on_a_good_configuration_and_names_the_place_of_an_error() {
+    let Some(dir) = bench("brian40-hier") else { return };
+    let out = mrt().args(["brian", "check"]).arg(&dir).output().unwrap();
+    assert!(out.status.success());
+    assert!(out.stdout.is_empty() && out.stderr.is_empty());
+
+    let broken = std::env::temp_dir().join(format!("mrt-brian-check-{}", std::process::id()));
+    copy_dir(&dir, &broken);
+    let rul = broken.join("behaviors/ApproachBall.rul");
+    let text = std::fs::read_to_string(&rul)
+        .unwrap()
+        .replace("(BallClose) => (SpeedModule SLOW);", "(BallClose) => (SpeedModule SLOWW);");
+    std::fs::write(&rul, text).unwrap();
+    let out = mrt().args(["brian", "check"]).arg(&broken).output().unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.starts_with("error in file "), "{err}");
+    assert!(
+        err.contains(
+            "ApproachBall.rul at line 2, column 29: action `SpeedModule` has no label `SLOWW`"
+        ),
+        "{err}"
+    );
+    std::fs::remove_dir_all(&broken).unwrap();
+}
+
+#[test]
+fn eval_reads_json_lines_and_matches_the_expected_commands() {
+    let Some(dir) = bench("brian40") else { return };
+    let cycles: Vec<String> = std::fs::read_to_string(dir.join("cycles.jsonl"))
+        .unwrap()
+        .lines()
+        .take(20)
+        .map(String::from)
+        .collect();
+    let expected: Vec<serde_json::Value> = std::fs::read_to_string(dir.join("expected.jsonl"))
+        .unwrap()
+        .lines()
+        .take(20)
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect();
+    let mut child = mrt()
+        .args(["brian", "eval"])
+        .arg(&dir)
+        .arg("--trace")
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .spawn()
+        .unwrap();
+    child.stdin.take().unwrap().write_all(cycles.join("\n").as_bytes()).unwrap();
+    let out = child.wait_with_output().unwrap();
+    assert!(out.status.success());
+    let got: Vec<serde_json::Value> = String::from_utf8(out.stdout)
+        .unwrap()
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect();
+    assert_eq!(got.len(), 20);
+    for (g, e) in got.iter().zip(&expected) {
+        for (k, v) in e.as_object().unwrap() {
+            let (g, v) = (g[k].as_f64().unwrap(), v.as_f64().unwrap());
+            let d = if k.contains("Angle") {
+                (g - v).rem_euclid(360.0).min((v - g).rem_euclid(360.0))
+            } else {
+                (g - v).abs()
+            };
+            assert!(d < 1e-3, "{k}: {g} vs {v}");
+        }
+        assert!(g["_trace"]["predicates"]["BallSeen"].is_array());
+        assert!(g["_trace"]["behaviors"]["SearchBall"]["active"].is_boolean());
+    }
+    // A malformed line is an error naming the line, not a panic.
+    let mut child = mrt()
+        .args(["brian", "eval"])
+        .arg(&dir)
+        .stdin(Stdio::piped())
+        .stderr(Stdio::piped())
+        .stdout(Stdio::null())
+        .spawn()
+        .unwrap();
+    child
+        .stdin
+        .take()
+        .unwrap()
+        .write_all(b"{\"BallDistance\": 10}\n{\"BallDistance\": \"far\"}\n")
+        .unwrap();
+    let out = child.wait_with_output().unwrap();
+    assert!(!out.status.success());
+    assert!(
+        String::from_utf8_lossy(&out.stderr).contains("input line 2"),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
+#[test]
+fn plot_draws_every_shape() {
+    let Some(dir) = bench("brian40-hier") else { return };
+    let svg = std::env::temp_dir().join(format!("mrt-brian-plot-{}.svg", std::process::id()));
+    let out = mrt().args(["brian", "plot"]).arg(&dir).arg("--out").arg(&svg).output().unwrap();
+    assert!(out.status.success());
+    let text = std::fs::read_to_string(&svg).unwrap();
+    assert!(text.starts_with("<svg"));
+    for name in [
+        "BALLDIST",
+        "OBSTDIST",
+        "ANGLE",
+        "PSPEED",
+        "PHEADING",
+        "SpeedModule",
+        "SpeedAngle",
+        "FRONTRIGHT",
+        "AHEAD_B",
+    ] {
+        assert!(text.contains(name), "{name} missing");
+    }
+    assert_eq!(text.matches("<polyline").count(), 4 + 3 + 6 + 6 + 3 + 4, "one curve per input set");
+    std::fs::remove_file(&svg).unwrap();
+}
