@@ -488,10 +488,12 @@ impl Brian {
         self.inputs.iter().position(|i| i.name == name)
     }
 
-    /// Sets an input for the next [`step`](Self::step). Reliability is clamped to `[0, 1]`.
+    /// Sets an input for the next [`step`](Self::step). Reliability is clamped to `[0, 1]`; a
+    /// NaN reliability counts as 0 (the datum is not trusted at all).
     pub fn set_input(&mut self, slot: usize, value: f64, reliability: f64) {
+        let reliability = if reliability.is_nan() { 0.0 } else { reliability.clamp(0.0, 1.0) };
         if let Some(i) = self.inputs.get_mut(slot) {
-            i.now = Some((value, reliability.clamp(0.0, 1.0)));
+            i.now = Some((value, reliability));
         }
     }
 
@@ -758,6 +760,42 @@ fn parse_rules(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use proptest::prelude::*;
+
+    fn soup() -> impl Strategy<Value = String> {
+        proptest::collection::vec(
+            prop_oneof![
+                Just("("), Just(")"), Just("AND"), Just("OR"), Just("NOT"), Just("D"), Just("P"),
+                Just("level"), Just("1"), Just("-2.5"), Just("A"), Just("B"), Just("=>"), Just("="),
+                Just(">"), Just(";"), Just("&DEL.Out"), Just("ANY"), Just("Out"), Just("HIGH"),
+                Just("#x\n"), Just("\n"), Just(" ")
+            ],
+            0..48,
+        )
+        .prop_map(|v| v.concat())
+    }
+
+    fn try_all(text: &str) {
+        let file = Path::new("x");
+        let Ok(toks) = tokenize(text, file) else { return };
+        let names = Names { inputs: &[], predicates: &[], predicate_actions: &[], file };
+        let actions = [Action { name: "Out".into(), labels: vec![("HIGH".into(), 1.0)], circular: false, proposed: None, offset: 0 }];
+        let _ = parse_rules(&mut Cursor::new(&toks, file, text), &names, &actions);
+        let _ = parse_behavior_list(&mut Cursor::new(&toks, file, text));
+        let _ = parse_definitions(&mut Cursor::new(&toks, file, text));
+    }
+
+    proptest! {
+        #[test]
+        fn rule_definition_and_behavior_parsers_never_panic_on_bytes(bytes in proptest::collection::vec(any::<u8>(), 0..200)) {
+            try_all(&String::from_utf8_lossy(&bytes));
+        }
+
+        #[test]
+        fn rule_definition_and_behavior_parsers_never_panic_on_token_soup(text in soup()) {
+            try_all(&text);
+        }
+    }
 
     /// §10.4.9 with `mult_weight_composer` and `average_float_composer`: GoToTarget (weight
     /// 0.67) proposes FAST 0.56 and 0.478, SLOW 0.968; AvoidObstacle (weight 1) SLOW 0.354.

@@ -1,0 +1,48 @@
+//! Bad inputs never panic and have documented effects: NaN belongs to no fuzzy set; ±∞ belong
+//! to the open sides (TOL/TOR); unknown names are ignored; reliability is clamped to [0, 1];
+//! a missing input reads as value 0, reliability 1 (§10.3.6).
+
+#![allow(clippy::unwrap_used)]
+
+use mrt_fuzzy::brian::Brian;
+use std::path::PathBuf;
+
+fn config() -> PathBuf {
+    let d = std::env::temp_dir().join(format!("mrt-fuzzy-robust-{}", std::process::id()));
+    std::fs::create_dir_all(d.join("behaviors")).unwrap();
+    let files = [
+        ("shape_ctof.txt", "(Dist (TOL (NEAR 10 20)) (TOR (FAR 10 20)))"),
+        ("ctof.txt", "(D Dist)"),
+        ("Predicate.ini", "Near = (D D NEAR);\nFar = (D D FAR);"),
+        ("Cando.ini", "Go = (OR (P Near) (P Far));"),
+        ("want.txt", "Go = (OR (P Near) (P Far));"),
+        ("behavior.txt", "(level 1 Go behaviors/Go.rul)"),
+        ("behaviors/Go.rul", "(Near) => (Speed SLOW);\n(Far) => (Speed FAST);"),
+        ("s_shape.txt", "(SPEED (SNG (SLOW 10)) (SNG (FAST 100)))"),
+        ("s_ftoc.txt", "(Speed SPEED)"),
+    ];
+    for (f, t) in files {
+        std::fs::write(d.join(f), t).unwrap();
+    }
+    d
+}
+
+#[test]
+fn bad_numbers_and_names_never_panic() {
+    let dir = config();
+    let mut b = Brian::from_dir(&dir).unwrap();
+    // Near: the robot slows down.
+    assert_eq!(b.run(&[("D", 5.0, 1.0)]).get("Speed"), Some(&10.0));
+    // NaN is in no set: nothing is proposed, the action is absent.
+    assert_eq!(b.run(&[("D", f64::NAN, 1.0)]).get("Speed"), None);
+    // +∞ is FAR, −∞ is NEAR.
+    assert_eq!(b.run(&[("D", f64::INFINITY, 1.0)]).get("Speed"), Some(&100.0));
+    assert_eq!(b.run(&[("D", f64::NEG_INFINITY, 1.0)]).get("Speed"), Some(&10.0));
+    // Reliability outside [0, 1] is clamped; NaN reliability proposes nothing.
+    assert_eq!(b.run(&[("D", 30.0, 7.0)]).get("Speed"), Some(&100.0));
+    assert_eq!(b.run(&[("D", 30.0, f64::NAN)]).get("Speed"), None);
+    // Unknown names are ignored; a missing input reads as (0, 1): nothing can run.
+    assert_eq!(b.run(&[("Nope", 1.0, 1.0)]).get("Speed"), None);
+    assert!(b.run(&[]).is_empty());
+    std::fs::remove_dir_all(&dir).unwrap();
+}
