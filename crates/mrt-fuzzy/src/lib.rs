@@ -5,10 +5,11 @@
 //! rules, composes them by CANDO/WANT conditions in a hierarchy, and defuzzifies the result into
 //! crisp commands.
 //!
-//! This crate is being built bottom-up. It holds today the fuzzy core shared by Mr. BRIAN and
-//! ThinkingCap's HBM behaviors: the fuzzy sets of §10.4.1 ([`FuzzySet`]), the (value,
-//! reliability) fuzzy datum and its operators ([`FuzzyValue`]), the shape and association files
-//! of §10.4.1 and §10.4.6 ([`shapes`]) with fuzzification and singleton defuzzification.
+//! The fuzzy core (sets of §10.4.1 as [`FuzzySet`], the (value, reliability) datum and its
+//! operators as [`FuzzyValue`], shapes, fuzzification and singleton defuzzification in
+//! [`shapes`]) is shared with ThinkingCap's HBM behaviors. The engine is [`brian::Brian`]: it
+//! loads a configuration directory of the manual's files and runs one cycle in well under a
+//! microsecond (see `docs/performance.md`).
 //!
 //! ```
 //! use mrt_fuzzy::shapes::{defuzzify, parse_shapes};
@@ -34,6 +35,11 @@
 //! | `shape_ctof.txt`, `s_shape.txt` | [`shapes::parse_shapes`], [`shapes::Shape`] |
 //! | `ctof.txt`, `s_ftoc.txt` | [`shapes::parse_associations`] |
 //! | default (singleton) defuzzification, formula 10.6 | [`shapes::defuzzify`] |
+//! | `Predicate.ini`, `PredicateActions.ini`, `Cando.ini`, `want.txt` | [`expr`] grammar, resolved by [`brian::Brian`] |
+//! | `behavior.txt`, `*.rul` rules with `&DEL` | [`brian::Brian::from_dir`] |
+//! | `weight_composer` / `float_composer` (max, average) | [`brian::Composer`] |
+//! | `threshold_filter` (0.49) | [`brian::Brian::set_threshold`] |
+//! | the checker of §10.4.7 | `mrt brian check DIR` (errors: [`BrianError`]) |
 #![deny(missing_docs)]
 
 pub mod brian;
