@@ -9,11 +9,16 @@ use std::fmt::Write as _;
 use std::io::{BufRead, Write};
 use std::path::Path;
 
-/// `mrt brian check DIR`: silent when the configuration is correct (like the manual's checker);
-/// otherwise the error, and exit status 1.
+/// `mrt brian check DIR`: silent when the configuration is correct (like the manual's checker)
+/// but for warnings (unused definitions); on an error, the error and exit status 1.
 pub fn check(dir: &Path) -> Result<()> {
     match Brian::from_dir(dir) {
-        Ok(_) => Ok(()),
+        Ok(b) => {
+            for w in b.warnings() {
+                eprintln!("{w}");
+            }
+            Ok(())
+        }
         Err(e) => {
             eprintln!("{e}");
             std::process::exit(1);

@@ -188,6 +188,8 @@ pub struct Brian {
     act_values: Vec<FuzzyValue>,
     lower: Vec<Acc>,
     level_acc: Vec<Acc>,
+    /// What the loader found suspicious but legal (unused definitions...).
+    warnings: Vec<String>,
     /// Last cycle's (CANDO, WANT) of each behavior, in run order; `None` when it did not run.
     activity: Vec<Option<Activity>>,
     /// Inputs that carry `Proposed<Action>` data (set by the engine, not by callers).
@@ -297,8 +299,19 @@ impl Brian {
             offset += n;
         }
 
+        let mut warnings = Vec::new();
+        for shape in shapes.iter().filter(|s| !assocs.iter().any(|a| a.shape == s.name)) {
+            warnings.push(warning(
+                &files.shape_ctof,
+                shape.span,
+                &format!("shape `{}` is not used in ctof.txt", shape.name),
+            ));
+        }
+        let mut pred_spans = Vec::new();
+        let mut pact_spans = Vec::new();
         let mut predicates: Vec<(String, Expr)> = Vec::new();
-        for (name, _span, raw) in parse_file(&files.predicates, parse_definitions)? {
+        for (name, span, raw) in parse_file(&files.predicates, parse_definitions)? {
+            pred_spans.push(span);
             let e = Names {
                 inputs: &inputs,
                 predicates: &predicates,
@@ -325,6 +338,7 @@ impl Brian {
                     file: &files.predicate_actions,
                 }
                 .resolve(&raw)?;
+                pact_spans.push(span);
                 predicate_actions.push((name, e));
             }
         }
@@ -409,10 +423,41 @@ impl Brian {
         }
         behaviors.sort_by(|a, b| (a.level, &a.name).cmp(&(b.level, &b.name)));
 
+        // Definitions nobody uses are legal but usually a mistake: warn.
+        let mut used_p = vec![false; predicates.len()];
+        let mut used_a = vec![false; predicate_actions.len()];
+        let exprs = predicates
+            .iter()
+            .map(|(_, e)| e)
+            .chain(predicate_actions.iter().map(|(_, e)| e))
+            .chain(behaviors.iter().flat_map(|b| b.cando.iter().chain(b.want.iter())))
+            .chain(behaviors.iter().flat_map(|b| b.rules.iter().map(|r| &r.precondition)));
+        for e in exprs {
+            mark_used(e, &mut used_p, &mut used_a);
+        }
+        for (i, (name, _)) in predicates.iter().enumerate().filter(|(i, _)| !used_p[*i]) {
+            warnings.push(warning(
+                &files.predicates,
+                pred_spans[i],
+                &format!("predicate `{name}` is never used"),
+            ));
+        }
+        for (i, (name, _)) in predicate_actions.iter().enumerate().filter(|(i, _)| !used_a[*i]) {
+            warnings.push(warning(
+                &files.predicate_actions,
+                pact_spans[i],
+                &format!("predicate action `{name}` is never used"),
+            ));
+        }
+        for b in behaviors.iter().filter(|b| b.want.is_none()) {
+            warnings.push(format!("warning in file {}: behavior `{}` has no WANT entry: its weight is 0 and it proposes nothing", files.want.display(), b.name));
+        }
+
         let slots = actions.iter().map(|a| a.labels.len()).sum();
         let is_proposed =
             (0..inputs.len()).map(|i| actions.iter().any(|a| a.proposed == Some(i))).collect();
         Ok(Brian {
+            warnings,
             activity: vec![None; behaviors.len()],
             is_proposed,
             outputs: vec![None; actions.len()],
@@ -429,6 +474,12 @@ impl Brian {
             actions,
             threshold: DEFAULT_THRESHOLD,
         })
+    }
+
+    /// Warnings from loading, in the checker's format: unused shapes, predicates and predicate
+    /// actions, behaviors without WANT.
+    pub fn warnings(&self) -> &[String] {
+        &self.warnings
     }
 
     /// Chooses the composer (default [`Composer::Max`]).
@@ -656,6 +707,28 @@ impl Brian {
     }
 }
 
+fn warning(file: &Path, span: Span, what: &str) -> String {
+    format!(
+        "warning in file {} at line {}, column {}: {what}",
+        file.display(),
+        span.line,
+        span.column
+    )
+}
+
+fn mark_used(e: &Expr, preds: &mut [bool], acts: &mut [bool]) {
+    match e {
+        Expr::And(a, b) | Expr::Or(a, b) => {
+            mark_used(a, preds, acts);
+            mark_used(b, preds, acts);
+        }
+        Expr::Not(a) => mark_used(a, preds, acts),
+        Expr::Pred(i) => preds[*i] = true,
+        Expr::Action(i) => acts[*i] = true,
+        Expr::Data(_) => {}
+    }
+}
+
 fn offset_of(inputs: &[Input]) -> usize {
     inputs.iter().map(|i| i.shape.sets.len()).sum()
 }
@@ -765,10 +838,29 @@ mod tests {
     fn soup() -> impl Strategy<Value = String> {
         proptest::collection::vec(
             prop_oneof![
-                Just("("), Just(")"), Just("AND"), Just("OR"), Just("NOT"), Just("D"), Just("P"),
-                Just("level"), Just("1"), Just("-2.5"), Just("A"), Just("B"), Just("=>"), Just("="),
-                Just(">"), Just(";"), Just("&DEL.Out"), Just("ANY"), Just("Out"), Just("HIGH"),
-                Just("#x\n"), Just("\n"), Just(" ")
+                Just("("),
+                Just(")"),
+                Just("AND"),
+                Just("OR"),
+                Just("NOT"),
+                Just("D"),
+                Just("P"),
+                Just("level"),
+                Just("1"),
+                Just("-2.5"),
+                Just("A"),
+                Just("B"),
+                Just("=>"),
+                Just("="),
+                Just(">"),
+                Just(";"),
+                Just("&DEL.Out"),
+                Just("ANY"),
+                Just("Out"),
+                Just("HIGH"),
+                Just("#x\n"),
+                Just("\n"),
+                Just(" ")
             ],
             0..48,
         )
@@ -779,7 +871,13 @@ mod tests {
         let file = Path::new("x");
         let Ok(toks) = tokenize(text, file) else { return };
         let names = Names { inputs: &[], predicates: &[], predicate_actions: &[], file };
-        let actions = [Action { name: "Out".into(), labels: vec![("HIGH".into(), 1.0)], circular: false, proposed: None, offset: 0 }];
+        let actions = [Action {
+            name: "Out".into(),
+            labels: vec![("HIGH".into(), 1.0)],
+            circular: false,
+            proposed: None,
+            offset: 0,
+        }];
         let _ = parse_rules(&mut Cursor::new(&toks, file, text), &names, &actions);
         let _ = parse_behavior_list(&mut Cursor::new(&toks, file, text));
         let _ = parse_definitions(&mut Cursor::new(&toks, file, text));

@@ -8,7 +8,11 @@ use mrt_fuzzy::brian::Brian;
 use std::path::PathBuf;
 
 fn config() -> PathBuf {
-    let d = std::env::temp_dir().join(format!("mrt-fuzzy-robust-{}", std::process::id()));
+    let d = std::env::temp_dir().join(format!(
+        "mrt-fuzzy-robust-{}-{:?}",
+        std::process::id(),
+        std::thread::current().id()
+    ));
     std::fs::create_dir_all(d.join("behaviors")).unwrap();
     let files = [
         ("shape_ctof.txt", "(Dist (TOL (NEAR 10 20)) (TOR (FAR 10 20)))"),
@@ -44,5 +48,34 @@ fn bad_numbers_and_names_never_panic() {
     // Unknown names are ignored; a missing input reads as (0, 1): nothing can run.
     assert_eq!(b.run(&[("Nope", 1.0, 1.0)]).get("Speed"), None);
     assert!(b.run(&[]).is_empty());
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn unused_definitions_are_warnings_with_their_place() {
+    let dir = config();
+    std::fs::write(
+        dir.join("shape_ctof.txt"),
+        "(Dist (TOL (NEAR 10 20)) (TOR (FAR 10 20)))\n(Spare (SNG (X 1)))",
+    )
+    .unwrap();
+    std::fs::write(
+        dir.join("Predicate.ini"),
+        "Near = (D D NEAR);\nFar = (D D FAR);\nLonely = (NOT (P Far));",
+    )
+    .unwrap();
+    let b = Brian::from_dir(&dir).unwrap();
+    let w = b.warnings();
+    assert_eq!(w.len(), 2, "{w:?}");
+    assert!(
+        w[0].ends_with("shape_ctof.txt at line 2, column 2: shape `Spare` is not used in ctof.txt"),
+        "{}",
+        w[0]
+    );
+    assert!(
+        w[1].ends_with("Predicate.ini at line 3, column 1: predicate `Lonely` is never used"),
+        "{}",
+        w[1]
+    );
     std::fs::remove_dir_all(&dir).unwrap();
 }
