@@ -79,3 +79,37 @@ fn unused_definitions_are_warnings_with_their_place() {
     );
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// §10.5: the previous cycle's outputs come back as inputs under the output's name with
+/// reliability 1, unless the new cycle supplies that name.
+#[test]
+fn previous_outputs_feed_back_as_inputs() {
+    let dir = config();
+    std::fs::write(
+        dir.join("shape_ctof.txt"),
+        "(Dist (TOL (NEAR 10 20)) (TOR (FAR 10 20)))\n(Sp (TOL (LOW 20 30)))",
+    )
+    .unwrap();
+    std::fs::write(dir.join("ctof.txt"), "(D Dist)\n(Speed Sp)").unwrap();
+    std::fs::write(
+        dir.join("Predicate.ini"),
+        "Near = (D D NEAR);\nFar = (D D FAR);\nWasSlow = (D Speed LOW);",
+    )
+    .unwrap();
+    std::fs::write(dir.join("want.txt"), "Go = (OR (P Near) (OR (P Far) (P WasSlow)));").unwrap();
+    let mut b = Brian::from_dir(&dir).unwrap();
+    let was_slow = |b: &Brian| {
+        b.trace()
+            .predicates
+            .iter()
+            .find(|(n, _)| *n == "WasSlow")
+            .map(|(_, v)| (v.value, v.reliability))
+    };
+    assert_eq!(b.run(&[("D", 5.0, 1.0)]).get("Speed"), Some(&10.0));
+    assert_eq!(was_slow(&b), Some((0.0, 1.0)), "first cycle: no previous output, Speed missing");
+    b.run(&[("D", 50.0, 1.0)]);
+    assert_eq!(was_slow(&b), Some((1.0, 1.0)), "previous Speed 10 is LOW");
+    b.run(&[("D", 50.0, 1.0), ("Speed", 100.0, 0.5)]);
+    assert_eq!(was_slow(&b), Some((0.0, 0.5)), "a supplied Speed wins over the previous output");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
