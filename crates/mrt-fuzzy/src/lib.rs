@@ -39,6 +39,7 @@
 //! | `behavior.txt`, `*.rul` rules with `&DEL` | [`brian::Brian::from_dir`] |
 //! | `weight_composer` / `float_composer` (max, average) | [`brian::Composer`] |
 //! | `threshold_filter` (0.49) | [`brian::Brian::set_threshold`] |
+//! | Parser and Messenger (§10.3.10) on the bus | [`member::BrianMember`], [`member::BrianInputs`], [`member::BrianCommands`] (feature `member`) |
 //! | the checker of §10.4.7 | `mrt brian check DIR` (errors: [`BrianError`]) |
 #![deny(missing_docs)]
 
@@ -46,6 +47,8 @@ pub mod brian;
 mod error;
 pub mod expr;
 pub mod lexer;
+#[cfg(feature = "member")]
+pub mod member;
 mod set;
 pub mod shapes;
 
