@@ -690,7 +690,12 @@ impl Brian {
             let value = p.value * p.reliability;
             for act in &rule.actions {
                 match *act {
-                    RuleAction::Propose(slot) => self.level_acc[slot].add(weight * value),
+                    // A rule that does not fire (value 0), or a behavior of weight 0, proposes
+                    // nothing: it must not count in the average composer's mean.
+                    RuleAction::Propose(slot) if weight * value > 0.0 => {
+                        self.level_acc[slot].add(weight * value)
+                    }
+                    RuleAction::Propose(_) => {}
                     RuleAction::Delete { action, label } if value > 0.0 => {
                         let a = &self.actions[action];
                         match label {
@@ -787,6 +792,12 @@ fn parse_rules(
         }
         let mut acts = Vec::new();
         while c.peek() == Some(&Tok::Open) {
+            // `(` followed by something that is not an action starts the next rule: the `;`
+            // of this one is missing.
+            let is_action = matches!(c.peek_at(1), Some(Tok::Word(w)) if w.starts_with("&DEL.") || actions.iter().any(|a| a.name == *w));
+            if !acts.is_empty() && !is_action {
+                return Err(c.expected("`;` at the end of the rule"));
+            }
             c.punct(Tok::Open, "`(`")?;
             let (name, span) = c.word("an action name or &DEL.<action>")?;
             let (label, lspan) = c.word("a label")?;

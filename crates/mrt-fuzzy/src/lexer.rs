@@ -130,6 +130,11 @@ impl<'a> Cursor<'a> {
         self.toks.get(self.pos).map(|(t, _)| t)
     }
 
+    /// The token `n` places after the next one (`peek_at(0)` is [`peek`](Self::peek)).
+    pub fn peek_at(&self, n: usize) -> Option<&'a Tok> {
+        self.toks.get(self.pos + n).map(|(t, _)| t)
+    }
+
     /// Where the next token is (or the end of the file).
     pub fn span(&self) -> Span {
         self.toks.get(self.pos).map_or(self.end, |(_, s)| *s)
