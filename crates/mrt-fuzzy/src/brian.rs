@@ -714,7 +714,7 @@ impl Brian {
 
 fn warning(file: &Path, span: Span, what: &str) -> String {
     format!(
-        "warning in file {} at line {}, column {}: {what}",
+        "warning in file {0} at line {1}: {what}\n  --> {0}:{1}:{2}",
         file.display(),
         span.line,
         span.column

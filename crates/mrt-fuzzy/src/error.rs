@@ -8,8 +8,9 @@ use std::path::{Path, PathBuf};
 #[non_exhaustive]
 pub enum BrianError {
     /// A syntax or meaning error at a place in a file. Displayed as the manual's checker does
-    /// (§10.4.7), with the column added: `error in file <path> at line <n>, column <c>: ...`.
-    #[error("error in file {} at line {line}, column {column}: {message}", file.display())]
+    /// (§10.4.7), `error in file <path> at line <n>: <what was expected>`, then a second line
+    /// `  --> <path>:<line>:<column>` that editors and terminals can jump to.
+    #[error("error in file {} at line {line}: {message}\n  --> {}:{line}:{column}", file.display(), file.display())]
     At {
         /// The file.
         file: PathBuf,

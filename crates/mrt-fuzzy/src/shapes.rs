@@ -290,20 +290,20 @@ mod tests {
         assert_eq!(resolve(&ok, &shapes, Path::new("ctof.txt")).unwrap(), vec![0]);
         let bad = parse_associations("\n  (TargetAngle Angle)\n", Path::new("ctof.txt")).unwrap();
         let e = resolve(&bad, &shapes, Path::new("ctof.txt")).unwrap_err().to_string();
-        assert_eq!(e, "error in file ctof.txt at line 2, column 4: unknown shape `Angle` for `TargetAngle` (known shapes: Distance)");
+        assert_eq!(e, "error in file ctof.txt at line 2: unknown shape `Angle` for `TargetAngle` (known shapes: Distance)\n  --> ctof.txt:2:4");
     }
 
     #[test]
     fn syntax_errors_name_file_line_and_column() {
         let cases = [
-            ("(Distance\n (TRX (A 1 2 3)))", "at line 2, column 3: expected a fuzzy set identifier (TRI, TOL, TOR, DIV, TRA, REC or SNG), found `TRX`"),
-            ("(Distance\n (TRI (A 1 2)))", "at line 2, column 13: expected value 3 of 3 of TRI `A` (TRI takes 3), found `)`"),
-            ("(Distance\n (TRI (A 1 2 3 4)))", "at line 2, column 16: expected `)` after the 3 values of TRI `A`, found the number `4`"),
-            ("(Distance\n (TRI (A 3 2 1)))", "at line 2, column 8: the values of TRI `A` must not decrease: [3.0, 2.0, 1.0]"),
-            ("(Distance\n (SNG (A 1))\n (SNG (A 2)))", "at line 3, column 8: label `A` appears twice in shape `Distance`"),
-            ("(D (SNG (A 1)))\n(D (SNG (B 1)))", "at line 2, column 2: shape `D` is already defined at line 1"),
-            ("(Distance\n (SNG (A 1))", "at line 2, column 13: expected `(` for another fuzzy set or `)` to close shape `Distance`, found end of file"),
-            ("Distance", "at line 1, column 1: expected `(` to start a shape, found `Distance`"),
+            ("(Distance\n (TRX (A 1 2 3)))", "at line 2: expected a fuzzy set identifier (TRI, TOL, TOR, DIV, TRA, REC or SNG), found `TRX`\n  --> s.txt:2:3"),
+            ("(Distance\n (TRI (A 1 2)))", "at line 2: expected value 3 of 3 of TRI `A` (TRI takes 3), found `)`\n  --> s.txt:2:13"),
+            ("(Distance\n (TRI (A 1 2 3 4)))", "at line 2: expected `)` after the 3 values of TRI `A`, found the number `4`\n  --> s.txt:2:16"),
+            ("(Distance\n (TRI (A 3 2 1)))", "at line 2: the values of TRI `A` must not decrease: [3.0, 2.0, 1.0]\n  --> s.txt:2:8"),
+            ("(Distance\n (SNG (A 1))\n (SNG (A 2)))", "at line 3: label `A` appears twice in shape `Distance`\n  --> s.txt:3:8"),
+            ("(D (SNG (A 1)))\n(D (SNG (B 1)))", "at line 2: shape `D` is already defined at line 1\n  --> s.txt:2:2"),
+            ("(Distance\n (SNG (A 1))", "at line 2: expected `(` for another fuzzy set or `)` to close shape `Distance`, found end of file\n  --> s.txt:2:13"),
+            ("Distance", "at line 1: expected `(` to start a shape, found `Distance`\n  --> s.txt:1:1"),
         ];
         for (text, want) in cases {
             let e = parse_shapes(text, Path::new("s.txt")).unwrap_err().to_string();

@@ -211,8 +211,8 @@ fn load_broken(case: &str) -> (PathBuf, BrianError) {
     (over, err)
 }
 
-/// Checks the error's place and its exact text, `error in file <path> at line <l>, column
-/// <c>: <message>`.
+/// Checks the error's place and its exact text: the manual checker's line
+/// `error in file <path> at line <l>: <message>`, then `  --> <path>:<l>:<c>`.
 fn check(case: &str, file: &str, line: usize, column: usize, message: &str) {
     let (dir, err) = load_broken(case);
     let path = dir.join(file);
@@ -224,7 +224,10 @@ fn check(case: &str, file: &str, line: usize, column: usize, message: &str) {
     }
     assert_eq!(
         err.to_string(),
-        format!("error in file {} at line {line}, column {column}: {message}", path.display()),
+        format!(
+            "error in file {0} at line {line}: {message}\n  --> {0}:{line}:{column}",
+            path.display()
+        ),
         "{case}"
     );
 }

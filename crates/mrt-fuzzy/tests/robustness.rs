@@ -68,12 +68,14 @@ fn unused_definitions_are_warnings_with_their_place() {
     let w = b.warnings();
     assert_eq!(w.len(), 2, "{w:?}");
     assert!(
-        w[0].ends_with("shape_ctof.txt at line 2, column 2: shape `Spare` is not used in ctof.txt"),
+        w[0].contains("shape_ctof.txt at line 2: shape `Spare` is not used in ctof.txt\n  --> ")
+            && w[0].ends_with("shape_ctof.txt:2:2"),
         "{}",
         w[0]
     );
     assert!(
-        w[1].ends_with("Predicate.ini at line 3, column 1: predicate `Lonely` is never used"),
+        w[1].contains("Predicate.ini at line 3: predicate `Lonely` is never used\n  --> ")
+            && w[1].ends_with("Predicate.ini:3:1"),
         "{}",
         w[1]
     );
