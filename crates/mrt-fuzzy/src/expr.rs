@@ -27,21 +27,36 @@ pub enum RawExpr {
     Pred(String, Span),
 }
 
+/// How deeply predicates may nest. Far beyond any real rule; it keeps a hostile file from
+/// overflowing the stack of the parser and of the evaluator.
+pub const MAX_DEPTH: usize = 200;
+
 /// Parses one parenthesized predicate.
 pub fn parse_expr(c: &mut Cursor<'_>) -> Result<RawExpr, BrianError> {
+    parse_nested(c, 0)
+}
+
+fn parse_nested(c: &mut Cursor<'_>, depth: usize) -> Result<RawExpr, BrianError> {
+    if depth >= MAX_DEPTH {
+        return Err(BrianError::at(
+            c.file(),
+            c.span(),
+            format!("predicates nest deeper than {MAX_DEPTH} levels"),
+        ));
+    }
     c.punct(Tok::Open, "`(` to start a predicate")?;
     let (head, span) = c.word("AND, OR, NOT, D, P or a predicate name")?;
     let e = match head.as_str() {
         "AND" | "OR" => {
-            let a = parse_expr(c)?;
-            let b = parse_expr(c)?;
+            let a = parse_nested(c, depth + 1)?;
+            let b = parse_nested(c, depth + 1)?;
             if head == "AND" {
                 RawExpr::And(Box::new(a), Box::new(b))
             } else {
                 RawExpr::Or(Box::new(a), Box::new(b))
             }
         }
-        "NOT" => RawExpr::Not(Box::new(parse_expr(c)?)),
+        "NOT" => RawExpr::Not(Box::new(parse_nested(c, depth + 1)?)),
         "D" => {
             let (data, dspan) = c.word("a datum name after D")?;
             let (label, _) = c.word(&format!("a label of `{data}`"))?;
@@ -117,4 +132,22 @@ pub fn parse_definitions(c: &mut Cursor<'_>) -> Result<Vec<(String, Span, RawExp
         out.push((name, span, e));
     }
     Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::lexer::tokenize;
+    use std::path::Path;
+
+    #[test]
+    fn deep_nesting_is_an_error_not_a_stack_overflow() {
+        let text = format!("X = {}(A){};", "(NOT ".repeat(100_000), ")".repeat(100_000));
+        let toks = tokenize(&text, Path::new("p")).unwrap();
+        let e = parse_definitions(&mut Cursor::new(&toks, Path::new("p"), &text)).unwrap_err();
+        assert!(e.to_string().contains("nest deeper than 200"), "{e}");
+        let ok = format!("X = {}(A){};", "(NOT ".repeat(150), ")".repeat(150));
+        let toks = tokenize(&ok, Path::new("p")).unwrap();
+        assert!(parse_definitions(&mut Cursor::new(&toks, Path::new("p"), &ok)).is_ok());
+    }
 }
