@@ -153,3 +153,48 @@ fn plot_draws_every_shape() {
     assert_eq!(text.matches("<polyline").count(), 4 + 3 + 6 + 6 + 3 + 4, "one curve per input set");
     std::fs::remove_file(&svg).unwrap();
 }
+
+/// The shipped harvester configuration (in the repository, so never skipped).
+#[test]
+fn check_eval_and_plot_work_on_the_shipped_harvester() {
+    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../configs/brian/harvester");
+    let out = mrt().args(["brian", "check"]).arg(&dir).output().unwrap();
+    assert!(
+        out.status.success() && out.stderr.is_empty(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let mut child = mrt()
+        .args(["brian", "eval"])
+        .arg(&dir)
+        .arg("--trace")
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .spawn()
+        .unwrap();
+    child
+        .stdin
+        .take()
+        .unwrap()
+        .write_all(b"{\"TargetDistance\": 300, \"TargetAngle\": 0, \"BatteryLevel\": 100, \"HomeDistance\": 400, \"HomeAngle\": 180}\n")
+        .unwrap();
+    let out = child.wait_with_output().unwrap();
+    assert!(out.status.success());
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    // Target far straight ahead: go FAST (75 cm/s), heading 0 (ahead).
+    assert_eq!(v["SpeedModule"].as_f64(), Some(75.0));
+    assert_eq!(v["SpeedAngle"].as_f64(), Some(0.0));
+    assert_eq!(v["_trace"]["behaviors"]["GoToTarget"]["active"], serde_json::Value::Bool(true));
+    let svg = std::env::temp_dir().join(format!("mrt-harvester-{}.svg", std::process::id()));
+    assert!(mrt()
+        .args(["brian", "plot"])
+        .arg(&dir)
+        .arg("--out")
+        .arg(&svg)
+        .output()
+        .unwrap()
+        .status
+        .success());
+    assert!(std::fs::read_to_string(&svg).unwrap().contains("TargetDistance"));
+    std::fs::remove_file(&svg).unwrap();
+}
