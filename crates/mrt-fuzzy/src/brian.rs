@@ -192,6 +192,8 @@ pub struct Brian {
     warnings: Vec<String>,
     /// Last cycle's (CANDO, WANT) of each behavior, in run order; `None` when it did not run.
     activity: Vec<Option<Activity>>,
+    /// For each input, the output of the same name that feeds it back (§10.5).
+    feedback: Vec<Option<usize>>,
     /// Inputs that carry `Proposed<Action>` data (set by the engine, not by callers).
     is_proposed: Vec<bool>,
     outputs: Vec<Option<f64>>,
@@ -449,6 +451,13 @@ impl Brian {
                 &format!("predicate action `{name}` is never used"),
             ));
         }
+        for b in behaviors.iter().filter(|b| b.cando.is_none()) {
+            warnings.push(format!(
+                "warning in file {}: behavior `{}` has no CANDO entry: it never runs",
+                files.cando.display(),
+                b.name
+            ));
+        }
         for b in behaviors.iter().filter(|b| b.want.is_none()) {
             warnings.push(format!("warning in file {}: behavior `{}` has no WANT entry: its weight is 0 and it proposes nothing", files.want.display(), b.name));
         }
@@ -456,7 +465,10 @@ impl Brian {
         let slots = actions.iter().map(|a| a.labels.len()).sum();
         let is_proposed =
             (0..inputs.len()).map(|i| actions.iter().any(|a| a.proposed == Some(i))).collect();
+        let feedback =
+            inputs.iter().map(|i| actions.iter().position(|a| a.name == i.name)).collect();
         Ok(Brian {
+            feedback,
             warnings,
             activity: vec![None; behaviors.len()],
             is_proposed,
@@ -638,22 +650,17 @@ impl Brian {
             }
         }
         for (ai, a) in self.actions.iter().enumerate() {
-            self.outputs[ai] = self.crisp(a);
+            self.outputs[ai] = self.crisp(a, self.composer);
         }
         // The previous cycle's outputs come back as inputs of the same name (§10.5).
-        for input in &mut self.inputs {
-            input.previous = self
-                .actions
-                .iter()
-                .position(|a| a.name == input.name)
-                .and_then(|ai| self.outputs[ai]);
+        for (input, fb) in self.inputs.iter_mut().zip(&self.feedback) {
+            input.previous = fb.and_then(|ai| self.outputs[ai]);
         }
     }
 
     /// Defuzzifies one action from the accumulated proposals.
-    fn crisp(&self, a: &Action) -> Option<f64> {
+    fn crisp(&self, a: &Action, c: Composer) -> Option<f64> {
         let w = &self.lower[a.offset..a.offset + a.labels.len()];
-        let c = self.composer;
         defuzzify(a.labels.iter().zip(w).map(|((_, s), w)| (*s, w.weight(c))), a.circular)
     }
 
@@ -662,7 +669,9 @@ impl Brian {
         for ai in 0..self.actions.len() {
             let a = &self.actions[ai];
             let Some(slot) = a.proposed else { continue };
-            let crisp = self.crisp(a);
+            // What lower levels propose is composed by max per label (issue 4), whatever
+            // composer the outputs use.
+            let crisp = self.crisp(a, Composer::Max);
             self.inputs[slot].now = crisp.map(|v| (v, 1.0));
             self.fuzzify(slot);
         }
@@ -670,7 +679,8 @@ impl Brian {
 
     fn run_behavior(&mut self, b: usize) {
         let beh = &self.behaviors[b];
-        let cando = beh.cando.as_ref().map_or(FuzzyValue::new(1.0, 1.0), |e| {
+        // No CANDO entry reads as missing, (0, 1): the behavior never runs (the checker warns).
+        let cando = beh.cando.as_ref().map_or(FuzzyValue::MISSING, |e| {
             e.eval(&self.data, &self.pred_values, &self.act_values)
         });
         if cando.value <= self.threshold {
@@ -696,6 +706,10 @@ impl Brian {
                         self.level_acc[slot].add(weight * value)
                     }
                     RuleAction::Propose(_) => {}
+                    // `&DEL` applies when the rule fires (value > 0), whatever the behavior's
+                    // weight: a running behavior (CANDO above the threshold) may suppress lower
+                    // levels even while its WANT gives its own proposals no weight. This is
+                    // what the shared conformance data (brian40-hier) require.
                     RuleAction::Delete { action, label } if value > 0.0 => {
                         let a = &self.actions[action];
                         match label {

@@ -55,8 +55,8 @@ fn is_number(w: &str) -> bool {
         && frac.is_none_or(|f| !f.is_empty() && f.bytes().all(|b| b.is_ascii_digit()))
 }
 
-/// Splits `text` into tokens with their positions. Fails only on a number that does not fit
-/// an `f64` (never: every digit string parses) — kept fallible for future token kinds.
+/// Splits `text` into tokens with their positions. Fails on a number too large for an `f64`
+/// (it would become infinite).
 pub fn tokenize(text: &str, file: &Path) -> Result<Vec<(Tok, Span)>, BrianError> {
     let mut out = Vec::new();
     for (li, line) in text.lines().enumerate() {
@@ -90,9 +90,15 @@ pub fn tokenize(text: &str, file: &Path) -> Result<Vec<(Tok, Span)>, BrianError>
                     }
                     let word: String = chars[start..i].iter().collect();
                     if is_number(&word) {
-                        let n = word.parse::<f64>().map_err(|_| {
-                            BrianError::at(file, span, format!("`{word}` is not a number"))
-                        })?;
+                        let n = word.parse::<f64>().ok().filter(|n| n.is_finite()).ok_or_else(
+                            || {
+                                BrianError::at(
+                                    file,
+                                    span,
+                                    format!("`{word}` is too large for a number"),
+                                )
+                            },
+                        )?;
                         out.push((Tok::Num(n), span));
                     } else {
                         out.push((Tok::Word(word), span));
@@ -203,6 +209,13 @@ mod tests {
         assert_eq!(t[8].0, Tok::Num(-40.0));
         assert_eq!(t[9].0, Tok::Num(60.0));
         assert_eq!(t.len(), 13);
+    }
+
+    #[test]
+    fn a_number_too_large_is_an_error_with_its_place() {
+        let text = format!("(S (SNG (A 1{})))", "0".repeat(400));
+        let e = tokenize(&text, Path::new("f")).unwrap_err().to_string();
+        assert!(e.starts_with("error in file f at line 1: `1000") && e.ends_with("f:1:12"), "{e}");
     }
 
     #[test]

@@ -81,3 +81,10 @@ fn a_behavior_without_enough_want_proposes_nothing() {
     // Top's WANT is `All` = 0 (Want 0.6): weight 0, so its LOW does not count.
     assert_eq!(out("(On) => (Out LOW);", "(P All)"), Some(100.0));
 }
+
+#[test]
+fn del_applies_when_the_rule_fires_even_at_weight_0() {
+    // Top runs (CANDO On) with weight 0: its MID does not count, but its deletion does, so
+    // nothing is left and the action is absent.
+    assert_eq!(out("(On) => (&DEL.Out ANY) (Out MID);", "(P All)"), None);
+}
