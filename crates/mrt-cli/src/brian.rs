@@ -72,9 +72,9 @@ pub fn eval(dir: &Path, input: Option<&Path>, trace: bool) -> Result<()> {
         let args: Vec<(&str, f64, f64)> =
             owned.iter().map(|(k, v, r)| (k.as_str(), *v, *r)).collect();
         let commands = brian.run(&args);
-        // BTreeMap: keys come out sorted.
+        // Commands iterate in name order: keys come out sorted.
         let mut obj: Map<String, Value> =
-            commands.into_iter().map(|(k, v)| (k, json!(v))).collect();
+            commands.iter().map(|(k, v)| (k.to_string(), json!(v))).collect();
         if trace {
             let t = brian.trace();
             let preds: Map<String, Value> =

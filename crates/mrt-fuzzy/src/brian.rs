@@ -15,6 +15,7 @@ use crate::set::{FuzzySet, FuzzyValue};
 use crate::shapes::{defuzzify, parse_associations, parse_shapes, resolve, Shape};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 /// The default CANDO threshold (§10.4.4): a behavior runs when its CANDO value is above it.
 pub const DEFAULT_THRESHOLD: f64 = 0.49;
@@ -192,6 +193,10 @@ pub struct Brian {
     warnings: Vec<String>,
     /// Last cycle's (CANDO, WANT) of each behavior, in run order; `None` when it did not run.
     activity: Vec<Option<Activity>>,
+    /// Output names sorted, with their index, shared with every [`Commands`].
+    sorted_names: Arc<[(Arc<str>, usize)]>,
+    /// The outputs as last handed out by [`Brian::run`].
+    shared_outputs: Arc<Vec<Option<f64>>>,
     /// For each input, the output of the same name that feeds it back (§10.5).
     feedback: Vec<Option<usize>>,
     /// Inputs that carry `Proposed<Action>` data (set by the engine, not by callers).
@@ -213,9 +218,66 @@ pub struct Trace<'a> {
     pub behaviors: Vec<(&'a str, i64, Option<Activity>)>,
 }
 
-/// The crisp commands of one cycle: action name → value, sorted by name. An action every
+/// The crisp commands of one cycle: action name → value, in name order. An action every
 /// behavior left at weight 0 is absent.
-pub type Commands = BTreeMap<String, f64>;
+///
+/// Cheap to return: it shares the engine's buffers (reference counts, no copy). When the caller
+/// has dropped the previous cycle's `Commands`, [`Brian::run`] reuses the buffer and allocates
+/// nothing; a kept `Commands` is never changed under its holder.
+#[derive(Clone)]
+pub struct Commands {
+    /// `(name, index into values)`, sorted by name.
+    names: Arc<[(Arc<str>, usize)]>,
+    values: Arc<Vec<Option<f64>>>,
+}
+
+impl Commands {
+    /// The value of an action, if it was produced.
+    pub fn get(&self, name: &str) -> Option<&f64> {
+        let i = self.names.binary_search_by(|(n, _)| (**n).cmp(name)).ok()?;
+        self.values.get(self.names[i].1)?.as_ref()
+    }
+
+    /// `(name, value)` of every produced action, in name order.
+    pub fn iter(&self) -> impl Iterator<Item = (&str, f64)> + '_ {
+        self.names
+            .iter()
+            .filter_map(|(n, i)| self.values.get(*i).copied().flatten().map(|v| (&**n, v)))
+    }
+
+    /// How many actions were produced.
+    pub fn len(&self) -> usize {
+        self.iter().count()
+    }
+
+    /// Whether no action was produced.
+    pub fn is_empty(&self) -> bool {
+        self.iter().next().is_none()
+    }
+
+    /// As an owned map (allocates).
+    pub fn to_map(&self) -> BTreeMap<String, f64> {
+        self.iter().map(|(k, v)| (k.to_string(), v)).collect()
+    }
+}
+
+impl std::ops::Index<&str> for Commands {
+    type Output = f64;
+    /// The value of a produced action. Panics when it was not produced: use
+    /// [`get`](Commands::get) for input-driven code.
+    fn index(&self, name: &str) -> &f64 {
+        match self.get(name) {
+            Some(v) => v,
+            None => panic!("no command `{name}` in this cycle"),
+        }
+    }
+}
+
+impl std::fmt::Debug for Commands {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_map().entries(self.iter()).finish()
+    }
+}
 
 struct Names<'a> {
     inputs: &'a [Input],
@@ -467,7 +529,12 @@ impl Brian {
             (0..inputs.len()).map(|i| actions.iter().any(|a| a.proposed == Some(i))).collect();
         let feedback =
             inputs.iter().map(|i| actions.iter().position(|a| a.name == i.name)).collect();
+        let mut sorted: Vec<(Arc<str>, usize)> =
+            actions.iter().enumerate().map(|(i, a)| (Arc::from(a.name.as_str()), i)).collect();
+        sorted.sort();
         Ok(Brian {
+            sorted_names: sorted.into(),
+            shared_outputs: Arc::new(vec![None; actions.len()]),
             feedback,
             warnings,
             activity: vec![None; behaviors.len()],
@@ -595,11 +662,9 @@ impl Brian {
             }
         }
         self.step();
-        self.actions
-            .iter()
-            .zip(&self.outputs)
-            .filter_map(|(a, o)| o.map(|v| (a.name.clone(), v)))
-            .collect()
+        // Reuses the shared buffer when no caller still holds the previous cycle's commands.
+        Arc::make_mut(&mut self.shared_outputs).copy_from_slice(&self.outputs);
+        Commands { names: self.sorted_names.clone(), values: self.shared_outputs.clone() }
     }
 
     fn fuzzify(&mut self, slot: usize) {

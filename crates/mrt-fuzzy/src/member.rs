@@ -68,7 +68,7 @@ impl Member for BrianMember {
         }
         let inputs: Vec<(&str, f64, f64)> =
             self.pending.iter().map(|(k, (v, r))| (k.as_str(), *v, *r)).collect();
-        let commands = self.brian.run(&inputs);
+        let commands = self.brian.run(&inputs).to_map();
         self.pending.clear();
         ctx.publish(BrianCommands { commands });
         Ok(())
