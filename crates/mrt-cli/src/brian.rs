@@ -55,6 +55,7 @@ fn fv(v: mrt_fuzzy::FuzzyValue) -> Value {
 /// `mrt brian eval DIR [--input FILE] [--trace]`: one JSON object of commands per input line.
 pub fn eval(dir: &Path, input: Option<&Path>, trace: bool) -> Result<()> {
     let mut brian = Brian::from_dir(dir)?;
+    brian.set_tracing(trace);
     let reader: Box<dyn BufRead> = match input {
         Some(p) => Box::new(std::io::BufReader::new(
             std::fs::File::open(p).with_context(|| format!("cannot open {}", p.display()))?,
@@ -94,9 +95,17 @@ pub fn eval(dir: &Path, input: Option<&Path>, trace: bool) -> Result<()> {
                     (n.to_string(), v)
                 })
                 .collect();
+            let proposals: Vec<Value> = t
+                .proposals
+                .iter()
+                .map(|p| match p.value {
+                    Some(v) => json!({"behavior": p.behavior, "action": p.action, "label": p.label, "value": v}),
+                    None => json!({"behavior": p.behavior, "action": p.action, "delete": p.label.unwrap_or("ANY")}),
+                })
+                .collect();
             obj.insert(
                 "_trace".into(),
-                json!({"predicates": preds, "predicate_actions": acts, "behaviors": behs}),
+                json!({"predicates": preds, "predicate_actions": acts, "behaviors": behs, "proposals": proposals}),
             );
         }
         writeln!(out, "{}", Value::Object(obj))?;

@@ -104,6 +104,8 @@ fn eval_reads_json_lines_and_matches_the_expected_commands() {
         }
         assert!(g["_trace"]["predicates"]["BallSeen"].is_array());
         assert!(g["_trace"]["behaviors"]["SearchBall"]["active"].is_boolean());
+        let proposals = g["_trace"]["proposals"].as_array().unwrap();
+        assert!(proposals.iter().all(|p| p["behavior"].is_string() && p["action"].is_string()));
     }
     // A malformed line is an error naming the line, not a panic.
     let mut child = mrt()
@@ -185,6 +187,16 @@ fn check_eval_and_plot_work_on_the_shipped_harvester() {
     assert_eq!(v["SpeedModule"].as_f64(), Some(75.0));
     assert_eq!(v["SpeedAngle"].as_f64(), Some(0.0));
     assert_eq!(v["_trace"]["behaviors"]["GoToTarget"]["active"], serde_json::Value::Bool(true));
+    // GoToTarget proposes FAST for a far target, at full weight.
+    let fast = v["_trace"]["proposals"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|p| {
+            p["behavior"] == "GoToTarget" && p["action"] == "SpeedModule" && p["label"] == "FAST"
+        })
+        .cloned();
+    assert!(fast.is_some_and(|p| p["value"].as_f64().unwrap() > 0.9), "{v}");
     let svg = std::env::temp_dir().join(format!("mrt-harvester-{}.svg", std::process::id()));
     assert!(mrt()
         .args(["brian", "plot"])

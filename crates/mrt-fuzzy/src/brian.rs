@@ -193,6 +193,10 @@ pub struct Brian {
     warnings: Vec<String>,
     /// Last cycle's (CANDO, WANT) of each behavior, in run order; `None` when it did not run.
     activity: Vec<Option<Activity>>,
+    /// Whether proposals are recorded for [`Brian::trace`].
+    tracing: bool,
+    /// `(behavior, action, label or None for ANY, value or None for a deletion)`.
+    traced: Vec<(usize, usize, Option<usize>, Option<f64>)>,
     /// Output names sorted, with their index, shared with every [`Commands`].
     sorted_names: Arc<[(Arc<str>, usize)]>,
     /// The outputs as last handed out by [`Brian::run`].
@@ -216,6 +220,23 @@ pub struct Trace<'a> {
     pub predicate_actions: Vec<(&'a str, FuzzyValue)>,
     /// Behaviors in run order: name, level, and (CANDO, WANT) when it ran.
     pub behaviors: Vec<(&'a str, i64, Option<Activity>)>,
+    /// Every proposal of the cycle, when tracing is on ([`Brian::set_tracing`]): behavior,
+    /// action, label, and its weighted value (proposal value × reliability × weight); deletions
+    /// (`&DEL`) appear with the label `&DEL ANY` or `&DEL <label>` and no value.
+    pub proposals: Vec<TracedProposal<'a>>,
+}
+
+/// One proposal (or deletion) of a traced cycle.
+#[derive(Clone, Debug, PartialEq)]
+pub struct TracedProposal<'a> {
+    /// The behavior.
+    pub behavior: &'a str,
+    /// The action.
+    pub action: &'a str,
+    /// The label (`None` with `delete` for `&DEL ... ANY`).
+    pub label: Option<&'a str>,
+    /// Weighted value; `None` for a deletion.
+    pub value: Option<f64>,
 }
 
 /// The crisp commands of one cycle: action name → value, in name order. An action every
@@ -533,6 +554,8 @@ impl Brian {
             actions.iter().enumerate().map(|(i, a)| (Arc::from(a.name.as_str()), i)).collect();
         sorted.sort();
         Ok(Brian {
+            tracing: false,
+            traced: Vec::new(),
             sorted_names: sorted.into(),
             shared_outputs: Arc::new(vec![None; actions.len()]),
             feedback,
@@ -559,6 +582,12 @@ impl Brian {
     /// actions, behaviors without WANT.
     pub fn warnings(&self) -> &[String] {
         &self.warnings
+    }
+
+    /// Records every proposal and deletion for [`trace`](Self::trace) (off by default: it costs
+    /// a little per proposal).
+    pub fn set_tracing(&mut self, on: bool) {
+        self.tracing = on;
     }
 
     /// Chooses the composer (default [`Composer::Max`]).
@@ -592,6 +621,16 @@ impl Brian {
                 .iter()
                 .map(|(n, _)| n.as_str())
                 .zip(self.act_values.iter().copied())
+                .collect(),
+            proposals: self
+                .traced
+                .iter()
+                .map(|&(b, a, l, value)| TracedProposal {
+                    behavior: &self.behaviors[b].name,
+                    action: &self.actions[a].name,
+                    label: l.map(|l| self.actions[a].labels[l].0.as_str()),
+                    value,
+                })
                 .collect(),
             behaviors: self
                 .behaviors
@@ -679,6 +718,7 @@ impl Brian {
     }
 
     fn cycle(&mut self) {
+        self.traced.clear();
         for slot in 0..self.inputs.len() {
             if self.is_proposed[slot] {
                 self.inputs[slot].now = None;
@@ -768,7 +808,13 @@ impl Brian {
                     // A rule that does not fire (value 0), or a behavior of weight 0, proposes
                     // nothing: it must not count in the average composer's mean.
                     RuleAction::Propose(slot) if weight * value > 0.0 => {
-                        self.level_acc[slot].add(weight * value)
+                        self.level_acc[slot].add(weight * value);
+                        if self.tracing {
+                            let ai =
+                                self.actions.iter().rposition(|a| a.offset <= slot).unwrap_or(0);
+                            let label = slot - self.actions[ai].offset;
+                            self.traced.push((b, ai, Some(label), Some(weight * value)));
+                        }
                     }
                     RuleAction::Propose(_) => {}
                     // `&DEL` applies when the rule fires (value > 0), whatever the behavior's
@@ -776,6 +822,9 @@ impl Brian {
                     // levels even while its WANT gives its own proposals no weight. This is
                     // what the shared conformance data (brian40-hier) require.
                     RuleAction::Delete { action, label } if value > 0.0 => {
+                        if self.tracing {
+                            self.traced.push((b, action, label, None));
+                        }
                         let a = &self.actions[action];
                         match label {
                             Some(k) => self.lower[a.offset + k] = Acc::default(),
