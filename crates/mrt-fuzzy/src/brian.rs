@@ -160,6 +160,8 @@ struct Rule {
 #[derive(Clone, Debug)]
 struct Behavior {
     name: String,
+    /// Where `behavior.txt` lists it.
+    span: Span,
     level: i64,
     cando: Option<Expr>,
     want: Option<Expr>,
@@ -313,7 +315,7 @@ impl Names<'_> {
             RawExpr::And(a, b) => Expr::And(Box::new(self.resolve(a)?), Box::new(self.resolve(b)?)),
             RawExpr::Or(a, b) => Expr::Or(Box::new(self.resolve(a)?), Box::new(self.resolve(b)?)),
             RawExpr::Not(a) => Expr::Not(Box::new(self.resolve(a)?)),
-            RawExpr::Data(d, l, span) => {
+            RawExpr::Data(d, l, span, label_span) => {
                 let Some(input) = self.inputs.iter().find(|i| i.name == *d) else {
                     return Err(BrianError::at(
                         self.file,
@@ -326,7 +328,7 @@ impl Names<'_> {
                         input.shape.sets.iter().map(|(l, _)| l.as_str()).collect();
                     return Err(BrianError::at(
                         self.file,
-                        *span,
+                        *label_span,
                         format!(
                             "`{d}` (shape `{}`) has no label `{l}` (labels: {})",
                             input.shape.name,
@@ -493,7 +495,7 @@ impl Brian {
                 }
                 None => None,
             };
-            behaviors.push(Behavior { name, level, cando, want, rules });
+            behaviors.push(Behavior { name, span, level, cando, want, rules });
         }
         for (file, defs) in [(&files.cando, &cando), (&files.want, &want)] {
             if let Some((n, span, _)) =
@@ -535,14 +537,20 @@ impl Brian {
             ));
         }
         for b in behaviors.iter().filter(|b| b.cando.is_none()) {
-            warnings.push(format!(
-                "warning in file {}: behavior `{}` has no CANDO entry: it never runs",
-                files.cando.display(),
-                b.name
-            ));
+            let what = format!(
+                "behavior `{}` has no CANDO entry in {}: it never runs",
+                b.name,
+                files.cando.display()
+            );
+            warnings.push(warning(&files.behaviors, b.span, &what));
         }
         for b in behaviors.iter().filter(|b| b.want.is_none()) {
-            warnings.push(format!("warning in file {}: behavior `{}` has no WANT entry: its weight is 0 and it proposes nothing", files.want.display(), b.name));
+            let what = format!(
+                "behavior `{}` has no WANT entry in {}: its weight is 0 and it proposes nothing",
+                b.name,
+                files.want.display()
+            );
+            warnings.push(warning(&files.behaviors, b.span, &what));
         }
 
         let slots = actions.iter().map(|a| a.labels.len()).sum();

@@ -21,8 +21,8 @@ pub enum RawExpr {
     Or(Box<RawExpr>, Box<RawExpr>),
     /// `(NOT a)`
     Not(Box<RawExpr>),
-    /// `(D data label)`
-    Data(String, String, Span),
+    /// `(D data label)`: the names and where each is written.
+    Data(String, String, Span, Span),
     /// `(P name)` or `(name)`
     Pred(String, Span),
 }
@@ -59,8 +59,8 @@ fn parse_nested(c: &mut Cursor<'_>, depth: usize) -> Result<RawExpr, BrianError>
         "NOT" => RawExpr::Not(Box::new(parse_nested(c, depth + 1)?)),
         "D" => {
             let (data, dspan) = c.word("a datum name after D")?;
-            let (label, _) = c.word(&format!("a label of `{data}`"))?;
-            RawExpr::Data(data, label, dspan)
+            let (label, lspan) = c.word(&format!("a label of `{data}`"))?;
+            RawExpr::Data(data, label, dspan, lspan)
         }
         "P" => {
             let (name, pspan) = c.word("a predicate name after P")?;
@@ -68,8 +68,8 @@ fn parse_nested(c: &mut Cursor<'_>, depth: usize) -> Result<RawExpr, BrianError>
         }
         _ => match c.peek() {
             Some(Tok::Word(_)) => {
-                let (label, _) = c.word("a label")?;
-                RawExpr::Data(head, label, span)
+                let (label, lspan) = c.word("a label")?;
+                RawExpr::Data(head, label, span, lspan)
             }
             _ => RawExpr::Pred(head, span),
         },

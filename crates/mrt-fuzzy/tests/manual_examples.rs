@@ -280,14 +280,14 @@ fn error_unknown_label_of_an_action() {
     );
 }
 
-/// An unknown label of a fuzzy datum: the place is the datum's name (column 20), not the label.
+/// An unknown label of a fuzzy datum: the place is the label.
 #[test]
 fn error_unknown_label_of_a_datum() {
     check(
         "unknown_data_label",
         "Predicate.ini",
         2,
-        20,
+        35,
         "`TargetDistance` (shape `Distance`) has no label `NEARBY` (labels: NEAREST, NEAR, FAR)",
     );
 }

@@ -115,3 +115,32 @@ fn previous_outputs_feed_back_as_inputs() {
     assert_eq!(was_slow(&b), Some((0.0, 0.5)), "a supplied Speed wins over the previous output");
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// A behavior without CANDO never runs, one without WANT has weight 0: both are warned about,
+/// at the behavior's line of `behavior.txt`.
+#[test]
+fn behaviors_without_cando_or_want_are_warned_about() {
+    let dir = config();
+    std::fs::write(
+        dir.join("behavior.txt"),
+        "(level 1 Go behaviors/Go.rul)\n(level 1 Idle behaviors/Go.rul)",
+    )
+    .unwrap();
+    let mut b = Brian::from_dir(&dir).unwrap();
+    let w = b.warnings().to_vec();
+    assert_eq!(w.len(), 2, "{w:?}");
+    assert!(
+        w[0].contains("behavior `Idle` has no CANDO entry") && w[0].ends_with("behavior.txt:2:10"),
+        "{}",
+        w[0]
+    );
+    assert!(
+        w[1].contains("behavior `Idle` has no WANT entry") && w[1].ends_with("behavior.txt:2:10"),
+        "{}",
+        w[1]
+    );
+    // Idle never runs: the commands are Go's alone.
+    assert_eq!(b.run(&[("D", 5.0, 1.0)]).get("Speed"), Some(&10.0));
+    assert!(b.trace().behaviors.iter().any(|(n, _, a)| *n == "Idle" && a.is_none()));
+    std::fs::remove_dir_all(&dir).unwrap();
+}
