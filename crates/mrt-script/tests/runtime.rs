@@ -1,0 +1,172 @@
+//! The Lua runtime of ThinkingCap behaviors (seed 001 §3): sandbox, budgets, loading strategies
+//! and hot reload with fallback.
+
+#![allow(clippy::unwrap_used)]
+
+use mrt_script::{LoadStrategy, LuaRuntime, Sandbox, Script, ScriptError};
+use std::path::PathBuf;
+
+fn rt() -> LuaRuntime {
+    LuaRuntime::new(Sandbox { instruction_budget: 1_000_000, memory_limit: 8 << 20 }).unwrap()
+}
+
+fn temp(name: &str, text: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("mrt-script-{}-{name}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let p = dir.join(format!("{name}.lua"));
+    std::fs::write(&p, text).unwrap();
+    p
+}
+
+#[test]
+fn scripts_see_only_the_safe_libraries() {
+    let rt = rt();
+    let probe = "local names = {'io', 'os', 'require', 'debug', 'dofile', 'loadfile', 'package', \
+                 'math', 'string', 'table', 'coroutine'}
+                 local out = {}
+                 for _, n in ipairs(names) do out[#out + 1] = n .. '=' .. type(_G[n]) end
+                 return table.concat(out, ' ')";
+    let s = Script::from_source(&rt, "probe.lua", probe, LoadStrategy::Compiled).unwrap();
+    assert_eq!(
+        s.call::<String>(&rt).unwrap(),
+        "io=nil os=nil require=nil debug=nil dofile=nil loadfile=nil package=nil \
+         math=table string=table table=table coroutine=table"
+    );
+    // `load` takes text only: precompiled bytecode (which can crash the VM) is refused.
+    let bin = Script::from_source(
+        &rt,
+        "bin.lua",
+        r#"local f, err = load("\27Lua\84\0", "x", "b") return tostring(f) .. " | " .. tostring(err)"#,
+        LoadStrategy::Compiled,
+    )
+    .unwrap();
+    let got = bin.call::<String>(&rt).unwrap();
+    assert!(got.starts_with("nil | ") && got.contains("binary"), "{got}");
+    // Text chunks still load.
+    let text = Script::from_source(
+        &rt,
+        "text.lua",
+        "return load('return 6 * 7')()",
+        LoadStrategy::Compiled,
+    )
+    .unwrap();
+    assert_eq!(text.call::<i64>(&rt).unwrap(), 42);
+    // Calling what was removed is an ordinary runtime error naming the script.
+    let s = Script::from_source(&rt, "evil.lua", "os.execute('rm -rf /')", LoadStrategy::Compiled)
+        .unwrap();
+    let e = s.call::<()>(&rt).unwrap_err();
+    assert!(
+        matches!(e, ScriptError::Runtime { .. })
+            && e.to_string().starts_with("evil.lua: runtime error"),
+        "{e}"
+    );
+}
+
+#[test]
+fn an_endless_loop_is_aborted_and_the_runtime_keeps_working() {
+    let rt = rt();
+    let spin =
+        Script::from_source(&rt, "spin.lua", "while true do end", LoadStrategy::Compiled).unwrap();
+    let e = spin.call::<()>(&rt).unwrap_err();
+    assert!(matches!(e, ScriptError::Budget { budget: 1_000_000, .. }), "{e}");
+    assert!(e.to_string().starts_with("spin.lua: aborted"), "{e}");
+    // The budget is per call: the next call, and other scripts, run normally.
+    let ok = Script::from_source(
+        &rt,
+        "ok.lua",
+        "local s = 0 for i = 1, 1000 do s = s + i end return s",
+        LoadStrategy::Compiled,
+    )
+    .unwrap();
+    assert_eq!(ok.call::<i64>(&rt).unwrap(), 500_500);
+    assert!(matches!(spin.call::<()>(&rt), Err(ScriptError::Budget { .. })));
+}
+
+#[test]
+fn a_memory_bomb_is_aborted_and_the_runtime_keeps_working() {
+    let rt = LuaRuntime::new(Sandbox { instruction_budget: u64::MAX / 2, memory_limit: 4 << 20 })
+        .unwrap();
+    let bomb = Script::from_source(
+        &rt,
+        "bomb.lua",
+        "local t = {} for i = 1, 1e9 do t[i] = string.rep('x', 1000) .. i end",
+        LoadStrategy::Compiled,
+    )
+    .unwrap();
+    let e = bomb.call::<()>(&rt).unwrap_err();
+    assert!(matches!(e, ScriptError::Memory { limit, .. } if limit == 4 << 20), "{e}");
+    let ok = Script::from_source(&rt, "ok.lua", "return 1 + 1", LoadStrategy::Compiled).unwrap();
+    assert_eq!(ok.call::<i64>(&rt).unwrap(), 2);
+}
+
+#[test]
+fn syntax_errors_name_the_file_and_line() {
+    let rt = rt();
+    let e = Script::from_source(
+        &rt,
+        "behaviors/lookball.lua",
+        "local x = 1\nif x then\n  x = \nend",
+        LoadStrategy::Compiled,
+    )
+    .err()
+    .unwrap();
+    match &e {
+        ScriptError::Syntax { file, line, .. } => {
+            assert_eq!((file.as_str(), *line), ("behaviors/lookball.lua", 4))
+        }
+        other => panic!("{other:?}"),
+    }
+    assert!(e.to_string().starts_with("behaviors/lookball.lua:4: "), "{e}");
+}
+
+#[test]
+fn the_three_loading_strategies_give_the_same_results() {
+    let path = temp("strategies", "n = (n or 0) + 1 return n * 10");
+    for strategy in [LoadStrategy::ReloadFromFile, LoadStrategy::Source, LoadStrategy::Compiled] {
+        let rt = rt();
+        let s = Script::from_file(&rt, &path, strategy).unwrap();
+        assert_eq!(s.strategy(), strategy);
+        let got: Vec<i64> = (0..3).map(|_| s.call(&rt).unwrap()).collect();
+        assert_eq!(got, [10, 20, 30], "{strategy:?}");
+    }
+    // ReloadFromFile sees an edit at the next call without any reload request.
+    let rt = rt();
+    let s = Script::from_file(&rt, &path, LoadStrategy::ReloadFromFile).unwrap();
+    assert_eq!(s.call::<i64>(&rt).unwrap(), 10);
+    std::fs::write(&path, "return -1").unwrap();
+    assert_eq!(s.call::<i64>(&rt).unwrap(), -1);
+}
+
+#[test]
+fn hot_reload_swaps_a_good_edit_and_rejects_a_bad_one() {
+    let path = temp("reload", "calls = (calls or 0) + 1 return 'v1'");
+    let rt = rt();
+    let s = Script::from_file(&rt, &path, LoadStrategy::Compiled).unwrap();
+    assert_eq!(s.call::<String>(&rt).unwrap(), "v1");
+    assert!(!s.reload_if_changed(&rt).unwrap(), "nothing changed yet");
+
+    // A good edit is picked up at the next cycle boundary; the state (globals) survives.
+    std::thread::sleep(std::time::Duration::from_millis(20)); // a distinct modification time
+    std::fs::write(&path, "calls = (calls or 0) + 1 return 'v2 after ' .. calls").unwrap();
+    assert!(s.reload_if_changed(&rt).unwrap());
+    assert_eq!(s.call::<String>(&rt).unwrap(), "v2 after 2");
+
+    // A broken edit is rejected with file:line, and v2 keeps running.
+    std::thread::sleep(std::time::Duration::from_millis(20));
+    std::fs::write(&path, "return 'v3' +").unwrap();
+    let e = s.reload_if_changed(&rt).unwrap_err();
+    assert!(e.to_string().starts_with(&format!("{}:1: ", path.display())), "{e}");
+    assert_eq!(s.call::<String>(&rt).unwrap(), "v2 after 3");
+    assert!(
+        !s.reload_if_changed(&rt).unwrap(),
+        "a broken file is reported once, not at every poll"
+    );
+
+    // Fixing the file recovers.
+    std::thread::sleep(std::time::Duration::from_millis(20));
+    std::fs::write(&path, "return 'v4'").unwrap();
+    assert!(s.reload_if_changed(&rt).unwrap());
+    assert_eq!(s.call::<String>(&rt).unwrap(), "v4");
+    // An explicit reload request (e.g. a message on the bus) works too.
+    assert!(s.reload(&rt).is_ok());
+}
