@@ -11,8 +11,8 @@
 //!   aborts that call with an error naming the script, and the runtime stays usable;
 //! - the three **loading strategies** of §3.2 ([`LoadStrategy`]): reload from the file at each
 //!   call, keep the source in memory, keep the compiled chunk in memory (default);
-//! - **hot reload** ([`Script::reload_if_changed`], [`Script::reload`]): a changed file is
-//!   compiled first; a file with an error is rejected with `file:line: message` and the old
+//! - **hot reload** ([`ScriptWatcher`] on `notify`, [`Script::reload_if_changed`],
+//!   [`Script::reload`] for an explicit request): a changed file is compiled first; a file with an error is rejected with `file:line: message` and the old
 //!   version keeps running. Lua globals (the scripts' persistent state) survive a reload.
 //!
 //! ```
@@ -36,6 +36,8 @@
 
 mod runtime;
 mod script;
+mod watch;
 
 pub use runtime::{LuaRuntime, Sandbox};
 pub use script::{LoadStrategy, Script, ScriptError};
+pub use watch::ScriptWatcher;

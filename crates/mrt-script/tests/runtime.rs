@@ -170,3 +170,52 @@ fn hot_reload_swaps_a_good_edit_and_rejects_a_bad_one() {
     // An explicit reload request (e.g. a message on the bus) works too.
     assert!(s.reload(&rt).is_ok());
 }
+
+/// Saves as editors do: write a new file, rename it over the old one (never a half-written
+/// script on disk).
+fn save(path: &std::path::Path, text: &str) {
+    let tmp = path.with_extension("lua.tmp");
+    std::fs::write(&tmp, text).unwrap();
+    std::fs::rename(&tmp, path).unwrap();
+}
+
+/// An edit on disk is reported by the watcher and swapped in at the next cycle boundary, while
+/// the behavior runs; a bad edit is reported and the old version keeps running.
+#[test]
+fn the_watcher_reports_edits_and_the_loop_swaps_them_in() {
+    let path = temp("watched", "return 'first'");
+    let rt = rt();
+    let s = Script::from_file(&rt, &path, LoadStrategy::Compiled).unwrap();
+    let mut w = mrt_script::ScriptWatcher::new().unwrap();
+    w.watch(&path).unwrap();
+    save(&path, "return 'second'");
+    // One "cycle" every 5 ms until the change arrives (liveness bound: 5 s).
+    let mut outputs = Vec::new();
+    for _ in 0..1000 {
+        for changed in w.changed() {
+            assert_eq!(changed, std::path::absolute(&path).unwrap());
+            s.reload(&rt).unwrap();
+        }
+        outputs.push(s.call::<String>(&rt).unwrap());
+        if outputs.last().is_some_and(|o| o == "second") {
+            break;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(5));
+    }
+    assert_eq!(outputs.last().map(String::as_str), Some("second"), "the edit was never picked up");
+    assert!(outputs.iter().all(|o| o == "first" || o == "second"));
+    // A bad edit: reported, rejected, the robot keeps "second".
+    save(&path, "return 'third' ..");
+    let mut rejected = false;
+    for _ in 0..1000 {
+        for _ in w.changed() {
+            rejected |= s.reload(&rt).is_err();
+        }
+        assert_eq!(s.call::<String>(&rt).unwrap(), "second");
+        if rejected {
+            break;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(5));
+    }
+    assert!(rejected, "the bad edit was never seen");
+}
