@@ -32,10 +32,12 @@
 //! | Member ID | [`MemberId`] |
 //! | Message type | [`MsgType`] |
 //! | `DCDT_TIME` | [`Time`] |
+//! | ThinkingCap LPS, LPO, GS, commands (seed 001 §3.3) | [`robot::WorldSnapshot`], [`robot::Lpo`], [`robot::RobotCommand`] |
 #![deny(missing_docs)]
 
 mod geometry;
 mod ids;
+pub mod robot;
 mod time;
 
 pub use geometry::{angle_diff, normalize_angle, normalize_angle_positive, Point2, Pose2, Vec2};

@@ -31,9 +31,10 @@
 //! | a behavior script | [`Script`] |
 //! | loading strategies: file each call / source in memory / compiled in memory (§3.2) | [`LoadStrategy`] |
 //!
-//! The robot API (`chaos.*`), HFSMs and the fuzzy HBM/CDB behaviors come next (issue 5).
+//! The robot API `chaos.*` is in [`chaos`]; HFSMs and the fuzzy HBM/CDB behaviors come next.
 #![deny(missing_docs)]
 
+pub mod chaos;
 mod runtime;
 mod script;
 mod watch;

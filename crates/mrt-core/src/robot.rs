@@ -1,0 +1,170 @@
+//! What a robot's behaviors read and write each cycle (ThinkingCap, seed 001 §3.3): a typed
+//! [`WorldSnapshot`] (local perceptual space, global state, team, game state) and a
+//! [`RobotCommand`] (velocities, kick, perceptual needs, behavior selection). The world model
+//! and the simulator fill the snapshot; behaviors (Lua or fuzzy) fill the command.
+
+use crate::{Pose2, Time, Vec2};
+use serde::{Deserialize, Serialize};
+
+/// Indices of the local perceptual space (LPS) objects (`BALL`, `NET1`, ... of chaoslib).
+pub mod lps {
+    /// The ball.
+    pub const BALL: usize = 0;
+    /// The opponent's net (the one to score in).
+    pub const NET1: usize = 1;
+    /// Our own net.
+    pub const NET2: usize = 2;
+    /// First landmark; landmarks are `LANDMARK0 .. LANDMARK0 + LANDMARKS`.
+    pub const LANDMARK0: usize = 3;
+    /// Number of landmarks.
+    pub const LANDMARKS: usize = 6;
+    /// Number of LPS slots.
+    pub const COUNT: usize = LANDMARK0 + LANDMARKS;
+}
+
+/// A local perceptual object (LPO): an object anchored in the robot's frame.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Lpo {
+    /// Distance, millimetres.
+    pub rho: f64,
+    /// Bearing, radians, counter-clockwise (left) positive, 0 straight ahead.
+    pub theta: f64,
+    /// How much the anchor is to be trusted, 0 (lost) to 1.
+    pub reliability: f64,
+    /// Seconds since it was last perceived.
+    pub seen_ago: f64,
+}
+
+/// A global estimate: a pose on the field and its quality, 0 (unknown) to 1.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Estimate {
+    /// The pose (for the ball, `theta` is unused).
+    pub pose: Pose2,
+    /// Quality, 0 to 1.
+    pub quality: f64,
+}
+
+/// A teammate as this robot believes it to be.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Mate {
+    /// The teammate's player number.
+    pub id: u32,
+    /// Where it is.
+    pub at: Estimate,
+}
+
+/// The game state set by the referee (`getCurrentState()`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
+pub enum GameState {
+    /// Before the game.
+    #[default]
+    Initial,
+    /// Robots walk to their kickoff positions.
+    Ready,
+    /// Robots wait for the kickoff.
+    Set,
+    /// The game runs.
+    Playing,
+    /// The half or the game is over.
+    Finished,
+}
+
+impl GameState {
+    /// The name scripts see: `INITIAL`, `READY`, `SET`, `PLAYING`, `FINISHED`.
+    pub fn name(self) -> &'static str {
+        match self {
+            GameState::Initial => "INITIAL",
+            GameState::Ready => "READY",
+            GameState::Set => "SET",
+            GameState::Playing => "PLAYING",
+            GameState::Finished => "FINISHED",
+        }
+    }
+}
+
+/// Everything a behavior may read in one cycle.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct WorldSnapshot {
+    /// When the snapshot was taken.
+    pub time: Time,
+    /// The LPS, indexed by [`lps`] constants ([`lps::COUNT`] entries).
+    pub lps: Vec<Lpo>,
+    /// The robot's own global pose (`gsGetMyPos`).
+    pub my_pos: Estimate,
+    /// The ball's velocity in the field frame, mm/s (`getBallVel`).
+    pub ball_vel: Vec2,
+    /// The ball's global position (`getGlobalBall`).
+    pub global_ball: Estimate,
+    /// Teammates (`getMates`).
+    pub mates: Vec<Mate>,
+    /// The current role (`getRole`), e.g. `attacker`.
+    pub role: String,
+    /// Whether this robot holds the ball booking (`haveBookedBall`).
+    pub ball_booked: bool,
+    /// The game state (`getCurrentState`).
+    pub game_state: GameState,
+}
+
+impl Default for WorldSnapshot {
+    /// Nothing seen, nothing known.
+    fn default() -> Self {
+        Self {
+            time: Time::ZERO,
+            lps: vec![Lpo::default(); lps::COUNT],
+            my_pos: Estimate::default(),
+            ball_vel: Vec2::zeros(),
+            global_ball: Estimate::default(),
+            mates: Vec::new(),
+            role: String::new(),
+            ball_booked: false,
+            game_state: GameState::default(),
+        }
+    }
+}
+
+/// Everything a behavior may ask for in one cycle. Fields not set keep their defaults
+/// (standing still, no kick, no needs).
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct RobotCommand {
+    /// Linear velocity, mm/s (`setVlin`).
+    pub vlin: f64,
+    /// Rotational velocity, degrees/s (`setVrot`).
+    pub vrot: f64,
+    /// Lateral velocity, mm/s (`setVlat`).
+    pub vlat: f64,
+    /// A kicking routine to perform (`setKick`).
+    pub kick: Option<i64>,
+    /// Perceptual needs `(LPS index, necessity)` (`setNeeded`); the largest wins per index.
+    pub needs: Vec<(usize, f64)>,
+    /// Whether localization landmarks are needed (`trackLandMarks`).
+    pub track_landmarks: bool,
+    /// The behavior to run next (`setBehavior`).
+    pub behavior: Option<String>,
+    /// A booking request: `Some(true)` book the ball, `Some(false)` release it.
+    pub book_ball: Option<bool>,
+}
+
+impl RobotCommand {
+    /// The necessity asserted for an LPS index this cycle (0 when none), combined by max.
+    pub fn need(&self, index: usize) -> f64 {
+        self.needs.iter().filter(|(i, _)| *i == index).map(|(_, v)| *v).fold(0.0, f64::max)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn defaults_mean_nothing_seen_and_standing_still() {
+        let w = WorldSnapshot::default();
+        assert_eq!(w.lps.len(), lps::COUNT);
+        assert_eq!(w.lps[lps::BALL].reliability, 0.0);
+        let mut c = RobotCommand::default();
+        assert_eq!((c.vlin, c.kick, c.need(lps::BALL)), (0.0, None, 0.0));
+        c.needs.push((lps::NET1, 0.7));
+        c.needs.push((lps::NET1, 0.4));
+        assert_eq!(c.need(lps::NET1), 0.7, "needs combine by max");
+        assert_eq!(GameState::Playing.name(), "PLAYING");
+    }
+}

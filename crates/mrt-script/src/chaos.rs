@@ -1,0 +1,254 @@
+//! The robot API `chaos.*` of ThinkingCap's chaoslib (seed 001 §3.3), so a TeamChaos behavior
+//! ports with minimal change. Reads a [`WorldSnapshot`], writes a [`RobotCommand`].
+//!
+//! | group | functions |
+//! |---|---|
+//! | data access | `lps_getLpo(i)` → `{rho, theta, reliability, seen_ago}`, `gsGetMyPos()` → `{x, y, theta, quality}`, `getBallVel()` → `{x, y}`, `getGlobalBall()` → `{x, y, quality}`, `getMates()` → `{{id, x, y, theta, quality}, ...}` |
+//! | control | `setVlin(v)`, `setVrot(v)`, `setVlat(v)`, `setKick(id)`, `setNeeded(i, v)`, `trackLandMarks()`, `setBehavior(name)` |
+//! | coordination | `getRole()` → `{name}`, `haveBookedBall()` → `{booked}`, `bookBall()`, `releaseBookedBall()` |
+//! | persistence | `getBehaviorInfo()` → `{timer (ms), isNew (1/0)}`, `setGlobal(key, type, value)`, `getGlobal(key)`, `getCurrentState()` → `"PLAYING"`... |
+//!
+//! Globals `BALL`, `NET1`, `NET2`, `LANDMARK0`.. and `INTEGER`, `FLOAT`, `STRING` are defined.
+//! A wrong argument type is a Lua error in the calling script, never a panic.
+
+use crate::runtime::LuaRuntime;
+use crate::script::ScriptError;
+use mlua::{Lua, Table, Value};
+use mrt_core::robot::{lps, RobotCommand, WorldSnapshot};
+use mrt_core::Time;
+use std::cell::RefCell;
+use std::collections::HashMap;
+use std::rc::Rc;
+
+/// A value of the persistent global hash table (`setGlobal`).
+#[derive(Clone, Debug, PartialEq)]
+pub enum GlobalValue {
+    /// `INTEGER`
+    Integer(i64),
+    /// `FLOAT`
+    Float(f64),
+    /// `STRING`
+    String(String),
+}
+
+/// The robot as the scripts see it: this cycle's world, the command being built, the
+/// persistent globals and the running behavior's activation info.
+#[derive(Debug, Default)]
+pub struct RobotIo {
+    /// What the behaviors read this cycle.
+    pub world: WorldSnapshot,
+    /// What the behaviors asked for this cycle.
+    pub command: RobotCommand,
+    globals: HashMap<String, GlobalValue>,
+    behavior: Option<String>,
+    behavior_since: Time,
+    is_new: bool,
+}
+
+impl RobotIo {
+    /// Starts a cycle: a new world, an empty command. `behavior` names the behavior about to
+    /// run; when it differs from the previous cycle's, `getBehaviorInfo().isNew` is 1 and its
+    /// timer restarts.
+    pub fn begin_cycle(&mut self, world: WorldSnapshot, behavior: &str) {
+        if self.behavior.as_deref() != Some(behavior) {
+            self.behavior = Some(behavior.to_string());
+            self.behavior_since = world.time;
+            self.is_new = true;
+        } else {
+            self.is_new = false;
+        }
+        self.world = world;
+        self.command = RobotCommand::default();
+    }
+
+    /// A persistent global (`getGlobal`), for tests and monitors.
+    pub fn global(&self, key: &str) -> Option<&GlobalValue> {
+        self.globals.get(key)
+    }
+}
+
+const INTEGER: i64 = 1;
+const FLOAT: i64 = 2;
+const STRING: i64 = 3;
+
+fn check_index(f: &str, i: i64) -> mlua::Result<usize> {
+    usize::try_from(i).ok().filter(|i| *i < lps::COUNT).ok_or_else(|| {
+        mlua::Error::runtime(format!(
+            "chaos.{f}: no LPS object at index {i} (0 to {})",
+            lps::COUNT - 1
+        ))
+    })
+}
+
+fn pose_table(
+    lua: &Lua,
+    x: f64,
+    y: f64,
+    theta: Option<f64>,
+    quality: Option<f64>,
+) -> mlua::Result<Table> {
+    let t = lua.create_table()?;
+    t.set("x", x)?;
+    t.set("y", y)?;
+    if let Some(th) = theta {
+        t.set("theta", th)?;
+    }
+    if let Some(q) = quality {
+        t.set("quality", q)?;
+    }
+    Ok(t)
+}
+
+/// Installs `chaos.*` and its constants in the runtime, bound to `io`.
+pub fn install(rt: &LuaRuntime, io: Rc<RefCell<RobotIo>>) -> Result<(), ScriptError> {
+    install_inner(&rt.lua, io).map_err(ScriptError::setup)
+}
+
+fn install_inner(lua: &Lua, io: Rc<RefCell<RobotIo>>) -> mlua::Result<()> {
+    let chaos = lua.create_table()?;
+    let g = lua.globals();
+    for (name, v) in [("BALL", lps::BALL), ("NET1", lps::NET1), ("NET2", lps::NET2)] {
+        g.set(name, v)?;
+    }
+    for k in 0..lps::LANDMARKS {
+        g.set(format!("LANDMARK{k}"), lps::LANDMARK0 + k)?;
+    }
+    g.set("INTEGER", INTEGER)?;
+    g.set("FLOAT", FLOAT)?;
+    g.set("STRING", STRING)?;
+
+    macro_rules! func {
+        ($name:literal, $io:ident, |$lua:ident, $args:tt : $ty:ty| $body:expr) => {{
+            let $io = io.clone();
+            chaos.set($name, lua.create_function(move |$lua, $args: $ty| $body)?)?;
+        }};
+    }
+
+    // Data access.
+    func!("lps_getLpo", io, |lua, i: i64| {
+        let i = check_index("lps_getLpo", i)?;
+        let o = io.borrow().world.lps.get(i).copied().unwrap_or_default();
+        let t = lua.create_table()?;
+        t.set("rho", o.rho)?;
+        t.set("theta", o.theta)?;
+        t.set("reliability", o.reliability)?;
+        t.set("seen_ago", o.seen_ago)?;
+        Ok(t)
+    });
+    func!("gsGetMyPos", io, |lua, (): ()| {
+        let p = io.borrow().world.my_pos;
+        pose_table(lua, p.pose.x, p.pose.y, Some(p.pose.theta), Some(p.quality))
+    });
+    func!("getBallVel", io, |lua, (): ()| {
+        let v = io.borrow().world.ball_vel;
+        pose_table(lua, v.x, v.y, None, None)
+    });
+    func!("getGlobalBall", io, |lua, (): ()| {
+        let b = io.borrow().world.global_ball;
+        pose_table(lua, b.pose.x, b.pose.y, None, Some(b.quality))
+    });
+    func!("getMates", io, |lua, (): ()| {
+        let t = lua.create_table()?;
+        for (k, m) in io.borrow().world.mates.iter().enumerate() {
+            let e = pose_table(
+                lua,
+                m.at.pose.x,
+                m.at.pose.y,
+                Some(m.at.pose.theta),
+                Some(m.at.quality),
+            )?;
+            e.set("id", m.id)?;
+            t.set(k + 1, e)?;
+        }
+        Ok(t)
+    });
+
+    // Control actions.
+    func!("setVlin", io, |_lua, v: f64| {
+        io.borrow_mut().command.vlin = v;
+        Ok(())
+    });
+    func!("setVrot", io, |_lua, v: f64| {
+        io.borrow_mut().command.vrot = v;
+        Ok(())
+    });
+    func!("setVlat", io, |_lua, v: f64| {
+        io.borrow_mut().command.vlat = v;
+        Ok(())
+    });
+    func!("setKick", io, |_lua, id: i64| {
+        io.borrow_mut().command.kick = Some(id);
+        Ok(())
+    });
+    func!("setNeeded", io, |_lua, (i, v): (i64, f64)| {
+        let i = check_index("setNeeded", i)?;
+        io.borrow_mut().command.needs.push((i, v.clamp(0.0, 1.0)));
+        Ok(())
+    });
+    func!("trackLandMarks", io, |_lua, (): ()| {
+        io.borrow_mut().command.track_landmarks = true;
+        Ok(())
+    });
+    func!("setBehavior", io, |_lua, name: String| {
+        io.borrow_mut().command.behavior = Some(name);
+        Ok(())
+    });
+
+    // Coordination.
+    func!("getRole", io, |lua, (): ()| {
+        let t = lua.create_table()?;
+        t.set("name", io.borrow().world.role.clone())?;
+        Ok(t)
+    });
+    func!("haveBookedBall", io, |lua, (): ()| {
+        let t = lua.create_table()?;
+        t.set("booked", io.borrow().world.ball_booked)?;
+        Ok(t)
+    });
+    func!("bookBall", io, |_lua, (): ()| {
+        io.borrow_mut().command.book_ball = Some(true);
+        Ok(())
+    });
+    func!("releaseBookedBall", io, |_lua, (): ()| {
+        io.borrow_mut().command.book_ball = Some(false);
+        Ok(())
+    });
+
+    // Persistence.
+    func!("getBehaviorInfo", io, |lua, (): ()| {
+        let io = io.borrow();
+        let t = lua.create_table()?;
+        t.set("timer", (io.world.time - io.behavior_since).as_secs_f64() * 1000.0)?;
+        t.set("isNew", i64::from(io.is_new))?;
+        Ok(t)
+    });
+    func!("setGlobal", io, |_lua, (key, ty, value): (String, i64, Value)| {
+        let v = match (ty, &value) {
+            (INTEGER, Value::Integer(i)) => GlobalValue::Integer(*i),
+            (INTEGER, Value::Number(n)) if n.fract() == 0.0 && n.is_finite() => GlobalValue::Integer(*n as i64),
+            (FLOAT, Value::Integer(i)) => GlobalValue::Float(*i as f64),
+            (FLOAT, Value::Number(n)) => GlobalValue::Float(*n),
+            (STRING, Value::String(s)) => GlobalValue::String(s.to_str()?.to_string()),
+            _ => {
+                return Err(mlua::Error::runtime(format!(
+                    "chaos.setGlobal(\"{key}\"): type {ty} does not match the value {} (INTEGER=1, FLOAT=2, STRING=3)",
+                    value.type_name()
+                )))
+            }
+        };
+        io.borrow_mut().globals.insert(key, v);
+        Ok(())
+    });
+    func!("getGlobal", io, |lua, key: String| {
+        Ok(match io.borrow().globals.get(&key) {
+            Some(GlobalValue::Integer(i)) => Value::Integer(*i),
+            Some(GlobalValue::Float(f)) => Value::Number(*f),
+            Some(GlobalValue::String(s)) => Value::String(lua.create_string(s)?),
+            None => Value::Nil,
+        })
+    });
+    func!("getCurrentState", io, |_lua, (): ()| Ok(io.borrow().world.game_state.name()));
+
+    g.set("chaos", chaos)?;
+    Ok(())
+}

@@ -1,0 +1,130 @@
+//! The `chaos.*` robot API (seed 001 §3.3) and the seed's `lookball` behavior (§4.3).
+
+#![allow(clippy::unwrap_used)]
+
+use mrt_core::robot::{lps, Estimate, GameState, Lpo, Mate, WorldSnapshot};
+use mrt_core::{Pose2, Time};
+use mrt_script::chaos::{install, GlobalValue, RobotIo};
+use mrt_script::{LoadStrategy, LuaRuntime, Sandbox, Script, ScriptError};
+use std::cell::RefCell;
+use std::path::PathBuf;
+use std::rc::Rc;
+
+fn setup() -> (LuaRuntime, Rc<RefCell<RobotIo>>) {
+    let rt = LuaRuntime::new(Sandbox::default()).unwrap();
+    let io = Rc::new(RefCell::new(RobotIo::default()));
+    install(&rt, io.clone()).unwrap();
+    (rt, io)
+}
+
+fn world_with_ball(theta: f64, t_ms: u64) -> WorldSnapshot {
+    let mut w = WorldSnapshot { time: Time::from_millis(t_ms), ..Default::default() };
+    w.lps[lps::BALL] = Lpo { rho: 400.0, theta, reliability: 0.9, seen_ago: 0.0 };
+    w
+}
+
+#[test]
+fn lookball_turns_towards_where_the_ball_was_and_speeds_up_after_400_ms() {
+    let (rt, io) = setup();
+    let path =
+        PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../behaviors/teamchaos/lookball.lua");
+    let s = Script::from_file(&rt, &path, LoadStrategy::Compiled).unwrap();
+    // First tick: the ball was last seen to the right (theta < 0): turn right, slowly.
+    io.borrow_mut().begin_cycle(world_with_ball(-0.5, 1000), "lookball");
+    s.call::<()>(&rt).unwrap();
+    {
+        let io = io.borrow();
+        assert_eq!((io.command.vlin, io.command.vrot, io.command.vlat), (0.0, -50.0, 0.0));
+        assert_eq!(io.command.need(lps::BALL), 1.0);
+        assert_eq!(io.global("BALL_DIRECTION"), Some(&GlobalValue::Integer(-1)));
+    }
+    // 300 ms later, still the same behavior: the direction stays (the ball is now to the left,
+    // but isNew is 0, so the stored direction is used), still slow.
+    io.borrow_mut().begin_cycle(world_with_ball(0.8, 1300), "lookball");
+    s.call::<()>(&rt).unwrap();
+    assert_eq!(io.borrow().command.vrot, -50.0);
+    // 500 ms after it started: faster.
+    io.borrow_mut().begin_cycle(world_with_ball(0.8, 1500), "lookball");
+    s.call::<()>(&rt).unwrap();
+    assert_eq!(io.borrow().command.vrot, -75.0);
+    // Another behavior ran in between: lookball is new again and re-reads the direction.
+    io.borrow_mut().begin_cycle(world_with_ball(0.8, 1600), "go2ball");
+    io.borrow_mut().begin_cycle(world_with_ball(0.8, 1700), "lookball");
+    s.call::<()>(&rt).unwrap();
+    assert_eq!(io.borrow().command.vrot, 50.0);
+}
+
+#[test]
+fn every_data_access_function_reads_the_snapshot() {
+    let (rt, io) = setup();
+    let mut w = world_with_ball(0.25, 42);
+    w.my_pos = Estimate { pose: Pose2::new(1000.0, -500.0, 0.5), quality: 0.8 };
+    w.global_ball = Estimate { pose: Pose2::new(2000.0, 300.0, 0.0), quality: 0.6 };
+    w.ball_vel = mrt_core::Vec2::new(100.0, -20.0);
+    w.mates =
+        vec![Mate { id: 3, at: Estimate { pose: Pose2::new(-100.0, 50.0, 1.0), quality: 0.5 } }];
+    w.role = "attacker".into();
+    w.ball_booked = true;
+    w.game_state = GameState::Playing;
+    io.borrow_mut().begin_cycle(w, "probe");
+    let probe = r#"
+        local b, p, v, g, m = chaos.lps_getLpo(BALL), chaos.gsGetMyPos(), chaos.getBallVel(), chaos.getGlobalBall(), chaos.getMates()
+        return string.format("%g %g %g %g|%g %g %g %g|%g %g|%g %g %g|%d %g %g|%s %s %s|%d %s",
+            b.rho, b.theta, b.reliability, b.seen_ago, p.x, p.y, p.theta, p.quality, v.x, v.y,
+            g.x, g.y, g.quality, m[1].id, m[1].x, m[1].quality, chaos.getRole().name,
+            tostring(chaos.haveBookedBall().booked), chaos.getCurrentState(),
+            chaos.getBehaviorInfo().isNew, tostring(NET1 == 1 and LANDMARK0 == 3))"#;
+    let s = Script::from_source(&rt, "probe.lua", probe, LoadStrategy::Compiled).unwrap();
+    assert_eq!(
+        s.call::<String>(&rt).unwrap(),
+        "400 0.25 0.9 0|1000 -500 0.5 0.8|100 -20|2000 300 0.6|3 -100 0.5|attacker true PLAYING|1 true"
+    );
+}
+
+#[test]
+fn control_coordination_and_persistence_write_the_command() {
+    let (rt, io) = setup();
+    io.borrow_mut().begin_cycle(WorldSnapshot::default(), "b");
+    let s = Script::from_source(
+        &rt,
+        "ctl.lua",
+        r#"chaos.setVlin(120) chaos.setVrot(-30) chaos.setVlat(5) chaos.setKick(2)
+           chaos.setNeeded(NET1, 0.7) chaos.setNeeded(NET1, 0.4) chaos.setNeeded(BALL, 3)
+           chaos.trackLandMarks() chaos.setBehavior("go2ball") chaos.bookBall()
+           chaos.setGlobal("n", INTEGER, 7) chaos.setGlobal("f", FLOAT, 2.5) chaos.setGlobal("s", STRING, "hi")
+           return chaos.getGlobal("n") + chaos.getGlobal("f"), chaos.getGlobal("s"), chaos.getGlobal("none")"#,
+        LoadStrategy::Compiled,
+    )
+    .unwrap();
+    let (sum, text, none): (f64, String, Option<i64>) = s.call(&rt).unwrap();
+    assert_eq!((sum, text.as_str(), none), (9.5, "hi", None));
+    let io = io.borrow();
+    let c = &io.command;
+    assert_eq!((c.vlin, c.vrot, c.vlat, c.kick), (120.0, -30.0, 5.0, Some(2)));
+    assert_eq!((c.need(lps::NET1), c.need(lps::BALL)), (0.7, 1.0), "max per object; clamped to 1");
+    assert!(c.track_landmarks);
+    assert_eq!((c.behavior.as_deref(), c.book_ball), (Some("go2ball"), Some(true)));
+}
+
+#[test]
+fn wrong_arguments_are_lua_errors_naming_the_script_not_panics() {
+    let (rt, io) = setup();
+    io.borrow_mut().begin_cycle(WorldSnapshot::default(), "b");
+    for (src, needle) in [
+        ("chaos.setVlin('fast')", "setVlin"),
+        ("chaos.lps_getLpo(99)", "no LPS object at index 99"),
+        ("chaos.setNeeded(-1, 1)", "no LPS object at index -1"),
+        ("chaos.setGlobal('k', INTEGER, 'text')", "does not match"),
+        ("chaos.setGlobal('k', 9, 1)", "does not match"),
+        ("chaos.nothere()", "nothere"),
+    ] {
+        let s = Script::from_source(&rt, "bad.lua", src, LoadStrategy::Compiled).unwrap();
+        let e = s.call::<()>(&rt).unwrap_err();
+        assert!(matches!(e, ScriptError::Runtime { .. }), "{src}: {e}");
+        let text = e.to_string();
+        assert!(
+            text.starts_with("bad.lua: runtime error") && text.contains(needle),
+            "{src}: {text}"
+        );
+    }
+}
