@@ -44,6 +44,24 @@ fn bench(c: &mut Criterion) {
     )
     .unwrap();
     c.bench_function("script_tick_minimal", |b| b.iter(|| tick.call::<i64>(&rt).unwrap()));
+    // A behavior tick with four robot-API calls (issue 5 goal: ≤ 0.5 µs).
+    let rt4 = LuaRuntime::new(Sandbox::default()).unwrap();
+    let io = std::rc::Rc::new(std::cell::RefCell::new(mrt_script::chaos::RobotIo::default()));
+    mrt_script::chaos::install(&rt4, io.clone()).unwrap();
+    io.borrow_mut().begin_cycle(mrt_core::robot::WorldSnapshot::default(), "tick");
+    let four = Script::from_source(
+        &rt4,
+        "four.lua",
+        "local b = chaos.lps_getLpo(BALL) chaos.setVlin(0) chaos.setVrot(b.theta) chaos.setNeeded(BALL, 1.0)",
+        LoadStrategy::Compiled,
+    )
+    .unwrap();
+    c.bench_function("script_tick_four_api_calls", |b| {
+        b.iter(|| {
+            io.borrow_mut().command.needs.clear();
+            four.call::<()>(&rt4).unwrap()
+        })
+    });
     // Hot reload: from a changed file to the new version ready (read + compile + swap).
     let s = Script::from_file(&rt, &path, LoadStrategy::Compiled).unwrap();
     c.bench_function("hot_reload_300_lines", |b| b.iter(|| s.reload(&rt).unwrap()));
