@@ -11,6 +11,19 @@ fn mrt() -> Command {
     Command::new(env!("CARGO_BIN_EXE_mrt"))
 }
 
+/// Runs `mrt brian eval DIR [--trace]` with `input` on stdin.
+fn eval(dir: &std::path::Path, trace: bool, input: &[u8]) -> std::process::Output {
+    let mut cmd = mrt();
+    cmd.args(["brian", "eval"]).arg(dir);
+    if trace {
+        cmd.arg("--trace");
+    }
+    let mut child =
+        cmd.stdin(Stdio::piped()).stdout(Stdio::piped()).stderr(Stdio::piped()).spawn().unwrap();
+    child.stdin.take().unwrap().write_all(input).unwrap();
+    child.wait_with_output().unwrap()
+}
+
 fn bench(name: &str) -> Option<PathBuf> {
     let d = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/bench").join(name);
     if d.exists() {
@@ -75,16 +88,7 @@ fn eval_reads_json_lines_and_matches_the_expected_commands() {
         .take(20)
         .map(|l| serde_json::from_str(l).unwrap())
         .collect();
-    let mut child = mrt()
-        .args(["brian", "eval"])
-        .arg(&dir)
-        .arg("--trace")
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .spawn()
-        .unwrap();
-    child.stdin.take().unwrap().write_all(cycles.join("\n").as_bytes()).unwrap();
-    let out = child.wait_with_output().unwrap();
+    let out = eval(&dir, true, cycles.join("\n").as_bytes());
     assert!(out.status.success());
     let got: Vec<serde_json::Value> = String::from_utf8(out.stdout)
         .unwrap()
@@ -108,21 +112,7 @@ fn eval_reads_json_lines_and_matches_the_expected_commands() {
         assert!(proposals.iter().all(|p| p["behavior"].is_string() && p["action"].is_string()));
     }
     // A malformed line is an error naming the line, not a panic.
-    let mut child = mrt()
-        .args(["brian", "eval"])
-        .arg(&dir)
-        .stdin(Stdio::piped())
-        .stderr(Stdio::piped())
-        .stdout(Stdio::null())
-        .spawn()
-        .unwrap();
-    child
-        .stdin
-        .take()
-        .unwrap()
-        .write_all(b"{\"BallDistance\": 10}\n{\"BallDistance\": \"far\"}\n")
-        .unwrap();
-    let out = child.wait_with_output().unwrap();
+    let out = eval(&dir, false, b"{\"BallDistance\": 10}\n{\"BallDistance\": \"far\"}\n");
     assert!(!out.status.success());
     assert!(
         String::from_utf8_lossy(&out.stderr).contains("input line 2"),
@@ -166,21 +156,11 @@ fn check_eval_and_plot_work_on_the_shipped_harvester() {
         "{}",
         String::from_utf8_lossy(&out.stderr)
     );
-    let mut child = mrt()
-        .args(["brian", "eval"])
-        .arg(&dir)
-        .arg("--trace")
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .spawn()
-        .unwrap();
-    child
-        .stdin
-        .take()
-        .unwrap()
-        .write_all(b"{\"TargetDistance\": 300, \"TargetAngle\": 0, \"BatteryLevel\": 100, \"HomeDistance\": 400, \"HomeAngle\": 180}\n")
-        .unwrap();
-    let out = child.wait_with_output().unwrap();
+    let out = eval(
+        &dir,
+        true,
+        b"{\"TargetDistance\": 300, \"TargetAngle\": 0, \"BatteryLevel\": 100, \"HomeDistance\": 400, \"HomeAngle\": 180}\n",
+    );
     assert!(out.status.success());
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     // Target far straight ahead: go FAST (75 cm/s), heading 0 (ahead).
