@@ -87,7 +87,7 @@ fn pose_table(
     theta: Option<f64>,
     quality: Option<f64>,
 ) -> mlua::Result<Table> {
-    let t = lua.create_table()?;
+    let t = lua.create_table_with_capacity(0, 4)?;
     t.set("x", x)?;
     t.set("y", y)?;
     if let Some(th) = theta {
@@ -128,7 +128,7 @@ fn install_inner(lua: &Lua, io: Rc<RefCell<RobotIo>>) -> mlua::Result<()> {
     func!("lps_getLpo", io, |lua, i: i64| {
         let i = check_index("lps_getLpo", i)?;
         let o = io.borrow().world.lps.get(i).copied().unwrap_or_default();
-        let t = lua.create_table()?;
+        let t = lua.create_table_with_capacity(0, 4)?;
         t.set("rho", o.rho)?;
         t.set("theta", o.theta)?;
         t.set("reliability", o.reliability)?;
@@ -148,7 +148,7 @@ fn install_inner(lua: &Lua, io: Rc<RefCell<RobotIo>>) -> mlua::Result<()> {
         pose_table(lua, b.pose.x, b.pose.y, None, Some(b.quality))
     });
     func!("getMates", io, |lua, (): ()| {
-        let t = lua.create_table()?;
+        let t = lua.create_table_with_capacity(io.borrow().world.mates.len(), 0)?;
         for (k, m) in io.borrow().world.mates.iter().enumerate() {
             let e = pose_table(
                 lua,
@@ -196,12 +196,12 @@ fn install_inner(lua: &Lua, io: Rc<RefCell<RobotIo>>) -> mlua::Result<()> {
 
     // Coordination.
     func!("getRole", io, |lua, (): ()| {
-        let t = lua.create_table()?;
+        let t = lua.create_table_with_capacity(0, 1)?;
         t.set("name", io.borrow().world.role.clone())?;
         Ok(t)
     });
     func!("haveBookedBall", io, |lua, (): ()| {
-        let t = lua.create_table()?;
+        let t = lua.create_table_with_capacity(0, 1)?;
         t.set("booked", io.borrow().world.ball_booked)?;
         Ok(t)
     });
@@ -217,7 +217,7 @@ fn install_inner(lua: &Lua, io: Rc<RefCell<RobotIo>>) -> mlua::Result<()> {
     // Persistence.
     func!("getBehaviorInfo", io, |lua, (): ()| {
         let io = io.borrow();
-        let t = lua.create_table()?;
+        let t = lua.create_table_with_capacity(0, 2)?;
         t.set("timer", (io.world.time - io.behavior_since).as_secs_f64() * 1000.0)?;
         t.set("isNew", i64::from(io.is_new))?;
         Ok(t)

@@ -186,15 +186,21 @@ impl Script {
     /// Runs the script once (one behavior tick) within the sandbox's budget, returning what
     /// the chunk returns. A failed call leaves the runtime and the script usable.
     pub fn call<R: FromLuaMulti>(&self, rt: &LuaRuntime) -> Result<R, ScriptError> {
-        let f = match (self.strategy, &self.path) {
-            (LoadStrategy::ReloadFromFile, Some(p)) => compile(rt, &self.name, &read(p)?)?,
+        let fresh = match (self.strategy, &self.path) {
+            (LoadStrategy::ReloadFromFile, Some(p)) => Some(compile(rt, &self.name, &read(p)?)?),
             (LoadStrategy::Source, _) | (LoadStrategy::ReloadFromFile, None) => {
-                compile(rt, &self.name, &self.source.borrow())?
+                Some(compile(rt, &self.name, &self.source.borrow())?)
             }
-            (LoadStrategy::Compiled, _) => self.compiled.borrow().clone(),
+            (LoadStrategy::Compiled, _) => None,
         };
         rt.reset_budget();
-        f.call::<R>(()).map_err(|e| ScriptError::from_lua(&self.name, rt, e))
+        let result = match fresh {
+            Some(f) => f.call::<R>(()),
+            // No clone of the kept function (a registry reference each time): call it in place.
+            // Nothing a script can do reaches `reload_source` during the call.
+            None => self.compiled.borrow().call::<R>(()),
+        };
+        result.map_err(|e| ScriptError::from_lua(&self.name, rt, e))
     }
 
     /// Replaces the script with `source` if it compiles; otherwise returns the error and keeps
