@@ -302,6 +302,7 @@ impl std::fmt::Debug for Commands {
     }
 }
 
+#[derive(Clone, Copy)]
 struct Names<'a> {
     inputs: &'a [Input],
     predicates: &'a [(String, Expr)],
@@ -385,6 +386,7 @@ impl Brian {
             inputs.push(Input { name: a.name.clone(), shape, offset, now: None, previous: None });
             offset += n;
         }
+        let fuzzy_data_len = offset;
 
         let mut warnings = Vec::new();
         for shape in shapes.iter().filter(|s| !assocs.iter().any(|a| a.shape == s.name)) {
@@ -480,19 +482,14 @@ impl Brian {
                     format!("behavior `{name}` is listed twice"),
                 ));
             }
-            let rules = parse_file(&rul, |c| {
-                parse_rules(c, &Names { file: &rul, ..names_ref(&names) }, &actions)
-            })?;
+            let rules =
+                parse_file(&rul, |c| parse_rules(c, &Names { file: &rul, ..names }, &actions))?;
             let cando = match cando.iter().find(|(n, _, _)| *n == name) {
-                Some((_, _, raw)) => {
-                    Some(Names { file: &files.cando, ..names_ref(&names) }.resolve(raw)?)
-                }
+                Some((_, _, raw)) => Some(Names { file: &files.cando, ..names }.resolve(raw)?),
                 None => None,
             };
             let want = match want.iter().find(|(n, _, _)| *n == name) {
-                Some((_, _, raw)) => {
-                    Some(Names { file: &files.want, ..names_ref(&names) }.resolve(raw)?)
-                }
+                Some((_, _, raw)) => Some(Names { file: &files.want, ..names }.resolve(raw)?),
                 None => None,
             };
             behaviors.push(Behavior { name, span, level, cando, want, rules });
@@ -572,7 +569,7 @@ impl Brian {
             is_proposed,
             outputs: vec![None; actions.len()],
             composer: Composer::default(),
-            data: vec![FuzzyValue::MISSING; offset_of(&inputs)],
+            data: vec![FuzzyValue::MISSING; fuzzy_data_len],
             pred_values: vec![FuzzyValue::MISSING; predicates.len()],
             act_values: vec![FuzzyValue::MISSING; predicate_actions.len()],
             lower: vec![Acc::default(); slots],
@@ -867,19 +864,6 @@ fn mark_used(e: &Expr, preds: &mut [bool], acts: &mut [bool]) {
         Expr::Pred(i) => preds[*i] = true,
         Expr::Action(i) => acts[*i] = true,
         Expr::Data(_) => {}
-    }
-}
-
-fn offset_of(inputs: &[Input]) -> usize {
-    inputs.iter().map(|i| i.shape.sets.len()).sum()
-}
-
-fn names_ref<'a>(n: &Names<'a>) -> Names<'a> {
-    Names {
-        inputs: n.inputs,
-        predicates: n.predicates,
-        predicate_actions: n.predicate_actions,
-        file: n.file,
     }
 }
 
