@@ -40,12 +40,14 @@
 //! | `weight_composer` / `float_composer` (max, average) | [`brian::Composer`] |
 //! | `threshold_filter` (0.49) | [`brian::Brian::set_threshold`] |
 //! | Parser and Messenger (§10.3.10) on the bus | [`member::BrianMember`], [`member::BrianInputs`], [`member::BrianCommands`] (feature `member`) |
+//! | ThinkingCap HBM rules and Context-Dependent Blending (seed 001 §4.1) | [`hbm::Blender`], [`hbm::ControlVariable`], Mamdani [`hbm::centroid`] |
 //! | the checker of §10.4.7 | `mrt brian check DIR` (errors: [`BrianError`]) |
 #![deny(missing_docs)]
 
 pub mod brian;
 mod error;
 pub mod expr;
+pub mod hbm;
 pub mod lexer;
 #[cfg(feature = "member")]
 pub mod member;
