@@ -21,13 +21,19 @@ pub enum ScriptError {
         /// Lua's explanation.
         message: String,
     },
-    /// The script raised an error while running.
-    #[error("{file}: runtime error: {message}")]
+    /// The script raised an error while running (including a chaos API called with wrong
+    /// arguments).
+    #[error("{file}:{line}: runtime error: {message}")]
     Runtime {
-        /// The script.
+        /// The script where it happened (the innermost script frame; a behavior `use`d by
+        /// another names its own file).
         file: String,
-        /// Lua's explanation, with its traceback position.
+        /// The line (0 when Lua did not say).
+        line: usize,
+        /// Lua's explanation, with the API function that refused its arguments.
         message: String,
+        /// Lua's stack traceback.
+        traceback: String,
     },
     /// The call ran past its instruction budget (an endless loop?).
     #[error("{file}: aborted after {budget} instructions (instruction budget exceeded)")]
@@ -80,8 +86,50 @@ impl ScriptError {
             let (line, msg) = split_position(message);
             return ScriptError::Syntax { file: file.into(), line, message: msg };
         }
-        ScriptError::Runtime { file: file.into(), message: text }
+        runtime_error(file, &text)
     }
+}
+
+/// Splits Lua's runtime error text into the innermost script position, a clean message and
+/// the traceback. Lua says `runtime error: name:LINE: message` for errors raised in Lua and
+/// `bad argument #1: ...` (no position) for arguments a Rust function refused; the traceback
+/// then names the function (`in field 'setVlin'`) and the script line that called it.
+fn runtime_error(file: &str, text: &str) -> ScriptError {
+    let (head, traceback) = match text.split_once("\nstack traceback:") {
+        Some((h, t)) => (h, t.trim().to_string()),
+        None => (text, String::new()),
+    };
+    let mut message = head;
+    while let Some(rest) = message.strip_prefix("runtime error: ") {
+        message = rest;
+    }
+    let mut position = script_position(message);
+    if let Some((_, _, rest)) = &position {
+        message = rest;
+    }
+    let mut message = message.trim().to_string();
+    let frames: Vec<&str> = traceback.lines().map(str::trim).collect();
+    if position.is_none() {
+        position = frames.iter().find_map(|f| script_position(f));
+    }
+    if let Some(callee) = frames.first().and_then(|f| f.strip_prefix("[C]: in ")) {
+        if message.starts_with("bad argument") {
+            message = format!("{message} (calling {callee})");
+        }
+    }
+    let (file, line) = match position {
+        Some((f, l, _)) => (f.to_string(), l),
+        None => (file.to_string(), 0),
+    };
+    ScriptError::Runtime { file, line, message, traceback }
+}
+
+/// `name:LINE: rest` at the start of `s` (name not `[C]`), as `(name, LINE, rest)`.
+fn script_position(s: &str) -> Option<(&str, usize, &str)> {
+    let (name, after) = s.split_once(':')?;
+    let (line, rest) = after.split_once(':')?;
+    let line = line.parse().ok()?;
+    (!name.is_empty() && !name.starts_with('[')).then_some((name, line, rest))
 }
 
 fn split_position(message: &str) -> (usize, String) {

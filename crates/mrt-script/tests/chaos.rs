@@ -107,23 +107,24 @@ fn control_coordination_and_persistence_write_the_command() {
 }
 
 #[test]
-fn wrong_arguments_are_lua_errors_naming_the_script_not_panics() {
+fn wrong_arguments_are_lua_errors_naming_the_script_line_and_function_not_panics() {
     let (rt, io) = setup();
     io.borrow_mut().begin_cycle(WorldSnapshot::default(), "b");
     for (src, needle) in [
-        ("chaos.setVlin('fast')", "setVlin"),
+        ("chaos.setVlin('fast')", "(calling field 'setVlin')"),
         ("chaos.lps_getLpo(99)", "no LPS object at index 99"),
         ("chaos.setNeeded(-1, 1)", "no LPS object at index -1"),
         ("chaos.setGlobal('k', INTEGER, 'text')", "does not match"),
         ("chaos.setGlobal('k', 9, 1)", "does not match"),
         ("chaos.nothere()", "nothere"),
     ] {
-        let s = Script::from_source(&rt, "bad.lua", src, LoadStrategy::Compiled).unwrap();
+        let src = format!("local x = 1\n{src}");
+        let s = Script::from_source(&rt, "bad.lua", &src, LoadStrategy::Compiled).unwrap();
         let e = s.call::<()>(&rt).unwrap_err();
         assert!(matches!(e, ScriptError::Runtime { .. }), "{src}: {e}");
         let text = e.to_string();
         assert!(
-            text.starts_with("bad.lua: runtime error") && text.contains(needle),
+            text.starts_with("bad.lua:2: runtime error") && text.contains(needle),
             "{src}: {text}"
         );
     }

@@ -57,7 +57,7 @@ fn scripts_see_only_the_safe_libraries() {
     let e = s.call::<()>(&rt).unwrap_err();
     assert!(
         matches!(e, ScriptError::Runtime { .. })
-            && e.to_string().starts_with("evil.lua: runtime error"),
+            && e.to_string().starts_with("evil.lua:1: runtime error"),
         "{e}"
     );
 }
