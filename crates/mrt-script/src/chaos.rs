@@ -50,15 +50,32 @@ impl RobotIo {
     /// run; when it differs from the previous cycle's, `getBehaviorInfo().isNew` is 1 and its
     /// timer restarts.
     pub fn begin_cycle(&mut self, world: WorldSnapshot, behavior: &str) {
+        self.new_cycle(world);
+        self.activate(behavior);
+    }
+
+    /// Starts a cycle: a new world, an empty command (the behavior is chosen later, e.g. by
+    /// an HFSM: then call [`RobotIo::activate`]).
+    pub fn new_cycle(&mut self, world: WorldSnapshot) {
+        self.world = world;
+        self.command = RobotCommand::default();
+    }
+
+    /// Says which behavior runs this cycle: when it differs from the previous cycle's,
+    /// `getBehaviorInfo().isNew` is 1 and its timer restarts.
+    pub fn activate(&mut self, behavior: &str) {
         if self.behavior.as_deref() != Some(behavior) {
             self.behavior = Some(behavior.to_string());
-            self.behavior_since = world.time;
+            self.behavior_since = self.world.time;
             self.is_new = true;
         } else {
             self.is_new = false;
         }
-        self.world = world;
-        self.command = RobotCommand::default();
+    }
+
+    /// The behavior running (the last one activated).
+    pub fn behavior(&self) -> Option<&str> {
+        self.behavior.as_deref()
     }
 
     /// A persistent global (`getGlobal`), for tests and monitors.

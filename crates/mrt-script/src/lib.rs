@@ -35,6 +35,8 @@
 #![deny(missing_docs)]
 
 pub mod chaos;
+pub mod hbm;
+pub mod hfsm;
 mod runtime;
 mod script;
 mod watch;

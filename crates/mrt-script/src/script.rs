@@ -51,6 +51,17 @@ pub enum ScriptError {
         /// The limit.
         limit: usize,
     },
+    /// The script compiled but what it defines is wrong (an HFSM with an unknown state, a
+    /// meta-state containing itself...).
+    #[error("{file}:{line}: {message}")]
+    Invalid {
+        /// The script.
+        file: String,
+        /// The line of the definition (0 when unknown).
+        line: usize,
+        /// What is wrong.
+        message: String,
+    },
     /// The script file could not be read.
     #[error("{file}: {source}")]
     Io {
@@ -70,7 +81,7 @@ impl ScriptError {
         ScriptError::Setup(e.to_string())
     }
 
-    fn from_lua(file: &str, rt: &LuaRuntime, e: mlua::Error) -> ScriptError {
+    pub(crate) fn from_lua(file: &str, rt: &LuaRuntime, e: mlua::Error) -> ScriptError {
         let text = e.to_string();
         if matches!(e, mlua::Error::MemoryError(_)) || text.contains("not enough memory") {
             return ScriptError::Memory { file: file.into(), limit: rt.sandbox().memory_limit };
@@ -229,6 +240,11 @@ impl Script {
     /// The loading strategy.
     pub fn strategy(&self) -> LoadStrategy {
         self.strategy
+    }
+
+    /// The compiled chunk (a cheap handle), for callers that run it inside another call.
+    pub(crate) fn function(&self) -> Function {
+        self.compiled.borrow().clone()
     }
 
     /// Runs the script once (one behavior tick) within the sandbox's budget, returning what

@@ -1,0 +1,481 @@
+//! Fuzzy HBM behaviors written in Lua and blended by context rules (ThinkingCap, seed 001 §4.1),
+//! on the fuzzy core of `mrt-fuzzy` ([`mrt_fuzzy::hbm::Blender`]).
+//!
+//! A behavior directory holds one Lua file per behavior, named after it (`gkcutb.lua` is the
+//! behavior `gkcutb`), and optionally `hbm.lua`, run once at load, for control variables and
+//! predicates shared by all behaviors. `*.hfsm.lua` files are state machines, not behaviors.
+//! A behavior file runs each time the behavior runs, like ThinkingCap's scripts; besides the
+//! `chaos.*` API it may use this rule language (the seed's pseudocode, in Lua):
+//!
+//! | seed | Lua |
+//! |---|---|
+//! | `if posLeft then strafe RIGHT` | `rule(posLeft, "strafe", "RIGHT")` |
+//! | `always go STAY` | `always("go", "STAY")` |
+//! | `if and(freeToKick, ballClose) then kick FRONTKICK` | `rule(AND(freeToKick, ballClose), "kick", "FRONTKICK")` |
+//! | `if ballClose then need NET1` | `need(ballClose, NET1)` |
+//! | `if ballFar then use go2ball` | `use(ballFar, "go2ball")` |
+//! | `or`, `not` | `OR(a, b, ...)`, `NOT(a)` (min / max / 1 − a) |
+//! | membership functions (figure 5) | `TRI(a, b, c)`, `TRA(a, b, c, d)`, `TOL(a, b)`, `TOR(a, b)`, `REC(a, b)`, `SNG(a)`, `DIV(a, b, c, d)`; a set is called on a value: `TOL(250, 750)(ball.rho)` |
+//! | control variables | `variable { name = "go", command = "vlin", min = -300, max = 300, mode = "centroid", labels = { STAY = TRI(-150, 0, 150), ... } }` |
+//!
+//! Truth values are numbers in `[0, 1]` (booleans count as 0 and 1). A `use`d behavior runs at
+//! activation `min(truth, activation of its user)`; what it asserts is clipped at that level
+//! and blended per control variable ([`mrt_fuzzy::hbm`] says how); a behavior at activation 0
+//! is not run. The default variables `go` (→ `vlin`), `turn` (→ `vrot`), `strafe` (→ `vlat`)
+//! and `kick` (→ `kick`) are defined in `hbm_defaults.lua`; after a cycle each variable that
+//! some rule asserted overrides the command field it drives, and the needs join the command's
+//! needs. A behavior that sets the command directly (`chaos.setVrot`, like `lookball`) works
+//! too.
+
+use crate::chaos::RobotIo;
+use crate::runtime::LuaRuntime;
+use crate::script::{LoadStrategy, Script, ScriptError};
+use mlua::{Lua, MetaMethod, Table, UserData, UserDataMethods, Value, Variadic};
+use mrt_core::robot::lps;
+use mrt_fuzzy::hbm::{Blender, ControlVariable, Defuzzification};
+use mrt_fuzzy::FuzzySet;
+use std::cell::RefCell;
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::rc::Rc;
+
+/// The default control variables, run before a directory's `hbm.lua`.
+pub const DEFAULT_VARIABLES: &str = include_str!("hbm_defaults.lua");
+
+/// How deep `use` may nest: deeper is a runaway hierarchy.
+pub const MAX_DEPTH: usize = 32;
+
+/// The robot command field a control variable drives.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Drives {
+    Vlin,
+    Vrot,
+    Vlat,
+    Kick,
+}
+
+/// A fuzzy set as Lua sees it: called on a value, it gives the membership.
+#[derive(Clone, Copy)]
+struct LuaSet(FuzzySet);
+
+impl UserData for LuaSet {
+    fn add_methods<M: UserDataMethods<Self>>(m: &mut M) {
+        m.add_meta_method(MetaMethod::Call, |_, s, x: f64| Ok(s.0.membership(x)));
+        m.add_meta_method(MetaMethod::ToString, |_, s, ()| {
+            Ok(format!("{}{:?}", s.0.identifier(), s.0.params()))
+        });
+    }
+}
+
+/// A truth value from Lua: a number (clamped to `[0, 1]`) or a boolean.
+fn truth(v: &Value, what: &str) -> mlua::Result<f64> {
+    match v {
+        Value::Boolean(b) => Ok(f64::from(u8::from(*b))),
+        Value::Integer(i) => Ok((*i as f64).clamp(0.0, 1.0)),
+        Value::Number(n) if n.is_nan() => Ok(0.0),
+        Value::Number(n) => Ok(n.clamp(0.0, 1.0)),
+        other => Err(mlua::Error::runtime(format!(
+            "{what}: a truth value must be a number or a boolean, not {}",
+            other.type_name()
+        ))),
+    }
+}
+
+/// What `variable { ... }` declared, in order, with the field each drives.
+type Declared = Vec<(ControlVariable, Option<Drives>)>;
+
+/// Everything the rule functions share.
+struct Shared {
+    behaviors: RefCell<BTreeMap<String, Script>>,
+    cdb: RefCell<Blender>,
+    declared: RefCell<Declared>,
+    /// The behaviors being run, outermost first (to refuse a behavior using itself).
+    running: RefCell<Vec<String>>,
+}
+
+/// A directory of HBM behaviors loaded into one Lua runtime.
+pub struct Hbm {
+    dir: PathBuf,
+    shared: Rc<Shared>,
+    drives: Vec<Option<Drives>>,
+    setup: Option<Script>,
+    io: Rc<RefCell<RobotIo>>,
+}
+
+impl Hbm {
+    /// Loads every behavior of `dir` (`*.lua` except `hbm.lua` and `*.hfsm.lua`), after the
+    /// default control variables and the directory's `hbm.lua`. The runtime must have `chaos`
+    /// installed on `io`. Any file that does not compile is an error naming it and its line.
+    pub fn load_dir(
+        rt: &LuaRuntime,
+        dir: impl AsRef<Path>,
+        io: Rc<RefCell<RobotIo>>,
+    ) -> Result<Hbm, ScriptError> {
+        let dir = dir.as_ref().to_path_buf();
+        let shared = Rc::new(Shared {
+            behaviors: RefCell::new(BTreeMap::new()),
+            cdb: RefCell::new(Blender::new(Vec::new(), lps::COUNT)),
+            declared: RefCell::new(Vec::new()),
+            running: RefCell::new(Vec::new()),
+        });
+        install(&rt.lua, &shared).map_err(ScriptError::setup)?;
+        let defaults =
+            Script::from_source(rt, "hbm_defaults.lua", DEFAULT_VARIABLES, LoadStrategy::Compiled)?;
+        defaults.call::<()>(rt)?;
+        let setup_path = dir.join("hbm.lua");
+        let setup = if setup_path.is_file() {
+            let s = Script::from_file(rt, &setup_path, LoadStrategy::Compiled)?;
+            s.call::<()>(rt)?;
+            Some(s)
+        } else {
+            None
+        };
+        let mut hbm = Hbm { dir, shared, drives: Vec::new(), setup, io };
+        hbm.rebuild_blender();
+        for (name, path) in behavior_files(&hbm.dir)? {
+            let script = Script::from_file(rt, &path, LoadStrategy::Compiled)?;
+            hbm.shared.behaviors.borrow_mut().insert(name, script);
+        }
+        Ok(hbm)
+    }
+
+    fn rebuild_blender(&mut self) {
+        let declared = self.shared.declared.borrow();
+        self.drives = declared.iter().map(|(_, d)| *d).collect();
+        let vars = declared.iter().map(|(v, _)| v.clone()).collect();
+        *self.shared.cdb.borrow_mut() = Blender::new(vars, lps::COUNT);
+    }
+
+    /// The behaviors' names, sorted.
+    pub fn names(&self) -> Vec<String> {
+        self.shared.behaviors.borrow().keys().cloned().collect()
+    }
+
+    /// Whether a behavior of that name is loaded.
+    pub fn contains(&self, name: &str) -> bool {
+        self.shared.behaviors.borrow().contains_key(name)
+    }
+
+    /// The control variables.
+    pub fn variables(&self) -> Vec<ControlVariable> {
+        self.shared.cdb.borrow().variables().to_vec()
+    }
+
+    /// Runs behavior `name` at top level (activation 1) within the sandbox's budget, then
+    /// writes the blended outputs and needs into the robot command. Call
+    /// [`RobotIo::new_cycle`] before. On error nothing fuzzy is written.
+    pub fn run(&self, rt: &LuaRuntime, name: &str) -> Result<(), ScriptError> {
+        let function = {
+            let behaviors = self.shared.behaviors.borrow();
+            let script = behaviors.get(name).ok_or_else(|| unknown(name, &behaviors))?;
+            script.function()
+        };
+        self.shared.cdb.borrow_mut().begin_cycle();
+        {
+            let mut running = self.shared.running.borrow_mut();
+            running.clear();
+            running.push(name.to_string());
+        }
+        rt.reset_budget();
+        let result = function.call::<()>(());
+        self.shared.running.borrow_mut().clear();
+        result.map_err(|e| ScriptError::from_lua(&self.file_of(name), rt, e))?;
+        let cdb = self.shared.cdb.borrow();
+        let mut io = self.io.borrow_mut();
+        let c = &mut io.command;
+        for (v, drives) in self.drives.iter().enumerate() {
+            let (Some(drives), Some(value)) = (drives, cdb.output(v)) else { continue };
+            match drives {
+                Drives::Vlin => c.vlin = value,
+                Drives::Vrot => c.vrot = value,
+                Drives::Vlat => c.vlat = value,
+                Drives::Kick => c.kick = (value != 0.0).then_some(value as i64),
+            }
+        }
+        c.needs.extend(
+            cdb.needs().iter().enumerate().filter(|(_, n)| **n > 0.0).map(|(i, n)| (i, *n)),
+        );
+        Ok(())
+    }
+
+    /// The label degrees of a variable after the last run (for tests and monitors).
+    pub fn degrees(&self, variable: &str) -> Vec<(String, f64)> {
+        let cdb = self.shared.cdb.borrow();
+        let Some(v) = cdb.variable_index(variable) else { return Vec::new() };
+        let labels = cdb.variables()[v].labels.iter().map(|(l, _)| l.clone());
+        labels.zip(cdb.degrees(v).iter().copied()).collect()
+    }
+
+    fn file_of(&self, name: &str) -> String {
+        self.dir.join(format!("{name}.lua")).display().to_string()
+    }
+
+    /// Reloads what changed on disk: edited behaviors, new behavior files, and `hbm.lua`
+    /// (re-run, control variables rebuilt). Each file that fails to compile is reported and
+    /// keeps its running version; the others are swapped in. Returns the names reloaded and
+    /// the errors. Call it at a cycle boundary.
+    pub fn reload_changed(&mut self, rt: &LuaRuntime) -> (Vec<String>, Vec<ScriptError>) {
+        let (mut done, mut errors) = (Vec::new(), Vec::new());
+        if let Some(setup) = &self.setup {
+            match setup.reload_if_changed(rt) {
+                Ok(false) => {}
+                Ok(true) => {
+                    self.shared.declared.borrow_mut().clear();
+                    let rerun = Script::from_source(
+                        rt,
+                        "hbm_defaults.lua",
+                        DEFAULT_VARIABLES,
+                        LoadStrategy::Compiled,
+                    )
+                    .and_then(|d| d.call::<()>(rt))
+                    .and_then(|()| setup.call::<()>(rt));
+                    match rerun {
+                        Ok(()) => done.push("hbm".to_string()),
+                        Err(e) => errors.push(e),
+                    }
+                    self.rebuild_blender();
+                }
+                Err(e) => errors.push(e),
+            }
+        }
+        let files = match behavior_files(&self.dir) {
+            Ok(f) => f,
+            Err(e) => {
+                errors.push(e);
+                return (done, errors);
+            }
+        };
+        for (name, path) in files {
+            let existing = self.shared.behaviors.borrow().contains_key(&name);
+            let result = if existing {
+                let behaviors = self.shared.behaviors.borrow();
+                behaviors.get(&name).map_or(Ok(false), |s| s.reload_if_changed(rt))
+            } else {
+                Script::from_file(rt, &path, LoadStrategy::Compiled).map(|s| {
+                    self.shared.behaviors.borrow_mut().insert(name.clone(), s);
+                    true
+                })
+            };
+            match result {
+                Ok(true) => done.push(name),
+                Ok(false) => {}
+                Err(e) => errors.push(e),
+            }
+        }
+        (done, errors)
+    }
+}
+
+fn unknown(name: &str, behaviors: &BTreeMap<String, Script>) -> ScriptError {
+    let known: Vec<&str> = behaviors.keys().map(String::as_str).collect();
+    ScriptError::Setup(format!("no behavior named '{name}' (known: {})", known.join(", ")))
+}
+
+/// The behavior files of a directory, `(name, path)`, sorted.
+pub fn behavior_files(dir: &Path) -> Result<Vec<(String, PathBuf)>, ScriptError> {
+    let entries = std::fs::read_dir(dir)
+        .map_err(|source| ScriptError::Io { file: dir.display().to_string(), source })?;
+    let mut files: Vec<(String, PathBuf)> = entries
+        .filter_map(Result::ok)
+        .map(|e| e.path())
+        .filter_map(|p| {
+            let file = p.file_name()?.to_str()?;
+            let name = file.strip_suffix(".lua")?;
+            let skip = name == "hbm" || name.ends_with(".hfsm") || name.starts_with('.');
+            (!skip && p.is_file()).then(|| (name.to_string(), p.clone()))
+        })
+        .collect();
+    files.sort();
+    Ok(files)
+}
+
+fn err(msg: String) -> mlua::Error {
+    mlua::Error::runtime(msg)
+}
+
+fn set_fn(lua: &Lua, g: &Table, name: &'static str, arity: usize) -> mlua::Result<()> {
+    let f = lua.create_function(move |_, args: Variadic<f64>| {
+        if args.len() != arity {
+            return Err(err(format!("{name} takes {arity} numbers, got {}", args.len())));
+        }
+        let set = FuzzySet::from_parts(name, &args)
+            .ok_or_else(|| err(format!("{name}: bad parameters")))?;
+        if !set.is_ordered() || args.iter().any(|p| !p.is_finite()) {
+            return Err(err(format!(
+                "{name}{:?}: parameters must be finite and in increasing order",
+                &args[..]
+            )));
+        }
+        Ok(LuaSet(set))
+    })?;
+    g.set(name, f)
+}
+
+/// Installs the rule language in the runtime's globals.
+fn install(lua: &Lua, shared: &Rc<Shared>) -> mlua::Result<()> {
+    let g = lua.globals();
+    for (name, arity) in
+        [("TRI", 3), ("TRA", 4), ("TOL", 2), ("TOR", 2), ("REC", 2), ("SNG", 1), ("DIV", 4)]
+    {
+        set_fn(lua, &g, name, arity)?;
+    }
+    g.set(
+        "AND",
+        lua.create_function(|_, args: Variadic<Value>| {
+            args.iter().try_fold(1.0, |acc, v| Ok(f64::min(acc, truth(v, "AND")?)))
+        })?,
+    )?;
+    g.set(
+        "OR",
+        lua.create_function(|_, args: Variadic<Value>| {
+            args.iter().try_fold(0.0, |acc, v| Ok(f64::max(acc, truth(v, "OR")?)))
+        })?,
+    )?;
+    g.set("NOT", lua.create_function(|_, v: Value| Ok(1.0 - truth(&v, "NOT")?))?)?;
+
+    let s = shared.clone();
+    g.set(
+        "variable",
+        lua.create_function(move |_, t: Table| {
+            let declared = declare(&t)?;
+            let mut all = s.declared.borrow_mut();
+            match all.iter_mut().find(|(v, _)| v.name == declared.0.name) {
+                Some(slot) => *slot = declared,
+                None => all.push(declared),
+            }
+            Ok(())
+        })?,
+    )?;
+
+    let s = shared.clone();
+    let fire = move |d: f64, var: &str, label: &str| -> mlua::Result<()> {
+        let mut cdb = s.cdb.borrow_mut();
+        let v = cdb.variable_index(var).ok_or_else(|| {
+            let names: Vec<&str> = cdb.variables().iter().map(|v| v.name.as_str()).collect();
+            err(format!("no control variable '{var}' (known: {})", names.join(", ")))
+        })?;
+        let l = cdb.variables()[v].label_index(label).ok_or_else(|| {
+            let labels: Vec<&str> =
+                cdb.variables()[v].labels.iter().map(|(l, _)| l.as_str()).collect();
+            err(format!("control variable '{var}' has no label '{label}' ({})", labels.join(", ")))
+        })?;
+        cdb.fire(v, l, d);
+        Ok(())
+    };
+    let fire = Rc::new(fire);
+    let f = fire.clone();
+    g.set(
+        "rule",
+        lua.create_function(move |_, (d, var, label): (Value, String, String)| {
+            f(truth(&d, "rule")?, &var, &label)
+        })?,
+    )?;
+    g.set(
+        "always",
+        lua.create_function(move |_, (var, label): (String, String)| fire(1.0, &var, &label))?,
+    )?;
+
+    let s = shared.clone();
+    g.set(
+        "need",
+        lua.create_function(move |_, (d, object): (Value, i64)| {
+            let d = truth(&d, "need")?;
+            let i = usize::try_from(object).ok().filter(|i| *i < lps::COUNT).ok_or_else(|| {
+                err(format!("need: no perceptual object {object} (0 to {})", lps::COUNT - 1))
+            })?;
+            s.cdb.borrow_mut().need(i, d);
+            Ok(())
+        })?,
+    )?;
+
+    let s = shared.clone();
+    g.set(
+        "use",
+        lua.create_function(move |_, (d, name): (Value, String)| {
+            let d = truth(&d, "use")?;
+            let function = {
+                let behaviors = s.behaviors.borrow();
+                let script = behaviors.get(&name).ok_or_else(|| {
+                    let known: Vec<&str> = behaviors.keys().map(String::as_str).collect();
+                    err(format!("use: no behavior named '{name}' (known: {})", known.join(", ")))
+                })?;
+                script.function()
+            };
+            {
+                let running = s.running.borrow();
+                if running.contains(&name) {
+                    return Err(err(format!(
+                        "use: behavior '{name}' uses itself: {} -> {name}",
+                        running.join(" -> ")
+                    )));
+                }
+                if running.len() >= MAX_DEPTH {
+                    return Err(err(format!("use: behaviors nested deeper than {MAX_DEPTH}")));
+                }
+            }
+            let a = s.cdb.borrow_mut().enter(d);
+            let result = if a > 0.0 {
+                s.running.borrow_mut().push(name);
+                let r = function.call::<()>(());
+                s.running.borrow_mut().pop();
+                r
+            } else {
+                Ok(())
+            };
+            s.cdb.borrow_mut().leave();
+            result
+        })?,
+    )?;
+    g.set("hbm_activation", {
+        let s = shared.clone();
+        lua.create_function(move |_, ()| Ok(s.cdb.borrow().activation()))?
+    })?;
+    Ok(())
+}
+
+/// Reads `variable { name, command, min, max, mode, labels }`.
+fn declare(t: &Table) -> mlua::Result<(ControlVariable, Option<Drives>)> {
+    let name: String = t.get("name")?;
+    let min: f64 = t.get("min")?;
+    let max: f64 = t.get("max")?;
+    let mode: Option<String> = t.get("mode")?;
+    let mode = match mode.as_deref() {
+        None | Some("centroid") => Defuzzification::Centroid,
+        Some("singleton") => Defuzzification::Singleton,
+        Some("choice") => Defuzzification::Choice,
+        Some(other) => {
+            return Err(err(format!(
+                "variable '{name}': mode '{other}' is not centroid, singleton or choice"
+            )))
+        }
+    };
+    let drives = match t.get::<Option<String>>("command")?.as_deref() {
+        None => None,
+        Some("vlin") => Some(Drives::Vlin),
+        Some("vrot") => Some(Drives::Vrot),
+        Some("vlat") => Some(Drives::Vlat),
+        Some("kick") => Some(Drives::Kick),
+        Some(other) => {
+            return Err(err(format!(
+                "variable '{name}': command '{other}' is not vlin, vrot, vlat or kick"
+            )))
+        }
+    };
+    if !(min < max) {
+        return Err(err(format!("variable '{name}': min {min} must be below max {max}")));
+    }
+    let labels: Table = t.get("labels")?;
+    let mut list = Vec::new();
+    for pair in labels.pairs::<String, mlua::AnyUserData>() {
+        let (label, set) = pair?;
+        let set = set.borrow::<LuaSet>()?.0;
+        list.push((label, set));
+    }
+    if list.is_empty() {
+        return Err(err(format!("variable '{name}' has no labels")));
+    }
+    list.sort_by(|a, b| a.0.cmp(&b.0));
+    let mut v = ControlVariable::new(&name, min, max, mode);
+    v.labels = list;
+    Ok((v, drives))
+}
