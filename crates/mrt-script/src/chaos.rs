@@ -40,6 +40,8 @@ pub struct RobotIo {
     /// What the behaviors asked for this cycle.
     pub command: RobotCommand,
     globals: HashMap<String, GlobalValue>,
+    /// The behaviors `setBehavior` may name; `None` accepts any name.
+    pub known_behaviors: Option<std::collections::BTreeSet<String>>,
     behavior: Option<String>,
     behavior_since: Time,
     is_new: bool,
@@ -207,7 +209,17 @@ fn install_inner(lua: &Lua, io: Rc<RefCell<RobotIo>>) -> mlua::Result<()> {
         Ok(())
     });
     func!("setBehavior", io, |_lua, name: String| {
-        io.borrow_mut().command.behavior = Some(name);
+        let mut io = io.borrow_mut();
+        if let Some(known) = &io.known_behaviors {
+            if !known.contains(&name) {
+                let list: Vec<&str> = known.iter().map(String::as_str).collect();
+                return Err(mlua::Error::runtime(format!(
+                    "chaos.setBehavior: no behavior named '{name}' (known: {})",
+                    list.join(", ")
+                )));
+            }
+        }
+        io.command.behavior = Some(name);
         Ok(())
     });
 

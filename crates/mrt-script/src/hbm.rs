@@ -461,7 +461,7 @@ fn declare(t: &Table) -> mlua::Result<(ControlVariable, Option<Drives>)> {
             )))
         }
     };
-    if !(min < max) {
+    if min.partial_cmp(&max) != Some(std::cmp::Ordering::Less) {
         return Err(err(format!("variable '{name}': min {min} must be below max {max}")));
     }
     let labels: Table = t.get("labels")?;

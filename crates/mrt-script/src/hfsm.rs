@@ -102,6 +102,7 @@ struct Status {
 pub struct Hfsm {
     file: String,
     path_on_disk: Option<PathBuf>,
+    modified: Option<std::time::SystemTime>,
     machines: Vec<Machine>,
     root: usize,
     active: Vec<Active>,
@@ -139,6 +140,7 @@ impl Hfsm {
             .map_err(|source| ScriptError::Io { file: path.display().to_string(), source })?;
         let mut h = Hfsm::from_source(rt, &path.display().to_string(), &source, io)?;
         h.path_on_disk = Some(path.to_path_buf());
+        h.modified = mtime(path);
         Ok(h)
     }
 
@@ -155,6 +157,7 @@ impl Hfsm {
         Ok(Hfsm {
             file: name.to_string(),
             path_on_disk: None,
+            modified: None,
             machines,
             root,
             active: Vec::new(),
@@ -286,6 +289,18 @@ impl Hfsm {
         self.reload_source(rt, &source)
     }
 
+    /// Reloads the file if it changed since the last (attempted) load; `Ok(true)` when the
+    /// new version was swapped in. A broken file is reported once, not at every poll.
+    pub fn reload_if_changed(&mut self, rt: &LuaRuntime) -> Result<bool, ScriptError> {
+        let Some(path) = &self.path_on_disk else { return Ok(false) };
+        let stamp = mtime(path);
+        if stamp == self.modified {
+            return Ok(false);
+        }
+        self.modified = stamp;
+        self.reload(rt).map(|()| true)
+    }
+
     /// Replaces the machine with `source` if it loads (see [`Hfsm::reload`]).
     pub fn reload_source(&mut self, rt: &LuaRuntime, source: &str) -> Result<(), ScriptError> {
         let (machines, root) = build(rt, &self.file, source)?;
@@ -298,7 +313,7 @@ impl Hfsm {
                 (m.name.clone(), m.states[a.state].name.clone())
             })
             .collect();
-        let old = std::mem::replace(&mut self.active, Vec::new());
+        let old = std::mem::take(&mut self.active);
         self.machines = machines;
         self.root = root;
         let mut m = root;
@@ -395,6 +410,10 @@ impl Hfsm {
         let others = self.machines.iter().filter(|m| &m.name != root).map(|m| m.name.clone());
         std::iter::once(root.clone()).chain(others).collect()
     }
+}
+
+fn mtime(path: &Path) -> Option<std::time::SystemTime> {
+    std::fs::metadata(path).and_then(|m| m.modified()).ok()
 }
 
 /// Whether a test's result lets the transition fire.

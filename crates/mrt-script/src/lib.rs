@@ -34,6 +34,7 @@
 //! The robot API `chaos.*` is in [`chaos`]; HFSMs and the fuzzy HBM/CDB behaviors come next.
 #![deny(missing_docs)]
 
+mod cap;
 pub mod chaos;
 pub mod hbm;
 pub mod hfsm;
@@ -41,6 +42,7 @@ mod runtime;
 mod script;
 mod watch;
 
+pub use cap::{Cycle, ThinkingCap};
 pub use runtime::{LuaRuntime, Sandbox};
 pub use script::{LoadStrategy, Script, ScriptError};
 pub use watch::ScriptWatcher;

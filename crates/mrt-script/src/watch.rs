@@ -19,6 +19,8 @@ pub struct ScriptWatcher {
     events: Receiver<notify::Result<Event>>,
     scripts: BTreeSet<PathBuf>,
     dirs: BTreeSet<PathBuf>,
+    /// Directories whose every `.lua` file counts as watched (new files included).
+    whole_dirs: BTreeSet<PathBuf>,
 }
 
 fn absolute(path: &Path) -> PathBuf {
@@ -31,7 +33,13 @@ impl ScriptWatcher {
         let (tx, events) = channel();
         let watcher = notify::recommended_watcher(tx)
             .map_err(|e| ScriptError::Setup(format!("file watcher: {e}")))?;
-        Ok(ScriptWatcher { watcher, events, scripts: BTreeSet::new(), dirs: BTreeSet::new() })
+        Ok(ScriptWatcher {
+            watcher,
+            events,
+            scripts: BTreeSet::new(),
+            dirs: BTreeSet::new(),
+            whole_dirs: BTreeSet::new(),
+        })
     }
 
     /// Starts watching a script file.
@@ -48,6 +56,25 @@ impl ScriptWatcher {
         Ok(())
     }
 
+    /// Starts watching every `.lua` file of a directory, including files created later.
+    pub fn watch_dir(&mut self, dir: impl AsRef<Path>) -> Result<(), ScriptError> {
+        let dir = absolute(dir.as_ref());
+        if self.dirs.insert(dir.clone()) {
+            self.watcher.watch(&dir, RecursiveMode::NonRecursive).map_err(|e| ScriptError::Io {
+                file: dir.display().to_string(),
+                source: std::io::Error::other(e.to_string()),
+            })?;
+        }
+        self.whole_dirs.insert(dir);
+        Ok(())
+    }
+
+    fn is_watched(&self, p: &Path) -> bool {
+        self.scripts.contains(p)
+            || (p.extension().is_some_and(|e| e == "lua")
+                && p.parent().is_some_and(|d| self.whole_dirs.contains(d)))
+    }
+
     /// The watched scripts touched since the last call (each once), without blocking.
     pub fn changed(&self) -> Vec<PathBuf> {
         let mut out = BTreeSet::new();
@@ -58,7 +85,7 @@ impl ScriptWatcher {
             }
             for p in ev.paths {
                 let p = absolute(&p);
-                if self.scripts.contains(&p) {
+                if self.is_watched(&p) {
                     out.insert(p);
                 }
             }

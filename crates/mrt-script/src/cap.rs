@@ -1,0 +1,187 @@
+//! One robot's behavioral layer as ThinkingCap runs it (seed 001 §2.1, §3.2): each cycle the
+//! high-level HFSM chooses a low-level behavior (`chaos.setBehavior`), and the HBM runs it,
+//! giving the robot command. Scripts edited on disk are reloaded at the next cycle boundary.
+//!
+//! Bad input never stops the robot: an HFSM that fails (runtime error, endless loop, a
+//! `setBehavior` naming no behavior) keeps the last good behavior for the cycle; a behavior
+//! that fails gives the safe command (stand still) for the cycle; a file that no longer
+//! compiles keeps its running version. Every error is reported in [`Cycle::errors`].
+
+use crate::chaos::{self, RobotIo};
+use crate::hbm::Hbm;
+use crate::hfsm::{Hfsm, Taken};
+use crate::runtime::{LuaRuntime, Sandbox};
+use crate::script::ScriptError;
+use crate::watch::ScriptWatcher;
+use mrt_core::robot::{RobotCommand, WorldSnapshot};
+use std::cell::RefCell;
+use std::path::{Path, PathBuf};
+use std::rc::Rc;
+
+/// What one cycle did.
+#[derive(Debug)]
+pub struct Cycle {
+    /// The command for the robot.
+    pub command: RobotCommand,
+    /// The HFSM's active path after the cycle (empty without an HFSM).
+    pub path: String,
+    /// The behavior that ran.
+    pub behavior: Option<String>,
+    /// The HFSM transition taken, if any.
+    pub taken: Option<Taken>,
+    /// Files reloaded before the cycle (behavior names, `hbm`, or the HFSM file).
+    pub reloaded: Vec<String>,
+    /// What went wrong (the robot went on regardless).
+    pub errors: Vec<ScriptError>,
+}
+
+/// Where the behavior to run comes from.
+enum Top {
+    Hfsm(Box<Hfsm>, PathBuf),
+    Behavior(String),
+}
+
+/// An HFSM (or one fixed behavior) over a directory of HBM behaviors, in one Lua runtime.
+pub struct ThinkingCap {
+    rt: LuaRuntime,
+    io: Rc<RefCell<RobotIo>>,
+    hbm: Hbm,
+    top: Top,
+    last_good: Option<String>,
+    watcher: Option<ScriptWatcher>,
+}
+
+impl ThinkingCap {
+    /// Loads the behaviors of `dir` and the HFSM file `machine`.
+    pub fn with_hfsm(
+        dir: impl AsRef<Path>,
+        machine: impl AsRef<Path>,
+        sandbox: Sandbox,
+    ) -> Result<ThinkingCap, ScriptError> {
+        let (rt, io, hbm) = Self::base(dir.as_ref(), sandbox)?;
+        let hfsm = Hfsm::from_file(&rt, machine.as_ref(), io.clone())?;
+        let top =
+            Top::Hfsm(Box::new(hfsm), std::path::absolute(machine.as_ref()).unwrap_or_default());
+        Ok(ThinkingCap { rt, io, hbm, top, last_good: None, watcher: None })
+    }
+
+    /// Loads the behaviors of `dir` and runs `behavior` every cycle.
+    pub fn with_behavior(
+        dir: impl AsRef<Path>,
+        behavior: &str,
+        sandbox: Sandbox,
+    ) -> Result<ThinkingCap, ScriptError> {
+        let (rt, io, hbm) = Self::base(dir.as_ref(), sandbox)?;
+        if !hbm.contains(behavior) {
+            return Err(ScriptError::Setup(format!(
+                "no behavior named '{behavior}' in {} (known: {})",
+                dir.as_ref().display(),
+                hbm.names().join(", ")
+            )));
+        }
+        let top = Top::Behavior(behavior.to_string());
+        Ok(ThinkingCap { rt, io, hbm, top, last_good: None, watcher: None })
+    }
+
+    fn base(
+        dir: &Path,
+        sandbox: Sandbox,
+    ) -> Result<(LuaRuntime, Rc<RefCell<RobotIo>>, Hbm), ScriptError> {
+        let rt = LuaRuntime::new(sandbox)?;
+        let io = Rc::new(RefCell::new(RobotIo::default()));
+        chaos::install(&rt, io.clone())?;
+        let hbm = Hbm::load_dir(&rt, dir, io.clone())?;
+        io.borrow_mut().known_behaviors = Some(hbm.names().into_iter().collect());
+        Ok((rt, io, hbm))
+    }
+
+    /// Watches the behavior directory and the HFSM file: edits are picked up at the next
+    /// cycle without polling the disk.
+    pub fn watch(&mut self, dir: impl AsRef<Path>) -> Result<(), ScriptError> {
+        let mut w = ScriptWatcher::new()?;
+        w.watch_dir(dir)?;
+        if let Top::Hfsm(_, path) = &self.top {
+            w.watch(path)?;
+        }
+        self.watcher = Some(w);
+        Ok(())
+    }
+
+    /// The Lua runtime (for tests and tools).
+    pub fn runtime(&self) -> &LuaRuntime {
+        &self.rt
+    }
+
+    /// The HBM behaviors.
+    pub fn hbm(&self) -> &Hbm {
+        &self.hbm
+    }
+
+    /// The HFSM, if one runs.
+    pub fn hfsm(&self) -> Option<&Hfsm> {
+        match &self.top {
+            Top::Hfsm(h, _) => Some(h),
+            Top::Behavior(_) => None,
+        }
+    }
+
+    /// The robot state the scripts see (globals, last command).
+    pub fn io(&self) -> std::cell::Ref<'_, RobotIo> {
+        self.io.borrow()
+    }
+
+    /// Reloads every changed file now (what a watcher or a reload request on the bus does
+    /// at the next cycle boundary). Returns what was reloaded and what was rejected.
+    pub fn reload_changed(&mut self) -> (Vec<String>, Vec<ScriptError>) {
+        let (mut done, mut errors) = self.hbm.reload_changed(&self.rt);
+        self.io.borrow_mut().known_behaviors = Some(self.hbm.names().into_iter().collect());
+        if let Top::Hfsm(h, _) = &mut self.top {
+            match h.reload_if_changed(&self.rt) {
+                Ok(true) => done.push(h.file().to_string()),
+                Ok(false) => {}
+                Err(e) => errors.push(e),
+            }
+        }
+        (done, errors)
+    }
+
+    /// Runs one cycle on `world`.
+    pub fn cycle(&mut self, world: WorldSnapshot) -> Cycle {
+        let (mut reloaded, mut errors) = (Vec::new(), Vec::new());
+        if self.watcher.as_ref().is_some_and(|w| !w.changed().is_empty()) {
+            (reloaded, errors) = self.reload_changed();
+        }
+        self.io.borrow_mut().new_cycle(world);
+        let mut taken = None;
+        let (chosen, path) = match &mut self.top {
+            Top::Behavior(name) => (Some(name.clone()), String::new()),
+            Top::Hfsm(h, _) => {
+                match h.step(&self.rt) {
+                    Ok(t) => taken = t,
+                    Err(e) => errors.push(e),
+                }
+                let asked = self.io.borrow().command.behavior.clone();
+                (asked.or_else(|| self.last_good.clone()), h.path())
+            }
+        };
+        let mut behavior = None;
+        if let Some(name) = chosen {
+            self.io.borrow_mut().activate(&name);
+            match self.hbm.run(&self.rt, &name) {
+                Ok(()) => {
+                    self.last_good = Some(name.clone());
+                    behavior = Some(name);
+                }
+                Err(e) => {
+                    errors.push(e);
+                    self.io.borrow_mut().command = RobotCommand::default();
+                }
+            }
+        }
+        let mut command = self.io.borrow().command.clone();
+        if command.behavior.is_none() {
+            command.behavior = behavior.clone();
+        }
+        Cycle { command, path, behavior, taken, reloaded, errors }
+    }
+}
