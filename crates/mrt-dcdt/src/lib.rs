@@ -94,6 +94,7 @@ mod msg;
 mod policy;
 mod pool;
 mod postoffice;
+pub mod robot_msgs;
 mod waker;
 pub mod wire;
 

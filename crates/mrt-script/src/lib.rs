@@ -38,6 +38,7 @@ mod cap;
 pub mod chaos;
 pub mod hbm;
 pub mod hfsm;
+pub mod member;
 mod runtime;
 mod script;
 mod watch;

@@ -1,0 +1,224 @@
+//! The behavior Members: ThinkingCap's HFSM and HBM on the DCDT bus (seed 001 §2.1).
+//!
+//! A [`BehaviorMember`] reads the latest [`WorldSnapshot`] from the bus, runs one cycle of an
+//! HFSM (the "HFSM Member") or of one HBM behavior (the "HBM Member") per activation (every
+//! 100 ms by default, as in the seed: [`DEFAULT_PERIOD`]), and publishes the [`RobotCommand`]
+//! and a [`BehaviorStatus`] (active path, behavior, errors) for monitors. A
+//! [`ReloadRequest`] on the bus reloads the edited scripts at the next cycle boundary, like the
+//! seed's editor sending a behavior to a running robot.
+//!
+//! A Lua state belongs to one thread, and Members may move between threads, so the scripts run
+//! on a worker thread owned by the Member; each cycle is one synchronous round trip (a few
+//! microseconds), so the stepped executor stays deterministic.
+
+use crate::cap::ThinkingCap;
+use crate::runtime::Sandbox;
+use mrt_core::robot::{RobotCommand, WorldSnapshot};
+use mrt_dcdt::{Context, Member, MemberError, Message, MsgType, RequestType, RESERVED_TYPES_START};
+use serde::{Deserialize, Serialize};
+use std::path::PathBuf;
+use std::sync::mpsc::{channel, Receiver, Sender};
+use std::thread::JoinHandle;
+use std::time::Duration;
+
+/// The seed's control period: "both a low-level and a high-level behavior are executed every
+/// 100 ms" (§3.2).
+pub const DEFAULT_PERIOD: Duration = Duration::from_millis(100);
+
+/// What a behavior Member did in its last cycle, for monitors.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct BehaviorStatus {
+    /// The HFSM's active path (`Attacker/Score/Align`), empty for an HBM Member.
+    pub path: String,
+    /// The behavior that ran.
+    pub behavior: Option<String>,
+    /// Files reloaded before this cycle.
+    pub reloaded: Vec<String>,
+    /// Errors of this cycle (the robot went on regardless).
+    pub errors: Vec<String>,
+}
+
+impl Message for BehaviorStatus {
+    const TYPE: MsgType = MsgType(RESERVED_TYPES_START + 0x30);
+    const NAME: &'static str = "BehaviorStatus";
+}
+
+/// Asks behavior Members to reload their changed scripts at the next cycle boundary.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct ReloadRequest;
+
+impl Message for ReloadRequest {
+    const TYPE: MsgType = MsgType(RESERVED_TYPES_START + 0x31);
+    const NAME: &'static str = "ReloadRequest";
+}
+
+/// What the Member runs.
+#[derive(Clone, Debug)]
+enum Top {
+    Hfsm(PathBuf),
+    Behavior(String),
+}
+
+enum Job {
+    Cycle(WorldSnapshot),
+    Reload,
+}
+
+struct Worker {
+    jobs: Sender<Job>,
+    replies: Receiver<(RobotCommand, BehaviorStatus)>,
+    thread: JoinHandle<()>,
+}
+
+/// An HFSM or HBM Member (see the module documentation).
+pub struct BehaviorMember {
+    name: String,
+    dir: PathBuf,
+    top: Top,
+    sandbox: Sandbox,
+    watch: bool,
+    worker: Option<Worker>,
+    world: WorldSnapshot,
+}
+
+impl BehaviorMember {
+    /// The HFSM Member: runs the machine of `machine` over the behaviors of `dir`.
+    pub fn hfsm(dir: impl Into<PathBuf>, machine: impl Into<PathBuf>) -> Self {
+        Self::new(dir.into(), Top::Hfsm(machine.into()))
+    }
+
+    /// The HBM Member: runs behavior `behavior` of `dir` every cycle.
+    pub fn hbm(dir: impl Into<PathBuf>, behavior: &str) -> Self {
+        Self::new(dir.into(), Top::Behavior(behavior.to_string()))
+    }
+
+    fn new(dir: PathBuf, top: Top) -> Self {
+        let name = match &top {
+            Top::Hfsm(p) => format!("hfsm:{}", p.display()),
+            Top::Behavior(b) => format!("hbm:{b}"),
+        };
+        Self {
+            name,
+            dir,
+            top,
+            sandbox: Sandbox::default(),
+            watch: false,
+            worker: None,
+            world: WorldSnapshot::default(),
+        }
+    }
+
+    /// Sets the sandbox limits.
+    pub fn with_sandbox(mut self, sandbox: Sandbox) -> Self {
+        self.sandbox = sandbox;
+        self
+    }
+
+    /// Also watches the files (`notify`): edits apply at the next cycle without a request.
+    pub fn watching(mut self, watch: bool) -> Self {
+        self.watch = watch;
+        self
+    }
+
+    fn spawn(&self) -> Result<Worker, MemberError> {
+        let (jobs, job_rx) = channel::<Job>();
+        let (reply_tx, replies) = channel();
+        let (ready_tx, ready_rx) = channel::<Result<(), String>>();
+        let (dir, top, sandbox, watch) =
+            (self.dir.clone(), self.top.clone(), self.sandbox, self.watch);
+        let thread = std::thread::Builder::new()
+            .name(self.name.clone())
+            .spawn(move || {
+                let loaded = match &top {
+                    Top::Hfsm(file) => ThinkingCap::with_hfsm(&dir, file, sandbox),
+                    Top::Behavior(name) => ThinkingCap::with_behavior(&dir, name, sandbox),
+                };
+                let mut cap = match loaded.and_then(|mut c| {
+                    if watch {
+                        c.watch(&dir)?;
+                    }
+                    Ok(c)
+                }) {
+                    Ok(c) => {
+                        let _ = ready_tx.send(Ok(()));
+                        c
+                    }
+                    Err(e) => {
+                        let _ = ready_tx.send(Err(e.to_string()));
+                        return;
+                    }
+                };
+                let mut pending_reload = false;
+                while let Ok(job) = job_rx.recv() {
+                    match job {
+                        Job::Reload => pending_reload = true,
+                        Job::Cycle(world) => {
+                            let mut reloaded = Vec::new();
+                            let mut early = Vec::new();
+                            if std::mem::take(&mut pending_reload) {
+                                (reloaded, early) = cap.reload_changed();
+                            }
+                            let c = cap.cycle(world);
+                            reloaded.extend(c.reloaded);
+                            let errors =
+                                early.iter().chain(&c.errors).map(ToString::to_string).collect();
+                            let status = BehaviorStatus {
+                                path: c.path,
+                                behavior: c.behavior,
+                                reloaded,
+                                errors,
+                            };
+                            if reply_tx.send((c.command, status)).is_err() {
+                                return;
+                            }
+                        }
+                    }
+                }
+            })
+            .map_err(|e| format!("cannot start the Lua thread: {e}"))?;
+        match ready_rx.recv() {
+            Ok(Ok(())) => Ok(Worker { jobs, replies, thread }),
+            Ok(Err(e)) => Err(e.into()),
+            Err(_) => Err("the Lua thread stopped while loading".into()),
+        }
+    }
+}
+
+impl Member for BehaviorMember {
+    fn name(&self) -> String {
+        self.name.clone()
+    }
+
+    fn init(&mut self, ctx: &mut Context<'_>) -> Result<(), MemberError> {
+        ctx.subscribe_to::<WorldSnapshot>(RequestType::All);
+        ctx.subscribe_to::<ReloadRequest>(RequestType::All);
+        self.worker = Some(self.spawn()?);
+        Ok(())
+    }
+
+    fn do_your_job(&mut self, ctx: &mut Context<'_>) -> Result<(), MemberError> {
+        let Some(worker) = &self.worker else { return Err("not initialized".into()) };
+        while let Some(m) = ctx.receive_msg() {
+            if m.msg_type() == WorldSnapshot::TYPE {
+                self.world = m.get::<WorldSnapshot>()?.clone();
+            } else if m.msg_type() == ReloadRequest::TYPE {
+                worker.jobs.send(Job::Reload).map_err(|_| "the Lua thread stopped")?;
+            }
+        }
+        worker.jobs.send(Job::Cycle(self.world.clone())).map_err(|_| "the Lua thread stopped")?;
+        let (command, status) = worker.replies.recv().map_err(|_| "the Lua thread stopped")?;
+        for e in &status.errors {
+            tracing::warn!(member = %self.name, "{e}");
+        }
+        ctx.publish(command);
+        ctx.publish(status);
+        Ok(())
+    }
+
+    fn close(&mut self, _ctx: &mut Context<'_>) {
+        if let Some(w) = self.worker.take() {
+            drop(w.jobs);
+            let _ = w.thread.join();
+        }
+    }
+}
