@@ -1,12 +1,15 @@
 //! `mrt`: the MRT command line.
 //!
 //! - `mrt demo [hello-agora|two-agoras]` runs a numbered example and prints what happens;
+//! - `mrt behave FILE [--world world.json] [--cycles N]` runs a Lua behavior or HFSM offline;
+//! - `mrt hfsm dot FILE [--dot out.dot] [--svg out.svg]` draws an HFSM;
 //! - `mrt check FILE...` checks DCDT Agora configuration files (MRT manual §3.3.1) and
 //!   prints each in canonical form, or the first error with file, line and column.
 //!
 //! Logging goes through `tracing`; set `RUST_LOG` (e.g. `RUST_LOG=mrt_dcdt=debug`) for more.
 #![allow(clippy::print_stdout)]
 
+mod behave;
 mod brian;
 
 use anyhow::{Context as _, Result};
@@ -33,6 +36,27 @@ enum Command {
     Brian {
         #[command(subcommand)]
         command: BrianCommand,
+    },
+    /// Run a Lua behavior or HFSM (`*.hfsm.lua`) against world snapshots and print each
+    /// cycle's commands as JSON Lines (behaviors are looked up beside FILE).
+    Behave {
+        /// The behavior or HFSM file.
+        file: PathBuf,
+        /// World snapshots as JSON: one object (used every cycle) or an array (one per cycle).
+        /// Without it the world is empty: nothing seen.
+        #[arg(long)]
+        world: Option<PathBuf>,
+        /// Cycles to run (default: 1, or the array's length).
+        #[arg(long)]
+        cycles: Option<usize>,
+        /// Simulated time between cycles, for worlds without a time.
+        #[arg(long, default_value_t = 100)]
+        period_ms: u64,
+    },
+    /// Hierarchical state machines (ThinkingCap HFSM).
+    Hfsm {
+        #[command(subcommand)]
+        command: HfsmCommand,
     },
     /// Check DCDT Agora configuration files.
     Check {
@@ -71,6 +95,21 @@ enum BrianCommand {
     },
 }
 
+#[derive(Subcommand)]
+enum HfsmCommand {
+    /// Write the machine as Graphviz dot (standard output or `--dot`) and draw it as SVG.
+    Dot {
+        /// The HFSM file.
+        file: PathBuf,
+        /// Where to write the dot text (default: standard output).
+        #[arg(long)]
+        dot: Option<PathBuf>,
+        /// Where to draw the machine as SVG.
+        #[arg(long)]
+        svg: Option<PathBuf>,
+    },
+}
+
 #[derive(Clone, Copy, ValueEnum)]
 enum Demo {
     /// 01: a periodic producer and an on-message consumer, on threads, in real time.
@@ -100,6 +139,12 @@ fn main() -> Result<()> {
             BrianCommand::Eval { dir, input, trace } => brian::eval(&dir, input.as_deref(), trace)?,
             BrianCommand::Plot { dir, out } => brian::plot(&dir, &out)?,
         },
+        Command::Behave { file, world, cycles, period_ms } => {
+            behave::behave(&file, world.as_deref(), cycles, period_ms)?
+        }
+        Command::Hfsm { command: HfsmCommand::Dot { file, dot, svg } } => {
+            behave::hfsm_dot(&file, dot.as_deref(), svg.as_deref())?
+        }
         Command::Check { files } => {
             let mut failed = 0;
             for f in &files {

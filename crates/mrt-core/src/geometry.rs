@@ -54,10 +54,11 @@ pub fn angle_diff(to: f64, from: f64) -> f64 {
 
 /// A posture on the plane: position `(x, y)` and heading `theta` (radians, in `(-π, π]`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
 pub struct Pose2 {
-    /// x coordinate, metres.
+    /// x coordinate (in the caller's unit: the robot world snapshot uses millimetres).
     pub x: f64,
-    /// y coordinate, metres.
+    /// y coordinate, same unit as `x`.
     pub y: f64,
     /// Heading, radians, normalized to `(-π, π]` by the constructors.
     pub theta: f64,

@@ -24,6 +24,7 @@ pub mod lps {
 
 /// A local perceptual object (LPO): an object anchored in the robot's frame.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
 pub struct Lpo {
     /// Distance, millimetres.
     pub rho: f64,
@@ -37,8 +38,10 @@ pub struct Lpo {
 
 /// A global estimate: a pose on the field and its quality, 0 (unknown) to 1.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
 pub struct Estimate {
-    /// The pose (for the ball, `theta` is unused).
+    /// The pose in the field frame: millimetres from the centre spot, x towards the
+    /// opponent's net, heading in radians (for the ball, `theta` is unused).
     pub pose: Pose2,
     /// Quality, 0 to 1.
     pub quality: f64,
@@ -46,6 +49,7 @@ pub struct Estimate {
 
 /// A teammate as this robot believes it to be.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
 pub struct Mate {
     /// The teammate's player number.
     pub id: u32,
@@ -84,6 +88,7 @@ impl GameState {
 
 /// Everything a behavior may read in one cycle.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
 pub struct WorldSnapshot {
     /// When the snapshot was taken.
     pub time: Time,
@@ -125,6 +130,7 @@ impl Default for WorldSnapshot {
 /// Everything a behavior may ask for in one cycle. Fields not set keep their defaults
 /// (standing still, no kick, no needs).
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
 pub struct RobotCommand {
     /// Linear velocity, mm/s (`setVlin`).
     pub vlin: f64,

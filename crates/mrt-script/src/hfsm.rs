@@ -344,7 +344,10 @@ impl Hfsm {
     /// The machine as Graphviz dot. With `clusters`, each machine is a cluster (for
     /// Graphviz); without, the machines are drawn side by side (for simple renderers).
     pub fn to_dot(&self, clusters: bool) -> String {
-        let q = |s: &str| format!("\"{}\"", s.replace('\\', "\\\\").replace('"', "\\\""));
+        let q = |s: &str| {
+            let s = s.replace('\\', "\\\\").replace('"', "\\\"").replace('\n', "\\n");
+            format!("\"{s}\"")
+        };
         let mut out = String::from("digraph hfsm {\n  rankdir=LR;\n  node [fontname=\"Helvetica\", fontsize=11];\n  edge [fontname=\"Helvetica\", fontsize=9];\n");
         for (mi, m) in self.machines.iter().enumerate() {
             let id = |s: usize| q(&format!("{}/{}", m.name, m.states[s].name));
@@ -360,14 +363,14 @@ impl Hfsm {
             let entry = q(&format!("{}/^", m.name));
             let _ = writeln!(
                 out,
-                "  {entry} [shape=point, width=0.15, xlabel={}];\n  {entry} -> {};",
+                "  {entry} [shape=point, width=0.15, label={}];\n  {entry} -> {};",
                 q(&format!("{}{root}", m.name)),
                 id(m.initial)
             );
             for (si, s) in m.states.iter().enumerate() {
                 let (shape, label) = match s.kind {
                     StateKind::Meta(inner) => {
-                        ("box3d", format!("{}\\n[{}]", s.name, self.machines[inner].name))
+                        ("box3d", format!("{}\n[{}]", s.name, self.machines[inner].name))
                     }
                     StateKind::Code(_) => ("box", s.name.clone()),
                 };
@@ -393,7 +396,7 @@ impl Hfsm {
                     "  {} -> {} [label={}];",
                     id(t.from),
                     id(t.to),
-                    q(&format!("{} [{}]\\n{}", t.name, t.priority, t.shown))
+                    q(&format!("{} [{}]\n{}", t.name, t.priority, t.shown))
                 );
             }
             if clusters {
