@@ -43,6 +43,8 @@ pub struct RobotIo {
     /// The behaviors `setBehavior` may name; `None` accepts any name.
     pub known_behaviors: Option<std::collections::BTreeSet<String>>,
     behavior: Option<String>,
+    /// Counts cycles, so per-cycle caches know when the world changed.
+    generation: u64,
     behavior_since: Time,
     is_new: bool,
 }
@@ -59,6 +61,7 @@ impl RobotIo {
     /// Starts a cycle: a new world, an empty command (the behavior is chosen later, e.g. by
     /// an HFSM: then call [`RobotIo::activate`]).
     pub fn new_cycle(&mut self, world: WorldSnapshot) {
+        self.generation += 1;
         self.world = world;
         self.command = RobotCommand::default();
     }
@@ -99,6 +102,24 @@ fn check_index(f: &str, i: i64) -> mlua::Result<usize> {
     })
 }
 
+fn fill_pose(
+    t: &Table,
+    x: f64,
+    y: f64,
+    theta: Option<f64>,
+    quality: Option<f64>,
+) -> mlua::Result<()> {
+    t.raw_set("x", x)?;
+    t.raw_set("y", y)?;
+    if let Some(th) = theta {
+        t.raw_set("theta", th)?;
+    }
+    if let Some(q) = quality {
+        t.raw_set("quality", q)?;
+    }
+    Ok(())
+}
+
 fn pose_table(
     lua: &Lua,
     x: f64,
@@ -107,15 +128,35 @@ fn pose_table(
     quality: Option<f64>,
 ) -> mlua::Result<Table> {
     let t = lua.create_table_with_capacity(0, 4)?;
-    t.set("x", x)?;
-    t.set("y", y)?;
-    if let Some(th) = theta {
-        t.set("theta", th)?;
-    }
-    if let Some(q) = quality {
-        t.set("quality", q)?;
-    }
+    fill_pose(&t, x, y, theta, quality)?;
     Ok(t)
+}
+
+/// A table filled at most once per cycle (see `RobotIo::generation`).
+#[derive(Default)]
+struct CycleTable(RefCell<Option<(u64, Table)>>);
+
+impl CycleTable {
+    fn get(
+        &self,
+        lua: &Lua,
+        generation: u64,
+        fill: impl FnOnce(&Table) -> mlua::Result<()>,
+    ) -> mlua::Result<Table> {
+        let mut slot = self.0.borrow_mut();
+        if let Some((g, t)) = &*slot {
+            if *g == generation {
+                return Ok(t.clone());
+            }
+        }
+        let t = match slot.take() {
+            Some((_, t)) => t,
+            None => lua.create_table_with_capacity(0, 4)?,
+        };
+        fill(&t)?;
+        *slot = Some((generation, t.clone()));
+        Ok(t)
+    }
 }
 
 /// Installs `chaos.*` and its constants in the runtime, bound to `io`.
@@ -144,27 +185,41 @@ fn install_inner(lua: &Lua, io: Rc<RefCell<RobotIo>>) -> mlua::Result<()> {
     }
 
     // Data access.
+    // Data tables are filled at most once per cycle and handed out again on later calls of
+    // the same cycle: behaviors and predicates ask for the ball many times a cycle. Treat them
+    // as read-only, as the seed's copies were.
+    let lpos: Vec<CycleTable> = (0..lps::COUNT).map(|_| CycleTable::default()).collect();
     func!("lps_getLpo", io, |lua, i: i64| {
         let i = check_index("lps_getLpo", i)?;
-        let o = io.borrow().world.lps.get(i).copied().unwrap_or_default();
-        let t = lua.create_table_with_capacity(0, 4)?;
-        t.set("rho", o.rho)?;
-        t.set("theta", o.theta)?;
-        t.set("reliability", o.reliability)?;
-        t.set("seen_ago", o.seen_ago)?;
-        Ok(t)
+        let io = io.borrow();
+        lpos[i].get(lua, io.generation, |t| {
+            let o = io.world.lps.get(i).copied().unwrap_or_default();
+            t.raw_set("rho", o.rho)?;
+            t.raw_set("theta", o.theta)?;
+            t.raw_set("reliability", o.reliability)?;
+            t.raw_set("seen_ago", o.seen_ago)
+        })
     });
+    let my_pos = CycleTable::default();
     func!("gsGetMyPos", io, |lua, (): ()| {
-        let p = io.borrow().world.my_pos;
-        pose_table(lua, p.pose.x, p.pose.y, Some(p.pose.theta), Some(p.quality))
+        let io = io.borrow();
+        let p = io.world.my_pos;
+        my_pos.get(lua, io.generation, |t| {
+            fill_pose(t, p.pose.x, p.pose.y, Some(p.pose.theta), Some(p.quality))
+        })
     });
+    let ball_vel = CycleTable::default();
     func!("getBallVel", io, |lua, (): ()| {
-        let v = io.borrow().world.ball_vel;
-        pose_table(lua, v.x, v.y, None, None)
+        let io = io.borrow();
+        let v = io.world.ball_vel;
+        ball_vel.get(lua, io.generation, |t| fill_pose(t, v.x, v.y, None, None))
     });
+    let global_ball = CycleTable::default();
     func!("getGlobalBall", io, |lua, (): ()| {
-        let b = io.borrow().world.global_ball;
-        pose_table(lua, b.pose.x, b.pose.y, None, Some(b.quality))
+        let io = io.borrow();
+        let b = io.world.global_ball;
+        global_ball
+            .get(lua, io.generation, |t| fill_pose(t, b.pose.x, b.pose.y, None, Some(b.quality)))
     });
     func!("getMates", io, |lua, (): ()| {
         let t = lua.create_table_with_capacity(io.borrow().world.mates.len(), 0)?;
@@ -208,10 +263,12 @@ fn install_inner(lua: &Lua, io: Rc<RefCell<RobotIo>>) -> mlua::Result<()> {
         io.borrow_mut().command.track_landmarks = true;
         Ok(())
     });
-    func!("setBehavior", io, |_lua, name: String| {
+    func!("setBehavior", io, |_lua, name: mlua::LuaString| {
+        let name = name.to_str()?;
+        let name: &str = &name;
         let mut io = io.borrow_mut();
         if let Some(known) = &io.known_behaviors {
-            if !known.contains(&name) {
+            if !known.contains(name) {
                 let list: Vec<&str> = known.iter().map(String::as_str).collect();
                 return Err(mlua::Error::runtime(format!(
                     "chaos.setBehavior: no behavior named '{name}' (known: {})",
@@ -219,7 +276,7 @@ fn install_inner(lua: &Lua, io: Rc<RefCell<RobotIo>>) -> mlua::Result<()> {
                 )));
             }
         }
-        io.command.behavior = Some(name);
+        io.command.behavior = Some(name.to_string());
         Ok(())
     });
 

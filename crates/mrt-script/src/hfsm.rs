@@ -80,6 +80,10 @@ struct Machine {
     states: Vec<State>,
     /// Sorted by (from, priority, file order).
     transitions: Vec<Transition>,
+    /// Per state: one Lua function that runs its transitions' tests in order and returns the
+    /// 1-based position (among that state's transitions) of the first that passes, or 0. One
+    /// call from Rust per level instead of one per transition.
+    dispatch: Vec<Option<Function>>,
 }
 
 /// One level of the active path.
@@ -200,9 +204,13 @@ impl Hfsm {
             'levels: for level in 0..self.active.len() {
                 let Active { machine, state, .. } = self.active[level];
                 let m = &self.machines[machine];
-                for t in m.transitions.iter().filter(|t| t.from == state) {
-                    let passed = passes(&t.test.call::<Value>(()).map_err(|e| self.err(rt, e))?);
-                    if passed {
+                let Some(dispatch) = &m.dispatch[state] else { continue };
+                let k: usize = dispatch.call(()).map_err(|e| self.err(rt, e))?;
+                if let Some(t) = k
+                    .checked_sub(1)
+                    .and_then(|k| m.transitions.iter().filter(|t| t.from == state).nth(k))
+                {
+                    {
                         let (name, to) = (t.name.clone(), t.to);
                         self.exit_from(rt, level)?;
                         self.enter(rt, machine, Some(to), now)?;
@@ -419,15 +427,20 @@ fn mtime(path: &Path) -> Option<std::time::SystemTime> {
     std::fs::metadata(path).and_then(|m| m.modified()).ok()
 }
 
-/// Whether a test's result lets the transition fire.
-fn passes(v: &Value) -> bool {
-    match v {
-        Value::Boolean(b) => *b,
-        Value::Integer(i) => *i >= 1,
-        Value::Number(n) => *n >= 0.5,
-        _ => false,
-    }
-}
+/// Builds a state's transition dispatcher (see `Machine::dispatch`). A test passes when it
+/// returns `true` or a number of at least 0.5.
+const DISPATCH: &str = r#"
+return function(tests)
+  local n = #tests
+  return function()
+    for i = 1, n do
+      local r = tests[i]()
+      if r == true or (type(r) == "number" and r >= 0.5) then return i end
+    end
+    return 0
+  end
+end
+"#;
 
 /// Runs the file and checks every machine: states, initial states, meta-states (which must
 /// exist and never contain themselves) and transitions (known states, a test).
@@ -477,6 +490,8 @@ fn build(rt: &LuaRuntime, file: &str, source: &str) -> Result<(Vec<Machine>, usi
     }
     let e =
         |line: usize, m: &str, msg: String| invalid(file, line, format!("machine '{m}': {msg}"));
+    let make_dispatch: Function =
+        lua.load(DISPATCH).set_name("=hfsm dispatch").eval().map_err(ScriptError::setup)?;
     let mut machines = Vec::with_capacity(raw.len());
     for (name, body, line) in &raw {
         let (name, line) = (name.as_str(), *line);
@@ -565,8 +580,19 @@ fn build(rt: &LuaRuntime, file: &str, source: &str) -> Result<(Vec<Machine>, usi
         transitions.sort_by(|(a, ka), (b, kb)| {
             a.from.cmp(&b.from).then(a.priority.total_cmp(&b.priority)).then(ka.cmp(kb))
         });
-        let transitions = transitions.into_iter().map(|(t, _)| t).collect();
-        machines.push(Machine { name: name.to_string(), initial, states, transitions });
+        let transitions: Vec<Transition> = transitions.into_iter().map(|(t, _)| t).collect();
+        let mut dispatch = Vec::with_capacity(states.len());
+        for s in 0..states.len() {
+            let tests: Vec<&Function> =
+                transitions.iter().filter(|t| t.from == s).map(|t| &t.test).collect();
+            dispatch.push(if tests.is_empty() {
+                None
+            } else {
+                let tests = lua.create_sequence_from(tests).map_err(ScriptError::setup)?;
+                Some(make_dispatch.call::<Function>(tests).map_err(ScriptError::setup)?)
+            });
+        }
+        machines.push(Machine { name: name.to_string(), initial, states, transitions, dispatch });
     }
     check_containment(file, &machines, &raw)?;
     let used: Vec<usize> = machines
