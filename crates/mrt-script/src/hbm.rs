@@ -220,7 +220,7 @@ impl Hbm {
             match setup.reload_if_changed(rt) {
                 Ok(false) => {}
                 Ok(true) => {
-                    self.shared.declared.borrow_mut().clear();
+                    let previous = std::mem::take(&mut *self.shared.declared.borrow_mut());
                     let rerun = Script::from_source(
                         rt,
                         "hbm_defaults.lua",
@@ -230,10 +230,16 @@ impl Hbm {
                     .and_then(|d| d.call::<()>(rt))
                     .and_then(|()| setup.call::<()>(rt));
                     match rerun {
-                        Ok(()) => done.push("hbm".to_string()),
-                        Err(e) => errors.push(e),
+                        Ok(()) => {
+                            done.push("hbm".to_string());
+                            self.rebuild_blender();
+                        }
+                        Err(e) => {
+                            // Keep the variables that were running.
+                            *self.shared.declared.borrow_mut() = previous;
+                            errors.push(e);
+                        }
                     }
-                    self.rebuild_blender();
                 }
                 Err(e) => errors.push(e),
             }

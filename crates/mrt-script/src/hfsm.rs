@@ -198,14 +198,25 @@ impl Hfsm {
         let now = self.io.borrow().world.time;
         rt.reset_budget();
         let mut taken = None;
+        let incomplete =
+            self.active.last().and_then(|a| match self.machines[a.machine].states[a.state].kind {
+                StateKind::Meta(inner) => Some(inner),
+                StateKind::Code(_) => None,
+            });
         if self.active.is_empty() {
             self.enter(rt, self.root, None, now)?;
+        } else if let Some(inner) = incomplete {
+            // An enter hook failed half-way into a meta-state last cycle: finish entering.
+            self.enter(rt, inner, None, now)?;
         } else {
             'levels: for level in 0..self.active.len() {
                 let Active { machine, state, .. } = self.active[level];
                 let m = &self.machines[machine];
                 let Some(dispatch) = &m.dispatch[state] else { continue };
-                let k: usize = dispatch.call(()).map_err(|e| self.err(rt, e))?;
+                let k: usize = match dispatch.call(()) {
+                    Ok(k) => k,
+                    Err(e) => return Err(self.transition_error(rt, machine, state, e)),
+                };
                 if let Some(t) = k
                     .checked_sub(1)
                     .and_then(|k| m.transitions.iter().filter(|t| t.from == state).nth(k))
@@ -230,6 +241,30 @@ impl Hfsm {
             }
         }
         Ok(taken)
+    }
+
+    /// The error of a state's transition tests, naming the transition that raised it. The
+    /// dispatcher runs all tests in one call, so on a runtime error (and only then) the tests
+    /// run again one by one to find the culprit.
+    fn transition_error(
+        &self,
+        rt: &LuaRuntime,
+        machine: usize,
+        state: usize,
+        e: mlua::Error,
+    ) -> ScriptError {
+        let mut err = self.err(rt, e);
+        if let ScriptError::Runtime { message, .. } = &mut err {
+            let m = &self.machines[machine];
+            let mut tests = m.transitions.iter().filter(|t| t.from == state);
+            if let Some(t) = tests.find(|t| t.test.call::<Value>(()).is_err()) {
+                message.push_str(&format!(
+                    " (test of transition '{}' of machine '{}')",
+                    t.name, m.name
+                ));
+            }
+        }
+        err
     }
 
     fn err(&self, rt: &LuaRuntime, e: mlua::Error) -> ScriptError {
@@ -335,7 +370,7 @@ impl Hfsm {
                 StateKind::Code(_) => break,
             }
         }
-        // A path that stops at a meta-state (or is empty) restarts below it at the next step.
+        // A path that no longer reaches a plain state starts the new machine over.
         let ends_in_code = self.active.last().is_some_and(|a| {
             matches!(self.machines[a.machine].states[a.state].kind, StateKind::Code(_))
         });
@@ -553,9 +588,12 @@ fn build(rt: &LuaRuntime, file: &str, source: &str) -> Result<(Vec<Machine>, usi
                 }
                 Value::String(s) => {
                     let expr = s.to_str().map_err(lua_err)?.to_string();
+                    // Padded with newlines so that Lua's positions name the line of the
+                    // machine's definition in the file.
+                    let padded = format!("{}return ({expr})", "\n".repeat(line.saturating_sub(1)));
                     let f = lua
-                        .load(format!("return ({expr})"))
-                        .set_name(format!("={file} [{name}: {tname}]"))
+                        .load(padded)
+                        .set_name(format!("@{file}"))
                         .set_mode(ChunkMode::Text)
                         .into_function()
                         .map_err(|err| {

@@ -1,0 +1,569 @@
+//! The shipped TeamChaos behaviors (`behaviors/teamchaos`, seed 001 §4 and §5) driven with
+//! scripted world snapshots: the seed's trackbnet1 example, the basic behaviors, the
+//! goalkeeper hierarchy and the Attacker HFSM, with the expected commands worked out by hand
+//! from the predicates of `hbm.lua` and the default control variables (Mamdani centroid).
+//!
+//! Default labels used below: go STAY = TRI(−150, 0, 150), SLOW = TRI(0, 150, 300),
+//! FAST = TOR(150, 300); turn RIGHT = TRI(−90, −45, 0), NONE = TRI(−45, 0, 45),
+//! LEFT = TRI(0, 45, 90); strafe RIGHT = TRI(−200, −100, 0), NONE = TRI(−100, 0, 100),
+//! LEFT = TRI(0, 100, 200). A symmetric label alone (at any degree) gives its peak: STAY 0,
+//! SLOW 150, turn LEFT 45, strafe RIGHT −100; FAST alone gives 250 (centroid of the right
+//! triangle 150..300).
+
+#![allow(clippy::unwrap_used)]
+
+use mrt_core::robot::{lps, Estimate, Lpo, WorldSnapshot};
+use mrt_core::{Pose2, Time};
+use mrt_script::{Cycle, Sandbox, ScriptError, ThinkingCap};
+use std::path::{Path, PathBuf};
+
+fn dir() -> PathBuf {
+    PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../../behaviors/teamchaos"))
+}
+
+/// A scripted world: by default nothing seen, the robot at the centre spot facing the
+/// opponent's net and well localized (quality 0.9).
+#[derive(Clone)]
+struct World(WorldSnapshot);
+
+impl World {
+    fn at(t_ms: u64) -> World {
+        let mut w = WorldSnapshot { time: Time::from_millis(t_ms), ..Default::default() };
+        w.my_pos.quality = 0.9;
+        World(w)
+    }
+
+    /// The ball seen at `rho` mm, bearing `theta` rad (left positive).
+    fn ball(mut self, rho: f64, theta: f64) -> World {
+        self.0.lps[lps::BALL] = Lpo { rho, theta, reliability: 0.9, seen_ago: 0.0 };
+        self
+    }
+
+    /// The ball not seen for `seen_ago` s, last at bearing `theta`.
+    fn ball_lost(mut self, theta: f64, seen_ago: f64) -> World {
+        self.0.lps[lps::BALL] = Lpo { rho: 1500.0, theta, reliability: 0.0, seen_ago };
+        self
+    }
+
+    /// The opponent's net seen at `rho` mm, bearing `theta`.
+    fn net1(mut self, rho: f64, theta: f64) -> World {
+        self.0.lps[lps::NET1] = Lpo { rho, theta, reliability: 0.9, seen_ago: 0.0 };
+        self
+    }
+
+    /// No net seen for `s` seconds.
+    fn nets_unseen(mut self, s: f64) -> World {
+        for i in [lps::NET1, lps::NET2] {
+            self.0.lps[i] = Lpo { rho: 0.0, theta: 0.0, reliability: 0.0, seen_ago: s };
+        }
+        self
+    }
+
+    /// The robot's global pose (mm, mm, rad) and localization quality.
+    fn me(mut self, x: f64, y: f64, theta: f64, quality: f64) -> World {
+        self.0.my_pos = Estimate { pose: Pose2::new(x, y, theta), quality };
+        self
+    }
+
+    /// The ball's global position, quality 0.9.
+    fn global_ball(mut self, x: f64, y: f64) -> World {
+        self.0.global_ball = Estimate { pose: Pose2::new(x, y, 0.0), quality: 0.9 };
+        self
+    }
+}
+
+fn cap(behavior: &str) -> ThinkingCap {
+    ThinkingCap::with_behavior(dir(), behavior, Sandbox::default()).unwrap()
+}
+
+/// One cycle of `behavior` on `w`, which must not fail.
+fn run(behavior: &str, w: World) -> Cycle {
+    let c = cap(behavior).cycle(w.0);
+    assert!(c.errors.is_empty(), "{behavior}: {:?}", c.errors);
+    assert_eq!(c.behavior.as_deref(), Some(behavior));
+    c
+}
+
+#[track_caller]
+fn close(got: f64, want: f64) {
+    assert!((got - want).abs() < 1e-6, "got {got}, want {want}");
+}
+
+/// Mamdani centroid of a piecewise linear membership given by its breakpoints `(x, μ)`:
+/// `∫xμ / ∫μ`, each linear piece contributing area h·(ya + yb)/2 and moment
+/// h/6·(ya·(2a + b) + yb·(a + 2b)). Used to spell out the hand computations.
+fn centroid(points: &[(f64, f64)]) -> f64 {
+    let (mut area, mut moment) = (0.0, 0.0);
+    for w in points.windows(2) {
+        let ((a, ya), (b, yb)) = (w[0], w[1]);
+        let h = b - a;
+        area += h * (ya + yb) / 2.0;
+        moment += h / 6.0 * (ya * (2.0 * a + b) + yb * (a + 2.0 * b));
+    }
+    moment / area
+}
+
+#[test]
+fn the_shipped_directory_loads_every_behavior_and_each_runs_cleanly() {
+    let c = cap("trackbnet1");
+    assert_eq!(
+        c.hbm().names(),
+        [
+            "alignbnet1",
+            "dokick",
+            "faceball",
+            "gkclearb",
+            "gkcutb",
+            "gkkeeparea",
+            "gkkeepbarea",
+            "gkkeepout",
+            "gklocalize",
+            "gkscanobj",
+            "gktracklms",
+            "go2ball",
+            "goalkeeper",
+            "lookball",
+            "trackbnet1",
+        ],
+        "hbm.lua and attacker.hfsm.lua are not behaviors"
+    );
+    // Every behavior runs without error on an empty world and on a busy one.
+    let busy = World::at(0)
+        .ball(700.0, 0.3)
+        .net1(3000.0, -0.2)
+        .me(-8000.0, 300.0, 0.2, 0.7)
+        .global_ball(-7400.0, 500.0);
+    for name in c.hbm().names() {
+        for w in [World(WorldSnapshot::default()), busy.clone()] {
+            let c = run(&name, w);
+            for v in [c.command.vlin, c.command.vrot, c.command.vlat] {
+                assert!(v.is_finite() && v.abs() <= 300.0, "{name}: {:?}", c.command);
+            }
+        }
+    }
+}
+
+/// The seed's worked example (§4.1): "In a situation where the ball is at 400mm from the robot,
+/// the truth-value of ballClose is 0.7, and these rules assert a value of needed of 1.0 for
+/// the anchor BALL and of 0.7 for NET1." ballClose = TOL(250, 750)(400) = (750 − 400) / 500.
+#[test]
+fn trackbnet1_needs_the_ball_always_and_the_net_when_close() {
+    let c = run("trackbnet1", World::at(0).ball(400.0, 0.0));
+    assert!((c.command.need(lps::BALL) - 1.0).abs() < 1e-9);
+    assert!((c.command.need(lps::NET1) - 0.7).abs() < 1e-9, "{:?}", c.command.needs);
+    // It moves nothing.
+    assert_eq!((c.command.vlin, c.command.vrot, c.command.vlat), (0.0, 0.0, 0.0));
+    // Ball at 1 m: not close, NET1 is not needed; at 200 mm fully close.
+    let c = run("trackbnet1", World::at(0).ball(1000.0, 0.0));
+    assert_eq!((c.command.need(lps::BALL), c.command.need(lps::NET1)), (1.0, 0.0));
+    let c = run("trackbnet1", World::at(0).ball(200.0, 0.0));
+    assert_eq!(c.command.need(lps::NET1), 1.0);
+    // A ball not seen (reliability 0) is not close, whatever its last distance.
+    let mut w = World::at(0).ball(400.0, 0.0);
+    w.0.lps[lps::BALL].reliability = 0.0;
+    assert_eq!(run("trackbnet1", w).command.need(lps::NET1), 0.0);
+}
+
+#[test]
+fn faceball_turns_towards_the_ball() {
+    // θ = 0.6: headedRight = TOR(0.05, 0.5)(0.6) = 1 → turn LEFT alone → +45 °/s.
+    let c = run("faceball", World::at(0).ball(1500.0, 0.6));
+    close(c.command.vrot, 45.0);
+    close(c.command.vlin, 0.0);
+    close(c.command.vlat, 0.0);
+    assert_eq!(c.command.need(lps::BALL), 1.0);
+    // θ = −0.6: turn RIGHT → −45.
+    close(run("faceball", World::at(0).ball(1500.0, -0.6)).command.vrot, -45.0);
+    // θ = 0: only NONE → 0.
+    close(run("faceball", World::at(0).ball(1500.0, 0.0)).command.vrot, 0.0);
+    // θ = 0.2: LEFT = (0.2 − 0.05) / 0.45 = 1/3 and NONE = TRI(−0.3, 0, 0.3)(0.2) = 1/3.
+    // NONE clipped at 1/3 is a trapezium −45..45 with top −30..30; LEFT clipped is 0..90 with
+    // top 15..75; their max is 1/3 from −30 to 75 with ramps −45..−30 and 75..90: symmetric
+    // about (−45 + 90) / 2 = 22.5.
+    close(run("faceball", World::at(0).ball(1500.0, 0.2)).command.vrot, 22.5);
+    close(run("faceball", World::at(0).ball(1500.0, -0.2)).command.vrot, -22.5);
+}
+
+#[test]
+fn go2ball_goes_forward_when_the_ball_is_ahead_and_far_not_when_at_the_side() {
+    // Ahead (θ 0) at 2 m: ballAhead 1, ballClose 0 → go FAST alone → 250; turn NONE → 0.
+    let c = run("go2ball", World::at(0).ball(2000.0, 0.0));
+    close(c.command.vlin, 250.0);
+    close(c.command.vrot, 0.0);
+    close(c.command.vlat, 0.0);
+    // At the side (θ 1.2): ballAhead 0 → go STAY → 0, turn LEFT → 45.
+    let c = run("go2ball", World::at(0).ball(2000.0, 1.2));
+    close(c.command.vlin, 0.0);
+    close(c.command.vrot, 45.0);
+    // Ahead at 400 mm: ballClose 0.7 → FAST 0.3, SLOW 0.7. The max of SLOW clipped at 0.7 and
+    // FAST clipped at 0.3 rises 0 → 0.7 over [0, 105], stays 0.7 to 195, follows SLOW down to
+    // 0.3 at 255, then FAST's 0.3 to 300: centroid 22398.75 / 143.25 = 156.36.
+    let c = run("go2ball", World::at(0).ball(400.0, 0.0));
+    let want = centroid(&[(0.0, 0.0), (105.0, 0.7), (195.0, 0.7), (255.0, 0.3), (300.0, 0.3)]);
+    close(want, 22398.75 / 143.25);
+    close(c.command.vlin, want);
+}
+
+#[test]
+fn dokick_kicks_when_the_ball_is_ahead_and_touching() {
+    // 200 mm ahead: ballTouching = TOL(150, 350)(200) = 0.75 → FRONTKICK 0.75 ≥ 0.5 → kick 1;
+    // go SLOW at NOT(0.75) = 0.25 → 150.
+    let c = run("dokick", World::at(0).ball(200.0, 0.0));
+    assert_eq!(c.command.kick, Some(1));
+    close(c.command.vlin, 150.0);
+    // 1 m: not touching → no kick, SLOW 1 → 150.
+    let c = run("dokick", World::at(0).ball(1000.0, 0.0));
+    assert_eq!(c.command.kick, None);
+    close(c.command.vlin, 150.0);
+    // 300 mm: touching (350 − 300) / 200 = 0.25 < 0.5 → no kick.
+    assert_eq!(run("dokick", World::at(0).ball(300.0, 0.0)).command.kick, None);
+    // 200 mm but off to the side (θ 1): not ahead → no kick, STAY, turn LEFT.
+    let c = run("dokick", World::at(0).ball(200.0, 1.0));
+    assert_eq!(c.command.kick, None);
+    close(c.command.vlin, 0.0);
+    close(c.command.vrot, 45.0);
+}
+
+#[test]
+fn alignbnet1_strafes_to_put_the_net_behind_the_ball() {
+    // Net seen 0.5 rad left of the ball: netLeftOfBall = TOR(0.05, 0.4)(0.5) = 1 → strafe
+    // RIGHT → −100; ball ahead → turn NONE → 0; go STAY → 0.
+    let c = run("alignbnet1", World::at(0).ball(400.0, 0.0).net1(3000.0, 0.5));
+    close(c.command.vlat, -100.0);
+    close(c.command.vrot, 0.0);
+    close(c.command.vlin, 0.0);
+    assert_eq!((c.command.need(lps::BALL), c.command.need(lps::NET1)), (1.0, 1.0));
+    // Net right of the ball → strafe LEFT → +100; behind it → NONE → 0.
+    close(run("alignbnet1", World::at(0).ball(400.0, 0.1).net1(3000.0, -0.4)).command.vlat, 100.0);
+    close(run("alignbnet1", World::at(0).ball(400.0, 0.0).net1(3000.0, 0.0)).command.vlat, 0.0);
+    // Net not seen: no strafe rule fires, vlat stays at its default 0.
+    close(run("alignbnet1", World::at(0).ball(400.0, 0.0)).command.vlat, 0.0);
+}
+
+#[test]
+fn gkcutb_strafes_back_onto_the_ball_to_net_line_and_clears_when_safe() {
+    // Ball at (−6000, 1000), our net's centre at (−9000, 0). At the robot's x = −8500 the
+    // line is at y = 1000 + (0 − 1000)·(−8500 + 6000)/(−9000 + 6000) = 1000 − 833.3 = 166.7.
+    // The robot at y = 800 is 633.3 mm left of it (+y): posLeft = TOR(50, 300) = 1 → strafe
+    // RIGHT → −100 (towards −y, back to the line, facing +x).
+    let heading = (1000.0f64 - 800.0).atan2(2500.0); // facing the ball
+    let w = World::at(0).me(-8500.0, 800.0, heading, 0.9).global_ball(-6000.0, 1000.0);
+    let c = run("gkcutb", w.ball(2508.0, 0.0));
+    close(c.command.vlat, -100.0);
+    close(c.command.vlin, 0.0);
+    // At y = −500 the robot is 666.7 mm right of the line: posRight = 1 → strafe LEFT → +100.
+    let w = World::at(0).me(-8500.0, -500.0, 0.0, 0.9).global_ball(-6000.0, 1000.0);
+    close(run("gkcutb", w.ball(2700.0, 0.6)).command.vlat, 100.0);
+    // On the line (ball and robot on y = 0): posAhead = 1 → strafe NONE → 0.
+    let w = World::at(0).me(-8500.0, 0.0, 0.0, 0.9).global_ball(-6000.0, 0.0);
+    let c = run("gkcutb", w.ball(2500.0, 0.0));
+    close(c.command.vlat, 0.0);
+    assert_eq!(c.command.kick, None, "ball far: no kick");
+    // Ball close (300 mm: ballClose = (750 − 300)/500 = 0.9) and heading 0 (freeToKick =
+    // TOL(0.5, 1.2)(0) = 1): FRONTKICK 0.9 → kick 1.
+    let w = World::at(0).me(-8500.0, 0.0, 0.0, 0.9).global_ball(-8200.0, 0.0);
+    assert_eq!(run("gkcutb", w.clone().ball(300.0, 0.0)).command.kick, Some(1));
+    // The same ball with the robot headed 2 rad (towards our own half): not safe, no kick.
+    let w = World::at(0).me(-8500.0, 0.0, 2.0, 0.9).global_ball(-8200.0, 0.0);
+    assert_eq!(run("gkcutb", w.ball(300.0, 0.0)).command.kick, None);
+}
+
+#[test]
+fn goalkeeper_scans_for_a_lost_ball_turning_towards_where_it_was() {
+    // Ball not seen (reliability 0), last seen to the right (θ −0.7), robot localized at its
+    // goal: NOT(ballSeen) = 1 → gkscanobj → lookball (turn −50 °/s for 400 ms, then −75) and
+    // gktracklms (track landmarks). Nothing else is used: no fuzzy output overrides lookball.
+    let mut cap = cap("goalkeeper");
+    let w = |t| World::at(t).me(-8500.0, 0.0, 0.0, 0.9).ball_lost(-0.7, 3.0);
+    let c = cap.cycle(w(1000).0);
+    assert!(c.errors.is_empty(), "{:?}", c.errors);
+    assert_eq!((c.command.vlin, c.command.vrot, c.command.vlat), (0.0, -50.0, 0.0));
+    assert!(c.command.track_landmarks);
+    assert_eq!(c.command.need(lps::BALL), 1.0);
+    let c = cap.cycle(w(1300).0);
+    assert_eq!(c.command.vrot, -50.0);
+    let c = cap.cycle(w(1500).0);
+    assert_eq!(c.command.vrot, -75.0, "faster after 400 ms");
+}
+
+#[test]
+fn goalkeeper_gets_out_of_its_net() {
+    // x = −9200 is behind our goal line: inOwnNet = TOL(−9100, −8850)(−9200) = 1 → gkkeepout
+    // alone (every other meta-rule has NOT(inOwnNet) = 0): go SLOW → 150 (forward), turn LEFT
+    // → 45, strafe NONE → 0, landmarks and NET1 needed. Even with the ball in view.
+    let c = run(
+        "goalkeeper",
+        World::at(0).me(-9200.0, 0.0, 0.0, 0.9).ball(1000.0, 0.0).global_ball(-8200.0, 0.0),
+    );
+    close(c.command.vlin, 150.0);
+    close(c.command.vrot, 45.0);
+    close(c.command.vlat, 0.0);
+    assert!(c.command.track_landmarks);
+    assert_eq!(c.command.need(lps::NET1), 1.0);
+    assert_eq!(c.command.kick, None);
+}
+
+#[test]
+fn goalkeeper_clears_a_ball_in_the_penalty_area() {
+    // Robot at x = −7700 facing +x, localized; ball seen 200 mm ahead, globally at x = −7500
+    // (penalty area: TOL(−6750, −6250)(−7500) = 1) → gkclearb at 1. There ballAhead = 1,
+    // ballClose = 1, freeToKick = 1 → dokick at 1 (go2ball at NOT(1) = 0, faceball 0,
+    // alignbnet1 0): FRONTKICK at ballTouching = 0.75 → kick 1; go SLOW 0.25 → 150.
+    let c = run(
+        "goalkeeper",
+        World::at(0).me(-7700.0, 0.0, 0.0, 0.9).ball(200.0, 0.0).global_ball(-7500.0, 0.0),
+    );
+    assert_eq!(c.command.kick, Some(1));
+    close(c.command.vlin, 150.0);
+    close(c.command.vrot, 0.0);
+    close(c.command.vlat, 0.0);
+    assert_eq!(c.command.need(lps::BALL), 1.0);
+    // The ball 1.5 m ahead, still in the area (x = −7200): ballClose 0 → go2ball at 1 → go
+    // FAST → 250, no kick.
+    let c = run(
+        "goalkeeper",
+        World::at(0).me(-8700.0, 0.0, 0.0, 0.9).ball(1500.0, 0.0).global_ball(-7200.0, 0.0),
+    );
+    close(c.command.vlin, 250.0);
+    assert_eq!(c.command.kick, None);
+}
+
+#[test]
+fn goalkeeper_cuts_the_ball_from_its_goal_area_and_localizes_when_lost() {
+    // Robot at (−8500, 500) in the goal area (TOL(−8250, −7750)(−8500) = 1, |y| = 500 ≤ 1500);
+    // ball at (−4000, 1000), outside the penalty area → gkcutb at 1. The ball-to-net line at
+    // x = −8500: y = 1000 − 1000·(−4500)/(−5000) = 100, so the robot is 400 mm left of it:
+    // strafe RIGHT → −100. The ball is at bearing atan2(500, 4500) = 0.11 (left): turn > 0.
+    let theta = 500.0f64.atan2(4500.0);
+    let c = run(
+        "goalkeeper",
+        World::at(0).me(-8500.0, 500.0, 0.0, 0.9).ball(4528.0, theta).global_ball(-4000.0, 1000.0),
+    );
+    close(c.command.vlat, -100.0);
+    assert!(c.command.vrot > 0.0 && c.command.vrot < 45.0, "{:?}", c.command);
+    close(c.command.vlin, 0.0);
+    // The same with localization quality 0.2: wellLocalized = TOR(0.4, 0.8)(0.2) = 0, lost 1 →
+    // gklocalize alone: stand still (STAY, NONE, NONE → 0), landmarks, both nets at 0.6.
+    let c = run(
+        "goalkeeper",
+        World::at(0).me(-8500.0, 500.0, 0.0, 0.2).ball(4528.0, theta).global_ball(-4000.0, 1000.0),
+    );
+    close(c.command.vlin, 0.0);
+    close(c.command.vrot, 0.0);
+    close(c.command.vlat, 0.0);
+    assert!(c.command.track_landmarks);
+    assert_eq!((c.command.need(lps::NET1), c.command.need(lps::NET2)), (0.6, 0.6));
+}
+
+/// The seed's Attacker (§5.2, figures 10 and 11) through a scripted approach: face the ball,
+/// walk to it, approach, kick, lose the alignment, realign, kick, the ball rolls away.
+#[test]
+fn the_attacker_hfsm_faces_walks_scores_and_follows_the_ball() {
+    let mut cap =
+        ThinkingCap::with_hfsm(dir(), dir().join("attacker.hfsm.lua"), Sandbox::default()).unwrap();
+    assert_eq!(cap.hfsm().unwrap().root(), "Attacker");
+    let aligned = 0.05; // |NET1.theta − BALL.theta| < 0.2 with the ball at θ 0
+    let worlds = [
+        // 0: ball far on the left: FaceBall (initial).
+        World::at(0).ball(2000.0, 1.2).net1(5000.0, 0.9),
+        // 1: still on the side: no transition.
+        World::at(100).ball(2000.0, 1.0).net1(5000.0, 0.9),
+        // 2: ahead (|θ| < 0.25): BallAhead → GoToBall.
+        World::at(200).ball(2000.0, 0.0).net1(5000.0, aligned),
+        // 3: localization quality 0.5 and no net seen for 6 s: GoToBall tracks landmarks and
+        //    needs NET1 at 0.5.
+        World::at(300).ball(2000.0, 0.0).me(0.0, 0.0, 0.0, 0.5).nets_unseen(6.0),
+        // 4: 450 mm (< 500): NearBall → Score, entered at ApproachBall.
+        World::at(400).ball(450.0, 0.0).net1(4000.0, 0.6),
+        // 5: 450 mm (< 600) and aligned: Kickable → DoKick.
+        World::at(500).ball(450.0, 0.0).net1(4000.0, aligned),
+        // 6: alignment lost: LostAlignment → Align.
+        World::at(600).ball(450.0, 0.0).net1(4000.0, 0.5),
+        // 7: aligned again, ball at 200 mm: Aligned → DoKick, which kicks.
+        World::at(700).ball(200.0, 0.0).net1(4000.0, aligned),
+        // 8: the ball rolled to 1.2 m and the net is off: Score's BallAway (> 900) and DoKick's
+        //    LostAlignment both pass; the enclosing meta-state's transition wins.
+        World::at(800).ball(1200.0, 0.0).net1(4000.0, 0.5),
+        // 9: the ball far on the right (|θ| > 0.8): BallAside → FaceBall.
+        World::at(900).ball(1200.0, -1.0).net1(4000.0, 0.5),
+    ];
+    let cycles: Vec<Cycle> = worlds.iter().map(|w| cap.cycle(w.0.clone())).collect();
+    for (k, c) in cycles.iter().enumerate() {
+        assert!(c.errors.is_empty(), "cycle {k}: {:?}", c.errors);
+    }
+    let paths: Vec<&str> = cycles.iter().map(|c| c.path.as_str()).collect();
+    assert_eq!(
+        paths,
+        [
+            "Attacker/FaceBall",
+            "Attacker/FaceBall",
+            "Attacker/GoToBall",
+            "Attacker/GoToBall",
+            "Attacker/Score/ApproachBall",
+            "Attacker/Score/DoKick",
+            "Attacker/Score/Align",
+            "Attacker/Score/DoKick",
+            "Attacker/GoToBall",
+            "Attacker/FaceBall",
+        ]
+    );
+    let taken: Vec<Option<(&str, &str)>> = cycles
+        .iter()
+        .map(|c| c.taken.as_ref().map(|t| (t.machine.as_str(), t.name.as_str())))
+        .collect();
+    assert_eq!(
+        taken,
+        [
+            None,
+            None,
+            Some(("Attacker", "BallAhead")),
+            None,
+            Some(("Attacker", "NearBall")),
+            Some(("Score", "Kickable")),
+            Some(("Score", "LostAlignment")),
+            Some(("Score", "Aligned")),
+            Some(("Attacker", "BallAway")),
+            Some(("Attacker", "BallAside")),
+        ]
+    );
+    for c in &cycles {
+        assert_eq!(
+            c.taken.as_ref().map(|t| t.path.as_str()),
+            c.taken.as_ref().map(|_| c.path.as_str())
+        );
+    }
+    let behaviors: Vec<&str> = cycles.iter().map(|c| c.behavior.as_deref().unwrap()).collect();
+    assert_eq!(
+        behaviors,
+        [
+            "faceball",
+            "faceball",
+            "go2ball",
+            "go2ball",
+            "go2ball",
+            "dokick",
+            "alignbnet1",
+            "dokick",
+            "go2ball",
+            "faceball",
+        ]
+    );
+    let cmd = |k: usize| &cycles[k].command;
+    // 0: faceball, ball left (θ 1.2) → turn LEFT 45, no forward motion.
+    close(cmd(0).vrot, 45.0);
+    close(cmd(0).vlin, 0.0);
+    // 2: go2ball, ball ahead at 2 m → FAST 250; well localized → no landmark tracking.
+    close(cmd(2).vlin, 250.0);
+    assert!(!cmd(2).track_landmarks);
+    assert_eq!(cmd(2).need(lps::NET1), 0.0);
+    // 3: quality 0.5 < 0.6 → trackLandMarks; nets unseen > 5 s → NET1 needed at 0.5.
+    assert!(cmd(3).track_landmarks);
+    assert_eq!(cmd(3).need(lps::NET1), 0.5);
+    close(cmd(3).vlin, 250.0);
+    // 4: ApproachBall runs go2ball at 450 mm: ballClose = (750 − 450)/500 = 0.6 → SLOW 0.6,
+    //    FAST 0.4: the max rises 0 → 0.6 over [0, 90], stays 0.6 to 210, follows SLOW down to
+    //    0.4 at 240, then FAST's 0.4 to 300: centroid 22260 / 138 = 161.30. No landmarks.
+    let want = centroid(&[(0.0, 0.0), (90.0, 0.6), (210.0, 0.6), (240.0, 0.4), (300.0, 0.4)]);
+    close(want, 22260.0 / 138.0);
+    close(cmd(4).vlin, want);
+    assert!(!cmd(4).track_landmarks);
+    // 5: dokick at 450 mm: not touching → no kick, SLOW → 150.
+    assert_eq!(cmd(5).kick, None);
+    close(cmd(5).vlin, 150.0);
+    // 6: alignbnet1, net 0.5 rad left of the ball → strafe RIGHT −100, no forward motion.
+    close(cmd(6).vlat, -100.0);
+    close(cmd(6).vlin, 0.0);
+    // 7: dokick at 200 mm → kick 1.
+    assert_eq!(cmd(7).kick, Some(1));
+    // 8: back in GoToBall, ball 1.2 m ahead → FAST 250.
+    close(cmd(8).vlin, 250.0);
+    // 9: faceball, ball right → −45.
+    close(cmd(9).vrot, -45.0);
+}
+
+#[test]
+fn the_attacker_aligns_first_when_approaching_a_misaligned_ball() {
+    let mut cap =
+        ThinkingCap::with_hfsm(dir(), dir().join("attacker.hfsm.lua"), Sandbox::default()).unwrap();
+    let worlds = [
+        World::at(0).ball(2000.0, 0.0).net1(5000.0, 0.0),
+        World::at(100).ball(2000.0, 0.0).net1(5000.0, 0.0),
+        World::at(200).ball(480.0, 0.0).net1(5000.0, -0.5),
+        // 650 mm: the seed's Kickable needs < 600: stay in ApproachBall.
+        World::at(300).ball(650.0, 0.0).net1(5000.0, -0.5),
+        // 550 mm, net 0.5 rad right of the ball: Misaligned → Align; strafe LEFT +100.
+        World::at(400).ball(550.0, 0.0).net1(5000.0, -0.5),
+    ];
+    let cycles: Vec<Cycle> = worlds.iter().map(|w| cap.cycle(w.0.clone())).collect();
+    let paths: Vec<&str> = cycles.iter().map(|c| c.path.as_str()).collect();
+    assert_eq!(
+        paths,
+        [
+            "Attacker/FaceBall",
+            "Attacker/GoToBall",
+            "Attacker/Score/ApproachBall",
+            "Attacker/Score/ApproachBall",
+            "Attacker/Score/Align",
+        ]
+    );
+    assert_eq!(cycles[4].taken.as_ref().map(|t| t.name.as_str()), Some("Misaligned"));
+    close(cycles[4].command.vlat, 100.0);
+}
+
+/// Copies the shared predicates and one behavior of the shipped directory into `to`.
+fn copy_behaviors(to: &Path, names: &[&str]) {
+    for n in names {
+        std::fs::copy(dir().join(n), to.join(n)).unwrap();
+    }
+}
+
+#[test]
+fn an_hfsm_naming_an_unknown_behavior_keeps_the_last_good_one_running() {
+    let tmp =
+        std::env::temp_dir().join(format!("mrt-script-teamchaos-{}-nothere", std::process::id()));
+    let _ = std::fs::remove_dir_all(&tmp);
+    std::fs::create_dir_all(&tmp).unwrap();
+    copy_behaviors(&tmp, &["hbm.lua", "go2ball.lua"]);
+    let machine = tmp.join("m.hfsm.lua");
+    std::fs::write(
+        &machine,
+        "machine \"M\" {\n\
+         initial = \"Go\",\n\
+         states = { Go = function()\n\
+           if chaos.lps_getLpo(BALL).rho < 300 then\n\
+             chaos.setBehavior(\"nothere\")\n\
+           else\n\
+             chaos.setBehavior(\"go2ball\")\n\
+           end\n\
+         end },\n\
+         }\n",
+    )
+    .unwrap();
+    let mut cap = ThinkingCap::with_hfsm(&tmp, &machine, Sandbox::default()).unwrap();
+    // Ball 2 m ahead: go2ball → FAST 250.
+    let c = cap.cycle(World::at(0).ball(2000.0, 0.0).0);
+    assert!(c.errors.is_empty(), "{:?}", c.errors);
+    assert_eq!((c.path.as_str(), c.behavior.as_deref()), ("M/Go", Some("go2ball")));
+    close(c.command.vlin, 250.0);
+    // Ball at 200 mm: the state asks for "nothere". The cycle reports it (file and line of
+    // the call) and go2ball keeps running: ballClose(200) = 1 → SLOW alone → 150.
+    let c = cap.cycle(World::at(100).ball(200.0, 0.0).0);
+    assert_eq!(c.errors.len(), 1, "{:?}", c.errors);
+    match &c.errors[0] {
+        ScriptError::Runtime { file, line, message, .. } => {
+            assert_eq!((file.as_str(), *line), (machine.display().to_string().as_str(), 5));
+            assert!(
+                message.contains("chaos.setBehavior: no behavior named 'nothere' (known: go2ball)"),
+                "{message}"
+            );
+        }
+        other => panic!("{other:?}"),
+    }
+    assert_eq!((c.path.as_str(), c.behavior.as_deref()), ("M/Go", Some("go2ball")));
+    close(c.command.vlin, 150.0);
+    // And back to normal.
+    let c = cap.cycle(World::at(200).ball(2000.0, 0.0).0);
+    assert!(c.errors.is_empty(), "{:?}", c.errors);
+    close(c.command.vlin, 250.0);
+    let _ = std::fs::remove_dir_all(&tmp);
+}
