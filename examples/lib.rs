@@ -6,6 +6,8 @@
 pub mod fuzzy_controller;
 #[path = "01_hello_agora.rs"]
 pub mod hello_agora;
+#[path = "04_teamchaos_behaviors.rs"]
+pub mod teamchaos_behaviors;
 #[path = "02_two_agoras.rs"]
 pub mod two_agoras;
 
@@ -31,6 +33,44 @@ mod tests {
         // its teammate listener hears only robot 2 (every 30 ms: 0..=90 -> 4).
         assert_eq!(seen.own, vec![1; 5]);
         assert_eq!(seen.teammates, vec![2; 4]);
+    }
+
+    #[test]
+    fn teamchaos_attacker_scores_and_hot_reload_applies_at_the_next_cycle() {
+        use super::teamchaos_behaviors::run;
+        let scratch =
+            std::env::temp_dir().join(format!("mrt-example-04-test-{}", std::process::id()));
+        let out = run(&scratch, false).unwrap();
+        std::fs::remove_dir_all(&scratch).unwrap();
+        let a = &out.attacker;
+        let paths: Vec<&str> = a.iter().map(|s| s.path.as_str()).collect();
+        // The ball starts on the left: face it, walk to it, score with a kick at the end.
+        assert_eq!(paths[0], "Attacker/FaceBall");
+        assert!(a[0].vrot > 0.0, "ball on the left: turn left");
+        let first_walk = paths.iter().position(|p| *p == "Attacker/GoToBall").unwrap();
+        assert!(paths.iter().skip(first_walk).any(|p| p.starts_with("Attacker/Score/")));
+        let last = a.last().unwrap();
+        assert_eq!((last.path.as_str(), last.kick), ("Attacker/Score/DoKick", Some(1)));
+        // Cycle 15: go2ball edited (FAST -> SLOW) and reloaded; the walk slows down at once.
+        assert_eq!(a[15].events, ["reloaded go2ball"]);
+        // Walking on FAST the robot sped up to 135 mm/s; the SLOW version gives under 120 at
+        // once (Mamdani centroids of FAST or SLOW clipped at ballAhead, against a little STAY).
+        assert!(a[14].vlin > 130.0 && a[15].vlin < 120.0, "{} -> {}", a[14].vlin, a[15].vlin);
+        assert!(a[15..20].iter().all(|s| s.behavior == "go2ball" && s.vlin < 120.0));
+        // Cycle 20: a broken edit is rejected with file:line, and the robot keeps going.
+        assert_eq!(a[20].events.len(), 1);
+        let rejected = &a[20].events[0];
+        assert!(
+            rejected.starts_with("rejected: ") && rejected.contains("go2ball.lua:"),
+            "{rejected}"
+        );
+        assert!(a[21..].iter().all(|s| s.events.is_empty()));
+        assert!(a[21].vlin > 0.0, "still walking with the last good go2ball");
+        // The goalkeeper: scanning for a lost ball, leaving its net, stepping onto the line.
+        let gk = &out.goalkeeper;
+        assert!(gk[0].vrot != 0.0 && gk[0].track_landmarks, "ball lost: turns to look for it");
+        assert!(gk[1].vlin > 0.0, "inside its net: moves out");
+        assert!(gk[2].vlat < 0.0, "off the line to the left: strafes right");
     }
 
     #[test]

@@ -133,10 +133,25 @@ impl ThinkingCap {
     /// Reloads every changed file now (what a watcher or a reload request on the bus does
     /// at the next cycle boundary). Returns what was reloaded and what was rejected.
     pub fn reload_changed(&mut self) -> (Vec<String>, Vec<ScriptError>) {
-        let (mut done, mut errors) = self.hbm.reload_changed(&self.rt);
+        self.reload(&[])
+    }
+
+    /// Reloads what changed, and the files in `touched` (as a watcher reports them) whatever
+    /// their modification times say.
+    fn reload(&mut self, touched: &[PathBuf]) -> (Vec<String>, Vec<ScriptError>) {
+        let names: Vec<String> = touched
+            .iter()
+            .filter_map(|p| p.file_name()?.to_str()?.strip_suffix(".lua").map(str::to_string))
+            .collect();
+        let (mut done, mut errors) = self.hbm.reload(&self.rt, &names);
         self.io.borrow_mut().known_behaviors = Some(self.hbm.names().into_iter().collect());
-        if let Top::Hfsm(h, _) = &mut self.top {
-            match h.reload_if_changed(&self.rt) {
+        if let Top::Hfsm(h, path) = &mut self.top {
+            let attempt = if touched.contains(path) {
+                h.reload(&self.rt).map(|()| true)
+            } else {
+                h.reload_if_changed(&self.rt)
+            };
+            match attempt {
                 Ok(true) => done.push(h.file().to_string()),
                 Ok(false) => {}
                 Err(e) => errors.push(e),
@@ -148,8 +163,9 @@ impl ThinkingCap {
     /// Runs one cycle on `world`.
     pub fn cycle(&mut self, world: WorldSnapshot) -> Cycle {
         let (mut reloaded, mut errors) = (Vec::new(), Vec::new());
-        if self.watcher.as_ref().is_some_and(|w| !w.changed().is_empty()) {
-            (reloaded, errors) = self.reload_changed();
+        let touched = self.watcher.as_ref().map(ScriptWatcher::changed).unwrap_or_default();
+        if !touched.is_empty() {
+            (reloaded, errors) = self.reload(&touched);
         }
         self.io.borrow_mut().new_cycle(world);
         let mut taken = None;

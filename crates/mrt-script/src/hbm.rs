@@ -215,9 +215,26 @@ impl Hbm {
     /// keeps its running version; the others are swapped in. Returns the names reloaded and
     /// the errors. Call it at a cycle boundary.
     pub fn reload_changed(&mut self, rt: &LuaRuntime) -> (Vec<String>, Vec<ScriptError>) {
+        self.reload(rt, &[])
+    }
+
+    /// Like [`Hbm::reload_changed`], and also reloads the files named in `forced` (behavior
+    /// names, `hbm` for `hbm.lua`) whatever their modification times say: a file watcher
+    /// reports edits that a coarse file-system clock may hide.
+    pub fn reload(
+        &mut self,
+        rt: &LuaRuntime,
+        forced: &[String],
+    ) -> (Vec<String>, Vec<ScriptError>) {
         let (mut done, mut errors) = (Vec::new(), Vec::new());
+        let forced_name = |n: &str| forced.iter().any(|f| f == n);
         if let Some(setup) = &self.setup {
-            match setup.reload_if_changed(rt) {
+            let attempt = if forced_name("hbm") {
+                setup.reload(rt).map(|()| true)
+            } else {
+                setup.reload_if_changed(rt)
+            };
+            match attempt {
                 Ok(false) => {}
                 Ok(true) => {
                     let previous = std::mem::take(&mut *self.shared.declared.borrow_mut());
@@ -255,7 +272,13 @@ impl Hbm {
             let existing = self.shared.behaviors.borrow().contains_key(&name);
             let result = if existing {
                 let behaviors = self.shared.behaviors.borrow();
-                behaviors.get(&name).map_or(Ok(false), |s| s.reload_if_changed(rt))
+                behaviors.get(&name).map_or(Ok(false), |s| {
+                    if forced_name(&name) {
+                        s.reload(rt).map(|()| true)
+                    } else {
+                        s.reload_if_changed(rt)
+                    }
+                })
             } else {
                 Script::from_file(rt, &path, LoadStrategy::Compiled).map(|s| {
                     self.shared.behaviors.borrow_mut().insert(name.clone(), s);

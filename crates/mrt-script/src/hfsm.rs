@@ -327,6 +327,7 @@ impl Hfsm {
     /// new machine starts over). On error the running machine is untouched.
     pub fn reload(&mut self, rt: &LuaRuntime) -> Result<(), ScriptError> {
         let Some(path) = self.path_on_disk.clone() else { return Ok(()) };
+        self.modified = mtime(&path);
         let source = std::fs::read_to_string(&path)
             .map_err(|source| ScriptError::Io { file: self.file.clone(), source })?;
         self.reload_source(rt, &source)
@@ -340,7 +341,6 @@ impl Hfsm {
         if stamp == self.modified {
             return Ok(false);
         }
-        self.modified = stamp;
         self.reload(rt).map(|()| true)
     }
 
