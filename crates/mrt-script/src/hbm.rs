@@ -30,7 +30,7 @@
 use crate::chaos::RobotIo;
 use crate::runtime::LuaRuntime;
 use crate::script::{LoadStrategy, Script, ScriptError};
-use mlua::{Lua, MetaMethod, Table, UserData, UserDataMethods, Value, Variadic};
+use mlua::{Lua, MetaMethod, Table, Value, Variadic};
 use mrt_core::robot::lps;
 use mrt_fuzzy::hbm::{Blender, ControlVariable, Defuzzification};
 use mrt_fuzzy::FuzzySet;
@@ -54,17 +54,24 @@ enum Drives {
     Kick,
 }
 
-/// A fuzzy set as Lua sees it: called on a value, it gives the membership.
-#[derive(Clone, Copy)]
-struct LuaSet(FuzzySet);
+/// The set identifiers, in the order of their codes in a Lua set table.
+const SET_KINDS: [(&str, usize); 7] =
+    [("TRI", 3), ("TRA", 4), ("TOL", 2), ("TOR", 2), ("REC", 2), ("SNG", 1), ("DIV", 4)];
 
-impl UserData for LuaSet {
-    fn add_methods<M: UserDataMethods<Self>>(m: &mut M) {
-        m.add_meta_method(MetaMethod::Call, |_, s, x: f64| Ok(s.0.membership(x)));
-        m.add_meta_method(MetaMethod::ToString, |_, s, ()| {
-            Ok(format!("{}{:?}", s.0.identifier(), s.0.params()))
-        });
+/// A fuzzy set as Lua sees it: a plain table `{kind, p1, p2, ...}` whose metatable makes it
+/// callable (`set(x)` is the membership of `x`). A table, not a userdata, so the garbage a
+/// behavior makes by building sets each cycle is cheap for Lua's collector (no finalizers).
+fn set_of(t: &Table) -> mlua::Result<FuzzySet> {
+    let kind: i64 = t.raw_get(1)?;
+    let (name, arity) =
+        usize::try_from(kind).ok().and_then(|k| SET_KINDS.get(k)).copied().ok_or_else(|| {
+            err("not a fuzzy set (build one with TRI, TRA, TOL, TOR, REC, SNG, DIV)".into())
+        })?;
+    let mut p = [0.0; 4];
+    for (i, slot) in p.iter_mut().enumerate().take(arity) {
+        *slot = t.raw_get(i + 2)?;
     }
+    FuzzySet::from_parts(name, &p[..arity]).ok_or_else(|| err(format!("{name}: bad parameters")))
 }
 
 /// A truth value from Lua: a number (clamped to `[0, 1]`) or a boolean.
@@ -322,8 +329,10 @@ fn err(msg: String) -> mlua::Error {
     mlua::Error::runtime(msg)
 }
 
-fn set_fn(lua: &Lua, g: &Table, name: &'static str, arity: usize) -> mlua::Result<()> {
-    let f = lua.create_function(move |_, args: Variadic<f64>| {
+fn set_fn(lua: &Lua, g: &Table, kind: usize, meta: &Table) -> mlua::Result<()> {
+    let (name, arity) = SET_KINDS[kind];
+    let meta = meta.clone();
+    let f = lua.create_function(move |lua, args: Variadic<f64>| {
         if args.len() != arity {
             return Err(err(format!("{name} takes {arity} numbers, got {}", args.len())));
         }
@@ -335,7 +344,13 @@ fn set_fn(lua: &Lua, g: &Table, name: &'static str, arity: usize) -> mlua::Resul
                 &args[..]
             )));
         }
-        Ok(LuaSet(set))
+        let t = lua.create_table_with_capacity(1 + arity, 0)?;
+        t.raw_set(1, kind)?;
+        for (i, p) in args.iter().enumerate() {
+            t.raw_set(i + 2, *p)?;
+        }
+        t.set_metatable(Some(meta.clone()))?;
+        Ok(t)
     })?;
     g.set(name, f)
 }
@@ -343,10 +358,21 @@ fn set_fn(lua: &Lua, g: &Table, name: &'static str, arity: usize) -> mlua::Resul
 /// Installs the rule language in the runtime's globals.
 fn install(lua: &Lua, shared: &Rc<Shared>) -> mlua::Result<()> {
     let g = lua.globals();
-    for (name, arity) in
-        [("TRI", 3), ("TRA", 4), ("TOL", 2), ("TOR", 2), ("REC", 2), ("SNG", 1), ("DIV", 4)]
-    {
-        set_fn(lua, &g, name, arity)?;
+    let meta = lua.create_table()?;
+    meta.set(
+        MetaMethod::Call.name(),
+        lua.create_function(|_, (t, x): (Table, f64)| Ok(set_of(&t)?.membership(x)))?,
+    )?;
+    meta.set(
+        MetaMethod::ToString.name(),
+        lua.create_function(|_, t: Table| {
+            let s = set_of(&t)?;
+            Ok(format!("{}{:?}", s.identifier(), s.params()))
+        })?,
+    )?;
+    meta.set("__metatable", "fuzzy set")?;
+    for kind in 0..SET_KINDS.len() {
+        set_fn(lua, &g, kind, &meta)?;
     }
     g.set(
         "AND",
@@ -495,10 +521,9 @@ fn declare(t: &Table) -> mlua::Result<(ControlVariable, Option<Drives>)> {
     }
     let labels: Table = t.get("labels")?;
     let mut list = Vec::new();
-    for pair in labels.pairs::<String, mlua::AnyUserData>() {
+    for pair in labels.pairs::<String, Table>() {
         let (label, set) = pair?;
-        let set = set.borrow::<LuaSet>()?.0;
-        list.push((label, set));
+        list.push((label, set_of(&set)?));
     }
     if list.is_empty() {
         return Err(err(format!("variable '{name}' has no labels")));

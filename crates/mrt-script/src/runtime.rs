@@ -54,6 +54,9 @@ impl LuaRuntime {
         .exec()
         .map_err(ScriptError::setup)?;
         lua.set_memory_limit(sandbox.memory_limit).map_err(ScriptError::setup)?;
+        // Behaviors make short-lived garbage every cycle (tables, closures, strings): the
+        // generational collector reclaims it in small steps, keeping the heap near its live size.
+        lua.gc_set_mode(mlua::state::GcMode::Generational(mlua::state::GcGenParams::default()));
         let ticks = Arc::new(AtomicU64::new(0));
         let counter = ticks.clone();
         let limit = sandbox.instruction_budget / u64::from(CHECK_EVERY);
