@@ -13,7 +13,7 @@
 
 use crate::runtime::LuaRuntime;
 use crate::script::ScriptError;
-use mlua::{Lua, Table, Value};
+use mlua::{Lua, LuaString, Table, Value};
 use mrt_core::robot::{lps, RobotCommand, WorldSnapshot};
 use mrt_core::Time;
 use std::cell::RefCell;
@@ -102,34 +102,50 @@ fn check_index(f: &str, i: i64) -> mlua::Result<usize> {
     })
 }
 
-fn fill_pose(
-    t: &Table,
-    x: f64,
-    y: f64,
-    theta: Option<f64>,
-    quality: Option<f64>,
-) -> mlua::Result<()> {
-    t.raw_set("x", x)?;
-    t.raw_set("y", y)?;
-    if let Some(th) = theta {
-        t.raw_set("theta", th)?;
-    }
-    if let Some(q) = quality {
-        t.raw_set("quality", q)?;
-    }
-    Ok(())
+/// The field names of the data tables, interned once: setting a field by a `&str` key
+/// interns the string again at every call, which cost more than the rest of a fill.
+struct Keys {
+    x: LuaString,
+    y: LuaString,
+    theta: LuaString,
+    quality: LuaString,
+    rho: LuaString,
+    reliability: LuaString,
+    seen_ago: LuaString,
 }
 
-fn pose_table(
-    lua: &Lua,
-    x: f64,
-    y: f64,
-    theta: Option<f64>,
-    quality: Option<f64>,
-) -> mlua::Result<Table> {
-    let t = lua.create_table_with_capacity(0, 4)?;
-    fill_pose(&t, x, y, theta, quality)?;
-    Ok(t)
+impl Keys {
+    fn new(lua: &Lua) -> mlua::Result<Keys> {
+        let k = |s: &str| lua.create_string(s);
+        Ok(Keys {
+            x: k("x")?,
+            y: k("y")?,
+            theta: k("theta")?,
+            quality: k("quality")?,
+            rho: k("rho")?,
+            reliability: k("reliability")?,
+            seen_ago: k("seen_ago")?,
+        })
+    }
+
+    fn fill_pose(
+        &self,
+        t: &Table,
+        x: f64,
+        y: f64,
+        theta: Option<f64>,
+        quality: Option<f64>,
+    ) -> mlua::Result<()> {
+        t.raw_set(&self.x, x)?;
+        t.raw_set(&self.y, y)?;
+        if let Some(th) = theta {
+            t.raw_set(&self.theta, th)?;
+        }
+        if let Some(q) = quality {
+            t.raw_set(&self.quality, q)?;
+        }
+        Ok(())
+    }
 }
 
 /// A table filled at most once per cycle (see `RobotIo::generation`).
@@ -189,43 +205,56 @@ fn install_inner(lua: &Lua, io: Rc<RefCell<RobotIo>>) -> mlua::Result<()> {
     // the same cycle: behaviors and predicates ask for the ball many times a cycle. Treat them
     // as read-only, as the seed's copies were.
     let lpos: Vec<CycleTable> = (0..lps::COUNT).map(|_| CycleTable::default()).collect();
+    let keys = Rc::new(Keys::new(lua)?);
+    let k = keys.clone();
     func!("lps_getLpo", io, |lua, i: i64| {
+        let keys = &k;
         let i = check_index("lps_getLpo", i)?;
         let io = io.borrow();
         lpos[i].get(lua, io.generation, |t| {
             let o = io.world.lps.get(i).copied().unwrap_or_default();
-            t.raw_set("rho", o.rho)?;
-            t.raw_set("theta", o.theta)?;
-            t.raw_set("reliability", o.reliability)?;
-            t.raw_set("seen_ago", o.seen_ago)
+            t.raw_set(&keys.rho, o.rho)?;
+            t.raw_set(&keys.theta, o.theta)?;
+            t.raw_set(&keys.reliability, o.reliability)?;
+            t.raw_set(&keys.seen_ago, o.seen_ago)
         })
     });
     let my_pos = CycleTable::default();
+    let k = keys.clone();
     func!("gsGetMyPos", io, |lua, (): ()| {
+        let keys = &k;
         let io = io.borrow();
         let p = io.world.my_pos;
         my_pos.get(lua, io.generation, |t| {
-            fill_pose(t, p.pose.x, p.pose.y, Some(p.pose.theta), Some(p.quality))
+            keys.fill_pose(t, p.pose.x, p.pose.y, Some(p.pose.theta), Some(p.quality))
         })
     });
     let ball_vel = CycleTable::default();
+    let k = keys.clone();
     func!("getBallVel", io, |lua, (): ()| {
+        let keys = &k;
         let io = io.borrow();
         let v = io.world.ball_vel;
-        ball_vel.get(lua, io.generation, |t| fill_pose(t, v.x, v.y, None, None))
+        ball_vel.get(lua, io.generation, |t| keys.fill_pose(t, v.x, v.y, None, None))
     });
     let global_ball = CycleTable::default();
+    let k = keys.clone();
     func!("getGlobalBall", io, |lua, (): ()| {
+        let keys = &k;
         let io = io.borrow();
         let b = io.world.global_ball;
-        global_ball
-            .get(lua, io.generation, |t| fill_pose(t, b.pose.x, b.pose.y, None, Some(b.quality)))
+        global_ball.get(lua, io.generation, |t| {
+            keys.fill_pose(t, b.pose.x, b.pose.y, None, Some(b.quality))
+        })
     });
+    let k = keys.clone();
     func!("getMates", io, |lua, (): ()| {
+        let keys = &k;
         let t = lua.create_table_with_capacity(io.borrow().world.mates.len(), 0)?;
         for (k, m) in io.borrow().world.mates.iter().enumerate() {
-            let e = pose_table(
-                lua,
+            let e = lua.create_table_with_capacity(0, 5)?;
+            keys.fill_pose(
+                &e,
                 m.at.pose.x,
                 m.at.pose.y,
                 Some(m.at.pose.theta),

@@ -30,7 +30,7 @@
 use crate::chaos::RobotIo;
 use crate::runtime::LuaRuntime;
 use crate::script::{LoadStrategy, Script, ScriptError};
-use mlua::{Lua, MetaMethod, Table, Value, Variadic};
+use mlua::{Lua, LuaString, MetaMethod, Table, Value, Variadic};
 use mrt_core::robot::lps;
 use mrt_fuzzy::hbm::{Blender, ControlVariable, Defuzzification};
 use mrt_fuzzy::FuzzySet;
@@ -421,13 +421,15 @@ fn install(lua: &Lua, shared: &Rc<Shared>) -> mlua::Result<()> {
     let f = fire.clone();
     g.set(
         "rule",
-        lua.create_function(move |_, (d, var, label): (Value, String, String)| {
-            f(truth(&d, "rule")?, &var, &label)
+        lua.create_function(move |_, (d, var, label): (Value, LuaString, LuaString)| {
+            f(truth(&d, "rule")?, &var.to_str()?, &label.to_str()?)
         })?,
     )?;
     g.set(
         "always",
-        lua.create_function(move |_, (var, label): (String, String)| fire(1.0, &var, &label))?,
+        lua.create_function(move |_, (var, label): (LuaString, LuaString)| {
+            fire(1.0, &var.to_str()?, &label.to_str()?)
+        })?,
     )?;
 
     let s = shared.clone();
