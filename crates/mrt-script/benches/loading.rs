@@ -65,6 +65,24 @@ fn bench(c: &mut Criterion) {
     // Hot reload: from a changed file to the new version ready (read + compile + swap).
     let s = Script::from_file(&rt, &path, LoadStrategy::Compiled).unwrap();
     c.bench_function("hot_reload_300_lines", |b| b.iter(|| s.reload(&rt).unwrap()));
+    // What the control loop does when the watcher has compiled the file off the control path:
+    // load the bytecode and swap it in.
+    let compiled = {
+        let mut w = mrt_script::ScriptWatcher::new().unwrap();
+        w.watch(&path).unwrap();
+        std::fs::write(&path, behavior_300_lines()).unwrap();
+        let start = std::time::Instant::now();
+        loop {
+            if let Some(c) = w.changes().pop() {
+                break c.compiled.unwrap();
+            }
+            assert!(start.elapsed() < Duration::from_secs(5), "no change reported");
+            std::thread::sleep(Duration::from_millis(1));
+        }
+    };
+    c.bench_function("install_precompiled_300_lines", |b| {
+        b.iter(|| s.install(&rt, &compiled).unwrap())
+    });
     let _ = std::fs::remove_dir_all(&dir);
 }
 

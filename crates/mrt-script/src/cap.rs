@@ -133,18 +133,34 @@ impl ThinkingCap {
     /// Reloads every changed file now (what a watcher or a reload request on the bus does
     /// at the next cycle boundary). Returns what was reloaded and what was rejected.
     pub fn reload_changed(&mut self) -> (Vec<String>, Vec<ScriptError>) {
-        self.reload(&[])
+        let (done, errors) = self.hbm.reload_changed(&self.rt);
+        self.after_hbm_change();
+        self.reload_hfsm(&[], done, errors)
     }
 
-    /// Reloads what changed, and the files in `touched` (as a watcher reports them) whatever
-    /// their modification times say.
-    fn reload(&mut self, touched: &[PathBuf]) -> (Vec<String>, Vec<ScriptError>) {
-        let names: Vec<String> = touched
-            .iter()
-            .filter_map(|p| p.file_name()?.to_str()?.strip_suffix(".lua").map(str::to_string))
-            .collect();
-        let (mut done, mut errors) = self.hbm.reload(&self.rt, &names);
+    /// Applies what the watcher compiled off the control path (see [`Hbm::apply`]).
+    fn apply(&mut self, changes: Vec<crate::watch::Change>) -> (Vec<String>, Vec<ScriptError>) {
+        let touched: Vec<PathBuf> = changes.iter().map(|c| c.path.clone()).collect();
+        let machine = match &self.top {
+            Top::Hfsm(_, path) => Some(path.clone()),
+            Top::Behavior(_) => None,
+        };
+        let behaviors = changes.into_iter().filter(|c| Some(&c.path) != machine.as_ref()).collect();
+        let (done, errors) = self.hbm.apply(&self.rt, behaviors);
+        self.after_hbm_change();
+        self.reload_hfsm(&touched, done, errors)
+    }
+
+    fn after_hbm_change(&mut self) {
         self.io.borrow_mut().known_behaviors = Some(self.hbm.names().into_iter().collect());
+    }
+
+    fn reload_hfsm(
+        &mut self,
+        touched: &[PathBuf],
+        mut done: Vec<String>,
+        mut errors: Vec<ScriptError>,
+    ) -> (Vec<String>, Vec<ScriptError>) {
         if let Top::Hfsm(h, path) = &mut self.top {
             let attempt = if touched.contains(path) {
                 h.reload(&self.rt).map(|()| true)
@@ -163,9 +179,9 @@ impl ThinkingCap {
     /// Runs one cycle on `world`.
     pub fn cycle(&mut self, world: WorldSnapshot) -> Cycle {
         let (mut reloaded, mut errors) = (Vec::new(), Vec::new());
-        let touched = self.watcher.as_ref().map(ScriptWatcher::changed).unwrap_or_default();
-        if !touched.is_empty() {
-            (reloaded, errors) = self.reload(&touched);
+        let changes = self.watcher.as_ref().map(ScriptWatcher::changes).unwrap_or_default();
+        if !changes.is_empty() {
+            (reloaded, errors) = self.apply(changes);
         }
         self.io.borrow_mut().new_cycle(world);
         let mut taken = None;

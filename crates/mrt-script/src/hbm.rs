@@ -30,6 +30,7 @@
 use crate::chaos::RobotIo;
 use crate::runtime::LuaRuntime;
 use crate::script::{LoadStrategy, Script, ScriptError};
+use crate::watch::Change;
 use mlua::{Lua, LuaString, MetaMethod, Table, Value, Variadic};
 use mrt_core::robot::lps;
 use mrt_fuzzy::hbm::{Blender, ControlVariable, Defuzzification};
@@ -215,6 +216,41 @@ impl Hbm {
 
     fn file_of(&self, name: &str) -> String {
         self.dir.join(format!("{name}.lua")).display().to_string()
+    }
+
+    /// Applies changes reported by a [`ScriptWatcher`](crate::ScriptWatcher): a behavior
+    /// compiled off the control path is swapped in as bytecode; a file that did not compile is
+    /// reported and the running version kept; `hbm.lua` is re-run; a new file is loaded.
+    /// Returns the names swapped in and the errors.
+    pub fn apply(
+        &mut self,
+        rt: &LuaRuntime,
+        changes: Vec<Change>,
+    ) -> (Vec<String>, Vec<ScriptError>) {
+        let (mut done, mut errors) = (Vec::new(), Vec::new());
+        let mut others = Vec::new();
+        for c in changes {
+            let Some(name) =
+                c.path.file_name().and_then(|n| n.to_str()).and_then(|n| n.strip_suffix(".lua"))
+            else {
+                continue;
+            };
+            let behaviors = self.shared.behaviors.borrow();
+            match (behaviors.get(name), c.compiled) {
+                (Some(script), Ok(k)) => match script.install(rt, &k) {
+                    Ok(()) => done.push(name.to_string()),
+                    Err(e) => errors.push(e),
+                },
+                (Some(_), Err(e)) => errors.push(e),
+                (None, _) => others.push(name.to_string()),
+            }
+        }
+        if !others.is_empty() {
+            let (d, e) = self.reload(rt, &others);
+            done.extend(d);
+            errors.extend(e);
+        }
+        (done, errors)
     }
 
     /// Reloads what changed on disk: edited behaviors, new behavior files, and `hbm.lua`

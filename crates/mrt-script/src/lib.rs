@@ -46,4 +46,4 @@ mod watch;
 pub use cap::{Cycle, ThinkingCap};
 pub use runtime::{LuaRuntime, Sandbox};
 pub use script::{LoadStrategy, Script, ScriptError};
-pub use watch::ScriptWatcher;
+pub use watch::{Change, Compiled, ScriptWatcher};

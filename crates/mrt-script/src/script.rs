@@ -1,6 +1,7 @@
 //! A behavior script: loading strategies, calls with budgets, hot reload with fallback.
 
 use crate::runtime::{LuaRuntime, BUDGET_EXCEEDED};
+use crate::watch::Compiled;
 use mlua::chunk::ChunkMode;
 use mlua::{FromLuaMulti, Function};
 use std::cell::RefCell;
@@ -79,6 +80,17 @@ pub enum ScriptError {
 impl ScriptError {
     pub(crate) fn setup(e: mlua::Error) -> ScriptError {
         ScriptError::Setup(e.to_string())
+    }
+
+    /// A compile error: `Syntax` with Lua's line when it is one.
+    pub(crate) fn syntax(file: &str, e: &mlua::Error) -> ScriptError {
+        match e {
+            mlua::Error::SyntaxError { message, .. } => {
+                let (line, msg) = split_position(message);
+                ScriptError::Syntax { file: file.into(), line, message: msg }
+            }
+            other => ScriptError::Setup(format!("{file}: {other}")),
+        }
     }
 
     pub(crate) fn from_lua(file: &str, rt: &LuaRuntime, e: mlua::Error) -> ScriptError {
@@ -273,6 +285,28 @@ impl Script {
         let f = compile(rt, &self.name, source)?;
         *self.compiled.borrow_mut() = f;
         *self.source.borrow_mut() = source.to_string();
+        Ok(())
+    }
+
+    /// Swaps in a version compiled off the control path (by the [`ScriptWatcher`]'s thread).
+    /// Loading bytecode is much cheaper than compiling text; the source is kept for the
+    /// `Source` strategy. Lua globals are kept.
+    ///
+    /// [`ScriptWatcher`]: crate::ScriptWatcher
+    pub fn install(&self, rt: &LuaRuntime, compiled: &Compiled) -> Result<(), ScriptError> {
+        // Our own compiler's output, never a script's: binary chunks are allowed here only.
+        let f = rt
+            .lua
+            .load(&compiled.bytecode[..])
+            .set_name(format!("@{}", self.name))
+            .set_mode(ChunkMode::Binary)
+            .into_function()
+            .map_err(|e| ScriptError::from_lua(&self.name, rt, e))?;
+        *self.compiled.borrow_mut() = f;
+        self.source.borrow_mut().clone_from(&compiled.source);
+        if let Some(path) = &self.path {
+            *self.modified.borrow_mut() = mtime(path);
+        }
         Ok(())
     }
 

@@ -219,3 +219,48 @@ fn the_watcher_reports_edits_and_the_loop_swaps_them_in() {
     }
     assert!(rejected, "the bad edit was never seen");
 }
+
+/// Waits (at most 5 s) for the watcher's next reported change.
+fn next_change(w: &mrt_script::ScriptWatcher) -> mrt_script::Change {
+    for _ in 0..1000 {
+        if let Some(c) = w.changes().pop() {
+            return c;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(5));
+    }
+    panic!("no change reported in 5 s");
+}
+
+/// The watcher compiles an edited script on its own thread: the control loop receives
+/// bytecode (or the syntax error, with its line) and only swaps it in. Both saving styles
+/// count: writing in place and renaming a new file over the old one.
+#[test]
+fn edits_are_compiled_off_the_control_path() {
+    let path = temp("offpath", "return 1");
+    let rt = rt();
+    let s = Script::from_file(&rt, &path, LoadStrategy::Compiled).unwrap();
+    let mut w = mrt_script::ScriptWatcher::new().unwrap();
+    w.watch(&path).unwrap();
+    std::fs::write(&path, "return 2").unwrap(); // in place
+    let change = next_change(&w);
+    assert_eq!(change.name, path.display().to_string());
+    let compiled = change.compiled.unwrap();
+    assert!(compiled.bytecode.starts_with(b"\x1bLua"), "Lua bytecode");
+    assert_eq!(compiled.source, "return 2");
+    assert_eq!(s.call::<i64>(&rt).unwrap(), 1, "nothing changes before the swap");
+    s.install(&rt, &compiled).unwrap();
+    assert_eq!(s.call::<i64>(&rt).unwrap(), 2);
+    save(&path, "local x = 1\nreturn (x +"); // renamed over, broken on line 2
+    match next_change(&w).compiled {
+        Err(ScriptError::Syntax { file, line, .. }) => {
+            assert_eq!((file, line), (path.display().to_string(), 2));
+        }
+        other => panic!("{other:?}"),
+    }
+    assert_eq!(s.call::<i64>(&rt).unwrap(), 2, "the running version stays");
+    // Runtime errors of an installed version still name the file and line.
+    std::fs::write(&path, "local t = nil\nreturn t.x").unwrap();
+    s.install(&rt, &next_change(&w).compiled.unwrap()).unwrap();
+    let e = s.call::<i64>(&rt).unwrap_err();
+    assert!(e.to_string().starts_with(&format!("{}:2: runtime error", path.display())), "{e}");
+}
