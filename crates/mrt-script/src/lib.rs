@@ -30,8 +30,13 @@
 //! | Lua interpreter embedded in the robot | [`LuaRuntime`] |
 //! | a behavior script | [`Script`] |
 //! | loading strategies: file each call / source in memory / compiled in memory (§3.2) | [`LoadStrategy`] |
+//! | chaoslib, the robot API (§3.3) | [`chaos`] |
+//! | HBM behaviors: fuzzy rules, perceptual rules, meta-rules, CDB (§4.1) | [`hbm`] (on [`mrt_fuzzy::hbm`]) |
+//! | HFSM: states, meta-states, prioritized transitions (§5.1) | [`hfsm`] |
+//! | the high-level object running HFSM and HBM every 100 ms (§2.2, §3.2) | [`ThinkingCap`], [`member::BehaviorMember`] |
+//! | sending an edited behavior to the running robot (§3.1) | [`ScriptWatcher`] (compiles off the control path), [`member::ReloadRequest`] |
 //!
-//! The robot API `chaos.*` is in [`chaos`]; HFSMs and the fuzzy HBM/CDB behaviors come next.
+//! The user guide is `docs/behaviors.md`; the seed's behaviors ship in `behaviors/teamchaos/`.
 #![deny(missing_docs)]
 
 mod cap;
