@@ -2,10 +2,12 @@
 //! high-level HFSM chooses a low-level behavior (`chaos.setBehavior`), and the HBM runs it,
 //! giving the robot command. Scripts edited on disk are reloaded at the next cycle boundary.
 //!
-//! Bad input never stops the robot: an HFSM that fails (runtime error, endless loop, a
-//! `setBehavior` naming no behavior) keeps the last good behavior for the cycle; a behavior
-//! that fails gives the safe command (stand still) for the cycle; a file that no longer
-//! compiles keeps its running version. Every error is reported in [`Cycle::errors`].
+//! Bad input never stops the robot's software: an HFSM that raises an error (or whose
+//! `setBehavior` names no behavior) keeps the last good behavior for the cycle; an HFSM or a
+//! behavior that runs away (instruction budget, memory limit), and a behavior that raises an
+//! error, give the safe command (stand still) for the cycle; a file that no longer compiles
+//! keeps its running version. The next cycle runs normally. Every error is reported in
+//! [`Cycle::errors`].
 
 use crate::chaos::{self, RobotIo};
 use crate::hbm::Hbm;
@@ -188,12 +190,22 @@ impl ThinkingCap {
         let (chosen, path) = match &mut self.top {
             Top::Behavior(name) => (Some(name.clone()), String::new()),
             Top::Hfsm(h, _) => {
+                let mut runaway = false;
                 match h.step(&self.rt) {
                     Ok(t) => taken = t,
-                    Err(e) => errors.push(e),
+                    Err(e) => {
+                        runaway =
+                            matches!(e, ScriptError::Budget { .. } | ScriptError::Memory { .. });
+                        errors.push(e);
+                    }
                 }
                 let asked = self.io.borrow().command.behavior.clone();
-                (asked.or_else(|| self.last_good.clone()), h.path())
+                let chosen = if runaway { None } else { asked.or_else(|| self.last_good.clone()) };
+                if runaway {
+                    // A runaway machine gets the safe command for this cycle.
+                    self.io.borrow_mut().command = RobotCommand::default();
+                }
+                (chosen, h.path())
             }
         };
         let mut behavior = None;

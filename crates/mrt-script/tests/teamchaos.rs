@@ -12,7 +12,7 @@
 
 #![allow(clippy::unwrap_used)]
 
-use mrt_core::robot::{lps, Estimate, Lpo, WorldSnapshot};
+use mrt_core::robot::{lps, Estimate, GameState, Lpo, WorldSnapshot};
 use mrt_core::{Pose2, Time};
 use mrt_script::{Cycle, Sandbox, ScriptError, ThinkingCap};
 use std::path::{Path, PathBuf};
@@ -584,4 +584,34 @@ fn the_heap_stays_small_over_many_cycles() {
         peak = peak.max(cap.runtime().used_memory());
     }
     assert!(peak < 256 << 10, "peak Lua heap {peak} bytes");
+}
+
+/// An HFSM that runs away (an endless loop in a state) gets the safe command for that cycle
+/// (stand still, no kick) and a budget error; the next cycle runs normally.
+#[test]
+fn a_runaway_hfsm_gets_the_safe_command_for_that_cycle() {
+    let scratch = std::env::temp_dir().join(format!("mrt-runaway-hfsm-{}", std::process::id()));
+    std::fs::create_dir_all(&scratch).unwrap();
+    for f in ["hbm.lua", "go2ball.lua"] {
+        std::fs::copy(dir().join(f), scratch.join(f)).unwrap();
+    }
+    let machine = scratch.join("spin.hfsm.lua");
+    std::fs::write(
+        &machine,
+        "machine \"M\" { initial = \"Walk\", states = { Walk = function()\n  chaos.setBehavior(\"go2ball\")\n  if chaos.getCurrentState() == \"FINISHED\" then while true do end end\nend } }\n",
+    )
+    .unwrap();
+    let sandbox = Sandbox { instruction_budget: 200_000, ..Sandbox::default() };
+    let mut cap = ThinkingCap::with_hfsm(&scratch, &machine, sandbox).unwrap();
+    let mut w = WorldSnapshot { game_state: GameState::Playing, ..Default::default() };
+    w.lps[lps::BALL] = Lpo { rho: 2000.0, theta: 0.0, reliability: 0.9, seen_ago: 0.0 };
+    let walking = cap.cycle(w.clone());
+    assert!(walking.errors.is_empty() && walking.command.vlin > 200.0, "{walking:?}");
+    let stuck = cap.cycle(WorldSnapshot { game_state: GameState::Finished, ..w.clone() });
+    assert!(matches!(stuck.errors.first(), Some(ScriptError::Budget { .. })), "{:?}", stuck.errors);
+    assert_eq!((stuck.command.vlin, stuck.command.vrot, stuck.command.kick), (0.0, 0.0, None));
+    assert_eq!(stuck.behavior, None);
+    let again = cap.cycle(w);
+    assert!(again.errors.is_empty() && again.command.vlin > 200.0, "{again:?}");
+    std::fs::remove_dir_all(&scratch).unwrap();
 }
