@@ -129,8 +129,8 @@ fn invalid(file: &str, line: usize, message: String) -> ScriptError {
     ScriptError::Invalid { file: file.to_string(), line, message }
 }
 
-/// A raw `machine "Name" { ... }` call: name, table, line of the call.
-type RawMachine = (String, Table, usize);
+/// A raw `machine "Name" { ... }` call: name, table, line of the call, file it is in.
+type RawMachine = (String, Table, usize, String);
 
 impl Hfsm {
     /// Loads a machine file. The runtime must have `chaos` installed on `io`.
@@ -482,13 +482,16 @@ end
 fn build(rt: &LuaRuntime, file: &str, source: &str) -> Result<(Vec<Machine>, usize), ScriptError> {
     let lua = &rt.lua;
     let raw: Rc<RefCell<Vec<RawMachine>>> = Rc::new(RefCell::new(Vec::new()));
+    // The file whose chunk is running (the main file, or an included one).
+    let current = Rc::new(RefCell::new(file.to_string()));
     let collector = raw.clone();
+    let cur = current.clone();
     let machine = lua
         .create_function(move |lua, name: String| {
             let line = lua.inspect_stack(1, |d| d.current_line()).flatten().unwrap_or(0);
-            let collector = collector.clone();
+            let (collector, at) = (collector.clone(), cur.borrow().clone());
             lua.create_function(move |_, body: Table| {
-                collector.borrow_mut().push((name.clone(), body, line));
+                collector.borrow_mut().push((name.clone(), body, line, at.clone()));
                 Ok(())
             })
         })
@@ -500,9 +503,37 @@ fn build(rt: &LuaRuntime, file: &str, source: &str) -> Result<(Vec<Machine>, usi
             Ok(t)
         })
         .map_err(ScriptError::setup)?;
+    // `include "other.hfsm.lua"`: machines of another file of the same directory, so that a
+    // machine is reused across files without copying. Each file once; plain names only.
+    let dir = Path::new(file).parent().map(Path::to_path_buf);
+    let included = Rc::new(RefCell::new(vec![file.to_string()]));
+    let cur = current.clone();
+    let include = lua
+        .create_function(move |lua, name: String| {
+            let plain = !name.contains(['/', '\\']) && name != ".." && name.ends_with(".hfsm.lua");
+            let Some(dir) = dir.as_ref().filter(|_| plain) else {
+                return Err(mlua::Error::runtime(format!(
+                    "include \"{name}\": give the plain name of a .hfsm.lua file in the same directory"
+                )));
+            };
+            let path = dir.join(&name);
+            let shown = path.display().to_string();
+            if included.borrow().contains(&shown) {
+                return Ok(());
+            }
+            included.borrow_mut().push(shown.clone());
+            let text = std::fs::read_to_string(&path)
+                .map_err(|e| mlua::Error::runtime(format!("include \"{name}\": {e}")))?;
+            let outer = std::mem::replace(&mut *cur.borrow_mut(), shown.clone());
+            let result = lua.load(text).set_name(format!("@{shown}")).set_mode(ChunkMode::Text).exec();
+            *cur.borrow_mut() = outer;
+            result
+        })
+        .map_err(ScriptError::setup)?;
     let g = lua.globals();
     g.set("machine", machine).map_err(ScriptError::setup)?;
     g.set("meta", meta).map_err(ScriptError::setup)?;
+    g.set("include", include).map_err(ScriptError::setup)?;
     rt.reset_budget();
     lua.load(source)
         .set_name(format!("@{file}"))
@@ -518,17 +549,17 @@ fn build(rt: &LuaRuntime, file: &str, source: &str) -> Result<(Vec<Machine>, usi
         ));
     }
     let mut index = HashMap::new();
-    for (i, (name, _, line)) in raw.iter().enumerate() {
+    for (i, (name, _, line, at)) in raw.iter().enumerate() {
         if index.insert(name.clone(), i).is_some() {
-            return Err(invalid(file, *line, format!("machine '{name}' is defined twice")));
+            return Err(invalid(at, *line, format!("machine '{name}' is defined twice")));
         }
     }
-    let e =
-        |line: usize, m: &str, msg: String| invalid(file, line, format!("machine '{m}': {msg}"));
     let make_dispatch: Function =
         lua.load(DISPATCH).set_name("=hfsm dispatch").eval().map_err(ScriptError::setup)?;
     let mut machines = Vec::with_capacity(raw.len());
-    for (name, body, line) in &raw {
+    for (name, body, line, at) in &raw {
+        let e =
+            |line: usize, m: &str, msg: String| invalid(at, line, format!("machine '{m}': {msg}"));
         let (name, line) = (name.as_str(), *line);
         let lua_err = |err: mlua::Error| e(line, name, err.to_string());
         let states_t: Table = body
@@ -632,7 +663,7 @@ fn build(rt: &LuaRuntime, file: &str, source: &str) -> Result<(Vec<Machine>, usi
         }
         machines.push(Machine { name: name.to_string(), initial, states, transitions, dispatch });
     }
-    check_containment(file, &machines, &raw)?;
+    check_containment(&machines, &raw)?;
     let used: Vec<usize> = machines
         .iter()
         .flat_map(|m| m.states.iter())
@@ -674,11 +705,7 @@ fn state(name: &str, v: Value, index: &HashMap<String, usize>) -> Result<State, 
 
 /// Refuses a machine that contains itself, directly or through other machines, naming the
 /// chain (`Score -> Approach -> Score`).
-fn check_containment(
-    file: &str,
-    machines: &[Machine],
-    raw: &[RawMachine],
-) -> Result<(), ScriptError> {
+fn check_containment(machines: &[Machine], raw: &[RawMachine]) -> Result<(), ScriptError> {
     fn visit(
         m: usize,
         machines: &[Machine],
@@ -711,7 +738,7 @@ fn check_containment(
             let names: Vec<&str> = chain.iter().map(|&i| machines[i].name.as_str()).collect();
             let first = chain[0];
             return Err(invalid(
-                file,
+                &raw[first].3,
                 raw[first].2,
                 format!(
                     "meta-state machine '{}' contains itself: {}",

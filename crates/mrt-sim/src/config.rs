@@ -1,0 +1,357 @@
+//! The simulator's configuration: field, ball, robots and match rules, read from TOML. Every
+//! field has a documented default (Middle Size League proportions, the MRT manual's IANUS3
+//! base), so a file only needs what it changes; `configs/sim/default.toml` lists them all.
+//!
+//! Units: metres, seconds, kilograms, radians.
+
+use serde::{Deserialize, Serialize};
+use std::path::Path;
+
+/// The field (Middle Size League proportions).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct FieldConfig {
+    /// Length between the goal lines.
+    pub length: f64,
+    /// Width between the side lines.
+    pub width: f64,
+    /// Free space between the lines and the surrounding walls.
+    pub border: f64,
+    /// Inner width of a goal.
+    pub goal_width: f64,
+    /// Depth of a goal behind its line.
+    pub goal_depth: f64,
+    /// Radius of the centre circle.
+    pub centre_circle_radius: f64,
+    /// Depth of the penalty area from the goal line.
+    pub penalty_area_depth: f64,
+    /// Width of the penalty area.
+    pub penalty_area_width: f64,
+}
+
+impl Default for FieldConfig {
+    fn default() -> Self {
+        Self {
+            length: 18.0,
+            width: 12.0,
+            border: 1.0,
+            goal_width: 2.0,
+            goal_depth: 0.6,
+            centre_circle_radius: 2.0,
+            penalty_area_depth: 2.25,
+            penalty_area_width: 6.5,
+        }
+    }
+}
+
+/// The ball (FIFA size 5).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct BallConfig {
+    /// Radius.
+    pub radius: f64,
+    /// Mass.
+    pub mass: f64,
+    /// Bounce off walls and robots, 0 to 1.
+    pub restitution: f64,
+    /// Rolling friction as linear damping (1/s): a free ball loses this fraction of its speed
+    /// per second, roughly.
+    pub rolling_damping: f64,
+}
+
+impl Default for BallConfig {
+    fn default() -> Self {
+        Self { radius: 0.11, mass: 0.43, restitution: 0.6, rolling_damping: 0.4 }
+    }
+}
+
+/// A robot base (defaults: the MRT manual's IANUS3, differential drive up to 1.2 m/s, with a
+/// pneumatic kicker).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct RobotConfig {
+    /// Radius of the round footprint.
+    pub radius: f64,
+    /// Mass.
+    pub mass: f64,
+    /// Top linear speed.
+    pub max_speed: f64,
+    /// Top acceleration.
+    pub max_accel: f64,
+    /// Top turning rate.
+    pub max_turn_rate: f64,
+    /// Speed given to the ball by a kick.
+    pub kick_speed: f64,
+    /// How far in front of the robot's edge the ball may be for a kick to reach it.
+    pub kick_reach: f64,
+    /// Half-width of the kicker's cone, radians.
+    pub kick_half_angle: f64,
+    /// Time between two kicks (the tank recharges).
+    pub kick_recharge: f64,
+}
+
+impl Default for RobotConfig {
+    fn default() -> Self {
+        Self {
+            radius: 0.25,
+            mass: 30.0,
+            max_speed: 1.2,
+            max_accel: 2.0,
+            max_turn_rate: 4.0,
+            kick_speed: 6.0,
+            kick_reach: 0.12,
+            kick_half_angle: 0.5,
+            kick_recharge: 1.0,
+        }
+    }
+}
+
+/// The rules and the clock.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct MatchConfig {
+    /// Length of a half.
+    pub half_duration: f64,
+    /// Robots per team (a goalkeeper and field players).
+    pub team_size: usize,
+    /// Physics step.
+    pub physics_step: f64,
+    /// Period of the robots' control cycle (the behaviors' 100 ms).
+    pub control_period: f64,
+    /// Time in SET before play starts after a kickoff.
+    pub set_duration: f64,
+    /// A ball that moved less than `stuck_distance` for this long is dropped elsewhere.
+    pub stuck_time: f64,
+    /// See `stuck_time`.
+    pub stuck_distance: f64,
+}
+
+impl Default for MatchConfig {
+    fn default() -> Self {
+        Self {
+            half_duration: 300.0,
+            team_size: 4,
+            physics_step: 0.01,
+            control_period: 0.1,
+            set_duration: 1.0,
+            stuck_time: 10.0,
+            stuck_distance: 0.2,
+        }
+    }
+}
+
+/// The object sensor: what a camera would detect.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct SensorConfig {
+    /// Half of the field of view, radians (π: omnidirectional vision, as on the MSL robots).
+    pub half_fov: f64,
+    /// Farthest distance at which an object is detected.
+    pub range: f64,
+    /// Standard deviation of the distance error, as a fraction of the distance.
+    pub distance_noise: f64,
+    /// Standard deviation of the bearing error, radians.
+    pub bearing_noise: f64,
+    /// Probability of missing a visible object in one frame.
+    pub miss_probability: f64,
+}
+
+impl Default for SensorConfig {
+    fn default() -> Self {
+        Self {
+            half_fov: std::f64::consts::PI,
+            range: 9.0,
+            distance_noise: 0.03,
+            bearing_noise: 0.02,
+            miss_probability: 0.05,
+        }
+    }
+}
+
+/// The whole configuration.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct SimConfig {
+    /// The field.
+    pub field: FieldConfig,
+    /// The ball.
+    pub ball: BallConfig,
+    /// The robots (both teams).
+    pub robot: RobotConfig,
+    /// The rules.
+    pub rules: MatchConfig,
+    /// The object sensor.
+    pub sensor: SensorConfig,
+}
+
+/// A configuration that cannot be used.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum ConfigError {
+    /// The file could not be read.
+    #[error("{file}: {source}")]
+    Io {
+        /// The file.
+        file: String,
+        /// The OS error.
+        #[source]
+        source: std::io::Error,
+    },
+    /// The TOML is malformed or names an unknown field.
+    #[error("{file}:{line}:{column}: {message}")]
+    Parse {
+        /// The file.
+        file: String,
+        /// Line, from 1.
+        line: usize,
+        /// Column, from 1.
+        column: usize,
+        /// What is wrong.
+        message: String,
+    },
+    /// A value is out of its range.
+    #[error("{file}: {message}")]
+    Invalid {
+        /// The file.
+        file: String,
+        /// What is wrong.
+        message: String,
+    },
+}
+
+impl SimConfig {
+    /// Parses a configuration; `file` names it in errors.
+    pub fn from_toml(text: &str, file: &str) -> Result<SimConfig, ConfigError> {
+        let cfg: SimConfig = toml::from_str(text).map_err(|e| {
+            let (line, column) = e.span().map_or((1, 1), |s| line_column(text, s.start));
+            ConfigError::Parse {
+                file: file.to_string(),
+                line,
+                column,
+                message: e.message().to_string(),
+            }
+        })?;
+        cfg.validate()
+            .map_err(|message| ConfigError::Invalid { file: file.to_string(), message })?;
+        Ok(cfg)
+    }
+
+    /// Reads a configuration file.
+    pub fn from_file(path: impl AsRef<Path>) -> Result<SimConfig, ConfigError> {
+        let path = path.as_ref();
+        let file = path.display().to_string();
+        let text = std::fs::read_to_string(path)
+            .map_err(|source| ConfigError::Io { file: file.clone(), source })?;
+        SimConfig::from_toml(&text, &file)
+    }
+
+    /// Checks that every value makes sense.
+    pub fn validate(&self) -> Result<(), String> {
+        let positive = [
+            ("field.length", self.field.length),
+            ("field.width", self.field.width),
+            ("field.goal_width", self.field.goal_width),
+            ("field.goal_depth", self.field.goal_depth),
+            ("ball.radius", self.ball.radius),
+            ("ball.mass", self.ball.mass),
+            ("robot.radius", self.robot.radius),
+            ("robot.mass", self.robot.mass),
+            ("robot.max_speed", self.robot.max_speed),
+            ("robot.max_accel", self.robot.max_accel),
+            ("robot.max_turn_rate", self.robot.max_turn_rate),
+            ("rules.half_duration", self.rules.half_duration),
+            ("rules.physics_step", self.rules.physics_step),
+            ("rules.control_period", self.rules.control_period),
+            ("sensor.range", self.sensor.range),
+        ];
+        for (name, v) in positive {
+            if !(v.is_finite() && v > 0.0) {
+                return Err(format!("{name} must be a positive number, not {v}"));
+            }
+        }
+        let non_negative = [
+            ("field.border", self.field.border),
+            ("ball.rolling_damping", self.ball.rolling_damping),
+            ("robot.kick_speed", self.robot.kick_speed),
+            ("robot.kick_recharge", self.robot.kick_recharge),
+            ("rules.set_duration", self.rules.set_duration),
+            ("sensor.distance_noise", self.sensor.distance_noise),
+            ("sensor.bearing_noise", self.sensor.bearing_noise),
+        ];
+        for (name, v) in non_negative {
+            if !(v.is_finite() && v >= 0.0) {
+                return Err(format!("{name} must be zero or more, not {v}"));
+            }
+        }
+        let unit = [
+            ("ball.restitution", self.ball.restitution),
+            ("sensor.miss_probability", self.sensor.miss_probability),
+        ];
+        for (name, v) in unit {
+            if !(0.0..=1.0).contains(&v) {
+                return Err(format!("{name} must be between 0 and 1, not {v}"));
+            }
+        }
+        if self.field.goal_width >= self.field.width {
+            return Err("field.goal_width must be smaller than field.width".into());
+        }
+        if !(1..=11).contains(&self.rules.team_size) {
+            return Err(format!("rules.team_size must be 1 to 11, not {}", self.rules.team_size));
+        }
+        if self.rules.control_period < self.rules.physics_step {
+            return Err("rules.control_period must be at least rules.physics_step".into());
+        }
+        Ok(())
+    }
+}
+
+/// Line and column (from 1) of a byte offset.
+fn line_column(text: &str, offset: usize) -> (usize, usize) {
+    let before = &text[..offset.min(text.len())];
+    let line = before.matches('\n').count() + 1;
+    let column = before.rsplit('\n').next().map_or(0, |l| l.chars().count()) + 1;
+    (line, column)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn an_empty_file_gives_the_documented_defaults() {
+        let cfg = SimConfig::from_toml("", "empty.toml").unwrap();
+        assert_eq!(cfg, SimConfig::default());
+        assert_eq!((cfg.field.length, cfg.field.width, cfg.robot.max_speed), (18.0, 12.0, 1.2));
+    }
+
+    #[test]
+    fn a_partial_file_changes_only_what_it_names() {
+        let cfg = SimConfig::from_toml("[rules]\nteam_size = 2\n", "two.toml").unwrap();
+        assert_eq!(cfg.rules.team_size, 2);
+        assert_eq!(cfg.rules.half_duration, 300.0);
+    }
+
+    #[test]
+    fn errors_name_file_line_and_column() {
+        let e = SimConfig::from_toml("[field]\nlength = 18.0\nwidht = 12.0\n", "typo.toml")
+            .unwrap_err();
+        let text = e.to_string();
+        assert!(text.starts_with("typo.toml:3:1: ") && text.contains("widht"), "{text}");
+        let e = SimConfig::from_toml("[ball]\nradius = -1\n", "neg.toml").unwrap_err();
+        assert!(e.to_string().contains("ball.radius must be a positive number"), "{e}");
+        let e = SimConfig::from_toml("[rules]\nteam_size = 0\n", "zero.toml").unwrap_err();
+        assert!(e.to_string().contains("team_size"), "{e}");
+    }
+
+    proptest::proptest! {
+        #[test]
+        fn random_text_never_panics(text in "\\PC{0,200}") {
+            let _ = SimConfig::from_toml(&text, "random.toml");
+        }
+
+        #[test]
+        fn random_bytes_never_panic(bytes in proptest::collection::vec(proptest::prelude::any::<u8>(), 0..300)) {
+            let _ = SimConfig::from_toml(&String::from_utf8_lossy(&bytes), "random.toml");
+        }
+    }
+}

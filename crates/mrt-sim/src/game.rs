@@ -1,0 +1,392 @@
+//! A match: the world, the referee, and one [`Brain`] per robot, stepped in lockstep on
+//! simulated time so that the same seed gives the same match.
+//!
+//! Every control period (100 ms by default) each robot looks through its object sensor, its
+//! brain turns the [`WorldSnapshot`] into a [`RobotCommand`], and the command drives the robot
+//! (mm/s and deg/s in the command, as the behaviors write them); then the physics runs until the
+//! next control period, with the referee watching every step.
+
+use crate::config::SimConfig;
+use crate::referee::{Call, Referee, Team};
+use crate::sensor::Perception;
+use crate::world::{Drive, World};
+use mrt_core::robot::{lps, GameState, RobotCommand, WorldSnapshot};
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
+
+/// What drives one robot: a behavior stack (Lua HFSM and HBM, Mr. BRIAN, ...).
+pub trait Brain {
+    /// One control cycle.
+    fn cycle(&mut self, world: &WorldSnapshot) -> RobotCommand;
+}
+
+/// Per-team statistics.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct TeamStats {
+    /// Goals scored.
+    pub goals: u32,
+    /// Kicks that reached the ball.
+    pub shots: u32,
+    /// Control cycles in which this team had the robot closest to the ball (within 1 m).
+    pub possession_cycles: u64,
+}
+
+/// One control cycle's positions, for drawings: ball, then every robot (m).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Frame {
+    /// Simulated time, s.
+    pub time: f64,
+    /// Ball position.
+    pub ball: (f64, f64),
+    /// Robot poses `(x, y, heading)`.
+    pub robots: Vec<(f64, f64, f64)>,
+}
+
+/// How a match ended.
+#[derive(Clone, Debug)]
+pub struct MatchReport {
+    /// The seed.
+    pub seed: u64,
+    /// Goals of (home, away).
+    pub score: (u32, u32),
+    /// Statistics of (home, away).
+    pub stats: [TeamStats; 2],
+    /// FNV-1a hash of every control cycle's positions (mm): equal hashes, equal matches.
+    pub trajectory_hash: u64,
+    /// Simulated seconds.
+    pub duration: f64,
+    /// What the referee decided, with the time.
+    pub calls: Vec<(f64, Call)>,
+    /// Kicks that reached the ball: time, robot, where.
+    pub shots: Vec<(f64, usize, (f64, f64))>,
+    /// Positions, one frame per control cycle (empty unless recorded).
+    pub frames: Vec<Frame>,
+}
+
+/// A match in progress.
+pub struct Match {
+    cfg: SimConfig,
+    seed: u64,
+    world: World,
+    referee: Referee,
+    brains: Vec<Box<dyn Brain>>,
+    eyes: Vec<Perception>,
+    rngs: Vec<ChaCha8Rng>,
+    stats: [TeamStats; 2],
+    hash: u64,
+    calls: Vec<(f64, Call)>,
+    shots: Vec<(f64, usize, (f64, f64))>,
+    frames: Vec<Frame>,
+    record: bool,
+}
+
+const FNV_OFFSET: u64 = 0xcbf2_9ce4_8422_2325;
+const FNV_PRIME: u64 = 0x0000_0100_0000_01b3;
+
+fn fnv(hash: u64, value: i64) -> u64 {
+    value.to_le_bytes().iter().fold(hash, |h, b| (h ^ u64::from(*b)).wrapping_mul(FNV_PRIME))
+}
+
+/// Millimetres, for hashing.
+fn mm(x: f64) -> i64 {
+    (x * 1000.0).round() as i64
+}
+
+impl Match {
+    /// A match between `home` and `away` (each `cfg.rules.team_size` brains; the first is
+    /// the goalkeeper; an empty `away` leaves home alone on the field), with all randomness
+    /// drawn from `seed`.
+    pub fn new(
+        cfg: &SimConfig,
+        seed: u64,
+        home: Vec<Box<dyn Brain>>,
+        away: Vec<Box<dyn Brain>>,
+    ) -> Result<Match, String> {
+        let n = cfg.rules.team_size;
+        if home.len() != n || (away.len() != n && !away.is_empty()) {
+            return Err(format!(
+                "each team needs {n} brains (home has {}, away {}; an empty away team plays \
+                 alone on the field)",
+                home.len(),
+                away.len()
+            ));
+        }
+        cfg.validate()?;
+        let robots = home.len() + away.len();
+        let mut world = World::new(cfg, robots);
+        let mut referee = Referee::new(n);
+        referee.start(&mut world);
+        let brains: Vec<Box<dyn Brain>> = home.into_iter().chain(away).collect();
+        let eyes = (0..robots).map(Perception::new).collect();
+        let rngs = (0..robots as u64)
+            .map(|i| {
+                ChaCha8Rng::seed_from_u64(seed.wrapping_mul(0x9E37_79B9_7F4A_7C15).wrapping_add(i))
+            })
+            .collect();
+        Ok(Match {
+            cfg: cfg.clone(),
+            seed,
+            world,
+            referee,
+            brains,
+            eyes,
+            rngs,
+            stats: Default::default(),
+            hash: FNV_OFFSET,
+            calls: Vec::new(),
+            shots: Vec::new(),
+            frames: Vec::new(),
+            record: false,
+        })
+    }
+
+    /// Keeps one [`Frame`] per control cycle for drawings.
+    pub fn record_frames(&mut self, on: bool) {
+        self.record = on;
+    }
+
+    /// The world.
+    pub fn world(&self) -> &World {
+        &self.world
+    }
+
+    /// The referee.
+    pub fn referee(&self) -> &Referee {
+        &self.referee
+    }
+
+    /// Whether the match is over.
+    pub fn finished(&self) -> bool {
+        self.referee.state() == GameState::Finished
+    }
+
+    /// Total simulated time of the match, s.
+    pub fn length(&self) -> f64 {
+        2.0 * self.cfg.rules.half_duration
+    }
+
+    /// Runs one control cycle and the physics up to the next one. Returns the referee's calls.
+    pub fn cycle(&mut self) -> Vec<Call> {
+        let playing = self.referee.state() == GameState::Playing;
+        let now = self.world.time();
+        for i in 0..self.brains.len() {
+            let snapshot =
+                self.eyes[i].look(&self.world, &self.referee, &self.cfg.sensor, &mut self.rngs[i]);
+            let cmd = self.brains[i].cycle(&snapshot);
+            if !playing {
+                self.world.drive(i, Drive::default());
+                continue;
+            }
+            self.world.drive(
+                i,
+                Drive {
+                    forward: cmd.vlin / 1000.0,
+                    left: cmd.vlat / 1000.0,
+                    turn: cmd.vrot.to_radians(),
+                },
+            );
+            if cmd.kick.is_some() && self.world.kick(i) {
+                let team = self.referee.team_of(i);
+                self.stats[team.index()].shots += 1;
+                self.shots.push((now, i, self.world.ball()));
+            }
+        }
+        self.account();
+        let steps =
+            (self.cfg.rules.control_period / self.cfg.rules.physics_step).round().max(1.0) as usize;
+        let mut calls = Vec::new();
+        for _ in 0..steps {
+            self.world.step();
+            if let Some(call) = self.referee.update(&mut self.world) {
+                if let Call::Goal(team) = call {
+                    self.stats[team.index()].goals += 1;
+                }
+                self.calls.push((self.world.time(), call.clone()));
+                calls.push(call);
+                if self.finished() {
+                    break;
+                }
+            }
+        }
+        calls
+    }
+
+    /// Possession, the trajectory hash and the recorded frame of this cycle.
+    fn account(&mut self) {
+        let ball = self.world.ball();
+        let mut best: Option<(f64, Team)> = None;
+        let mut robots = Vec::with_capacity(self.world.robot_count());
+        self.hash = fnv(fnv(self.hash, mm(ball.0)), mm(ball.1));
+        for i in 0..self.world.robot_count() {
+            let Some(p) = self.world.robot(i) else { continue };
+            self.hash = fnv(fnv(fnv(self.hash, mm(p.x)), mm(p.y)), mm(p.theta));
+            let d = (p.x - ball.0).hypot(p.y - ball.1);
+            if d < 1.0 && best.is_none_or(|(b, _)| d < b) {
+                best = Some((d, self.referee.team_of(i)));
+            }
+            robots.push((p.x, p.y, p.theta));
+        }
+        if let Some((_, team)) = best {
+            self.stats[team.index()].possession_cycles += 1;
+        }
+        if self.record {
+            self.frames.push(Frame { time: self.world.time(), ball, robots });
+        }
+    }
+
+    /// Plays until the end (or until `max_seconds` of simulated time), calling `progress` with
+    /// the simulated time after each control cycle.
+    pub fn play(mut self, max_seconds: f64, mut progress: impl FnMut(f64)) -> MatchReport {
+        while !self.finished() && self.world.time() < max_seconds {
+            self.cycle();
+            progress(self.world.time());
+        }
+        let score = self.referee.score();
+        MatchReport {
+            seed: self.seed,
+            score,
+            stats: self.stats,
+            trajectory_hash: self.hash,
+            duration: self.world.time(),
+            calls: self.calls,
+            shots: self.shots,
+            frames: self.frames,
+        }
+    }
+}
+
+/// A simple hand-written player, the baseline: it goes round to a point behind the ball on
+/// the line from the opponent's net, then drives through the ball and kicks when it is lined
+/// up with the net. The goalkeeper (`keeper`) stays on its goal line in front of the ball.
+#[derive(Clone, Debug, Default)]
+pub struct Chaser {
+    /// Plays as goalkeeper.
+    pub keeper: bool,
+}
+
+impl Chaser {
+    /// Velocities towards a target point `(tx, ty)` (team frame, mm), facing `face` (rad).
+    fn go(me: mrt_core::Pose2, (tx, ty): (f64, f64), face: f64, c: &mut RobotCommand) {
+        let (dx, dy) = (tx - me.x, ty - me.y);
+        let err = mrt_core::normalize_angle(face - me.theta);
+        c.vrot = (err.to_degrees() * 3.0).clamp(-200.0, 200.0);
+        // Move in the robot frame (holonomic base): forward and sideways components.
+        let (s, co) = (me.theta.sin(), me.theta.cos());
+        let (fw, left) = (dx * co + dy * s, -dx * s + dy * co);
+        let d = dx.hypot(dy).max(1.0);
+        let speed = (d * 2.0).min(1200.0);
+        c.vlin = fw / d * speed;
+        c.vlat = left / d * speed;
+    }
+}
+
+impl Brain for Chaser {
+    fn cycle(&mut self, w: &WorldSnapshot) -> RobotCommand {
+        let mut c = RobotCommand::default();
+        let ball = w.lps[lps::BALL];
+        c.needs.push((lps::BALL, 1.0));
+        if ball.reliability < 0.2 {
+            c.vrot = 60.0; // look around
+            return c;
+        }
+        let me = w.my_pos.pose;
+        // Ball in the team frame (mm); x towards the opponent's net at (9000, 0).
+        let a = me.theta + ball.theta;
+        let (bx, by) = (me.x + ball.rho * a.cos(), me.y + ball.rho * a.sin());
+        if self.keeper {
+            let target = (-8700.0, by.clamp(-900.0, 900.0));
+            Chaser::go(me, target, a, &mut c);
+        } else {
+            let (gx, gy) = (9000.0 - bx, -by);
+            let g = gx.hypot(gy).max(1.0);
+            let (ux, uy) = (gx / g, gy / g);
+            let shot = uy.atan2(ux);
+            // Lined up: behind the ball, looking at the net.
+            let (rx, ry) = (bx - me.x, by - me.y);
+            let along = (rx * ux + ry * uy) / rx.hypot(ry).max(1.0);
+            let lined_up = along > 0.9 && ball.rho < 1500.0;
+            if lined_up {
+                Chaser::go(me, (bx + 200.0 * ux, by + 200.0 * uy), shot, &mut c);
+                if ball.rho < 450.0
+                    && ball.theta.abs() < 0.3
+                    && mrt_core::normalize_angle(me.theta - shot).abs() < 0.35
+                {
+                    c.kick = Some(1);
+                }
+            } else {
+                // Go round: to a point behind the ball, stepping aside first when in front.
+                let (mut px, mut py) = (bx - 500.0 * ux, by - 500.0 * uy);
+                if along < 0.0 {
+                    let side = if (me.x - bx) * uy - (me.y - by) * ux > 0.0 { 1.0 } else { -1.0 };
+                    px += side * 600.0 * uy;
+                    py -= side * 600.0 * ux;
+                }
+                Chaser::go(me, (px, py), a, &mut c);
+            }
+        }
+        c
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn chasers(n: usize) -> Vec<Box<dyn Brain>> {
+        (0..n).map(|i| Box::new(Chaser { keeper: i == 0 }) as Box<dyn Brain>).collect()
+    }
+
+    fn short(minutes: f64, team: usize) -> SimConfig {
+        let mut cfg = SimConfig::default();
+        cfg.rules.half_duration = minutes * 60.0;
+        cfg.rules.team_size = team;
+        cfg
+    }
+
+    #[test]
+    fn a_match_with_the_same_seed_is_the_same_match() {
+        let cfg = short(0.5, 2);
+        let play =
+            |seed| Match::new(&cfg, seed, chasers(2), chasers(2)).unwrap().play(f64::MAX, |_| {});
+        let (a, b, c) = (play(7), play(7), play(8));
+        assert_eq!((a.score, a.trajectory_hash), (b.score, b.trajectory_hash));
+        assert_ne!(a.trajectory_hash, c.trajectory_hash, "another seed, another match");
+        assert!((a.duration - 60.0).abs() < 0.011, "two halves of 30 s: {}", a.duration);
+        assert!(a.calls.iter().any(|(_, c)| *c == Call::HalfTime));
+    }
+
+    #[test]
+    fn a_chaser_alone_scores_within_two_minutes() {
+        let cfg = short(2.0, 1);
+        let m = Match::new(
+            &cfg,
+            1,
+            vec![Box::new(Chaser { keeper: false })],
+            vec![Box::new(Chaser { keeper: true })],
+        )
+        .unwrap();
+        // The away keeper stands still as a test dummy only if it cannot see; here it defends.
+        let report = m.play(120.0, |_| {});
+        assert!(report.stats[0].shots > 0, "{:?}", report.stats);
+        assert!(
+            report.score.0 >= 1,
+            "home scored within two minutes: {:?} {:?}",
+            report.score,
+            report.calls
+        );
+    }
+
+    #[test]
+    fn the_chaos_team_alone_scores_within_two_minutes() {
+        let cfg = short(2.0, 2);
+        let home = crate::teams::team(crate::teams::Stack::Chaos, 2, None).unwrap();
+        let report = Match::new(&cfg, 3, home, Vec::new()).unwrap().play(120.0, |_| {});
+        assert!(report.score.0 >= 1, "{:?} {:?} {:?}", report.score, report.stats, report.calls);
+    }
+
+    #[test]
+    fn wrong_team_sizes_are_refused() {
+        let cfg = short(1.0, 2);
+        assert!(Match::new(&cfg, 1, chasers(1), chasers(2)).is_err());
+    }
+}

@@ -1,0 +1,321 @@
+//! The referee: game states, kickoffs, goals, a ball out of the field, halves and the
+//! stuck-ball rule. It reads the [`World`], moves the ball and robots where the rules say, and
+//! tells the robots the game state (what `chaos.getCurrentState()` returns).
+//!
+//! Teams: [`Team::Home`] defends the west goal (−x) in the first half and the east goal in the
+//! second; robots `0..n` are home, `n..2n` away; robot 0 of each team is its goalkeeper.
+
+use crate::world::World;
+use mrt_core::robot::GameState;
+use mrt_core::Pose2;
+use std::f64::consts::PI;
+
+/// A side of the match.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Team {
+    /// The first team named (`--home`).
+    Home,
+    /// The second team (`--away`).
+    Away,
+}
+
+impl Team {
+    /// The other team.
+    pub fn other(self) -> Team {
+        match self {
+            Team::Home => Team::Away,
+            Team::Away => Team::Home,
+        }
+    }
+
+    /// 0 for home, 1 for away.
+    pub fn index(self) -> usize {
+        match self {
+            Team::Home => 0,
+            Team::Away => 1,
+        }
+    }
+}
+
+/// Something the referee decided.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Call {
+    /// A goal for this team.
+    Goal(Team),
+    /// The ball left the field at this point; it was put back.
+    Out {
+        /// Where it left.
+        at: (f64, f64),
+    },
+    /// The ball had not moved for the stuck time; it was dropped at this point.
+    Dropped {
+        /// Where it went.
+        at: (f64, f64),
+    },
+    /// The first half ended; teams change sides.
+    HalfTime,
+    /// The match is over.
+    FullTime,
+}
+
+/// The referee's state.
+#[derive(Clone, Debug)]
+pub struct Referee {
+    state: GameState,
+    half: u8,
+    half_started: f64,
+    set_until: f64,
+    score: [u32; 2],
+    team_size: usize,
+    /// Where the ball was when it last moved more than the stuck distance, and when.
+    anchor: ((f64, f64), f64),
+}
+
+impl Referee {
+    /// A referee for teams of `team_size` robots; the game is in `INITIAL`.
+    pub fn new(team_size: usize) -> Referee {
+        Referee {
+            state: GameState::Initial,
+            half: 1,
+            half_started: 0.0,
+            set_until: 0.0,
+            score: [0, 0],
+            team_size,
+            anchor: ((0.0, 0.0), 0.0),
+        }
+    }
+
+    /// The game state the robots are told.
+    pub fn state(&self) -> GameState {
+        self.state
+    }
+
+    /// The half being played (1 or 2).
+    pub fn half(&self) -> u8 {
+        self.half
+    }
+
+    /// Goals of (home, away).
+    pub fn score(&self) -> (u32, u32) {
+        (self.score[0], self.score[1])
+    }
+
+    /// The team of robot `i`.
+    pub fn team_of(&self, robot: usize) -> Team {
+        if robot < self.team_size {
+            Team::Home
+        } else {
+            Team::Away
+        }
+    }
+
+    /// The direction (+1 east, −1 west) in which `team` attacks now.
+    pub fn attack_direction(&self, team: Team) -> f64 {
+        let home_east = if self.half == 1 { 1.0 } else { -1.0 };
+        match team {
+            Team::Home => home_east,
+            Team::Away => -home_east,
+        }
+    }
+
+    /// Starts the match: kickoff for home.
+    pub fn start(&mut self, world: &mut World) {
+        self.half_started = world.time();
+        self.kickoff(world, Team::Home);
+    }
+
+    /// Places everyone for a kickoff by `team` and goes to `SET` for the set duration.
+    pub fn kickoff(&mut self, world: &mut World, team: Team) {
+        let cfg = world.config().clone();
+        let (hl, r) = (cfg.field.length / 2.0, cfg.robot.radius);
+        world.place_ball(0.0, 0.0);
+        for i in 0..world.robot_count() {
+            let t = self.team_of(i);
+            let k = if t == Team::Home { i } else { i - self.team_size };
+            let dir = self.attack_direction(t);
+            // Goalkeeper on the goal line; field players spread over the own half, the
+            // kicking team's first field player at the centre circle.
+            let (x, y) = if k == 0 {
+                (-dir * (hl - 0.5), 0.0)
+            } else if k == 1 && t == team {
+                (-dir * (2.0 * r + cfg.ball.radius), 0.0)
+            } else {
+                let lanes = (self.team_size.max(2) - 1) as f64;
+                let lane = (k - 1) as f64;
+                let y = (lane - (lanes - 1.0) / 2.0) * (cfg.field.width / (lanes + 1.0));
+                (-dir * (cfg.field.centre_circle_radius + 0.5 + lane * 0.8), y)
+            };
+            let heading = if dir > 0.0 { 0.0 } else { PI };
+            world.place_robot(i, Pose2::new(x, y, heading));
+        }
+        self.state = GameState::Set;
+        self.set_until = world.time() + cfg.rules.set_duration;
+        self.anchor = ((0.0, 0.0), world.time());
+    }
+
+    /// Applies the rules after a physics step. Returns what was decided, if anything.
+    pub fn update(&mut self, world: &mut World) -> Option<Call> {
+        let cfg = world.config().clone();
+        let now = world.time();
+        match self.state {
+            GameState::Initial | GameState::Ready | GameState::Finished => return None,
+            GameState::Set => {
+                if now + 1e-9 >= self.set_until {
+                    self.state = GameState::Playing;
+                }
+                return None;
+            }
+            GameState::Playing => {}
+        }
+        if now - self.half_started >= cfg.rules.half_duration - 1e-9 {
+            if self.half == 1 {
+                self.half = 2;
+                self.half_started = now;
+                self.kickoff(world, Team::Away);
+                return Some(Call::HalfTime);
+            }
+            self.state = GameState::Finished;
+            return Some(Call::FullTime);
+        }
+        let (bx, by) = world.ball();
+        let (hl, hw) = (cfg.field.length / 2.0, cfg.field.width / 2.0);
+        let r = cfg.ball.radius;
+        // A goal: the whole ball over the goal line, between the posts.
+        if bx.abs() > hl + r && by.abs() < cfg.field.goal_width / 2.0 {
+            let scorer = if bx.signum() == self.attack_direction(Team::Home) {
+                Team::Home
+            } else {
+                Team::Away
+            };
+            self.score[scorer.index()] += 1;
+            self.kickoff(world, scorer.other());
+            return Some(Call::Goal(scorer));
+        }
+        // Out: the whole ball over a line (and not in a goal). Put back 0.5 m inside.
+        if bx.abs() > hl + r || by.abs() > hw + r {
+            let x = bx.clamp(-(hl - 0.5), hl - 0.5);
+            let y = by.clamp(-(hw - 0.5), hw - 0.5);
+            world.place_ball(x, y);
+            self.anchor = ((x, y), now);
+            return Some(Call::Out { at: (bx, by) });
+        }
+        // Stuck: the ball has not moved enough for too long.
+        let ((ax, ay), since) = self.anchor;
+        if (bx - ax).hypot(by - ay) > cfg.rules.stuck_distance {
+            self.anchor = ((bx, by), now);
+        } else if now - since >= cfg.rules.stuck_time {
+            // The nearest of the four neutral points (quarter of the field) or the centre.
+            let spots = [
+                (0.0, 0.0),
+                (hl / 2.0, hw / 2.0),
+                (hl / 2.0, -hw / 2.0),
+                (-hl / 2.0, hw / 2.0),
+                (-hl / 2.0, -hw / 2.0),
+            ];
+            let at = spots
+                .into_iter()
+                .filter(|(x, y)| (x - bx).hypot(y - by) > 1.0)
+                .min_by(|a, b| {
+                    let da = (a.0 - bx).hypot(a.1 - by);
+                    let db = (b.0 - bx).hypot(b.1 - by);
+                    da.total_cmp(&db)
+                })
+                .unwrap_or((0.0, 0.0));
+            world.place_ball(at.0, at.1);
+            self.anchor = (at, now);
+            return Some(Call::Dropped { at });
+        }
+        None
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::config::SimConfig;
+
+    fn setup() -> (World, Referee) {
+        let mut cfg = SimConfig::default();
+        cfg.rules.half_duration = 20.0;
+        let mut w = World::new(&cfg, 8);
+        let mut r = Referee::new(4);
+        r.start(&mut w);
+        (w, r)
+    }
+
+    fn run(w: &mut World, r: &mut Referee, seconds: f64) -> Vec<Call> {
+        let steps = (seconds / w.config().rules.physics_step).round() as usize;
+        (0..steps)
+            .filter_map(|_| {
+                w.step();
+                r.update(w)
+            })
+            .collect()
+    }
+
+    #[test]
+    fn kickoff_places_both_teams_in_their_halves_then_play_starts() {
+        let (mut w, mut r) = setup();
+        assert_eq!(r.state(), GameState::Set);
+        for i in 0..4 {
+            assert!(w.robot(i).unwrap().x < 0.0, "home robot {i} in the west half");
+            assert!(w.robot(i + 4).unwrap().x > 0.0, "away robot {i} in the east half");
+        }
+        assert_eq!(w.robot(0).unwrap().x, -8.5, "home goalkeeper on its line");
+        assert_eq!(w.ball(), (0.0, 0.0));
+        run(&mut w, &mut r, 1.0);
+        assert_eq!(r.state(), GameState::Playing);
+    }
+
+    #[test]
+    fn a_ball_in_the_east_goal_is_a_home_goal_and_away_kicks_off() {
+        let (mut w, mut r) = setup();
+        run(&mut w, &mut r, 1.0);
+        w.place_ball(9.3, 0.2);
+        let calls = run(&mut w, &mut r, 0.02);
+        assert_eq!(calls, [Call::Goal(Team::Home)]);
+        assert_eq!(r.score(), (1, 0));
+        assert_eq!((r.state(), w.ball()), (GameState::Set, (0.0, 0.0)));
+        // Away kicks off: its first field player stands next to the ball, on the east side.
+        let p = w.robot(5).unwrap();
+        assert!(p.x > 0.0 && p.x < 1.0 && p.y == 0.0, "{p:?}");
+    }
+
+    #[test]
+    fn a_ball_over_the_side_line_is_put_back_inside() {
+        let (mut w, mut r) = setup();
+        run(&mut w, &mut r, 1.0);
+        w.place_ball(3.0, 6.3);
+        let calls = run(&mut w, &mut r, 0.02);
+        assert!(matches!(calls.as_slice(), [Call::Out { .. }]), "{calls:?}");
+        let (x, y) = w.ball();
+        assert!((x - 3.0).abs() < 1e-3 && (y - 5.5).abs() < 1e-3, "({x}, {y})");
+        // Beside the goal (over the goal line, outside the posts) is out, not a goal.
+        w.place_ball(-9.3, 2.5);
+        let calls = run(&mut w, &mut r, 0.02);
+        assert!(matches!(calls.as_slice(), [Call::Out { .. }]), "{calls:?}");
+        assert_eq!(r.score(), (0, 0));
+    }
+
+    #[test]
+    fn a_stuck_ball_is_dropped_at_a_neutral_point() {
+        let (mut w, mut r) = setup();
+        run(&mut w, &mut r, 1.0);
+        w.place_ball(4.0, 2.0);
+        let calls = run(&mut w, &mut r, 10.5);
+        assert_eq!(calls, [Call::Dropped { at: (4.5, 3.0) }]);
+    }
+
+    #[test]
+    fn halves_change_sides_and_the_match_ends() {
+        let (mut w, mut r) = setup();
+        assert_eq!(r.attack_direction(Team::Home), 1.0);
+        let calls = run(&mut w, &mut r, 21.5);
+        assert!(calls.contains(&Call::HalfTime), "{calls:?}");
+        assert_eq!((r.half(), r.attack_direction(Team::Home)), (2, -1.0));
+        assert!(w.robot(0).unwrap().x > 8.0, "home goalkeeper now defends the east goal");
+        let calls = run(&mut w, &mut r, 20.0);
+        assert!(calls.contains(&Call::FullTime), "{calls:?}");
+        assert_eq!(r.state(), GameState::Finished);
+    }
+}

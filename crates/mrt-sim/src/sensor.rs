@@ -1,0 +1,263 @@
+//! The object sensor: what a robot's camera would detect, as distance and bearing with
+//! range-dependent noise, a field of view, occlusion by other robots and random misses. It is
+//! the documented stand-in for camera images and colour vision (a later issue), and stays as
+//! the fast mode.
+//!
+//! [`Perception`] turns detections into the robot's [`WorldSnapshot`], in the robot's team
+//! frame (millimetres; x towards the opponent's net, whichever half the team plays in): an
+//! object not seen this frame keeps its last estimate, moved with the robot's own motion, with
+//! its reliability decaying, like the seed's LPS anchors.
+
+use crate::config::SensorConfig;
+use crate::referee::{Referee, Team};
+use crate::world::World;
+use mrt_core::robot::{lps, Estimate, Lpo, Mate, WorldSnapshot};
+use mrt_core::{normalize_angle, Pose2, Time, Vec2};
+use rand::{Rng, RngCore};
+
+/// Reliability kept per control cycle by an object that was not seen again.
+pub const DECAY: f64 = 0.85;
+
+/// Standard normal sample (Box–Muller), from any RNG.
+fn gauss(rng: &mut dyn RngCore) -> f64 {
+    let u1: f64 = rng.random_range(f64::EPSILON..1.0);
+    let u2: f64 = rng.random_range(0.0..1.0);
+    (-2.0 * u1.ln()).sqrt() * (2.0 * std::f64::consts::PI * u2).cos()
+}
+
+/// One robot's view: its LPS memory, in the field frame, between cycles.
+#[derive(Clone, Debug)]
+pub struct Perception {
+    robot: usize,
+    /// Last estimate of each LPS object in field coordinates (m), its reliability, and when
+    /// it was seen.
+    memory: Vec<Option<((f64, f64), f64, f64)>>,
+}
+
+/// Field positions (m) of the LPS objects for `team`: ball, opponent's net, own net, and six
+/// landmarks (the four corners and the two ends of the half-way line).
+fn targets(world: &World, referee: &Referee, team: Team) -> [(f64, f64); lps::COUNT] {
+    let f = &world.config().field;
+    let (hl, hw) = (f.length / 2.0, f.width / 2.0);
+    let dir = referee.attack_direction(team);
+    let ball = world.ball();
+    [
+        ball,
+        (dir * hl, 0.0),
+        (-dir * hl, 0.0),
+        (hl, hw),
+        (hl, -hw),
+        (-hl, hw),
+        (-hl, -hw),
+        (0.0, hw),
+        (0.0, -hw),
+    ]
+}
+
+/// Whether the segment from `a` to `b` passes within `radius` of `c`.
+fn blocks(a: (f64, f64), b: (f64, f64), c: (f64, f64), radius: f64) -> bool {
+    let (dx, dy) = (b.0 - a.0, b.1 - a.1);
+    let len2 = dx * dx + dy * dy;
+    if len2 == 0.0 {
+        return false;
+    }
+    let t = (((c.0 - a.0) * dx + (c.1 - a.1) * dy) / len2).clamp(0.0, 1.0);
+    let (px, py) = (a.0 + t * dx, a.1 + t * dy);
+    // Only objects strictly between the two ends hide the target.
+    t > 0.0 && t < 1.0 && (px - c.0).hypot(py - c.1) < radius
+}
+
+impl Perception {
+    /// A robot that has seen nothing yet.
+    pub fn new(robot: usize) -> Perception {
+        Perception { robot, memory: vec![None; lps::COUNT] }
+    }
+
+    /// Looks once and returns the world snapshot for this cycle.
+    pub fn look(
+        &mut self,
+        world: &World,
+        referee: &Referee,
+        cfg: &SensorConfig,
+        rng: &mut dyn RngCore,
+    ) -> WorldSnapshot {
+        let me = world.robot(self.robot).unwrap_or_default();
+        let team = referee.team_of(self.robot);
+        let now = world.time();
+        let r_robot = world.config().robot.radius;
+        let robots: Vec<(f64, f64)> = (0..world.robot_count())
+            .filter(|&i| i != self.robot)
+            .filter_map(|i| world.robot(i).map(|p| (p.x, p.y)))
+            .collect();
+        for (k, target) in targets(world, referee, team).into_iter().enumerate() {
+            let (dx, dy) = (target.0 - me.x, target.1 - me.y);
+            let dist = dx.hypot(dy);
+            let bearing = normalize_angle(dy.atan2(dx) - me.theta);
+            let occluded =
+                k == lps::BALL && robots.iter().any(|&c| blocks((me.x, me.y), target, c, r_robot));
+            let visible = dist <= cfg.range && bearing.abs() <= cfg.half_fov && !occluded;
+            let missed = rng.random_bool(cfg.miss_probability.clamp(0.0, 1.0));
+            if visible && !missed {
+                let d = (dist * (1.0 + cfg.distance_noise * gauss(rng))).max(0.0);
+                let b = bearing + cfg.bearing_noise * gauss(rng);
+                let a = me.theta + b;
+                let seen = (me.x + d * a.cos(), me.y + d * a.sin());
+                self.memory[k] = Some((seen, 1.0, now));
+            } else if let Some((_, rel, _)) = &mut self.memory[k] {
+                *rel *= DECAY;
+            }
+        }
+        self.snapshot(world, referee, me, team)
+    }
+
+    fn snapshot(&self, world: &World, referee: &Referee, me: Pose2, team: Team) -> WorldSnapshot {
+        let now = world.time();
+        let dir = referee.attack_direction(team);
+        // Team frame: x towards the opponent's net. Field → team is a half turn when the team
+        // attacks west.
+        let to_team = |x: f64, y: f64| (dir * x * 1000.0, dir * y * 1000.0);
+        let heading =
+            if dir > 0.0 { me.theta } else { normalize_angle(me.theta + std::f64::consts::PI) };
+        let mut w = WorldSnapshot {
+            time: Time::from_secs_f64(now),
+            game_state: referee.state(),
+            ..Default::default()
+        };
+        for (k, m) in self.memory.iter().enumerate() {
+            let Some(((x, y), rel, seen)) = *m else { continue };
+            let (dx, dy) = (x - me.x, y - me.y);
+            w.lps[k] = Lpo {
+                rho: dx.hypot(dy) * 1000.0,
+                theta: normalize_angle(dy.atan2(dx) - me.theta),
+                reliability: rel,
+                seen_ago: now - seen,
+            };
+        }
+        let (mx, my) = to_team(me.x, me.y);
+        w.my_pos = Estimate { pose: Pose2::new(mx, my, heading), quality: 0.9 };
+        if let Some(((bx, by), rel, _)) = self.memory[lps::BALL] {
+            let (x, y) = to_team(bx, by);
+            w.global_ball = Estimate { pose: Pose2::new(x, y, 0.0), quality: rel };
+        }
+        let (vx, vy) = world.ball_velocity();
+        w.ball_vel = Vec2::new(dir * vx * 1000.0, dir * vy * 1000.0);
+        for i in 0..world.robot_count() {
+            if i == self.robot || referee.team_of(i) != team {
+                continue;
+            }
+            let Some(p) = world.robot(i) else { continue };
+            let (x, y) = to_team(p.x, p.y);
+            let th =
+                if dir > 0.0 { p.theta } else { normalize_angle(p.theta + std::f64::consts::PI) };
+            let id = u32::try_from(i).unwrap_or(u32::MAX);
+            w.mates.push(Mate { id, at: Estimate { pose: Pose2::new(x, y, th), quality: 0.9 } });
+        }
+        w
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::config::SimConfig;
+    use rand::SeedableRng;
+    use rand_chacha::ChaCha8Rng;
+
+    fn exact() -> SensorConfig {
+        SensorConfig {
+            distance_noise: 0.0,
+            bearing_noise: 0.0,
+            miss_probability: 0.0,
+            ..Default::default()
+        }
+    }
+
+    fn setup() -> (World, Referee) {
+        let mut w = World::new(&SimConfig::default(), 8);
+        let mut r = Referee::new(4);
+        r.start(&mut w);
+        (w, r)
+    }
+
+    #[test]
+    fn distance_and_bearing_in_the_team_frame() {
+        let (mut w, r) = setup();
+        let mut rng = ChaCha8Rng::seed_from_u64(1);
+        // Home attacks east. Robot 1 at (-2, 0) facing north; ball at (0, 2): 2.828 m away,
+        // 45° to the right of the heading (bearing -π/4).
+        w.place_robot(1, Pose2::new(-2.0, 0.0, std::f64::consts::FRAC_PI_2));
+        w.place_ball(0.0, 2.0);
+        let s = Perception::new(1).look(&w, &r, &exact(), &mut rng);
+        let ball = s.lps[lps::BALL];
+        assert!((ball.rho - 2828.427).abs() < 0.01, "{ball:?}");
+        assert!((ball.theta + std::f64::consts::FRAC_PI_4).abs() < 1e-6, "{ball:?}"); // f32 physics
+        assert_eq!(ball.reliability, 1.0);
+        // The own net (west, (-9, 0)) is 7 m away on the left (bearing +π/2); the opponent's
+        // net, 11 m away, is beyond the 9 m range.
+        let net = s.lps[lps::NET2];
+        assert!((net.rho - 7000.0).abs() < 0.01, "{net:?}");
+        assert!((net.theta - std::f64::consts::FRAC_PI_2).abs() < 1e-6, "{net:?}");
+        assert_eq!(s.lps[lps::NET1].reliability, 0.0);
+        assert_eq!((s.my_pos.pose.x, s.my_pos.pose.y), (-2000.0, 0.0));
+        // An away robot sees the same field turned half round: x towards the west goal.
+        w.place_robot(5, Pose2::new(2.0, 1.0, std::f64::consts::PI));
+        let s = Perception::new(5).look(&w, &r, &exact(), &mut rng);
+        assert!((s.my_pos.pose.x + 2000.0).abs() < 1e-9 && (s.my_pos.pose.y + 1000.0).abs() < 1e-9);
+        assert!(s.my_pos.pose.theta.abs() < 1e-6, "facing its attack direction");
+        assert_eq!(s.mates.len(), 3);
+    }
+
+    #[test]
+    fn a_robot_in_between_hides_the_ball_and_the_memory_fades() {
+        let (mut w, r) = setup();
+        let mut rng = ChaCha8Rng::seed_from_u64(2);
+        w.place_robot(1, Pose2::new(-3.0, 0.0, 0.0));
+        w.place_ball(0.0, 0.0);
+        let mut p = Perception::new(1);
+        let first = p.look(&w, &r, &exact(), &mut rng);
+        assert_eq!(first.lps[lps::BALL].reliability, 1.0);
+        w.place_robot(6, Pose2::new(-1.5, 0.05, 0.0)); // in the line of sight
+        let hidden = p.look(&w, &r, &exact(), &mut rng);
+        assert!((hidden.lps[lps::BALL].reliability - DECAY).abs() < 1e-12);
+        assert!((hidden.lps[lps::BALL].rho - 3000.0).abs() < 1e-6, "last estimate kept");
+    }
+
+    #[test]
+    fn a_narrow_field_of_view_and_range_limit_what_is_seen() {
+        let (mut w, r) = setup();
+        let mut rng = ChaCha8Rng::seed_from_u64(3);
+        let cfg = SensorConfig { half_fov: 0.5, range: 5.0, ..exact() };
+        w.place_robot(1, Pose2::new(-5.0, 0.0, std::f64::consts::PI)); // facing west
+        w.place_ball(-1.0, 0.0);
+        let s = Perception::new(1).look(&w, &r, &cfg, &mut rng);
+        assert_eq!(s.lps[lps::BALL].reliability, 0.0, "4 m behind the robot");
+        assert_eq!(s.lps[lps::NET2].reliability, 1.0, "own net 4 m ahead");
+        assert_eq!(s.lps[lps::NET1].reliability, 0.0, "opponent's net 14 m behind");
+        assert_eq!(
+            s.lps[lps::LANDMARK0 + 2].reliability,
+            0.0,
+            "corner (-9, 6): 7.2 m, out of range"
+        );
+    }
+
+    #[test]
+    fn noise_is_seeded_and_proportional_to_distance() {
+        let (mut w, r) = setup();
+        // Off the kickoff lanes (y = 0, ±3), so nobody stands in the line of sight.
+        w.place_robot(1, Pose2::new(-6.0, 1.5, 0.0));
+        w.place_ball(0.0, 1.5);
+        let cfg = SensorConfig { miss_probability: 0.0, ..Default::default() };
+        let sample = |seed| {
+            let mut rng = ChaCha8Rng::seed_from_u64(seed);
+            (0..400)
+                .map(|_| Perception::new(1).look(&w, &r, &cfg, &mut rng).lps[lps::BALL].rho)
+                .collect::<Vec<_>>()
+        };
+        assert_eq!(sample(7), sample(7), "same seed, same noise");
+        let v = sample(8);
+        let mean = v.iter().sum::<f64>() / v.len() as f64;
+        let sd = (v.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / v.len() as f64).sqrt();
+        // 3 % of 6 m = 180 mm.
+        assert!((mean - 6000.0).abs() < 40.0 && (sd - 180.0).abs() < 30.0, "{mean} ± {sd}");
+    }
+}

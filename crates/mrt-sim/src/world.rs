@@ -1,0 +1,338 @@
+//! The physical world on `rapier2d`, seen from above: a walled field with two goals, a ball
+//! that rolls, bounces and is kicked, and round robots driven by velocity commands.
+//!
+//! Frame: metres, origin at the centre spot, +x towards the east goal, +y to the north,
+//! headings counter-clockwise from +x. Nothing here knows about teams or rules (see
+//! [`crate::referee`]).
+
+use crate::config::SimConfig;
+use mrt_core::Pose2;
+use rapier2d::prelude::*;
+
+/// A robot's velocity set-point in its own frame (m/s forward, m/s to the left, rad/s).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Drive {
+    /// Forward speed.
+    pub forward: f64,
+    /// Sideways speed, left positive (0 for a differential drive).
+    pub left: f64,
+    /// Turning rate, counter-clockwise positive.
+    pub turn: f64,
+}
+
+struct Robot {
+    body: RigidBodyHandle,
+    drive: Drive,
+    /// Simulated time when the kicker is charged again.
+    kick_ready_at: f64,
+}
+
+/// The physical world.
+pub struct World {
+    cfg: SimConfig,
+    physics: PhysicsWorld,
+    ball: RigidBodyHandle,
+    robots: Vec<Robot>,
+    time: f64,
+}
+
+fn v(x: f64, y: f64) -> Vector {
+    Vector::new(x as f32, y as f32)
+}
+
+impl World {
+    /// An empty field with the ball on the centre spot and `robots` robots lined up on the
+    /// south side line (place them with [`World::place_robot`]).
+    pub fn new(cfg: &SimConfig, robots: usize) -> World {
+        let mut physics = PhysicsWorld::default();
+        physics.gravity = Vector::ZERO;
+        physics.integration_parameters.dt = cfg.rules.physics_step as f32;
+        let f = &cfg.field;
+        let (hl, hw) = (f.length / 2.0, f.width / 2.0);
+        let (wx, wy) = (hl + f.border, hw + f.border);
+        let wall = 0.1;
+        let walls = physics.insert_body(RigidBodyBuilder::fixed());
+        // `bounce`: walls give the ball back, goal nets swallow it.
+        let add = |physics: &mut PhysicsWorld,
+                   (cx, cy): (f64, f64),
+                   (hx, hy): (f64, f64),
+                   bounce: f32| {
+            let c = ColliderBuilder::cuboid(hx as f32, hy as f32)
+                .translation(v(cx, cy))
+                .restitution(bounce)
+                .restitution_combine_rule(CoefficientCombineRule::Min)
+                .friction(0.2);
+            physics.colliders.insert_with_parent(c, walls, &mut physics.bodies);
+        };
+        // Outer walls.
+        add(&mut physics, (0.0, wy + wall), (wx + 2.0 * wall, wall), 0.5);
+        add(&mut physics, (0.0, -wy - wall), (wx + 2.0 * wall, wall), 0.5);
+        add(&mut physics, (wx + wall, 0.0), (wall, wy + 2.0 * wall), 0.5);
+        add(&mut physics, (-wx - wall, 0.0), (wall, wy + 2.0 * wall), 0.5);
+        // Goals: a back and two sides behind each goal line.
+        let (gw, gd) = (f.goal_width / 2.0, f.goal_depth);
+        for side in [-1.0, 1.0] {
+            add(&mut physics, (side * (hl + gd + wall), 0.0), (wall, gw + wall), 0.0);
+            for s in [-1.0, 1.0] {
+                add(
+                    &mut physics,
+                    (side * (hl + gd / 2.0), s * (gw + wall)),
+                    (gd / 2.0 + wall, wall),
+                    0.0,
+                );
+            }
+        }
+        let b = &cfg.ball;
+        let ball_area = std::f64::consts::PI * b.radius * b.radius;
+        let (ball, _) = physics.insert(
+            RigidBodyBuilder::dynamic().linear_damping(b.rolling_damping as f32).ccd_enabled(true),
+            ColliderBuilder::ball(b.radius as f32)
+                .density((b.mass / ball_area) as f32)
+                .restitution(b.restitution as f32)
+                .friction(0.3),
+        );
+        let r = &cfg.robot;
+        let robot_area = std::f64::consts::PI * r.radius * r.radius;
+        let robots = (0..robots)
+            .map(|i| {
+                let x = -hl + 1.0 + i as f64 * (2.5 * r.radius);
+                let (body, _) = physics.insert(
+                    RigidBodyBuilder::dynamic().translation(v(x, -hw - f.border / 2.0)),
+                    ColliderBuilder::ball(r.radius as f32)
+                        .density((r.mass / robot_area) as f32)
+                        .restitution(0.2)
+                        .friction(0.5),
+                );
+                Robot { body, drive: Drive::default(), kick_ready_at: 0.0 }
+            })
+            .collect();
+        World { cfg: cfg.clone(), physics, ball, robots, time: 0.0 }
+    }
+
+    /// The configuration.
+    pub fn config(&self) -> &SimConfig {
+        &self.cfg
+    }
+
+    /// Simulated seconds since the start.
+    pub fn time(&self) -> f64 {
+        self.time
+    }
+
+    /// Number of robots.
+    pub fn robot_count(&self) -> usize {
+        self.robots.len()
+    }
+
+    /// The ball's centre.
+    pub fn ball(&self) -> (f64, f64) {
+        let t = self.physics.bodies[self.ball].translation();
+        (f64::from(t.x), f64::from(t.y))
+    }
+
+    /// The ball's velocity.
+    pub fn ball_velocity(&self) -> (f64, f64) {
+        let l = self.physics.bodies[self.ball].linvel();
+        (f64::from(l.x), f64::from(l.y))
+    }
+
+    /// Puts the ball at rest at `(x, y)`.
+    pub fn place_ball(&mut self, x: f64, y: f64) {
+        let body = &mut self.physics.bodies[self.ball];
+        body.set_translation(v(x, y), true);
+        body.set_linvel(Vector::ZERO, true);
+        body.set_angvel(0.0, true);
+    }
+
+    /// A robot's pose (`None` for an unknown index).
+    pub fn robot(&self, i: usize) -> Option<Pose2> {
+        let body = &self.physics.bodies[self.robots.get(i)?.body];
+        let t = body.translation();
+        Some(Pose2::new(f64::from(t.x), f64::from(t.y), f64::from(body.rotation().angle())))
+    }
+
+    /// Puts a robot at rest at a pose, with a stopped drive.
+    pub fn place_robot(&mut self, i: usize, pose: Pose2) {
+        let Some(r) = self.robots.get_mut(i) else { return };
+        r.drive = Drive::default();
+        let body = &mut self.physics.bodies[r.body];
+        body.set_position(Pose::new(v(pose.x, pose.y), pose.theta as f32), true);
+        body.set_linvel(Vector::ZERO, true);
+        body.set_angvel(0.0, true);
+    }
+
+    /// Sets a robot's velocity set-point (limited to the robot's top speeds).
+    pub fn drive(&mut self, i: usize, drive: Drive) {
+        let r = &self.cfg.robot;
+        let finite = |x: f64| if x.is_finite() { x } else { 0.0 };
+        let (mut fw, mut left) = (finite(drive.forward), finite(drive.left));
+        let speed = fw.hypot(left);
+        if speed > r.max_speed {
+            fw *= r.max_speed / speed;
+            left *= r.max_speed / speed;
+        }
+        let turn = finite(drive.turn).clamp(-r.max_turn_rate, r.max_turn_rate);
+        if let Some(robot) = self.robots.get_mut(i) {
+            robot.drive = Drive { forward: fw, left, turn };
+        }
+    }
+
+    /// Fires robot `i`'s kicker: if it is charged and the ball lies in front of the robot
+    /// within reach, the ball leaves along the robot's heading at the kick speed. Returns
+    /// whether the ball was kicked.
+    pub fn kick(&mut self, i: usize) -> bool {
+        let Some(pose) = self.robot(i) else { return false };
+        let rc = &self.cfg.robot;
+        let Some(robot) = self.robots.get_mut(i) else { return false };
+        if self.time < robot.kick_ready_at {
+            return false;
+        }
+        robot.kick_ready_at = self.time + rc.kick_recharge;
+        let (bx, by) = self.ball();
+        let (dx, dy) = (bx - pose.x, by - pose.y);
+        let reach = rc.radius + self.cfg.ball.radius + rc.kick_reach;
+        let bearing = mrt_core::normalize_angle(dy.atan2(dx) - pose.theta);
+        if dx.hypot(dy) > reach || bearing.abs() > rc.kick_half_angle {
+            return false;
+        }
+        let (c, s) = (pose.theta.cos(), pose.theta.sin());
+        let body = &mut self.physics.bodies[self.ball];
+        body.set_linvel(v(rc.kick_speed * c, rc.kick_speed * s), true);
+        true
+    }
+
+    /// Advances the world by one physics step: robots accelerate towards their set-points
+    /// (within the acceleration limit), then rapier moves everything.
+    pub fn step(&mut self) {
+        let dt = self.cfg.rules.physics_step;
+        let max_dv = self.cfg.robot.max_accel * dt;
+        let max_dw = 4.0 * self.cfg.robot.max_turn_rate * dt;
+        for r in &self.robots {
+            let body = &mut self.physics.bodies[r.body];
+            let th = f64::from(body.rotation().angle());
+            let (c, s) = (th.cos(), th.sin());
+            let target =
+                (r.drive.forward * c - r.drive.left * s, r.drive.forward * s + r.drive.left * c);
+            let now = body.linvel();
+            let (dvx, dvy) = (target.0 - f64::from(now.x), target.1 - f64::from(now.y));
+            let dv = dvx.hypot(dvy);
+            let k = if dv > max_dv { max_dv / dv } else { 1.0 };
+            body.set_linvel(v(f64::from(now.x) + dvx * k, f64::from(now.y) + dvy * k), true);
+            let w = f64::from(body.angvel());
+            let dw = (r.drive.turn - w).clamp(-max_dw, max_dw);
+            body.set_angvel((w + dw) as f32, true);
+        }
+        self.physics.step();
+        self.time += dt;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn world(robots: usize) -> World {
+        World::new(&SimConfig::default(), robots)
+    }
+
+    #[test]
+    fn a_free_ball_rolls_to_a_stop_and_walls_keep_it_in() {
+        let mut w = world(0);
+        w.place_ball(0.0, 0.0);
+        // Kick it north at 6 m/s: rolling friction slows it (damping 0.4/s: about 6/0.4 = 15 m
+        // of travel without walls), the north wall at y = 7 bounces it back.
+        w.physics.bodies[w.ball].set_linvel(v(0.0, 6.0), true);
+        let mut max_y: f64 = 0.0;
+        for _ in 0..2000 {
+            w.step();
+            max_y = max_y.max(w.ball().1);
+        }
+        let (bx, by) = w.ball();
+        let speed = w.ball_velocity().0.hypot(w.ball_velocity().1);
+        assert!(max_y < 7.0 && max_y > 6.5, "stopped by the wall at 7 m: {max_y}");
+        assert!(by < max_y - 0.5, "bounced back: {by}");
+        assert!(bx.abs() < 1e-3 && speed < 0.3, "({bx}, {by}) at {speed} m/s after 20 s");
+    }
+
+    #[test]
+    fn robots_accelerate_within_their_limits_and_respect_top_speed() {
+        let mut w = world(1);
+        w.place_robot(0, Pose2::new(0.0, 0.0, 0.0));
+        w.drive(0, Drive { forward: 5.0, left: 0.0, turn: 0.0 });
+        w.step();
+        let after_one = w.robot(0).unwrap().x;
+        // 2 m/s² for 10 ms: 0.02 m/s, so about 0.2 mm in the first step.
+        assert!(after_one > 0.0 && after_one < 0.001, "{after_one}");
+        for _ in 0..300 {
+            w.step();
+        }
+        let v = w.physics.bodies[w.robots[0].body].linvel();
+        assert!((f64::from(v.x) - 1.2).abs() < 1e-3, "top speed 1.2 m/s: {}", v.x);
+    }
+
+    #[test]
+    fn a_robot_turns_and_drives_along_its_heading() {
+        let mut w = world(1);
+        w.place_robot(0, Pose2::new(0.0, 0.0, std::f64::consts::FRAC_PI_2));
+        w.drive(0, Drive { forward: 1.0, left: 0.0, turn: 0.0 });
+        for _ in 0..200 {
+            w.step();
+        }
+        let p = w.robot(0).unwrap();
+        assert!(p.x.abs() < 0.01 && p.y > 1.0, "heading north: {p:?}");
+    }
+
+    #[test]
+    fn the_kicker_needs_the_ball_in_front_and_a_charged_tank() {
+        let mut w = world(1);
+        w.place_robot(0, Pose2::new(0.0, 0.0, 0.0));
+        w.place_ball(0.40, 0.0); // 0.25 + 0.11 + 0.04 in front
+        assert!(w.kick(0));
+        assert!((w.ball_velocity().0 - 6.0).abs() < 1e-3);
+        w.place_ball(0.40, 0.0);
+        assert!(!w.kick(0), "recharging");
+        for _ in 0..100 {
+            w.step();
+        }
+        w.place_robot(0, Pose2::new(0.0, 0.0, 0.0));
+        w.place_ball(-0.40, 0.0);
+        assert!(!w.kick(0), "behind the robot");
+        w.place_ball(1.0, 0.0);
+        assert!(!w.kick(0), "out of reach");
+    }
+
+    #[test]
+    fn the_ball_enters_a_goal_but_not_the_wall_beside_it() {
+        let mut w = world(0);
+        w.place_ball(8.0, 0.0);
+        w.physics.bodies[w.ball].set_linvel(v(5.0, 0.0), true);
+        for _ in 0..200 {
+            w.step();
+        }
+        let (x, y) = w.ball();
+        assert!(x > 9.0 && x < 9.6 && y.abs() < 1.0, "in the east goal: ({x}, {y})");
+        w.place_ball(8.0, 3.0);
+        w.physics.bodies[w.ball].set_linvel(v(5.0, 0.0), true);
+        for _ in 0..200 {
+            w.step();
+        }
+        let (x, _) = w.ball();
+        assert!(x < 10.0, "stopped by the east wall at 10 m: {x}");
+    }
+
+    #[test]
+    fn same_inputs_same_trajectory() {
+        let run = || {
+            let mut w = world(2);
+            w.place_robot(0, Pose2::new(-1.0, 0.0, 0.0));
+            w.place_robot(1, Pose2::new(1.0, 0.2, std::f64::consts::PI));
+            w.drive(0, Drive { forward: 1.0, left: 0.0, turn: 0.3 });
+            w.drive(1, Drive { forward: 1.0, left: 0.1, turn: 0.0 });
+            for _ in 0..500 {
+                w.step();
+            }
+            (w.robot(0), w.robot(1), w.ball())
+        };
+        assert_eq!(run(), run());
+    }
+}
