@@ -114,6 +114,16 @@ pub struct Hfsm {
     io: Rc<RefCell<RobotIo>>,
 }
 
+impl std::fmt::Debug for Hfsm {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Hfsm")
+            .field("file", &self.file)
+            .field("machines", &self.machine_names())
+            .field("path", &self.status.borrow().path)
+            .finish_non_exhaustive()
+    }
+}
+
 /// One transition taken during a step.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Taken {

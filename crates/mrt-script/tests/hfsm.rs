@@ -725,3 +725,45 @@ fn a_failing_enter_hook_of_a_meta_state_does_not_leave_the_machine_without_a_lea
     step(&rt, &io, &mut h, world(200, 0.0)).unwrap();
     assert_eq!((h.path().as_str(), io.borrow().command.vlin), ("T/M/X", 7.0));
 }
+
+/// `include "x.hfsm.lua"` reuses the machines of another file of the same directory without
+/// copying them; an error in an included machine names the included file; only plain names of
+/// `.hfsm.lua` files are accepted, each file is read once.
+#[test]
+fn include_reuses_machines_from_another_file() {
+    let dir = std::env::temp_dir().join(format!("mrt-hfsm-include-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(
+        dir.join("inner.hfsm.lua"),
+        "machine \"Inner\" { initial = \"X\", states = { X = function() chaos.setVlin(3) end } }\n",
+    )
+    .unwrap();
+    let main = dir.join("main.hfsm.lua");
+    std::fs::write(
+        &main,
+        "include \"inner.hfsm.lua\"\ninclude \"inner.hfsm.lua\"\nmachine \"Top\" { initial = \"M\", states = { M = meta \"Inner\" } }\n",
+    )
+    .unwrap();
+    let rt = LuaRuntime::new(Sandbox::default()).unwrap();
+    let io = Rc::new(RefCell::new(RobotIo::default()));
+    install(&rt, io.clone()).unwrap();
+    let mut h = Hfsm::from_file(&rt, &main, io.clone()).unwrap();
+    assert_eq!(h.root(), "Top", "the including machine is the root");
+    io.borrow_mut().new_cycle(WorldSnapshot::default());
+    h.step(&rt).unwrap();
+    assert_eq!((h.path().as_str(), io.borrow().command.vlin), ("Top/M/X", 3.0));
+    // An error inside the included file names that file and its line.
+    std::fs::write(
+        dir.join("inner.hfsm.lua"),
+        "\nmachine \"Inner\" { initial = \"Nope\", states = { X = true } }\n",
+    )
+    .unwrap();
+    let e = Hfsm::from_file(&rt, &main, io.clone()).unwrap_err().to_string();
+    assert!(e.contains("inner.hfsm.lua:2:") && e.contains("Nope"), "{e}");
+    for bad in ["../x.hfsm.lua", "/etc/passwd", "other.lua"] {
+        std::fs::write(&main, format!("include \"{bad}\"\n")).unwrap();
+        let e = Hfsm::from_file(&rt, &main, io.clone()).unwrap_err().to_string();
+        assert!(e.contains("plain name"), "{bad}: {e}");
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}

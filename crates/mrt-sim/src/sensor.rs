@@ -25,13 +25,21 @@ fn gauss(rng: &mut dyn RngCore) -> f64 {
     (-2.0 * u1.ln()).sqrt() * (2.0 * std::f64::consts::PI * u2).cos()
 }
 
+/// What a robot remembers of one LPS object: where it was last seen (field frame, m), its
+/// reliability, and when it was seen (s).
+#[derive(Clone, Copy, Debug)]
+struct Memory {
+    at: (f64, f64),
+    reliability: f64,
+    seen: f64,
+}
+
 /// One robot's view: its LPS memory, in the field frame, between cycles.
 #[derive(Clone, Debug)]
 pub struct Perception {
     robot: usize,
-    /// Last estimate of each LPS object in field coordinates (m), its reliability, and when
-    /// it was seen.
-    memory: Vec<Option<((f64, f64), f64, f64)>>,
+    /// Last estimate of each LPS object.
+    memory: Vec<Option<Memory>>,
 }
 
 /// Field positions (m) of the LPS objects for `team`: ball, opponent's net, own net, and six
@@ -102,9 +110,9 @@ impl Perception {
                 let b = bearing + cfg.bearing_noise * gauss(rng);
                 let a = me.theta + b;
                 let seen = (me.x + d * a.cos(), me.y + d * a.sin());
-                self.memory[k] = Some((seen, 1.0, now));
-            } else if let Some((_, rel, _)) = &mut self.memory[k] {
-                *rel *= DECAY;
+                self.memory[k] = Some(Memory { at: seen, reliability: 1.0, seen: now });
+            } else if let Some(m) = &mut self.memory[k] {
+                m.reliability *= DECAY;
             }
         }
         self.snapshot(world, referee, me, team)
@@ -124,7 +132,7 @@ impl Perception {
             ..Default::default()
         };
         for (k, m) in self.memory.iter().enumerate() {
-            let Some(((x, y), rel, seen)) = *m else { continue };
+            let Some(Memory { at: (x, y), reliability: rel, seen }) = *m else { continue };
             let (dx, dy) = (x - me.x, y - me.y);
             w.lps[k] = Lpo {
                 rho: dx.hypot(dy) * 1000.0,
@@ -135,7 +143,7 @@ impl Perception {
         }
         let (mx, my) = to_team(me.x, me.y);
         w.my_pos = Estimate { pose: Pose2::new(mx, my, heading), quality: 0.9 };
-        if let Some(((bx, by), rel, _)) = self.memory[lps::BALL] {
+        if let Some(Memory { at: (bx, by), reliability: rel, .. }) = self.memory[lps::BALL] {
             let (x, y) = to_team(bx, by);
             w.global_ball = Estimate { pose: Pose2::new(x, y, 0.0), quality: rel };
         }

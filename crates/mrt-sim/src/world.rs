@@ -44,8 +44,7 @@ impl World {
     /// An empty field with the ball on the centre spot and `robots` robots lined up on the
     /// south side line (place them with [`World::place_robot`]).
     pub fn new(cfg: &SimConfig, robots: usize) -> World {
-        let mut physics = PhysicsWorld::default();
-        physics.gravity = Vector::ZERO;
+        let mut physics = PhysicsWorld { gravity: Vector::ZERO, ..Default::default() };
         physics.integration_parameters.dt = cfg.rules.physics_step as f32;
         let f = &cfg.field;
         let (hl, hw) = (f.length / 2.0, f.width / 2.0);
