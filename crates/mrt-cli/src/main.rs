@@ -1,5 +1,6 @@
 //! `mrt`: the MRT command line.
 //!
+//! - `mrt sim [--seed N] [--matches N] [--plot match.svg]` plays a simulated match;
 //! - `mrt demo [hello-agora|two-agoras]` runs a numbered example and prints what happens;
 //! - `mrt behave FILE [--world world.json] [--cycles N]` runs a Lua behavior or HFSM offline;
 //! - `mrt hfsm dot FILE [--dot out.dot] [--svg out.svg]` draws an HFSM;
@@ -11,6 +12,7 @@
 
 mod behave;
 mod brian;
+mod sim;
 
 use anyhow::{Context as _, Result};
 use clap::{Parser, Subcommand, ValueEnum};
@@ -26,6 +28,37 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
+    /// Play a simulated robot-soccer match on the embedded default world (or a series).
+    Sim {
+        /// Simulator configuration (TOML; see configs/sim/default.toml). Default: built in.
+        #[arg(long)]
+        config: Option<PathBuf>,
+        /// Seed of all randomness: the same seed gives the same match.
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+        /// The home team's stack: chaos (Lua HFSM + fuzzy behaviors) or chaser (baseline).
+        #[arg(long, default_value = "chaos")]
+        home: String,
+        /// The away team's stack.
+        #[arg(long, default_value = "chaser")]
+        away: String,
+        /// Play this many matches (seeds seed, seed+1, ...) on all cores and report
+        /// win/draw/loss with confidence intervals.
+        #[arg(long, default_value_t = 1)]
+        matches: usize,
+        /// Draw the match (field, trajectories, shots) to this SVG file.
+        #[arg(long)]
+        plot: Option<PathBuf>,
+        /// Run at wall-clock speed, for watching.
+        #[arg(long)]
+        realtime: bool,
+        /// Length of a half in seconds (default from the configuration: 300).
+        #[arg(long)]
+        half: Option<f64>,
+        /// Run the TeamChaos behaviors of this directory instead of the built-in ones.
+        #[arg(long)]
+        behaviors: Option<PathBuf>,
+    },
     /// Run a demo: an Agora with Members exchanging messages.
     Demo {
         /// Which example to run.
@@ -139,6 +172,19 @@ fn main() -> Result<()> {
             BrianCommand::Eval { dir, input, trace } => brian::eval(&dir, input.as_deref(), trace)?,
             BrianCommand::Plot { dir, out } => brian::plot(&dir, &out)?,
         },
+        Command::Sim { config, seed, home, away, matches, plot, realtime, half, behaviors } => {
+            sim::run(&sim::SimArgs {
+                config,
+                seed,
+                home,
+                away,
+                matches,
+                plot,
+                realtime,
+                half,
+                behaviors,
+            })?
+        }
         Command::Behave { file, world, cycles, period_ms } => {
             behave::behave(&file, world.as_deref(), cycles, period_ms)?
         }

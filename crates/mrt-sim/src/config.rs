@@ -355,3 +355,15 @@ mod tests {
         }
     }
 }
+
+#[cfg(test)]
+mod shipped {
+    use super::*;
+
+    /// `configs/sim/default.toml` documents exactly the built-in defaults.
+    #[test]
+    fn the_shipped_default_file_equals_the_built_in_defaults() {
+        let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../configs/sim/default.toml");
+        assert_eq!(SimConfig::from_file(path).unwrap(), SimConfig::default());
+    }
+}

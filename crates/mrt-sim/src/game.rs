@@ -379,7 +379,8 @@ mod tests {
     #[test]
     fn the_chaos_team_alone_scores_within_two_minutes() {
         let cfg = short(2.0, 2);
-        let home = crate::teams::team(crate::teams::Stack::Chaos, 2, None).unwrap();
+        let home =
+            crate::teams::team(crate::teams::Stack::Chaos, 2, cfg.robot.radius, None).unwrap();
         let report = Match::new(&cfg, 3, home, Vec::new()).unwrap().play(120.0, |_| {});
         assert!(report.score.0 >= 1, "{:?} {:?} {:?}", report.score, report.stats, report.calls);
     }

@@ -89,24 +89,31 @@ pub fn embedded_teamchaos() -> Result<PathBuf, String> {
 /// A robot driven by ThinkingCap.
 pub struct ChaosBrain {
     cap: ThinkingCap,
+    /// The base's radius, mm: TeamChaos measured distances from an AIBO's head, so on a round
+    /// base the brain measures LPS distances from the robot's edge.
+    edge: f64,
 }
 
 impl ChaosBrain {
     /// The goalkeeper (`goalkeeper.lua`) or a field player (`player.hfsm.lua`) of `dir`.
-    pub fn new(dir: &Path, keeper: bool) -> Result<ChaosBrain, String> {
+    pub fn new(dir: &Path, keeper: bool, robot_radius_m: f64) -> Result<ChaosBrain, String> {
         let sandbox = Sandbox::default();
         let cap = if keeper {
             ThinkingCap::with_behavior(dir, "goalkeeper", sandbox)
         } else {
             ThinkingCap::with_hfsm(dir, dir.join("player.hfsm.lua"), sandbox)
         };
-        Ok(ChaosBrain { cap: cap.map_err(|e| e.to_string())? })
+        Ok(ChaosBrain { cap: cap.map_err(|e| e.to_string())?, edge: robot_radius_m * 1000.0 })
     }
 }
 
 impl Brain for ChaosBrain {
     fn cycle(&mut self, world: &WorldSnapshot) -> RobotCommand {
-        let c = self.cap.cycle(world.clone());
+        let mut seen = world.clone();
+        for o in &mut seen.lps {
+            o.rho = (o.rho - self.edge).max(0.0);
+        }
+        let c = self.cap.cycle(seen);
         for e in &c.errors {
             tracing::warn!("chaos robot: {e}");
         }
@@ -123,6 +130,7 @@ impl Brain for ChaosBrain {
 pub fn team(
     stack: Stack,
     size: usize,
+    robot_radius_m: f64,
     behaviors: Option<&Path>,
 ) -> Result<Vec<Box<dyn Brain>>, String> {
     match stack {
@@ -135,7 +143,10 @@ pub fn team(
                 None => embedded_teamchaos()?,
             };
             (0..size)
-                .map(|i| ChaosBrain::new(&dir, i == 0).map(|b| Box::new(b) as Box<dyn Brain>))
+                .map(|i| {
+                    ChaosBrain::new(&dir, i == 0, robot_radius_m)
+                        .map(|b| Box::new(b) as Box<dyn Brain>)
+                })
                 .collect()
         }
     }

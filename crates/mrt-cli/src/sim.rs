@@ -1,0 +1,315 @@
+//! `mrt sim`: a simulated match (or a series of them) on the embedded default world.
+
+use anyhow::{anyhow, Context as _, Result};
+use indicatif::{ProgressBar, ProgressStyle};
+use mrt_sim::config::SimConfig;
+use mrt_sim::game::{Match, MatchReport};
+use mrt_sim::referee::{Call, Team};
+use mrt_sim::teams::{team, Stack};
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+/// What `mrt sim` was asked.
+pub struct SimArgs {
+    pub config: Option<PathBuf>,
+    pub seed: u64,
+    pub home: String,
+    pub away: String,
+    pub matches: usize,
+    pub plot: Option<PathBuf>,
+    pub realtime: bool,
+    pub half: Option<f64>,
+    pub behaviors: Option<PathBuf>,
+}
+
+fn config(args: &SimArgs) -> Result<SimConfig> {
+    let mut cfg = match &args.config {
+        Some(p) => SimConfig::from_file(p).map_err(|e| anyhow!("{e}"))?,
+        None => SimConfig::default(),
+    };
+    if let Some(h) = args.half {
+        cfg.rules.half_duration = h;
+    }
+    cfg.validate().map_err(|e| anyhow!("{e}"))?;
+    Ok(cfg)
+}
+
+fn play_one(
+    cfg: &SimConfig,
+    seed: u64,
+    stacks: (Stack, Stack),
+    behaviors: Option<&Path>,
+    record: bool,
+    mut progress: impl FnMut(f64),
+) -> Result<MatchReport> {
+    let n = cfg.rules.team_size;
+    let r = cfg.robot.radius;
+    let home = team(stacks.0, n, r, behaviors).map_err(|e| anyhow!("home team: {e}"))?;
+    let away = team(stacks.1, n, r, behaviors).map_err(|e| anyhow!("away team: {e}"))?;
+    let mut m = Match::new(cfg, seed, home, away).map_err(|e| anyhow!("{e}"))?;
+    m.record_frames(record);
+    Ok(m.play(f64::MAX, &mut progress))
+}
+
+/// Runs `mrt sim`.
+pub fn run(args: &SimArgs) -> Result<()> {
+    let cfg = config(args)?;
+    let stacks = (
+        Stack::parse(&args.home).map_err(|e| anyhow!("--home: {e}"))?,
+        Stack::parse(&args.away).map_err(|e| anyhow!("--away: {e}"))?,
+    );
+    if args.matches > 1 {
+        return series(args, &cfg, stacks);
+    }
+    let length = 2.0 * cfg.rules.half_duration;
+    let bar = ProgressBar::new(length.ceil() as u64).with_style(
+        ProgressStyle::with_template(
+            "{spinner} match time {pos}/{len} s [{bar:40}] {msg} ({elapsed})",
+        )
+        .map_err(|e| anyhow!("{e}"))?
+        .progress_chars("=> "),
+    );
+    let started = std::time::Instant::now();
+    let realtime = args.realtime;
+    let report =
+        play_one(&cfg, args.seed, stacks, args.behaviors.as_deref(), args.plot.is_some(), |t| {
+            bar.set_position(t as u64);
+            if realtime {
+                let ahead = t - started.elapsed().as_secs_f64();
+                if ahead > 0.0 {
+                    std::thread::sleep(std::time::Duration::from_secs_f64(ahead));
+                }
+            }
+        })?;
+    bar.finish_and_clear();
+    let (h, a) = (stacks.0.name(), stacks.1.name());
+    println!(
+        "{h} (home) {} : {} {a} (away)   seed {}",
+        report.score.0, report.score.1, report.seed
+    );
+    let total =
+        (report.stats[0].possession_cycles + report.stats[1].possession_cycles).max(1) as f64;
+    for (i, name) in [(0, h), (1, a)] {
+        let s = &report.stats[i];
+        println!(
+            "  {name:<8} goals {:>2}  shots {:>3}  possession {:>5.1} %",
+            s.goals,
+            s.shots,
+            100.0 * s.possession_cycles as f64 / total
+        );
+    }
+    for (t, call) in &report.calls {
+        if let Call::Goal(team) = call {
+            let who = if *team == Team::Home { h } else { a };
+            println!("  goal {who:<8} at {:>3}:{:02}", (*t as u64) / 60, (*t as u64) % 60);
+        }
+    }
+    println!(
+        "  {:.0} s of play simulated in {:.1} s; trajectory hash {:016x}",
+        report.duration,
+        started.elapsed().as_secs_f64(),
+        report.trajectory_hash
+    );
+    if let Some(p) = &args.plot {
+        std::fs::write(p, plot(&cfg, &report, (h, a)))
+            .with_context(|| format!("cannot write {}", p.display()))?;
+        println!("  drawing: {}", p.display());
+    }
+    Ok(())
+}
+
+/// Wilson score interval (95 %) of `k` successes in `n` trials, in percent.
+fn wilson(k: usize, n: usize) -> (f64, f64) {
+    if n == 0 {
+        return (0.0, 100.0);
+    }
+    let (n, p, z) = (n as f64, k as f64 / n as f64, 1.96_f64);
+    let centre = (p + z * z / (2.0 * n)) / (1.0 + z * z / n);
+    let half = z * (p * (1.0 - p) / n + z * z / (4.0 * n * n)).sqrt() / (1.0 + z * z / n);
+    (100.0 * (centre - half).max(0.0), 100.0 * (centre + half).min(1.0))
+}
+
+fn series(args: &SimArgs, cfg: &SimConfig, stacks: (Stack, Stack)) -> Result<()> {
+    let threads = std::thread::available_parallelism().map_or(1, usize::from).min(args.matches);
+    let bar = ProgressBar::new(args.matches as u64).with_style(
+        ProgressStyle::with_template(
+            "{spinner} matches {pos}/{len} [{bar:40}] ({elapsed}, eta {eta})",
+        )
+        .map_err(|e| anyhow!("{e}"))?
+        .progress_chars("=> "),
+    );
+    let seeds: Vec<u64> = (0..args.matches as u64).map(|k| args.seed.wrapping_add(k)).collect();
+    let results = std::sync::Mutex::new(Vec::new());
+    std::thread::scope(|s| {
+        for chunk in seeds.chunks(seeds.len().div_ceil(threads)) {
+            let (bar, results, behaviors) = (&bar, &results, args.behaviors.as_deref());
+            s.spawn(move || {
+                for &seed in chunk {
+                    let r = play_one(cfg, seed, stacks, behaviors, false, |_| {});
+                    if let Ok(mut v) = results.lock() {
+                        v.push(r.map(|r| (seed, r.score)));
+                    }
+                    bar.inc(1);
+                }
+            });
+        }
+    });
+    bar.finish_and_clear();
+    let results = results.into_inner().map_err(|_| anyhow!("a match thread failed"))?;
+    let mut scores = Vec::new();
+    for r in results {
+        scores.push(r?);
+    }
+    scores.sort();
+    let n = scores.len();
+    let wins = scores.iter().filter(|(_, (h, a))| h > a).count();
+    let draws = scores.iter().filter(|(_, (h, a))| h == a).count();
+    let losses = n - wins - draws;
+    let (h, a) = (stacks.0.name(), stacks.1.name());
+    println!(
+        "{n} matches, {h} (home) against {a} (away), seeds {}..={}",
+        args.seed,
+        args.seed + n as u64 - 1
+    );
+    for (label, k) in [("wins", wins), ("draws", draws), ("losses", losses)] {
+        let (lo, hi) = wilson(k, n);
+        println!(
+            "  {label:<7}{k:>4}  ({:>5.1} %, 95 % CI {lo:.1}–{hi:.1} %)",
+            100.0 * k as f64 / n as f64
+        );
+    }
+    let goals: (u32, u32) = scores.iter().fold((0, 0), |acc, (_, (x, y))| (acc.0 + x, acc.1 + y));
+    println!(
+        "  goals {} : {} (mean {:.2} : {:.2})",
+        goals.0,
+        goals.1,
+        goals.0 as f64 / n as f64,
+        goals.1 as f64 / n as f64
+    );
+    Ok(())
+}
+
+/// The match as SVG: the field, every robot's and the ball's trajectory, shots and goals.
+fn plot(cfg: &SimConfig, r: &MatchReport, names: (&str, &str)) -> String {
+    let f = &cfg.field;
+    let (hl, hw, b) = (f.length / 2.0, f.width / 2.0, f.border);
+    let scale = 50.0; // px per m
+    let (w, h) = ((f.length + 2.0 * b) * scale, (f.width + 2.0 * b) * scale + 40.0);
+    let px = |x: f64| (x + hl + b) * scale;
+    let py = |y: f64| (hw + b - y) * scale + 40.0;
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        r##"<svg xmlns="http://www.w3.org/2000/svg" width="{w:.0}" height="{h:.0}" viewBox="0 0 {w:.0} {h:.0}" font-family="sans-serif">"##
+    );
+    let _ = writeln!(
+        s,
+        r##"<rect x="0" y="40" width="{w:.0}" height="{:.0}" fill="#2e7d32"/>"##,
+        h - 40.0
+    );
+    let line = r##"stroke="white" stroke-width="2" fill="none""##;
+    let _ = writeln!(
+        s,
+        r##"<rect x="{:.1}" y="{:.1}" width="{:.1}" height="{:.1}" {line}/>"##,
+        px(-hl),
+        py(hw),
+        f.length * scale,
+        f.width * scale
+    );
+    let _ = writeln!(
+        s,
+        r##"<line x1="{:.1}" y1="{:.1}" x2="{:.1}" y2="{:.1}" {line}/>"##,
+        px(0.0),
+        py(hw),
+        px(0.0),
+        py(-hw)
+    );
+    let _ = writeln!(
+        s,
+        r##"<circle cx="{:.1}" cy="{:.1}" r="{:.1}" {line}/>"##,
+        px(0.0),
+        py(0.0),
+        f.centre_circle_radius * scale
+    );
+    for (side, colour) in [(-1.0, "#1565c0"), (1.0, "#fdd835")] {
+        let x = if side < 0.0 { px(-hl - f.goal_depth) } else { px(hl) };
+        let _ = writeln!(
+            s,
+            r##"<rect x="{x:.1}" y="{:.1}" width="{:.1}" height="{:.1}" fill="{colour}"/>"##,
+            py(f.goal_width / 2.0),
+            f.goal_depth * scale,
+            f.goal_width * scale
+        );
+        let pa = if side < 0.0 { px(-hl) } else { px(hl - f.penalty_area_depth) };
+        let _ = writeln!(
+            s,
+            r##"<rect x="{pa:.1}" y="{:.1}" width="{:.1}" height="{:.1}" {line}/>"##,
+            py(f.penalty_area_width / 2.0),
+            f.penalty_area_depth * scale,
+            f.penalty_area_width * scale
+        );
+    }
+    let n = cfg.rules.team_size;
+    let robots = r.frames.first().map_or(0, |fr| fr.robots.len());
+    for i in 0..robots {
+        let colour = if i < n { "#e53935" } else { "#8e24aa" };
+        let mut d = String::new();
+        for (k, fr) in r.frames.iter().enumerate() {
+            let (x, y, _) = fr.robots[i];
+            let _ = write!(d, "{}{:.1},{:.1} ", if k == 0 { "M" } else { "L" }, px(x), py(y));
+        }
+        let _ = writeln!(
+            s,
+            r##"<path d="{d}" stroke="{colour}" stroke-width="1.2" fill="none" opacity="0.55"/>"##
+        );
+    }
+    // The ball's path, broken where the referee moved it (kickoff, out, dropped ball).
+    let mut d = String::new();
+    let mut last: Option<(f64, f64)> = None;
+    for fr in &r.frames {
+        let jump = last.is_none_or(|(x, y)| (fr.ball.0 - x).hypot(fr.ball.1 - y) > 1.5);
+        let _ =
+            write!(d, "{}{:.1},{:.1} ", if jump { "M" } else { "L" }, px(fr.ball.0), py(fr.ball.1));
+        last = Some(fr.ball);
+    }
+    let _ = writeln!(
+        s,
+        r##"<path d="{d}" stroke="white" stroke-width="1.5" fill="none" opacity="0.8"/>"##
+    );
+    for (_, robot, (x, y)) in &r.shots {
+        let colour = if *robot < n { "#e53935" } else { "#8e24aa" };
+        let _ = writeln!(
+            s,
+            r##"<circle cx="{:.1}" cy="{:.1}" r="4" fill="{colour}" stroke="black"/>"##,
+            px(*x),
+            py(*y)
+        );
+    }
+    let goals = r.calls.iter().filter(|(_, c)| matches!(c, Call::Goal(_))).count();
+    let _ = writeln!(
+        s,
+        r##"<text x="10" y="26" font-size="20">{} (home, red) {} : {} {} (away, purple) — seed {}, {} goals, {} shots (dots); white: the ball</text>"##,
+        names.0,
+        r.score.0,
+        r.score.1,
+        names.1,
+        r.seed,
+        goals,
+        r.shots.len()
+    );
+    s.push_str("</svg>\n");
+    s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Wilson interval, by hand: 5 of 10 at 95 % gives 23.7 %–76.3 %.
+    #[test]
+    fn wilson_interval_by_hand() {
+        let (lo, hi) = wilson(5, 10);
+        assert!((lo - 23.66).abs() < 0.05 && (hi - 76.34).abs() < 0.05, "{lo} {hi}");
+        assert_eq!(wilson(0, 0), (0.0, 100.0));
+    }
+}

@@ -1,0 +1,66 @@
+//! `mrt sim`: a short match, its reproducibility, the drawing, a series, bad options.
+
+#![allow(clippy::unwrap_used)]
+
+use std::process::Command;
+
+fn mrt() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_mrt"))
+}
+
+fn run(args: &[&str]) -> (bool, String, String) {
+    let out = mrt().arg("sim").args(args).output().unwrap();
+    (
+        out.status.success(),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+fn hash_of(stdout: &str) -> String {
+    stdout.split("trajectory hash ").nth(1).unwrap().split_whitespace().next().unwrap().to_string()
+}
+
+#[test]
+fn a_short_match_reports_score_stats_and_reproduces_from_its_seed() {
+    let (ok, out, err) = run(&["--half", "20", "--seed", "5"]);
+    assert!(ok, "{err}");
+    assert!(out.starts_with("chaos (home) ") && out.contains("chaser (away)   seed 5"), "{out}");
+    assert!(out.contains("possession") && out.contains("40 s of play"), "{out}");
+    let (_, again, _) = run(&["--half", "20", "--seed", "5"]);
+    assert_eq!(hash_of(&out), hash_of(&again), "same seed, same match");
+    let (_, other, _) = run(&["--half", "20", "--seed", "6"]);
+    assert_ne!(hash_of(&out), hash_of(&other));
+}
+
+#[test]
+fn the_match_is_drawn_as_svg() {
+    let svg = std::env::temp_dir().join(format!("mrt-sim-cli-{}.svg", std::process::id()));
+    let (ok, out, err) = run(&["--half", "10", "--plot", svg.to_str().unwrap()]);
+    assert!(ok && out.contains("drawing: "), "{out}{err}");
+    let text = std::fs::read_to_string(&svg).unwrap();
+    assert!(text.starts_with("<svg") && text.contains("<path") && text.contains("seed 1"));
+    std::fs::remove_file(&svg).unwrap();
+}
+
+#[test]
+fn a_series_reports_wins_draws_and_losses_with_intervals() {
+    let (ok, out, err) =
+        run(&["--half", "5", "--matches", "3", "--home", "chaser", "--away", "chaser"]);
+    assert!(ok, "{err}");
+    assert!(
+        out.starts_with("3 matches, chaser (home) against chaser (away), seeds 1..=3"),
+        "{out}"
+    );
+    assert!(out.contains("wins") && out.contains("95 % CI"), "{out}");
+}
+
+#[test]
+fn bad_options_are_clear_errors() {
+    let (ok, _, err) = run(&["--home", "milan9"]);
+    assert!(!ok && err.contains("--home: unknown team stack 'milan9'"), "{err}");
+    let (ok, _, err) = run(&["--half=-3"]);
+    assert!(!ok && err.contains("half_duration"), "{err}");
+    let (ok, _, err) = run(&["--config", "/nonexistent.toml"]);
+    assert!(!ok && err.contains("/nonexistent.toml"), "{err}");
+}
