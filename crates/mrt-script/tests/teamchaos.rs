@@ -123,6 +123,7 @@ fn the_shipped_directory_loads_every_behavior_and_each_runs_cleanly() {
             "go2ball",
             "goalkeeper",
             "lookball",
+            "stand",
             "trackbnet1",
         ],
         "hbm.lua and attacker.hfsm.lua are not behaviors"

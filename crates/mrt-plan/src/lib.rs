@@ -1,0 +1,58 @@
+//! # mrt-plan: kinematics, two-mice odometry and guidance
+//!
+//! The acting end of an MRT robot as a plain library (no bus, no Lua): from a wanted velocity
+//! to wheel speeds for the two MRT bases (MRT manual ch. 12: IANUS3, Triskar; the AIRBoard of
+//! ch. 5 takes one set point per motor), the dead-reckoning sensor made of two optical mice
+//! (manual ch. 4), and the three guidance modes of the ISocRob Guidance µAgent (seed `003`
+//! §3.2.3): velocity with a sonar stop, go-to-posture, and potential fields around obstacles,
+//! including "behind the ball" targets.
+//!
+//! ```
+//! use mrt_core::Pose2;
+//! use mrt_plan::kinematics::{integrate, DiffDrive, Kinematics, Twist};
+//! use mrt_plan::mice::MiceOdometry;
+//!
+//! // IANUS3 asked for 2 m/s while turning at 1 rad/s: the right wheel would need
+//! // (2 + 0.2) / 0.05 = 44 rad/s > 24, so the whole twist is scaled by 24/44 (curvature kept).
+//! let ianus = DiffDrive::ianus3();
+//! let twist = ianus.limit(&Twist::new(2.0, 0.0, 1.0));
+//! assert!((twist.vx - 12.0 / 11.0).abs() < 1e-9 && (twist.omega - 6.0 / 11.0).abs() < 1e-9);
+//! let wheels = ianus.inverse(&twist); // rad/s, [left, right]
+//! assert!(wheels.right() > wheels.left());
+//!
+//! // The mice see that motion for 20 ms and give it back.
+//! let after = integrate(Pose2::identity(), &twist, 0.02);
+//! let mice = MiceOdometry::new(0.2, 1e-4)?;
+//! let readings = mice.readings_for(after.x, after.y, after.theta);
+//! let d = mice.displacement(&readings)?;
+//! assert!((d.dx - after.x).abs() < 1e-12 && (d.dtheta - after.theta).abs() < 1e-12);
+//! # Ok::<(), mrt_plan::PlanError>(())
+//! ```
+//!
+//! Start with [`kinematics::Kinematics`] and [`kinematics::integrate`] (the simulator's motion
+//! step), [`mice::MiceOdometry`], and [`guidance::PotentialField`].
+//!
+//! | seed name | Rust |
+//! |---|---|
+//! | IANUS3 base, two central wheels, 1.2 m/s (manual §12.5) | [`kinematics::DiffDrive`], [`kinematics::DiffDriveParams::IANUS3`] |
+//! | Triskar base, three omni wheels at 120° (manual §12.6) | [`kinematics::Omni3`], [`kinematics::Omni3Params::TRISKAR`] |
+//! | AIRBoard set points, PWM (manual ch. 5) | [`kinematics::WheelSpeeds`], [`kinematics::duty_cycle`] |
+//! | arc of circumference per sampling period (manual §4.1) | [`kinematics::integrate`] |
+//! | mice readings `x̄_l, ȳ_l, x̄_r, ȳ_r` (manual §4.1) | [`mice::MiceReadings`] |
+//! | eq. (4.1), (4.2) and the mid-point of the mice | [`mice::MiceOdometry::displacement`], [`mice::MiceArcs`] |
+//! | eq. (4.3)–(4.5) | [`mice::update_pose`] |
+//! | `x̄_r = x̄_l` error detection, error reduction (manual §4.2) | [`mice::MiceOdometry::check`], [`mice::MiceOdometry::reduce`] |
+//! | velocity mode, halted by the sonars (ISocRob §3.2.3) | [`guidance::VelocityGuard`], [`guidance::Sonar`] |
+//! | position mode | [`guidance::PositionMode`] |
+//! | potential field mode, ball as a repelling obstacle | [`guidance::PotentialField`], [`guidance::Obstacle`], [`guidance::behind_ball`], [`guidance::sonar_obstacles`] |
+//!
+//! The manual's mice equations have typos; [`mice`] lists each one with the corrected formula,
+//! and a test pins each fix. No feature flags. Errors: [`PlanError`].
+#![deny(missing_docs)]
+
+mod error;
+pub mod guidance;
+pub mod kinematics;
+pub mod mice;
+
+pub use error::PlanError;
