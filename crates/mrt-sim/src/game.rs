@@ -63,13 +63,13 @@ pub struct MatchReport {
     pub frames: Vec<Frame>,
 }
 
-/// A match in progress.
-pub struct Match {
+/// The physical side of a match, whatever drives the robots: the world, the referee, the
+/// robots' eyes with their random streams, and the book (statistics, hash, calls, frames).
+pub struct Pitch {
     cfg: SimConfig,
     seed: u64,
     world: World,
     referee: Referee,
-    brains: Vec<Box<dyn Brain>>,
     eyes: Vec<Perception>,
     rngs: Vec<ChaCha8Rng>,
     stats: [TeamStats; 2],
@@ -92,44 +92,33 @@ fn mm(x: f64) -> i64 {
     (x * 1000.0).round() as i64
 }
 
-impl Match {
-    /// A match between `home` and `away` (each `cfg.rules.team_size` brains; the first is
-    /// the goalkeeper; an empty `away` leaves home alone on the field), with all randomness
-    /// drawn from `seed`.
-    pub fn new(
-        cfg: &SimConfig,
-        seed: u64,
-        home: Vec<Box<dyn Brain>>,
-        away: Vec<Box<dyn Brain>>,
-    ) -> Result<Match, String> {
+impl Pitch {
+    /// A pitch with `home` and `away` robots (`away` is `cfg.rules.team_size` or 0: home alone
+    /// on the field), kickoff done, all randomness drawn from `seed`.
+    pub fn new(cfg: &SimConfig, seed: u64, home: usize, away: usize) -> Result<Pitch, String> {
         let n = cfg.rules.team_size;
-        if home.len() != n || (away.len() != n && !away.is_empty()) {
+        if home != n || (away != n && away != 0) {
             return Err(format!(
-                "each team needs {n} brains (home has {}, away {}; an empty away team plays \
-                 alone on the field)",
-                home.len(),
-                away.len()
+                "each team needs {n} robots (home has {home}, away {away}; an empty away team \
+                 plays alone on the field)"
             ));
         }
         cfg.validate()?;
-        let robots = home.len() + away.len();
+        let robots = home + away;
         let mut world = World::new(cfg, robots);
         let mut referee = Referee::new(n);
         referee.start(&mut world);
-        let brains: Vec<Box<dyn Brain>> = home.into_iter().chain(away).collect();
-        let eyes = (0..robots).map(Perception::new).collect();
         let rngs = (0..robots as u64)
             .map(|i| {
                 ChaCha8Rng::seed_from_u64(seed.wrapping_mul(0x9E37_79B9_7F4A_7C15).wrapping_add(i))
             })
             .collect();
-        Ok(Match {
+        Ok(Pitch {
             cfg: cfg.clone(),
             seed,
             world,
             referee,
-            brains,
-            eyes,
+            eyes: (0..robots).map(Perception::new).collect(),
             rngs,
             stats: Default::default(),
             hash: FNV_OFFSET,
@@ -140,9 +129,9 @@ impl Match {
         })
     }
 
-    /// Keeps one [`Frame`] per control cycle for drawings.
-    pub fn record_frames(&mut self, on: bool) {
-        self.record = on;
+    /// The configuration.
+    pub fn config(&self) -> &SimConfig {
+        &self.cfg
     }
 
     /// The world.
@@ -160,37 +149,34 @@ impl Match {
         self.referee.state() == GameState::Finished
     }
 
-    /// Total simulated time of the match, s.
-    pub fn length(&self) -> f64 {
-        2.0 * self.cfg.rules.half_duration
+    /// Robot `i` looks through its object sensor.
+    pub fn look(&mut self, i: usize) -> WorldSnapshot {
+        self.eyes[i].look(&self.world, &self.referee, &self.cfg.sensor, &mut self.rngs[i])
     }
 
-    /// Runs one control cycle and the physics up to the next one. Returns the referee's calls.
-    pub fn cycle(&mut self) -> Vec<Call> {
-        let playing = self.referee.state() == GameState::Playing;
-        let now = self.world.time();
-        for i in 0..self.brains.len() {
-            let snapshot =
-                self.eyes[i].look(&self.world, &self.referee, &self.cfg.sensor, &mut self.rngs[i]);
-            let cmd = self.brains[i].cycle(&snapshot);
-            if !playing {
-                self.world.drive(i, Drive::default());
-                continue;
-            }
-            self.world.drive(
-                i,
-                Drive {
-                    forward: cmd.vlin / 1000.0,
-                    left: cmd.vlat / 1000.0,
-                    turn: cmd.vrot.to_radians(),
-                },
-            );
-            if cmd.kick.is_some() && self.world.kick(i) {
-                let team = self.referee.team_of(i);
-                self.stats[team.index()].shots += 1;
-                self.shots.push((now, i, self.world.ball()));
-            }
+    /// Applies robot `i`'s command (mm/s, deg/s; a kick request fires the kicker). Outside
+    /// `PLAYING` the robot is held still.
+    pub fn apply(&mut self, i: usize, cmd: &RobotCommand) {
+        if self.referee.state() != GameState::Playing {
+            self.world.drive(i, Drive::default());
+            return;
         }
+        let drive = Drive {
+            forward: cmd.vlin / 1000.0,
+            left: cmd.vlat / 1000.0,
+            turn: cmd.vrot.to_radians(),
+        };
+        self.world.drive(i, drive);
+        if cmd.kick.is_some() && self.world.kick(i) {
+            let team = self.referee.team_of(i);
+            self.stats[team.index()].shots += 1;
+            self.shots.push((self.world.time(), i, self.world.ball()));
+        }
+    }
+
+    /// Books this control cycle, then runs the physics (with the referee) up to the next one.
+    /// Returns the referee's calls.
+    pub fn advance(&mut self) -> Vec<Call> {
         self.account();
         let steps =
             (self.cfg.rules.control_period / self.cfg.rules.physics_step).round().max(1.0) as usize;
@@ -234,17 +220,16 @@ impl Match {
         }
     }
 
-    /// Plays until the end (or until `max_seconds` of simulated time), calling `progress` with
-    /// the simulated time after each control cycle.
-    pub fn play(mut self, max_seconds: f64, mut progress: impl FnMut(f64)) -> MatchReport {
-        while !self.finished() && self.world.time() < max_seconds {
-            self.cycle();
-            progress(self.world.time());
-        }
-        let score = self.referee.score();
+    /// Keeps one [`Frame`] per control cycle for drawings.
+    pub fn record_frames(&mut self, on: bool) {
+        self.record = on;
+    }
+
+    /// The match's report.
+    pub fn report(self) -> MatchReport {
         MatchReport {
             seed: self.seed,
-            score,
+            score: self.referee.score(),
             stats: self.stats,
             trajectory_hash: self.hash,
             duration: self.world.time(),
@@ -252,6 +237,68 @@ impl Match {
             shots: self.shots,
             frames: self.frames,
         }
+    }
+}
+
+/// A match whose robots' brains are called directly, in order (the fast mode; see
+/// [`crate::bus`] for robots as Agoras on the bus).
+pub struct Match {
+    pitch: Pitch,
+    brains: Vec<Box<dyn Brain>>,
+}
+
+impl Match {
+    /// A match between `home` and `away` (each `cfg.rules.team_size` brains; the first is
+    /// the goalkeeper; an empty `away` leaves home alone on the field), with all randomness
+    /// drawn from `seed`.
+    pub fn new(
+        cfg: &SimConfig,
+        seed: u64,
+        home: Vec<Box<dyn Brain>>,
+        away: Vec<Box<dyn Brain>>,
+    ) -> Result<Match, String> {
+        let pitch = Pitch::new(cfg, seed, home.len(), away.len())?;
+        Ok(Match { pitch, brains: home.into_iter().chain(away).collect() })
+    }
+
+    /// Keeps one [`Frame`] per control cycle for drawings.
+    pub fn record_frames(&mut self, on: bool) {
+        self.pitch.record_frames(on);
+    }
+
+    /// The world.
+    pub fn world(&self) -> &World {
+        self.pitch.world()
+    }
+
+    /// The referee.
+    pub fn referee(&self) -> &Referee {
+        self.pitch.referee()
+    }
+
+    /// Whether the match is over.
+    pub fn finished(&self) -> bool {
+        self.pitch.finished()
+    }
+
+    /// Runs one control cycle and the physics up to the next one. Returns the referee's calls.
+    pub fn cycle(&mut self) -> Vec<Call> {
+        for i in 0..self.brains.len() {
+            let snapshot = self.pitch.look(i);
+            let cmd = self.brains[i].cycle(&snapshot);
+            self.pitch.apply(i, &cmd);
+        }
+        self.pitch.advance()
+    }
+
+    /// Plays until the end (or until `max_seconds` of simulated time), calling `progress` with
+    /// the simulated time after each control cycle.
+    pub fn play(mut self, max_seconds: f64, mut progress: impl FnMut(f64)) -> MatchReport {
+        while !self.finished() && self.world().time() < max_seconds {
+            self.cycle();
+            progress(self.world().time());
+        }
+        self.pitch.report()
     }
 }
 
