@@ -58,6 +58,10 @@ enum Command {
         /// Run the TeamChaos behaviors of this directory instead of the built-in ones.
         #[arg(long)]
         behaviors: Option<PathBuf>,
+        /// Call the robots' brains directly instead of running each robot as an Agora with
+        /// its Members on the bus (faster; the default shows the real MRT wiring).
+        #[arg(long)]
+        direct: bool,
     },
     /// Run a demo: an Agora with Members exchanging messages.
     Demo {
@@ -172,19 +176,29 @@ fn main() -> Result<()> {
             BrianCommand::Eval { dir, input, trace } => brian::eval(&dir, input.as_deref(), trace)?,
             BrianCommand::Plot { dir, out } => brian::plot(&dir, &out)?,
         },
-        Command::Sim { config, seed, home, away, matches, plot, realtime, half, behaviors } => {
-            sim::run(&sim::SimArgs {
-                config,
-                seed,
-                home,
-                away,
-                matches,
-                plot,
-                realtime,
-                half,
-                behaviors,
-            })?
-        }
+        Command::Sim {
+            config,
+            seed,
+            home,
+            away,
+            matches,
+            plot,
+            realtime,
+            half,
+            behaviors,
+            direct,
+        } => sim::run(&sim::SimArgs {
+            config,
+            seed,
+            home,
+            away,
+            matches,
+            plot,
+            realtime,
+            half,
+            behaviors,
+            direct,
+        })?,
         Command::Behave { file, world, cycles, period_ms } => {
             behave::behave(&file, world.as_deref(), cycles, period_ms)?
         }

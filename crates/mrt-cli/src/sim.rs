@@ -2,12 +2,13 @@
 
 use anyhow::{anyhow, Context as _, Result};
 use indicatif::{ProgressBar, ProgressStyle};
+use mrt_sim::bus::BusMatch;
 use mrt_sim::config::SimConfig;
 use mrt_sim::game::{Match, MatchReport};
 use mrt_sim::referee::{Call, Team};
 use mrt_sim::teams::{team, Stack};
 use std::fmt::Write as _;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 /// What `mrt sim` was asked.
 pub struct SimArgs {
@@ -20,6 +21,7 @@ pub struct SimArgs {
     pub realtime: bool,
     pub half: Option<f64>,
     pub behaviors: Option<PathBuf>,
+    pub direct: bool,
 }
 
 fn config(args: &SimArgs) -> Result<SimConfig> {
@@ -38,12 +40,18 @@ fn play_one(
     cfg: &SimConfig,
     seed: u64,
     stacks: (Stack, Stack),
-    behaviors: Option<&Path>,
+    args: &SimArgs,
     record: bool,
     mut progress: impl FnMut(f64),
 ) -> Result<MatchReport> {
-    let n = cfg.rules.team_size;
-    let r = cfg.robot.radius;
+    let behaviors = args.behaviors.as_deref();
+    if !args.direct {
+        let mut m = BusMatch::new(cfg, seed, stacks.0, Some(stacks.1), behaviors)
+            .map_err(|e| anyhow!("{e}"))?;
+        m.record_frames(record);
+        return m.play(&mut progress).map_err(|e| anyhow!("{e}"));
+    }
+    let (n, r) = (cfg.rules.team_size, cfg.robot.radius);
     let home = team(stacks.0, n, r, behaviors).map_err(|e| anyhow!("home team: {e}"))?;
     let away = team(stacks.1, n, r, behaviors).map_err(|e| anyhow!("away team: {e}"))?;
     let mut m = Match::new(cfg, seed, home, away).map_err(|e| anyhow!("{e}"))?;
@@ -71,16 +79,15 @@ pub fn run(args: &SimArgs) -> Result<()> {
     );
     let started = std::time::Instant::now();
     let realtime = args.realtime;
-    let report =
-        play_one(&cfg, args.seed, stacks, args.behaviors.as_deref(), args.plot.is_some(), |t| {
-            bar.set_position(t as u64);
-            if realtime {
-                let ahead = t - started.elapsed().as_secs_f64();
-                if ahead > 0.0 {
-                    std::thread::sleep(std::time::Duration::from_secs_f64(ahead));
-                }
+    let report = play_one(&cfg, args.seed, stacks, args, args.plot.is_some(), |t| {
+        bar.set_position(t as u64);
+        if realtime {
+            let ahead = t - started.elapsed().as_secs_f64();
+            if ahead > 0.0 {
+                std::thread::sleep(std::time::Duration::from_secs_f64(ahead));
             }
-        })?;
+        }
+    })?;
     bar.finish_and_clear();
     let (h, a) = (stacks.0.name(), stacks.1.name());
     println!(
@@ -105,9 +112,10 @@ pub fn run(args: &SimArgs) -> Result<()> {
         }
     }
     println!(
-        "  {:.0} s of play simulated in {:.1} s; trajectory hash {:016x}",
+        "  {:.0} s of play simulated in {:.1} s ({}); trajectory hash {:016x}",
         report.duration,
         started.elapsed().as_secs_f64(),
+        if args.direct { "brains called directly" } else { "each robot an Agora on the bus" },
         report.trajectory_hash
     );
     if let Some(p) = &args.plot {
@@ -142,10 +150,10 @@ fn series(args: &SimArgs, cfg: &SimConfig, stacks: (Stack, Stack)) -> Result<()>
     let results = std::sync::Mutex::new(Vec::new());
     std::thread::scope(|s| {
         for chunk in seeds.chunks(seeds.len().div_ceil(threads)) {
-            let (bar, results, behaviors) = (&bar, &results, args.behaviors.as_deref());
+            let (bar, results) = (&bar, &results);
             s.spawn(move || {
                 for &seed in chunk {
-                    let r = play_one(cfg, seed, stacks, behaviors, false, |_| {});
+                    let r = play_one(cfg, seed, stacks, args, false, |_| {});
                     if let Ok(mut v) = results.lock() {
                         v.push(r.map(|r| (seed, r.score)));
                     }

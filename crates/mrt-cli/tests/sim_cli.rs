@@ -27,6 +27,9 @@ fn a_short_match_reports_score_stats_and_reproduces_from_its_seed() {
     assert!(ok, "{err}");
     assert!(out.starts_with("chaos (home) ") && out.contains("chaser (away)   seed 5"), "{out}");
     assert!(out.contains("possession") && out.contains("40 s of play"), "{out}");
+    assert!(out.contains("each robot an Agora on the bus"), "{out}");
+    let (_, direct, _) = run(&["--half", "20", "--seed", "5", "--direct"]);
+    assert!(direct.contains("brains called directly"), "{direct}");
     let (_, again, _) = run(&["--half", "20", "--seed", "5"]);
     assert_eq!(hash_of(&out), hash_of(&again), "same seed, same match");
     let (_, other, _) = run(&["--half", "20", "--seed", "6"]);

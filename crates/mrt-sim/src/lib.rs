@@ -19,6 +19,7 @@
 //! ```
 #![deny(missing_docs)]
 
+pub mod bus;
 pub mod config;
 pub mod game;
 pub mod referee;

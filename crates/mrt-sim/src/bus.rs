@@ -1,0 +1,397 @@
+//! Robots as Agoras on the bus (DCDT, MRT manual ch. 3): the simulator's default wiring.
+//!
+//! Each robot is one [`Agora`](mrt_dcdt::Agora) with three Members, all on the simulated clock
+//! of one [`SteppedExecutor`] so that the match stays deterministic:
+//!
+//! 1. **`Eyes`** (the camera driver and the world-state Member, periodic): looks through the
+//!    object sensor, merges the teammates' reports received over the bus, and publishes the
+//!    [`WorldSnapshot`]; it also publishes a [`MateReport`] (its pose and its ball estimate)
+//!    that the teammates' Agoras receive through their team's `InnerLinkManager` — a
+//!    `RequestType::Remote` subscription, so a robot never hears itself.
+//! 2. **the behaviors**: a [`BehaviorMember`] running the TeamChaos HFSM or goalkeeper for the
+//!    Chaos stack, or a [`BrainMember`] around any `Send` [`Brain`] (the baseline);
+//! 3. **`Motor`** (the motor and kicker driver, on message): turns each [`RobotCommand`] into
+//!    wheel set-points and kicks.
+//!
+//! Body adaptation belongs to the drivers, as the seed's Commander Module did for its legs: on
+//! the Chaos robots `Eyes` measures distances from the robot's edge and `Motor` scales the
+//! behaviors' AIBO-sized set-points (see [`crate::teams`]).
+
+use crate::game::{Brain, MatchReport, Pitch};
+use crate::referee::Call;
+use crate::teams::{embedded_teamchaos, Stack, CHAOS_LINEAR_SCALE, CHAOS_TURN_SCALE};
+use mrt_core::robot::{Estimate, Mate, RobotCommand, WorldSnapshot};
+use mrt_core::SimClock;
+use mrt_dcdt::{
+    Activation, Context, InnerLinkManager, Member, MemberError, Message, MsgType, RequestType,
+    SteppedExecutor, RESERVED_TYPES_START,
+};
+use mrt_script::member::BehaviorMember;
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+use std::path::Path;
+use std::sync::{Arc, Mutex, MutexGuard};
+use std::time::Duration;
+
+/// What a robot tells its teammates every cycle (team frame, mm).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct MateReport {
+    /// The robot's player number.
+    pub id: u32,
+    /// Where it believes it is.
+    pub pose: Estimate,
+    /// Where it believes the ball is (quality 0 when it has no idea).
+    pub ball: Estimate,
+}
+
+impl Message for MateReport {
+    const TYPE: MsgType = MsgType(RESERVED_TYPES_START + 0x40);
+    const NAME: &'static str = "MateReport";
+}
+
+/// How a team's drivers adapt the behaviors to the robot's body.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Body {
+    /// Subtracted from every LPS distance (mm).
+    pub edge: f64,
+    /// Multiplies linear set-points.
+    pub linear: f64,
+    /// Multiplies turning set-points.
+    pub turn: f64,
+}
+
+impl Body {
+    /// No adaptation.
+    pub const PLAIN: Body = Body { edge: 0.0, linear: 1.0, turn: 1.0 };
+}
+
+type Shared = Arc<Mutex<Pitch>>;
+
+fn lock(p: &Shared) -> Result<MutexGuard<'_, Pitch>, MemberError> {
+    p.lock().map_err(|_| MemberError::from("the pitch lock is poisoned"))
+}
+
+/// The camera driver and world-state Member of one robot.
+struct Eyes {
+    pitch: Shared,
+    robot: usize,
+    body: Body,
+    mates: BTreeMap<u32, Mate>,
+}
+
+impl Member for Eyes {
+    fn name(&self) -> String {
+        format!("eyes-{}", self.robot)
+    }
+
+    fn init(&mut self, ctx: &mut Context<'_>) -> Result<(), MemberError> {
+        ctx.subscribe_to::<MateReport>(RequestType::Remote);
+        Ok(())
+    }
+
+    fn do_your_job(&mut self, ctx: &mut Context<'_>) -> Result<(), MemberError> {
+        while let Some(m) = ctx.receive_msg() {
+            let r = m.get::<MateReport>()?;
+            self.mates.insert(r.id, Mate { id: r.id, at: r.pose });
+        }
+        let mut w = lock(&self.pitch)?.look(self.robot);
+        // Teammates as the bus told them, not as the simulator knows them.
+        w.mates = self.mates.values().copied().collect();
+        let id = u32::try_from(self.robot).unwrap_or(u32::MAX);
+        ctx.publish(MateReport { id, pose: w.my_pos, ball: w.global_ball });
+        for o in &mut w.lps {
+            o.rho = (o.rho - self.body.edge).max(0.0);
+        }
+        ctx.publish(w);
+        Ok(())
+    }
+}
+
+/// The motor and kicker driver of one robot.
+struct Motor {
+    pitch: Shared,
+    robot: usize,
+    body: Body,
+}
+
+impl Member for Motor {
+    fn name(&self) -> String {
+        format!("motor-{}", self.robot)
+    }
+
+    fn init(&mut self, ctx: &mut Context<'_>) -> Result<(), MemberError> {
+        ctx.subscribe_to::<RobotCommand>(RequestType::Local);
+        Ok(())
+    }
+
+    fn do_your_job(&mut self, ctx: &mut Context<'_>) -> Result<(), MemberError> {
+        let mut last = None;
+        while let Some(m) = ctx.receive_msg() {
+            last = Some(m.get::<RobotCommand>()?.clone());
+        }
+        if let Some(mut cmd) = last {
+            cmd.vlin *= self.body.linear;
+            cmd.vlat *= self.body.linear;
+            cmd.vrot *= self.body.turn;
+            lock(&self.pitch)?.apply(self.robot, &cmd);
+        }
+        Ok(())
+    }
+}
+
+/// Runs any `Send` [`Brain`] as a behavior Member: world snapshot in, command out.
+pub struct BrainMember {
+    brain: Box<dyn Brain + Send>,
+    world: Option<WorldSnapshot>,
+}
+
+impl BrainMember {
+    /// A Member around `brain`.
+    pub fn new(brain: Box<dyn Brain + Send>) -> Self {
+        Self { brain, world: None }
+    }
+}
+
+impl Member for BrainMember {
+    fn init(&mut self, ctx: &mut Context<'_>) -> Result<(), MemberError> {
+        ctx.subscribe_to::<WorldSnapshot>(RequestType::Local);
+        Ok(())
+    }
+
+    fn do_your_job(&mut self, ctx: &mut Context<'_>) -> Result<(), MemberError> {
+        while let Some(m) = ctx.receive_msg() {
+            self.world = Some(m.get::<WorldSnapshot>()?.clone());
+        }
+        if let Some(w) = &self.world {
+            ctx.publish(self.brain.cycle(w));
+        }
+        Ok(())
+    }
+}
+
+/// A match whose robots are Agoras on the bus.
+pub struct BusMatch {
+    pitch: Shared,
+    exec: SteppedExecutor,
+    period: Duration,
+    /// Each team's community of Agoras (home, then away).
+    links: Vec<InnerLinkManager>,
+}
+
+impl BusMatch {
+    /// A match between two stacks, `team_size` robots each (robot 0 keeps goal), or home alone
+    /// when `away` is `None`. `behaviors` overrides the compiled-in TeamChaos files.
+    pub fn new(
+        cfg: &crate::config::SimConfig,
+        seed: u64,
+        home: Stack,
+        away: Option<Stack>,
+        behaviors: Option<&Path>,
+    ) -> Result<BusMatch, String> {
+        let n = cfg.rules.team_size;
+        let pitch = Pitch::new(cfg, seed, n, if away.is_some() { n } else { 0 })?;
+        let pitch = Arc::new(Mutex::new(pitch));
+        let period = Duration::from_secs_f64(cfg.rules.control_period);
+        let mut exec = SteppedExecutor::new(SimClock::new(), period);
+        let dir = match behaviors {
+            Some(d) => d.to_path_buf(),
+            None => embedded_teamchaos()?,
+        };
+        let chaos_body = Body {
+            edge: cfg.robot.radius * 1000.0,
+            linear: CHAOS_LINEAR_SCALE,
+            turn: CHAOS_TURN_SCALE,
+        };
+        let mut links = Vec::new();
+        for (t, stack) in [Some(home), away].into_iter().enumerate() {
+            let Some(stack) = stack else { continue };
+            let team_link = InnerLinkManager::new();
+            links.push(team_link.clone());
+            for k in 0..n {
+                let robot = t * n + k;
+                let id = u32::try_from(robot + 1).map_err(|e| e.to_string())?;
+                let mut agora = exec
+                    .agora_builder(id)
+                    .inner_link(&team_link)
+                    .build()
+                    .map_err(|e| e.to_string())?;
+                let every = Activation::Periodic(period);
+                let body = if stack == Stack::Chaos { chaos_body } else { Body::PLAIN };
+                let eyes = Eyes { pitch: pitch.clone(), robot, body, mates: BTreeMap::new() };
+                let mut ids = vec![agora.add_member(eyes, every)];
+                ids.push(match stack {
+                    Stack::Chaos if k == 0 => {
+                        agora.add_member(BehaviorMember::hbm(&dir, "goalkeeper"), every)
+                    }
+                    Stack::Chaos => agora
+                        .add_member(BehaviorMember::hfsm(&dir, dir.join("player.hfsm.lua")), every),
+                    Stack::Chaser => {
+                        let brain = crate::game::Chaser { keeper: k == 0 };
+                        agora.add_member(BrainMember::new(Box::new(brain)), every)
+                    }
+                });
+                ids.push(agora.add_member(
+                    Motor { pitch: pitch.clone(), robot, body },
+                    Activation::OnMessage,
+                ));
+                for m in ids {
+                    agora.activate_member(m).map_err(|e| e.to_string())?;
+                }
+                exec.add_agora(agora).map_err(|e| e.to_string())?;
+            }
+        }
+        Ok(BusMatch { pitch, exec, period, links })
+    }
+
+    /// A team's community of Agoras (0 home, 1 away), to attach monitors to.
+    pub fn team_link(&self, team: usize) -> Option<&InnerLinkManager> {
+        self.links.get(team)
+    }
+
+    /// The executor, to add monitoring Agoras.
+    pub fn executor(&mut self) -> &mut SteppedExecutor {
+        &mut self.exec
+    }
+
+    /// Keeps one frame per control cycle for drawings.
+    pub fn record_frames(&mut self, on: bool) {
+        if let Ok(mut p) = self.pitch.lock() {
+            p.record_frames(on);
+        }
+    }
+
+    /// One control cycle: every Agora runs (eyes, behaviors, motors), then the physics runs
+    /// up to the next cycle. Returns the referee's calls.
+    pub fn cycle(&mut self) -> Result<Vec<Call>, String> {
+        self.exec.run_for(self.period);
+        let mut p = self.pitch.lock().map_err(|_| "the pitch lock is poisoned".to_string())?;
+        Ok(p.advance())
+    }
+
+    /// Plays until the end, calling `progress` with the simulated time after each cycle.
+    pub fn play(mut self, mut progress: impl FnMut(f64)) -> Result<MatchReport, String> {
+        loop {
+            let (done, t) = {
+                let p = self.pitch.lock().map_err(|_| "the pitch lock is poisoned".to_string())?;
+                (p.finished(), p.world().time())
+            };
+            if done {
+                break;
+            }
+            self.cycle()?;
+            progress(t);
+        }
+        let reports = self.exec.finish();
+        let failures: Vec<String> = reports
+            .iter()
+            .flat_map(|r| r.members.iter())
+            .filter(|m| m.panics > 0 || m.errors > 0)
+            .map(|m| format!("{} ({} errors, {} panics)", m.name, m.errors, m.panics))
+            .collect();
+        if !failures.is_empty() {
+            tracing::warn!("members with faults during the match: {}", failures.join(", "));
+        }
+        let pitch =
+            Arc::try_unwrap(self.pitch).map_err(|_| "the pitch is still shared".to_string())?;
+        Ok(pitch.into_inner().map_err(|_| "the pitch lock is poisoned".to_string())?.report())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::config::SimConfig;
+
+    fn short(seconds: f64, team: usize) -> SimConfig {
+        let mut cfg = SimConfig::default();
+        cfg.rules.half_duration = seconds;
+        cfg.rules.team_size = team;
+        cfg
+    }
+
+    #[test]
+    fn a_bus_match_is_deterministic_and_both_stacks_play() {
+        let cfg = short(20.0, 2);
+        let play = || {
+            BusMatch::new(&cfg, 4, Stack::Chaos, Some(Stack::Chaser), None)
+                .unwrap()
+                .play(|_| {})
+                .unwrap()
+        };
+        let (a, b) = (play(), play());
+        assert_eq!((a.score, a.trajectory_hash, &a.stats), (b.score, b.trajectory_hash, &b.stats));
+        assert!((a.duration - 40.0).abs() < 0.011, "{}", a.duration);
+        assert!(
+            a.stats[0].possession_cycles > 0 && a.stats[1].possession_cycles > 0,
+            "{:?}",
+            a.stats
+        );
+    }
+
+    /// The same robot code gives the same match whether the brains run as Members on the bus
+    /// or are called directly (the behaviors here do not read their teammates, the only input
+    /// that differs: the bus delivers a teammate's report one cycle late).
+    #[test]
+    fn the_bus_and_the_direct_wiring_play_the_same_match() {
+        let cfg = short(15.0, 2);
+        let bus = BusMatch::new(&cfg, 9, Stack::Chaos, Some(Stack::Chaser), None)
+            .unwrap()
+            .play(|_| {})
+            .unwrap();
+        let r = cfg.robot.radius;
+        let home = crate::teams::team(Stack::Chaos, 2, r, None).unwrap();
+        let away = crate::teams::team(Stack::Chaser, 2, r, None).unwrap();
+        let direct = crate::game::Match::new(&cfg, 9, home, away).unwrap().play(f64::MAX, |_| {});
+        assert_eq!((bus.score, bus.trajectory_hash), (direct.score, direct.trajectory_hash));
+    }
+
+    #[test]
+    fn the_chaos_team_alone_on_the_bus_scores_within_two_minutes() {
+        let cfg = short(120.0, 2);
+        let report =
+            BusMatch::new(&cfg, 3, Stack::Chaos, None, None).unwrap().play(|_| {}).unwrap();
+        let first = report.calls.iter().find(|(_, c)| matches!(c, Call::Goal(_)));
+        assert!(first.is_some_and(|(t, _)| *t <= 120.0), "{:?}", report.calls);
+    }
+
+    /// Teammates know each other only through the bus: a MateReport crosses the team's
+    /// InnerLinkManager (Remote subscription), never to the other team, and never to an Agora
+    /// on no link.
+    #[test]
+    fn teammates_hear_each_other_over_the_bus() {
+        struct Listen(Arc<Mutex<std::collections::BTreeSet<u32>>>);
+        impl Member for Listen {
+            fn init(&mut self, ctx: &mut Context<'_>) -> Result<(), MemberError> {
+                ctx.subscribe_to::<MateReport>(RequestType::Remote);
+                Ok(())
+            }
+            fn do_your_job(&mut self, ctx: &mut Context<'_>) -> Result<(), MemberError> {
+                while let Some(m) = ctx.receive_msg() {
+                    let id = m.get::<MateReport>()?.id;
+                    self.0.lock().map_err(|_| "poisoned")?.insert(id);
+                }
+                Ok(())
+            }
+        }
+        let cfg = short(5.0, 2);
+        let mut m = BusMatch::new(&cfg, 1, Stack::Chaser, Some(Stack::Chaser), None).unwrap();
+        let period = m.period;
+        let (on_home, alone) = (Arc::default(), Arc::default());
+        for (id, link, heard) in [(98, m.team_link(0).cloned(), &on_home), (99, None, &alone)] {
+            let mut b = m.executor().agora_builder(id);
+            if let Some(l) = &link {
+                b = b.inner_link(l);
+            }
+            let mut agora = b.build().unwrap();
+            let member = agora.add_member(Listen(Arc::clone(heard)), Activation::Periodic(period));
+            agora.activate_member(member).unwrap();
+            m.executor().add_agora(agora).unwrap();
+        }
+        for _ in 0..5 {
+            m.cycle().unwrap();
+        }
+        let ids: Vec<u32> = on_home.lock().unwrap().iter().copied().collect();
+        assert_eq!(ids, [0, 1], "the home robots' reports, not the away team's (2, 3)");
+        assert!(alone.lock().unwrap().is_empty(), "not on any team's link");
+    }
+}
