@@ -36,11 +36,12 @@ enum Command {
         /// Seed of all randomness: the same seed gives the same match.
         #[arg(long, default_value_t = 1)]
         seed: u64,
-        /// The home team's stack: chaos (Lua HFSM + fuzzy behaviors) or chaser (baseline).
-        #[arg(long, default_value = "chaos")]
+        /// The home team's stack: milan (Mr. BRIAN fuzzy behaviors), chaos (TeamChaos' Lua
+        /// state machines and fuzzy behaviors) or chaser (a hand-written baseline).
+        #[arg(long, default_value = "milan")]
         home: String,
-        /// The away team's stack.
-        #[arg(long, default_value = "chaser")]
+        /// The away team's stack (same choices).
+        #[arg(long, default_value = "chaos")]
         away: String,
         /// Play this many matches (seeds seed, seed+1, ...) on all cores and report
         /// win/draw/loss with confidence intervals.

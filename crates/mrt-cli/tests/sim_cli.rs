@@ -25,7 +25,7 @@ fn hash_of(stdout: &str) -> String {
 fn a_short_match_reports_score_stats_and_reproduces_from_its_seed() {
     let (ok, out, err) = run(&["--half", "20", "--seed", "5"]);
     assert!(ok, "{err}");
-    assert!(out.starts_with("chaos (home) ") && out.contains("chaser (away)   seed 5"), "{out}");
+    assert!(out.starts_with("milan (home) ") && out.contains("chaos (away)   seed 5"), "{out}");
     assert!(out.contains("possession") && out.contains("40 s of play"), "{out}");
     assert!(out.contains("each robot an Agora on the bus"), "{out}");
     let (_, direct, _) = run(&["--half", "20", "--seed", "5", "--direct"]);

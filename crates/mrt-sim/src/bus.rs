@@ -19,7 +19,9 @@
 
 use crate::game::{Brain, MatchReport, Pitch};
 use crate::referee::Call;
-use crate::teams::{embedded_teamchaos, Stack, CHAOS_LINEAR_SCALE, CHAOS_TURN_SCALE};
+use crate::teams::{
+    embedded_milan, embedded_teamchaos, MilanBrain, Stack, CHAOS_LINEAR_SCALE, CHAOS_TURN_SCALE,
+};
 use mrt_core::robot::{Estimate, Mate, RobotCommand, WorldSnapshot};
 use mrt_core::SimClock;
 use mrt_dcdt::{
@@ -225,6 +227,10 @@ impl BusMatch {
                     }
                     Stack::Chaos => agora
                         .add_member(BehaviorMember::hfsm(&dir, dir.join("player.hfsm.lua")), every),
+                    Stack::Milan => {
+                        let brain = MilanBrain::new(&embedded_milan()?, k == 0)?;
+                        agora.add_member(BrainMember::new(Box::new(brain)), every)
+                    }
                     Stack::Chaser => {
                         let brain = crate::game::Chaser { keeper: k == 0 };
                         agora.add_member(BrainMember::new(Box::new(brain)), every)

@@ -433,6 +433,15 @@ mod tests {
     }
 
     #[test]
+    fn the_milan_team_alone_scores_within_two_minutes() {
+        let cfg = short(2.0, 2);
+        let home =
+            crate::teams::team(crate::teams::Stack::Milan, 2, cfg.robot.radius, None).unwrap();
+        let report = Match::new(&cfg, 3, home, Vec::new()).unwrap().play(120.0, |_| {});
+        assert!(report.score.0 >= 1, "{:?} {:?} {:?}", report.score, report.stats, report.calls);
+    }
+
+    #[test]
     fn wrong_team_sizes_are_refused() {
         let cfg = short(1.0, 2);
         assert!(Match::new(&cfg, 1, chasers(1), chasers(2)).is_err());

@@ -11,7 +11,8 @@
 //! Module turned set-points into a walking style for its own body.
 
 use crate::game::{Brain, Chaser};
-use mrt_core::robot::{RobotCommand, WorldSnapshot};
+use mrt_core::robot::{lps, RobotCommand, WorldSnapshot};
+use mrt_fuzzy::brian::Brian;
 use mrt_script::{Sandbox, ThinkingCap};
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
@@ -21,6 +22,8 @@ use std::sync::OnceLock;
 pub enum Stack {
     /// TeamChaos: Lua HFSM and fuzzy HBM behaviors.
     Chaos,
+    /// Team Milan: Mr. BRIAN fuzzy behaviors (`configs/brian/milan`).
+    Milan,
     /// The hand-written baseline.
     Chaser,
 }
@@ -30,8 +33,9 @@ impl Stack {
     pub fn parse(s: &str) -> Result<Stack, String> {
         match s {
             "chaos" => Ok(Stack::Chaos),
+            "milan" => Ok(Stack::Milan),
             "chaser" => Ok(Stack::Chaser),
-            other => Err(format!("unknown team stack '{other}' (chaos, chaser)")),
+            other => Err(format!("unknown team stack '{other}' (chaos, milan, chaser)")),
         }
     }
 
@@ -39,6 +43,7 @@ impl Stack {
     pub fn name(self) -> &'static str {
         match self {
             Stack::Chaos => "chaos",
+            Stack::Milan => "milan",
             Stack::Chaser => "chaser",
         }
     }
@@ -67,23 +72,57 @@ const TEAMCHAOS: &[(&str, &str)] = &[
     ("trackbnet1.lua", include_str!("../../../behaviors/teamchaos/trackbnet1.lua")),
 ];
 
+/// Team Milan's Mr. BRIAN configuration, compiled in.
+const MILAN: &[(&str, &str)] = &[
+    ("Cando.ini", include_str!("../../../configs/brian/milan/Cando.ini")),
+    ("Predicate.ini", include_str!("../../../configs/brian/milan/Predicate.ini")),
+    ("PredicateActions.ini", include_str!("../../../configs/brian/milan/PredicateActions.ini")),
+    ("behavior.txt", include_str!("../../../configs/brian/milan/behavior.txt")),
+    (
+        "behaviors/AvoidObstacle.rul",
+        include_str!("../../../configs/brian/milan/behaviors/AvoidObstacle.rul"),
+    ),
+    ("behaviors/GoToBall.rul", include_str!("../../../configs/brian/milan/behaviors/GoToBall.rul")),
+    ("behaviors/KeepGoal.rul", include_str!("../../../configs/brian/milan/behaviors/KeepGoal.rul")),
+    ("behaviors/KickBall.rul", include_str!("../../../configs/brian/milan/behaviors/KickBall.rul")),
+    (
+        "behaviors/SearchBall.rul",
+        include_str!("../../../configs/brian/milan/behaviors/SearchBall.rul"),
+    ),
+    ("ctof.txt", include_str!("../../../configs/brian/milan/ctof.txt")),
+    ("s_ftoc.txt", include_str!("../../../configs/brian/milan/s_ftoc.txt")),
+    ("s_shape.txt", include_str!("../../../configs/brian/milan/s_shape.txt")),
+    ("shape_ctof.txt", include_str!("../../../configs/brian/milan/shape_ctof.txt")),
+    ("want.txt", include_str!("../../../configs/brian/milan/want.txt")),
+];
+
 /// Linear set-points are multiplied by this on a Middle Size League base.
 pub const CHAOS_LINEAR_SCALE: f64 = 4.0;
 /// Turning set-points are multiplied by this.
 pub const CHAOS_TURN_SCALE: f64 = 2.0;
 
+fn materialize(name: &str, files: &[(&str, &str)]) -> Result<PathBuf, String> {
+    let dir = std::env::temp_dir().join(format!("mrt-{name}-{}", std::process::id()));
+    for (file, text) in files {
+        let path = dir.join(file);
+        if let Some(parent) = path.parent() {
+            std::fs::create_dir_all(parent).map_err(|e| format!("{}: {e}", parent.display()))?;
+        }
+        std::fs::write(&path, text).map_err(|e| format!("{}: {e}", path.display()))?;
+    }
+    Ok(dir)
+}
+
 /// Writes the compiled-in TeamChaos files to a directory of this process (once) and returns it.
 pub fn embedded_teamchaos() -> Result<PathBuf, String> {
     static DIR: OnceLock<Result<PathBuf, String>> = OnceLock::new();
-    DIR.get_or_init(|| {
-        let dir = std::env::temp_dir().join(format!("mrt-teamchaos-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).map_err(|e| format!("{}: {e}", dir.display()))?;
-        for (name, text) in TEAMCHAOS {
-            std::fs::write(dir.join(name), text).map_err(|e| format!("{name}: {e}"))?;
-        }
-        Ok(dir)
-    })
-    .clone()
+    DIR.get_or_init(|| materialize("teamchaos", TEAMCHAOS)).clone()
+}
+
+/// Writes the compiled-in Team Milan configuration to a directory of this process (once).
+pub fn embedded_milan() -> Result<PathBuf, String> {
+    static DIR: OnceLock<Result<PathBuf, String>> = OnceLock::new();
+    DIR.get_or_init(|| materialize("milan", MILAN)).clone()
 }
 
 /// A robot driven by ThinkingCap.
@@ -125,6 +164,89 @@ impl Brain for ChaosBrain {
     }
 }
 
+/// A robot driven by Mr. BRIAN: the manual's Parser turns the world snapshot into crisp
+/// inputs `(name, value, reliability)`, the engine runs one cycle, the Messenger turns
+/// `SpeedModule`/`SpeedAngle` (a holonomic direction of motion), `Rotation` and `Kick` into
+/// the robot command.
+pub struct MilanBrain {
+    brian: Brian,
+    keeper: bool,
+}
+
+/// Degrees in [0, 360) of an angle in radians.
+fn deg360(a: f64) -> f64 {
+    a.to_degrees().rem_euclid(360.0)
+}
+
+impl MilanBrain {
+    /// The goalkeeper or a field player, on the configuration of `dir`.
+    pub fn new(dir: &Path, keeper: bool) -> Result<MilanBrain, String> {
+        Ok(MilanBrain { brian: Brian::from_dir(dir).map_err(|e| e.to_string())?, keeper })
+    }
+
+    /// The Parser: crisp inputs from the world snapshot (team frame, mm, degrees).
+    pub fn inputs(&self, w: &WorldSnapshot) -> Vec<(&'static str, f64, f64)> {
+        let me = w.my_pos.pose;
+        let q = w.my_pos.quality;
+        let mut v = vec![("Keeper", f64::from(u8::from(self.keeper)), 1.0), ("Always", 1.0, 1.0)];
+        v.push(("HeadingBearing", deg360(me.theta), q));
+        let ball = w.lps[lps::BALL];
+        if ball.reliability >= 0.1 {
+            let r = ball.reliability;
+            v.push(("BallDistance", ball.rho, r));
+            v.push(("BallBearing", deg360(ball.theta), r));
+            // The ball and the point 400 mm behind it on the line from the opponent's net.
+            let a = me.theta + ball.theta;
+            let (bx, by) = (me.x + ball.rho * a.cos(), me.y + ball.rho * a.sin());
+            let (gx, gy) = (9000.0 - bx, -by);
+            let g = gx.hypot(gy).max(1.0);
+            let (ux, uy) = (gx / g, gy / g);
+            let (px, py) = (bx - 400.0 * ux, by - 400.0 * uy);
+            let (dx, dy) = (px - me.x, py - me.y);
+            v.push(("ApproachDistance", dx.hypot(dy), r));
+            v.push(("ApproachAngle", deg360(dy.atan2(dx) - me.theta), r));
+            let mis = mrt_core::normalize_angle(a - uy.atan2(ux)).abs().to_degrees();
+            v.push(("Misalignment", mis, r));
+            if self.keeper {
+                // Stand 500 mm out of the goal line (x = -9000), facing the field, level with
+                // the ball within the posts.
+                v.push(("KeeperOffset", by.clamp(-900.0, 900.0) - me.y, r));
+            }
+        }
+        if self.keeper {
+            v.push(("KeeperDepth", me.x - (-9000.0 + 500.0), q));
+        }
+        let nearest = w
+            .mates
+            .iter()
+            .map(|m| (m.at.pose.x - me.x, m.at.pose.y - me.y))
+            .min_by(|a, b| a.0.hypot(a.1).total_cmp(&b.0.hypot(b.1)));
+        if let Some((dx, dy)) = nearest {
+            v.push(("ObstacleDistance", dx.hypot(dy), 1.0));
+            v.push(("ObstacleBearing", deg360(dy.atan2(dx) - me.theta), 1.0));
+        }
+        v
+    }
+}
+
+impl Brain for MilanBrain {
+    fn cycle(&mut self, w: &WorldSnapshot) -> RobotCommand {
+        let inputs = self.inputs(w);
+        let out = self.brian.run(&inputs);
+        let mut c = RobotCommand::default();
+        let speed = out.get("SpeedModule").copied().unwrap_or(0.0);
+        let dir = out.get("SpeedAngle").copied().unwrap_or(0.0).to_radians();
+        c.vlin = speed * dir.cos();
+        c.vlat = speed * dir.sin();
+        c.vrot = out.get("Rotation").copied().unwrap_or(0.0);
+        if out.get("Kick").is_some_and(|k| *k > 0.5) {
+            c.kick = Some(1);
+        }
+        c.needs.push((lps::BALL, 1.0));
+        c
+    }
+}
+
 /// The brains of one team of `size` robots (robot 0 keeps goal). `behaviors` overrides the
 /// compiled-in TeamChaos files.
 pub fn team(
@@ -134,6 +256,12 @@ pub fn team(
     behaviors: Option<&Path>,
 ) -> Result<Vec<Box<dyn Brain>>, String> {
     match stack {
+        Stack::Milan => {
+            let dir = embedded_milan()?;
+            (0..size)
+                .map(|i| MilanBrain::new(&dir, i == 0).map(|b| Box::new(b) as Box<dyn Brain>))
+                .collect()
+        }
         Stack::Chaser => {
             Ok((0..size).map(|i| Box::new(Chaser { keeper: i == 0 }) as Box<dyn Brain>).collect())
         }
