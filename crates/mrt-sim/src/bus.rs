@@ -17,6 +17,7 @@
 //! the Chaos robots `Eyes` measures distances from the robot's edge and `Motor` scales the
 //! behaviors' AIBO-sized set-points (see [`crate::teams`]).
 
+use crate::drivers::{Base, MotorDriver, SimulatedAirboard};
 use crate::game::{Brain, MatchReport, Pitch};
 use crate::referee::Call;
 use crate::teams::{
@@ -69,6 +70,10 @@ impl Body {
 
 type Shared = Arc<Mutex<Pitch>>;
 
+fn lock_pitch(p: &Shared) -> Result<MutexGuard<'_, Pitch>, String> {
+    p.lock().map_err(|_| "the pitch lock is poisoned".to_string())
+}
+
 fn lock(p: &Shared) -> Result<MutexGuard<'_, Pitch>, MemberError> {
     p.lock().map_err(|_| MemberError::from("the pitch lock is poisoned"))
 }
@@ -109,11 +114,14 @@ impl Member for Eyes {
     }
 }
 
-/// The motor and kicker driver of one robot.
+/// The motor and kicker driver of one robot: commands become duty cycles for its motor
+/// driver (the processing side of the AIRBoard), kick requests fire the kicker.
 struct Motor {
     pitch: Shared,
     robot: usize,
     body: Body,
+    base: Base,
+    driver: Box<dyn MotorDriver>,
 }
 
 impl Member for Motor {
@@ -135,7 +143,10 @@ impl Member for Motor {
             cmd.vlin *= self.body.linear;
             cmd.vlat *= self.body.linear;
             cmd.vrot *= self.body.turn;
-            lock(&self.pitch)?.apply(self.robot, &cmd);
+            self.driver.set_duty(&self.base.duties(&cmd)).map_err(|e| e.to_string())?;
+            if cmd.kick.is_some() {
+                lock(&self.pitch)?.kick(self.robot);
+            }
         }
         Ok(())
     }
@@ -236,10 +247,10 @@ impl BusMatch {
                         agora.add_member(BrainMember::new(Box::new(brain)), every)
                     }
                 });
-                ids.push(agora.add_member(
-                    Motor { pitch: pitch.clone(), robot, body },
-                    Activation::OnMessage,
-                ));
+                let base = lock_pitch(&pitch)?.base();
+                let driver = Box::new(SimulatedAirboard::new(pitch.clone(), robot, base));
+                let motor = Motor { pitch: pitch.clone(), robot, body, base, driver };
+                ids.push(agora.add_member(motor, Activation::OnMessage));
                 for m in ids {
                     agora.activate_member(m).map_err(|e| e.to_string())?;
                 }

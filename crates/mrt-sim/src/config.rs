@@ -70,6 +70,9 @@ impl Default for BallConfig {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct RobotConfig {
+    /// The wheels: `omni` (three omni wheels, the manual's Triskar) or `differential` (two
+    /// central wheels, the manual's IANUS3: no sideways motion).
+    pub base: String,
     /// Radius of the round footprint.
     pub radius: f64,
     /// Mass.
@@ -93,6 +96,7 @@ pub struct RobotConfig {
 impl Default for RobotConfig {
     fn default() -> Self {
         Self {
+            base: "omni".into(),
             radius: 0.25,
             mass: 30.0,
             max_speed: 1.2,
@@ -292,6 +296,7 @@ impl SimConfig {
                 return Err(format!("{name} must be between 0 and 1, not {v}"));
             }
         }
+        crate::drivers::Base::parse(&self.robot.base)?;
         if self.field.goal_width >= self.field.width {
             return Err("field.goal_width must be smaller than field.width".into());
         }

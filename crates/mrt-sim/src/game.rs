@@ -7,6 +7,7 @@
 //! next control period, with the referee watching every step.
 
 use crate::config::SimConfig;
+use crate::drivers::Base;
 use crate::referee::{Call, Referee, Team};
 use crate::sensor::Perception;
 use crate::world::{Drive, World};
@@ -67,6 +68,7 @@ pub struct MatchReport {
 /// robots' eyes with their random streams, and the book (statistics, hash, calls, frames).
 pub struct Pitch {
     cfg: SimConfig,
+    base: Base,
     seed: u64,
     world: World,
     referee: Referee,
@@ -115,6 +117,7 @@ impl Pitch {
             .collect();
         Ok(Pitch {
             cfg: cfg.clone(),
+            base: Base::parse(&cfg.robot.base)?,
             seed,
             world,
             referee,
@@ -154,23 +157,35 @@ impl Pitch {
         self.eyes[i].look(&self.world, &self.referee, &self.cfg.sensor, &mut self.rngs[i])
     }
 
-    /// Applies robot `i`'s command (mm/s, deg/s; a kick request fires the kicker). Outside
-    /// `PLAYING` the robot is held still.
-    pub fn apply(&mut self, i: usize, cmd: &RobotCommand) {
-        if self.referee.state() != GameState::Playing {
-            self.world.drive(i, Drive::default());
-            return;
-        }
-        let drive = Drive {
-            forward: cmd.vlin / 1000.0,
-            left: cmd.vlat / 1000.0,
-            turn: cmd.vrot.to_radians(),
-        };
-        self.world.drive(i, drive);
-        if cmd.kick.is_some() && self.world.kick(i) {
+    /// The robots' base (kinematics and wheel limits).
+    pub fn base(&self) -> Base {
+        self.base
+    }
+
+    /// Sets robot `i`'s body velocity (what its motor driver achieved). Outside `PLAYING` the
+    /// robot is held still.
+    pub fn drive(&mut self, i: usize, drive: Drive) {
+        let playing = self.referee.state() == GameState::Playing;
+        self.world.drive(i, if playing { drive } else { Drive::default() });
+    }
+
+    /// Fires robot `i`'s kicker (only while `PLAYING`); a kick that reaches the ball counts as
+    /// a shot.
+    pub fn kick(&mut self, i: usize) {
+        if self.referee.state() == GameState::Playing && self.world.kick(i) {
             let team = self.referee.team_of(i);
             self.stats[team.index()].shots += 1;
             self.shots.push((self.world.time(), i, self.world.ball()));
+        }
+    }
+
+    /// Applies robot `i`'s command (mm/s, deg/s) through its base's kinematics and motor
+    /// duty cycles, as its driver would; a kick request fires the kicker.
+    pub fn apply(&mut self, i: usize, cmd: &RobotCommand) {
+        let drive = self.base.drive_for(&self.base.duties(cmd)).unwrap_or_default();
+        self.drive(i, drive);
+        if cmd.kick.is_some() {
+            self.kick(i);
         }
     }
 

@@ -21,6 +21,7 @@
 
 pub mod bus;
 pub mod config;
+pub mod drivers;
 pub mod game;
 pub mod referee;
 pub mod sensor;
