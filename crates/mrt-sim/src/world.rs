@@ -200,6 +200,34 @@ impl World {
         true
     }
 
+    /// What a ring of `count` sonars around robot `i` measures (m from the robot's edge, the
+    /// first sonar straight ahead, then counter-clockwise, evenly spaced, as the SuperScout's
+    /// sixteen): each beam of half-width `half_beam` is three rays (centre and edges) that see
+    /// walls, goals, robots and the ball; the nearest hit counts, `range` when nothing is hit.
+    /// Noise is the caller's (see [`crate::sensor`]).
+    pub fn sonar(&self, i: usize, count: usize, half_beam: f64, range: f64) -> Vec<f64> {
+        let (Some(pose), Some(robot)) = (self.robot(i), self.robots.get(i)) else {
+            return Vec::new();
+        };
+        let r = self.cfg.robot.radius;
+        let filter = QueryFilter::default().exclude_rigid_body(robot.body);
+        (0..count)
+            .map(|k| {
+                let centre = pose.theta + 2.0 * std::f64::consts::PI * k as f64 / count as f64;
+                [centre - half_beam, centre, centre + half_beam]
+                    .into_iter()
+                    .map(|a| {
+                        let (c, s) = (a.cos(), a.sin());
+                        let ray = Ray::new(v(pose.x + r * c, pose.y + r * s), v(c, s));
+                        self.physics
+                            .cast_ray(&ray, range as f32, true, filter)
+                            .map_or(range, |(_, toi)| f64::from(toi))
+                    })
+                    .fold(range, f64::min)
+            })
+            .collect()
+    }
+
     /// Advances the world by one physics step: robots accelerate towards their set-points
     /// (within the acceleration limit), then rapier moves everything.
     pub fn step(&mut self) {
@@ -317,6 +345,41 @@ mod tests {
         }
         let (x, _) = w.ball();
         assert!(x < 10.0, "stopped by the east wall at 10 m: {x}");
+    }
+
+    /// Sonar geometry by hand: robot at (8, 0) facing east, radius 0.25 m. Straight ahead lies
+    /// the goal mouth: the net's back is at 9 + 0.6 = 9.6 m, so sonar 0 reads 9.6 − 8.25 = 1.35.
+    /// Sonar 4 (90°, north) would see the north wall at 7 − 0.25 = 6.75 m, beyond a 5 m range:
+    /// 5. A ball 1 m behind (at x = 7) is seen by sonar 8 at 1 − 0.25 − 0.11 = 0.64 m.
+    #[test]
+    fn sonars_see_walls_goals_and_the_ball() {
+        let mut w = world(1);
+        w.place_robot(0, Pose2::new(8.0, 0.0, 0.0));
+        w.place_ball(7.0, 0.0);
+        w.step();
+        let s = w.sonar(0, 16, 0.0, 5.0);
+        assert_eq!(s.len(), 16);
+        assert!((s[0] - 1.35).abs() < 0.01, "{s:?}");
+        assert_eq!(s[4], 5.0, "{s:?}");
+        assert!((s[8] - 0.64).abs() < 0.01, "{s:?}");
+        assert!(w.sonar(9, 16, 0.1, 5.0).is_empty(), "no such robot");
+    }
+
+    /// The beam width matters: a ball 0.45 m off the axis of sonar 8 is missed by a thin beam
+    /// (the centre ray passes 0.45 m from the ball's centre, more than its 0.11 m radius) and
+    /// caught by a ±0.5 rad beam's edge ray. By hand: that ray starts on the robot's edge at
+    /// (8 − 0.25·cos 0.5, 0.25·sin 0.5) = (7.781, 0.120) heading (−0.878, 0.479); the ball's
+    /// centre (7.2, 0.45) lies 0.668 m along it and 0.012 m beside it, so the ray meets the ball
+    /// at 0.668 − √(0.11² − 0.012²) = 0.559 m.
+    #[test]
+    fn a_wide_beam_sees_what_a_thin_one_misses() {
+        let mut w = world(1);
+        w.place_robot(0, Pose2::new(8.0, 0.0, 0.0));
+        w.place_ball(7.2, 0.45);
+        w.step();
+        assert_eq!(w.sonar(0, 16, 0.0, 5.0)[8], 5.0);
+        let wide = w.sonar(0, 16, 0.5, 5.0)[8];
+        assert!((wide - 0.559).abs() < 0.005, "{wide}");
     }
 
     #[test]
