@@ -59,7 +59,7 @@ pub fn behave(
     let mut out = stdout.lock();
     for (k, mut w) in worlds(world, cycles)?.into_iter().enumerate() {
         if w.time == Time::ZERO {
-            w.time = Time::from_millis(k as u64 * period_ms);
+            w.time = Time::from_secs_f64(k as f64 * period_ms as f64 / 1000.0);
         }
         let time_ms = (w.time.as_secs_f64() * 1e6).round() / 1e3;
         let c = cap.cycle(w);

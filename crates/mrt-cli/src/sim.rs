@@ -177,7 +177,7 @@ fn series(args: &SimArgs, cfg: &SimConfig, stacks: (Stack, Stack)) -> Result<()>
     println!(
         "{n} matches, {h} (home) against {a} (away), seeds {}..={}",
         args.seed,
-        args.seed + n as u64 - 1
+        args.seed.wrapping_add(n as u64).wrapping_sub(1)
     );
     for (label, k) in [("wins", wins), ("draws", draws), ("losses", losses)] {
         let (lo, hi) = wilson(k, n);

@@ -63,7 +63,8 @@ pub struct ControlVariable {
     pub min: f64,
     /// The upper end of its range.
     pub max: f64,
-    /// The labels, in declaration order.
+    /// The labels, in the order given (the Lua `variable{}` sorts them by name); the first of
+    /// equally strong labels wins a `Choice`.
     pub labels: Vec<(String, FuzzySet)>,
     /// How it is defuzzified.
     pub defuzzification: Defuzzification,

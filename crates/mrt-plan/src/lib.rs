@@ -29,8 +29,9 @@
 //! # Ok::<(), mrt_plan::PlanError>(())
 //! ```
 //!
-//! Start with [`kinematics::Kinematics`] and [`kinematics::integrate`] (the simulator's motion
-//! step), [`mice::MiceOdometry`], and [`guidance::PotentialField`].
+//! Start with [`kinematics::Kinematics`] and [`kinematics::integrate`] (exact dead reckoning
+//! over one period; `mrt-sim` moves its robots with rapier2d and uses the kinematics to turn
+//! commands into wheel duty cycles and back), [`mice::MiceOdometry`], and [`guidance::PotentialField`].
 //!
 //! | seed name | Rust |
 //! |---|---|

@@ -140,6 +140,18 @@ impl ThinkingCap {
         self.reload_hfsm(&[], done, errors)
     }
 
+    /// An explicit reload request: what changed, and the HFSM whatever its stamp says (the
+    /// files it includes have no stamp of their own).
+    pub fn reload_requested(&mut self) -> (Vec<String>, Vec<ScriptError>) {
+        let (done, errors) = self.hbm.reload_changed(&self.rt);
+        self.after_hbm_change();
+        let machine: Vec<PathBuf> = match &self.top {
+            Top::Hfsm(_, path) => vec![path.clone()],
+            Top::Behavior(_) => Vec::new(),
+        };
+        self.reload_hfsm(&machine, done, errors)
+    }
+
     /// Applies what the watcher compiled off the control path (see [`Hbm::apply`]).
     fn apply(&mut self, changes: Vec<crate::watch::Change>) -> (Vec<String>, Vec<ScriptError>) {
         let touched: Vec<PathBuf> = changes.iter().map(|c| c.path.clone()).collect();
@@ -147,7 +159,13 @@ impl ThinkingCap {
             Top::Hfsm(_, path) => Some(path.clone()),
             Top::Behavior(_) => None,
         };
-        let behaviors = changes.into_iter().filter(|c| Some(&c.path) != machine.as_ref()).collect();
+        let behaviors = changes
+            .into_iter()
+            .filter(|c| {
+                Some(&c.path) != machine.as_ref()
+                    && !c.path.to_string_lossy().ends_with(".hfsm.lua")
+            })
+            .collect();
         let (done, errors) = self.hbm.apply(&self.rt, behaviors);
         self.after_hbm_change();
         self.reload_hfsm(&touched, done, errors)
@@ -164,7 +182,14 @@ impl ThinkingCap {
         mut errors: Vec<ScriptError>,
     ) -> (Vec<String>, Vec<ScriptError>) {
         if let Top::Hfsm(h, path) = &mut self.top {
-            let attempt = if touched.contains(path) {
+            // The machine file, or a machine file it may include, changed.
+            let machine_touched = touched.iter().any(|p| {
+                p == path
+                    || p.file_name()
+                        .and_then(|n| n.to_str())
+                        .is_some_and(|n| n.ends_with(".hfsm.lua"))
+            });
+            let attempt = if machine_touched {
                 h.reload(&self.rt).map(|()| true)
             } else {
                 h.reload_if_changed(&self.rt)

@@ -554,7 +554,9 @@ fn declare(t: &Table) -> mlua::Result<(ControlVariable, Option<Drives>)> {
             )))
         }
     };
-    if min.partial_cmp(&max) != Some(std::cmp::Ordering::Less) {
+    if !(min.is_finite() && max.is_finite())
+        || min.partial_cmp(&max) != Some(std::cmp::Ordering::Less)
+    {
         return Err(err(format!("variable '{name}': min {min} must be below max {max}")));
     }
     let labels: Table = t.get("labels")?;

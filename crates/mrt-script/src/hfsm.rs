@@ -608,7 +608,7 @@ fn build(rt: &LuaRuntime, file: &str, source: &str) -> Result<(Vec<Machine>, usi
                 .get::<Option<String>>("name")
                 .map_err(lua_err)?
                 .unwrap_or(format!("{from}->{to}"));
-            let at = |s: &str| {
+            let state_index = |s: &str| {
                 find(s).ok_or_else(|| {
                     e(
                         line,
@@ -620,7 +620,7 @@ fn build(rt: &LuaRuntime, file: &str, source: &str) -> Result<(Vec<Machine>, usi
                     )
                 })
             };
-            let (f, to_i) = (at(&from)?, at(&to)?);
+            let (f, to_i) = (state_index(&from)?, state_index(&to)?);
             let priority: f64 = t.get::<Option<f64>>("priority").map_err(lua_err)?.unwrap_or(0.0);
             let (test, shown) = match t.get::<Value>("test").map_err(lua_err)? {
                 Value::Function(f) => {
@@ -634,7 +634,7 @@ fn build(rt: &LuaRuntime, file: &str, source: &str) -> Result<(Vec<Machine>, usi
                     let padded = format!("{}return ({expr})", "\n".repeat(line.saturating_sub(1)));
                     let f = lua
                         .load(padded)
-                        .set_name(format!("@{file}"))
+                        .set_name(format!("@{at}"))
                         .set_mode(ChunkMode::Text)
                         .into_function()
                         .map_err(|err| {

@@ -156,7 +156,7 @@ impl BehaviorMember {
                             let mut reloaded = Vec::new();
                             let mut early = Vec::new();
                             if std::mem::take(&mut pending_reload) {
-                                (reloaded, early) = cap.reload_changed();
+                                (reloaded, early) = cap.reload_requested();
                             }
                             let c = cap.cycle(world);
                             reloaded.extend(c.reloaded);
@@ -190,7 +190,8 @@ impl Member for BehaviorMember {
     }
 
     fn init(&mut self, ctx: &mut Context<'_>) -> Result<(), MemberError> {
-        ctx.subscribe_to::<WorldSnapshot>(RequestType::All);
+        // Only this robot's own world (an Agora may share a link with teammates).
+        ctx.subscribe_to::<WorldSnapshot>(RequestType::Local);
         ctx.subscribe_to::<ReloadRequest>(RequestType::All);
         self.worker = Some(self.spawn()?);
         Ok(())

@@ -297,13 +297,13 @@ impl Script {
         // Our own compiler's output, never a script's: binary chunks are allowed here only.
         let f = rt
             .lua
-            .load(&compiled.bytecode[..])
+            .load(compiled.bytecode())
             .set_name(format!("@{}", self.name))
             .set_mode(ChunkMode::Binary)
             .into_function()
             .map_err(|e| ScriptError::from_lua(&self.name, rt, e))?;
         *self.compiled.borrow_mut() = f;
-        self.source.borrow_mut().clone_from(&compiled.source);
+        compiled.source().clone_into(&mut self.source.borrow_mut());
         if let Some(path) = &self.path {
             *self.modified.borrow_mut() = mtime(path);
         }

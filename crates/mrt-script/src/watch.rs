@@ -21,13 +21,24 @@ use std::path::{Path, PathBuf};
 use std::sync::mpsc::{channel, Receiver, Sender};
 use std::sync::{Arc, Mutex};
 
-/// A script compiled off the control path: its text and its bytecode.
+/// A script compiled off the control path: its text and its bytecode. Only the watcher makes
+/// these (the fields are private), so only bytecode of MRT's own compiler is ever loaded.
 #[derive(Clone, Debug)]
 pub struct Compiled {
+    source: String,
+    bytecode: Vec<u8>,
+}
+
+impl Compiled {
     /// The source text that was compiled.
-    pub source: String,
+    pub fn source(&self) -> &str {
+        &self.source
+    }
+
     /// Lua 5.4 bytecode of the chunk, with debug information (lines in errors).
-    pub bytecode: Vec<u8>,
+    pub fn bytecode(&self) -> &[u8] {
+        &self.bytecode
+    }
 }
 
 /// One watched script that changed on disk.
@@ -79,13 +90,15 @@ fn absolute(path: &Path) -> PathBuf {
 /// Whether the event says a file now holds its complete new content.
 fn is_written(kind: &EventKind) -> bool {
     match kind {
-        EventKind::Create(CreateKind::File | CreateKind::Any)
-        | EventKind::Modify(ModifyKind::Name(
+        EventKind::Modify(ModifyKind::Name(
             RenameMode::To | RenameMode::Both | RenameMode::Any,
         )) => true,
         EventKind::Access(AccessKind::Close(AccessMode::Write)) => true,
-        // Only Linux reports closes; elsewhere a modification is the best there is.
-        EventKind::Modify(_) => !cfg!(target_os = "linux"),
+        // Only Linux reports closes; elsewhere creation and modification are the best there
+        // is. (On Linux a new file counts when it is closed after writing.)
+        EventKind::Create(CreateKind::File | CreateKind::Any) | EventKind::Modify(_) => {
+            !cfg!(target_os = "linux")
+        }
         _ => false,
     }
 }

@@ -245,8 +245,8 @@ fn edits_are_compiled_off_the_control_path() {
     let change = next_change(&w);
     assert_eq!(change.name, path.display().to_string());
     let compiled = change.compiled.unwrap();
-    assert!(compiled.bytecode.starts_with(b"\x1bLua"), "Lua bytecode");
-    assert_eq!(compiled.source, "return 2");
+    assert!(compiled.bytecode().starts_with(b"\x1bLua"), "Lua bytecode");
+    assert_eq!(compiled.source(), "return 2");
     assert_eq!(s.call::<i64>(&rt).unwrap(), 1, "nothing changes before the swap");
     s.install(&rt, &compiled).unwrap();
     assert_eq!(s.call::<i64>(&rt).unwrap(), 2);

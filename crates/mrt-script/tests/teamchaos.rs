@@ -616,3 +616,41 @@ fn a_runaway_hfsm_gets_the_safe_command_for_that_cycle() {
     assert!(again.errors.is_empty() && again.command.vlin > 200.0, "{again:?}");
     std::fs::remove_dir_all(&scratch).unwrap();
 }
+
+/// A reload request reloads the machine even when only a file it includes changed: the
+/// player machine includes the Attacker; a broken Attacker is reported with its own file and
+/// line and the running machine stays; a good edit is swapped in.
+#[test]
+fn editing_an_included_machine_file_reloads_the_machine() {
+    let scratch = std::env::temp_dir().join(format!("mrt-include-reload-{}", std::process::id()));
+    std::fs::create_dir_all(&scratch).unwrap();
+    for e in std::fs::read_dir(dir()).unwrap() {
+        let p = e.unwrap().path();
+        if p.extension().is_some_and(|x| x == "lua") {
+            std::fs::copy(&p, scratch.join(p.file_name().unwrap())).unwrap();
+        }
+    }
+    let mut cap =
+        ThinkingCap::with_hfsm(&scratch, scratch.join("player.hfsm.lua"), Sandbox::default())
+            .unwrap();
+    let w = WorldSnapshot { game_state: GameState::Playing, ..Default::default() };
+    assert!(cap.cycle(w.clone()).errors.is_empty());
+    let attacker = scratch.join("attacker.hfsm.lua");
+    let good = std::fs::read_to_string(&attacker).unwrap();
+    std::fs::write(&attacker, format!("{good}\nmachine \"Broken\" {{")).unwrap();
+    let (_, errors) = cap.reload_requested();
+    let text = errors.iter().map(ToString::to_string).collect::<Vec<_>>().join("\n");
+    assert!(text.contains("attacker.hfsm.lua:"), "{text}");
+    assert!(cap.cycle(w.clone()).errors.is_empty(), "the old machine keeps running");
+    std::fs::write(
+        &attacker,
+        good.replace("math.abs(chaos.lps_getLpo(BALL).theta) < 0.25", "true"),
+    )
+    .unwrap();
+    let (done, errors) = cap.reload_requested();
+    assert!(
+        errors.is_empty() && done.iter().any(|d| d.ends_with("player.hfsm.lua")),
+        "{done:?} {errors:?}"
+    );
+    std::fs::remove_dir_all(&scratch).unwrap();
+}

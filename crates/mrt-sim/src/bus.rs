@@ -4,7 +4,8 @@
 //! of one [`SteppedExecutor`] so that the match stays deterministic:
 //!
 //! 1. **`Eyes`** (the camera driver and the world-state Member, periodic): looks through the
-//!    object sensor, merges the teammates' reports received over the bus, and publishes the
+//!    object sensor, takes its teammates' poses from their reports received over the bus, and
+//!    publishes the
 //!    [`WorldSnapshot`]; it also publishes a [`MateReport`] (its pose and its ball estimate)
 //!    that the teammates' Agoras receive through their team's `InnerLinkManager` — a
 //!    `RequestType::Remote` subscription, so a robot never hears itself.
@@ -206,9 +207,11 @@ impl BusMatch {
         let pitch = Arc::new(Mutex::new(pitch));
         let period = Duration::from_secs_f64(cfg.rules.control_period);
         let mut exec = SteppedExecutor::new(SimClock::new(), period);
+        let chaos_plays = home == Stack::Chaos || away == Some(Stack::Chaos);
         let dir = match behaviors {
             Some(d) => d.to_path_buf(),
-            None => embedded_teamchaos()?,
+            None if chaos_plays => embedded_teamchaos()?,
+            None => std::path::PathBuf::new(),
         };
         let chaos_body = Body {
             edge: cfg.robot.radius * 1000.0,
@@ -287,16 +290,9 @@ impl BusMatch {
 
     /// Plays until the end, calling `progress` with the simulated time after each cycle.
     pub fn play(mut self, mut progress: impl FnMut(f64)) -> Result<MatchReport, String> {
-        loop {
-            let (done, t) = {
-                let p = self.pitch.lock().map_err(|_| "the pitch lock is poisoned".to_string())?;
-                (p.finished(), p.world().time())
-            };
-            if done {
-                break;
-            }
+        while !lock_pitch(&self.pitch)?.finished() {
             self.cycle()?;
-            progress(t);
+            progress(lock_pitch(&self.pitch)?.world().time());
         }
         let reports = self.exec.finish();
         let failures: Vec<String> = reports

@@ -1,6 +1,6 @@
 //! The simulator's configuration: field, ball, robots and match rules, read from TOML. Every
-//! field has a documented default (Middle Size League proportions, the MRT manual's IANUS3
-//! base), so a file only needs what it changes; `configs/sim/default.toml` lists them all.
+//! field has a documented default (Middle Size League proportions, a robot base of the MRT
+//! manual's size and speed), so a file only needs what it changes; `configs/sim/default.toml` lists them all.
 //!
 //! Units: metres, seconds, kilograms, radians.
 
@@ -65,8 +65,8 @@ impl Default for BallConfig {
     }
 }
 
-/// A robot base (defaults: the MRT manual's IANUS3, differential drive up to 1.2 m/s, with a
-/// pneumatic kicker).
+/// A robot base (defaults: a round 50 cm base on three omni wheels, like the manual's Triskar,
+/// up to 1.2 m/s as its IANUS3, with a pneumatic kicker).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct RobotConfig {
@@ -273,6 +273,38 @@ impl SimConfig {
                 return Err(format!("{name} must be a positive number, not {v}"));
             }
         }
+        let at_least = [
+            ("field.length", self.field.length, 2.0),
+            ("field.width", self.field.width, 2.0),
+            ("rules.stuck_time", self.rules.stuck_time, 0.1),
+            ("rules.stuck_distance", self.rules.stuck_distance, 0.001),
+            ("sensor.half_fov", self.sensor.half_fov, 0.01),
+            ("robot.kick_half_angle", self.robot.kick_half_angle, 0.0),
+            ("robot.kick_reach", self.robot.kick_reach, 0.0),
+            ("field.centre_circle_radius", self.field.centre_circle_radius, 0.0),
+            ("field.penalty_area_depth", self.field.penalty_area_depth, 0.0),
+            ("field.penalty_area_width", self.field.penalty_area_width, 0.0),
+        ];
+        for (name, v, min) in at_least {
+            if !(v.is_finite() && v >= min) {
+                return Err(format!("{name} must be at least {min}, not {v}"));
+            }
+        }
+        if self.sensor.half_fov > std::f64::consts::PI
+            || self.robot.kick_half_angle > std::f64::consts::PI
+        {
+            return Err("sensor.half_fov and robot.kick_half_angle must be at most π".into());
+        }
+        if self.rules.control_period > 10.0 || self.rules.physics_step > 1.0 {
+            return Err(
+                "rules.control_period must be at most 10 s and rules.physics_step 1 s".into()
+            );
+        }
+        if self.field.penalty_area_depth >= self.field.length / 2.0
+            || self.field.penalty_area_width > self.field.width
+        {
+            return Err("the penalty area must fit in its half of the field".into());
+        }
         let non_negative = [
             ("field.border", self.field.border),
             ("ball.rolling_damping", self.ball.rolling_damping),
@@ -346,6 +378,21 @@ mod tests {
         assert!(e.to_string().contains("ball.radius must be a positive number"), "{e}");
         let e = SimConfig::from_toml("[rules]\nteam_size = 0\n", "zero.toml").unwrap_err();
         assert!(e.to_string().contains("team_size"), "{e}");
+    }
+
+    #[test]
+    fn values_that_would_break_the_rules_are_refused() {
+        for (text, needle) in [
+            ("[field]\nlength = 0.5\n", "field.length must be at least 2"),
+            ("[rules]\nstuck_time = -1.0\n", "rules.stuck_time"),
+            ("[rules]\ncontrol_period = 1e30\n", "control_period"),
+            ("[sensor]\nhalf_fov = 7.0\n", "half_fov"),
+            ("[field]\npenalty_area_depth = 12.0\n", "penalty area"),
+            ("[robot]\nbase = \"legs\"\n", "robot.base must be differential or omni"),
+        ] {
+            let e = SimConfig::from_toml(text, "bad.toml").unwrap_err().to_string();
+            assert!(e.contains(needle), "{text}: {e}");
+        }
     }
 
     proptest::proptest! {

@@ -145,6 +145,8 @@ impl Referee {
                 let y = (lane - (lanes - 1.0) / 2.0) * (cfg.field.width / (lanes + 1.0));
                 (-dir * (cfg.field.centre_circle_radius + 0.5 + lane * 0.8), y)
             };
+            // Many robots on a small field: never behind the own goal line.
+            let x = x.clamp(-(hl - r - 0.1), hl - r - 0.1);
             let heading = if dir > 0.0 { 0.0 } else { PI };
             world.place_robot(i, Pose2::new(x, y, heading));
         }
@@ -193,8 +195,9 @@ impl Referee {
         }
         // Out: the whole ball over a line (and not in a goal). Put back 0.5 m inside.
         if bx.abs() > hl + r || by.abs() > hw + r {
-            let x = bx.clamp(-(hl - 0.5), hl - 0.5);
-            let y = by.clamp(-(hw - 0.5), hw - 0.5);
+            let (mx, my) = ((hl - 0.5).max(0.0), (hw - 0.5).max(0.0));
+            let x = bx.clamp(-mx, mx);
+            let y = by.clamp(-my, my);
             world.place_ball(x, y);
             self.anchor = ((x, y), now);
             return Some(Call::Out { at: (bx, by) });
@@ -265,6 +268,27 @@ mod tests {
         assert_eq!(w.ball(), (0.0, 0.0));
         run(&mut w, &mut r, 1.0);
         assert_eq!(r.state(), GameState::Playing);
+    }
+
+    /// Eleven a side on a small field: the kickoff lanes would reach past the goal line; every
+    /// robot is still placed on the field, in its own half.
+    #[test]
+    fn many_robots_on_a_small_field_stay_on_it_at_kickoff() {
+        let mut cfg = SimConfig::default();
+        cfg.field.length = 8.0;
+        cfg.field.width = 6.0;
+        cfg.field.penalty_area_depth = 1.0;
+        cfg.field.penalty_area_width = 3.0;
+        cfg.rules.team_size = 11;
+        cfg.validate().unwrap();
+        let mut w = World::new(&cfg, 22);
+        let mut r = Referee::new(11);
+        r.start(&mut w);
+        for i in 0..22 {
+            let p = w.robot(i).unwrap();
+            assert!(p.x.abs() < 4.0 && p.y.abs() < 3.0, "robot {i} at {p:?}");
+            assert_eq!(p.x < 0.0, i < 11, "robot {i} in its own half: {p:?}");
+        }
     }
 
     #[test]

@@ -49,16 +49,19 @@ fn targets(world: &World, referee: &Referee, team: Team) -> [(f64, f64); lps::CO
     let (hl, hw) = (f.length / 2.0, f.width / 2.0);
     let dir = referee.attack_direction(team);
     let ball = world.ball();
+    // Landmarks are named in the team frame, so LANDMARK0 is always the opponent's left corner
+    // whichever half the team plays in.
+    let l = |x: f64, y: f64| (dir * x, dir * y);
     [
         ball,
-        (dir * hl, 0.0),
-        (-dir * hl, 0.0),
-        (hl, hw),
-        (hl, -hw),
-        (-hl, hw),
-        (-hl, -hw),
-        (0.0, hw),
-        (0.0, -hw),
+        l(hl, 0.0),
+        l(-hl, 0.0),
+        l(hl, hw),
+        l(hl, -hw),
+        l(-hl, hw),
+        l(-hl, -hw),
+        l(0.0, hw),
+        l(0.0, -hw),
     ]
 }
 
@@ -147,8 +150,11 @@ impl Perception {
             let (x, y) = to_team(bx, by);
             w.global_ball = Estimate { pose: Pose2::new(x, y, 0.0), quality: rel };
         }
-        let (vx, vy) = world.ball_velocity();
-        w.ball_vel = Vec2::new(dir * vx * 1000.0, dir * vy * 1000.0);
+        // The ball's velocity only when it is seen this frame (a tracker would estimate it).
+        if self.memory[lps::BALL].is_some_and(|m| m.seen == now) {
+            let (vx, vy) = world.ball_velocity();
+            w.ball_vel = Vec2::new(dir * vx * 1000.0, dir * vy * 1000.0);
+        }
         for i in 0..world.robot_count() {
             if i == self.robot || referee.team_of(i) != team {
                 continue;

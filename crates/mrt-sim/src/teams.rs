@@ -4,6 +4,8 @@
 //!   behaviors for robot 0, the `player.hfsm.lua` machine (the seed's Attacker inside a game
 //!   loop) for the field players. The files are compiled into the binary, so a match needs no
 //!   setup; `--behaviors DIR` runs edited copies instead.
+//! - **Milan**: the MRT manual's team on Mr. BRIAN (`configs/brian/milan`, compiled in):
+//!   [`MilanBrain`] is the manual's Parser and Messenger around the engine.
 //! - **Chaser**: the hand-written baseline player ([`crate::game::Chaser`]).
 //!
 //! TeamChaos tuned its behaviors for AIBO walking speeds (about 0.3 m/s); on a Middle Size
@@ -29,7 +31,7 @@ pub enum Stack {
 }
 
 impl Stack {
-    /// Parses `chaos` or `chaser`.
+    /// Parses `chaos`, `milan` or `chaser`.
     pub fn parse(s: &str) -> Result<Stack, String> {
         match s {
             "chaos" => Ok(Stack::Chaos),
@@ -103,6 +105,10 @@ pub const CHAOS_TURN_SCALE: f64 = 2.0;
 
 fn materialize(name: &str, files: &[(&str, &str)]) -> Result<PathBuf, String> {
     let dir = std::env::temp_dir().join(format!("mrt-{name}-{}", std::process::id()));
+    // A directory left by an earlier process with the same id must not add stale files.
+    if dir.exists() {
+        std::fs::remove_dir_all(&dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    }
     for (file, text) in files {
         let path = dir.join(file);
         if let Some(parent) = path.parent() {
