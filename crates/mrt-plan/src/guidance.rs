@@ -65,9 +65,24 @@ pub struct GuidanceCommand {
 /// Velocity mode: stops the translation when a sonar in the direction of motion reads less than
 /// `safety_distance`.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(try_from = "VelocityGuardParams")]
 pub struct VelocityGuard {
     safety_distance: f64,
     half_cone: f64,
+}
+
+/// What a serialized [`VelocityGuard`] holds, checked by [`VelocityGuard::new`] when read.
+#[derive(Deserialize)]
+struct VelocityGuardParams {
+    safety_distance: f64,
+    half_cone: f64,
+}
+
+impl TryFrom<VelocityGuardParams> for VelocityGuard {
+    type Error = PlanError;
+    fn try_from(p: VelocityGuardParams) -> Result<Self, PlanError> {
+        VelocityGuard::new(p.safety_distance, p.half_cone)
+    }
 }
 
 impl Default for VelocityGuard {

@@ -128,9 +128,24 @@ pub struct MiceArcs {
 /// The two-mice odometry sensor: mice `distance` (`D`) apart, and the tolerance of the
 /// `x̄_r = x̄_l` check.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(try_from = "MiceOdometryParams")]
 pub struct MiceOdometry {
     distance: f64,
     tolerance: f64,
+}
+
+/// What a serialized [`MiceOdometry`] holds, checked by [`MiceOdometry::new`] when read.
+#[derive(Deserialize)]
+struct MiceOdometryParams {
+    distance: f64,
+    tolerance: f64,
+}
+
+impl TryFrom<MiceOdometryParams> for MiceOdometry {
+    type Error = PlanError;
+    fn try_from(p: MiceOdometryParams) -> Result<Self, PlanError> {
+        MiceOdometry::new(p.distance, p.tolerance)
+    }
 }
 
 /// `sign` with `sign(0) = 0`, as in eq. (4.2).
@@ -311,6 +326,19 @@ mod tests {
     use super::*;
     use proptest::prelude::*;
     use std::f64::consts::PI;
+
+    /// Reading a sensor from a file checks it like `new` does: `D = 0` would divide by zero.
+    #[test]
+    fn deserializing_checks_the_parameters() {
+        let ok: MiceOdometry =
+            serde_json::from_str(r#"{"distance": 0.2, "tolerance": 0.001}"#).unwrap();
+        assert_eq!(ok, MiceOdometry::new(0.2, 0.001).unwrap());
+        assert!(serde_json::from_str::<MiceOdometry>(r#"{"distance": 0.0, "tolerance": 0.001}"#)
+            .is_err());
+        let guard: Result<crate::guidance::VelocityGuard, _> =
+            serde_json::from_str(r#"{"safety_distance": -1.0, "half_cone": 0.5}"#);
+        assert!(guard.is_err());
+    }
 
     fn close(a: f64, b: f64) -> bool {
         (a - b).abs() < 1e-12
