@@ -21,9 +21,7 @@
 use crate::drivers::{Base, MotorDriver, SimulatedAirboard};
 use crate::game::{Brain, MatchReport, Pitch};
 use crate::referee::Call;
-use crate::teams::{
-    embedded_milan, embedded_teamchaos, MilanBrain, Stack, CHAOS_LINEAR_SCALE, CHAOS_TURN_SCALE,
-};
+use crate::teams::{embedded_milan, embedded_teamchaos, Body, MilanBrain, Stack};
 use mrt_core::robot::{Estimate, Mate, RobotCommand, WorldSnapshot};
 use mrt_core::SimClock;
 use mrt_dcdt::{
@@ -51,22 +49,6 @@ pub struct MateReport {
 impl Message for MateReport {
     const TYPE: MsgType = MsgType(RESERVED_TYPES_START + 0x40);
     const NAME: &'static str = "MateReport";
-}
-
-/// How a team's drivers adapt the behaviors to the robot's body.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Body {
-    /// Subtracted from every LPS distance (mm).
-    pub edge: f64,
-    /// Multiplies linear set-points.
-    pub linear: f64,
-    /// Multiplies turning set-points.
-    pub turn: f64,
-}
-
-impl Body {
-    /// No adaptation.
-    pub const PLAIN: Body = Body { edge: 0.0, linear: 1.0, turn: 1.0 };
 }
 
 type Shared = Arc<Mutex<Pitch>>;
@@ -107,9 +89,7 @@ impl Member for Eyes {
         w.mates = self.mates.values().copied().collect();
         let id = u32::try_from(self.robot).unwrap_or(u32::MAX);
         ctx.publish(MateReport { id, pose: w.my_pos, ball: w.global_ball });
-        for o in &mut w.lps {
-            o.rho = (o.rho - self.body.edge).max(0.0);
-        }
+        self.body.perceive(&mut w);
         ctx.publish(w);
         Ok(())
     }
@@ -141,9 +121,7 @@ impl Member for Motor {
             last = Some(m.get::<RobotCommand>()?.clone());
         }
         if let Some(mut cmd) = last {
-            cmd.vlin *= self.body.linear;
-            cmd.vlat *= self.body.linear;
-            cmd.vrot *= self.body.turn;
+            self.body.act(&mut cmd);
             self.driver.set_duty(&self.base.duties(&cmd)).map_err(|e| e.to_string())?;
             if cmd.kick.is_some() {
                 lock(&self.pitch)?.kick(self.robot);
@@ -213,11 +191,7 @@ impl BusMatch {
             None if chaos_plays => embedded_teamchaos()?,
             None => std::path::PathBuf::new(),
         };
-        let chaos_body = Body {
-            edge: cfg.robot.radius * 1000.0,
-            linear: CHAOS_LINEAR_SCALE,
-            turn: CHAOS_TURN_SCALE,
-        };
+        let chaos_body = Body::chaos(cfg.robot.radius);
         let mut links = Vec::new();
         for (t, stack) in [Some(home), away].into_iter().enumerate() {
             let Some(stack) = stack else { continue };

@@ -98,10 +98,44 @@ const MILAN: &[(&str, &str)] = &[
     ("want.txt", include_str!("../../../configs/brian/milan/want.txt")),
 ];
 
-/// Linear set-points are multiplied by this on a Middle Size League base.
-pub const CHAOS_LINEAR_SCALE: f64 = 4.0;
-/// Turning set-points are multiplied by this.
-pub const CHAOS_TURN_SCALE: f64 = 2.0;
+/// How a team's drivers adapt the behaviors to the robot's body, as the seed's Commander
+/// Module did for its legs: the camera driver shifts distances, the motor driver scales
+/// set-points.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Body {
+    /// Subtracted from every LPS distance (mm).
+    pub edge: f64,
+    /// Multiplies linear set-points.
+    pub linear: f64,
+    /// Multiplies turning set-points.
+    pub turn: f64,
+}
+
+impl Body {
+    /// No adaptation.
+    pub const PLAIN: Body = Body { edge: 0.0, linear: 1.0, turn: 1.0 };
+
+    /// TeamChaos' behaviors on a round base of `radius_m` metres: distances from the robot's
+    /// edge (TeamChaos measured from an AIBO's head), linear set-points ×4 and turning ×2
+    /// (they were tuned for AIBO walking, about 0.3 m/s).
+    pub fn chaos(radius_m: f64) -> Body {
+        Body { edge: radius_m * 1000.0, linear: 4.0, turn: 2.0 }
+    }
+
+    /// The camera driver's side: distances from the robot's edge.
+    pub fn perceive(&self, w: &mut WorldSnapshot) {
+        for o in &mut w.lps {
+            o.rho = (o.rho - self.edge).max(0.0);
+        }
+    }
+
+    /// The motor driver's side: scaled set-points.
+    pub fn act(&self, cmd: &mut RobotCommand) {
+        cmd.vlin *= self.linear;
+        cmd.vlat *= self.linear;
+        cmd.vrot *= self.turn;
+    }
+}
 
 fn materialize(name: &str, files: &[(&str, &str)]) -> Result<PathBuf, String> {
     let dir = std::env::temp_dir().join(format!("mrt-{name}-{}", std::process::id()));
@@ -134,9 +168,7 @@ pub fn embedded_milan() -> Result<PathBuf, String> {
 /// A robot driven by ThinkingCap.
 pub struct ChaosBrain {
     cap: ThinkingCap,
-    /// The base's radius, mm: TeamChaos measured distances from an AIBO's head, so on a round
-    /// base the brain measures LPS distances from the robot's edge.
-    edge: f64,
+    body: Body,
 }
 
 impl ChaosBrain {
@@ -148,24 +180,20 @@ impl ChaosBrain {
         } else {
             ThinkingCap::with_hfsm(dir, dir.join("player.hfsm.lua"), sandbox)
         };
-        Ok(ChaosBrain { cap: cap.map_err(|e| e.to_string())?, edge: robot_radius_m * 1000.0 })
+        Ok(ChaosBrain { cap: cap.map_err(|e| e.to_string())?, body: Body::chaos(robot_radius_m) })
     }
 }
 
 impl Brain for ChaosBrain {
     fn cycle(&mut self, world: &WorldSnapshot) -> RobotCommand {
         let mut seen = world.clone();
-        for o in &mut seen.lps {
-            o.rho = (o.rho - self.edge).max(0.0);
-        }
+        self.body.perceive(&mut seen);
         let c = self.cap.cycle(seen);
         for e in &c.errors {
             tracing::warn!("chaos robot: {e}");
         }
         let mut cmd = c.command;
-        cmd.vlin *= CHAOS_LINEAR_SCALE;
-        cmd.vlat *= CHAOS_LINEAR_SCALE;
-        cmd.vrot *= CHAOS_TURN_SCALE;
+        self.body.act(&mut cmd);
         cmd
     }
 }
