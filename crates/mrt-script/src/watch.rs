@@ -110,10 +110,17 @@ thread_local! {
 }
 
 /// Reads and compiles a script the way [`Script`](crate::Script) names it.
-pub(crate) fn compile_file(path: &Path, name: &str) -> Result<Compiled, ScriptError> {
-    let source = std::fs::read_to_string(path)
-        .map_err(|source| ScriptError::Io { file: name.to_string(), source })?;
-    COMPILER.with(|lua| {
+/// `None` for an empty file: events arrive after the fact, and a file read while an editor is
+/// saving it again (truncated, not yet written) is empty; the save's own event follows. (A
+/// behavior emptied on purpose is therefore not reloaded: delete its rules instead, or leave a
+/// comment in it.)
+pub(crate) fn compile_file(path: &Path, name: &str) -> Option<Result<Compiled, ScriptError>> {
+    let source = match std::fs::read_to_string(path) {
+        Ok(s) if s.is_empty() => return None,
+        Ok(s) => s,
+        Err(source) => return Some(Err(ScriptError::Io { file: name.to_string(), source })),
+    };
+    Some(COMPILER.with(|lua| {
         let f = lua
             .load(&source)
             .set_name(format!("@{name}"))
@@ -121,7 +128,7 @@ pub(crate) fn compile_file(path: &Path, name: &str) -> Result<Compiled, ScriptEr
             .into_function()
             .map_err(|e| ScriptError::syntax(name, &e))?;
         Ok(Compiled { bytecode: f.dump(false), source })
-    })
+    }))
 }
 
 fn on_event(list: &Mutex<WatchList>, tx: &Sender<Change>, ev: notify::Result<Event>) {
@@ -139,7 +146,7 @@ fn on_event(list: &Mutex<WatchList>, tx: &Sender<Change>, ev: notify::Result<Eve
         if !path.is_file() {
             continue;
         }
-        let compiled = compile_file(&path, &name);
+        let Some(compiled) = compile_file(&path, &name) else { continue };
         if tx.send(Change { path, name, compiled }).is_err() {
             return;
         }

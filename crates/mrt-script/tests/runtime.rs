@@ -264,3 +264,17 @@ fn edits_are_compiled_off_the_control_path() {
     let e = s.call::<i64>(&rt).unwrap_err();
     assert!(e.to_string().starts_with(&format!("{}:2: runtime error", path.display())), "{e}");
 }
+
+/// An empty file is not a new version: the watcher sees files truncated by an editor that is
+/// saving them again, and waits for the save's own event.
+#[test]
+fn an_emptied_file_is_not_reported_as_a_new_version() {
+    let path = temp("emptied", "return 1");
+    let mut w = mrt_script::ScriptWatcher::new().unwrap();
+    w.watch(&path).unwrap();
+    std::fs::write(&path, "").unwrap();
+    std::thread::sleep(std::time::Duration::from_millis(200));
+    assert!(w.changes().is_empty(), "nothing to compile yet");
+    std::fs::write(&path, "return 3").unwrap();
+    assert_eq!(next_change(&w).compiled.unwrap().source(), "return 3");
+}
