@@ -2,12 +2,11 @@
 
 use anyhow::{anyhow, Context as _, Result};
 use indicatif::{ProgressBar, ProgressStyle};
-use mrt_sim::bus::BusMatch;
 use mrt_sim::config::SimConfig;
-use mrt_sim::game::{Match, MatchReport};
+use mrt_sim::game::MatchReport;
 use mrt_sim::referee::{Call, Team};
-use mrt_sim::teams::{team, Stack};
-use std::fmt::Write as _;
+use mrt_sim::teams::Stack;
+use mrt_sim::{play, Wiring};
 use std::path::PathBuf;
 
 /// What `mrt sim` was asked.
@@ -42,21 +41,11 @@ fn play_one(
     stacks: (Stack, Stack),
     args: &SimArgs,
     record: bool,
-    mut progress: impl FnMut(f64),
+    progress: impl FnMut(f64),
 ) -> Result<MatchReport> {
-    let behaviors = args.behaviors.as_deref();
-    if !args.direct {
-        let mut m = BusMatch::new(cfg, seed, stacks.0, Some(stacks.1), behaviors)
-            .map_err(|e| anyhow!("{e}"))?;
-        m.record_frames(record);
-        return m.play(&mut progress).map_err(|e| anyhow!("{e}"));
-    }
-    let (n, r) = (cfg.rules.team_size, cfg.robot.radius);
-    let home = team(stacks.0, n, r, behaviors).map_err(|e| anyhow!("home team: {e}"))?;
-    let away = team(stacks.1, n, r, behaviors).map_err(|e| anyhow!("away team: {e}"))?;
-    let mut m = Match::new(cfg, seed, home, away).map_err(|e| anyhow!("{e}"))?;
-    m.record_frames(record);
-    Ok(m.play(f64::MAX, &mut progress))
+    let wiring = if args.direct { Wiring::Direct } else { Wiring::Bus };
+    play(cfg, seed, stacks, wiring, args.behaviors.as_deref(), record, progress)
+        .map_err(|e| anyhow!("{e}"))
 }
 
 /// Runs `mrt sim`.
@@ -119,7 +108,7 @@ pub fn run(args: &SimArgs) -> Result<()> {
         report.trajectory_hash
     );
     if let Some(p) = &args.plot {
-        std::fs::write(p, plot(&cfg, &report, (h, a)))
+        std::fs::write(p, report.to_svg(&cfg, (h, a)))
             .with_context(|| format!("cannot write {}", p.display()))?;
         println!("  drawing: {}", p.display());
     }
@@ -195,118 +184,6 @@ fn series(args: &SimArgs, cfg: &SimConfig, stacks: (Stack, Stack)) -> Result<()>
         goals.1 as f64 / n as f64
     );
     Ok(())
-}
-
-/// The match as SVG: the field, every robot's and the ball's trajectory, shots and goals.
-fn plot(cfg: &SimConfig, r: &MatchReport, names: (&str, &str)) -> String {
-    let f = &cfg.field;
-    let (hl, hw, b) = (f.length / 2.0, f.width / 2.0, f.border);
-    let scale = 50.0; // px per m
-    let (w, h) = ((f.length + 2.0 * b) * scale, (f.width + 2.0 * b) * scale + 40.0);
-    let px = |x: f64| (x + hl + b) * scale;
-    let py = |y: f64| (hw + b - y) * scale + 40.0;
-    let mut s = String::new();
-    let _ = writeln!(
-        s,
-        r##"<svg xmlns="http://www.w3.org/2000/svg" width="{w:.0}" height="{h:.0}" viewBox="0 0 {w:.0} {h:.0}" font-family="sans-serif">"##
-    );
-    let _ = writeln!(
-        s,
-        r##"<rect x="0" y="40" width="{w:.0}" height="{:.0}" fill="#2e7d32"/>"##,
-        h - 40.0
-    );
-    let line = r##"stroke="white" stroke-width="2" fill="none""##;
-    let _ = writeln!(
-        s,
-        r##"<rect x="{:.1}" y="{:.1}" width="{:.1}" height="{:.1}" {line}/>"##,
-        px(-hl),
-        py(hw),
-        f.length * scale,
-        f.width * scale
-    );
-    let _ = writeln!(
-        s,
-        r##"<line x1="{:.1}" y1="{:.1}" x2="{:.1}" y2="{:.1}" {line}/>"##,
-        px(0.0),
-        py(hw),
-        px(0.0),
-        py(-hw)
-    );
-    let _ = writeln!(
-        s,
-        r##"<circle cx="{:.1}" cy="{:.1}" r="{:.1}" {line}/>"##,
-        px(0.0),
-        py(0.0),
-        f.centre_circle_radius * scale
-    );
-    for (side, colour) in [(-1.0, "#1565c0"), (1.0, "#fdd835")] {
-        let x = if side < 0.0 { px(-hl - f.goal_depth) } else { px(hl) };
-        let _ = writeln!(
-            s,
-            r##"<rect x="{x:.1}" y="{:.1}" width="{:.1}" height="{:.1}" fill="{colour}"/>"##,
-            py(f.goal_width / 2.0),
-            f.goal_depth * scale,
-            f.goal_width * scale
-        );
-        let pa = if side < 0.0 { px(-hl) } else { px(hl - f.penalty_area_depth) };
-        let _ = writeln!(
-            s,
-            r##"<rect x="{pa:.1}" y="{:.1}" width="{:.1}" height="{:.1}" {line}/>"##,
-            py(f.penalty_area_width / 2.0),
-            f.penalty_area_depth * scale,
-            f.penalty_area_width * scale
-        );
-    }
-    let n = cfg.rules.team_size;
-    let robots = r.frames.first().map_or(0, |fr| fr.robots.len());
-    for i in 0..robots {
-        let colour = if i < n { "#e53935" } else { "#8e24aa" };
-        let mut d = String::new();
-        for (k, fr) in r.frames.iter().enumerate() {
-            let (x, y, _) = fr.robots[i];
-            let _ = write!(d, "{}{:.1},{:.1} ", if k == 0 { "M" } else { "L" }, px(x), py(y));
-        }
-        let _ = writeln!(
-            s,
-            r##"<path d="{d}" stroke="{colour}" stroke-width="1.2" fill="none" opacity="0.55"/>"##
-        );
-    }
-    // The ball's path, broken where the referee moved it (kickoff, out, dropped ball).
-    let mut d = String::new();
-    let mut last: Option<(f64, f64)> = None;
-    for fr in &r.frames {
-        let jump = last.is_none_or(|(x, y)| (fr.ball.0 - x).hypot(fr.ball.1 - y) > 1.5);
-        let _ =
-            write!(d, "{}{:.1},{:.1} ", if jump { "M" } else { "L" }, px(fr.ball.0), py(fr.ball.1));
-        last = Some(fr.ball);
-    }
-    let _ = writeln!(
-        s,
-        r##"<path d="{d}" stroke="white" stroke-width="1.5" fill="none" opacity="0.8"/>"##
-    );
-    for (_, robot, (x, y)) in &r.shots {
-        let colour = if *robot < n { "#e53935" } else { "#8e24aa" };
-        let _ = writeln!(
-            s,
-            r##"<circle cx="{:.1}" cy="{:.1}" r="4" fill="{colour}" stroke="black"/>"##,
-            px(*x),
-            py(*y)
-        );
-    }
-    let goals = r.calls.iter().filter(|(_, c)| matches!(c, Call::Goal(_))).count();
-    let _ = writeln!(
-        s,
-        r##"<text x="10" y="26" font-size="20">{} (home, red) {} : {} {} (away, purple) — seed {}, {} goals, {} shots (dots); white: the ball</text>"##,
-        names.0,
-        r.score.0,
-        r.score.1,
-        names.1,
-        r.seed,
-        goals,
-        r.shots.len()
-    );
-    s.push_str("</svg>\n");
-    s
 }
 
 #[cfg(test)]

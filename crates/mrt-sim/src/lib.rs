@@ -23,7 +23,48 @@ pub mod bus;
 pub mod config;
 pub mod drivers;
 pub mod game;
+pub mod plot;
 pub mod referee;
 pub mod sensor;
 pub mod teams;
 pub mod world;
+
+use std::path::Path;
+
+/// How the robots' brains are called.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Wiring {
+    /// Each robot an Agora with its Members on the bus ([`bus::BusMatch`]).
+    Bus,
+    /// The brains called directly, in order ([`game::Match`]); faster, same match.
+    Direct,
+}
+
+/// Plays one match between two stacks (`home`, `away`), `cfg.rules.team_size` robots each,
+/// from `seed`; `behaviors` overrides the compiled-in TeamChaos files; `record` keeps the frames
+/// for [`game::MatchReport::to_svg`]; `progress` gets the simulated time after each cycle.
+pub fn play(
+    cfg: &config::SimConfig,
+    seed: u64,
+    (home, away): (teams::Stack, teams::Stack),
+    wiring: Wiring,
+    behaviors: Option<&Path>,
+    record: bool,
+    mut progress: impl FnMut(f64),
+) -> Result<game::MatchReport, String> {
+    match wiring {
+        Wiring::Bus => {
+            let mut m = bus::BusMatch::new(cfg, seed, home, Some(away), behaviors)?;
+            m.record_frames(record);
+            m.play(&mut progress)
+        }
+        Wiring::Direct => {
+            let (n, r) = (cfg.rules.team_size, cfg.robot.radius);
+            let home = teams::team(home, n, r, behaviors).map_err(|e| format!("home team: {e}"))?;
+            let away = teams::team(away, n, r, behaviors).map_err(|e| format!("away team: {e}"))?;
+            let mut m = game::Match::new(cfg, seed, home, away)?;
+            m.record_frames(record);
+            Ok(m.play(f64::MAX, &mut progress))
+        }
+    }
+}
