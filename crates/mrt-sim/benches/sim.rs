@@ -28,9 +28,8 @@ fn bench(c: &mut Criterion) {
         ("chaos_vs_chaser", Stack::Chaos, Stack::Chaser),
     ];
     for (name, home, away) in stacks {
-        let r = cfg.robot.radius;
         let mut m =
-            Match::new(&cfg, 1, team(home, 4, r, None).unwrap(), team(away, 4, r, None).unwrap())
+            Match::new(&cfg, 1, team(home, &cfg, None).unwrap(), team(away, &cfg, None).unwrap())
                 .unwrap();
         c.bench_function(&format!("control_cycle_{name}"), |b| b.iter(|| m.cycle()));
     }
@@ -41,12 +40,11 @@ fn bench(c: &mut Criterion) {
     g.sample_size(10);
     g.bench_function("chaos_vs_chaser", |b| {
         b.iter(|| {
-            let r = short.robot.radius;
             let m = Match::new(
                 &short,
                 1,
-                team(Stack::Chaos, 4, r, None).unwrap(),
-                team(Stack::Chaser, 4, r, None).unwrap(),
+                team(Stack::Chaos, &short, None).unwrap(),
+                team(Stack::Chaser, &short, None).unwrap(),
             )
             .unwrap();
             m.play(f64::MAX, |_| {})

@@ -21,7 +21,7 @@
 use crate::drivers::{Base, MotorDriver, SimulatedAirboard};
 use crate::game::{Brain, MatchReport, Pitch};
 use crate::referee::Call;
-use crate::teams::{embedded_milan, embedded_teamchaos, Body, MilanBrain, Stack};
+use crate::teams::{embedded_milan, embedded_teamchaos, Body, Geometry, MilanBrain, Stack};
 use mrt_core::robot::{Estimate, Mate, RobotCommand, WorldSnapshot};
 use mrt_core::SimClock;
 use mrt_dcdt::{
@@ -216,11 +216,13 @@ impl BusMatch {
                     Stack::Chaos => agora
                         .add_member(BehaviorMember::hfsm(&dir, dir.join("player.hfsm.lua")), every),
                     Stack::Milan => {
-                        let brain = MilanBrain::new(&embedded_milan()?, k == 0)?;
+                        let brain =
+                            MilanBrain::new(&embedded_milan()?, k == 0, Geometry::of(&cfg.field))?;
                         agora.add_member(BrainMember::new(Box::new(brain)), every)
                     }
                     Stack::Chaser => {
-                        let brain = crate::game::Chaser { keeper: k == 0 };
+                        let brain =
+                            crate::game::Chaser { keeper: k == 0, field: Geometry::of(&cfg.field) };
                         agora.add_member(BrainMember::new(Box::new(brain)), every)
                     }
                 });
@@ -325,9 +327,8 @@ mod tests {
             .unwrap()
             .play(|_| {})
             .unwrap();
-        let r = cfg.robot.radius;
-        let home = crate::teams::team(Stack::Chaos, 2, r, None).unwrap();
-        let away = crate::teams::team(Stack::Chaser, 2, r, None).unwrap();
+        let home = crate::teams::team(Stack::Chaos, &cfg, None).unwrap();
+        let away = crate::teams::team(Stack::Chaser, &cfg, None).unwrap();
         let direct = crate::game::Match::new(&cfg, 9, home, away).unwrap().play(f64::MAX, |_| {});
         assert_eq!((bus.score, bus.trajectory_hash), (direct.score, direct.trajectory_hash));
     }

@@ -324,6 +324,8 @@ impl Match {
 pub struct Chaser {
     /// Plays as goalkeeper.
     pub keeper: bool,
+    /// The field it plays on.
+    pub field: crate::teams::Geometry,
 }
 
 impl Chaser {
@@ -352,14 +354,15 @@ impl Brain for Chaser {
             return c;
         }
         let me = w.my_pos.pose;
-        // Ball in the team frame (mm); x towards the opponent's net at (9000, 0).
+        // Ball in the team frame (mm); x towards the opponent's net at (half length, 0).
+        let (hl, gw) = (self.field.half_length, self.field.goal_half_width);
         let a = me.theta + ball.theta;
         let (bx, by) = (me.x + ball.rho * a.cos(), me.y + ball.rho * a.sin());
         if self.keeper {
-            let target = (-8700.0, by.clamp(-900.0, 900.0));
+            let target = (-(hl - 300.0), by.clamp(-(gw - 100.0), gw - 100.0));
             Chaser::go(me, target, a, &mut c);
         } else {
-            let (gx, gy) = (9000.0 - bx, -by);
+            let (gx, gy) = (hl - bx, -by);
             let g = gx.hypot(gy).max(1.0);
             let (ux, uy) = (gx / g, gy / g);
             let shot = uy.atan2(ux);
@@ -395,7 +398,9 @@ mod tests {
     use super::*;
 
     fn chasers(n: usize) -> Vec<Box<dyn Brain>> {
-        (0..n).map(|i| Box::new(Chaser { keeper: i == 0 }) as Box<dyn Brain>).collect()
+        (0..n)
+            .map(|i| Box::new(Chaser { keeper: i == 0, ..Chaser::default() }) as Box<dyn Brain>)
+            .collect()
     }
 
     fn short(minutes: f64, team: usize) -> SimConfig {
@@ -423,8 +428,8 @@ mod tests {
         let m = Match::new(
             &cfg,
             1,
-            vec![Box::new(Chaser { keeper: false })],
-            vec![Box::new(Chaser { keeper: true })],
+            vec![Box::new(Chaser { keeper: false, ..Chaser::default() })],
+            vec![Box::new(Chaser { keeper: true, ..Chaser::default() })],
         )
         .unwrap();
         // The away keeper stands still as a test dummy only if it cannot see; here it defends.
@@ -441,8 +446,7 @@ mod tests {
     #[test]
     fn the_chaos_team_alone_scores_within_two_minutes() {
         let cfg = short(2.0, 2);
-        let home =
-            crate::teams::team(crate::teams::Stack::Chaos, 2, cfg.robot.radius, None).unwrap();
+        let home = crate::teams::team(crate::teams::Stack::Chaos, &cfg, None).unwrap();
         let report = Match::new(&cfg, 3, home, Vec::new()).unwrap().play(120.0, |_| {});
         assert!(report.score.0 >= 1, "{:?} {:?} {:?}", report.score, report.stats, report.calls);
     }
@@ -450,10 +454,26 @@ mod tests {
     #[test]
     fn the_milan_team_alone_scores_within_two_minutes() {
         let cfg = short(2.0, 2);
-        let home =
-            crate::teams::team(crate::teams::Stack::Milan, 2, cfg.robot.radius, None).unwrap();
+        let home = crate::teams::team(crate::teams::Stack::Milan, &cfg, None).unwrap();
         let report = Match::new(&cfg, 3, home, Vec::new()).unwrap().play(120.0, |_| {});
         assert!(report.score.0 >= 1, "{:?} {:?} {:?}", report.score, report.stats, report.calls);
+    }
+
+    /// On a smaller field (12 × 8 m, 1.5 m goals) Milan and the baseline aim at the goals that
+    /// are there: each scores alone within two minutes.
+    #[test]
+    fn milan_and_the_baseline_play_on_the_configured_field() {
+        let mut cfg = short(2.0, 2);
+        cfg.field.length = 12.0;
+        cfg.field.width = 8.0;
+        cfg.field.goal_width = 1.5;
+        cfg.field.penalty_area_width = 4.0;
+        cfg.field.penalty_area_depth = 1.5;
+        for stack in [crate::teams::Stack::Milan, crate::teams::Stack::Chaser] {
+            let home = crate::teams::team(stack, &cfg, None).unwrap();
+            let report = Match::new(&cfg, 5, home, Vec::new()).unwrap().play(120.0, |_| {});
+            assert!(report.score.0 >= 1, "{stack:?}: {:?} {:?}", report.score, report.calls);
+        }
     }
 
     #[test]

@@ -59,9 +59,8 @@ pub fn play(
             m.play(&mut progress)
         }
         Wiring::Direct => {
-            let (n, r) = (cfg.rules.team_size, cfg.robot.radius);
-            let home = teams::team(home, n, r, behaviors).map_err(|e| format!("home team: {e}"))?;
-            let away = teams::team(away, n, r, behaviors).map_err(|e| format!("away team: {e}"))?;
+            let home = teams::team(home, cfg, behaviors).map_err(|e| format!("home team: {e}"))?;
+            let away = teams::team(away, cfg, behaviors).map_err(|e| format!("away team: {e}"))?;
             let mut m = game::Match::new(cfg, seed, home, away)?;
             m.record_frames(record);
             Ok(m.play(f64::MAX, &mut progress))

@@ -98,6 +98,29 @@ const MILAN: &[(&str, &str)] = &[
     ("want.txt", include_str!("../../../configs/brian/milan/want.txt")),
 ];
 
+/// The field as the teams need it, in the team frame (mm).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Geometry {
+    /// From the centre spot to a goal line.
+    pub half_length: f64,
+    /// From the middle of a goal to a post.
+    pub goal_half_width: f64,
+}
+
+impl Default for Geometry {
+    /// The default Middle Size League field.
+    fn default() -> Self {
+        Geometry::of(&crate::config::FieldConfig::default())
+    }
+}
+
+impl Geometry {
+    /// The geometry of a configured field.
+    pub fn of(f: &crate::config::FieldConfig) -> Geometry {
+        Geometry { half_length: f.length * 500.0, goal_half_width: f.goal_width * 500.0 }
+    }
+}
+
 /// How a team's drivers adapt the behaviors to the robot's body, as the seed's Commander
 /// Module did for its legs: the camera driver shifts distances, the motor driver scales
 /// set-points.
@@ -205,6 +228,7 @@ impl Brain for ChaosBrain {
 pub struct MilanBrain {
     brian: Brian,
     keeper: bool,
+    field: Geometry,
 }
 
 /// Degrees in [0, 360) of an angle in radians.
@@ -214,8 +238,8 @@ fn deg360(a: f64) -> f64 {
 
 impl MilanBrain {
     /// The goalkeeper or a field player, on the configuration of `dir`.
-    pub fn new(dir: &Path, keeper: bool) -> Result<MilanBrain, String> {
-        Ok(MilanBrain { brian: Brian::from_dir(dir).map_err(|e| e.to_string())?, keeper })
+    pub fn new(dir: &Path, keeper: bool, field: Geometry) -> Result<MilanBrain, String> {
+        Ok(MilanBrain { brian: Brian::from_dir(dir).map_err(|e| e.to_string())?, keeper, field })
     }
 
     /// The Parser: crisp inputs from the world snapshot (team frame, mm, degrees).
@@ -232,7 +256,8 @@ impl MilanBrain {
             // The ball and the point 400 mm behind it on the line from the opponent's net.
             let a = me.theta + ball.theta;
             let (bx, by) = (me.x + ball.rho * a.cos(), me.y + ball.rho * a.sin());
-            let (gx, gy) = (9000.0 - bx, -by);
+            let (hl, gw) = (self.field.half_length, self.field.goal_half_width);
+            let (gx, gy) = (hl - bx, -by);
             let g = gx.hypot(gy).max(1.0);
             let (ux, uy) = (gx / g, gy / g);
             let (px, py) = (bx - 400.0 * ux, by - 400.0 * uy);
@@ -242,13 +267,13 @@ impl MilanBrain {
             let mis = mrt_core::normalize_angle(a - uy.atan2(ux)).abs().to_degrees();
             v.push(("Misalignment", mis, r));
             if self.keeper {
-                // Stand 500 mm out of the goal line (x = -9000), facing the field, level with
-                // the ball within the posts.
-                v.push(("KeeperOffset", by.clamp(-900.0, 900.0) - me.y, r));
+                // Stand 500 mm out of the goal line, facing the field, level with the ball
+                // within the posts.
+                v.push(("KeeperOffset", by.clamp(-(gw - 100.0), gw - 100.0) - me.y, r));
             }
         }
         if self.keeper {
-            v.push(("KeeperDepth", me.x - (-9000.0 + 500.0), q));
+            v.push(("KeeperDepth", me.x - (-self.field.half_length + 500.0), q));
         }
         let nearest = w
             .mates
@@ -283,22 +308,27 @@ impl Brain for MilanBrain {
 
 /// The brains of one team of `size` robots (robot 0 keeps goal). `behaviors` overrides the
 /// compiled-in TeamChaos files.
+/// The TeamChaos Lua behaviors still assume the default field (`FIELD_HALF_LENGTH` in their
+/// `hbm.lua`); Milan and the baseline play on the configured one.
 pub fn team(
     stack: Stack,
-    size: usize,
-    robot_radius_m: f64,
+    cfg: &crate::config::SimConfig,
     behaviors: Option<&Path>,
 ) -> Result<Vec<Box<dyn Brain>>, String> {
+    let (size, robot_radius_m) = (cfg.rules.team_size, cfg.robot.radius);
+    let field = Geometry::of(&cfg.field);
     match stack {
         Stack::Milan => {
             let dir = embedded_milan()?;
             (0..size)
-                .map(|i| MilanBrain::new(&dir, i == 0).map(|b| Box::new(b) as Box<dyn Brain>))
+                .map(|i| {
+                    MilanBrain::new(&dir, i == 0, field).map(|b| Box::new(b) as Box<dyn Brain>)
+                })
                 .collect()
         }
-        Stack::Chaser => {
-            Ok((0..size).map(|i| Box::new(Chaser { keeper: i == 0 }) as Box<dyn Brain>).collect())
-        }
+        Stack::Chaser => Ok((0..size)
+            .map(|i| Box::new(Chaser { keeper: i == 0, field }) as Box<dyn Brain>)
+            .collect()),
         Stack::Chaos => {
             let dir = match behaviors {
                 Some(d) => d.to_path_buf(),

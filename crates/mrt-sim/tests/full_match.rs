@@ -10,9 +10,8 @@ use mrt_sim::teams::{team, Stack};
 
 fn play(seed: u64) -> MatchReport {
     let cfg = SimConfig::default();
-    let r = cfg.robot.radius;
-    let home = team(Stack::Chaos, 4, r, None).unwrap();
-    let away = team(Stack::Chaser, 4, r, None).unwrap();
+    let home = team(Stack::Chaos, &cfg, None).unwrap();
+    let away = team(Stack::Chaser, &cfg, None).unwrap();
     Match::new(&cfg, seed, home, away).unwrap().play(f64::MAX, |_| {})
 }
 
