@@ -29,41 +29,7 @@ struct Cli {
 #[derive(Subcommand)]
 enum Command {
     /// Play a simulated robot-soccer match on the embedded default world (or a series).
-    Sim {
-        /// Simulator configuration (TOML; see configs/sim/default.toml). Default: built in.
-        #[arg(long)]
-        config: Option<PathBuf>,
-        /// Seed of all randomness: the same seed gives the same match.
-        #[arg(long, default_value_t = 1)]
-        seed: u64,
-        /// The home team's stack: milan (Mr. BRIAN fuzzy behaviors), chaos (TeamChaos' Lua
-        /// state machines and fuzzy behaviors) or chaser (a hand-written baseline).
-        #[arg(long, default_value = "milan")]
-        home: String,
-        /// The away team's stack (same choices).
-        #[arg(long, default_value = "chaos")]
-        away: String,
-        /// Play this many matches (seeds seed, seed+1, ...) on all cores and report
-        /// win/draw/loss with confidence intervals.
-        #[arg(long, default_value_t = 1)]
-        matches: usize,
-        /// Draw the match (field, trajectories, shots) to this SVG file.
-        #[arg(long)]
-        plot: Option<PathBuf>,
-        /// Run at wall-clock speed, for watching.
-        #[arg(long)]
-        realtime: bool,
-        /// Length of a half in seconds (default from the configuration: 300).
-        #[arg(long)]
-        half: Option<f64>,
-        /// Run the TeamChaos behaviors of this directory instead of the built-in ones.
-        #[arg(long)]
-        behaviors: Option<PathBuf>,
-        /// Call the robots' brains directly instead of running each robot as an Agora with
-        /// its Members on the bus (faster; the default shows the real MRT wiring).
-        #[arg(long)]
-        direct: bool,
-    },
+    Sim(sim::SimArgs),
     /// Run a demo: an Agora with Members exchanging messages.
     Demo {
         /// Which example to run.
@@ -177,29 +143,7 @@ fn main() -> Result<()> {
             BrianCommand::Eval { dir, input, trace } => brian::eval(&dir, input.as_deref(), trace)?,
             BrianCommand::Plot { dir, out } => brian::plot(&dir, &out)?,
         },
-        Command::Sim {
-            config,
-            seed,
-            home,
-            away,
-            matches,
-            plot,
-            realtime,
-            half,
-            behaviors,
-            direct,
-        } => sim::run(&sim::SimArgs {
-            config,
-            seed,
-            home,
-            away,
-            matches,
-            plot,
-            realtime,
-            half,
-            behaviors,
-            direct,
-        })?,
+        Command::Sim(args) => sim::run(&args)?,
         Command::Behave { file, world, cycles, period_ms } => {
             behave::behave(&file, world.as_deref(), cycles, period_ms)?
         }

@@ -9,17 +9,41 @@ use mrt_sim::teams::Stack;
 use mrt_sim::{play, Wiring};
 use std::path::PathBuf;
 
-/// What `mrt sim` was asked.
+/// What `mrt sim` was asked (its command-line options).
+#[derive(clap::Args)]
 pub struct SimArgs {
+    /// Simulator configuration (TOML; see configs/sim/default.toml). Default: built in.
+    #[arg(long)]
     pub config: Option<PathBuf>,
+    /// Seed of all randomness: the same seed gives the same match.
+    #[arg(long, default_value_t = 1)]
     pub seed: u64,
+    /// The home team's stack: milan (Mr. BRIAN fuzzy behaviors), chaos (TeamChaos' Lua
+    /// state machines and fuzzy behaviors) or chaser (a hand-written baseline).
+    #[arg(long, default_value = "milan")]
     pub home: String,
+    /// The away team's stack (same choices).
+    #[arg(long, default_value = "chaos")]
     pub away: String,
+    /// Play this many matches (seeds seed, seed+1, ...) on all cores and report
+    /// win/draw/loss with confidence intervals.
+    #[arg(long, default_value_t = 1)]
     pub matches: usize,
+    /// Draw the match (field, trajectories, shots) to this SVG file.
+    #[arg(long)]
     pub plot: Option<PathBuf>,
+    /// Run at wall-clock speed, for watching.
+    #[arg(long)]
     pub realtime: bool,
+    /// Length of a half in seconds (default from the configuration: 300).
+    #[arg(long)]
     pub half: Option<f64>,
+    /// Run the TeamChaos behaviors of this directory instead of the built-in ones.
+    #[arg(long)]
     pub behaviors: Option<PathBuf>,
+    /// Call the robots' brains directly instead of running each robot as an Agora with
+    /// its Members on the bus (faster; the default shows the real MRT wiring).
+    #[arg(long)]
     pub direct: bool,
 }
 

@@ -39,7 +39,7 @@
 
 use crate::chaos::RobotIo;
 use crate::runtime::LuaRuntime;
-use crate::script::ScriptError;
+use crate::script::{mtime, ScriptError};
 use mlua::chunk::ChunkMode;
 use mlua::{Function, Lua, Table, Value};
 use mrt_core::Time;
@@ -466,10 +466,6 @@ impl Hfsm {
         let others = self.machines.iter().filter(|m| &m.name != root).map(|m| m.name.clone());
         std::iter::once(root.clone()).chain(others).collect()
     }
-}
-
-fn mtime(path: &Path) -> Option<std::time::SystemTime> {
-    std::fs::metadata(path).and_then(|m| m.modified()).ok()
 }
 
 /// Builds a state's transition dispatcher (see `Machine::dispatch`). A test passes when it

@@ -201,7 +201,8 @@ fn read(path: &Path) -> Result<String, ScriptError> {
         .map_err(|source| ScriptError::Io { file: path.display().to_string(), source })
 }
 
-fn mtime(path: &Path) -> Option<SystemTime> {
+/// A file's modification time (`None` when it cannot be read).
+pub(crate) fn mtime(path: &Path) -> Option<SystemTime> {
     std::fs::metadata(path).and_then(|m| m.modified()).ok()
 }
 

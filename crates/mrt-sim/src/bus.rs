@@ -21,7 +21,7 @@
 use crate::drivers::{Base, MotorDriver, SimulatedAirboard};
 use crate::game::{Brain, MatchReport, Pitch};
 use crate::referee::Call;
-use crate::teams::{embedded_milan, embedded_teamchaos, Body, Geometry, MilanBrain, Stack};
+use crate::teams::{embedded_teamchaos, send_brain, Body, Stack, CHAOS_KEEPER, CHAOS_PLAYER};
 use mrt_core::robot::{Estimate, Mate, RobotCommand, WorldSnapshot};
 use mrt_core::SimClock;
 use mrt_dcdt::{
@@ -211,19 +211,13 @@ impl BusMatch {
                 let mut ids = vec![agora.add_member(eyes, every)];
                 ids.push(match stack {
                     Stack::Chaos if k == 0 => {
-                        agora.add_member(BehaviorMember::hbm(&dir, "goalkeeper"), every)
+                        agora.add_member(BehaviorMember::hbm(&dir, CHAOS_KEEPER), every)
                     }
-                    Stack::Chaos => agora
-                        .add_member(BehaviorMember::hfsm(&dir, dir.join("player.hfsm.lua")), every),
-                    Stack::Milan => {
-                        let brain =
-                            MilanBrain::new(&embedded_milan()?, k == 0, Geometry::of(&cfg.field))?;
-                        agora.add_member(BrainMember::new(Box::new(brain)), every)
+                    Stack::Chaos => {
+                        agora.add_member(BehaviorMember::hfsm(&dir, dir.join(CHAOS_PLAYER)), every)
                     }
-                    Stack::Chaser => {
-                        let brain =
-                            crate::game::Chaser { keeper: k == 0, field: Geometry::of(&cfg.field) };
-                        agora.add_member(BrainMember::new(Box::new(brain)), every)
+                    other => {
+                        agora.add_member(BrainMember::new(send_brain(other, k == 0, cfg)?), every)
                     }
                 });
                 let base = lock_pitch(&pitch)?.base();

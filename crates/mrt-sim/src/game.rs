@@ -357,15 +357,14 @@ impl Brain for Chaser {
         // Ball in the team frame (mm); x towards the opponent's net at (half length, 0).
         let (hl, gw) = (self.field.half_length, self.field.goal_half_width);
         let a = me.theta + ball.theta;
-        let (bx, by) = (me.x + ball.rho * a.cos(), me.y + ball.rho * a.sin());
+        let (bx, by) = crate::teams::Geometry::ball_at(me, &ball);
         if self.keeper {
             let target = (-(hl - 300.0), by.clamp(-(gw - 100.0), gw - 100.0));
             Chaser::go(me, target, a, &mut c);
         } else {
-            let (gx, gy) = (hl - bx, -by);
-            let g = gx.hypot(gy).max(1.0);
-            let (ux, uy) = (gx / g, gy / g);
-            let shot = uy.atan2(ux);
+            let behind = self.field.behind_ball((bx, by), 500.0);
+            let shot = behind.theta;
+            let (ux, uy) = (shot.cos(), shot.sin());
             // Lined up: behind the ball, looking at the net.
             let (rx, ry) = (bx - me.x, by - me.y);
             let along = (rx * ux + ry * uy) / rx.hypot(ry).max(1.0);
@@ -380,7 +379,7 @@ impl Brain for Chaser {
                 }
             } else {
                 // Go round: to a point behind the ball, stepping aside first when in front.
-                let (mut px, mut py) = (bx - 500.0 * ux, by - 500.0 * uy);
+                let (mut px, mut py) = (behind.x, behind.y);
                 if along < 0.0 {
                     let side = if (me.x - bx) * uy - (me.y - by) * ux > 0.0 { 1.0 } else { -1.0 };
                     px += side * 600.0 * uy;

@@ -13,8 +13,10 @@
 //! Module turned set-points into a walking style for its own body.
 
 use crate::game::{Brain, Chaser};
-use mrt_core::robot::{lps, RobotCommand, WorldSnapshot};
+use mrt_core::robot::{lps, Lpo, RobotCommand, WorldSnapshot};
+use mrt_core::{Point2, Pose2};
 use mrt_fuzzy::brian::Brian;
+use mrt_plan::guidance::behind_ball;
 use mrt_script::{Sandbox, ThinkingCap};
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
@@ -119,6 +121,20 @@ impl Geometry {
     pub fn of(f: &crate::config::FieldConfig) -> Geometry {
         Geometry { half_length: f.length * 500.0, goal_half_width: f.goal_width * 500.0 }
     }
+
+    /// Where the ball is in the team frame (mm), from the robot's pose and its LPS ball.
+    pub fn ball_at(me: Pose2, ball: &Lpo) -> (f64, f64) {
+        let a = me.theta + ball.theta;
+        (me.x + ball.rho * a.cos(), me.y + ball.rho * a.sin())
+    }
+
+    /// The posture `distance` mm behind the ball on the line from the opponent's net, facing
+    /// the net ([`behind_ball`]); with the ball on the net's centre, simply `distance` short of
+    /// it, facing the net.
+    pub fn behind_ball(&self, ball: (f64, f64), distance: f64) -> Pose2 {
+        let (b, goal) = (Point2::new(ball.0, ball.1), Point2::new(self.half_length, 0.0));
+        behind_ball(b, goal, distance).unwrap_or(Pose2::new(ball.0 - distance, ball.1, 0.0))
+    }
 }
 
 /// How a team's drivers adapt the behaviors to the robot's body, as the seed's Commander
@@ -188,6 +204,11 @@ pub fn embedded_milan() -> Result<PathBuf, String> {
     DIR.get_or_init(|| materialize("milan", MILAN)).clone()
 }
 
+/// The Chaos goalkeeper's behavior.
+pub const CHAOS_KEEPER: &str = "goalkeeper";
+/// The Chaos field players' machine file.
+pub const CHAOS_PLAYER: &str = "player.hfsm.lua";
+
 /// A robot driven by ThinkingCap.
 pub struct ChaosBrain {
     cap: ThinkingCap,
@@ -199,9 +220,9 @@ impl ChaosBrain {
     pub fn new(dir: &Path, keeper: bool, robot_radius_m: f64) -> Result<ChaosBrain, String> {
         let sandbox = Sandbox::default();
         let cap = if keeper {
-            ThinkingCap::with_behavior(dir, "goalkeeper", sandbox)
+            ThinkingCap::with_behavior(dir, CHAOS_KEEPER, sandbox)
         } else {
-            ThinkingCap::with_hfsm(dir, dir.join("player.hfsm.lua"), sandbox)
+            ThinkingCap::with_hfsm(dir, dir.join(CHAOS_PLAYER), sandbox)
         };
         Ok(ChaosBrain { cap: cap.map_err(|e| e.to_string())?, body: Body::chaos(robot_radius_m) })
     }
@@ -254,17 +275,14 @@ impl MilanBrain {
             v.push(("BallDistance", ball.rho, r));
             v.push(("BallBearing", deg360(ball.theta), r));
             // The ball and the point 400 mm behind it on the line from the opponent's net.
-            let a = me.theta + ball.theta;
-            let (bx, by) = (me.x + ball.rho * a.cos(), me.y + ball.rho * a.sin());
-            let (hl, gw) = (self.field.half_length, self.field.goal_half_width);
-            let (gx, gy) = (hl - bx, -by);
-            let g = gx.hypot(gy).max(1.0);
-            let (ux, uy) = (gx / g, gy / g);
-            let (px, py) = (bx - 400.0 * ux, by - 400.0 * uy);
-            let (dx, dy) = (px - me.x, py - me.y);
+            let (bx, by) = Geometry::ball_at(me, &ball);
+            let spot = self.field.behind_ball((bx, by), 400.0);
+            let (dx, dy) = (spot.x - me.x, spot.y - me.y);
             v.push(("ApproachDistance", dx.hypot(dy), r));
             v.push(("ApproachAngle", deg360(dy.atan2(dx) - me.theta), r));
-            let mis = mrt_core::normalize_angle(a - uy.atan2(ux)).abs().to_degrees();
+            let a = me.theta + ball.theta;
+            let mis = mrt_core::normalize_angle(a - spot.theta).abs().to_degrees();
+            let gw = self.field.goal_half_width;
             v.push(("Misalignment", mis, r));
             if self.keeper {
                 // Stand 500 mm out of the goal line, facing the field, level with the ball
@@ -315,31 +333,35 @@ pub fn team(
     cfg: &crate::config::SimConfig,
     behaviors: Option<&Path>,
 ) -> Result<Vec<Box<dyn Brain>>, String> {
-    let (size, robot_radius_m) = (cfg.rules.team_size, cfg.robot.radius);
+    let size = cfg.rules.team_size;
+    if stack != Stack::Chaos {
+        return (0..size).map(|i| Ok(send_brain(stack, i == 0, cfg)? as Box<dyn Brain>)).collect();
+    }
+    let dir = match behaviors {
+        Some(d) => d.to_path_buf(),
+        None => embedded_teamchaos()?,
+    };
+    (0..size)
+        .map(|i| {
+            ChaosBrain::new(&dir, i == 0, cfg.robot.radius).map(|b| Box::new(b) as Box<dyn Brain>)
+        })
+        .collect()
+}
+
+/// A brain that may move between threads (a bus Member): Milan or the baseline. The Chaos
+/// stack lives in a Lua state, which may not: it runs as a [`ChaosBrain`] or, on the bus, as a
+/// `BehaviorMember`.
+pub fn send_brain(
+    stack: Stack,
+    keeper: bool,
+    cfg: &crate::config::SimConfig,
+) -> Result<Box<dyn Brain + Send>, String> {
     let field = Geometry::of(&cfg.field);
     match stack {
-        Stack::Milan => {
-            let dir = embedded_milan()?;
-            (0..size)
-                .map(|i| {
-                    MilanBrain::new(&dir, i == 0, field).map(|b| Box::new(b) as Box<dyn Brain>)
-                })
-                .collect()
-        }
-        Stack::Chaser => Ok((0..size)
-            .map(|i| Box::new(Chaser { keeper: i == 0, field }) as Box<dyn Brain>)
-            .collect()),
+        Stack::Milan => Ok(Box::new(MilanBrain::new(&embedded_milan()?, keeper, field)?)),
+        Stack::Chaser => Ok(Box::new(Chaser { keeper, field })),
         Stack::Chaos => {
-            let dir = match behaviors {
-                Some(d) => d.to_path_buf(),
-                None => embedded_teamchaos()?,
-            };
-            (0..size)
-                .map(|i| {
-                    ChaosBrain::new(&dir, i == 0, robot_radius_m)
-                        .map(|b| Box::new(b) as Box<dyn Brain>)
-                })
-                .collect()
+            Err("the Chaos stack runs in a Lua state (ChaosBrain, BehaviorMember)".into())
         }
     }
 }
