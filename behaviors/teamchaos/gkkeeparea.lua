@@ -1,7 +1,7 @@
 -- gkkeeparea (seed 001 §4.3): face forward, then move back into the goal area.
 local p = chaos.gsGetMyPos()
 local facingForward = TRI(-0.3, 0, 0.3)(p.theta)
-local homeX = -FIELD_HALF_LENGTH + GOAL_AREA_DEPTH / 2
+local homeX = -field().half_length + GOAL_AREA_DEPTH / 2
 rule(TOR(0.1, 0.6)(p.theta), "turn", "RIGHT")       -- turned left: turn right
 rule(TOL(-0.6, -0.1)(p.theta), "turn", "LEFT")
 rule(facingForward, "turn", "NONE")

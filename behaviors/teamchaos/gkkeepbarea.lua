@@ -3,7 +3,7 @@
 local p = chaos.gsGetMyPos()
 local back = math.abs(p.theta)                         -- pi when facing our net
 local facingBack = TOR(math.pi - 0.4, math.pi - 0.05)(back)
-local targetX = -FIELD_HALF_LENGTH + PENALTY_AREA_DEPTH - 300
+local targetX = -field().half_length + field().penalty_area_depth - 300
 rule(AND(NOT(facingBack), TOR(0, 0.1)(p.theta)), "turn", "LEFT")   -- turn the short way round
 rule(AND(NOT(facingBack), TOL(-0.1, 0)(p.theta)), "turn", "RIGHT")
 rule(facingBack, "turn", "NONE")

@@ -2,12 +2,12 @@
 -- predicates the rules use. Run once when the directory is loaded (and again when edited).
 -- Units: LPS distances in mm and bearings in radians (left positive); the global frame has its
 -- origin at the centre spot, x towards the opponent's net (NET1), our net (NET2) at
--- x = -FIELD_HALF_LENGTH.
+-- x = -field().half_length.
 
-FIELD_HALF_LENGTH = 9000 -- Middle Size League field, 18 m x 12 m
-GOAL_HALF_WIDTH = 1000
+-- The field the robot plays on, from the world model's map (half_length, half_width,
+-- goal_half_width, penalty_area_depth, in mm): 18 m x 12 m in the Middle Size League.
+function field() return chaos.getField() end
 GOAL_AREA_DEPTH = 750
-PENALTY_AREA_DEPTH = 2250
 
 -- Membership functions (figure 5 style), built once.
 local CLOSE = TOL(250, 750)         -- 1 up to 25 cm, 0 from 75 cm: 0.7 at 40 cm
@@ -56,25 +56,118 @@ end
 function wellLocalized() return TOR(0.4, 0.8)(chaos.gsGetMyPos().quality) end
 
 -- Goalkeeper geometry, from the global state.
--- Inside our own net: behind the goal line (x < -FIELD_HALF_LENGTH), fading over 25 cm.
-function inOwnNet() return TOL(-FIELD_HALF_LENGTH - 100, -FIELD_HALF_LENGTH + 150)(chaos.gsGetMyPos().x) end
+-- Inside our own net: behind the goal line (x < -half_length), fading over 25 cm.
+function inOwnNet()
+  local hl = field().half_length
+  return TOL(-hl - 100, -hl + 150)(chaos.gsGetMyPos().x)
+end
 function inGoalArea()
-  local p = chaos.gsGetMyPos()
-  return AND(TOL(-FIELD_HALF_LENGTH + GOAL_AREA_DEPTH, -FIELD_HALF_LENGTH + GOAL_AREA_DEPTH + 500)(p.x),
-             TOL(GOAL_HALF_WIDTH + 500, GOAL_HALF_WIDTH + 1000)(math.abs(p.y)))
+  local p, f = chaos.gsGetMyPos(), field()
+  return AND(TOL(-f.half_length + GOAL_AREA_DEPTH, -f.half_length + GOAL_AREA_DEPTH + 500)(p.x),
+             TOL(f.goal_half_width + 500, f.goal_half_width + 1000)(math.abs(p.y)))
 end
 function ballInArea()
-  local b = chaos.getGlobalBall()
-  return AND(TOR(0.2, 0.5)(b.quality),
-             TOL(-FIELD_HALF_LENGTH + PENALTY_AREA_DEPTH, -FIELD_HALF_LENGTH + PENALTY_AREA_DEPTH + 500)(b.x))
+  local b, f = chaos.getGlobalBall(), field()
+  local line = -f.half_length + f.penalty_area_depth
+  return AND(TOR(0.2, 0.5)(b.quality), TOL(line, line + 500)(b.x))
 end
 
 -- Signed lateral offset (mm) of the robot from the line joining the ball to the centre of our
 -- net, positive when the robot is on the left of that line as seen from the field (+y).
 function offsetFromBallToNet()
   local b, p = chaos.getGlobalBall(), chaos.gsGetMyPos()
-  local nx = -FIELD_HALF_LENGTH
+  local nx = -field().half_length
   if math.abs(b.x - nx) < 1 then return p.y - b.y end
   local yline = b.y + (0 - b.y) * (p.x - b.x) / (nx - b.x)
   return p.y - yline
+end
+
+-- Team play: roles (seed 001 §5.1, figure 8: attacker, supporter, defender). Every field
+-- player ranks itself by its distance to the global ball (its own sighting or a teammate's)
+-- among the field players it hears from; the goalkeeper stays out of the ranking.
+function ballKnown() return chaos.getGlobalBall().quality > 0.2 end
+
+local function distanceToBall(x, y)
+  local b = chaos.getGlobalBall()
+  return math.sqrt((b.x - x) ^ 2 + (b.y - y) ^ 2)
+end
+
+-- 1 for the field player closest to the ball, 2 for the next, ... `margin` (mm) is taken off
+-- the robot's own distance: the robot that holds a role keeps it until a teammate is clearly
+-- better placed, so two robots do not swap roles at every cycle.
+function ballRank(margin)
+  local p = chaos.gsGetMyPos()
+  local mine = distanceToBall(p.x, p.y) - (margin or 0)
+  local rank = 1
+  for _, m in ipairs(chaos.getMates()) do
+    if not m.keeper and distanceToBall(m.x, m.y) < mine then rank = rank + 1 end
+  end
+  return rank
+end
+
+local function clampToField(x, y)
+  local f = field()
+  local mx, my = f.half_length - 500, f.half_width - 500
+  return math.max(-mx, math.min(mx, x)), math.max(-my, math.min(my, y))
+end
+
+-- Where the supporter waits: 2 m behind the ball and 1.5 m towards the middle of the field,
+-- ready for a rebound or a loose ball.
+function supportSpot()
+  local b = chaos.getGlobalBall()
+  local side = b.y > 0 and -1 or 1
+  return clampToField(b.x - 2000, b.y + side * 1500)
+end
+
+-- Where the defender stands: on the line from the centre of our net to the ball, 40 % of the
+-- way out (between 2.5 m and 4.5 m from the net), cutting the ball's way to the goal.
+function defendSpot()
+  local b, hl = chaos.getGlobalBall(), field().half_length
+  local dx, dy = b.x + hl, b.y
+  local d = math.max(1, math.sqrt(dx * dx + dy * dy))
+  local r = math.max(2500, math.min(4500, 0.4 * d))
+  if r > d then r = d end
+  return clampToField(-hl + dx / d * r, dy / d * r)
+end
+
+-- The bearing (rad, left positive) from the robot to a field point, and the point in the
+-- robot's frame (forward, left) in mm.
+function bearingTo(x, y)
+  local p = chaos.gsGetMyPos()
+  local a = math.atan(y - p.y, x - p.x) - p.theta
+  return math.atan(math.sin(a), math.cos(a))
+end
+function inRobotFrame(x, y)
+  local p = chaos.gsGetMyPos()
+  local dx, dy = x - p.x, y - p.y
+  local c, s = math.cos(p.theta), math.sin(p.theta)
+  return dx * c + dy * s, -dx * s + dy * c
+end
+
+-- The unit vector from the ball to the opponent's net, and how far the robot is along it from
+-- the ball (mm; negative: behind the ball, where a push sends the ball towards the net).
+function ballToNet()
+  local b, hl = chaos.getGlobalBall(), field().half_length
+  local ux, uy = hl - b.x, -b.y
+  local n = math.max(1, math.sqrt(ux * ux + uy * uy))
+  return ux / n, uy / n
+end
+function aheadOfBall()
+  local b, p = chaos.getGlobalBall(), chaos.gsGetMyPos()
+  local ux, uy = ballToNet()
+  return (p.x - b.x) * ux + (p.y - b.y) * uy
+end
+
+-- The spot `d` mm behind the ball on the line from the opponent's net; a robot on the wrong
+-- side of the ball goes round it, 700 mm to the side it is on, so as not to push the ball
+-- towards its own net.
+function behindBall(d)
+  local b, p = chaos.getGlobalBall(), chaos.gsGetMyPos()
+  local ux, uy = ballToNet()
+  local x, y = b.x - ux * d, b.y - uy * d
+  if aheadOfBall() > -d / 2 then
+    local side = ((p.x - b.x) * uy - (p.y - b.y) * ux) > 0 and 1 or -1
+    x, y = x + side * 700 * uy, y - side * 700 * ux
+  end
+  return clampToField(x, y)
 end

@@ -1,24 +1,62 @@
--- A field player for a whole match: wait while the game is stopped, look for the ball when it
--- is lost, and play the Attacker (seed 001 §5.2) while it is seen. The Attacker machine is
--- reused from its own file, not copied (seed §5.1: meta-states are referenced, not duplicated).
+-- A field player for a whole match (seed 001 §5.1, figure 8): wait while the game is stopped,
+-- then play one of three roles, renegotiated every cycle from the shared world state:
+-- the field player closest to the ball is the Attacker (the seed's Attacker of §5.2, reused
+-- from its own file, not copied), the next one the Supporter, the others Defenders. A player
+-- that has lost the ball goes to where its teammates see it, or looks around for it.
 
 include "attacker.hfsm.lua"
 
 local function playing() return chaos.getCurrentState() == "PLAYING" end
+local function target(x, y) TARGET_X, TARGET_Y = x, y end
+local function ballSeenNow() return chaos.lps_getLpo(BALL).reliability > 0.5 end
+
+-- Keep a role for 400 mm of advantage before handing it over.
+local HOLD = 400
 
 machine "Player" {
   initial = "Wait",
   states = {
     Wait = function() chaos.setBehavior("stand") end,
-    Search = function() chaos.setBehavior("lookball") end,
-    Play = meta "Attacker",
+    Search = function()
+      if ballKnown() then
+        local b = chaos.getGlobalBall()
+        target(b.x, b.y)
+        chaos.setBehavior("gotopos")
+      else
+        chaos.setBehavior("lookball")
+      end
+    end,
+    Attack = meta "Attacker",
+    -- Far from the ball or on its wrong side: run to the spot behind it, facing it (an
+    -- omnidirectional base turns on the way); the Attacker takes over close behind the ball.
+    GetBehind = function() target(behindBall(600)) chaos.setBehavior("gotopos") end,
+    Support = function() target(supportSpot()) chaos.setBehavior("gotopos") end,
+    Defend = function() target(defendSpot()) chaos.setBehavior("gotopos") end,
   },
   transitions = {
     { name = "Start", from = "Wait", to = "Search", test = playing },
     -- Checked first (enclosing level): the referee stopped the game.
     { name = "Stop", from = "Search", to = "Wait", priority = -1, test = function() return not playing() end },
-    { name = "Stop", from = "Play", to = "Wait", priority = -1, test = function() return not playing() end },
-    { name = "BallSeen", from = "Search", to = "Play", test = "chaos.lps_getLpo(BALL).reliability > 0.5" },
-    { name = "BallLost", from = "Play", to = "Search", test = "chaos.lps_getLpo(BALL).reliability < 0.2" },
+    { name = "Stop", from = "Attack", to = "Wait", priority = -1, test = function() return not playing() end },
+    { name = "Stop", from = "Support", to = "Wait", priority = -1, test = function() return not playing() end },
+    { name = "Stop", from = "Defend", to = "Wait", priority = -1, test = function() return not playing() end },
+    { name = "BallSeen", from = "Search", to = "GetBehind", test = function() return ballSeenNow() and ballRank(0) == 1 end },
+    { name = "Support", from = "Search", to = "Support", priority = 1, test = function() return ballKnown() and ballRank(0) == 2 end },
+    { name = "Defend", from = "Search", to = "Defend", priority = 2, test = function() return ballKnown() and ballRank(0) > 2 end },
+    { name = "BallLost", from = "Attack", to = "Search", test = "chaos.lps_getLpo(BALL).reliability < 0.2" },
+    { name = "WrongSide", from = "Attack", to = "GetBehind", priority = 2, test = function() return aheadOfBall() > -150 or chaos.lps_getLpo(BALL).rho > 2000 end },
+    { name = "Behind", from = "GetBehind", to = "Attack", test = function() return aheadOfBall() < -400 and chaos.lps_getLpo(BALL).rho < 1000 and ballSeenNow() end },
+    { name = "Stop", from = "GetBehind", to = "Wait", priority = -1, test = function() return not playing() end },
+    { name = "GiveWay", from = "GetBehind", to = "Support", priority = 1, test = function() return ballRank(HOLD) > 1 end },
+    { name = "BallLost", from = "GetBehind", to = "Search", priority = 2, test = function() return not ballKnown() end },
+    { name = "GiveWay", from = "Attack", to = "Support", priority = 1, test = function() return ballRank(HOLD) > 1 end },
+    { name = "TakeOver", from = "Support", to = "GetBehind", test = function() return ballSeenNow() and ballRank(-HOLD) == 1 end },
+    { name = "TakeOver", from = "Defend", to = "GetBehind", test = function() return ballSeenNow() and ballRank(-HOLD) == 1 end },
+    { name = "Swap", from = "Support", to = "Defend", priority = 1, test = function() return ballRank(-HOLD) > 2 end },
+    { name = "Swap", from = "Defend", to = "Support", priority = 1, test = function() return ballRank(HOLD) == 2 end },
+    { name = "Closest", from = "Support", to = "Search", priority = 3, test = function() return ballRank(-HOLD) == 1 end },
+    { name = "Closest", from = "Defend", to = "Search", priority = 3, test = function() return ballRank(-HOLD) == 1 end },
+    { name = "BallLost", from = "Support", to = "Search", priority = 2, test = function() return not ballKnown() end },
+    { name = "BallLost", from = "Defend", to = "Search", priority = 2, test = function() return not ballKnown() end },
   },
 }

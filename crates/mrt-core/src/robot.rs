@@ -55,6 +55,35 @@ pub struct Mate {
     pub id: u32,
     /// Where it is.
     pub at: Estimate,
+    /// Whether it keeps goal (role negotiation leaves the goalkeeper out).
+    pub keeper: bool,
+}
+
+/// The field as the world model's map knows it (`getField`), in millimetres: behaviors read
+/// their geometry from here instead of assuming one field size.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct Field {
+    /// From the centre spot to a goal line.
+    pub half_length: f64,
+    /// From the centre line to a side line.
+    pub half_width: f64,
+    /// From the middle of a goal to a post.
+    pub goal_half_width: f64,
+    /// From the goal line to the penalty area's line.
+    pub penalty_area_depth: f64,
+}
+
+impl Default for Field {
+    /// The Middle Size League field of the seeds' time: 18 m x 12 m, goals 2 m wide.
+    fn default() -> Self {
+        Field {
+            half_length: 9000.0,
+            half_width: 6000.0,
+            goal_half_width: 1000.0,
+            penalty_area_depth: 2250.0,
+        }
+    }
 }
 
 /// The game state set by the referee (`getCurrentState()`).
@@ -108,6 +137,8 @@ pub struct WorldSnapshot {
     pub ball_booked: bool,
     /// The game state (`getCurrentState`).
     pub game_state: GameState,
+    /// The field (`getField`).
+    pub field: Field,
 }
 
 impl Default for WorldSnapshot {
@@ -123,6 +154,7 @@ impl Default for WorldSnapshot {
             role: String::new(),
             ball_booked: false,
             game_state: GameState::default(),
+            field: Field::default(),
         }
     }
 }

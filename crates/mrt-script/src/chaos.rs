@@ -3,7 +3,7 @@
 //!
 //! | group | functions |
 //! |---|---|
-//! | data access | `lps_getLpo(i)` → `{rho, theta, reliability, seen_ago}`, `gsGetMyPos()` → `{x, y, theta, quality}`, `getBallVel()` → `{x, y}`, `getGlobalBall()` → `{x, y, quality}`, `getMates()` → `{{id, x, y, theta, quality}, ...}` |
+//! | data access | `lps_getLpo(i)` → `{rho, theta, reliability, seen_ago}`, `gsGetMyPos()` → `{x, y, theta, quality}`, `getBallVel()` → `{x, y}`, `getGlobalBall()` → `{x, y, quality}`, `getMates()` → `{{id, x, y, theta, quality, keeper}, ...}`, `getField()` → `{half_length, half_width, goal_half_width, penalty_area_depth}` (mm) |
 //! | control | `setVlin(v)`, `setVrot(v)`, `setVlat(v)`, `setKick(id)`, `setNeeded(i, v)`, `trackLandMarks()`, `setBehavior(name)` |
 //! | coordination | `getRole()` → `{name}`, `haveBookedBall()` → `{booked}`, `bookBall()`, `releaseBookedBall()` |
 //! | persistence | `getBehaviorInfo()` → `{timer (ms), isNew (1/0)}`, `setGlobal(key, type, value)`, `getGlobal(key)`, `getCurrentState()` → `"PLAYING"`... |
@@ -237,6 +237,17 @@ fn install_inner(lua: &Lua, io: Rc<RefCell<RobotIo>>) -> mlua::Result<()> {
         let v = io.world.ball_vel;
         ball_vel.get(lua, io.generation, |t| keys.fill_pose(t, v.x, v.y, None, None))
     });
+    let field = CycleTable::default();
+    func!("getField", io, |lua, (): ()| {
+        let io = io.borrow();
+        let f = io.world.field;
+        field.get(lua, io.generation, |t| {
+            t.raw_set("half_length", f.half_length)?;
+            t.raw_set("half_width", f.half_width)?;
+            t.raw_set("goal_half_width", f.goal_half_width)?;
+            t.raw_set("penalty_area_depth", f.penalty_area_depth)
+        })
+    });
     let global_ball = CycleTable::default();
     let k = keys.clone();
     func!("getGlobalBall", io, |lua, (): ()| {
@@ -261,6 +272,7 @@ fn install_inner(lua: &Lua, io: Rc<RefCell<RobotIo>>) -> mlua::Result<()> {
                 Some(m.at.quality),
             )?;
             e.set("id", m.id)?;
+            e.set("keeper", m.keeper)?;
             t.set(k + 1, e)?;
         }
         Ok(t)

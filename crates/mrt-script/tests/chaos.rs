@@ -61,8 +61,12 @@ fn every_data_access_function_reads_the_snapshot() {
     w.my_pos = Estimate { pose: Pose2::new(1000.0, -500.0, 0.5), quality: 0.8 };
     w.global_ball = Estimate { pose: Pose2::new(2000.0, 300.0, 0.0), quality: 0.6 };
     w.ball_vel = mrt_core::Vec2::new(100.0, -20.0);
-    w.mates =
-        vec![Mate { id: 3, at: Estimate { pose: Pose2::new(-100.0, 50.0, 1.0), quality: 0.5 } }];
+    w.mates = vec![Mate {
+        id: 3,
+        at: Estimate { pose: Pose2::new(-100.0, 50.0, 1.0), quality: 0.5 },
+        keeper: true,
+    }];
+    w.field.half_length = 6000.0;
     w.role = "attacker".into();
     w.ball_booked = true;
     w.game_state = GameState::Playing;
@@ -73,11 +77,15 @@ fn every_data_access_function_reads_the_snapshot() {
             b.rho, b.theta, b.reliability, b.seen_ago, p.x, p.y, p.theta, p.quality, v.x, v.y,
             g.x, g.y, g.quality, m[1].id, m[1].x, m[1].quality, chaos.getRole().name,
             tostring(chaos.haveBookedBall().booked), chaos.getCurrentState(),
-            chaos.getBehaviorInfo().isNew, tostring(NET1 == 1 and LANDMARK0 == 3))"#;
+            chaos.getBehaviorInfo().isNew, tostring(NET1 == 1 and LANDMARK0 == 3))
+            .. string.format("|%s %g %g %g %g", tostring(m[1].keeper), chaos.getField().half_length,
+                chaos.getField().half_width, chaos.getField().goal_half_width,
+                chaos.getField().penalty_area_depth)"#;
     let s = Script::from_source(&rt, "probe.lua", probe, LoadStrategy::Compiled).unwrap();
     assert_eq!(
         s.call::<String>(&rt).unwrap(),
-        "400 0.25 0.9 0|1000 -500 0.5 0.8|100 -20|2000 300 0.6|3 -100 0.5|attacker true PLAYING|1 true"
+        "400 0.25 0.9 0|1000 -500 0.5 0.8|100 -20|2000 300 0.6|3 -100 0.5|attacker true PLAYING|1 true\
+         |true 6000 6000 1000 2250"
     );
 }
 

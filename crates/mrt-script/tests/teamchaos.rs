@@ -65,6 +65,19 @@ impl World {
         self
     }
 
+    /// A teammate at (x, y) (mm), facing the opponent's net.
+    fn mate(mut self, id: u32, x: f64, y: f64, keeper: bool) -> World {
+        let at = Estimate { pose: Pose2::new(x, y, 0.0), quality: 0.9 };
+        self.0.mates.push(mrt_core::robot::Mate { id, at, keeper });
+        self
+    }
+
+    /// The game state.
+    fn playing(mut self) -> World {
+        self.0.game_state = mrt_core::robot::GameState::Playing;
+        self
+    }
+
     /// The ball's global position, quality 0.9.
     fn global_ball(mut self, x: f64, y: f64) -> World {
         self.0.global_ball = Estimate { pose: Pose2::new(x, y, 0.0), quality: 0.9 };
@@ -122,6 +135,7 @@ fn the_shipped_directory_loads_every_behavior_and_each_runs_cleanly() {
             "gktracklms",
             "go2ball",
             "goalkeeper",
+            "gotopos",
             "lookball",
             "stand",
             "trackbnet1",
@@ -653,4 +667,81 @@ fn editing_an_included_machine_file_reloads_the_machine() {
         "{done:?} {errors:?}"
     );
     std::fs::remove_dir_all(&scratch).unwrap();
+}
+
+/// The field player's roles (seed 001 §5.1, figure 8). The robot stands at (−2000, 0) facing
+/// the opponent's net; the ball is 800 mm ahead, at (−1200, 0). The goalkeeper at (−8500, 0)
+/// is always left out of the ranking. The first cycle enters Wait, the second starts the game
+/// (Search); from the third the role is played, and `gotopos` drives towards its spot:
+/// - alone near the ball: rank 1 → GetBehind, then (800 mm ahead, 800 mm behind the ball on
+///   its line to the net: aheadOfBall = −800 < −400) Behind → the seed's Attacker;
+/// - a teammate at (−1000, 300), 361 mm from the ball: rank 2 → Support. The spot is 2 m
+///   behind the ball and 1.5 m towards the middle (the ball is at y = 0, so +y): (−3200, 1500),
+///   in the robot's frame 1200 mm back and 1500 mm left: go BACK alone (centroid of
+///   TOL(−300, −150) on [−300, 300]: a right triangle from −300 to −150, centroid −250),
+///   strafe LEFT alone (100), ball ahead: turn NONE (0);
+/// - a second teammate at (−1500, −200), 361 mm from the ball: rank 3 → Defend. The spot is on
+///   the line from our net (−9000, 0) to the ball, 0.4 × 7800 = 3120 mm out: (−5880, 0), 3880
+///   mm behind the robot: go BACK (−250), strafe NONE (0).
+#[test]
+fn field_players_share_the_roles_by_their_distance_to_the_ball() {
+    let player = || {
+        ThinkingCap::with_hfsm(dir(), dir().join("player.hfsm.lua"), Sandbox::default()).unwrap()
+    };
+    let base = |t| {
+        World::at(t)
+            .playing()
+            .me(-2000.0, 0.0, 0.0, 0.9)
+            .ball(800.0, 0.0)
+            .global_ball(-1200.0, 0.0)
+            .net1(7800.0, 0.0)
+            .mate(0, -8500.0, 0.0, true)
+    };
+    let run4 = |extra: &dyn Fn(World) -> World| {
+        let mut cap = player();
+        (0..4)
+            .map(|k| {
+                let c = cap.cycle(extra(base(k * 100)).0);
+                assert!(c.errors.is_empty(), "{:?}", c.errors);
+                c
+            })
+            .collect::<Vec<_>>()
+    };
+    let alone = run4(&|w| w);
+    let paths: Vec<&str> = alone.iter().map(|c| c.path.as_str()).collect();
+    assert_eq!(
+        paths,
+        ["Player/Wait", "Player/Search", "Player/GetBehind", "Player/Attack/FaceBall"]
+    );
+
+    let second = run4(&|w| w.mate(2, -1000.0, 300.0, false));
+    assert_eq!(second[2].path, "Player/Support");
+    assert_eq!(second[2].behavior.as_deref(), Some("gotopos"));
+    let c = &second[2].command;
+    close(c.vlin, -250.0);
+    close(c.vlat, 100.0);
+    close(c.vrot, 0.0);
+
+    let third = run4(&|w| w.mate(2, -1000.0, 300.0, false).mate(3, -1500.0, -200.0, false));
+    assert_eq!(third[2].path, "Player/Defend");
+    let c = &third[2].command;
+    close(c.vlin, -250.0);
+    close(c.vlat, 0.0);
+}
+
+/// The behaviors read the field from the world model (`getField`): on a 12 m field the
+/// goalkeeper's own net is at x = −6000, so a keeper standing at x = −6050 is in it
+/// (inOwnNet = TOL(−6100, −5850)(−6050) = 0.8 ≥ every other meta-rule's NOT(inOwnNet) = 0.2;
+/// `gkkeepout` wins the blend: it turns LEFT and needs the net, as in
+/// `goalkeeper_gets_out_of_its_net`), while on the default 18 m field the same robot is 3 m
+/// out of its net and `gkkeepout` has no say (turn follows the ball straight ahead: 0).
+#[test]
+fn the_behaviors_play_on_the_field_the_world_model_describes() {
+    let w = World::at(0).me(-6050.0, 0.0, 0.0, 0.9).ball(2000.0, 0.0).global_ball(-4000.0, 0.0);
+    let mut small = w.clone();
+    small.0.field.half_length = 6000.0;
+    let on_small = run("goalkeeper", small);
+    let on_default = run("goalkeeper", w);
+    assert!(on_small.command.vrot > 20.0 && on_small.command.need(lps::NET1) > 0.7);
+    assert!(on_default.command.vrot.abs() < 1e-9, "{:?}", on_default.command);
 }

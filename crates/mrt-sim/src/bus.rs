@@ -21,30 +21,21 @@
 use crate::drivers::{Base, MotorDriver, SimulatedAirboard};
 use crate::game::{Brain, MatchReport, Pitch};
 use crate::referee::Call;
+use crate::sensor::merge_team;
 use crate::teams::{embedded_teamchaos, send_brain, Body, Stack, CHAOS_KEEPER, CHAOS_PLAYER};
-use mrt_core::robot::{Estimate, Mate, RobotCommand, WorldSnapshot};
+use mrt_core::robot::{RobotCommand, WorldSnapshot};
 use mrt_core::SimClock;
 use mrt_dcdt::{
     Activation, Context, InnerLinkManager, Member, MemberError, Message, MsgType, RequestType,
     SteppedExecutor, RESERVED_TYPES_START,
 };
 use mrt_script::member::BehaviorMember;
-use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::path::Path;
 use std::sync::{Arc, Mutex, MutexGuard};
 use std::time::Duration;
 
-/// What a robot tells its teammates every cycle (team frame, mm).
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct MateReport {
-    /// The robot's player number.
-    pub id: u32,
-    /// Where it believes it is.
-    pub pose: Estimate,
-    /// Where it believes the ball is (quality 0 when it has no idea).
-    pub ball: Estimate,
-}
+pub use crate::sensor::MateReport;
 
 impl Message for MateReport {
     const TYPE: MsgType = MsgType(RESERVED_TYPES_START + 0x40);
@@ -66,7 +57,7 @@ struct Eyes {
     pitch: Shared,
     robot: usize,
     body: Body,
-    mates: BTreeMap<u32, Mate>,
+    mates: BTreeMap<u32, MateReport>,
 }
 
 impl Member for Eyes {
@@ -82,13 +73,17 @@ impl Member for Eyes {
     fn do_your_job(&mut self, ctx: &mut Context<'_>) -> Result<(), MemberError> {
         while let Some(m) = ctx.receive_msg() {
             let r = m.get::<MateReport>()?;
-            self.mates.insert(r.id, Mate { id: r.id, at: r.pose });
+            self.mates.insert(r.id, *r);
         }
-        let mut w = lock(&self.pitch)?.look(self.robot);
-        // Teammates as the bus told them, not as the simulator knows them.
-        w.mates = self.mates.values().copied().collect();
-        let id = u32::try_from(self.robot).unwrap_or(u32::MAX);
-        ctx.publish(MateReport { id, pose: w.my_pos, ball: w.global_ball });
+        let (mut w, report) = {
+            let mut pitch = lock(&self.pitch)?;
+            let w = pitch.look(self.robot);
+            let report = pitch.mate_report(self.robot, &w);
+            (w, report)
+        };
+        // Teammates and their ball as the bus told them, not as the simulator knows them.
+        merge_team(&mut w, self.mates.values());
+        ctx.publish(report);
         self.body.perceive(&mut w);
         ctx.publish(w);
         Ok(())
@@ -191,7 +186,7 @@ impl BusMatch {
             None if chaos_plays => embedded_teamchaos()?,
             None => std::path::PathBuf::new(),
         };
-        let chaos_body = Body::chaos(cfg.robot.radius);
+        let chaos_body = Body::chaos(cfg);
         let mut links = Vec::new();
         for (t, stack) in [Some(home), away].into_iter().enumerate() {
             let Some(stack) = stack else { continue };
@@ -312,8 +307,8 @@ mod tests {
     }
 
     /// The same robot code gives the same match whether the brains run as Members on the bus
-    /// or are called directly (the behaviors here do not read their teammates, the only input
-    /// that differs: the bus delivers a teammate's report one cycle late).
+    /// or are called directly (teammates' reports included: the direct wiring hands them over
+    /// with the bus's timing).
     #[test]
     fn the_bus_and_the_direct_wiring_play_the_same_match() {
         let cfg = short(15.0, 2);

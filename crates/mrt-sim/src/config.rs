@@ -150,8 +150,11 @@ impl Default for MatchConfig {
 pub struct SensorConfig {
     /// Half of the field of view, radians (π: omnidirectional vision, as on the MSL robots).
     pub half_fov: f64,
-    /// Farthest distance at which an object is detected.
+    /// Farthest distance at which the ball is detected.
     pub range: f64,
+    /// Farthest distance at which the nets and the landmarks (large, brightly coloured) are
+    /// detected.
+    pub landmark_range: f64,
     /// Standard deviation of the distance error, as a fraction of the distance.
     pub distance_noise: f64,
     /// Standard deviation of the bearing error, radians.
@@ -165,6 +168,7 @@ impl Default for SensorConfig {
         Self {
             half_fov: std::f64::consts::PI,
             range: 9.0,
+            landmark_range: 20.0,
             distance_noise: 0.03,
             bearing_noise: 0.02,
             miss_probability: 0.05,
@@ -267,6 +271,7 @@ impl SimConfig {
             ("rules.physics_step", self.rules.physics_step),
             ("rules.control_period", self.rules.control_period),
             ("sensor.range", self.sensor.range),
+            ("sensor.landmark_range", self.sensor.landmark_range),
         ];
         for (name, v) in positive {
             if !(v.is_finite() && v > 0.0) {

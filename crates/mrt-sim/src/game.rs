@@ -9,7 +9,7 @@
 use crate::config::SimConfig;
 use crate::drivers::Base;
 use crate::referee::{Call, Referee, Team};
-use crate::sensor::Perception;
+use crate::sensor::{merge_team, MateReport, Perception};
 use crate::world::{Drive, World};
 use mrt_core::robot::{lps, GameState, RobotCommand, WorldSnapshot};
 use rand::SeedableRng;
@@ -157,6 +157,13 @@ impl Pitch {
         self.eyes[i].look(&self.world, &self.referee, &self.cfg.sensor, &mut self.rngs[i])
     }
 
+    /// What robot `i` tells its teammates about its snapshot `w` (robot 0 of each team keeps
+    /// goal).
+    pub fn mate_report(&self, i: usize, w: &WorldSnapshot) -> MateReport {
+        let keeper = i % self.cfg.rules.team_size.max(1) == 0;
+        MateReport::of(u32::try_from(i).unwrap_or(u32::MAX), keeper, w)
+    }
+
     /// The robots' base (kinematics and wheel limits).
     pub fn base(&self) -> Base {
         self.base
@@ -260,6 +267,8 @@ impl Pitch {
 pub struct Match {
     pitch: Pitch,
     brains: Vec<Box<dyn Brain>>,
+    /// Each robot's latest report to its teammates.
+    reports: Vec<Option<MateReport>>,
 }
 
 impl Match {
@@ -273,7 +282,8 @@ impl Match {
         away: Vec<Box<dyn Brain>>,
     ) -> Result<Match, String> {
         let pitch = Pitch::new(cfg, seed, home.len(), away.len())?;
-        Ok(Match { pitch, brains: home.into_iter().chain(away).collect() })
+        let brains: Vec<_> = home.into_iter().chain(away).collect();
+        Ok(Match { pitch, reports: vec![None; brains.len()], brains })
     }
 
     /// Keeps one [`Frame`] per control cycle for drawings.
@@ -297,9 +307,23 @@ impl Match {
     }
 
     /// Runs one control cycle and the physics up to the next one. Returns the referee's calls.
+    ///
+    /// Teammates' reports reach a robot as they would on the bus: those of the robots before
+    /// it in this cycle, those of the robots after it from the previous cycle.
     pub fn cycle(&mut self) -> Vec<Call> {
         for i in 0..self.brains.len() {
-            let snapshot = self.pitch.look(i);
+            let mut snapshot = self.pitch.look(i);
+            let own = self.pitch.mate_report(i, &snapshot);
+            let team = self.pitch.referee().team_of(i);
+            let referee = self.pitch.referee();
+            let mates = self
+                .reports
+                .iter()
+                .enumerate()
+                .filter(|(j, _)| *j != i && referee.team_of(*j) == team)
+                .filter_map(|(_, r)| r.as_ref());
+            merge_team(&mut snapshot, mates);
+            self.reports[i] = Some(own);
             let cmd = self.brains[i].cycle(&snapshot);
             self.pitch.apply(i, &cmd);
         }

@@ -7,16 +7,58 @@
 //! frame (millimetres; x towards the opponent's net, whichever half the team plays in): an
 //! object not seen this frame keeps its last estimate, moved with the robot's own motion, with
 //! its reliability decaying, like the seed's LPS anchors.
+//!
+//! The team side of the world state is [`merge_team`]: teammates as their [`MateReport`]s
+//! tell them, and the global ball from the best sighting, one's own or a teammate's.
 
 use crate::config::SensorConfig;
 use crate::referee::{Referee, Team};
 use crate::world::World;
-use mrt_core::robot::{lps, Estimate, Lpo, Mate, WorldSnapshot};
+use mrt_core::robot::{lps, Estimate, Field, Lpo, Mate, WorldSnapshot};
 use mrt_core::{normalize_angle, Pose2, Time, Vec2};
 use rand::{Rng, RngCore};
 
 /// Reliability kept per control cycle by an object that was not seen again.
 pub const DECAY: f64 = 0.85;
+
+/// A teammate's ball counts this much of its own quality: a second-hand sighting, one cycle
+/// old, is trusted a little less than one's own.
+pub const SHARED_BALL: f64 = 0.9;
+
+/// What a robot tells its teammates every cycle (team frame, mm): its own pose and its own
+/// sighting of the ball (never what it heard from others, so stale news does not circulate).
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct MateReport {
+    /// The robot's player number.
+    pub id: u32,
+    /// Whether it keeps goal.
+    pub keeper: bool,
+    /// Where it believes it is.
+    pub pose: Estimate,
+    /// Where it believes the ball is (quality 0 when it has no idea).
+    pub ball: Estimate,
+}
+
+impl MateReport {
+    /// The report of robot `id` on its world snapshot (before [`merge_team`]).
+    pub fn of(id: u32, keeper: bool, w: &WorldSnapshot) -> MateReport {
+        MateReport { id, keeper, pose: w.my_pos, ball: w.global_ball }
+    }
+}
+
+/// The team side of the world state: `w.mates` from the teammates' reports (in their order),
+/// and the global ball replaced by a teammate's sighting when that is better than one's own
+/// (quality × [`SHARED_BALL`]). The LPS stays what the robot itself perceived.
+pub fn merge_team<'a>(w: &mut WorldSnapshot, reports: impl IntoIterator<Item = &'a MateReport>) {
+    w.mates.clear();
+    for r in reports {
+        w.mates.push(Mate { id: r.id, at: r.pose, keeper: r.keeper });
+        let shared = r.ball.quality * SHARED_BALL;
+        if shared > w.global_ball.quality {
+            w.global_ball = Estimate { pose: r.ball.pose, quality: shared };
+        }
+    }
+}
 
 /// Standard normal sample (Box–Muller), from any RNG.
 fn gauss(rng: &mut dyn RngCore) -> f64 {
@@ -106,7 +148,8 @@ impl Perception {
             let bearing = normalize_angle(dy.atan2(dx) - me.theta);
             let occluded =
                 k == lps::BALL && robots.iter().any(|&c| blocks((me.x, me.y), target, c, r_robot));
-            let visible = dist <= cfg.range && bearing.abs() <= cfg.half_fov && !occluded;
+            let range = if k == lps::BALL { cfg.range } else { cfg.landmark_range };
+            let visible = dist <= range && bearing.abs() <= cfg.half_fov && !occluded;
             let missed = rng.random_bool(cfg.miss_probability.clamp(0.0, 1.0));
             if visible && !missed {
                 let d = (dist * (1.0 + cfg.distance_noise * gauss(rng))).max(0.0);
@@ -129,9 +172,16 @@ impl Perception {
         let to_team = |x: f64, y: f64| (dir * x * 1000.0, dir * y * 1000.0);
         let heading =
             if dir > 0.0 { me.theta } else { normalize_angle(me.theta + std::f64::consts::PI) };
+        let f = &world.config().field;
         let mut w = WorldSnapshot {
             time: Time::from_secs_f64(now),
             game_state: referee.state(),
+            field: Field {
+                half_length: f.length * 500.0,
+                half_width: f.width * 500.0,
+                goal_half_width: f.goal_width * 500.0,
+                penalty_area_depth: f.penalty_area_depth * 1000.0,
+            },
             ..Default::default()
         };
         for (k, m) in self.memory.iter().enumerate() {
@@ -154,17 +204,6 @@ impl Perception {
         if self.memory[lps::BALL].is_some_and(|m| m.seen == now) {
             let (vx, vy) = world.ball_velocity();
             w.ball_vel = Vec2::new(dir * vx * 1000.0, dir * vy * 1000.0);
-        }
-        for i in 0..world.robot_count() {
-            if i == self.robot || referee.team_of(i) != team {
-                continue;
-            }
-            let Some(p) = world.robot(i) else { continue };
-            let (x, y) = to_team(p.x, p.y);
-            let th =
-                if dir > 0.0 { p.theta } else { normalize_angle(p.theta + std::f64::consts::PI) };
-            let id = u32::try_from(i).unwrap_or(u32::MAX);
-            w.mates.push(Mate { id, at: Estimate { pose: Pose2::new(x, y, th), quality: 0.9 } });
         }
         w
     }
@@ -207,18 +246,22 @@ mod tests {
         assert!((ball.theta + std::f64::consts::FRAC_PI_4).abs() < 1e-6, "{ball:?}"); // f32 physics
         assert_eq!(ball.reliability, 1.0);
         // The own net (west, (-9, 0)) is 7 m away on the left (bearing +π/2); the opponent's
-        // net, 11 m away, is beyond the 9 m range.
+        // net is 11 m away: beyond the ball's 9 m range, within the landmarks' 20 m.
         let net = s.lps[lps::NET2];
         assert!((net.rho - 7000.0).abs() < 0.01, "{net:?}");
         assert!((net.theta - std::f64::consts::FRAC_PI_2).abs() < 1e-6, "{net:?}");
-        assert_eq!(s.lps[lps::NET1].reliability, 0.0);
+        assert_eq!(s.lps[lps::NET1].reliability, 1.0);
+        assert!((s.lps[lps::NET1].rho - 11000.0).abs() < 0.01, "{:?}", s.lps[lps::NET1]);
+        let short = SensorConfig { landmark_range: 9.0, ..exact() };
+        let s2 = Perception::new(1).look(&w, &r, &short, &mut rng);
+        assert_eq!(s2.lps[lps::NET1].reliability, 0.0, "11 m: beyond a 9 m landmark range");
         assert_eq!((s.my_pos.pose.x, s.my_pos.pose.y), (-2000.0, 0.0));
         // An away robot sees the same field turned half round: x towards the west goal.
         w.place_robot(5, Pose2::new(2.0, 1.0, std::f64::consts::PI));
         let s = Perception::new(5).look(&w, &r, &exact(), &mut rng);
         assert!((s.my_pos.pose.x + 2000.0).abs() < 1e-9 && (s.my_pos.pose.y + 1000.0).abs() < 1e-9);
         assert!(s.my_pos.pose.theta.abs() < 1e-6, "facing its attack direction");
-        assert_eq!(s.mates.len(), 3);
+        assert_eq!(s.field.half_length, 9000.0);
     }
 
     #[test]
@@ -240,7 +283,7 @@ mod tests {
     fn a_narrow_field_of_view_and_range_limit_what_is_seen() {
         let (mut w, r) = setup();
         let mut rng = ChaCha8Rng::seed_from_u64(3);
-        let cfg = SensorConfig { half_fov: 0.5, range: 5.0, ..exact() };
+        let cfg = SensorConfig { half_fov: 0.5, range: 5.0, landmark_range: 5.0, ..exact() };
         w.place_robot(1, Pose2::new(-5.0, 0.0, std::f64::consts::PI)); // facing west
         w.place_ball(-1.0, 0.0);
         let s = Perception::new(1).look(&w, &r, &cfg, &mut rng);
@@ -252,6 +295,40 @@ mod tests {
             0.0,
             "corner (-9, 6): 7.2 m, out of range"
         );
+    }
+
+    #[test]
+    fn teammates_and_their_better_ball_sightings_merge_into_the_world_state() {
+        let mut w = WorldSnapshot {
+            global_ball: Estimate { pose: Pose2::new(100.0, 0.0, 0.0), quality: 0.5 },
+            ..Default::default()
+        };
+        let report = |id, q, x| MateReport {
+            id,
+            keeper: id == 0,
+            pose: Estimate { pose: Pose2::new(-1000.0 * f64::from(id), 0.0, 0.0), quality: 0.9 },
+            ball: Estimate { pose: Pose2::new(x, 50.0, 0.0), quality: q },
+        };
+        // 0.9 × 0.5 = 0.45 < 0.5: one's own sighting stays; 0.9 × 0.8 = 0.72 wins.
+        let reports = [report(0, 0.5, 200.0), report(2, 0.8, 300.0), report(3, 0.7, 400.0)];
+        merge_team(&mut w, &reports);
+        assert_eq!(
+            w.mates.iter().map(|m| (m.id, m.keeper)).collect::<Vec<_>>(),
+            [(0, true), (2, false), (3, false)]
+        );
+        assert_eq!(w.mates[1].at.pose.x, -2000.0);
+        assert!((w.global_ball.quality - 0.72).abs() < 1e-12, "{:?}", w.global_ball);
+        assert_eq!((w.global_ball.pose.x, w.global_ball.pose.y), (300.0, 50.0));
+        // A robot that sees the ball well keeps its own estimate.
+        let mut sharp = WorldSnapshot {
+            global_ball: Estimate { quality: 1.0, ..Default::default() },
+            ..Default::default()
+        };
+        merge_team(&mut sharp, &reports);
+        assert_eq!(sharp.global_ball.quality, 1.0);
+        // The report carries the robot's own sighting, not the merged one.
+        let r = MateReport::of(7, false, &w);
+        assert_eq!((r.id, r.ball.quality), (7, w.global_ball.quality));
     }
 
     #[test]

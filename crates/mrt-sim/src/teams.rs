@@ -68,6 +68,7 @@ const TEAMCHAOS: &[(&str, &str)] = &[
     ("gkscanobj.lua", include_str!("../../../behaviors/teamchaos/gkscanobj.lua")),
     ("gktracklms.lua", include_str!("../../../behaviors/teamchaos/gktracklms.lua")),
     ("go2ball.lua", include_str!("../../../behaviors/teamchaos/go2ball.lua")),
+    ("gotopos.lua", include_str!("../../../behaviors/teamchaos/gotopos.lua")),
     ("goalkeeper.lua", include_str!("../../../behaviors/teamchaos/goalkeeper.lua")),
     ("hbm.lua", include_str!("../../../behaviors/teamchaos/hbm.lua")),
     ("lookball.lua", include_str!("../../../behaviors/teamchaos/lookball.lua")),
@@ -154,11 +155,15 @@ impl Body {
     /// No adaptation.
     pub const PLAIN: Body = Body { edge: 0.0, linear: 1.0, turn: 1.0 };
 
-    /// TeamChaos' behaviors on a round base of `radius_m` metres: distances from the robot's
-    /// edge (TeamChaos measured from an AIBO's head), linear set-points ×4 and turning ×2
-    /// (they were tuned for AIBO walking, about 0.3 m/s).
-    pub fn chaos(radius_m: f64) -> Body {
-        Body { edge: radius_m * 1000.0, linear: 4.0, turn: 2.0 }
+    /// TeamChaos' behaviors on the configured robot: linear set-points ×4.8 (FAST, 250 mm/s,
+    /// becomes the base's 1.2 m/s) and turning ×3 (they were tuned for AIBO walking, about
+    /// 0.3 m/s); distances from a point ahead of the robot's centre chosen so that the
+    /// behaviors' "touching" (`TOUCHING` in `hbm.lua` reaches 0.5 at 250 mm, where `dokick`
+    /// fires) falls 30 mm inside the kicker's reach: a kick never fires at a ball it cannot
+    /// reach and wastes the valve's recharge.
+    pub fn chaos(cfg: &crate::config::SimConfig) -> Body {
+        let reach = (cfg.robot.radius + cfg.ball.radius + cfg.robot.kick_reach) * 1000.0;
+        Body { edge: (reach - 280.0).max(0.0), linear: 4.8, turn: 3.0 }
     }
 
     /// The camera driver's side: distances from the robot's edge.
@@ -216,15 +221,20 @@ pub struct ChaosBrain {
 }
 
 impl ChaosBrain {
-    /// The goalkeeper (`goalkeeper.lua`) or a field player (`player.hfsm.lua`) of `dir`.
-    pub fn new(dir: &Path, keeper: bool, robot_radius_m: f64) -> Result<ChaosBrain, String> {
+    /// The goalkeeper (`goalkeeper.lua`) or a field player (`player.hfsm.lua`) of `dir`, on
+    /// the robot of `cfg`.
+    pub fn new(
+        dir: &Path,
+        keeper: bool,
+        cfg: &crate::config::SimConfig,
+    ) -> Result<ChaosBrain, String> {
         let sandbox = Sandbox::default();
         let cap = if keeper {
             ThinkingCap::with_behavior(dir, CHAOS_KEEPER, sandbox)
         } else {
             ThinkingCap::with_hfsm(dir, dir.join(CHAOS_PLAYER), sandbox)
         };
-        Ok(ChaosBrain { cap: cap.map_err(|e| e.to_string())?, body: Body::chaos(robot_radius_m) })
+        Ok(ChaosBrain { cap: cap.map_err(|e| e.to_string())?, body: Body::chaos(cfg) })
     }
 }
 
@@ -326,8 +336,6 @@ impl Brain for MilanBrain {
 
 /// The brains of one team of `size` robots (robot 0 keeps goal). `behaviors` overrides the
 /// compiled-in TeamChaos files.
-/// The TeamChaos Lua behaviors still assume the default field (`FIELD_HALF_LENGTH` in their
-/// `hbm.lua`); Milan and the baseline play on the configured one.
 pub fn team(
     stack: Stack,
     cfg: &crate::config::SimConfig,
@@ -342,9 +350,7 @@ pub fn team(
         None => embedded_teamchaos()?,
     };
     (0..size)
-        .map(|i| {
-            ChaosBrain::new(&dir, i == 0, cfg.robot.radius).map(|b| Box::new(b) as Box<dyn Brain>)
-        })
+        .map(|i| ChaosBrain::new(&dir, i == 0, cfg).map(|b| Box::new(b) as Box<dyn Brain>))
         .collect()
 }
 
