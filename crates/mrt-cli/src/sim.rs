@@ -45,6 +45,10 @@ pub struct SimArgs {
     /// its Members on the bus (faster; the default shows the real MRT wiring).
     #[arg(long)]
     pub direct: bool,
+    /// Measure: play `--matches` full matches (3 if not given) one after the other on one
+    /// core, headless, and report how many times faster than real time they ran.
+    #[arg(long)]
+    pub bench: bool,
 }
 
 fn config(args: &SimArgs) -> Result<SimConfig> {
@@ -79,6 +83,9 @@ pub fn run(args: &SimArgs) -> Result<()> {
         Stack::parse(&args.home).map_err(|e| anyhow!("--home: {e}"))?,
         Stack::parse(&args.away).map_err(|e| anyhow!("--away: {e}"))?,
     );
+    if args.bench {
+        return bench(args, &cfg, stacks);
+    }
     if args.matches > 1 {
         return series(args, &cfg, stacks);
     }
@@ -124,6 +131,18 @@ pub fn run(args: &SimArgs) -> Result<()> {
             println!("  goal {who:<8} at {:>3}:{:02}", (*t as u64) / 60, (*t as u64) % 60);
         }
     }
+    let n = cfg.rules.team_size;
+    for f in &report.faults {
+        let (team, k) = if f.robot < n { (h, f.robot) } else { (a, f.robot - n) };
+        println!(
+            "  robot {} ({team} #{k}) faulted {} times from {}:{:02} (stood still meanwhile): {}",
+            f.robot,
+            f.count,
+            (f.first_at as u64) / 60,
+            (f.first_at as u64) % 60,
+            f.message
+        );
+    }
     println!(
         "  {:.0} s of play simulated in {:.1} s ({}); trajectory hash {:016x}",
         report.duration,
@@ -136,6 +155,44 @@ pub fn run(args: &SimArgs) -> Result<()> {
             .with_context(|| format!("cannot write {}", p.display()))?;
         println!("  drawing: {}", p.display());
     }
+    Ok(())
+}
+
+/// `mrt sim --bench`: full matches one after the other, speed as times real time.
+fn bench(args: &SimArgs, cfg: &SimConfig, stacks: (Stack, Stack)) -> Result<()> {
+    let n = if args.matches > 1 { args.matches } else { 3 };
+    let wiring = if args.direct { "brains called directly" } else { "each robot an Agora" };
+    println!(
+        "{n} matches of 2 x {:.0} s, {} v {}, {} ({wiring}), one core:",
+        cfg.rules.half_duration,
+        cfg.rules.team_size,
+        cfg.rules.team_size,
+        format_args!("{} vs {}", stacks.0.name(), stacks.1.name()),
+    );
+    let bar = ProgressBar::new(n as u64);
+    let mut speeds = Vec::with_capacity(n);
+    for k in 0..n as u64 {
+        let seed = args.seed.wrapping_add(k);
+        let started = std::time::Instant::now();
+        let r = play_one(cfg, seed, stacks, args, false, |_| {})?;
+        let wall = started.elapsed().as_secs_f64();
+        speeds.push(r.duration / wall.max(1e-9));
+        bar.suspend(|| {
+            println!(
+                "  seed {seed}: {:.0} s simulated in {wall:.2} s: {:.0}x real time",
+                r.duration,
+                r.duration / wall.max(1e-9)
+            )
+        });
+        bar.inc(1);
+    }
+    bar.finish_and_clear();
+    speeds.sort_by(f64::total_cmp);
+    let median = speeds[speeds.len() / 2];
+    println!(
+        "  median {median:.0}x real time (goal: at least 100x): {}",
+        if median >= 100.0 { "met" } else { "not met" }
+    );
     Ok(())
 }
 

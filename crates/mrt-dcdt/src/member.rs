@@ -130,6 +130,8 @@ pub struct MemberReport {
     pub restarts: u64,
     /// Its state at the end.
     pub state: MemberState,
+    /// The last failure (`init` error, job error or panic), for reports.
+    pub last_error: Option<String>,
 }
 
 /// First restart delay after a crash; doubles with every consecutive crash up to
@@ -158,6 +160,7 @@ pub(crate) struct Runner {
     errors: u64,
     panics: u64,
     restarts: u64,
+    last_error: Option<String>,
 }
 
 /// What one call of [`Runner::step`] did.
@@ -204,10 +207,12 @@ impl Runner {
             errors: 0,
             panics: 0,
             restarts: 0,
+            last_error: None,
         }
     }
 
     fn fail(&mut self, what: &str, reason: &str) {
+        self.last_error = Some(format!("{what}: {reason}"));
         self.consecutive_failures += 1;
         let shift = (self.consecutive_failures - 1).min(16);
         let backoff = BASE_BACKOFF.saturating_mul(1u32 << shift).min(MAX_BACKOFF);
@@ -280,6 +285,7 @@ impl Runner {
                 self.consecutive_failures = 0;
                 if let Err(e) = r {
                     self.errors += 1;
+                    self.last_error = Some(format!("job failed: {e}"));
                     tracing::warn!(member = %self.name, cycle = self.cycles, "member {} job failed: {e}", self.name);
                 }
                 if terminate {
@@ -348,6 +354,7 @@ impl Runner {
             panics: self.panics,
             restarts: self.restarts,
             state: self.state.get(),
+            last_error: self.last_error.clone(),
         }
     }
 }

@@ -1,5 +1,7 @@
 //! The simulator's hot paths: one physics step with eight robots, one control cycle of a match
-//! (eight object-sensor looks, eight brains, ten physics steps), and a whole short match.
+//! (eight object-sensor looks, eight brains, ten physics steps), and whole short matches: the
+//! full-stack default (Milan on Mr. BRIAN against Chaos on Lua, each robot an Agora on the bus)
+//! and the direct wiring. Speed as times real time = 60 s / the match's time.
 //!
 //! Run: `cargo bench -p mrt-sim`. Results go to `docs/performance.md`.
 #![allow(missing_docs, clippy::unwrap_used)]
@@ -9,6 +11,7 @@ use mrt_sim::config::SimConfig;
 use mrt_sim::game::Match;
 use mrt_sim::teams::{team, Stack};
 use mrt_sim::world::{Drive, World};
+use mrt_sim::Wiring;
 use std::time::Duration;
 
 fn bench(c: &mut Criterion) {
@@ -26,6 +29,7 @@ fn bench(c: &mut Criterion) {
     let stacks = [
         ("chaser_vs_chaser", Stack::Chaser, Stack::Chaser),
         ("chaos_vs_chaser", Stack::Chaos, Stack::Chaser),
+        ("milan_vs_chaos", Stack::Milan, Stack::Chaos),
     ];
     for (name, home, away) in stacks {
         let mut m =
@@ -48,6 +52,18 @@ fn bench(c: &mut Criterion) {
             )
             .unwrap();
             m.play(f64::MAX, |_| {})
+        })
+    });
+    g.bench_function("milan_vs_chaos_direct", |b| {
+        b.iter(|| {
+            let stacks = (Stack::Milan, Stack::Chaos);
+            mrt_sim::play(&short, 1, stacks, Wiring::Direct, None, false, |_| {}).unwrap()
+        })
+    });
+    g.bench_function("milan_vs_chaos_bus", |b| {
+        b.iter(|| {
+            let stacks = (Stack::Milan, Stack::Chaos);
+            mrt_sim::play(&short, 1, stacks, Wiring::Bus, None, false, |_| {}).unwrap()
         })
     });
     g.finish();

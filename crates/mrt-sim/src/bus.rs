@@ -1,6 +1,6 @@
 //! Robots as Agoras on the bus (DCDT, MRT manual ch. 3): the simulator's default wiring.
 //!
-//! Each robot is one [`Agora`](mrt_dcdt::Agora) with three Members, all on the simulated clock
+//! Each robot is one [`Agora`](mrt_dcdt::Agora) with four Members, all on the simulated clock
 //! of one [`SteppedExecutor`] so that the match stays deterministic:
 //!
 //! 1. **`Eyes`** (the camera driver and the world-state Member, periodic): looks through the
@@ -12,7 +12,11 @@
 //! 2. **the behaviors**: a [`BehaviorMember`] running the TeamChaos HFSM or goalkeeper for the
 //!    Chaos stack, or a [`BrainMember`] around any `Send` [`Brain`] (the baseline);
 //! 3. **`Motor`** (the motor and kicker driver, on message): turns each [`RobotCommand`] into
-//!    wheel set-points and kicks.
+//!    wheel set-points and kicks;
+//! 4. **`FaultBook`** (on message): books the behavior Member's script errors against the
+//!    robot. A Member that fails to start, fails or panics is restarted by its executor and
+//!    booked too when the match ends: the match goes on, the robot stands still meanwhile, and
+//!    [`MatchReport::faults`] says which file and line.
 //!
 //! Body adaptation belongs to the drivers, as the seed's Commander Module did for its legs: on
 //! the Chaos robots `Eyes` measures distances from the robot's edge and `Motor` scales the
@@ -29,7 +33,7 @@ use mrt_dcdt::{
     Activation, Context, InnerLinkManager, Member, MemberError, Message, MsgType, RequestType,
     SteppedExecutor, RESERVED_TYPES_START,
 };
-use mrt_script::member::BehaviorMember;
+use mrt_script::member::{BehaviorMember, BehaviorStatus};
 use std::collections::BTreeMap;
 use std::path::Path;
 use std::sync::{Arc, Mutex, MutexGuard};
@@ -120,6 +124,33 @@ impl Member for Motor {
             self.driver.set_duty(&self.base.duties(&cmd)).map_err(|e| e.to_string())?;
             if cmd.kick.is_some() {
                 lock(&self.pitch)?.kick(self.robot);
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Books a robot's script errors (its behavior Member's `BehaviorStatus`) against the robot,
+/// as a referee's assistant would note a robot that stopped.
+struct FaultBook {
+    pitch: Shared,
+    robot: usize,
+}
+
+impl Member for FaultBook {
+    fn name(&self) -> String {
+        format!("faults-{}", self.robot)
+    }
+
+    fn init(&mut self, ctx: &mut Context<'_>) -> Result<(), MemberError> {
+        ctx.subscribe_to::<BehaviorStatus>(RequestType::Local);
+        Ok(())
+    }
+
+    fn do_your_job(&mut self, ctx: &mut Context<'_>) -> Result<(), MemberError> {
+        while let Some(m) = ctx.receive_msg() {
+            if let Some(e) = m.get::<BehaviorStatus>()?.errors.first() {
+                lock(&self.pitch)?.fault(self.robot, 1, e);
             }
         }
         Ok(())
@@ -219,6 +250,8 @@ impl BusMatch {
                 let driver = Box::new(SimulatedAirboard::new(pitch.clone(), robot, base));
                 let motor = Motor { pitch: pitch.clone(), robot, body, base, driver };
                 ids.push(agora.add_member(motor, Activation::OnMessage));
+                let book = FaultBook { pitch: pitch.clone(), robot };
+                ids.push(agora.add_member(book, Activation::OnMessage));
                 for m in ids {
                     agora.activate_member(m).map_err(|e| e.to_string())?;
                 }
@@ -259,15 +292,21 @@ impl BusMatch {
             self.cycle()?;
             progress(lock_pitch(&self.pitch)?.world().time());
         }
+        // Members that failed to start, failed jobs or panicked (each was restarted).
         let reports = self.exec.finish();
-        let failures: Vec<String> = reports
-            .iter()
-            .flat_map(|r| r.members.iter())
-            .filter(|m| m.panics > 0 || m.errors > 0)
-            .map(|m| format!("{} ({} errors, {} panics)", m.name, m.errors, m.panics))
-            .collect();
-        if !failures.is_empty() {
-            tracing::warn!("members with faults during the match: {}", failures.join(", "));
+        {
+            let mut pitch = lock_pitch(&self.pitch)?;
+            for r in &reports {
+                let robot = usize::try_from(r.agora.0).unwrap_or(usize::MAX).wrapping_sub(1);
+                if robot >= pitch.world().robot_count() {
+                    continue; // a monitoring Agora, not a robot
+                }
+                for m in r.members.iter().filter(|m| m.last_error.is_some()) {
+                    let count = m.errors + m.panics + m.restarts.max(1);
+                    let why = m.last_error.as_deref().unwrap_or_default();
+                    pitch.fault(robot, count, &format!("member {}: {why}", m.name));
+                }
+            }
         }
         let pitch =
             Arc::try_unwrap(self.pitch).map_err(|_| "the pitch is still shared".to_string())?;
@@ -320,6 +359,65 @@ mod tests {
         let away = crate::teams::team(Stack::Chaser, &cfg, None).unwrap();
         let direct = crate::game::Match::new(&cfg, 9, home, away).unwrap().play(f64::MAX, |_| {});
         assert_eq!((bus.score, bus.trajectory_hash), (direct.score, direct.trajectory_hash));
+    }
+
+    /// Bad behavior files never stop a match: a file that does not compile stops the robots
+    /// that load it (they stand still), a behavior that runs away is cut off by its budget;
+    /// both are reported with the file and line, on the bus and in the direct wiring.
+    #[test]
+    fn broken_or_runaway_behaviors_stop_their_robot_and_are_reported() {
+        let tmp = std::env::temp_dir().join(format!("mrt-sim-broken-{}", std::process::id()));
+        let src = embedded_teamchaos().unwrap();
+        let copy = |to: &Path| {
+            std::fs::create_dir_all(to).unwrap();
+            for e in std::fs::read_dir(&src).unwrap() {
+                let p = e.unwrap().path();
+                std::fs::copy(&p, to.join(p.file_name().unwrap())).unwrap();
+            }
+        };
+        let cfg = short(5.0, 2);
+        // 1. A syntax error in go2ball.lua (line 11): no Chaos robot can load its behaviors.
+        let broken = tmp.join("broken");
+        copy(&broken);
+        let go2ball = broken.join("go2ball.lua");
+        let text = std::fs::read_to_string(&go2ball).unwrap();
+        std::fs::write(&go2ball, format!("{}rule(ballSeen(, 'go')\n", text)).unwrap();
+        let line = text.lines().count() + 1;
+        let want = format!("go2ball.lua:{line}:");
+        let bus = BusMatch::new(&cfg, 1, Stack::Chaos, Some(Stack::Chaser), Some(&broken))
+            .unwrap()
+            .play(|_| {})
+            .unwrap();
+        let home = crate::teams::team(Stack::Chaos, &cfg, Some(&broken)).unwrap();
+        let away = crate::teams::team(Stack::Chaser, &cfg, None).unwrap();
+        let direct = crate::game::Match::new(&cfg, 1, home, away).unwrap().play(f64::MAX, |_| {});
+        for r in [&bus, &direct] {
+            assert!((r.duration - 10.0).abs() < 0.011, "the match went on: {}", r.duration);
+            let robots: Vec<usize> = r.faults.iter().map(|f| f.robot).collect();
+            assert_eq!(robots, [0, 1], "{:?}", r.faults);
+            assert!(r.faults.iter().all(|f| f.message.contains(&want)), "{:?}", r.faults);
+            assert_eq!(r.stats[0].shots, 0, "stopped robots do not play");
+        }
+        // 2. A goalkeeper behavior that never ends: the budget cuts it off every cycle.
+        let looping = tmp.join("looping");
+        copy(&looping);
+        let keeper = looping.join("goalkeeper.lua");
+        let text = std::fs::read_to_string(&keeper).unwrap();
+        std::fs::write(&keeper, format!("while true do end\n{text}")).unwrap();
+        let bus = BusMatch::new(&cfg, 1, Stack::Chaos, Some(Stack::Chaser), Some(&looping))
+            .unwrap()
+            .play(|_| {})
+            .unwrap();
+        assert!((bus.duration - 10.0).abs() < 0.011);
+        let keeper = bus.faults.iter().find(|f| f.robot == 0);
+        assert!(
+            keeper.is_some_and(|f| f.message.contains("goalkeeper.lua")
+                && f.message.contains("instruction budget")
+                && f.count > 1),
+            "{:?}",
+            bus.faults
+        );
+        std::fs::remove_dir_all(&tmp).unwrap();
     }
 
     #[test]

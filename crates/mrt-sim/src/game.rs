@@ -19,6 +19,49 @@ use rand_chacha::ChaCha8Rng;
 pub trait Brain {
     /// One control cycle.
     fn cycle(&mut self, world: &WorldSnapshot) -> RobotCommand;
+
+    /// What went wrong since the last call (a script error with its file and line, ...): the
+    /// match books it against the robot. The robot went on (or stood still) regardless.
+    fn take_faults(&mut self) -> Vec<String> {
+        Vec::new()
+    }
+}
+
+/// A robot whose software could not start (a behavior file that does not load, ...): it stands
+/// still for the whole match, and its reason is booked once.
+#[derive(Debug)]
+pub struct Stopped {
+    reason: Option<String>,
+}
+
+impl Stopped {
+    /// A robot stopped for `reason`.
+    pub fn new(reason: impl Into<String>) -> Stopped {
+        Stopped { reason: Some(reason.into()) }
+    }
+}
+
+impl Brain for Stopped {
+    fn cycle(&mut self, _world: &WorldSnapshot) -> RobotCommand {
+        RobotCommand::default()
+    }
+
+    fn take_faults(&mut self) -> Vec<String> {
+        self.reason.take().into_iter().collect()
+    }
+}
+
+/// What went wrong with one robot's software during a match.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RobotFault {
+    /// The robot (0 .. team size: home, then away).
+    pub robot: usize,
+    /// Simulated time of the first fault, s.
+    pub first_at: f64,
+    /// How many faults (faulty cycles, failed starts, panics).
+    pub count: u64,
+    /// The first fault's message (which file and line, for script errors).
+    pub message: String,
 }
 
 /// Per-team statistics.
@@ -62,6 +105,8 @@ pub struct MatchReport {
     pub shots: Vec<(f64, usize, (f64, f64))>,
     /// Positions, one frame per control cycle (empty unless recorded).
     pub frames: Vec<Frame>,
+    /// Robots whose software failed during the match, by robot.
+    pub faults: Vec<RobotFault>,
 }
 
 /// The physical side of a match, whatever drives the robots: the world, the referee, the
@@ -80,6 +125,7 @@ pub struct Pitch {
     shots: Vec<(f64, usize, (f64, f64))>,
     frames: Vec<Frame>,
     record: bool,
+    faults: Vec<RobotFault>,
 }
 
 const FNV_OFFSET: u64 = 0xcbf2_9ce4_8422_2325;
@@ -129,6 +175,7 @@ impl Pitch {
             shots: Vec::new(),
             frames: Vec::new(),
             record: false,
+            faults: Vec::new(),
         })
     }
 
@@ -155,6 +202,18 @@ impl Pitch {
     /// Robot `i` looks through its object sensor.
     pub fn look(&mut self, i: usize) -> WorldSnapshot {
         self.eyes[i].look(&self.world, &self.referee, &self.cfg.sensor, &mut self.rngs[i])
+    }
+
+    /// Books a fault of robot `i`'s software (`count` of them, the first one's `message`).
+    pub fn fault(&mut self, i: usize, count: u64, message: &str) {
+        if let Some(f) = self.faults.iter_mut().find(|f| f.robot == i) {
+            f.count += count;
+            return;
+        }
+        tracing::warn!(robot = i, "robot {i}: {message}");
+        let first_at = self.world.time();
+        self.faults.push(RobotFault { robot: i, first_at, count, message: message.to_string() });
+        self.faults.sort_by_key(|f| f.robot);
     }
 
     /// What robot `i` tells its teammates about its snapshot `w` (robot 0 of each team keeps
@@ -258,6 +317,7 @@ impl Pitch {
             calls: self.calls,
             shots: self.shots,
             frames: self.frames,
+            faults: self.faults,
         }
     }
 }
@@ -325,6 +385,9 @@ impl Match {
             merge_team(&mut snapshot, mates);
             self.reports[i] = Some(own);
             let cmd = self.brains[i].cycle(&snapshot);
+            for fault in self.brains[i].take_faults() {
+                self.pitch.fault(i, 1, &fault);
+            }
             self.pitch.apply(i, &cmd);
         }
         self.pitch.advance()

@@ -12,7 +12,7 @@
 //! League base the Chaos brain scales the behaviors' set-points, as the seed's Commander
 //! Module turned set-points into a walking style for its own body.
 
-use crate::game::{Brain, Chaser};
+use crate::game::{Brain, Chaser, Stopped};
 use mrt_core::robot::{lps, Lpo, RobotCommand, WorldSnapshot};
 use mrt_core::{Point2, Pose2};
 use mrt_fuzzy::brian::Brian;
@@ -218,6 +218,7 @@ pub const CHAOS_PLAYER: &str = "player.hfsm.lua";
 pub struct ChaosBrain {
     cap: ThinkingCap,
     body: Body,
+    faults: Vec<String>,
 }
 
 impl ChaosBrain {
@@ -234,7 +235,11 @@ impl ChaosBrain {
         } else {
             ThinkingCap::with_hfsm(dir, dir.join(CHAOS_PLAYER), sandbox)
         };
-        Ok(ChaosBrain { cap: cap.map_err(|e| e.to_string())?, body: Body::chaos(cfg) })
+        Ok(ChaosBrain {
+            cap: cap.map_err(|e| e.to_string())?,
+            body: Body::chaos(cfg),
+            faults: Vec::new(),
+        })
     }
 }
 
@@ -243,12 +248,17 @@ impl Brain for ChaosBrain {
         let mut seen = world.clone();
         self.body.perceive(&mut seen);
         let c = self.cap.cycle(seen);
-        for e in &c.errors {
-            tracing::warn!("chaos robot: {e}");
+        // One fault per faulty cycle, named by its first error.
+        if let Some(e) = c.errors.first() {
+            self.faults.push(e.to_string());
         }
         let mut cmd = c.command;
         self.body.act(&mut cmd);
         cmd
+    }
+
+    fn take_faults(&mut self) -> Vec<String> {
+        std::mem::take(&mut self.faults)
     }
 }
 
@@ -349,9 +359,13 @@ pub fn team(
         Some(d) => d.to_path_buf(),
         None => embedded_teamchaos()?,
     };
-    (0..size)
-        .map(|i| ChaosBrain::new(&dir, i == 0, cfg).map(|b| Box::new(b) as Box<dyn Brain>))
-        .collect()
+    // A robot whose behaviors do not load stands still and is reported; the match goes on.
+    Ok((0..size)
+        .map(|i| match ChaosBrain::new(&dir, i == 0, cfg) {
+            Ok(b) => Box::new(b) as Box<dyn Brain>,
+            Err(e) => Box::new(Stopped::new(e)),
+        })
+        .collect())
 }
 
 /// A brain that may move between threads (a bus Member): Milan or the baseline. The Chaos
