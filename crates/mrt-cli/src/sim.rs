@@ -134,13 +134,12 @@ pub fn run(args: &SimArgs) -> Result<()> {
     let n = cfg.rules.team_size;
     for f in &report.faults {
         let (team, k) = if f.robot < n { (h, f.robot) } else { (a, f.robot - n) };
+        let from = f
+            .first_at
+            .map_or(String::new(), |t| format!(" from {}:{:02}", (t as u64) / 60, (t as u64) % 60));
         println!(
-            "  robot {} ({team} #{k}) faulted {} times from {}:{:02} (stood still meanwhile): {}",
-            f.robot,
-            f.count,
-            (f.first_at as u64) / 60,
-            (f.first_at as u64) % 60,
-            f.message
+            "  robot {} ({team} #{k}) faulted {} times{from} (stood still meanwhile): {}",
+            f.robot, f.count, f.message
         );
     }
     println!(

@@ -304,7 +304,8 @@ impl BusMatch {
                 for m in r.members.iter().filter(|m| m.last_error.is_some()) {
                     let count = m.errors + m.panics + m.restarts.max(1);
                     let why = m.last_error.as_deref().unwrap_or_default();
-                    pitch.fault(robot, count, &format!("member {}: {why}", m.name));
+                    let first_at = (m.cycles == 0).then_some(0.0);
+                    pitch.fault_at(robot, first_at, count, &format!("member {}: {why}", m.name));
                 }
             }
         }
@@ -396,6 +397,7 @@ mod tests {
             let robots: Vec<usize> = r.faults.iter().map(|f| f.robot).collect();
             assert_eq!(robots, [0, 1], "{:?}", r.faults);
             assert!(r.faults.iter().all(|f| f.message.contains(&want)), "{:?}", r.faults);
+            assert!(r.faults.iter().all(|f| f.first_at == Some(0.0)), "from the start");
             assert_eq!(r.stats[0].shots, 0, "stopped robots do not play");
         }
         // 2. A goalkeeper behavior that never ends: the budget cuts it off every cycle.

@@ -56,8 +56,9 @@ impl Brain for Stopped {
 pub struct RobotFault {
     /// The robot (0 .. team size: home, then away).
     pub robot: usize,
-    /// Simulated time of the first fault, s.
-    pub first_at: f64,
+    /// Simulated time of the first fault, s, when known (a Member that failed and was
+    /// restarted is only known from its report at the end; one that never ran failed at 0).
+    pub first_at: Option<f64>,
     /// How many faults (faulty cycles, failed starts, panics).
     pub count: u64,
     /// The first fault's message (which file and line, for script errors).
@@ -204,14 +205,19 @@ impl Pitch {
         self.eyes[i].look(&self.world, &self.referee, &self.cfg.sensor, &mut self.rngs[i])
     }
 
-    /// Books a fault of robot `i`'s software (`count` of them, the first one's `message`).
+    /// Books a fault of robot `i`'s software now (`count` of them, the first one's `message`).
     pub fn fault(&mut self, i: usize, count: u64, message: &str) {
+        let now = self.world.time();
+        self.fault_at(i, Some(now), count, message);
+    }
+
+    /// Books a fault of robot `i`'s software first seen at `first_at` (if known).
+    pub fn fault_at(&mut self, i: usize, first_at: Option<f64>, count: u64, message: &str) {
         if let Some(f) = self.faults.iter_mut().find(|f| f.robot == i) {
             f.count += count;
             return;
         }
         tracing::warn!(robot = i, "robot {i}: {message}");
-        let first_at = self.world.time();
         self.faults.push(RobotFault { robot: i, first_at, count, message: message.to_string() });
         self.faults.sort_by_key(|f| f.robot);
     }
