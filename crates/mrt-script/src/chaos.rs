@@ -259,23 +259,28 @@ fn install_inner(lua: &Lua, io: Rc<RefCell<RobotIo>>) -> mlua::Result<()> {
         })
     });
     let k = keys.clone();
+    // Role negotiation asks for the mates several times a cycle: one list per cycle.
+    let mates = CycleTable::default();
     func!("getMates", io, |lua, (): ()| {
         let keys = &k;
-        let t = lua.create_table_with_capacity(io.borrow().world.mates.len(), 0)?;
-        for (k, m) in io.borrow().world.mates.iter().enumerate() {
-            let e = lua.create_table_with_capacity(0, 5)?;
-            keys.fill_pose(
-                &e,
-                m.at.pose.x,
-                m.at.pose.y,
-                Some(m.at.pose.theta),
-                Some(m.at.quality),
-            )?;
-            e.set("id", m.id)?;
-            e.set("keeper", m.keeper)?;
-            t.set(k + 1, e)?;
-        }
-        Ok(t)
+        let io = io.borrow();
+        mates.get(lua, io.generation, |t| {
+            t.clear()?;
+            for (k, m) in io.world.mates.iter().enumerate() {
+                let e = lua.create_table_with_capacity(0, 6)?;
+                keys.fill_pose(
+                    &e,
+                    m.at.pose.x,
+                    m.at.pose.y,
+                    Some(m.at.pose.theta),
+                    Some(m.at.quality),
+                )?;
+                e.set("id", m.id)?;
+                e.set("keeper", m.keeper)?;
+                t.raw_set(k + 1, e)?;
+            }
+            Ok(())
+        })
     });
 
     // Control actions.

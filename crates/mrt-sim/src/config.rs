@@ -29,6 +29,18 @@ pub struct FieldConfig {
     pub penalty_area_width: f64,
 }
 
+impl FieldConfig {
+    /// The field as the robots' world model knows it (millimetres, half sizes).
+    pub fn map(&self) -> mrt_core::robot::Field {
+        mrt_core::robot::Field {
+            half_length: self.length * 500.0,
+            half_width: self.width * 500.0,
+            goal_half_width: self.goal_width * 500.0,
+            penalty_area_depth: self.penalty_area_depth * 1000.0,
+        }
+    }
+}
+
 impl Default for FieldConfig {
     fn default() -> Self {
         Self {

@@ -380,8 +380,8 @@ impl Match {
         for i in 0..self.brains.len() {
             let mut snapshot = self.pitch.look(i);
             let own = self.pitch.mate_report(i, &snapshot);
-            let team = self.pitch.referee().team_of(i);
             let referee = self.pitch.referee();
+            let team = referee.team_of(i);
             let mates = self
                 .reports
                 .iter()

@@ -14,7 +14,7 @@
 use crate::config::SensorConfig;
 use crate::referee::{Referee, Team};
 use crate::world::World;
-use mrt_core::robot::{lps, Estimate, Field, Lpo, Mate, WorldSnapshot};
+use mrt_core::robot::{lps, Estimate, Lpo, Mate, WorldSnapshot};
 use mrt_core::{normalize_angle, Pose2, Time, Vec2};
 use rand::{Rng, RngCore};
 
@@ -172,16 +172,10 @@ impl Perception {
         let to_team = |x: f64, y: f64| (dir * x * 1000.0, dir * y * 1000.0);
         let heading =
             if dir > 0.0 { me.theta } else { normalize_angle(me.theta + std::f64::consts::PI) };
-        let f = &world.config().field;
         let mut w = WorldSnapshot {
             time: Time::from_secs_f64(now),
             game_state: referee.state(),
-            field: Field {
-                half_length: f.length * 500.0,
-                half_width: f.width * 500.0,
-                goal_half_width: f.goal_width * 500.0,
-                penalty_area_depth: f.penalty_area_depth * 1000.0,
-            },
+            field: world.config().field.map(),
             ..Default::default()
         };
         for (k, m) in self.memory.iter().enumerate() {

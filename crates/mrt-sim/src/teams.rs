@@ -120,7 +120,8 @@ impl Default for Geometry {
 impl Geometry {
     /// The geometry of a configured field.
     pub fn of(f: &crate::config::FieldConfig) -> Geometry {
-        Geometry { half_length: f.length * 500.0, goal_half_width: f.goal_width * 500.0 }
+        let m = f.map();
+        Geometry { half_length: m.half_length, goal_half_width: m.goal_half_width }
     }
 
     /// Where the ball is in the team frame (mm), from the robot's pose and its LPS ball.
