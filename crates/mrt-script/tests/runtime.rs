@@ -258,9 +258,18 @@ fn edits_are_compiled_off_the_control_path() {
         other => panic!("{other:?}"),
     }
     assert_eq!(s.call::<i64>(&rt).unwrap(), 2, "the running version stays");
-    // Runtime errors of an installed version still name the file and line.
+    // Runtime errors of an installed version still name the file and line. (A rename save
+    // may be reported twice: skip a late duplicate of the broken version.)
     std::fs::write(&path, "local t = nil\nreturn t.x").unwrap();
-    s.install(&rt, &next_change(&w).compiled.unwrap()).unwrap();
+    let compiled = loop {
+        match next_change(&w).compiled {
+            Ok(c) => break c,
+            Err(ScriptError::Syntax { line: 2, .. }) => continue,
+            Err(other) => panic!("{other:?}"),
+        }
+    };
+    assert_eq!(compiled.source(), "local t = nil\nreturn t.x");
+    s.install(&rt, &compiled).unwrap();
     let e = s.call::<i64>(&rt).unwrap_err();
     assert!(e.to_string().starts_with(&format!("{}:2: runtime error", path.display())), "{e}");
 }
