@@ -94,7 +94,10 @@ pub fn hfsm_dot(file: &Path, dot: Option<&Path>, svg: Option<&Path>) -> Result<(
         Some(p) => {
             std::fs::write(p, &text).with_context(|| format!("cannot write {}", p.display()))?
         }
-        None => print!("{text}"),
+        None => {
+            use std::io::Write as _;
+            std::io::stdout().lock().write_all(text.as_bytes())?
+        }
     }
     if let Some(p) = svg {
         let drawing = render_svg(&hfsm.to_dot(false))?;

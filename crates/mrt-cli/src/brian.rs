@@ -226,6 +226,6 @@ pub fn plot(dir: &Path, out: &Path) -> Result<()> {
         y0 + 10.0
     );
     std::fs::write(out, svg).with_context(|| format!("cannot write {}", out.display()))?;
-    println!("wrote {}", out.display());
+    outln!("wrote {}", out.display());
     Ok(())
 }

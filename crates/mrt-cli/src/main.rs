@@ -10,6 +10,12 @@
 //! Logging goes through `tracing`; set `RUST_LOG` (e.g. `RUST_LOG=mrt_dcdt=debug`) for more.
 #![allow(clippy::print_stdout)]
 
+/// `println!` for results: ends the program quietly when standard output has been closed
+/// (`mrt sim | head -3`), where `println!` would panic on the broken pipe.
+macro_rules! outln {
+    ($($arg:tt)*) => { $crate::write_line(format_args!($($arg)*)) };
+}
+
 mod behave;
 mod brian;
 mod sim;
@@ -122,6 +128,28 @@ enum Demo {
     TwoAgoras,
 }
 
+/// Writes one line to standard output; a closed pipe ends the program with status 0 (the
+/// reader has what it wanted), any other write error with status 1.
+fn write_line(args: std::fmt::Arguments<'_>) {
+    use std::io::Write as _;
+    let mut out = std::io::stdout().lock();
+    if let Err(e) = out.write_fmt(args).and_then(|()| out.write_all(b"\n")) {
+        if e.kind() == std::io::ErrorKind::BrokenPipe {
+            std::process::exit(0);
+        }
+        eprintln!("error: cannot write to standard output: {e}");
+        std::process::exit(1);
+    }
+}
+
+/// Whether an error comes from writing to a closed pipe.
+fn is_broken_pipe(e: &anyhow::Error) -> bool {
+    e.chain().any(|c| {
+        c.downcast_ref::<std::io::Error>()
+            .is_some_and(|io| io.kind() == std::io::ErrorKind::BrokenPipe)
+    })
+}
+
 fn main() -> Result<()> {
     tracing_subscriber::fmt()
         .with_env_filter(
@@ -130,9 +158,16 @@ fn main() -> Result<()> {
         )
         .with_writer(std::io::stderr)
         .init();
-    match Cli::parse().command {
+    match run(Cli::parse().command) {
+        Err(e) if is_broken_pipe(&e) => Ok(()),
+        other => other,
+    }
+}
+
+fn run(command: Command) -> Result<()> {
+    match command {
         Command::Demo { which: Demo::HelloAgora } => {
-            println!("MRT demo 01_hello_agora: a Greeter (periodic, 100 ms) and a Listener (on-message)\n");
+            outln!("MRT demo 01_hello_agora: a Greeter (periodic, 100 ms) and a Listener (on-message)\n");
             mrt_examples::hello_agora::main().context("the hello-agora demo failed")?;
         }
         Command::Demo { which: Demo::TwoAgoras } => {
@@ -154,7 +189,7 @@ fn main() -> Result<()> {
             let mut failed = 0;
             for f in &files {
                 match AgoraConfig::from_file(f) {
-                    Ok(cfg) => println!("# {}: ok\n{cfg}", f.display()),
+                    Ok(cfg) => outln!("# {}: ok\n{cfg}", f.display()),
                     Err(e) => {
                         eprintln!("error: {e}");
                         failed += 1;

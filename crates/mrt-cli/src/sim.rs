@@ -110,15 +110,12 @@ pub fn run(args: &SimArgs) -> Result<()> {
     })?;
     bar.finish_and_clear();
     let (h, a) = (stacks.0.name(), stacks.1.name());
-    println!(
-        "{h} (home) {} : {} {a} (away)   seed {}",
-        report.score.0, report.score.1, report.seed
-    );
+    outln!("{h} (home) {} : {} {a} (away)   seed {}", report.score.0, report.score.1, report.seed);
     let total =
         (report.stats[0].possession_cycles + report.stats[1].possession_cycles).max(1) as f64;
     for (i, name) in [(0, h), (1, a)] {
         let s = &report.stats[i];
-        println!(
+        outln!(
             "  {name:<8} goals {:>2}  shots {:>3}  possession {:>5.1} %",
             s.goals,
             s.shots,
@@ -128,7 +125,7 @@ pub fn run(args: &SimArgs) -> Result<()> {
     for (t, call) in &report.calls {
         if let Call::Goal(team) = call {
             let who = if *team == Team::Home { h } else { a };
-            println!("  goal {who:<8} at {:>3}:{:02}", (*t as u64) / 60, (*t as u64) % 60);
+            outln!("  goal {who:<8} at {:>3}:{:02}", (*t as u64) / 60, (*t as u64) % 60);
         }
     }
     let n = cfg.rules.team_size;
@@ -137,12 +134,14 @@ pub fn run(args: &SimArgs) -> Result<()> {
         let from = f
             .first_at
             .map_or(String::new(), |t| format!(" from {}:{:02}", (t as u64) / 60, (t as u64) % 60));
-        println!(
+        outln!(
             "  robot {} ({team} #{k}) faulted {} times{from} (stood still meanwhile): {}",
-            f.robot, f.count, f.message
+            f.robot,
+            f.count,
+            f.message
         );
     }
-    println!(
+    outln!(
         "  {:.0} s of play simulated in {:.1} s ({}); trajectory hash {:016x}",
         report.duration,
         started.elapsed().as_secs_f64(),
@@ -152,7 +151,7 @@ pub fn run(args: &SimArgs) -> Result<()> {
     if let Some(p) = &args.plot {
         std::fs::write(p, report.to_svg(&cfg, (h, a)))
             .with_context(|| format!("cannot write {}", p.display()))?;
-        println!("  drawing: {}", p.display());
+        outln!("  drawing: {}", p.display());
     }
     Ok(())
 }
@@ -161,7 +160,7 @@ pub fn run(args: &SimArgs) -> Result<()> {
 fn bench(args: &SimArgs, cfg: &SimConfig, stacks: (Stack, Stack)) -> Result<()> {
     let n = if args.matches > 1 { args.matches } else { 3 };
     let wiring = if args.direct { "brains called directly" } else { "each robot an Agora" };
-    println!(
+    outln!(
         "{n} matches of 2 x {:.0} s, {} v {}, {} ({wiring}), one core:",
         cfg.rules.half_duration,
         cfg.rules.team_size,
@@ -177,7 +176,7 @@ fn bench(args: &SimArgs, cfg: &SimConfig, stacks: (Stack, Stack)) -> Result<()> 
         let wall = started.elapsed().as_secs_f64();
         speeds.push(r.duration / wall.max(1e-9));
         bar.suspend(|| {
-            println!(
+            outln!(
                 "  seed {seed}: {:.0} s simulated in {wall:.2} s: {:.0}x real time",
                 r.duration,
                 r.duration / wall.max(1e-9)
@@ -188,7 +187,7 @@ fn bench(args: &SimArgs, cfg: &SimConfig, stacks: (Stack, Stack)) -> Result<()> 
     bar.finish_and_clear();
     speeds.sort_by(f64::total_cmp);
     let median = speeds[speeds.len() / 2];
-    println!(
+    outln!(
         "  median {median:.0}x real time (goal: at least 100x): {}",
         if median >= 100.0 { "met" } else { "not met" }
     );
@@ -243,20 +242,20 @@ fn series(args: &SimArgs, cfg: &SimConfig, stacks: (Stack, Stack)) -> Result<()>
     let draws = scores.iter().filter(|(_, (h, a))| h == a).count();
     let losses = n - wins - draws;
     let (h, a) = (stacks.0.name(), stacks.1.name());
-    println!(
+    outln!(
         "{n} matches, {h} (home) against {a} (away), seeds {}..={}",
         args.seed,
         args.seed.wrapping_add(n as u64).wrapping_sub(1)
     );
     for (label, k) in [("wins", wins), ("draws", draws), ("losses", losses)] {
         let (lo, hi) = wilson(k, n);
-        println!(
+        outln!(
             "  {label:<7}{k:>4}  ({:>5.1} %, 95 % CI {lo:.1}–{hi:.1} %)",
             100.0 * k as f64 / n as f64
         );
     }
     let goals: (u32, u32) = scores.iter().fold((0, 0), |acc, (_, (x, y))| (acc.0 + x, acc.1 + y));
-    println!(
+    outln!(
         "  goals {} : {} (mean {:.2} : {:.2})",
         goals.0,
         goals.1,

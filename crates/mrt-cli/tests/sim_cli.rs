@@ -67,3 +67,18 @@ fn bad_options_are_clear_errors() {
     let (ok, _, err) = run(&["--config", "/nonexistent.toml"]);
     assert!(!ok && err.contains("/nonexistent.toml"), "{err}");
 }
+
+#[test]
+fn a_closed_standard_output_ends_the_program_quietly() {
+    // `mrt sim | head -1` closes the pipe before the report is written: no panic, status 0.
+    let mut child = mrt()
+        .args(["sim", "--half", "2"])
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    drop(child.stdout.take());
+    let out = child.wait_with_output().unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success() && !err.contains("panicked"), "{:?}: {err}", out.status);
+}
