@@ -3,7 +3,7 @@
 use crate::script::ScriptError;
 use mlua::{HookTriggers, Lua, LuaOptions, StdLib, VmState};
 use std::sync::atomic::{AtomicU64, Ordering};
-use std::sync::Arc;
+use std::sync::{Arc, Mutex, PoisonError};
 
 /// Limits applied to every script call.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -31,6 +31,8 @@ pub struct LuaRuntime {
     sandbox: Sandbox,
     /// Instructions executed by the current call, in units of `CHECK_EVERY`.
     ticks: Arc<AtomicU64>,
+    /// Where the last call ran past its budget: the script (its chunk name) and the line.
+    overrun_at: Arc<Mutex<Option<(String, usize)>>>,
 }
 
 /// Globals removed from the base library: they reach files or load arbitrary code.
@@ -59,16 +61,24 @@ impl LuaRuntime {
         lua.gc_set_mode(mlua::state::GcMode::Generational(mlua::state::GcGenParams::default()));
         let ticks = Arc::new(AtomicU64::new(0));
         let counter = ticks.clone();
+        let overrun_at = Arc::new(Mutex::new(None));
+        let position = overrun_at.clone();
         let limit = sandbox.instruction_budget / u64::from(CHECK_EVERY);
-        lua.set_hook(HookTriggers::new().every_nth_instruction(CHECK_EVERY), move |_, _| {
+        lua.set_hook(HookTriggers::new().every_nth_instruction(CHECK_EVERY), move |_, debug| {
             if counter.fetch_add(1, Ordering::Relaxed) + 1 > limit {
+                // The running function is the one that loops: note its script and line so
+                // that the error names them, even inside a behavior `use`d by another.
+                let source = debug.source();
+                let file = source.source.as_deref().and_then(|s| s.strip_prefix('@'));
+                *position.lock().unwrap_or_else(PoisonError::into_inner) =
+                    file.map(|f| (f.to_string(), debug.current_line().unwrap_or(0)));
                 Err(mlua::Error::runtime(BUDGET_EXCEEDED))
             } else {
                 Ok(VmState::Continue)
             }
         })
         .map_err(ScriptError::setup)?;
-        Ok(LuaRuntime { lua, sandbox, ticks })
+        Ok(LuaRuntime { lua, sandbox, ticks, overrun_at })
     }
 
     /// The limits.
@@ -79,6 +89,11 @@ impl LuaRuntime {
     /// Starts a new call's budget.
     pub(crate) fn reset_budget(&self) {
         self.ticks.store(0, Ordering::Relaxed);
+    }
+
+    /// Where the last budget overrun happened (script, line), if in a script; cleared.
+    pub(crate) fn take_overrun(&self) -> Option<(String, usize)> {
+        self.overrun_at.lock().unwrap_or_else(PoisonError::into_inner).take()
     }
 
     /// Memory in use by the Lua state, in bytes.

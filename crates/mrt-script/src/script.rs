@@ -37,10 +37,13 @@ pub enum ScriptError {
         traceback: String,
     },
     /// The call ran past its instruction budget (an endless loop?).
-    #[error("{file}: aborted after {budget} instructions (instruction budget exceeded)")]
+    #[error("{file}:{line}: aborted after {budget} instructions (instruction budget exceeded)")]
     Budget {
-        /// The script.
+        /// The script that was running when the budget ran out (a behavior `use`d by another
+        /// names its own file).
         file: String,
+        /// The line it was running (0 when unknown).
+        line: usize,
         /// The budget.
         budget: u64,
     },
@@ -99,10 +102,8 @@ impl ScriptError {
             return ScriptError::Memory { file: file.into(), limit: rt.sandbox().memory_limit };
         }
         if text.contains(BUDGET_EXCEEDED) {
-            return ScriptError::Budget {
-                file: file.into(),
-                budget: rt.sandbox().instruction_budget,
-            };
+            let (file, line) = rt.take_overrun().unwrap_or_else(|| (file.into(), 0));
+            return ScriptError::Budget { file, line, budget: rt.sandbox().instruction_budget };
         }
         if let mlua::Error::SyntaxError { message, .. } = &e {
             // Lua says `[string "name"]:LINE: message` or `name:LINE: message`.

@@ -608,9 +608,10 @@ fn a_runaway_loop_gives_a_budget_error_and_a_stop_command_for_that_cycle() {
     let c = cap.cycle(ball_at(2000.0, 100));
     assert_eq!(c.errors.len(), 1);
     match &c.errors[0] {
-        ScriptError::Budget { file, budget } => {
-            assert_eq!((file.as_str(), *budget), (spin.display().to_string().as_str(), 1_000_000))
-        }
+        ScriptError::Budget { file, line, budget } => assert_eq!(
+            (file.as_str(), *line, *budget),
+            (spin.display().to_string().as_str(), 3, 1_000_000)
+        ),
         other => panic!("{other:?}"),
     }
     assert_eq!(c.command, RobotCommand::default(), "stop: all zeros, no kick, no needs");
@@ -621,10 +622,15 @@ fn a_runaway_loop_gives_a_budget_error_and_a_stop_command_for_that_cycle() {
         assert!(c.errors.is_empty(), "{:?}", c.errors);
         assert_eq!((c.command.vlin, c.command.vrot), (300.0, 42.0));
     }
-    // The same inside a sub-behavior.
+    // The same inside a sub-behavior: the error names the sub-behavior's file and line.
     let mut cap = ThinkingCap::with_behavior(dir.path(), "outer", sandbox).unwrap();
     let c = cap.cycle(ball_at(2000.0, 0));
-    assert!(matches!(c.errors[..], [ScriptError::Budget { .. }]), "{:?}", c.errors);
+    assert!(matches!(c.errors[..], [ScriptError::Budget { line: 3, .. }]), "{:?}", c.errors);
+    assert!(
+        c.errors[0].to_string().starts_with(&format!("{}:3: aborted after", spin.display())),
+        "{}",
+        c.errors[0]
+    );
     assert_eq!(c.command, RobotCommand::default());
     let c = cap.cycle(ball_at(500.0, 100));
     assert!(c.errors.is_empty(), "{:?}", c.errors);

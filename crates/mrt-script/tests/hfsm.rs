@@ -572,7 +572,8 @@ fn a_runtime_error_in_state_code_names_the_file_and_line_and_the_next_step_works
     .unwrap();
     step(&rt, &io, &mut h, world(0, 2000.0)).unwrap();
     let e = step(&rt, &io, &mut h, world(100, 2000.0)).unwrap_err();
-    assert!(matches!(e, ScriptError::Budget { budget: 100_000, .. }), "{e}");
+    assert!(matches!(e, ScriptError::Budget { budget: 100_000, line: 3, .. }), "{e}");
+    assert!(e.to_string().starts_with("spin.hfsm.lua:3: aborted"), "{e}");
     assert_eq!(h.path(), "S/A");
     let t = step(&rt, &io, &mut h, world(200, 100.0)).unwrap();
     assert_eq!(taken_name(&t), Some(("S", "A->B", "S/B")));

@@ -69,7 +69,7 @@ fn an_endless_loop_is_aborted_and_the_runtime_keeps_working() {
         Script::from_source(&rt, "spin.lua", "while true do end", LoadStrategy::Compiled).unwrap();
     let e = spin.call::<()>(&rt).unwrap_err();
     assert!(matches!(e, ScriptError::Budget { budget: 1_000_000, .. }), "{e}");
-    assert!(e.to_string().starts_with("spin.lua: aborted"), "{e}");
+    assert!(e.to_string().starts_with("spin.lua:1: aborted"), "{e}");
     // The budget is per call: the next call, and other scripts, run normally.
     let ok = Script::from_source(
         &rt,

@@ -413,7 +413,7 @@ mod tests {
         assert!((bus.duration - 10.0).abs() < 0.011);
         let keeper = bus.faults.iter().find(|f| f.robot == 0);
         assert!(
-            keeper.is_some_and(|f| f.message.contains("goalkeeper.lua")
+            keeper.is_some_and(|f| f.message.contains("goalkeeper.lua:1: aborted after")
                 && f.message.contains("instruction budget")
                 && f.count > 1),
             "{:?}",
