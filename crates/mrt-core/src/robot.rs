@@ -139,6 +139,9 @@ pub struct WorldSnapshot {
     pub game_state: GameState,
     /// The field (`getField`).
     pub field: Field,
+    /// In `READY`: where the referee's kickoff formation wants this robot (team frame, mm,
+    /// heading in radians; `getKickoffPose`). `None` in the other states.
+    pub kickoff_pose: Option<Pose2>,
 }
 
 impl Default for WorldSnapshot {
@@ -155,6 +158,7 @@ impl Default for WorldSnapshot {
             ball_booked: false,
             game_state: GameState::default(),
             field: Field::default(),
+            kickoff_pose: None,
         }
     }
 }
@@ -180,6 +184,20 @@ pub struct RobotCommand {
     pub behavior: Option<String>,
     /// A booking request: `Some(true)` book the ball, `Some(false)` release it.
     pub book_ball: Option<bool>,
+    /// A posture for guidance to reach instead of the velocities above (`setTarget`).
+    pub target: Option<Target>,
+}
+
+/// A posture handed to guidance (ISocRob, seed `003` §3.2.3): instead of velocities, the
+/// behavior says where to be and guidance drives there, in position mode or, with `avoid`, in
+/// potential-field mode around what the sonars see.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct Target {
+    /// Where to be, in the team frame like [`Estimate::pose`]: mm, heading in radians.
+    pub pose: Pose2,
+    /// Go round obstacles (potential-field mode) rather than straight (position mode).
+    pub avoid: bool,
 }
 
 impl RobotCommand {

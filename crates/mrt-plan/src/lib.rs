@@ -45,6 +45,7 @@
 //! | `x̄_r = x̄_l` error detection, error reduction (manual §4.2) | [`mice::MiceOdometry::check`], [`mice::MiceOdometry::reduce`] |
 //! | velocity mode, halted by the sonars (ISocRob §3.2.3) | [`guidance::VelocityGuard`], [`guidance::Sonar`] |
 //! | position mode | [`guidance::PositionMode`] |
+//! | the Guidance µAgent: the mode a command asks for, sonar echoes, ball echoes told apart | [`guide::Guidance`] |
 //! | potential field mode, ball as a repelling obstacle | [`guidance::PotentialField`], [`guidance::Obstacle`], [`guidance::behind_ball`], [`guidance::sonar_obstacles`] |
 //!
 //! The manual's mice equations have typos; [`mice`] lists each one with the corrected formula,
@@ -53,6 +54,7 @@
 
 mod error;
 pub mod guidance;
+pub mod guide;
 pub mod kinematics;
 pub mod mice;
 

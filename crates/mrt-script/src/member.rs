@@ -60,7 +60,7 @@ enum Top {
 }
 
 enum Job {
-    Cycle(WorldSnapshot),
+    Cycle(Box<WorldSnapshot>),
     Reload,
 }
 
@@ -158,7 +158,7 @@ impl BehaviorMember {
                             if std::mem::take(&mut pending_reload) {
                                 (reloaded, early) = cap.reload_requested();
                             }
-                            let c = cap.cycle(world);
+                            let c = cap.cycle(*world);
                             reloaded.extend(c.reloaded);
                             let errors =
                                 early.iter().chain(&c.errors).map(ToString::to_string).collect();
@@ -206,7 +206,7 @@ impl Member for BehaviorMember {
                 worker.jobs.send(Job::Reload).map_err(|_| "the Lua thread stopped")?;
             }
         }
-        worker.jobs.send(Job::Cycle(self.world.clone())).map_err(|_| "the Lua thread stopped")?;
+        worker.jobs.send(Job::Cycle(Box::new(self.world.clone()))).map_err(|_| "the Lua thread stopped")?;
         let (command, status) = worker.replies.recv().map_err(|_| "the Lua thread stopped")?;
         for e in &status.errors {
             tracing::warn!(member = %self.name, "{e}");

@@ -1,0 +1,362 @@
+//! The Guidance µAgent of ISocRob (seed `003`, §3.2.3) as one call per control cycle: it sits
+//! between the behaviors and the motor driver and runs the mode the behavior's command asks
+//! for, with the sonar ring as its obstacle sensor.
+//!
+//! - a command **without a target** is a velocity reference: **velocity mode**
+//!   ([`VelocityGuard`]) passes it on unless a sonar sees an obstacle in the direction of
+//!   motion, then the translation is halted. Echoes from where the world model puts the ball
+//!   are not obstacles here: a soccer robot must be able to touch the ball, and with a sonar
+//!   ring it could not otherwise (the seed's footnote on the headaches of halting);
+//! - a command with a [`Target`] without `avoid`: **position mode** ([`PositionMode`]);
+//! - with `avoid`: **potential-field mode** ([`PotentialField`]): the sonar echoes, the ball's
+//!   included as the seed says, repel; the target attracts.
+//!
+//! At this boundary the units are the behaviors' ([`RobotCommand`]: mm/s, degrees/s; poses in
+//! the team frame in mm), inside they are [`crate::guidance`]'s (m, rad).
+//!
+//! ```
+//! use mrt_core::robot::{RobotCommand, Target};
+//! use mrt_core::{Point2, Pose2};
+//! use mrt_plan::guidance::Sonar;
+//! use mrt_plan::guide::{Guidance, Mode};
+//!
+//! let guidance = Guidance::default();
+//! let me = Pose2::new(0.0, 0.0, 0.0);
+//! // Forward at 1 m/s, a wall 0.3 m ahead (sonar 0): halted, still turning.
+//! let ring: Vec<Sonar> = (0..16).map(|i| Sonar::new(Sonar::ring_bearing(i, 16), 0.3)).collect();
+//! let go = RobotCommand { vlin: 1000.0, vrot: 30.0, ..Default::default() };
+//! let g = guidance.guide(&go, &me, None, &ring);
+//! assert!(g.halted && g.command.vlin == 0.0 && g.command.vrot == 30.0);
+//! // The same echo where the ball is: not an obstacle, the robot goes on to the ball.
+//! let g = guidance.guide(&go, &me, Some(Point2::new(410.0, 0.0)), &ring);
+//! assert!(!g.halted && g.command.vlin == 1000.0);
+//! // Go to (1 m, 0) in position mode: straight ahead, at most 1.2 m/s.
+//! let to = RobotCommand {
+//!     target: Some(Target { pose: Pose2::new(1000.0, 0.0, 0.0), avoid: false }),
+//!     ..Default::default()
+//! };
+//! let g = guidance.guide(&to, &me, None, &[]);
+//! assert_eq!(g.mode, Mode::Position);
+//! assert!((g.command.vlin - 1200.0).abs() < 1e-9 && g.command.vlat.abs() < 1e-9);
+//! ```
+
+use crate::guidance::{
+    GuidanceCommand, Obstacle, PositionMode, PotentialField, Sonar, VelocityGuard,
+};
+use crate::kinematics::Twist;
+use mrt_core::robot::{RobotCommand, Target};
+use mrt_core::{Point2, Pose2};
+
+/// The mode guidance ran in one cycle.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Mode {
+    /// A velocity reference, halted by the sonars.
+    #[default]
+    Velocity,
+    /// Straight to a target posture.
+    Position,
+    /// To a target posture around what the sonars see.
+    Potential,
+}
+
+/// What guidance hands to the motor driver.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Guided {
+    /// The command to drive: velocities in mm/s and degrees/s, the behavior's kick, needs and
+    /// the rest kept, the target consumed.
+    pub command: RobotCommand,
+    /// The mode that made it.
+    pub mode: Mode,
+    /// Velocity mode: a sonar halted the translation. Target modes: the target is reached.
+    pub halted: bool,
+}
+
+/// How near an echo must be to the ball's estimated centre to be the ball, beyond the ball's
+/// radius (m): a sonar's beam and the estimate's noise put the echo off the ball's surface.
+const BALL_ECHO_TOLERANCE: f64 = 0.15;
+
+/// Radius of the obstacle a lone echo stands for in potential-field mode (m).
+const ECHO_RADIUS: f64 = 0.1;
+
+/// Echoes of neighbouring sonars closer than this to each other are one obstacle (m).
+const SAME_OBSTACLE: f64 = 0.35;
+
+/// The Guidance µAgent: the three modes and their parameters.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Guidance {
+    guard: VelocityGuard,
+    field: PotentialField,
+    ball_radius: f64,
+}
+
+impl Default for Guidance {
+    /// The defaults of [`VelocityGuard`] and [`PotentialField`] (a holonomic Middle Size
+    /// League robot, 1.2 m/s) and a FIFA size 5 ball (0.11 m).
+    fn default() -> Self {
+        Guidance::new(VelocityGuard::default(), PotentialField::default(), 0.11)
+    }
+}
+
+impl Guidance {
+    /// Guidance with these modes; `ball_radius` (m) tells the ball's echoes apart.
+    pub fn new(guard: VelocityGuard, field: PotentialField, ball_radius: f64) -> Self {
+        let ball_radius = if ball_radius.is_finite() { ball_radius.max(0.0) } else { 0.0 };
+        Guidance { guard, field, ball_radius }
+    }
+
+    /// One cycle: `cmd` from the behaviors, the robot's pose `me` and the ball's position (team
+    /// frame, mm; `None` when unknown), the sonar ring (robot frame, m from the centre).
+    pub fn guide(
+        &self,
+        cmd: &RobotCommand,
+        me: &Pose2,
+        ball: Option<Point2>,
+        sonars: &[Sonar],
+    ) -> Guided {
+        let pose = Pose2::new(me.x / 1000.0, me.y / 1000.0, me.theta);
+        let (mode, out) = match cmd.target {
+            None => {
+                let ball = ball.map(|b| Point2::new(b.x / 1000.0, b.y / 1000.0));
+                let echoes: Vec<Sonar> =
+                    sonars.iter().filter(|s| !self.is_ball(&pose, ball, s)).copied().collect();
+                let twist = Twist::new(cmd.vlin / 1000.0, cmd.vlat / 1000.0, cmd.vrot.to_radians());
+                (Mode::Velocity, self.guard.apply(&twist, &echoes))
+            }
+            Some(Target { pose: target, avoid }) => {
+                let target = Pose2::new(target.x / 1000.0, target.y / 1000.0, target.theta);
+                if avoid {
+                    let obstacles = echo_obstacles(&pose, sonars);
+                    (Mode::Potential, self.field.command(&pose, &target, &obstacles))
+                } else {
+                    (Mode::Position, self.position().command(&pose, &target))
+                }
+            }
+        };
+        let GuidanceCommand { twist, done } = out;
+        let command = RobotCommand {
+            vlin: twist.vx * 1000.0,
+            vlat: twist.vy * 1000.0,
+            vrot: twist.omega.to_degrees(),
+            target: None,
+            ..cmd.clone()
+        };
+        Guided { command, mode, halted: done }
+    }
+
+    /// Position mode with the potential field's gains and limits.
+    fn position(&self) -> PositionMode {
+        PositionMode::new(*self.field.position_params()).unwrap_or_default()
+    }
+
+    /// Whether echo `s` seen from `pose` comes from the ball at `ball` (m).
+    fn is_ball(&self, pose: &Pose2, ball: Option<Point2>, s: &Sonar) -> bool {
+        let Some(ball) = ball else { return false };
+        if !(s.range.is_finite() && s.bearing.is_finite()) {
+            return false;
+        }
+        let (sn, cs) = s.bearing.sin_cos();
+        let echo = pose.transform_point(Point2::new(s.range * cs, s.range * sn));
+        (echo - ball).norm() <= self.ball_radius + BALL_ECHO_TOLERANCE
+    }
+}
+
+/// The obstacles the sonar ring sees from `pose` (field frame, m): the echoes of neighbouring
+/// sonars (in ring order, the last next to the first) that lie within [`SAME_OBSTACLE`] of
+/// each other are one circle, whose near side is at their mean and whose radius covers them.
+///
+/// One circle per object matters: a robot ahead echoes in two or three sonars, and as separate
+/// circles their sideways pushes cancel and leave the robot stalled in front of it; as one
+/// circle the potential field walks round it.
+pub fn echo_obstacles(pose: &Pose2, sonars: &[Sonar]) -> Vec<Obstacle> {
+    let points: Vec<Option<Point2>> = sonars
+        .iter()
+        .map(|s| {
+            (s.range.is_finite() && s.bearing.is_finite() && s.range > 0.0).then(|| {
+                let (sn, cs) = s.bearing.sin_cos();
+                pose.transform_point(Point2::new(s.range * cs, s.range * sn))
+            })
+        })
+        .collect();
+    // Start after a silent sonar (or a break between echoes) so that no cluster wraps.
+    let n = points.len();
+    let apart = |a: &Option<Point2>, b: &Option<Point2>| match (a, b) {
+        (Some(a), Some(b)) => (a - b).norm() > SAME_OBSTACLE,
+        _ => true,
+    };
+    let start = (0..n).find(|&k| apart(&points[(k + n - 1) % n], &points[k])).unwrap_or(0);
+    let mut obstacles = Vec::new();
+    let mut cluster: Vec<Point2> = Vec::new();
+    for k in 0..n {
+        let (here, next) = (&points[(start + k) % n], &points[(start + k + 1) % n]);
+        if let Some(p) = here {
+            cluster.push(*p);
+        }
+        if apart(here, next) || k + 1 == n {
+            if let Some(o) = circle(pose, &cluster) {
+                obstacles.push(o);
+            }
+            cluster.clear();
+        }
+    }
+    obstacles
+}
+
+/// The circle standing for echoes `points` seen from `pose`: near side at their mean.
+fn circle(pose: &Pose2, points: &[Point2]) -> Option<Obstacle> {
+    let first = points.first()?;
+    let sum = points.iter().fold(nalgebra::Vector2::zeros(), |s, p| s + (p - first));
+    let mean = first + sum / points.len() as f64;
+    let spread = points.iter().map(|p| (p - mean).norm()).fold(0.0, f64::max);
+    let radius = spread.max(ECHO_RADIUS);
+    let away = mean - pose.position();
+    let u = if away.norm() > 1e-9 { away / away.norm() } else { away };
+    let c = mean + u * radius;
+    Some(Obstacle::new(c.x, c.y, radius))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::guidance::{PositionParams, PotentialParams};
+
+    fn ring(range: f64) -> Vec<Sonar> {
+        (0..16).map(|i| Sonar::new(Sonar::ring_bearing(i, 16), range)).collect()
+    }
+
+    /// Velocity mode passes a reference through unchanged when nothing is near (mm/s and
+    /// degrees/s in, the same out), halts the translation for a robot ahead but not for the
+    /// ball, and looks sideways for a sideways motion.
+    #[test]
+    fn velocity_mode_halts_for_obstacles_not_for_the_ball() {
+        let g = Guidance::default();
+        let me = Pose2::new(1000.0, 500.0, std::f64::consts::FRAC_PI_2); // facing +y
+        let go = RobotCommand { vlin: 800.0, vrot: -20.0, kick: Some(1), ..Default::default() };
+        let free = g.guide(&go, &me, None, &ring(f64::INFINITY));
+        assert_eq!(
+            (free.command.clone(), free.mode, free.halted),
+            (go.clone(), Mode::Velocity, false)
+        );
+        // An echo 0.4 m ahead (inside 0.5 m): halted, turning and kick kept.
+        let mut near = ring(f64::INFINITY);
+        near[0].range = 0.4;
+        let h = g.guide(&go, &me, None, &near);
+        assert!(h.halted && h.command.vlin == 0.0 && h.command.vrot == go.vrot);
+        assert_eq!(h.command.kick, Some(1));
+        // The ball 0.51 m ahead in the field (1000, 1010): its near side at 0.4 m is that echo.
+        let b = g.guide(&go, &me, Some(Point2::new(1000.0, 1010.0)), &near);
+        assert!(!b.halted && b.command.vlin == 800.0, "{b:?}");
+        // The ball elsewhere (behind the robot) does not hide the echo ahead.
+        assert!(g.guide(&go, &me, Some(Point2::new(1000.0, 0.0)), &near).halted);
+        // Moving left (vlat) looks at sonar 4 (90°), not sonar 0.
+        let left = RobotCommand { vlat: 500.0, ..Default::default() };
+        assert!(!g.guide(&left, &me, None, &near).halted);
+        near[4].range = 0.3;
+        assert!(g.guide(&left, &me, None, &near).halted);
+    }
+
+    /// Clustering by hand, robot at the origin facing +x, four sonars at 0°, 90°, 180°, 270°
+    /// and then eight: echoes 0.5 m ahead and 0.5 m to the left are 0.71 m apart: two
+    /// obstacles, each a lone echo (radius 0.1 m, centre 0.6 m out). With eight sonars, echoes
+    /// at 0° (0.5 m) and 45° (0.5 m) are 0.38 m apart... still two; at 0.4 m they are
+    /// 2 · 0.4 · sin 22.5° = 0.306 m apart: one circle, near side at their mean
+    /// (0.341, 0.141), radius 0.153 (half their distance).
+    #[test]
+    fn neighbouring_echoes_are_one_obstacle() {
+        let me = Pose2::new(0.0, 0.0, 0.0);
+        let four = |r: [f64; 4]| -> Vec<Sonar> {
+            (0..4).map(|i| Sonar::new(Sonar::ring_bearing(i, 4), r[i])).collect()
+        };
+        let inf = f64::INFINITY;
+        let two = echo_obstacles(&me, &four([0.5, 0.5, inf, inf]));
+        assert_eq!(two.len(), 2);
+        assert!((two[0].center - Point2::new(0.6, 0.0)).norm() < 1e-9, "{two:?}");
+        assert!((two[1].center - Point2::new(0.0, 0.6)).norm() < 1e-9 && two[1].radius == 0.1);
+        assert!(echo_obstacles(&me, &four([inf; 4])).is_empty());
+        let eight = |r0: f64, r1: f64| -> Vec<Obstacle> {
+            let mut s: Vec<Sonar> =
+                (0..8).map(|i| Sonar::new(Sonar::ring_bearing(i, 8), inf)).collect();
+            (s[0].range, s[1].range) = (r0, r1);
+            echo_obstacles(&me, &s)
+        };
+        assert_eq!(eight(0.5, 0.5).len(), 2);
+        let one = eight(0.4, 0.4);
+        assert_eq!(one.len(), 1, "{one:?}");
+        let half = 0.4 * (std::f64::consts::PI / 8.0).sin();
+        let mean = Point2::new((0.4 + 0.4 * 0.5f64.sqrt()) / 2.0, 0.4 * 0.5f64.sqrt() / 2.0);
+        assert!((one[0].radius - half).abs() < 1e-9);
+        let near_side = one[0].center - (mean - Point2::origin()).normalize() * half;
+        assert!((near_side - mean).norm() < 1e-9, "{one:?}");
+        // A ring whose last and first sonars see the same object: one obstacle, no wrap split.
+        let mut s: Vec<Sonar> =
+            (0..8).map(|i| Sonar::new(Sonar::ring_bearing(i, 8), inf)).collect();
+        (s[7].range, s[0].range) = (0.4, 0.4);
+        assert_eq!(echo_obstacles(&me, &s).len(), 1);
+    }
+
+    /// Position mode by hand: from (0, 0) facing +x to (0.5 m, 0.2 m) facing +x with gain
+    /// 1.5 /s: velocity 1.5 · (0.5, 0.2) = (0.75, 0.3) m/s, under 1.2 m/s; no heading error.
+    #[test]
+    fn position_mode_by_hand() {
+        let g = Guidance::default();
+        let cmd = RobotCommand {
+            target: Some(Target { pose: Pose2::new(500.0, 200.0, 0.0), avoid: false }),
+            ..Default::default()
+        };
+        let out = g.guide(&cmd, &Pose2::new(0.0, 0.0, 0.0), None, &ring(0.3));
+        assert_eq!(out.mode, Mode::Position);
+        assert!((out.command.vlin - 750.0).abs() < 1e-9, "{out:?}");
+        assert!((out.command.vlat - 300.0).abs() < 1e-9 && out.command.vrot.abs() < 1e-9);
+        assert_eq!(out.command.target, None, "the target is consumed");
+        // There: done, standing still.
+        let at = g.guide(&cmd, &Pose2::new(500.0, 200.0, 0.0), None, &[]);
+        assert!(at.halted && at.command.vlin == 0.0 && at.command.vlat == 0.0);
+    }
+
+    /// Potential-field mode walks round an obstacle that position mode would drive into: a
+    /// robot 1 m ahead on the way to a target 2 m ahead, seen by the sonars each cycle.
+    #[test]
+    fn potential_mode_goes_round_what_the_sonars_see() {
+        let params = PositionParams::default();
+        let g = Guidance::new(
+            VelocityGuard::default(),
+            PotentialField::new(params, PotentialParams::default()).unwrap(),
+            0.11,
+        );
+        let obstacle = Point2::new(1.0, 0.0); // m, a robot of radius 0.25
+        let sonars_at = |p: &Pose2| -> Vec<Sonar> {
+            (0..16)
+                .map(|i| {
+                    let bearing = Sonar::ring_bearing(i, 16);
+                    let dir = p.theta + bearing;
+                    let (ox, oy) = (obstacle.x - p.x / 1000.0, obstacle.y - p.y / 1000.0);
+                    // The ray from the centre meets the circle of radius 0.25 m?
+                    let along = ox * dir.cos() + oy * dir.sin();
+                    let off2 = ox * ox + oy * oy - along * along;
+                    let range = if along > 0.0 && off2 < 0.0625 {
+                        along - (0.0625 - off2).sqrt()
+                    } else {
+                        f64::INFINITY
+                    };
+                    Sonar::new(bearing, range)
+                })
+                .collect()
+        };
+        let target = Target { pose: Pose2::new(2000.0, 0.0, 0.0), avoid: true };
+        let cmd = RobotCommand { target: Some(target), ..Default::default() };
+        let mut me = Pose2::new(0.0, 0.0, 0.0);
+        let mut closest = f64::INFINITY;
+        for _ in 0..400 {
+            let out = g.guide(&cmd, &me, None, &sonars_at(&me));
+            assert_eq!(out.mode, Mode::Potential);
+            let c = out.command;
+            let dt = 0.02;
+            let (s, co) = me.theta.sin_cos();
+            me.x += (c.vlin * co - c.vlat * s) * dt;
+            me.y += (c.vlin * s + c.vlat * co) * dt;
+            me.theta += c.vrot.to_radians() * dt;
+            closest = closest.min((me.x / 1000.0 - obstacle.x).hypot(me.y / 1000.0 - obstacle.y));
+        }
+        assert!((me.x - 2000.0).abs() < 50.0 && me.y.abs() < 50.0, "reached: {me:?}");
+        assert!(closest > 0.5, "never touched the obstacle (0.25 + 0.25 m): {closest}");
+    }
+}
