@@ -114,25 +114,25 @@ impl Guidance {
         sonars: &[Sonar],
     ) -> Guided {
         let pose = Pose2::new(me.x / 1000.0, me.y / 1000.0, me.theta);
-        let (mode, out) = match cmd.target {
-            None => {
-                let ball = ball.map(|b| Point2::new(b.x / 1000.0, b.y / 1000.0));
-                let echoes: Vec<Sonar> =
-                    sonars.iter().filter(|s| !self.is_ball(&pose, ball, s)).copied().collect();
-                let twist = Twist::new(cmd.vlin / 1000.0, cmd.vlat / 1000.0, cmd.vrot.to_radians());
-                (Mode::Velocity, self.guard.apply(&twist, &echoes))
+        let Some(Target { pose: target, avoid }) = cmd.target else {
+            // Velocity mode: the reference itself, or its turn only.
+            let ball = ball.map(|b| Point2::new(b.x / 1000.0, b.y / 1000.0));
+            let echoes: Vec<Sonar> =
+                sonars.iter().filter(|s| !self.is_ball(&pose, ball, s)).copied().collect();
+            let twist = Twist::new(cmd.vlin / 1000.0, cmd.vlat / 1000.0, cmd.vrot.to_radians());
+            let halted = self.guard.apply(&twist, &echoes).done;
+            let mut command = cmd.clone();
+            if halted {
+                (command.vlin, command.vlat) = (0.0, 0.0);
             }
-            Some(Target { pose: target, avoid }) => {
-                let target = Pose2::new(target.x / 1000.0, target.y / 1000.0, target.theta);
-                if avoid {
-                    let obstacles = echo_obstacles(&pose, sonars);
-                    (Mode::Potential, self.field.command(&pose, &target, &obstacles))
-                } else {
-                    (Mode::Position, self.position().command(&pose, &target))
-                }
-            }
+            return Guided { command, mode: Mode::Velocity, halted };
         };
-        let GuidanceCommand { twist, done } = out;
+        let target = Pose2::new(target.x / 1000.0, target.y / 1000.0, target.theta);
+        let (mode, GuidanceCommand { twist, done }) = if avoid {
+            (Mode::Potential, self.field.command(&pose, &target, &echo_obstacles(&pose, sonars)))
+        } else {
+            (Mode::Position, self.position().command(&pose, &target))
+        };
         let command = RobotCommand {
             vlin: twist.vx * 1000.0,
             vlat: twist.vy * 1000.0,

@@ -206,7 +206,10 @@ impl Member for BehaviorMember {
                 worker.jobs.send(Job::Reload).map_err(|_| "the Lua thread stopped")?;
             }
         }
-        worker.jobs.send(Job::Cycle(Box::new(self.world.clone()))).map_err(|_| "the Lua thread stopped")?;
+        worker
+            .jobs
+            .send(Job::Cycle(Box::new(self.world.clone())))
+            .map_err(|_| "the Lua thread stopped")?;
         let (command, status) = worker.replies.recv().map_err(|_| "the Lua thread stopped")?;
         for e in &status.errors {
             tracing::warn!(member = %self.name, "{e}");
