@@ -1,5 +1,5 @@
--- A field player for a whole match (seed 001 §5.1, figure 8): wait while the game is stopped,
--- then play one of three roles, renegotiated every cycle from the shared world state:
+-- A field player for a whole match (seed 001 §5.1, figure 8): wait while the game is stopped
+-- (walking to the kickoff position in READY), then play one of three roles, renegotiated every cycle from the shared world state:
 -- the field player closest to the ball is the Attacker (the seed's Attacker of §5.2, reused
 -- from its own file, not copied), the next one the Supporter, the others Defenders. A player
 -- that has lost the ball goes to where its teammates see it, or looks around for it.
@@ -16,7 +16,7 @@ local HOLD = 400
 machine "Player" {
   initial = "Wait",
   states = {
-    Wait = function() chaos.setBehavior("stand") end,
+    Wait = function() chaos.setBehavior(chaos.getKickoffPose() and "ready" or "stand") end,
     Search = function()
       if ballKnown() then
         local b = chaos.getGlobalBall()

@@ -3,8 +3,8 @@
 //!
 //! | group | functions |
 //! |---|---|
-//! | data access | `lps_getLpo(i)` → `{rho, theta, reliability, seen_ago}`, `gsGetMyPos()` → `{x, y, theta, quality}`, `getBallVel()` → `{x, y}`, `getGlobalBall()` → `{x, y, quality}`, `getMates()` → `{{id, x, y, theta, quality, keeper}, ...}`, `getField()` → `{half_length, half_width, goal_half_width, penalty_area_depth}` (mm) |
-//! | control | `setVlin(v)`, `setVrot(v)`, `setVlat(v)`, `setKick(id)`, `setNeeded(i, v)`, `trackLandMarks()`, `setBehavior(name)` |
+//! | data access | `lps_getLpo(i)` → `{rho, theta, reliability, seen_ago}`, `gsGetMyPos()` → `{x, y, theta, quality}`, `getBallVel()` → `{x, y}`, `getGlobalBall()` → `{x, y, quality}`, `getMates()` → `{{id, x, y, theta, quality, keeper}, ...}`, `getField()` → `{half_length, half_width, goal_half_width, penalty_area_depth}` (mm), `getKickoffPose()` → `{x, y, theta}` in `READY`, else `nil` |
+//! | control | `setVlin(v)`, `setVrot(v)`, `setVlat(v)`, `setKick(id)`, `setNeeded(i, v)`, `trackLandMarks()`, `setBehavior(name)`, `setTarget(x, y, theta[, avoid])` (a posture for guidance: position mode, or potential field round obstacles when `avoid`, the default) |
 //! | coordination | `getRole()` → `{name}`, `haveBookedBall()` → `{booked}`, `bookBall()`, `releaseBookedBall()` |
 //! | persistence | `getBehaviorInfo()` → `{timer (ms), isNew (1/0)}`, `setGlobal(key, type, value)`, `getGlobal(key)`, `getCurrentState()` → `"PLAYING"`... |
 //!
@@ -47,6 +47,11 @@ pub struct RobotIo {
     generation: u64,
     behavior_since: Time,
     is_new: bool,
+    /// Each behavior run through `use`: the last cycle (generation) it ran and since when it
+    /// has been running.
+    used: HashMap<String, (u64, Time)>,
+    /// The `use`d behaviors running now, innermost last, with their `(since, is_new)`.
+    using: Vec<(Time, bool)>,
 }
 
 impl RobotIo {
@@ -62,6 +67,7 @@ impl RobotIo {
     /// an HFSM: then call [`RobotIo::activate`]).
     pub fn new_cycle(&mut self, world: WorldSnapshot) {
         self.generation += 1;
+        self.using.clear();
         self.world = world;
         self.command = RobotCommand::default();
     }
@@ -76,6 +82,23 @@ impl RobotIo {
         } else {
             self.is_new = false;
         }
+    }
+
+    /// A behavior starts running through `use`: from now on `getBehaviorInfo` is its own. It
+    /// is new when it did not run in the previous cycle (nor earlier in this one).
+    pub(crate) fn enter_used(&mut self, name: &str) {
+        let (now, generation) = (self.world.time, self.generation);
+        let (since, is_new) = match self.used.get(name) {
+            Some(&(last, since)) if last + 1 >= generation => (since, false),
+            _ => (now, true),
+        };
+        self.used.insert(name.to_string(), (generation, since));
+        self.using.push((since, is_new));
+    }
+
+    /// The innermost `use`d behavior ended.
+    pub(crate) fn leave_used(&mut self) {
+        self.using.pop();
     }
 
     /// The behavior running (the last one activated).
@@ -283,7 +306,26 @@ fn install_inner(lua: &Lua, io: Rc<RefCell<RobotIo>>) -> mlua::Result<()> {
         })
     });
 
+    let k = keys.clone();
+    func!("getKickoffPose", io, |lua, (): ()| {
+        let Some(p) = io.borrow().world.kickoff_pose else { return Ok(Value::Nil) };
+        let t = lua.create_table_with_capacity(0, 3)?;
+        k.fill_pose(&t, p.x, p.y, Some(p.theta), None)?;
+        Ok(Value::Table(t))
+    });
+
     // Control actions.
+    func!("setTarget", io, |_lua, (x, y, theta, avoid): (f64, f64, f64, Option<bool>)| {
+        if !(x.is_finite() && y.is_finite() && theta.is_finite()) {
+            return Err(mlua::Error::runtime(format!(
+                "bad argument: setTarget needs finite numbers, not ({x}, {y}, {theta})"
+            )));
+        }
+        let pose = mrt_core::Pose2::new(x, y, theta);
+        io.borrow_mut().command.target =
+            Some(mrt_core::robot::Target { pose, avoid: avoid.unwrap_or(true) });
+        Ok(())
+    });
     func!("setVlin", io, |_lua, v: f64| {
         io.borrow_mut().command.vlin = v;
         Ok(())
@@ -350,8 +392,10 @@ fn install_inner(lua: &Lua, io: Rc<RefCell<RobotIo>>) -> mlua::Result<()> {
     func!("getBehaviorInfo", io, |lua, (): ()| {
         let io = io.borrow();
         let t = lua.create_table_with_capacity(0, 2)?;
-        t.set("timer", (io.world.time - io.behavior_since).as_secs_f64() * 1000.0)?;
-        t.set("isNew", i64::from(io.is_new))?;
+        // The innermost behavior running: a `use`d one, or the top behavior.
+        let (since, is_new) = io.using.last().copied().unwrap_or((io.behavior_since, io.is_new));
+        t.set("timer", (io.world.time - since).as_secs_f64() * 1000.0)?;
+        t.set("isNew", i64::from(is_new))?;
         Ok(t)
     });
     func!("setGlobal", io, |_lua, (key, ty, value): (String, i64, Value)| {

@@ -99,6 +99,8 @@ struct Shared {
     declared: RefCell<Declared>,
     /// The behaviors being run, outermost first (to refuse a behavior using itself).
     running: RefCell<Vec<String>>,
+    /// The robot's I/O: a `use`d behavior's `getBehaviorInfo` is its own.
+    io: Rc<RefCell<RobotIo>>,
 }
 
 /// A directory of HBM behaviors loaded into one Lua runtime.
@@ -125,6 +127,7 @@ impl Hbm {
             cdb: RefCell::new(Blender::new(Vec::new(), lps::COUNT)),
             declared: RefCell::new(Vec::new()),
             running: RefCell::new(Vec::new()),
+            io: io.clone(),
         });
         install(&rt.lua, &shared).map_err(ScriptError::setup)?;
         let defaults =
@@ -508,9 +511,11 @@ fn install(lua: &Lua, shared: &Rc<Shared>) -> mlua::Result<()> {
             }
             let a = s.cdb.borrow_mut().enter(d);
             let result = if a > 0.0 {
+                s.io.borrow_mut().enter_used(&name);
                 s.running.borrow_mut().push(name);
                 let r = function.call::<()>(());
                 s.running.borrow_mut().pop();
+                s.io.borrow_mut().leave_used();
                 r
             } else {
                 Ok(())

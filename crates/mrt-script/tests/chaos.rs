@@ -137,3 +137,37 @@ fn wrong_arguments_are_lua_errors_naming_the_script_line_and_function_not_panics
         );
     }
 }
+
+/// `getKickoffPose` gives the referee's place in READY (nil otherwise); `setTarget` hands
+/// guidance a posture, avoiding obstacles unless told not to; bad numbers are Lua errors.
+#[test]
+fn kickoff_pose_and_targets() {
+    use mrt_core::robot::Target;
+    let rt = LuaRuntime::new(Sandbox::default()).unwrap();
+    let io = Rc::new(RefCell::new(RobotIo::default()));
+    install(&rt, io.clone()).unwrap();
+    let run = |world: WorldSnapshot, code: &str| {
+        io.borrow_mut().begin_cycle(world, "t");
+        let r = Script::from_source(&rt, "t.lua", code, LoadStrategy::Compiled)
+            .unwrap()
+            .call::<()>(&rt);
+        (r, io.borrow().command.target)
+    };
+    let go = "local p = chaos.getKickoffPose() if p then chaos.setTarget(p.x, p.y, p.theta) end";
+    let ready = WorldSnapshot {
+        game_state: GameState::Ready,
+        kickoff_pose: Some(Pose2::new(-4000.0, 1500.0, 0.5)),
+        ..Default::default()
+    };
+    let (r, target) = run(ready, go);
+    r.unwrap();
+    assert_eq!(target, Some(Target { pose: Pose2::new(-4000.0, 1500.0, 0.5), avoid: true }));
+    let (r, target) = run(WorldSnapshot::default(), go);
+    r.unwrap();
+    assert_eq!(target, None, "no kickoff pose outside READY");
+    let (r, target) = run(WorldSnapshot::default(), "chaos.setTarget(100, 200, 0, false)");
+    r.unwrap();
+    assert_eq!(target, Some(Target { pose: Pose2::new(100.0, 200.0, 0.0), avoid: false }));
+    let (r, _) = run(WorldSnapshot::default(), "chaos.setTarget(0/0, 0, 0)");
+    assert!(r.unwrap_err().to_string().contains("setTarget needs finite numbers"));
+}

@@ -726,3 +726,32 @@ fn a_failing_hbm_lua_edit_keeps_the_old_variables() {
     // Observed: 167.857 (the default centroid variable).
     close(cap.cycle(ball_at(1000.0, 100)).command.vlin, 200.0);
 }
+
+/// `getBehaviorInfo` inside a behavior run through `use` is that behavior's own: new the
+/// first cycle it runs after a cycle without it, its timer from then, even though the top
+/// behavior has been running all along (lookball under the goalkeeper relies on it).
+#[test]
+fn a_used_behavior_has_its_own_behavior_info() {
+    let dir = Dir::new("usedinfo");
+    dir.write("hbm.lua", SINGLETON_HBM);
+    dir.write(
+        "inner.lua",
+        "local i = chaos.getBehaviorInfo() chaos.setVlat(i.isNew) chaos.setKick(math.floor(i.timer))",
+    );
+    dir.write("outer.lua", r#"if chaos.lps_getLpo(BALL).rho < 1000 then use(1, "inner") end"#);
+    let mut cap = ThinkingCap::with_behavior(dir.path(), "outer", Sandbox::default()).unwrap();
+    let info = |cap: &mut ThinkingCap, rho: f64, t: u64| {
+        let c = cap.cycle(ball_at(rho, t));
+        assert!(c.errors.is_empty(), "{:?}", c.errors);
+        (c.command.vlat, c.command.kick)
+    };
+    assert_eq!(info(&mut cap, 2000.0, 0), (0.0, None), "inner not run");
+    assert_eq!(info(&mut cap, 2000.0, 100), (0.0, None));
+    // The outer behavior is 200 ms old, inner starts now: new, timer 0.
+    assert_eq!(info(&mut cap, 500.0, 200), (1.0, Some(0)));
+    assert_eq!(info(&mut cap, 500.0, 300), (0.0, Some(100)));
+    assert_eq!(info(&mut cap, 500.0, 400), (0.0, Some(200)));
+    // A cycle without it, then again: new again.
+    info(&mut cap, 2000.0, 500);
+    assert_eq!(info(&mut cap, 500.0, 600), (1.0, Some(0)));
+}

@@ -137,6 +137,7 @@ fn the_shipped_directory_loads_every_behavior_and_each_runs_cleanly() {
             "goalkeeper",
             "gotopos",
             "lookball",
+            "ready",
             "stand",
             "trackbnet1",
         ],
@@ -748,4 +749,32 @@ fn the_behaviors_play_on_the_field_the_world_model_describes() {
     let on_default = run("goalkeeper", w);
     assert!(on_small.command.vrot > 20.0 && on_small.command.need(lps::NET1) > 0.7);
     assert!(on_default.command.vrot.abs() < 1e-9, "{:?}", on_default.command);
+}
+
+/// In READY the referee tells each robot its kickoff place (`getKickoffPose`): a field player
+/// waits with the `ready` behavior and the goalkeeper's top behavior hands over to it; both
+/// ask guidance for that posture (`setTarget`, round obstacles) instead of velocities. In SET
+/// they stand.
+#[test]
+fn in_ready_the_players_and_the_goalkeeper_walk_to_their_kickoff_places() {
+    let place = mrt_core::Pose2::new(-3000.0, 1200.0, 0.0);
+    let ready = |mut w: World| {
+        w.0.game_state = GameState::Ready;
+        w.0.kickoff_pose = Some(place);
+        w
+    };
+    let want = Some(mrt_core::robot::Target { pose: place, avoid: true });
+    let mut player =
+        ThinkingCap::with_hfsm(dir(), dir().join("player.hfsm.lua"), Sandbox::default()).unwrap();
+    let c = player.cycle(ready(World::at(0).me(-5000.0, -5000.0, 1.57, 0.9).ball(4000.0, 0.5)).0);
+    assert!(c.errors.is_empty(), "{:?}", c.errors);
+    assert_eq!((c.path.as_str(), c.behavior.as_deref()), ("Player/Wait", Some("ready")));
+    assert_eq!(c.command.target, want);
+    assert_eq!(c.command.need(lps::BALL), 1.0);
+    let keeper = run("goalkeeper", ready(World::at(0).me(-8000.0, -5000.0, 1.57, 0.9)));
+    assert_eq!(keeper.command.target, want);
+    let mut set = World::at(100).me(-3000.0, 1200.0, 0.0, 0.9).0;
+    set.game_state = GameState::Set;
+    let c = player.cycle(set);
+    assert_eq!((c.behavior.as_deref(), c.command.target), (Some("stand"), None));
 }

@@ -1,6 +1,6 @@
 //! Robots as Agoras on the bus (DCDT, MRT manual ch. 3): the simulator's default wiring.
 //!
-//! Each robot is one [`Agora`](mrt_dcdt::Agora) with four Members, all on the simulated clock
+//! Each robot is one [`Agora`](mrt_dcdt::Agora) with six Members, all on the simulated clock
 //! of one [`SteppedExecutor`] so that the match stays deterministic:
 //!
 //! 1. **`Eyes`** (the camera driver and the world-state Member, periodic): looks through the
@@ -9,21 +9,25 @@
 //!    [`WorldSnapshot`]; it also publishes a [`MateReport`] (its pose and its ball estimate)
 //!    that the teammates' Agoras receive through their team's `InnerLinkManager` — a
 //!    `RequestType::Remote` subscription, so a robot never hears itself.
-//! 2. **the behaviors**: a [`BehaviorMember`] running the TeamChaos HFSM or goalkeeper for the
-//!    Chaos stack, or a [`BrainMember`] around any `Send` [`Brain`] (the baseline);
-//! 3. **`Motor`** (the motor and kicker driver, on message): turns each [`RobotCommand`] into
+//! 2. **`Sonars`** (the sonar ring's driver, periodic): publishes a [`SonarScan`];
+//! 3. **the behaviors**: a [`BehaviorMember`] running the TeamChaos HFSM or goalkeeper for the
+//!    Chaos stack, or a [`BrainMember`] around any `Send` [`Brain`] (Milan, the baseline);
+//! 4. **`Guide`** (guidance, ISocRob §3.2.3, on message): turns the behaviors'
+//!    [`RobotCommand`] into a [`MotorCommand`] with [`mrt_plan::guide::Guidance`]: velocity
+//!    mode halted by the sonars, or position and potential-field modes to a target posture;
+//! 5. **`Motor`** (the motor and kicker driver, on message): turns each [`MotorCommand`] into
 //!    wheel set-points and kicks;
-//! 4. **`FaultBook`** (on message): books the behavior Member's script errors against the
+//! 6. **`FaultBook`** (on message): books the behavior Member's script errors against the
 //!    robot. A Member that fails to start, fails or panics is restarted by its executor and
 //!    booked too when the match ends: the match goes on, the robot stands still meanwhile, and
 //!    [`MatchReport::faults`] says which file and line.
 //!
 //! Body adaptation belongs to the drivers, as the seed's Commander Module did for its legs: on
-//! the Chaos robots `Eyes` measures distances from the robot's edge and `Motor` scales the
-//! behaviors' AIBO-sized set-points (see [`crate::teams`]).
+//! the Chaos robots `Eyes` measures distances from the robot's edge and `Guide` scales the
+//! behaviors' AIBO-sized set-points before guiding them (see [`crate::teams`]).
 
 use crate::drivers::{Base, MotorDriver, SimulatedAirboard};
-use crate::game::{Brain, MatchReport, Pitch};
+use crate::game::{guide, Brain, MatchReport, Pitch};
 use crate::referee::Call;
 use crate::sensor::merge_team;
 use crate::teams::{embedded_teamchaos, send_brain, Body, Stack, CHAOS_KEEPER, CHAOS_PLAYER};
@@ -33,6 +37,8 @@ use mrt_dcdt::{
     Activation, Context, InnerLinkManager, Member, MemberError, Message, MsgType, RequestType,
     SteppedExecutor, RESERVED_TYPES_START,
 };
+use mrt_plan::guidance::Sonar;
+use mrt_plan::guide::Guidance;
 use mrt_script::member::{BehaviorMember, BehaviorStatus};
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -44,6 +50,29 @@ pub use crate::sensor::MateReport;
 impl Message for MateReport {
     const TYPE: MsgType = MsgType(RESERVED_TYPES_START + 0x40);
     const NAME: &'static str = "MateReport";
+}
+
+/// One reading of the sonar ring (robot frame, m from the centre, ring order; no echo is an
+/// infinite range), published by the sonar driver every cycle.
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct SonarScan {
+    /// The sonars.
+    pub sonars: Vec<Sonar>,
+}
+
+impl Message for SonarScan {
+    const TYPE: MsgType = MsgType(RESERVED_TYPES_START + 0x41);
+    const NAME: &'static str = "SonarScan";
+}
+
+/// What guidance asks of the motor and kicker driver: the velocities to drive (mm/s, deg/s)
+/// and the kick.
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct MotorCommand(pub RobotCommand);
+
+impl Message for MotorCommand {
+    const TYPE: MsgType = MsgType(RESERVED_TYPES_START + 0x42);
+    const NAME: &'static str = "MotorCommand";
 }
 
 type Shared = Arc<Mutex<Pitch>>;
@@ -94,12 +123,70 @@ impl Member for Eyes {
     }
 }
 
+/// The sonar ring's driver of one robot.
+struct Sonars {
+    pitch: Shared,
+    robot: usize,
+}
+
+impl Member for Sonars {
+    fn name(&self) -> String {
+        format!("sonars-{}", self.robot)
+    }
+
+    fn do_your_job(&mut self, ctx: &mut Context<'_>) -> Result<(), MemberError> {
+        let sonars = lock(&self.pitch)?.sonar(self.robot);
+        ctx.publish(SonarScan { sonars });
+        Ok(())
+    }
+}
+
+/// Guidance of one robot: the behaviors' command, adapted to the body, through the Guidance
+/// µAgent with the latest world state and sonar scan.
+struct Guide {
+    robot: usize,
+    body: Body,
+    guidance: Guidance,
+    world: WorldSnapshot,
+    scan: SonarScan,
+}
+
+impl Member for Guide {
+    fn name(&self) -> String {
+        format!("guide-{}", self.robot)
+    }
+
+    fn init(&mut self, ctx: &mut Context<'_>) -> Result<(), MemberError> {
+        ctx.subscribe_to::<RobotCommand>(RequestType::Local);
+        ctx.subscribe_to::<WorldSnapshot>(RequestType::Local);
+        ctx.subscribe_to::<SonarScan>(RequestType::Local);
+        Ok(())
+    }
+
+    fn do_your_job(&mut self, ctx: &mut Context<'_>) -> Result<(), MemberError> {
+        let mut last = None;
+        while let Some(m) = ctx.receive_msg() {
+            if let Ok(c) = m.get::<RobotCommand>() {
+                last = Some(c.clone());
+            } else if let Ok(w) = m.get::<WorldSnapshot>() {
+                self.world.clone_from(w);
+            } else {
+                self.scan.clone_from(m.get::<SonarScan>()?);
+            }
+        }
+        if let Some(mut cmd) = last {
+            self.body.act(&mut cmd);
+            ctx.publish(MotorCommand(guide(&self.guidance, &cmd, &self.world, &self.scan.sonars)));
+        }
+        Ok(())
+    }
+}
+
 /// The motor and kicker driver of one robot: commands become duty cycles for its motor
 /// driver (the processing side of the AIRBoard), kick requests fire the kicker.
 struct Motor {
     pitch: Shared,
     robot: usize,
-    body: Body,
     base: Base,
     driver: Box<dyn MotorDriver>,
 }
@@ -110,17 +197,16 @@ impl Member for Motor {
     }
 
     fn init(&mut self, ctx: &mut Context<'_>) -> Result<(), MemberError> {
-        ctx.subscribe_to::<RobotCommand>(RequestType::Local);
+        ctx.subscribe_to::<MotorCommand>(RequestType::Local);
         Ok(())
     }
 
     fn do_your_job(&mut self, ctx: &mut Context<'_>) -> Result<(), MemberError> {
         let mut last = None;
         while let Some(m) = ctx.receive_msg() {
-            last = Some(m.get::<RobotCommand>()?.clone());
+            last = Some(m.get::<MotorCommand>()?.0.clone());
         }
-        if let Some(mut cmd) = last {
-            self.body.act(&mut cmd);
+        if let Some(cmd) = last {
             self.driver.set_duty(&self.base.duties(&cmd)).map_err(|e| e.to_string())?;
             if cmd.kick.is_some() {
                 lock(&self.pitch)?.kick(self.robot);
@@ -235,6 +321,7 @@ impl BusMatch {
                 let body = if stack == Stack::Chaos { chaos_body } else { Body::PLAIN };
                 let eyes = Eyes { pitch: pitch.clone(), robot, body, mates: BTreeMap::new() };
                 let mut ids = vec![agora.add_member(eyes, every)];
+                ids.push(agora.add_member(Sonars { pitch: pitch.clone(), robot }, every));
                 ids.push(match stack {
                     Stack::Chaos if k == 0 => {
                         agora.add_member(BehaviorMember::hbm(&dir, CHAOS_KEEPER), every)
@@ -246,9 +333,20 @@ impl BusMatch {
                         agora.add_member(BrainMember::new(send_brain(other, k == 0, cfg)?), every)
                     }
                 });
-                let base = lock_pitch(&pitch)?.base();
+                let (base, guidance) = {
+                    let p = lock_pitch(&pitch)?;
+                    (p.base(), p.guidance())
+                };
+                let guide = Guide {
+                    robot,
+                    body,
+                    guidance,
+                    world: WorldSnapshot::default(),
+                    scan: SonarScan::default(),
+                };
+                ids.push(agora.add_member(guide, Activation::OnMessage));
                 let driver = Box::new(SimulatedAirboard::new(pitch.clone(), robot, base));
-                let motor = Motor { pitch: pitch.clone(), robot, body, base, driver };
+                let motor = Motor { pitch: pitch.clone(), robot, base, driver };
                 ids.push(agora.add_member(motor, Activation::OnMessage));
                 let book = FaultBook { pitch: pitch.clone(), robot };
                 ids.push(agora.add_member(book, Activation::OnMessage));

@@ -134,6 +134,9 @@ pub struct MatchConfig {
     pub physics_step: f64,
     /// Period of the robots' control cycle (the behaviors' 100 ms).
     pub control_period: f64,
+    /// Longest time in READY, walking to the kickoff positions; robots farther than
+    /// [`READY_TOLERANCE`] from theirs by then are placed on them. 0: placed at once.
+    pub ready_duration: f64,
     /// Time in SET before play starts after a kickoff.
     pub set_duration: f64,
     /// A ball that moved less than `stuck_distance` for this long is dropped elsewhere.
@@ -149,6 +152,7 @@ impl Default for MatchConfig {
             team_size: 4,
             physics_step: 0.01,
             control_period: 0.1,
+            ready_duration: 15.0,
             set_duration: 1.0,
             stuck_time: 10.0,
             stuck_distance: 0.2,
@@ -188,6 +192,74 @@ impl Default for SensorConfig {
     }
 }
 
+/// How near its kickoff position a robot must be for READY to end early, and not to be
+/// placed when it ends (m).
+pub const READY_TOLERANCE: f64 = 0.3;
+
+/// The ring of sonars (ISocRob's SuperScout: sixteen, evenly spaced).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct SonarConfig {
+    /// Sonars in the ring, the first straight ahead, then counter-clockwise.
+    pub count: usize,
+    /// Half the width of a beam, radians.
+    pub half_beam: f64,
+    /// Farthest echo, m; beyond it a sonar reads nothing.
+    pub range: f64,
+    /// Standard deviation of a reading, m.
+    pub noise: f64,
+}
+
+impl Default for SonarConfig {
+    fn default() -> Self {
+        Self { count: 16, half_beam: 0.2, range: 3.0, noise: 0.01 }
+    }
+}
+
+/// Guidance (ISocRob §3.2.3) between the behaviors and the motors.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct GuidanceConfig {
+    /// Velocity mode halts the translation when a sonar within `half_cone` of the direction
+    /// of motion reads less than this, m from the robot's centre.
+    pub safety_distance: f64,
+    /// See `safety_distance`, radians.
+    pub half_cone: f64,
+}
+
+impl Default for GuidanceConfig {
+    /// 0.35 m from the centre (0.1 m from a 0.25 m robot's edge), ±30°.
+    fn default() -> Self {
+        Self { safety_distance: 0.35, half_cone: std::f64::consts::PI / 6.0 }
+    }
+}
+
+impl GuidanceConfig {
+    /// The Guidance µAgent for robots of `cfg`.
+    pub fn guidance(&self, cfg: &SimConfig) -> Result<mrt_plan::guide::Guidance, String> {
+        use mrt_plan::guidance::{PositionParams, PotentialField, PotentialParams, VelocityGuard};
+        let steering = match crate::drivers::Base::parse(&cfg.robot.base)? {
+            crate::drivers::Base::Differential(_) => mrt_plan::kinematics::Steering::Differential,
+            crate::drivers::Base::Omni(_) => mrt_plan::kinematics::Steering::Holonomic,
+        };
+        let position = PositionParams {
+            steering,
+            max_speed: cfg.robot.max_speed,
+            max_omega: cfg.robot.max_turn_rate,
+            position_tolerance: 0.05,
+            angle_tolerance: 0.05,
+            ..PositionParams::default()
+        };
+        let obstacles =
+            PotentialParams { robot_radius: cfg.robot.radius, ..PotentialParams::default() };
+        let guard = VelocityGuard::new(self.safety_distance, self.half_cone)
+            .map_err(|e| format!("guidance: {e}"))?;
+        let field =
+            PotentialField::new(position, obstacles).map_err(|e| format!("guidance: {e}"))?;
+        Ok(mrt_plan::guide::Guidance::new(guard, field, cfg.ball.radius))
+    }
+}
+
 /// The whole configuration.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
@@ -202,6 +274,10 @@ pub struct SimConfig {
     pub rules: MatchConfig,
     /// The object sensor.
     pub sensor: SensorConfig,
+    /// The sonar ring.
+    pub sonar: SonarConfig,
+    /// Guidance.
+    pub guidance: GuidanceConfig,
 }
 
 /// A configuration that cannot be used.
@@ -284,6 +360,7 @@ impl SimConfig {
             ("rules.control_period", self.rules.control_period),
             ("sensor.range", self.sensor.range),
             ("sensor.landmark_range", self.sensor.landmark_range),
+            ("sonar.range", self.sonar.range),
         ];
         for (name, v) in positive {
             if !(v.is_finite() && v > 0.0) {
@@ -330,6 +407,9 @@ impl SimConfig {
             ("rules.set_duration", self.rules.set_duration),
             ("sensor.distance_noise", self.sensor.distance_noise),
             ("sensor.bearing_noise", self.sensor.bearing_noise),
+            ("rules.ready_duration", self.rules.ready_duration),
+            ("sonar.noise", self.sonar.noise),
+            ("sonar.half_beam", self.sonar.half_beam),
         ];
         for (name, v) in non_negative {
             if !(v.is_finite() && v >= 0.0) {
@@ -355,6 +435,13 @@ impl SimConfig {
         if self.rules.control_period < self.rules.physics_step {
             return Err("rules.control_period must be at least rules.physics_step".into());
         }
+        if !(1..=64).contains(&self.sonar.count) || self.sonar.half_beam > 1.0 {
+            return Err(format!(
+                "sonar.count must be 1 to 64 (not {}) and sonar.half_beam at most 1 rad",
+                self.sonar.count
+            ));
+        }
+        self.guidance.guidance(self)?;
         Ok(())
     }
 }

@@ -9,9 +9,12 @@
 use crate::config::SimConfig;
 use crate::drivers::Base;
 use crate::referee::{Call, Referee, Team};
-use crate::sensor::{merge_team, MateReport, Perception};
+use crate::sensor::{merge_team, sonar_ring, MateReport, Perception};
 use crate::world::{Drive, World};
-use mrt_core::robot::{lps, GameState, RobotCommand, WorldSnapshot};
+use mrt_core::robot::{lps, GameState, RobotCommand, Target, WorldSnapshot};
+use mrt_core::Point2;
+use mrt_plan::guidance::Sonar;
+use mrt_plan::guide::Guidance;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 
@@ -115,6 +118,7 @@ pub struct MatchReport {
 pub struct Pitch {
     cfg: SimConfig,
     base: Base,
+    guidance: Guidance,
     seed: u64,
     world: World,
     referee: Referee,
@@ -165,6 +169,7 @@ impl Pitch {
         Ok(Pitch {
             cfg: cfg.clone(),
             base: Base::parse(&cfg.robot.base)?,
+            guidance: cfg.guidance.guidance(cfg)?,
             seed,
             world,
             referee,
@@ -205,6 +210,17 @@ impl Pitch {
         self.eyes[i].look(&self.world, &self.referee, &self.cfg.sensor, &mut self.rngs[i])
     }
 
+    /// Robot `i`'s sonar ring listens once (after [`Pitch::look`] in a cycle: both draw from
+    /// the robot's random stream).
+    pub fn sonar(&mut self, i: usize) -> Vec<Sonar> {
+        sonar_ring(&self.world, i, &self.cfg.sonar, &mut self.rngs[i])
+    }
+
+    /// The robots' Guidance µAgent.
+    pub fn guidance(&self) -> Guidance {
+        self.guidance
+    }
+
     /// Books a fault of robot `i`'s software now (`count` of them, the first one's `message`).
     pub fn fault(&mut self, i: usize, count: u64, message: &str) {
         let now = self.world.time();
@@ -234,11 +250,11 @@ impl Pitch {
         self.base
     }
 
-    /// Sets robot `i`'s body velocity (what its motor driver achieved). Outside `PLAYING` the
-    /// robot is held still.
+    /// Sets robot `i`'s body velocity (what its motor driver achieved). Outside `READY` and
+    /// `PLAYING` the robot is held still.
     pub fn drive(&mut self, i: usize, drive: Drive) {
-        let playing = self.referee.state() == GameState::Playing;
-        self.world.drive(i, if playing { drive } else { Drive::default() });
+        let moving = matches!(self.referee.state(), GameState::Ready | GameState::Playing);
+        self.world.drive(i, if moving { drive } else { Drive::default() });
     }
 
     /// Fires robot `i`'s kicker (only while `PLAYING`); a kick that reaches the ball counts as
@@ -328,6 +344,19 @@ impl Pitch {
     }
 }
 
+/// Guidance for one robot's cycle: the behaviors' command `cmd`, the world state the robot
+/// believes (its pose, the ball where it is known) and its sonar ring. Both wirings call this.
+pub fn guide(
+    g: &Guidance,
+    cmd: &RobotCommand,
+    w: &WorldSnapshot,
+    sonars: &[Sonar],
+) -> RobotCommand {
+    let ball = w.global_ball;
+    let ball = (ball.quality >= 0.1).then(|| Point2::new(ball.pose.x, ball.pose.y));
+    g.guide(cmd, &w.my_pos.pose, ball, sonars).command
+}
+
 /// A match whose robots' brains are called directly, in order (the fast mode; see
 /// [`crate::bus`] for robots as Agoras on the bus).
 pub struct Match {
@@ -390,10 +419,12 @@ impl Match {
                 .filter_map(|(_, r)| r.as_ref());
             merge_team(&mut snapshot, mates);
             self.reports[i] = Some(own);
+            let sonars = self.pitch.sonar(i);
             let cmd = self.brains[i].cycle(&snapshot);
             for fault in self.brains[i].take_faults() {
                 self.pitch.fault(i, 1, &fault);
             }
+            let cmd = guide(&self.pitch.guidance(), &cmd, &snapshot, &sonars);
             self.pitch.apply(i, &cmd);
         }
         self.pitch.advance()
@@ -437,8 +468,22 @@ impl Chaser {
     }
 }
 
+/// In READY, the command that walks to the kickoff position (guidance's potential-field mode,
+/// round the other robots), watching the ball; `None` in the other states.
+pub fn walk_to_kickoff(w: &WorldSnapshot) -> Option<RobotCommand> {
+    let pose = w.kickoff_pose.filter(|_| w.game_state == GameState::Ready)?;
+    Some(RobotCommand {
+        target: Some(Target { pose, avoid: true }),
+        needs: vec![(lps::BALL, 1.0)],
+        ..RobotCommand::default()
+    })
+}
+
 impl Brain for Chaser {
     fn cycle(&mut self, w: &WorldSnapshot) -> RobotCommand {
+        if let Some(c) = walk_to_kickoff(w) {
+            return c;
+        }
         let mut c = RobotCommand::default();
         let ball = w.lps[lps::BALL];
         c.needs.push((lps::BALL, 1.0));
@@ -500,6 +545,42 @@ mod tests {
         cfg.rules.half_duration = minutes * 60.0;
         cfg.rules.team_size = team;
         cfg
+    }
+
+    /// Velocity mode in the simulator: a robot driven straight at the north wall (at y = 7 m,
+    /// the field's 6 m plus the 1 m border) at 0.4 m/s from 1 m away. Through guidance, its
+    /// sonars halt it when the wall is 0.35 m from its centre; braking (0.4² / (2 · 2) = 0.04
+    /// m) and one control period of delay (0.04 m) leave it short of the wall. Without
+    /// guidance it drives into the wall. The sonars hear through the simulator's ray casts and
+    /// noise; READY lets robots move.
+    #[test]
+    fn guidance_halts_a_robot_before_the_wall_and_without_it_the_robot_hits() {
+        let mut cfg = SimConfig::default();
+        cfg.rules.ready_duration = 100.0;
+        cfg.rules.team_size = 2;
+        let drive = |guided: bool| {
+            let mut pitch = Pitch::new(&cfg, 1, 2, 2).unwrap();
+            pitch
+                .world
+                .place_robot(1, mrt_core::Pose2::new(3.0, 5.75, std::f64::consts::FRAC_PI_2));
+            let go = RobotCommand { vlin: 400.0, ..RobotCommand::default() };
+            let mut closest = f64::INFINITY;
+            for _ in 0..40 {
+                let w = pitch.look(1);
+                let sonars = pitch.sonar(1);
+                assert_eq!(sonars.len(), 16);
+                let cmd =
+                    if guided { guide(&pitch.guidance(), &go, &w, &sonars) } else { go.clone() };
+                pitch.apply(1, &cmd);
+                pitch.advance();
+                let edge = 7.0 - pitch.world().robot(1).unwrap().y - cfg.robot.radius;
+                closest = closest.min(edge);
+            }
+            closest
+        };
+        let guided = drive(true);
+        assert!(guided > 0.01 && guided < 0.1, "stopped short of the wall: {guided} m");
+        assert!(drive(false) < 0.005, "without guidance it reaches the wall");
     }
 
     #[test]

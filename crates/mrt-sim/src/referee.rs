@@ -1,10 +1,14 @@
 //! The referee: game states, kickoffs, goals, a ball out of the field, halves and the
-//! stuck-ball rule. It reads the [`World`], moves the ball and robots where the rules say, and
+//! stuck-ball rule. Every kickoff (the first, after a goal, after half time) goes through
+//! `READY`, in which the robots walk to the kickoff formation ([`Referee::kickoff_pose`]
+//! tells each robot its place), then `SET`, then `PLAYING`. The half's clock runs on through
+//! READY and SET, as in association football. It reads the [`World`], moves the ball and robots where the rules say, and
 //! tells the robots the game state (what `chaos.getCurrentState()` returns).
 //!
 //! Teams: [`Team::Home`] defends the west goal (−x) in the first half and the east goal in the
 //! second; robots `0..n` are home, `n..2n` away; robot 0 of each team is its goalkeeper.
 
+use crate::config::READY_TOLERANCE;
 use crate::world::World;
 use mrt_core::robot::GameState;
 use mrt_core::Pose2;
@@ -56,6 +60,12 @@ pub enum Call {
     HalfTime,
     /// The match is over.
     FullTime,
+    /// READY ended: the robots that were not at their kickoff position by then were placed
+    /// there; the game is in SET.
+    Set {
+        /// How many robots were placed.
+        placed: usize,
+    },
 }
 
 /// The referee's state.
@@ -65,6 +75,9 @@ pub struct Referee {
     half: u8,
     half_started: f64,
     set_until: f64,
+    ready_until: f64,
+    /// Each robot's place in the current kickoff formation (field frame, m).
+    formation: Vec<Pose2>,
     score: [u32; 2],
     team_size: usize,
     /// Where the ball was when it last moved more than the stuck distance, and when.
@@ -79,6 +92,8 @@ impl Referee {
             half: 1,
             half_started: 0.0,
             set_until: 0.0,
+            ready_until: 0.0,
+            formation: Vec::new(),
             score: [0, 0],
             team_size,
             anchor: ((0.0, 0.0), 0.0),
@@ -118,57 +133,91 @@ impl Referee {
         }
     }
 
-    /// Starts the match: kickoff for home.
+    /// Where robot `robot` stands in the kickoff formation (field frame, m), while in READY.
+    pub fn kickoff_pose(&self, robot: usize) -> Option<Pose2> {
+        (self.state == GameState::Ready).then(|| self.formation.get(robot).copied()).flatten()
+    }
+
+    /// Starts the match: the robots enter on their side line (each team on its own half, the
+    /// goalkeeper nearest its goal, facing the field), then READY for home's kickoff.
     pub fn start(&mut self, world: &mut World) {
         self.half_started = world.time();
+        let cfg = world.config().clone();
+        let (hl, hw) = (cfg.field.length / 2.0, cfg.field.width / 2.0);
+        let n = self.team_size.max(1);
+        let step = ((hl - 1.0) / n as f64).clamp(2.0 * cfg.robot.radius + 0.05, 1.2);
+        for i in 0..world.robot_count() {
+            let t = self.team_of(i);
+            let k = if t == Team::Home { i } else { i - self.team_size };
+            let x = (hl - 0.5 - step * k as f64).max(cfg.robot.radius);
+            let x = -self.attack_direction(t) * x;
+            world.place_robot(i, Pose2::new(x, -hw, std::f64::consts::FRAC_PI_2));
+        }
         self.kickoff(world, Team::Home);
     }
 
-    /// Places everyone for a kickoff by `team` and goes to `SET` for the set duration.
+    /// The ball on the centre spot and READY for a kickoff by `team`: the robots walk to the
+    /// formation (goalkeeper on the goal line, the kicking team's first field player next to
+    /// the ball, the others spread over their own half) for at most `rules.ready_duration`.
     pub fn kickoff(&mut self, world: &mut World, team: Team) {
         let cfg = world.config().clone();
         let (hl, r) = (cfg.field.length / 2.0, cfg.robot.radius);
         world.place_ball(0.0, 0.0);
-        for i in 0..world.robot_count() {
-            let t = self.team_of(i);
-            let k = if t == Team::Home { i } else { i - self.team_size };
-            let dir = self.attack_direction(t);
-            // Goalkeeper on the goal line; field players spread over the own half, the
-            // kicking team's first field player at the centre circle.
-            let (x, y) = if k == 0 {
-                (-dir * (hl - 0.5), 0.0)
-            } else if k == 1 && t == team {
-                (-dir * (2.0 * r + cfg.ball.radius), 0.0)
-            } else {
-                let lanes = (self.team_size.max(2) - 1) as f64;
-                let lane = (k - 1) as f64;
-                let y = (lane - (lanes - 1.0) / 2.0) * (cfg.field.width / (lanes + 1.0));
-                (-dir * (cfg.field.centre_circle_radius + 0.5 + lane * 0.8), y)
-            };
-            // Many robots on a small field: never behind the own goal line.
-            let x = x.clamp(-(hl - r - 0.1), hl - r - 0.1);
-            let heading = if dir > 0.0 { 0.0 } else { PI };
-            world.place_robot(i, Pose2::new(x, y, heading));
-        }
-        self.state = GameState::Set;
-        self.set_until = world.time() + cfg.rules.set_duration;
+        self.formation = (0..world.robot_count())
+            .map(|i| {
+                let t = self.team_of(i);
+                let k = if t == Team::Home { i } else { i - self.team_size };
+                let dir = self.attack_direction(t);
+                let (x, y) = if k == 0 {
+                    (-dir * (hl - 0.5), 0.0)
+                } else if k == 1 && t == team {
+                    (-dir * (2.0 * r + cfg.ball.radius), 0.0)
+                } else {
+                    let lanes = (self.team_size.max(2) - 1) as f64;
+                    let lane = (k - 1) as f64;
+                    let y = (lane - (lanes - 1.0) / 2.0) * (cfg.field.width / (lanes + 1.0));
+                    (-dir * (cfg.field.centre_circle_radius + 0.5 + lane * 0.8), y)
+                };
+                // Many robots on a small field: never behind the own goal line.
+                let x = x.clamp(-(hl - r - 0.1), hl - r - 0.1);
+                Pose2::new(x, y, if dir > 0.0 { 0.0 } else { PI })
+            })
+            .collect();
+        self.state = GameState::Ready;
+        self.ready_until = world.time() + cfg.rules.ready_duration;
         self.anchor = ((0.0, 0.0), world.time());
+        if cfg.rules.ready_duration <= 0.0 {
+            self.end_ready(world);
+        }
+    }
+
+    /// Ends READY: robots farther than [`READY_TOLERANCE`] from their place are put there,
+    /// the ball back on the centre spot, SET for `rules.set_duration`. Returns how many robots
+    /// were placed.
+    fn end_ready(&mut self, world: &mut World) -> usize {
+        let mut placed = 0;
+        for (i, spot) in self.formation.iter().enumerate() {
+            let off = world.robot(i).map_or(f64::INFINITY, |p| (p.x - spot.x).hypot(p.y - spot.y));
+            if off > READY_TOLERANCE {
+                world.place_robot(i, *spot);
+                placed += 1;
+            }
+        }
+        world.place_ball(0.0, 0.0);
+        self.state = GameState::Set;
+        self.set_until = world.time() + world.config().rules.set_duration;
+        self.anchor = ((0.0, 0.0), world.time());
+        placed
     }
 
     /// Applies the rules after a physics step. Returns what was decided, if anything.
     pub fn update(&mut self, world: &mut World) -> Option<Call> {
         let cfg = world.config().clone();
         let now = world.time();
-        match self.state {
-            GameState::Initial | GameState::Ready | GameState::Finished => return None,
-            GameState::Set => {
-                if now + 1e-9 >= self.set_until {
-                    self.state = GameState::Playing;
-                }
-                return None;
-            }
-            GameState::Playing => {}
+        if matches!(self.state, GameState::Initial | GameState::Finished) {
+            return None;
         }
+        // The half's clock runs in READY and SET too.
         if now - self.half_started >= cfg.rules.half_duration - 1e-9 {
             if self.half == 1 {
                 self.half = 2;
@@ -178,6 +227,27 @@ impl Referee {
             }
             self.state = GameState::Finished;
             return Some(Call::FullTime);
+        }
+        match self.state {
+            GameState::Ready => {
+                let there = self.formation.iter().enumerate().all(|(i, spot)| {
+                    world
+                        .robot(i)
+                        .is_some_and(|p| (p.x - spot.x).hypot(p.y - spot.y) <= READY_TOLERANCE)
+                });
+                if there || now + 1e-9 >= self.ready_until {
+                    let placed = self.end_ready(world);
+                    return Some(Call::Set { placed });
+                }
+                return None;
+            }
+            GameState::Set => {
+                if now + 1e-9 >= self.set_until {
+                    self.state = GameState::Playing;
+                }
+                return None;
+            }
+            _ => {}
         }
         let (bx, by) = world.ball();
         let (hl, hw) = (cfg.field.length / 2.0, cfg.field.width / 2.0);
@@ -237,9 +307,11 @@ mod tests {
     use super::*;
     use crate::config::SimConfig;
 
+    /// The rules without READY: robots are placed at once.
     fn setup() -> (World, Referee) {
         let mut cfg = SimConfig::default();
         cfg.rules.half_duration = 20.0;
+        cfg.rules.ready_duration = 0.0;
         let mut w = World::new(&cfg, 8);
         let mut r = Referee::new(4);
         r.start(&mut w);
@@ -280,6 +352,7 @@ mod tests {
         cfg.field.penalty_area_depth = 1.0;
         cfg.field.penalty_area_width = 3.0;
         cfg.rules.team_size = 11;
+        cfg.rules.ready_duration = 0.0;
         cfg.validate().unwrap();
         let mut w = World::new(&cfg, 22);
         let mut r = Referee::new(11);
@@ -289,6 +362,57 @@ mod tests {
             assert!(p.x.abs() < 4.0 && p.y.abs() < 3.0, "robot {i} at {p:?}");
             assert_eq!(p.x < 0.0, i < 11, "robot {i} in its own half: {p:?}");
         }
+    }
+
+    /// READY with nobody walking: the robots enter on their side lines (home west of the
+    /// centre, away east, on y = −6 facing the field), each is told its place, and after
+    /// `ready_duration` the referee places the ones not within 0.3 m of it: here all but one,
+    /// which was put 0.2 m from its place by hand.
+    #[test]
+    fn ready_places_the_robots_that_did_not_walk_to_the_formation() {
+        let mut cfg = SimConfig::default();
+        cfg.rules.ready_duration = 5.0;
+        let mut w = World::new(&cfg, 8);
+        let mut r = Referee::new(4);
+        r.start(&mut w);
+        assert_eq!(r.state(), GameState::Ready);
+        for i in 0..8 {
+            let p = w.robot(i).unwrap();
+            assert!((p.y + 6.0).abs() < 1e-3 && (p.x < 0.0) == (i < 4), "robot {i}: {p:?}");
+        }
+        // Home goalkeeper's place: its goal line, facing east; away's first field player is
+        // not the kicker (home kicks off): 2.5 m into its half.
+        assert_eq!(r.kickoff_pose(0), Some(Pose2::new(-8.5, 0.0, 0.0)));
+        assert_eq!(r.kickoff_pose(1), Some(Pose2::new(-0.61, 0.0, 0.0)));
+        let away1 = r.kickoff_pose(5).unwrap();
+        assert!((away1.x - 2.5).abs() < 1e-9 && (away1.theta - PI).abs() < 1e-9, "{away1:?}");
+        let near = r.kickoff_pose(2).unwrap();
+        w.place_robot(2, Pose2::new(near.x + 0.2, near.y, 0.0));
+        let calls = run(&mut w, &mut r, 4.9);
+        assert!(calls.is_empty() && r.state() == GameState::Ready, "{calls:?}");
+        let calls = run(&mut w, &mut r, 0.2);
+        assert_eq!(calls, [Call::Set { placed: 7 }]);
+        assert_eq!((r.state(), r.kickoff_pose(0)), (GameState::Set, None), "told only in READY");
+        let p = w.robot(2).unwrap();
+        assert!((p.x - near.x - 0.2).abs() < 0.01, "within 0.3 m: left where it was, {p:?}");
+        assert!((w.robot(0).unwrap().x + 8.5).abs() < 1e-3, "the goalkeeper was placed");
+    }
+
+    /// READY ends as soon as every robot is within 0.3 m of its place: nobody is placed, SET
+    /// follows, then play after `set_duration`.
+    #[test]
+    fn ready_ends_early_when_everyone_is_in_place() {
+        let cfg = SimConfig::default();
+        let mut w = World::new(&cfg, 8);
+        let mut r = Referee::new(4);
+        r.start(&mut w);
+        for i in 0..8 {
+            w.place_robot(i, r.kickoff_pose(i).unwrap());
+        }
+        assert_eq!(run(&mut w, &mut r, 0.01), [Call::Set { placed: 0 }]);
+        assert_eq!(r.state(), GameState::Set);
+        run(&mut w, &mut r, 1.0);
+        assert_eq!(r.state(), GameState::Playing);
     }
 
     #[test]

@@ -11,12 +11,14 @@
 //! The team side of the world state is [`merge_team`]: teammates as their [`MateReport`]s
 //! tell them, and the global ball from the best sighting, one's own or a teammate's.
 
-use crate::config::SensorConfig;
+use crate::config::{SensorConfig, SonarConfig};
 use crate::referee::{Referee, Team};
 use crate::world::World;
 use mrt_core::robot::{lps, Estimate, Lpo, Mate, WorldSnapshot};
 use mrt_core::{normalize_angle, Pose2, Time, Vec2};
+use mrt_plan::guidance::Sonar;
 use rand::{Rng, RngCore};
+use std::f64::consts::PI;
 
 /// Reliability kept per control cycle by an object that was not seen again.
 pub const DECAY: f64 = 0.85;
@@ -61,6 +63,25 @@ pub fn merge_team<'a>(w: &mut WorldSnapshot, reports: impl IntoIterator<Item = &
 }
 
 /// Standard normal sample (Box–Muller), from any RNG.
+/// What robot `i`'s sonar ring hears (robot frame, m from the centre, ring order; no echo is
+/// an infinite range): [`World::sonar`]'s edge distances plus the radius, with noise.
+pub fn sonar_ring(world: &World, i: usize, cfg: &SonarConfig, rng: &mut dyn RngCore) -> Vec<Sonar> {
+    let radius = world.config().robot.radius;
+    world
+        .sonar(i, cfg.count, cfg.half_beam, cfg.range)
+        .into_iter()
+        .enumerate()
+        .map(|(k, edge)| {
+            let range = if edge >= cfg.range - 1e-9 {
+                f64::INFINITY
+            } else {
+                (edge + radius + cfg.noise * gauss(rng)).max(0.0)
+            };
+            Sonar::new(Sonar::ring_bearing(k, cfg.count), range)
+        })
+        .collect()
+}
+
 fn gauss(rng: &mut dyn RngCore) -> f64 {
     let u1: f64 = rng.random_range(f64::EPSILON..1.0);
     let u2: f64 = rng.random_range(0.0..1.0);
@@ -170,8 +191,7 @@ impl Perception {
         // Team frame: x towards the opponent's net. Field → team is a half turn when the team
         // attacks west.
         let to_team = |x: f64, y: f64| (dir * x * 1000.0, dir * y * 1000.0);
-        let heading =
-            if dir > 0.0 { me.theta } else { normalize_angle(me.theta + std::f64::consts::PI) };
+        let heading = if dir > 0.0 { me.theta } else { normalize_angle(me.theta + PI) };
         let mut w = WorldSnapshot {
             time: Time::from_secs_f64(now),
             game_state: referee.state(),
@@ -190,6 +210,11 @@ impl Perception {
         }
         let (mx, my) = to_team(me.x, me.y);
         w.my_pos = Estimate { pose: Pose2::new(mx, my, heading), quality: 0.9 };
+        w.kickoff_pose = referee.kickoff_pose(self.robot).map(|p| {
+            let (x, y) = to_team(p.x, p.y);
+            let theta = if dir > 0.0 { p.theta } else { normalize_angle(p.theta + PI) };
+            Pose2::new(x, y, theta)
+        });
         if let Some(Memory { at: (bx, by), reliability: rel, .. }) = self.memory[lps::BALL] {
             let (x, y) = to_team(bx, by);
             w.global_ball = Estimate { pose: Pose2::new(x, y, 0.0), quality: rel };

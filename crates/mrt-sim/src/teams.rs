@@ -73,6 +73,7 @@ const TEAMCHAOS: &[(&str, &str)] = &[
     ("hbm.lua", include_str!("../../../behaviors/teamchaos/hbm.lua")),
     ("lookball.lua", include_str!("../../../behaviors/teamchaos/lookball.lua")),
     ("player.hfsm.lua", include_str!("../../../behaviors/teamchaos/player.hfsm.lua")),
+    ("ready.lua", include_str!("../../../behaviors/teamchaos/ready.lua")),
     ("stand.lua", include_str!("../../../behaviors/teamchaos/stand.lua")),
     ("trackbnet1.lua", include_str!("../../../behaviors/teamchaos/trackbnet1.lua")),
 ];
@@ -329,6 +330,10 @@ impl MilanBrain {
 
 impl Brain for MilanBrain {
     fn cycle(&mut self, w: &WorldSnapshot) -> RobotCommand {
+        // The game state is the Messenger's: in READY, walk to the kickoff position.
+        if let Some(c) = crate::game::walk_to_kickoff(w) {
+            return c;
+        }
         let inputs = self.inputs(w);
         let out = self.brian.run(&inputs);
         let mut c = RobotCommand::default();

@@ -1,6 +1,7 @@
 //! A full default match (2 × 5 min, four robots a side, Milan on Mr. BRIAN at home against
 //! Chaos on Lua, each robot an Agora on the bus: what `mrt sim` plays) finishes, both teams
 //! score, and the same seed reproduces it exactly: the same score and the same trajectory hash.
+//! Before every kickoff the robots walk to the formation in READY themselves.
 
 #![allow(clippy::unwrap_used)]
 
@@ -17,14 +18,24 @@ fn default_match(seed: u64) -> MatchReport {
 
 #[test]
 fn a_full_match_finishes_and_reproduces_its_trajectory_hash() {
-    let (a, b) = (default_match(4), default_match(4));
+    let (a, b) = (default_match(6), default_match(6));
     assert!((a.duration - 600.0).abs() < 0.011, "two halves of 300 s: {}", a.duration);
     assert_eq!(a.calls.last().map(|(_, c)| c), Some(&Call::FullTime));
     assert!(a.calls.iter().any(|(_, c)| *c == Call::HalfTime));
     assert_eq!((a.score, a.trajectory_hash), (b.score, b.trajectory_hash));
     assert_eq!(a.stats, b.stats);
-    // Both teams play: each moves to the ball, kicks it and scores (seed 4: 3 : 2).
+    // Both teams play: each moves to the ball, kicks it and scores (seed 6: 1 : 2).
     assert!(a.score.0 > 0 && a.score.1 > 0, "{:?}", a.score);
+    // Every kickoff went through READY, and the robots walked to their places: the referee
+    // placed few of them (one kickoff at the start, one per goal, one at half time).
+    let placed: Vec<usize> = a
+        .calls
+        .iter()
+        .filter_map(|(_, c)| if let Call::Set { placed } = c { Some(*placed) } else { None })
+        .collect();
+    let kickoffs = 2 + (a.score.0 + a.score.1) as usize;
+    assert_eq!(placed.len(), kickoffs, "{:?}", a.calls);
+    assert!(placed.iter().sum::<usize>() * 10 <= kickoffs * 8, "placed by the referee: {placed:?}");
     assert!(a.stats[0].possession_cycles > 0 && a.stats[1].possession_cycles > 0);
     assert!(a.faults.is_empty(), "{:?}", a.faults);
 }
