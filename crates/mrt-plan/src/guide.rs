@@ -161,7 +161,7 @@ impl Guidance {
 }
 
 /// The obstacles the sonar ring sees from `pose` (field frame, m): the echoes of neighbouring
-/// sonars (in ring order, the last next to the first) that lie within [`SAME_OBSTACLE`] of
+/// sonars (in ring order, the last next to the first) that lie within 0.35 m of
 /// each other are one circle, whose near side is at their mean and whose radius covers them.
 ///
 /// One circle per object matters: a robot ahead echoes in two or three sonars, and as separate

@@ -2,8 +2,9 @@
 //!
 //! A simulated Middle Size League soccer match in which every robot runs the real MRT stack.
 //! The physics is `rapier2d` seen from above ([`world`]); the rules are a referee
-//! ([`referee`]); robots see through an object sensor that reports what a camera would
-//! detect ([`sensor`]).
+//! ([`referee`]: READY, SET, PLAYING, ...); robots see through an object sensor that reports
+//! what a camera would detect and hear through a sonar ring ([`sensor`]); between their
+//! behaviors and their motors sits guidance ([`mrt_plan::guide::Guidance`], see [`bus`]).
 //!
 //! ```
 //! use mrt_sim::config::SimConfig;

@@ -210,7 +210,9 @@ impl World {
             return Vec::new();
         };
         let r = self.cfg.robot.radius;
-        let filter = QueryFilter::default().exclude_rigid_body(robot.body);
+        let query = self
+            .physics
+            .query_pipeline_with_filter(QueryFilter::default().exclude_rigid_body(robot.body));
         (0..count)
             .map(|k| {
                 let centre = pose.theta + 2.0 * std::f64::consts::PI * k as f64 / count as f64;
@@ -219,8 +221,8 @@ impl World {
                     .map(|a| {
                         let (c, s) = (a.cos(), a.sin());
                         let ray = Ray::new(v(pose.x + r * c, pose.y + r * s), v(c, s));
-                        self.physics
-                            .cast_ray(&ray, range as f32, true, filter)
+                        query
+                            .cast_ray(&ray, range as f32, true)
                             .map_or(range, |(_, toi)| f64::from(toi))
                     })
                     .fold(range, f64::min)
