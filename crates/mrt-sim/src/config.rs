@@ -234,9 +234,10 @@ impl Default for GuidanceConfig {
     }
 }
 
-impl GuidanceConfig {
-    /// The Guidance µAgent for robots of `cfg`.
-    pub fn guidance(&self, cfg: &SimConfig) -> Result<mrt_plan::guide::Guidance, String> {
+impl SimConfig {
+    /// The Guidance µAgent for these robots (`[guidance]`, the robot's base, speed and size).
+    pub fn guidance(&self) -> Result<mrt_plan::guide::Guidance, String> {
+        let cfg = self;
         use mrt_plan::guidance::{PositionParams, PotentialField, PotentialParams, VelocityGuard};
         let steering = match crate::drivers::Base::parse(&cfg.robot.base)? {
             crate::drivers::Base::Differential(_) => mrt_plan::kinematics::Steering::Differential,
@@ -252,7 +253,7 @@ impl GuidanceConfig {
         };
         let obstacles =
             PotentialParams { robot_radius: cfg.robot.radius, ..PotentialParams::default() };
-        let guard = VelocityGuard::new(self.safety_distance, self.half_cone)
+        let guard = VelocityGuard::new(cfg.guidance.safety_distance, cfg.guidance.half_cone)
             .map_err(|e| format!("guidance: {e}"))?;
         let field =
             PotentialField::new(position, obstacles).map_err(|e| format!("guidance: {e}"))?;
@@ -441,7 +442,7 @@ impl SimConfig {
                 self.sonar.count
             ));
         }
-        self.guidance.guidance(self)?;
+        self.guidance()?;
         Ok(())
     }
 }

@@ -169,7 +169,7 @@ impl Pitch {
         Ok(Pitch {
             cfg: cfg.clone(),
             base: Base::parse(&cfg.robot.base)?,
-            guidance: cfg.guidance.guidance(cfg)?,
+            guidance: cfg.guidance()?,
             seed,
             world,
             referee,

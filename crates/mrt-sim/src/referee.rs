@@ -191,15 +191,22 @@ impl Referee {
         }
     }
 
+    /// Whether robot `i` stands within [`READY_TOLERANCE`] of its place in the formation.
+    fn in_place(&self, world: &World, i: usize) -> bool {
+        match (world.robot(i), self.formation.get(i)) {
+            (Some(p), Some(spot)) => (p.x - spot.x).hypot(p.y - spot.y) <= READY_TOLERANCE,
+            _ => false,
+        }
+    }
+
     /// Ends READY: robots farther than [`READY_TOLERANCE`] from their place are put there,
     /// the ball back on the centre spot, SET for `rules.set_duration`. Returns how many robots
     /// were placed.
     fn end_ready(&mut self, world: &mut World) -> usize {
         let mut placed = 0;
-        for (i, spot) in self.formation.iter().enumerate() {
-            let off = world.robot(i).map_or(f64::INFINITY, |p| (p.x - spot.x).hypot(p.y - spot.y));
-            if off > READY_TOLERANCE {
-                world.place_robot(i, *spot);
+        for i in 0..self.formation.len() {
+            if !self.in_place(world, i) {
+                world.place_robot(i, self.formation[i]);
                 placed += 1;
             }
         }
