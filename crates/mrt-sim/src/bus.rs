@@ -1,36 +1,42 @@
 //! Robots as Agoras on the bus (DCDT, MRT manual ch. 3): the simulator's default wiring.
 //!
-//! Each robot is one [`Agora`](mrt_dcdt::Agora) with six Members, all on the simulated clock
+//! Each robot is one [`Agora`](mrt_dcdt::Agora) with eight Members, all on the simulated clock
 //! of one [`SteppedExecutor`] so that the match stays deterministic:
 //!
-//! 1. **`Eyes`** (the camera driver and the world-state Member, periodic): looks through the
-//!    object sensor, takes its teammates' poses from their reports received over the bus, and
-//!    publishes the
-//!    [`WorldSnapshot`]; it also publishes a [`MateReport`] (its pose and its ball estimate)
-//!    that the teammates' Agoras receive through their team's `InnerLinkManager` — a
-//!    `RequestType::Remote` subscription, so a robot never hears itself.
-//! 2. **`Sonars`** (the sonar ring's driver, periodic): publishes a [`SonarScan`];
-//! 3. **the behaviors**: a [`BehaviorMember`] running the TeamChaos HFSM or goalkeeper for the
+//! 1. **`OdometryDriver`** (periodic): publishes the two optical mice's and the wheels'
+//!    readings since the last cycle ([`Odometry`]);
+//! 2. **`CameraDriver`** (periodic): publishes what the object sensor sees, as distance and
+//!    bearing, with the game controller's news ([`CameraFrame`]);
+//! 3. **`WorldState`** (periodic): fuses both into the robot's own pose and LPS
+//!    ([`WorldModel`]: an EKF predicted by the mice, or the wheels, and corrected by the
+//!    landmarks), takes its teammates' poses from their reports received over the bus, and
+//!    publishes the [`WorldSnapshot`]; it also publishes a [`MateReport`] (its pose and its
+//!    ball estimate) that the teammates' Agoras receive through their team's
+//!    `InnerLinkManager` — a `RequestType::Remote` subscription, so a robot never hears
+//!    itself.
+//! 4. **`Sonars`** (the sonar ring's driver, periodic): publishes a [`SonarScan`];
+//! 5. **the behaviors**: a [`BehaviorMember`] running the TeamChaos HFSM or goalkeeper for the
 //!    Chaos stack, or a [`BrainMember`] around any `Send` [`Brain`] (Milan, the baseline);
-//! 4. **`Guide`** (guidance, ISocRob §3.2.3, on message): turns the behaviors'
+//! 6. **`Guide`** (guidance, ISocRob §3.2.3, on message): turns the behaviors'
 //!    [`RobotCommand`] into a [`MotorCommand`] with [`mrt_plan::guide::Guidance`]: velocity
 //!    mode halted by the sonars, or position and potential-field modes to a target posture;
-//! 5. **`Motor`** (the motor and kicker driver, on message): turns each [`MotorCommand`] into
+//! 7. **`Motor`** (the motor and kicker driver, on message): turns each [`MotorCommand`] into
 //!    wheel set-points and kicks;
-//! 6. **`FaultBook`** (on message): books the behavior Member's script errors against the
+//! 8. **`FaultBook`** (on message): books the behavior Member's script errors against the
 //!    robot. A Member that fails to start, fails or panics is restarted by its executor and
 //!    booked too when the match ends: the match goes on, the robot stands still meanwhile, and
 //!    [`MatchReport::faults`] says which file and line.
 //!
 //! Body adaptation belongs to the drivers, as the seed's Commander Module did for its legs: on
-//! the Chaos robots `Eyes` measures distances from the robot's edge and `Guide` scales the
+//! the Chaos robots `WorldState` measures distances from the robot's edge and `Guide` scales the
 //! behaviors' AIBO-sized set-points before guiding them (see [`crate::teams`]).
 
 use crate::drivers::{Base, MotorDriver, SimulatedAirboard};
 use crate::game::{guide, Brain, MatchReport, Pitch};
 use crate::referee::Call;
-use crate::sensor::merge_team;
+use crate::sensor::{merge_team, CameraFrame, Odometry};
 use crate::teams::{embedded_teamchaos, send_brain, Body, Stack, CHAOS_KEEPER, CHAOS_PLAYER};
+use crate::worldstate::WorldModel;
 use mrt_core::robot::{RobotCommand, WorldSnapshot};
 use mrt_core::SimClock;
 use mrt_dcdt::{
@@ -50,6 +56,16 @@ pub use crate::sensor::MateReport;
 impl Message for MateReport {
     const TYPE: MsgType = MsgType(RESERVED_TYPES_START + 0x40);
     const NAME: &'static str = "MateReport";
+}
+
+impl Message for Odometry {
+    const TYPE: MsgType = MsgType(RESERVED_TYPES_START + 0x43);
+    const NAME: &'static str = "Odometry";
+}
+
+impl Message for CameraFrame {
+    const TYPE: MsgType = MsgType(RESERVED_TYPES_START + 0x44);
+    const NAME: &'static str = "CameraFrame";
 }
 
 /// One reading of the sonar ring (robot frame, m from the centre, ring order; no echo is an
@@ -85,35 +101,81 @@ fn lock(p: &Shared) -> Result<MutexGuard<'_, Pitch>, MemberError> {
     p.lock().map_err(|_| MemberError::from("the pitch lock is poisoned"))
 }
 
-/// The camera driver and world-state Member of one robot.
-struct Eyes {
+/// The odometry driver of one robot: the mice and the wheels since the last cycle.
+struct OdometryDriver {
     pitch: Shared,
     robot: usize,
+}
+
+impl Member for OdometryDriver {
+    fn name(&self) -> String {
+        format!("odometry-{}", self.robot)
+    }
+
+    fn do_your_job(&mut self, ctx: &mut Context<'_>) -> Result<(), MemberError> {
+        let odometry = lock(&self.pitch)?.odometry(self.robot);
+        ctx.publish(odometry);
+        Ok(())
+    }
+}
+
+/// The camera driver of one robot (the object sensor), with the game controller's news.
+struct CameraDriver {
+    pitch: Shared,
+    robot: usize,
+}
+
+impl Member for CameraDriver {
+    fn name(&self) -> String {
+        format!("camera-{}", self.robot)
+    }
+
+    fn do_your_job(&mut self, ctx: &mut Context<'_>) -> Result<(), MemberError> {
+        let frame = lock(&self.pitch)?.camera(self.robot);
+        ctx.publish(frame);
+        Ok(())
+    }
+}
+
+/// The world-state Member of one robot: odometry and camera frames into its [`WorldModel`],
+/// teammates from their reports over the bus; publishes the [`WorldSnapshot`] and its own
+/// [`MateReport`].
+struct WorldState {
+    robot: usize,
+    keeper: bool,
     body: Body,
+    model: WorldModel,
     mates: BTreeMap<u32, MateReport>,
 }
 
-impl Member for Eyes {
+impl Member for WorldState {
     fn name(&self) -> String {
-        format!("eyes-{}", self.robot)
+        format!("world-state-{}", self.robot)
     }
 
     fn init(&mut self, ctx: &mut Context<'_>) -> Result<(), MemberError> {
+        ctx.subscribe_to::<Odometry>(RequestType::Local);
+        ctx.subscribe_to::<CameraFrame>(RequestType::Local);
         ctx.subscribe_to::<MateReport>(RequestType::Remote);
         Ok(())
     }
 
     fn do_your_job(&mut self, ctx: &mut Context<'_>) -> Result<(), MemberError> {
+        let mut frame = None;
         while let Some(m) = ctx.receive_msg() {
-            let r = m.get::<MateReport>()?;
-            self.mates.insert(r.id, *r);
+            if let Ok(o) = m.get::<Odometry>() {
+                self.model.odometry(o);
+            } else if let Ok(f) = m.get::<CameraFrame>() {
+                frame = Some(f.clone());
+            } else {
+                let r = m.get::<MateReport>()?;
+                self.mates.insert(r.id, *r);
+            }
         }
-        let (mut w, report) = {
-            let mut pitch = lock(&self.pitch)?;
-            let w = pitch.look(self.robot);
-            let report = pitch.mate_report(self.robot, &w);
-            (w, report)
-        };
+        let Some(frame) = frame else { return Ok(()) };
+        let mut w = self.model.camera(&frame);
+        let id = u32::try_from(self.robot).unwrap_or(u32::MAX);
+        let report = MateReport::of(id, self.keeper, &w);
         // Teammates and their ball as the bus told them, not as the simulator knows them.
         merge_team(&mut w, self.mates.values());
         ctx.publish(report);
@@ -319,8 +381,16 @@ impl BusMatch {
                     .map_err(|e| e.to_string())?;
                 let every = Activation::Periodic(period);
                 let body = if stack == Stack::Chaos { chaos_body } else { Body::PLAIN };
-                let eyes = Eyes { pitch: pitch.clone(), robot, body, mates: BTreeMap::new() };
-                let mut ids = vec![agora.add_member(eyes, every)];
+                let model = lock_pitch(&pitch)?.world_model();
+                let odometry = OdometryDriver { pitch: pitch.clone(), robot };
+                let camera = CameraDriver { pitch: pitch.clone(), robot };
+                let state =
+                    WorldState { robot, keeper: k == 0, body, model, mates: BTreeMap::new() };
+                let mut ids = vec![
+                    agora.add_member(odometry, every),
+                    agora.add_member(camera, every),
+                    agora.add_member(state, every),
+                ];
                 ids.push(agora.add_member(Sonars { pitch: pitch.clone(), robot }, every));
                 ids.push(match stack {
                     Stack::Chaos if k == 0 => {

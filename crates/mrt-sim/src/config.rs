@@ -216,6 +216,48 @@ impl Default for SonarConfig {
     }
 }
 
+/// The odometry sensors: two optical mice underneath (MRT manual ch. 4) and the wheel
+/// encoders. These numbers describe the *simulated* sensors; the world-state Member's filter
+/// assumes its own (see [`crate::worldstate`]).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct OdometryConfig {
+    /// Distance between the two mice (`D` of the manual's §4.1), m.
+    pub mice_distance: f64,
+    /// Standard deviation of each mouse reading, as a fraction of the distance it moved.
+    pub mice_noise: f64,
+    /// Probability that a mouse under-reads in one cycle (it lifts, or the floor is too
+    /// uniform): its reading is then 50–100 % of the true one, in the true direction (§4.2).
+    pub mice_miss_probability: f64,
+    /// Largest difference of the two mice's `x̄` accepted as consistent, m per cycle (the
+    /// manual's error detection); larger differences are reduced (§4.2) or, failing that,
+    /// the cycle uses the wheels.
+    pub mice_tolerance: f64,
+    /// Standard deviation of the wheel odometry, as a fraction of the motion. The wheels also
+    /// count motion that did not happen when the robot is blocked (they slip).
+    pub wheel_noise: f64,
+}
+
+impl Default for OdometryConfig {
+    fn default() -> Self {
+        Self {
+            mice_distance: 0.2,
+            mice_noise: 0.005,
+            mice_miss_probability: 0.02,
+            mice_tolerance: 0.003,
+            wheel_noise: 0.05,
+        }
+    }
+}
+
+impl OdometryConfig {
+    /// The two-mice sensor these settings describe.
+    pub fn mice(&self) -> Result<mrt_plan::mice::MiceOdometry, String> {
+        mrt_plan::mice::MiceOdometry::new(self.mice_distance, self.mice_tolerance)
+            .map_err(|e| format!("odometry: {e}"))
+    }
+}
+
 /// Guidance (ISocRob §3.2.3) between the behaviors and the motors.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
@@ -279,6 +321,8 @@ pub struct SimConfig {
     pub sonar: SonarConfig,
     /// Guidance.
     pub guidance: GuidanceConfig,
+    /// The odometry sensors.
+    pub odometry: OdometryConfig,
 }
 
 /// A configuration that cannot be used.
@@ -411,6 +455,8 @@ impl SimConfig {
             ("rules.ready_duration", self.rules.ready_duration),
             ("sonar.noise", self.sonar.noise),
             ("sonar.half_beam", self.sonar.half_beam),
+            ("odometry.mice_noise", self.odometry.mice_noise),
+            ("odometry.wheel_noise", self.odometry.wheel_noise),
         ];
         for (name, v) in non_negative {
             if !(v.is_finite() && v >= 0.0) {
@@ -420,6 +466,7 @@ impl SimConfig {
         let unit = [
             ("ball.restitution", self.ball.restitution),
             ("sensor.miss_probability", self.sensor.miss_probability),
+            ("odometry.mice_miss_probability", self.odometry.mice_miss_probability),
         ];
         for (name, v) in unit {
             if !(0.0..=1.0).contains(&v) {
@@ -443,6 +490,7 @@ impl SimConfig {
             ));
         }
         self.guidance()?;
+        self.odometry.mice()?;
         Ok(())
     }
 }

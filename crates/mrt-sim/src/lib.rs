@@ -3,7 +3,9 @@
 //! A simulated Middle Size League soccer match in which every robot runs the real MRT stack.
 //! The physics is `rapier2d` seen from above ([`world`]); the rules are a referee
 //! ([`referee`]: READY, SET, PLAYING, ...); robots see through an object sensor that reports
-//! what a camera would detect and hear through a sonar ring ([`sensor`]); between their
+//! what a camera would detect, feel their motion through optical mice and wheel encoders and
+//! hear through a sonar ring ([`sensor`]); each robot's world state fuses odometry and sightings
+//! into its own pose estimate ([`worldstate`]); between their
 //! behaviors and their motors sits guidance ([`mrt_plan::guide::Guidance`], see [`bus`]).
 //!
 //! ```
@@ -29,6 +31,7 @@ pub mod referee;
 pub mod sensor;
 pub mod teams;
 pub mod world;
+pub mod worldstate;
 
 use std::path::Path;
 

@@ -3,25 +3,22 @@
 //! the documented stand-in for camera images and colour vision (a later issue), and stays as
 //! the fast mode.
 //!
-//! [`Perception`] turns detections into the robot's [`WorldSnapshot`], in the robot's team
-//! frame (millimetres; x towards the opponent's net, whichever half the team plays in): an
-//! object not seen this frame keeps its last estimate, moved with the robot's own motion, with
-//! its reliability decaying, like the seed's LPS anchors.
+//! The odometry sensors ([`Odometer`]) are two optical mice (MRT manual ch. 4) and the wheel
+//! encoders. Both drivers report raw readings ([`CameraFrame`], [`Odometry`]); the robot's
+//! world-state Member turns them into its world snapshot ([`crate::worldstate`]).
 //!
 //! The team side of the world state is [`merge_team`]: teammates as their [`MateReport`]s
 //! tell them, and the global ball from the best sighting, one's own or a teammate's.
 
-use crate::config::{SensorConfig, SonarConfig};
-use crate::referee::{Referee, Team};
+use crate::config::{OdometryConfig, SensorConfig, SonarConfig};
+use crate::referee::Referee;
 use crate::world::World;
-use mrt_core::robot::{lps, Estimate, Lpo, Mate, WorldSnapshot};
-use mrt_core::{normalize_angle, Pose2, Time, Vec2};
+use mrt_core::robot::{lps, Estimate, GameState, Mate, WorldSnapshot};
+use mrt_core::{normalize_angle, Pose2};
 use mrt_plan::guidance::Sonar;
+use mrt_plan::kinematics::{integrate, Twist};
+use mrt_plan::mice::{Displacement, MiceOdometry, MiceReadings};
 use rand::{Rng, RngCore};
-use std::f64::consts::PI;
-
-/// Reliability kept per control cycle by an object that was not seen again.
-pub const DECAY: f64 = 0.85;
 
 /// A teammate's ball counts this much of its own quality: a second-hand sighting, one cycle
 /// old, is trusted a little less than one's own.
@@ -62,7 +59,6 @@ pub fn merge_team<'a>(w: &mut WorldSnapshot, reports: impl IntoIterator<Item = &
     }
 }
 
-/// Standard normal sample (Box–Muller), from any RNG.
 /// What robot `i`'s sonar ring hears (robot frame, m from the centre, ring order; no echo is
 /// an infinite range): [`World::sonar`]'s edge distances plus the radius, with noise.
 pub fn sonar_ring(world: &World, i: usize, cfg: &SonarConfig, rng: &mut dyn RngCore) -> Vec<Sonar> {
@@ -82,49 +78,30 @@ pub fn sonar_ring(world: &World, i: usize, cfg: &SonarConfig, rng: &mut dyn RngC
         .collect()
 }
 
+/// Standard normal sample (Box–Muller), from any RNG.
 fn gauss(rng: &mut dyn RngCore) -> f64 {
     let u1: f64 = rng.random_range(f64::EPSILON..1.0);
     let u2: f64 = rng.random_range(0.0..1.0);
     (-2.0 * u1.ln()).sqrt() * (2.0 * std::f64::consts::PI * u2).cos()
 }
 
-/// What a robot remembers of one LPS object: where it was last seen (field frame, m), its
-/// reliability, and when it was seen (s).
-#[derive(Clone, Copy, Debug)]
-struct Memory {
-    at: (f64, f64),
-    reliability: f64,
-    seen: f64,
-}
-
-/// One robot's view: its LPS memory, in the field frame, between cycles.
-#[derive(Clone, Debug)]
-pub struct Perception {
-    robot: usize,
-    /// Last estimate of each LPS object.
-    memory: Vec<Option<Memory>>,
-}
-
-/// Field positions (m) of the LPS objects for `team`: ball, opponent's net, own net, and six
-/// landmarks (the four corners and the two ends of the half-way line).
-fn targets(world: &World, referee: &Referee, team: Team) -> [(f64, f64); lps::COUNT] {
+/// Field positions (m) of the objects the camera knows, in [`FIELD_OBJECTS`] order: ball,
+/// east net, west net, and six landmarks (the four corners, NE, SE, NW, SW, and the north and
+/// south ends of the half-way line). The camera tells them apart by colour, not by team: the
+/// world-state Member maps them onto the team's LPS slots.
+fn targets(world: &World) -> [(f64, f64); FIELD_OBJECTS] {
     let f = &world.config().field;
     let (hl, hw) = (f.length / 2.0, f.width / 2.0);
-    let dir = referee.attack_direction(team);
-    let ball = world.ball();
-    // Landmarks are named in the team frame, so LANDMARK0 is always the opponent's left corner
-    // whichever half the team plays in.
-    let l = |x: f64, y: f64| (dir * x, dir * y);
     [
-        ball,
-        l(hl, 0.0),
-        l(-hl, 0.0),
-        l(hl, hw),
-        l(hl, -hw),
-        l(-hl, hw),
-        l(-hl, -hw),
-        l(0.0, hw),
-        l(0.0, -hw),
+        world.ball(),
+        (hl, 0.0),
+        (-hl, 0.0),
+        (hl, hw),
+        (hl, -hw),
+        (-hl, hw),
+        (-hl, -hw),
+        (0.0, hw),
+        (0.0, -hw),
     ]
 }
 
@@ -141,90 +118,163 @@ fn blocks(a: (f64, f64), b: (f64, f64), c: (f64, f64), radius: f64) -> bool {
     t > 0.0 && t < 1.0 && (px - c.0).hypot(py - c.1) < radius
 }
 
-impl Perception {
-    /// A robot that has seen nothing yet.
-    pub fn new(robot: usize) -> Perception {
-        Perception { robot, memory: vec![None; lps::COUNT] }
+/// How many objects the camera knows: the ball, two nets, six landmarks (as many as LPS slots).
+pub const FIELD_OBJECTS: usize = lps::COUNT;
+
+/// One object detected in one frame: distance (m) and bearing (rad, counter-clockwise from
+/// the robot's heading), with the sensor's noise.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct Sighting {
+    /// Distance, m.
+    pub distance: f64,
+    /// Bearing, rad.
+    pub bearing: f64,
+}
+
+/// What the game controller tells every robot each cycle (field frame, m).
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct GameInfo {
+    /// The referee's state.
+    pub state: GameState,
+    /// The direction the robot's team attacks: +1 east, −1 west.
+    pub attack: f64,
+    /// The robot's place in the kickoff formation, in READY.
+    pub kickoff_pose: Option<Pose2>,
+}
+
+/// One frame of the object sensor, published by the camera driver.
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct CameraFrame {
+    /// Simulated time of the frame, s.
+    pub time: f64,
+    /// What was seen, in [`FIELD_OBJECTS`] order (`None`: not seen this frame).
+    pub sightings: [Option<Sighting>; FIELD_OBJECTS],
+    /// The ball's velocity in the robot's frame (m/s), when the ball is seen: the stand-in
+    /// for a ball tracker.
+    pub ball_velocity: Option<(f64, f64)>,
+    /// The game controller's news.
+    pub game: GameInfo,
+}
+
+/// What the camera of robot `robot` sees now (the object sensor): every object within its
+/// range and field of view, not hidden behind another robot (the ball) and not missed, as
+/// distance and bearing with range-dependent noise.
+pub fn look(
+    world: &World,
+    referee: &Referee,
+    robot: usize,
+    cfg: &SensorConfig,
+    rng: &mut dyn RngCore,
+) -> CameraFrame {
+    let me = world.robot(robot).unwrap_or_default();
+    let team = referee.team_of(robot);
+    let r_robot = world.config().robot.radius;
+    let robots: Vec<(f64, f64)> = (0..world.robot_count())
+        .filter(|&i| i != robot)
+        .filter_map(|i| world.robot(i).map(|p| (p.x, p.y)))
+        .collect();
+    let mut frame = CameraFrame {
+        time: world.time(),
+        game: GameInfo {
+            state: referee.state(),
+            attack: referee.attack_direction(team),
+            kickoff_pose: referee.kickoff_pose(robot),
+        },
+        ..Default::default()
+    };
+    for (k, target) in targets(world).into_iter().enumerate() {
+        let (dx, dy) = (target.0 - me.x, target.1 - me.y);
+        let dist = dx.hypot(dy);
+        let bearing = normalize_angle(dy.atan2(dx) - me.theta);
+        let occluded =
+            k == lps::BALL && robots.iter().any(|&c| blocks((me.x, me.y), target, c, r_robot));
+        let range = if k == lps::BALL { cfg.range } else { cfg.landmark_range };
+        let visible = dist <= range && bearing.abs() <= cfg.half_fov && !occluded;
+        let missed = rng.random_bool(cfg.miss_probability.clamp(0.0, 1.0));
+        if visible && !missed {
+            let distance = (dist * (1.0 + cfg.distance_noise * gauss(rng))).max(0.0);
+            let bearing = normalize_angle(bearing + cfg.bearing_noise * gauss(rng));
+            frame.sightings[k] = Some(Sighting { distance, bearing });
+        }
+    }
+    if frame.sightings[lps::BALL].is_some() {
+        let (vx, vy) = world.ball_velocity();
+        let (s, c) = me.theta.sin_cos();
+        frame.ball_velocity = Some((c * vx + s * vy, -s * vx + c * vy));
+    }
+    frame
+}
+
+/// What the odometry sensors read over one control cycle, published by the odometry driver.
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct Odometry {
+    /// The two optical mice, each in its own frame (MRT manual ch. 4), m.
+    pub mice: MiceReadings,
+    /// The wheel encoders' motion, in the robot frame at the start of the cycle.
+    pub wheels: Displacement,
+    /// The robot was put down by hand at this pose (field frame, m) since the last reading:
+    /// the motion above counts from there. The operator tells the robot, as a team does when
+    /// it places its robots before a match.
+    pub placed: Option<Pose2>,
+}
+
+/// The odometry driver of one simulated robot: mice and wheels since its last reading.
+#[derive(Clone, Debug)]
+pub struct Odometer {
+    robot: usize,
+    mice: MiceOdometry,
+    last: Option<Pose2>,
+    placements: u32,
+}
+
+impl Odometer {
+    /// The driver of robot `robot`'s mice (`mice`: their geometry) and wheels.
+    pub fn new(robot: usize, mice: MiceOdometry) -> Odometer {
+        Odometer { robot, mice, last: None, placements: 0 }
     }
 
-    /// Looks once and returns the world snapshot for this cycle.
-    pub fn look(
+    /// Reads the sensors: the mice see the body's true motion since the last reading (as the
+    /// manual's forward model gives it, §4.1), with noise and occasional under-reading (§4.2);
+    /// the wheels count the velocity set-point over `period` (they slip when the body is
+    /// blocked), with noise.
+    pub fn read(
         &mut self,
         world: &World,
-        referee: &Referee,
-        cfg: &SensorConfig,
+        cfg: &OdometryConfig,
+        period: f64,
         rng: &mut dyn RngCore,
-    ) -> WorldSnapshot {
-        let me = world.robot(self.robot).unwrap_or_default();
-        let team = referee.team_of(self.robot);
-        let now = world.time();
-        let r_robot = world.config().robot.radius;
-        let robots: Vec<(f64, f64)> = (0..world.robot_count())
-            .filter(|&i| i != self.robot)
-            .filter_map(|i| world.robot(i).map(|p| (p.x, p.y)))
-            .collect();
-        for (k, target) in targets(world, referee, team).into_iter().enumerate() {
-            let (dx, dy) = (target.0 - me.x, target.1 - me.y);
-            let dist = dx.hypot(dy);
-            let bearing = normalize_angle(dy.atan2(dx) - me.theta);
-            let occluded =
-                k == lps::BALL && robots.iter().any(|&c| blocks((me.x, me.y), target, c, r_robot));
-            let range = if k == lps::BALL { cfg.range } else { cfg.landmark_range };
-            let visible = dist <= range && bearing.abs() <= cfg.half_fov && !occluded;
-            let missed = rng.random_bool(cfg.miss_probability.clamp(0.0, 1.0));
-            if visible && !missed {
-                let d = (dist * (1.0 + cfg.distance_noise * gauss(rng))).max(0.0);
-                let b = bearing + cfg.bearing_noise * gauss(rng);
-                let a = me.theta + b;
-                let seen = (me.x + d * a.cos(), me.y + d * a.sin());
-                self.memory[k] = Some(Memory { at: seen, reliability: 1.0, seen: now });
-            } else if let Some(m) = &mut self.memory[k] {
-                m.reliability *= DECAY;
-            }
-        }
-        self.snapshot(world, referee, me, team)
-    }
-
-    fn snapshot(&self, world: &World, referee: &Referee, me: Pose2, team: Team) -> WorldSnapshot {
-        let now = world.time();
-        let dir = referee.attack_direction(team);
-        // Team frame: x towards the opponent's net. Field → team is a half turn when the team
-        // attacks west.
-        let to_team = |x: f64, y: f64| (dir * x * 1000.0, dir * y * 1000.0);
-        let heading = if dir > 0.0 { me.theta } else { normalize_angle(me.theta + PI) };
-        let mut w = WorldSnapshot {
-            time: Time::from_secs_f64(now),
-            game_state: referee.state(),
-            field: world.config().field.map(),
-            ..Default::default()
+    ) -> Odometry {
+        let now = world.robot(self.robot).unwrap_or_default();
+        let (count, at) = world.placement(self.robot);
+        let mut placed = None;
+        let from = if count != self.placements {
+            self.placements = count;
+            placed = Some(at);
+            at
+        } else {
+            self.last.unwrap_or(now)
         };
-        for (k, m) in self.memory.iter().enumerate() {
-            let Some(Memory { at: (x, y), reliability: rel, seen }) = *m else { continue };
-            let (dx, dy) = (x - me.x, y - me.y);
-            w.lps[k] = Lpo {
-                rho: dx.hypot(dy) * 1000.0,
-                theta: normalize_angle(dy.atan2(dx) - me.theta),
-                reliability: rel,
-                seen_ago: now - seen,
-            };
-        }
-        let (mx, my) = to_team(me.x, me.y);
-        w.my_pos = Estimate { pose: Pose2::new(mx, my, heading), quality: 0.9 };
-        w.kickoff_pose = referee.kickoff_pose(self.robot).map(|p| {
-            let (x, y) = to_team(p.x, p.y);
-            let theta = if dir > 0.0 { p.theta } else { normalize_angle(p.theta + PI) };
-            Pose2::new(x, y, theta)
-        });
-        if let Some(Memory { at: (bx, by), reliability: rel, .. }) = self.memory[lps::BALL] {
-            let (x, y) = to_team(bx, by);
-            w.global_ball = Estimate { pose: Pose2::new(x, y, 0.0), quality: rel };
-        }
-        // The ball's velocity only when it is seen this frame (a tracker would estimate it).
-        if self.memory[lps::BALL].is_some_and(|m| m.seen == now) {
-            let (vx, vy) = world.ball_velocity();
-            w.ball_vel = Vec2::new(dir * vx * 1000.0, dir * vy * 1000.0);
-        }
-        w
+        self.last = Some(now);
+        let d = now.relative_to(&from);
+        let mut mice = self.mice.readings_for(d.x, d.y, normalize_angle(d.theta));
+        let mut mouse = |x: &mut f64, y: &mut f64| {
+            let length = x.hypot(*y);
+            if rng.random_bool(cfg.mice_miss_probability.clamp(0.0, 1.0)) {
+                let read = rng.random_range(0.5..1.0);
+                *x *= read;
+                *y *= read;
+            }
+            *x += cfg.mice_noise * length * gauss(rng);
+            *y += cfg.mice_noise * length * gauss(rng);
+        };
+        mouse(&mut mice.x_left, &mut mice.y_left);
+        mouse(&mut mice.x_right, &mut mice.y_right);
+        let drive = world.drive_setpoint(self.robot);
+        let twist = Twist::new(drive.forward, drive.left, drive.turn);
+        let moved = integrate(Pose2::default(), &twist, period);
+        let mut noisy = |v: f64| v * (1.0 + cfg.wheel_noise * gauss(rng));
+        let wheels = Displacement::new(noisy(moved.x), noisy(moved.y), noisy(moved.theta));
+        Odometry { mice, wheels, placed }
     }
 }
 
@@ -251,51 +301,54 @@ mod tests {
         (w, r)
     }
 
+    /// Field objects in sensor order.
+    const EAST_NET: usize = 1;
+    const WEST_NET: usize = 2;
+    const NW_CORNER: usize = 5;
+
     #[test]
-    fn distance_and_bearing_in_the_team_frame() {
+    fn distance_and_bearing_of_what_the_camera_sees() {
         let (mut w, r) = setup();
         let mut rng = ChaCha8Rng::seed_from_u64(1);
-        // Home attacks east. Robot 1 at (-2, 0) facing north; ball at (0, 2): 2.828 m away,
-        // 45° to the right of the heading (bearing -π/4).
+        // Robot 1 at (-2, 0) facing north; ball at (0, 2): 2.828 m away, 45° to the right of
+        // the heading (bearing -π/4).
         w.place_robot(1, Pose2::new(-2.0, 0.0, std::f64::consts::FRAC_PI_2));
         w.place_ball(0.0, 2.0);
-        let s = Perception::new(1).look(&w, &r, &exact(), &mut rng);
-        let ball = s.lps[lps::BALL];
-        assert!((ball.rho - 2828.427).abs() < 0.01, "{ball:?}");
-        assert!((ball.theta + std::f64::consts::FRAC_PI_4).abs() < 1e-6, "{ball:?}"); // f32 physics
-        assert_eq!(ball.reliability, 1.0);
-        // The own net (west, (-9, 0)) is 7 m away on the left (bearing +π/2); the opponent's
-        // net is 11 m away: beyond the ball's 9 m range, within the landmarks' 20 m.
-        let net = s.lps[lps::NET2];
-        assert!((net.rho - 7000.0).abs() < 0.01, "{net:?}");
-        assert!((net.theta - std::f64::consts::FRAC_PI_2).abs() < 1e-6, "{net:?}");
-        assert_eq!(s.lps[lps::NET1].reliability, 1.0);
-        assert!((s.lps[lps::NET1].rho - 11000.0).abs() < 0.01, "{:?}", s.lps[lps::NET1]);
+        let f = look(&w, &r, 1, &exact(), &mut rng);
+        let ball = f.sightings[lps::BALL].unwrap();
+        assert!((ball.distance - 2.828427).abs() < 1e-5, "{ball:?}");
+        assert!((ball.bearing + std::f64::consts::FRAC_PI_4).abs() < 1e-6, "{ball:?}"); // f32
+                                                                                        // The west net (-9, 0) is 7 m away on the left (bearing +π/2); the east net is 11 m
+                                                                                        // away: beyond the ball's 9 m range, within the landmarks' 20 m.
+        let net = f.sightings[WEST_NET].unwrap();
+        assert!(
+            (net.distance - 7.0).abs() < 1e-5
+                && (net.bearing - std::f64::consts::FRAC_PI_2).abs() < 1e-6
+        );
+        assert!((f.sightings[EAST_NET].unwrap().distance - 11.0).abs() < 1e-5);
         let short = SensorConfig { landmark_range: 9.0, ..exact() };
-        let s2 = Perception::new(1).look(&w, &r, &short, &mut rng);
-        assert_eq!(s2.lps[lps::NET1].reliability, 0.0, "11 m: beyond a 9 m landmark range");
-        assert_eq!((s.my_pos.pose.x, s.my_pos.pose.y), (-2000.0, 0.0));
-        // An away robot sees the same field turned half round: x towards the west goal.
-        w.place_robot(5, Pose2::new(2.0, 1.0, std::f64::consts::PI));
-        let s = Perception::new(5).look(&w, &r, &exact(), &mut rng);
-        assert!((s.my_pos.pose.x + 2000.0).abs() < 1e-9 && (s.my_pos.pose.y + 1000.0).abs() < 1e-9);
-        assert!(s.my_pos.pose.theta.abs() < 1e-6, "facing its attack direction");
-        assert_eq!(s.field.half_length, 9000.0);
+        let f2 = look(&w, &r, 1, &short, &mut rng);
+        assert_eq!(f2.sightings[EAST_NET], None, "11 m: beyond a 9 m landmark range");
+        // The game controller's news: home attacks east in the first half, away west.
+        assert_eq!((f.game.attack, f.game.state), (1.0, GameState::Ready));
+        assert_eq!(look(&w, &r, 5, &exact(), &mut rng).game.attack, -1.0);
+        assert_eq!(f.game.kickoff_pose, r.kickoff_pose(1));
+        assert_eq!(f.time, w.time());
+        // A still ball: zero velocity, reported because the ball is seen.
+        assert_eq!(f.ball_velocity, Some((0.0, 0.0)));
     }
 
     #[test]
-    fn a_robot_in_between_hides_the_ball_and_the_memory_fades() {
+    fn a_robot_in_between_hides_the_ball() {
         let (mut w, r) = setup();
         let mut rng = ChaCha8Rng::seed_from_u64(2);
         w.place_robot(1, Pose2::new(-3.0, 0.0, 0.0));
         w.place_ball(0.0, 0.0);
-        let mut p = Perception::new(1);
-        let first = p.look(&w, &r, &exact(), &mut rng);
-        assert_eq!(first.lps[lps::BALL].reliability, 1.0);
+        assert!(look(&w, &r, 1, &exact(), &mut rng).sightings[lps::BALL].is_some());
         w.place_robot(6, Pose2::new(-1.5, 0.05, 0.0)); // in the line of sight
-        let hidden = p.look(&w, &r, &exact(), &mut rng);
-        assert!((hidden.lps[lps::BALL].reliability - DECAY).abs() < 1e-12);
-        assert!((hidden.lps[lps::BALL].rho - 3000.0).abs() < 1e-6, "last estimate kept");
+        let hidden = look(&w, &r, 1, &exact(), &mut rng);
+        assert_eq!((hidden.sightings[lps::BALL], hidden.ball_velocity), (None, None));
+        assert!(hidden.sightings[WEST_NET].is_some(), "landmarks stand above the robots");
     }
 
     #[test]
@@ -305,15 +358,90 @@ mod tests {
         let cfg = SensorConfig { half_fov: 0.5, range: 5.0, landmark_range: 5.0, ..exact() };
         w.place_robot(1, Pose2::new(-5.0, 0.0, std::f64::consts::PI)); // facing west
         w.place_ball(-1.0, 0.0);
-        let s = Perception::new(1).look(&w, &r, &cfg, &mut rng);
-        assert_eq!(s.lps[lps::BALL].reliability, 0.0, "4 m behind the robot");
-        assert_eq!(s.lps[lps::NET2].reliability, 1.0, "own net 4 m ahead");
-        assert_eq!(s.lps[lps::NET1].reliability, 0.0, "opponent's net 14 m behind");
-        assert_eq!(
-            s.lps[lps::LANDMARK0 + 2].reliability,
-            0.0,
-            "corner (-9, 6): 7.2 m, out of range"
-        );
+        let f = look(&w, &r, 1, &cfg, &mut rng);
+        assert_eq!(f.sightings[lps::BALL], None, "4 m behind the robot");
+        assert!(f.sightings[WEST_NET].is_some(), "west net 4 m ahead");
+        assert_eq!(f.sightings[EAST_NET], None, "east net 14 m behind");
+        assert_eq!(f.sightings[NW_CORNER], None, "corner (-9, 6): 7.2 m, out of range");
+    }
+
+    #[test]
+    fn the_mice_read_the_body_motion_and_the_wheels_the_set_point() {
+        let (mut w, _) = setup();
+        let mut rng = ChaCha8Rng::seed_from_u64(4);
+        let exact = OdometryConfig {
+            mice_noise: 0.0,
+            mice_miss_probability: 0.0,
+            wheel_noise: 0.0,
+            ..Default::default()
+        };
+        let mice = exact.mice().unwrap();
+        let mut odo = Odometer::new(2, mice);
+        // The first reading tells where the robot was put down (start of the match).
+        let first = odo.read(&w, &exact, 0.1, &mut rng);
+        let placed = w.placement(2).1;
+        assert_eq!(first.placed, Some(placed));
+        let d = mice.displacement(&first.mice).unwrap();
+        assert!(d.dx.hypot(d.dy) < 1e-6 && d.dtheta.abs() < 1e-6, "f32 physics: {d:?}");
+        // Drive forward, sideways and turning for 0.3 s: the mice invert to the body's true
+        // motion (manual §4.1; they read it whole, as one arc), the wheels to the set-point.
+        let start = Pose2::new(0.0, 0.0, 0.3);
+        w.place_robot(2, start);
+        odo.read(&w, &exact, 0.1, &mut rng);
+        let drive = crate::world::Drive { forward: 0.8, left: 0.3, turn: 1.0 };
+        w.drive(2, drive);
+        for _ in 0..30 {
+            w.step();
+        }
+        let o = odo.read(&w, &exact, 0.1, &mut rng);
+        assert_eq!(o.placed, None);
+        let truth = w.robot(2).unwrap().relative_to(&start);
+        let d = mice.displacement(&o.mice).unwrap();
+        assert!((d.dx - truth.x).abs() < 1e-6 && (d.dy - truth.y).abs() < 1e-6, "{d:?} {truth:?}");
+        assert!((d.dtheta - truth.theta).abs() < 1e-6, "{d:?} {truth:?}");
+        assert!(d.dx > 0.05 && d.dtheta > 0.1, "it moved (accelerating from rest): {d:?}");
+        // Wheels: 0.1 s of the set-point along an arc: 1 rad/s for 0.1 s is 0.1 rad.
+        assert!((o.wheels.dtheta - 0.1).abs() < 1e-12, "{:?}", o.wheels);
+        assert!((o.wheels.dx - 0.08).abs() < 0.005 && (o.wheels.dy - 0.03).abs() < 0.005);
+        // A robot put down again: the reading counts from where it was put.
+        let there = Pose2::new(3.0, -1.0, -2.0);
+        w.place_robot(2, there);
+        let again = odo.read(&w, &exact, 0.1, &mut rng);
+        assert_eq!(again.placed, Some(there));
+        assert!(mice.displacement(&again.mice).unwrap().dx.abs() < 1e-6);
+    }
+
+    #[test]
+    fn a_mouse_sometimes_under_reads_and_noise_is_proportional() {
+        let (mut w, _) = setup();
+        let cfg = OdometryConfig { mice_miss_probability: 0.5, ..Default::default() };
+        let mice = cfg.mice().unwrap();
+        let mut rng = ChaCha8Rng::seed_from_u64(5);
+        let mut odo = Odometer::new(1, mice);
+        w.place_robot(1, Pose2::new(0.0, 0.0, 0.0));
+        odo.read(&w, &cfg, 0.1, &mut rng);
+        let (mut short, mut total) = (0, 0);
+        for _ in 0..200 {
+            w.drive(1, crate::world::Drive { forward: 0.5, left: 0.5, turn: 0.0 });
+            for _ in 0..10 {
+                w.step();
+            }
+            let o = odo.read(&w, &cfg, 0.1, &mut rng);
+            // One mouse under-read when their lengths differ by more than the noise (0.5 %).
+            let (l, r) = (o.mice.x_left.hypot(o.mice.y_left), o.mice.x_right.hypot(o.mice.y_right));
+            total += 1;
+            if (l - r).abs() > 0.04 * l.max(r) {
+                short += 1;
+            }
+            if w.robot(1).unwrap().x.abs() > 4.0 || w.robot(1).unwrap().y.abs() > 4.0 {
+                w.place_robot(1, Pose2::new(0.0, 0.0, 0.0));
+                odo.read(&w, &cfg, 0.1, &mut rng);
+            }
+        }
+        // P(at least one of two mice misses) = 1 − 0.5² = 0.75; a miss shorter than 4 % is
+        // not counted (P = 0.08 of a miss): ≈ 0.75 − 0.06 = 0.69.
+        let rate = f64::from(short) / f64::from(total);
+        assert!((0.55..0.8).contains(&rate), "{rate}");
     }
 
     #[test]
@@ -360,11 +488,13 @@ mod tests {
         let sample = |seed| {
             let mut rng = ChaCha8Rng::seed_from_u64(seed);
             (0..400)
-                .map(|_| Perception::new(1).look(&w, &r, &cfg, &mut rng).lps[lps::BALL].rho)
+                .filter_map(|_| look(&w, &r, 1, &cfg, &mut rng).sightings[lps::BALL])
+                .map(|s| s.distance * 1000.0)
                 .collect::<Vec<_>>()
         };
         assert_eq!(sample(7), sample(7), "same seed, same noise");
         let v = sample(8);
+        assert_eq!(v.len(), 400, "no misses configured");
         let mean = v.iter().sum::<f64>() / v.len() as f64;
         let sd = (v.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / v.len() as f64).sqrt();
         // 3 % of 6 m = 180 mm.

@@ -25,6 +25,8 @@ struct Robot {
     drive: Drive,
     /// Simulated time when the kicker is charged again.
     kick_ready_at: f64,
+    /// How often the robot was put down by hand, and where last.
+    placed: (u32, Pose2),
 }
 
 /// The physical world.
@@ -102,7 +104,12 @@ impl World {
                         .restitution(0.2)
                         .friction(0.5),
                 );
-                Robot { body, drive: Drive::default(), kick_ready_at: 0.0 }
+                Robot {
+                    body,
+                    drive: Drive::default(),
+                    kick_ready_at: 0.0,
+                    placed: (0, Pose2::default()),
+                }
             })
             .collect();
         World { cfg: cfg.clone(), physics, ball, robots, time: 0.0 }
@@ -154,10 +161,23 @@ impl World {
     pub fn place_robot(&mut self, i: usize, pose: Pose2) {
         let Some(r) = self.robots.get_mut(i) else { return };
         r.drive = Drive::default();
+        r.placed = (r.placed.0.wrapping_add(1), pose);
         let body = &mut self.physics.bodies[r.body];
         body.set_position(Pose::new(v(pose.x, pose.y), pose.theta as f32), true);
         body.set_linvel(Vector::ZERO, true);
         body.set_angvel(0.0, true);
+    }
+
+    /// How many times robot `i` was put down with [`World::place_robot`], and where last
+    /// (`(0, origin)` for a robot never placed or an unknown index).
+    pub fn placement(&self, i: usize) -> (u32, Pose2) {
+        self.robots.get(i).map_or((0, Pose2::default()), |r| r.placed)
+    }
+
+    /// Robot `i`'s velocity set-point (what its wheels turn at; the body may lag behind or be
+    /// blocked).
+    pub fn drive_setpoint(&self, i: usize) -> Drive {
+        self.robots.get(i).map_or(Drive::default(), |r| r.drive)
     }
 
     /// Sets a robot's velocity set-point (limited to the robot's top speeds).

@@ -1,0 +1,558 @@
+//! The world-state Member's model: a robot's own estimate of where it is and of what it saw,
+//! from its odometry and its object sensor only (never from the simulator's truth).
+//!
+//! - **Pose**: an extended Kalman filter on `(x, y, θ)` in the field frame (m, rad). Each
+//!   cycle it *predicts* with the odometry: the two optical mice by the manual's ch. 4
+//!   equations ([`MiceOdometry::displacement`]), reduced by §4.2 when their `x̄` disagree, and
+//!   the wheels when the mice cannot be trusted (the readings stay inconsistent after the
+//!   reduction). It then *corrects* with every net and landmark the camera saw (distance and
+//!   bearing to a known position on the field map). A sighting that disagrees with the
+//!   estimate by more than [`GATE`] (Mahalanobis distance squared, 2 degrees of freedom) is
+//!   rejected as an outlier; when most sightings of a frame are rejected the filter admits it
+//!   is lost, widens its uncertainty and takes the same sightings again. (With the default
+//!   sensors this happens a few times a match per robot, mostly after a mouse under-read
+//!   while the robot drove straight: its `x̄` is then 0 on both mice, so the manual's check
+//!   cannot see the error, and the heading jumps.)
+//! - **LPS** (seed `001` §3, the perceptual anchors): each object keeps the field position
+//!   where it was last seen, computed from the pose estimate; an object not seen in a frame
+//!   keeps it, so its robot-relative position moves with the robot's own estimated motion,
+//!   and its reliability decays by [`DECAY`] per cycle.
+//! - **Snapshot**: everything in the team frame of [`WorldSnapshot`] (mm, x towards the
+//!   opponent's net, whichever half the team plays in, as the game controller says).
+//!
+//! The pose's quality is `exp(−σ_xy / 0.5 m − σ_θ / 0.5 rad)` from the filter's covariance
+//! (`σ_xy` the root mean square of the x and y standard deviations): above 0.9 when the
+//! robot sees the landmarks, falling as it goes without them.
+
+use crate::sensor::{CameraFrame, Odometry, Sighting, FIELD_OBJECTS};
+use mrt_core::robot::{lps, Estimate, Field, Lpo, WorldSnapshot};
+use mrt_core::{normalize_angle, Pose2, Time, Vec2};
+use mrt_plan::mice::{Displacement, MiceOdometry, MiceReadings};
+use mrt_plan::PlanError;
+use nalgebra::{Matrix2, Matrix2x3, Matrix3, Vector2, Vector3};
+use std::f64::consts::PI;
+
+/// Reliability kept per control cycle by an object that was not seen again.
+pub const DECAY: f64 = 0.85;
+
+/// Sightings farther from the estimate than this (squared Mahalanobis distance, 2 degrees of
+/// freedom: about 1 in 3000 true sightings) are outliers.
+pub const GATE: f64 = 16.0;
+
+/// Process noise assumed for the mice: standard deviation per cycle as a fraction of the
+/// motion, plus a turn error per metre travelled (rad/m).
+const MICE_SIGMA: (f64, f64) = (0.03, 0.05);
+/// The same for the wheels (they slip).
+const WHEEL_SIGMA: (f64, f64) = (0.15, 0.3);
+/// Process noise added every cycle whatever the motion (m, rad): the filter never becomes
+/// so sure of itself that it refuses the camera.
+const FLOOR: (f64, f64) = (0.002, 0.002);
+/// Uncertainty after being put down by hand (m, rad).
+const PLACED_SIGMA: (f64, f64) = (0.05, 0.05);
+/// Uncertainty added when the filter finds itself lost (m, rad).
+const LOST_SIGMA: (f64, f64) = (1.0, 0.5);
+/// The field map's distances are in mm.
+const MM: f64 = 1000.0;
+
+/// LPS slot → field object (sensor order) for a team attacking west: its frame is the field
+/// turned half round, so its opponent's net is the west net, its "north-east" corner the
+/// field's south-west one, and so on.
+const ATTACKING_WEST: [usize; FIELD_OBJECTS] = [0, 2, 1, 6, 5, 4, 3, 8, 7];
+
+/// Where one object was last seen (field frame, m), how reliable that is, and when (s).
+#[derive(Clone, Copy, Debug)]
+struct Memory {
+    at: (f64, f64),
+    reliability: f64,
+    seen: f64,
+}
+
+/// What the filter used and refused, counted since it started.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct FilterCounts {
+    /// Cycles predicted with consistent mice readings.
+    pub mice: u64,
+    /// Cycles predicted with mice readings repaired by the §4.2 reduction.
+    pub reduced: u64,
+    /// Cycles predicted with the wheels (the mice could not be trusted).
+    pub wheels: u64,
+    /// Landmark sightings that corrected the pose.
+    pub corrections: u64,
+    /// Landmark sightings rejected as outliers.
+    pub rejected: u64,
+    /// Frames after which the filter admitted it was lost.
+    pub lost: u64,
+}
+
+/// One robot's world state between cycles.
+#[derive(Clone, Debug)]
+pub struct WorldModel {
+    field: Field,
+    mice: MiceOdometry,
+    distance_noise: f64,
+    bearing_noise: f64,
+    pose: Pose2,
+    cov: Matrix3<f64>,
+    memory: [Option<Memory>; FIELD_OBJECTS],
+    counts: FilterCounts,
+}
+
+impl WorldModel {
+    /// A robot on `field` (the map, mm) with two mice `mice`, whose camera has the relative
+    /// distance error `distance_noise` and the bearing error `bearing_noise` (rad), that does
+    /// not know yet where it is.
+    pub fn new(field: Field, mice: MiceOdometry, distance_noise: f64, bearing_noise: f64) -> Self {
+        WorldModel {
+            field,
+            mice,
+            distance_noise,
+            bearing_noise,
+            pose: Pose2::default(),
+            cov: Matrix3::from_diagonal(&Vector3::new(100.0, 100.0, PI * PI)),
+            memory: [None; FIELD_OBJECTS],
+            counts: FilterCounts::default(),
+        }
+    }
+
+    /// The pose estimate (field frame, m).
+    pub fn pose(&self) -> Pose2 {
+        self.pose
+    }
+
+    /// Standard deviations of the estimate: position (m, root mean square of x and y) and
+    /// heading (rad).
+    pub fn sigma(&self) -> (f64, f64) {
+        (
+            ((self.cov[(0, 0)] + self.cov[(1, 1)]) / 2.0).max(0.0).sqrt(),
+            self.cov[(2, 2)].max(0.0).sqrt(),
+        )
+    }
+
+    /// The pose's quality, 0 to 1 (module doc).
+    pub fn quality(&self) -> f64 {
+        let (xy, theta) = self.sigma();
+        (-xy / 0.5 - theta / 0.5).exp()
+    }
+
+    /// What the filter used and refused so far.
+    pub fn counts(&self) -> FilterCounts {
+        self.counts
+    }
+
+    /// Sets the pose, as when the robot is put down by hand.
+    pub fn place(&mut self, pose: Pose2) {
+        self.pose = pose;
+        let (xy, theta) = PLACED_SIGMA;
+        self.cov = Matrix3::from_diagonal(&Vector3::new(xy * xy, xy * xy, theta * theta));
+    }
+
+    /// One cycle's odometry: a placement resets the pose, then the motion moves it.
+    pub fn odometry(&mut self, o: &Odometry) {
+        if let Some(p) = o.placed {
+            self.place(p);
+        }
+        match self.mice_motion(&o.mice) {
+            Some((d, reduced)) => {
+                if reduced {
+                    self.counts.reduced += 1;
+                } else {
+                    self.counts.mice += 1;
+                }
+                self.predict(&d, MICE_SIGMA);
+            }
+            None => {
+                self.counts.wheels += 1;
+                self.predict(&o.wheels, WHEEL_SIGMA);
+            }
+        }
+    }
+
+    /// The mice's motion if they can be trusted, and whether it needed the §4.2 reduction.
+    /// A reduction that scales a reading by more than 2 is refused: a mouse under-reads by at
+    /// most half in the sensor model, and a larger factor amplifies noise in small `x̄`.
+    fn mice_motion(&self, r: &MiceReadings) -> Option<(Displacement, bool)> {
+        match self.mice.displacement(r) {
+            Ok(d) => Some((d, false)),
+            Err(PlanError::MiceInconsistent { .. }) => {
+                let fixed = self.mice.reduce(r).ok()?;
+                let grew = |a: f64, b: f64, c: f64, d: f64| a.hypot(b) <= 2.0 * c.hypot(d);
+                let plausible = grew(fixed.x_left, fixed.y_left, r.x_left, r.y_left)
+                    && grew(fixed.x_right, fixed.y_right, r.x_right, r.y_right);
+                plausible.then(|| self.mice.displacement(&fixed).ok().map(|d| (d, true))).flatten()
+            }
+            Err(_) => None,
+        }
+    }
+
+    /// The EKF prediction: the pose moves by `d` (robot frame); the uncertainty grows with
+    /// `sigma` = (fraction of the motion, turn error per metre).
+    fn predict(&mut self, d: &Displacement, sigma: (f64, f64)) {
+        if !(d.dx.is_finite() && d.dy.is_finite() && d.dtheta.is_finite()) {
+            return;
+        }
+        let (s, c) = self.pose.theta.sin_cos();
+        let f = Matrix3::new(
+            1.0,
+            0.0,
+            -s * d.dx - c * d.dy,
+            0.0,
+            1.0,
+            c * d.dx - s * d.dy,
+            0.0,
+            0.0,
+            1.0,
+        );
+        let dist = d.dx.hypot(d.dy);
+        let fwd = sigma.0 * d.dx.abs() + FLOOR.0;
+        let side = sigma.0 * d.dy.abs() + FLOOR.0;
+        let turn = sigma.0 * d.dtheta.abs() + sigma.1 * dist + FLOOR.1;
+        let q = Matrix3::from_diagonal(&Vector3::new(fwd * fwd, side * side, turn * turn));
+        let rot = Matrix3::new(c, -s, 0.0, s, c, 0.0, 0.0, 0.0, 1.0);
+        self.cov = f * self.cov * f.transpose() + rot * q * rot.transpose();
+        let p = self.pose.compose(&d.as_pose());
+        self.pose = Pose2::new(p.x, p.y, normalize_angle(p.theta));
+    }
+
+    /// Field position (m) of field object `k` (1..: nets and landmarks, sensor order).
+    fn landmark(&self, k: usize) -> Option<(f64, f64)> {
+        let (hl, hw) = (self.field.half_length / MM, self.field.half_width / MM);
+        let at = [
+            (hl, 0.0),
+            (-hl, 0.0),
+            (hl, hw),
+            (hl, -hw),
+            (-hl, hw),
+            (-hl, -hw),
+            (0.0, hw),
+            (0.0, -hw),
+        ];
+        k.checked_sub(1).and_then(|i| at.get(i).copied())
+    }
+
+    /// The EKF correction by one sighting of a landmark at `at`. Returns whether it was
+    /// accepted (not gated out).
+    fn correct(&mut self, at: (f64, f64), z: &Sighting) -> bool {
+        let (dx, dy) = (at.0 - self.pose.x, at.1 - self.pose.y);
+        let q = dx * dx + dy * dy;
+        let rho = q.sqrt();
+        if rho < 0.3 || !(z.distance.is_finite() && z.bearing.is_finite()) {
+            return true; // too close to linearise; nothing learnt, nothing wrong
+        }
+        let h = Matrix2x3::new(-dx / rho, -dy / rho, 0.0, dy / q, -dx / q, -1.0);
+        let innovation = Vector2::new(
+            z.distance - rho,
+            normalize_angle(z.bearing - (dy.atan2(dx) - self.pose.theta)),
+        );
+        let sd = self.distance_noise * z.distance + 0.01;
+        let sb = self.bearing_noise + 0.005;
+        let r = Matrix2::new(sd * sd, 0.0, 0.0, sb * sb);
+        let s = h * self.cov * h.transpose() + r;
+        let Some(s_inv) = s.try_inverse() else { return false };
+        if (innovation.transpose() * s_inv * innovation)[(0, 0)] > GATE {
+            return false;
+        }
+        let k = self.cov * h.transpose() * s_inv;
+        let step = k * innovation;
+        self.pose = Pose2::new(
+            self.pose.x + step[0],
+            self.pose.y + step[1],
+            normalize_angle(self.pose.theta + step[2]),
+        );
+        // Joseph form: stays symmetric and positive.
+        let i_kh = Matrix3::identity() - k * h;
+        self.cov = i_kh * self.cov * i_kh.transpose() + k * r * k.transpose();
+        true
+    }
+
+    /// One camera frame: the nets and landmarks correct the pose, every sighting refreshes the
+    /// LPS memory, and the snapshot is built. Call after this cycle's [`WorldModel::odometry`].
+    pub fn camera(&mut self, frame: &CameraFrame) -> WorldSnapshot {
+        let (seen, rejected) = self.correct_all(frame);
+        if seen >= 3 && 2 * rejected > seen {
+            // Most landmarks disagree: the estimate is wrong, not the camera. Widen the
+            // uncertainty and listen to the same sightings again.
+            self.counts.lost += 1;
+            let (xy, theta) = LOST_SIGMA;
+            self.cov += Matrix3::from_diagonal(&Vector3::new(xy * xy, xy * xy, theta * theta));
+            self.correct_all(frame);
+        }
+        let me = self.pose;
+        for (k, z) in frame.sightings.iter().enumerate() {
+            match z {
+                Some(z) => {
+                    let a = me.theta + z.bearing;
+                    let at = (me.x + z.distance * a.cos(), me.y + z.distance * a.sin());
+                    self.memory[k] = Some(Memory { at, reliability: 1.0, seen: frame.time });
+                }
+                None => {
+                    if let Some(m) = &mut self.memory[k] {
+                        m.reliability *= DECAY;
+                    }
+                }
+            }
+        }
+        self.snapshot(frame)
+    }
+
+    /// Corrects the pose with every net and landmark of `frame`. Returns how many were seen
+    /// and how many of them were rejected.
+    fn correct_all(&mut self, frame: &CameraFrame) -> (u64, u64) {
+        let (mut seen, mut rejected) = (0, 0);
+        for (k, z) in frame.sightings.iter().enumerate() {
+            let (Some(z), Some(at)) = (z, self.landmark(k)) else { continue };
+            seen += 1;
+            if self.correct(at, z) {
+                self.counts.corrections += 1;
+            } else {
+                rejected += 1;
+            }
+        }
+        self.counts.rejected += rejected;
+        (seen, rejected)
+    }
+
+    /// The world snapshot in the team frame.
+    fn snapshot(&self, frame: &CameraFrame) -> WorldSnapshot {
+        let me = self.pose;
+        let west = frame.game.attack < 0.0;
+        let dir = if west { -1.0 } else { 1.0 };
+        let to_team = |x: f64, y: f64| (dir * x * MM, dir * y * MM);
+        let turn = |theta: f64| if west { normalize_angle(theta + PI) } else { theta };
+        let mut w = WorldSnapshot {
+            time: Time::from_secs_f64(frame.time),
+            game_state: frame.game.state,
+            field: self.field,
+            ..Default::default()
+        };
+        for (slot, lpo) in w.lps.iter_mut().enumerate() {
+            let object = if west { ATTACKING_WEST[slot] } else { slot };
+            let Some(Memory { at: (x, y), reliability, seen }) = self.memory[object] else {
+                continue;
+            };
+            let (dx, dy) = (x - me.x, y - me.y);
+            *lpo = Lpo {
+                rho: dx.hypot(dy) * MM,
+                theta: normalize_angle(dy.atan2(dx) - me.theta),
+                reliability,
+                seen_ago: frame.time - seen,
+            };
+        }
+        let (mx, my) = to_team(me.x, me.y);
+        w.my_pos = Estimate { pose: Pose2::new(mx, my, turn(me.theta)), quality: self.quality() };
+        w.kickoff_pose = frame.game.kickoff_pose.map(|p| {
+            let (x, y) = to_team(p.x, p.y);
+            Pose2::new(x, y, turn(p.theta))
+        });
+        if let Some(Memory { at: (bx, by), reliability, .. }) = self.memory[lps::BALL] {
+            let (x, y) = to_team(bx, by);
+            w.global_ball = Estimate { pose: Pose2::new(x, y, 0.0), quality: reliability };
+        }
+        if let Some((vx, vy)) = frame.ball_velocity {
+            // Robot frame → field (by the estimated heading) → team.
+            let (s, c) = me.theta.sin_cos();
+            let (fx, fy) = to_team(c * vx - s * vy, s * vx + c * vy);
+            w.ball_vel = Vec2::new(fx, fy);
+        }
+        w
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::sensor::GameInfo;
+    use mrt_core::robot::GameState;
+
+    fn model() -> WorldModel {
+        // The default field: 18 m × 12 m. Mice 0.2 m apart, 3 mm tolerance.
+        let mice = MiceOdometry::new(0.2, 0.003).unwrap();
+        WorldModel::new(Field::default(), mice, 0.03, 0.02)
+    }
+
+    /// Exact sightings, from `at`, of the field objects at `objects` (field frame, m).
+    fn frame(at: Pose2, time: f64, attack: f64, objects: &[(usize, (f64, f64))]) -> CameraFrame {
+        let mut f = CameraFrame {
+            time,
+            game: GameInfo { state: GameState::Playing, attack, kickoff_pose: None },
+            ..Default::default()
+        };
+        for &(k, (x, y)) in objects {
+            let (dx, dy) = (x - at.x, y - at.y);
+            f.sightings[k] = Some(Sighting {
+                distance: dx.hypot(dy),
+                bearing: normalize_angle(dy.atan2(dx) - at.theta),
+            });
+        }
+        f
+    }
+
+    /// Every landmark of the default field, sensor order (1..=8).
+    fn landmarks() -> Vec<(usize, (f64, f64))> {
+        let at = [
+            (9.0, 0.0),
+            (-9.0, 0.0),
+            (9.0, 6.0),
+            (9.0, -6.0),
+            (-9.0, 6.0),
+            (-9.0, -6.0),
+            (0.0, 6.0),
+            (0.0, -6.0),
+        ];
+        at.into_iter().enumerate().map(|(i, p)| (i + 1, p)).collect()
+    }
+
+    fn exact_mice(d: Pose2) -> Odometry {
+        let mice = MiceOdometry::new(0.2, 0.003).unwrap();
+        Odometry { mice: mice.readings_for(d.x, d.y, d.theta), ..Default::default() }
+    }
+
+    #[test]
+    fn the_mice_alone_carry_the_pose_along_the_path() {
+        let mut m = model();
+        m.place(Pose2::new(-2.0, 1.0, 0.5));
+        let mut truth = Pose2::new(-2.0, 1.0, 0.5);
+        // A curve with a sideways component (omni base), 50 cycles.
+        let step = Pose2::new(0.08, 0.02, 0.06);
+        for _ in 0..50 {
+            m.odometry(&exact_mice(step));
+            truth = truth.compose(&step);
+        }
+        let p = m.pose();
+        assert!((p.x - truth.x).abs() < 1e-9 && (p.y - truth.y).abs() < 1e-9, "{p:?} {truth:?}");
+        assert!(normalize_angle(p.theta - truth.theta).abs() < 1e-9);
+        assert_eq!(m.counts().mice, 50);
+        // Without a landmark the uncertainty only grows: 50 cycles of 8 cm with 3 % error.
+        let (xy, _) = m.sigma();
+        assert!(xy > PLACED_SIGMA.0, "{xy}");
+        assert!(m.quality() < 0.9);
+    }
+
+    #[test]
+    fn landmarks_pull_a_wrong_estimate_back_to_the_truth() {
+        let mut m = model();
+        let truth = Pose2::new(3.0, -2.0, 2.0);
+        // The robot believes it is 0.6 m and 0.15 rad off, and knows it is unsure.
+        m.place(Pose2::new(3.4, -2.45, 2.15));
+        m.cov = Matrix3::from_diagonal(&Vector3::new(0.25, 0.25, 0.04));
+        for t in 0..5 {
+            m.odometry(&exact_mice(Pose2::default()));
+            m.camera(&frame(truth, f64::from(t) * 0.1, 1.0, &landmarks()));
+        }
+        let p = m.pose();
+        assert!((p.x - truth.x).hypot(p.y - truth.y) < 0.01, "{p:?}");
+        assert!(normalize_angle(p.theta - truth.theta).abs() < 0.005, "{p:?}");
+        assert_eq!((m.counts().corrections, m.counts().rejected), (40, 0));
+        // Sure of itself now: 8 landmarks a frame at 3 % and 0.02 rad.
+        assert!(m.quality() > 0.75, "{}", m.quality());
+    }
+
+    #[test]
+    fn an_outlier_is_rejected_and_a_lost_robot_finds_itself() {
+        let mut m = model();
+        let truth = Pose2::new(0.0, 0.0, 0.0);
+        m.place(truth);
+        for t in 0..3 {
+            m.odometry(&exact_mice(Pose2::default()));
+            m.camera(&frame(truth, f64::from(t) * 0.1, 1.0, &landmarks()));
+        }
+        // One net reported 3 m too close: gated out, the pose does not move.
+        let mut bad = frame(truth, 0.3, 1.0, &landmarks());
+        if let Some(s) = &mut bad.sightings[1] {
+            s.distance -= 3.0;
+        }
+        m.odometry(&exact_mice(Pose2::default()));
+        m.camera(&bad);
+        assert_eq!(m.counts().rejected, 1);
+        assert!(m.pose().x.abs() < 0.01 && m.pose().y.abs() < 0.01, "{:?}", m.pose());
+        // Kidnapped: moved 2 m without odometry. Every landmark disagrees → lost, widen, and
+        // the following frames bring it back.
+        let kidnapped = Pose2::new(2.0, 1.0, 0.0);
+        for t in 4..14 {
+            m.odometry(&exact_mice(Pose2::default()));
+            m.camera(&frame(kidnapped, f64::from(t) * 0.1, 1.0, &landmarks()));
+        }
+        assert!(m.counts().lost >= 1, "{:?}", m.counts());
+        let p = m.pose();
+        assert!((p.x - 2.0).hypot(p.y - 1.0) < 0.05, "{p:?} {:?}", m.counts());
+    }
+
+    #[test]
+    fn an_under_reading_mouse_is_repaired_and_broken_mice_give_way_to_the_wheels() {
+        let mut m = model();
+        m.place(Pose2::default());
+        // Sideways and forward (omni): x̄ ≠ 0, so a short mouse shows. The left mouse reads
+        // 70 % of its motion: §4.2 scales it back exactly.
+        let step = Pose2::new(0.1, 0.05, 0.02);
+        let mut o = exact_mice(step);
+        o.mice.x_left *= 0.7;
+        o.mice.y_left *= 0.7;
+        m.odometry(&o);
+        let p = m.pose();
+        assert!((p.x - 0.1).abs() < 1e-9 && (p.y - 0.05).abs() < 1e-9, "{p:?}");
+        assert_eq!(m.counts().reduced, 1);
+        // Opposite x̄: no reduction possible → the wheels' motion is used.
+        let mut o = exact_mice(step);
+        o.mice.x_left = -o.mice.x_left;
+        o.wheels = Displacement::new(0.2, 0.0, 0.0);
+        m.odometry(&o);
+        assert_eq!(m.counts().wheels, 1);
+        let expected = p.compose(&Pose2::new(0.2, 0.0, 0.0));
+        assert!(m.pose().distance(&expected) < 1e-9, "{:?} {expected:?}", m.pose());
+        // A short mouse whose x̄ is almost 0 would be scaled by > 2: refused, wheels again.
+        let mut o = exact_mice(Pose2::new(0.1, 0.001, 0.0));
+        o.mice.x_left = 0.0002;
+        o.mice.x_right = 0.0042;
+        m.odometry(&o);
+        assert_eq!(m.counts().wheels, 2);
+        // NaN readings: the wheels too.
+        let mut o = exact_mice(step);
+        o.mice.y_right = f64::NAN;
+        m.odometry(&o);
+        assert_eq!(m.counts().wheels, 3);
+        assert!(m.pose().x.is_finite());
+    }
+
+    #[test]
+    fn the_snapshot_is_in_the_team_frame_and_unseen_objects_fade() {
+        let mut m = model();
+        let at = Pose2::new(-2.0, 0.0, std::f64::consts::FRAC_PI_2);
+        m.place(at);
+        m.odometry(&Odometry::default());
+        let mut objects = landmarks();
+        objects.push((lps::BALL, (0.0, 2.0)));
+        // Attacking east: the team frame is the field frame (mm).
+        let w = m.camera(&frame(at, 1.0, 1.0, &objects));
+        let ball = w.lps[lps::BALL];
+        assert!((ball.rho - 2828.427).abs() < 0.01 && (ball.theta + PI / 4.0).abs() < 1e-9);
+        assert_eq!((ball.reliability, ball.seen_ago), (1.0, 0.0));
+        // The own net (west, (-9, 0)): 7 m on the left.
+        let own = w.lps[lps::NET2];
+        assert!((own.rho - 7000.0).abs() < 0.01 && (own.theta - PI / 2.0).abs() < 1e-9);
+        assert!((w.my_pos.pose.x + 2000.0).abs() < 1e-6 && w.my_pos.pose.y.abs() < 1e-6);
+        assert!(
+            (w.global_ball.pose.x).abs() < 1e-6 && (w.global_ball.pose.y - 2000.0).abs() < 1e-6
+        );
+        // Attacking west: the same field turned half round; the opponent's net (NET1) is
+        // the west net, 7 m on the left, and "landmark 0" (the opponent's left corner) is
+        // the field's south-west corner.
+        let mut m2 = model();
+        m2.place(at);
+        let w = m2.camera(&frame(at, 1.0, -1.0, &objects));
+        assert!((w.lps[lps::NET1].rho - 7000.0).abs() < 0.01);
+        assert!((w.lps[lps::NET1].theta - PI / 2.0).abs() < 1e-9);
+        let sw = w.lps[lps::LANDMARK0];
+        let (dx, dy) = (-9.0 - at.x, -6.0 - at.y);
+        assert!((sw.rho - dx.hypot(dy) * 1000.0).abs() < 0.01, "{sw:?}");
+        assert!((w.my_pos.pose.x - 2000.0).abs() < 1e-6, "{:?}", w.my_pos);
+        assert!((w.my_pos.pose.theta + PI / 2.0).abs() < 1e-9, "north is the team's −y");
+        assert!((w.global_ball.pose.y + 2000.0).abs() < 1e-6);
+        // Nothing seen next cycle: memories stay where they were, fading; the robot moves
+        // 1 m forward (north) by the mice, so the ball, 2 m north-east, is now 2.236 m away.
+        m.odometry(&exact_mice(Pose2::new(1.0, 0.0, 0.0)));
+        let w = m.camera(&frame(at, 1.1, 1.0, &[]));
+        let ball = w.lps[lps::BALL];
+        assert!((ball.reliability - DECAY).abs() < 1e-12);
+        assert!((ball.rho - 5f64.sqrt() * 1000.0).abs() < 0.01, "{ball:?}");
+        assert!((ball.seen_ago - 0.1).abs() < 1e-9);
+    }
+}
