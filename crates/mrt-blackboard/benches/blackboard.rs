@@ -1,4 +1,5 @@
-//! Blackboard hot paths: `get` of a float, `set` without and with a watcher.
+//! Blackboard hot paths: `get` of a float, `set` without and with a watcher, and a relay
+//! GETV round trip over TCP on loopback.
 #![allow(missing_docs, clippy::unwrap_used)]
 use criterion::{criterion_group, criterion_main, Criterion};
 use mrt_blackboard::Blackboard;
@@ -40,6 +41,17 @@ fn bench(c: &mut Criterion) {
             }
             bb.set(black_box("local.var.machine.config.def.near-ball"), x)
         })
+    });
+    drop(watch);
+    // The relay over TCP on loopback: one GETV request and its reply.
+    let cfg = mrt_blackboard::RelayConfig {
+        addr: std::net::SocketAddr::from(([127, 0, 0, 1], 0)),
+        ..Default::default()
+    };
+    let relay = mrt_blackboard::Relay::start(bb.clone(), cfg).unwrap();
+    let mut client = mrt_blackboard::RelayClient::connect(relay.local_addr(), None).unwrap();
+    c.bench_function("relay_getv_round_trip", |b| {
+        b.iter(|| client.request(black_box("GETV local.var.machine.config.def.near-ball")).unwrap())
     });
 }
 

@@ -7,7 +7,8 @@
 //! are `Int`, `Float`, `Bool` or `String` ([`value`]), each stamped with the time it was set
 //! on this robot's clock. Watchers receive changes ([`Blackboard::watch`]); initial values
 //! come from `config.dat` and `config-<id>.dat` ([`config`]); the [`Proxy`] Member carries
-//! shared changes between robots over the DCDT bus.
+//! shared changes between robots over the DCDT bus; the [`Relay`] lets a person watch and set
+//! variables over TCP (`docs/relay-protocol.md`, `mrt bb`).
 //!
 //! ```
 //! use mrt_blackboard::Blackboard;
@@ -27,10 +28,12 @@
 pub mod board;
 pub mod config;
 pub mod proxy;
+pub mod relay;
 pub mod symbol;
 pub mod value;
 
 pub use board::{BbError, Blackboard, Change, Stamped, Update, Watch};
 pub use proxy::{BbUpdate, Proxy};
+pub use relay::{Relay, RelayClient, RelayConfig};
 pub use symbol::{Kind, Pattern, Scope, Symbol, SymbolError};
 pub use value::{FromValue, Value, ValueType};

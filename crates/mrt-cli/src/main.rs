@@ -1,6 +1,7 @@
 //! `mrt`: the MRT command line.
 //!
 //! - `mrt sim [--seed N] [--matches N] [--plot match.svg]` plays a simulated match;
+//! - `mrt bb serve|get|set|watch|list` serves a blackboard with its relay, or talks to one;
 //! - `mrt demo [hello-agora|two-agoras]` runs a numbered example and prints what happens;
 //! - `mrt behave FILE [--world world.json] [--cycles N]` runs a Lua behavior or HFSM offline;
 //! - `mrt hfsm dot FILE [--dot out.dot] [--svg out.svg]` draws an HFSM;
@@ -16,6 +17,7 @@ macro_rules! outln {
     ($($arg:tt)*) => { $crate::write_line(format_args!($($arg)*)) };
 }
 
+mod bb;
 mod behave;
 mod brian;
 mod sim;
@@ -36,6 +38,12 @@ struct Cli {
 enum Command {
     /// Play a simulated robot-soccer match on the embedded default world (or a series).
     Sim(sim::SimArgs),
+    /// The blackboard: serve one with its relay, or get, set, watch and list variables
+    /// through a relay (docs/relay-protocol.md).
+    Bb {
+        #[command(subcommand)]
+        command: bb::BbCommand,
+    },
     /// Run a demo: an Agora with Members exchanging messages.
     Demo {
         /// Which example to run.
@@ -179,6 +187,7 @@ fn run(command: Command) -> Result<()> {
             BrianCommand::Plot { dir, out } => brian::plot(&dir, &out)?,
         },
         Command::Sim(args) => sim::run(&args)?,
+        Command::Bb { command } => bb::run(command)?,
         Command::Behave { file, world, cycles, period_ms } => {
             behave::behave(&file, world.as_deref(), cycles, period_ms)?
         }

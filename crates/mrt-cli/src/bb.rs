@@ -1,0 +1,142 @@
+//! `mrt bb`: a blackboard with its relay (`serve`), and the relay's client (`get`, `set`,
+//! `watch`, `list`). The protocol: `docs/relay-protocol.md`.
+
+use anyhow::{bail, Context as _, Result};
+use clap::{Args, Subcommand};
+use mrt_blackboard::relay::{RelayClient, RelayConfig, DEFAULT_PORT};
+use mrt_blackboard::{Blackboard, Relay};
+use std::net::SocketAddr;
+use std::path::PathBuf;
+use std::sync::Arc;
+
+/// Where the relay is, and its token.
+#[derive(Args)]
+pub struct Target {
+    /// The relay's address.
+    #[arg(long, default_value_t = SocketAddr::from(([127, 0, 0, 1], DEFAULT_PORT)))]
+    addr: SocketAddr,
+    /// The relay's shared token (needed when it listens beyond this machine).
+    #[arg(long, env = "MRT_RELAY_TOKEN", hide_env_values = true)]
+    token: Option<String>,
+}
+
+/// `mrt bb` commands.
+#[derive(Subcommand)]
+pub enum BbCommand {
+    /// Run a blackboard with its relay until interrupted (initial values from
+    /// DIR/config.dat and DIR/config-<robot>.dat).
+    Serve {
+        #[command(flatten)]
+        target: Target,
+        /// Directory of config.dat and config-<robot>.dat.
+        #[arg(long)]
+        config_dir: Option<PathBuf>,
+        /// The robot's ID.
+        #[arg(long, default_value_t = 1)]
+        robot: u32,
+    },
+    /// Print a variable: `<Type> <value>` and its age in ms.
+    Get {
+        /// The symbol (`local.var.machine.role`).
+        symbol: String,
+        #[command(flatten)]
+        target: Target,
+    },
+    /// Set a variable: `mrt bb set local.var.machine.role String '"keeper"'`.
+    Set {
+        /// The symbol.
+        symbol: String,
+        /// Int, Float, Bool or String.
+        value_type: String,
+        /// The value (a String in double quotes).
+        value: String,
+        #[command(flatten)]
+        target: Target,
+    },
+    /// Print changes of the variables the patterns cover (`local.var.machine.*`).
+    Watch {
+        /// Symbols or prefixes ending in `.*`.
+        #[arg(required = true)]
+        patterns: Vec<String>,
+        /// Refresh period, ms.
+        #[arg(long, default_value_t = 500)]
+        refresh: u64,
+        /// Stop after this many changes.
+        #[arg(long)]
+        count: Option<usize>,
+        #[command(flatten)]
+        target: Target,
+    },
+    /// List the symbols on the blackboard (under a pattern) with their values.
+    List {
+        /// A pattern (`local.*`); all symbols without it.
+        pattern: Option<String>,
+        #[command(flatten)]
+        target: Target,
+    },
+}
+
+fn connect(t: &Target) -> Result<RelayClient> {
+    RelayClient::connect(t.addr, t.token.as_deref()).with_context(|| {
+        format!("cannot reach the relay at {} (is `mrt bb serve` or a robot running?)", t.addr)
+    })
+}
+
+/// Runs one `mrt bb` command.
+pub fn run(command: BbCommand) -> Result<()> {
+    match command {
+        BbCommand::Serve { target, config_dir, robot } => {
+            let bb = Blackboard::new(robot, Arc::new(mrt_core::WallClock::new()));
+            if let Some(dir) = &config_dir {
+                let read = mrt_blackboard::config::load_dir(&bb, dir)?;
+                if read.is_empty() {
+                    bail!("{}: neither config.dat nor config-{robot}.dat is there", dir.display());
+                }
+                for f in read {
+                    eprintln!("loaded {}", f.display());
+                }
+            }
+            let cfg =
+                RelayConfig { addr: target.addr, token: target.token, ..RelayConfig::default() };
+            let relay = Relay::start(bb, cfg)?;
+            outln!("relay of robot {robot} listening on {}", relay.local_addr());
+            loop {
+                std::thread::park();
+            }
+        }
+        BbCommand::Get { symbol, target } => {
+            let reply = connect(&target)?.request(&format!("GETV {symbol}"))?;
+            let rest = reply.strip_prefix("GETV ").and_then(|r| r.strip_prefix(symbol.as_str()));
+            outln!("{}", rest.unwrap_or(&reply).trim());
+        }
+        BbCommand::Set { symbol, value_type, value, target } => {
+            connect(&target)?.request(&format!("SETV {symbol} {value_type} {value}"))?;
+        }
+        BbCommand::Watch { patterns, refresh, count, target } => {
+            let mut c = connect(&target)?;
+            c.request(&format!("REFR {refresh}"))?;
+            for p in &patterns {
+                c.request(&format!("ADDW {p}"))?;
+            }
+            let mut seen = 0;
+            while count.is_none_or(|n| seen < n) {
+                let line = c.next_push()?;
+                outln!("{}", line.strip_prefix("WATCH ").unwrap_or(&line));
+                seen += 1;
+            }
+        }
+        BbCommand::List { pattern, target } => {
+            let mut c = connect(&target)?;
+            let reply = c.request(&format!("LSTV {}", pattern.as_deref().unwrap_or("")))?;
+            for symbol in reply.split_whitespace().skip(2) {
+                let v = c.request(&format!("GETV {symbol}"));
+                let shown = match &v {
+                    Ok(r) => r.strip_prefix("GETV ").unwrap_or(r).to_string(),
+                    Err(_) => format!("{symbol} (talk queue)"),
+                };
+                outln!("{shown}");
+            }
+        }
+    }
+    Ok(())
+}
