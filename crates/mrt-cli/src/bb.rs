@@ -24,11 +24,11 @@ pub struct Target {
 #[derive(Subcommand)]
 pub enum BbCommand {
     /// Run a blackboard with its relay until interrupted (initial values from
-    /// DIR/config.dat and DIR/config-<robot>.dat).
+    /// DIR/config.dat, then DIR/config-ROBOT.dat).
     Serve {
         #[command(flatten)]
         target: Target,
-        /// Directory of config.dat and config-<robot>.dat.
+        /// Directory of config.dat and config-ROBOT.dat (ROBOT: the robot ID).
         #[arg(long)]
         config_dir: Option<PathBuf>,
         /// The robot's ID.

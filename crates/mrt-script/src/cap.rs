@@ -15,6 +15,7 @@ use crate::hfsm::{Hfsm, Taken};
 use crate::runtime::{LuaRuntime, Sandbox};
 use crate::script::ScriptError;
 use crate::watch::ScriptWatcher;
+use mrt_blackboard::Blackboard;
 use mrt_core::robot::{RobotCommand, WorldSnapshot};
 use std::cell::RefCell;
 use std::path::{Path, PathBuf};
@@ -60,11 +61,7 @@ impl ThinkingCap {
         machine: impl AsRef<Path>,
         sandbox: Sandbox,
     ) -> Result<ThinkingCap, ScriptError> {
-        let (rt, io, hbm) = Self::base(dir.as_ref(), sandbox)?;
-        let hfsm = Hfsm::from_file(&rt, machine.as_ref(), io.clone())?;
-        let top =
-            Top::Hfsm(Box::new(hfsm), std::path::absolute(machine.as_ref()).unwrap_or_default());
-        Ok(ThinkingCap { rt, io, hbm, top, last_good: None, watcher: None })
+        Self::load_hfsm(dir, machine, sandbox, None)
     }
 
     /// Loads the behaviors of `dir` and runs `behavior` every cycle.
@@ -73,7 +70,32 @@ impl ThinkingCap {
         behavior: &str,
         sandbox: Sandbox,
     ) -> Result<ThinkingCap, ScriptError> {
-        let (rt, io, hbm) = Self::base(dir.as_ref(), sandbox)?;
+        Self::load_behavior(dir, behavior, sandbox, None)
+    }
+
+    /// [`ThinkingCap::with_hfsm`] with `bb.*` bound to the robot's `blackboard`, from the
+    /// first line loaded (`hbm.lua` included).
+    pub fn load_hfsm(
+        dir: impl AsRef<Path>,
+        machine: impl AsRef<Path>,
+        sandbox: Sandbox,
+        blackboard: Option<Blackboard>,
+    ) -> Result<ThinkingCap, ScriptError> {
+        let (rt, io, hbm) = Self::base(dir.as_ref(), sandbox, blackboard)?;
+        let hfsm = Hfsm::from_file(&rt, machine.as_ref(), io.clone())?;
+        let top =
+            Top::Hfsm(Box::new(hfsm), std::path::absolute(machine.as_ref()).unwrap_or_default());
+        Ok(ThinkingCap { rt, io, hbm, top, last_good: None, watcher: None })
+    }
+
+    /// [`ThinkingCap::with_behavior`] with `bb.*` bound to the robot's `blackboard`.
+    pub fn load_behavior(
+        dir: impl AsRef<Path>,
+        behavior: &str,
+        sandbox: Sandbox,
+        blackboard: Option<Blackboard>,
+    ) -> Result<ThinkingCap, ScriptError> {
+        let (rt, io, hbm) = Self::base(dir.as_ref(), sandbox, blackboard)?;
         if !hbm.contains(behavior) {
             return Err(ScriptError::Setup(format!(
                 "no behavior named '{behavior}' in {} (known: {})",
@@ -88,10 +110,14 @@ impl ThinkingCap {
     fn base(
         dir: &Path,
         sandbox: Sandbox,
+        blackboard: Option<Blackboard>,
     ) -> Result<(LuaRuntime, Rc<RefCell<RobotIo>>, Hbm), ScriptError> {
         let rt = LuaRuntime::new(sandbox)?;
         let io = Rc::new(RefCell::new(RobotIo::default()));
         chaos::install(&rt, io.clone())?;
+        if let Some(bb) = blackboard {
+            crate::blackboard::install(&rt, bb)?;
+        }
         let hbm = Hbm::load_dir(&rt, dir, io.clone())?;
         io.borrow_mut().known_behaviors = Some(hbm.names().into_iter().collect());
         Ok((rt, io, hbm))

@@ -39,6 +39,7 @@
 //! The user guide is `docs/behaviors.md`; the seed's behaviors ship in `behaviors/teamchaos/`.
 #![deny(missing_docs)]
 
+pub mod blackboard;
 mod cap;
 pub mod chaos;
 pub mod hbm;

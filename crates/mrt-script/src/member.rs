@@ -79,6 +79,7 @@ pub struct BehaviorMember {
     watch: bool,
     worker: Option<Worker>,
     world: WorldSnapshot,
+    blackboard: Option<mrt_blackboard::Blackboard>,
 }
 
 impl BehaviorMember {
@@ -105,12 +106,19 @@ impl BehaviorMember {
             watch: false,
             worker: None,
             world: WorldSnapshot::default(),
+            blackboard: None,
         }
     }
 
     /// Sets the sandbox limits.
     pub fn with_sandbox(mut self, sandbox: Sandbox) -> Self {
         self.sandbox = sandbox;
+        self
+    }
+
+    /// Binds `bb.*` in the behaviors to the robot's blackboard.
+    pub fn with_blackboard(mut self, bb: mrt_blackboard::Blackboard) -> Self {
+        self.blackboard = Some(bb);
         self
     }
 
@@ -124,14 +132,14 @@ impl BehaviorMember {
         let (jobs, job_rx) = channel::<Job>();
         let (reply_tx, replies) = channel();
         let (ready_tx, ready_rx) = channel::<Result<(), String>>();
-        let (dir, top, sandbox, watch) =
-            (self.dir.clone(), self.top.clone(), self.sandbox, self.watch);
+        let (dir, top, sandbox, watch, bb) =
+            (self.dir.clone(), self.top.clone(), self.sandbox, self.watch, self.blackboard.clone());
         let thread = std::thread::Builder::new()
             .name(self.name.clone())
             .spawn(move || {
                 let loaded = match &top {
-                    Top::Hfsm(file) => ThinkingCap::with_hfsm(&dir, file, sandbox),
-                    Top::Behavior(name) => ThinkingCap::with_behavior(&dir, name, sandbox),
+                    Top::Hfsm(file) => ThinkingCap::load_hfsm(&dir, file, sandbox, bb),
+                    Top::Behavior(name) => ThinkingCap::load_behavior(&dir, name, sandbox, bb),
                 };
                 let mut cap = match loaded.and_then(|mut c| {
                     if watch {
