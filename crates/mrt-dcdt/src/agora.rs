@@ -28,6 +28,7 @@ pub(crate) struct AgoraShared {
     pub(crate) clock: SharedClock,
     pub(crate) post_office: Arc<PostOffice>,
     pub(crate) route: Route,
+    pub(crate) outlet: crate::outlet::OutletSlot,
     shutdown: AtomicBool,
     wakers: RwLock<Vec<Arc<Waker>>>,
 }
@@ -110,6 +111,7 @@ impl AgoraBuilder {
             clock: self.clock.unwrap_or_else(|| Arc::new(WallClock::new())),
             post_office,
             route,
+            outlet: crate::outlet::OutletSlot::default(),
             shutdown: AtomicBool::new(false),
             wakers: RwLock::new(Vec::new()),
         });
@@ -195,6 +197,12 @@ impl Agora {
     /// The PostOffice.
     pub fn post_office(&self) -> &PostOffice {
         &self.shared.post_office
+    }
+
+    /// The handle a network layer uses to send this Agora's messages out and deliver the ones
+    /// it receives ([`crate::outlet`]).
+    pub fn port(&self) -> crate::outlet::AgoraPort {
+        crate::outlet::AgoraPort { shared: self.shared.clone() }
     }
 
     fn new_member_id(&mut self) -> MemberId {

@@ -118,7 +118,7 @@ impl Endpoint {
     /// Whether a message of `ty` shared now would reach any Member, in this Agora or (for a
     /// community) another. Lets a producer skip work nobody would read.
     pub fn has_subscribers(&self, ty: MsgType) -> bool {
-        self.shared.route.has_subscribers(self.shared.id, ty)
+        self.shared.route.has_subscribers(self.shared.id, ty) || self.shared.outlet.wants(ty)
     }
 
     /// Creates a raw message of `ty` with delivery warranty `None` (`CreateMsg(type)`).
@@ -189,8 +189,20 @@ impl Endpoint {
 
     #[inline]
     fn route(&self, ty: MsgType, make: &mut dyn FnMut() -> MsgRef) -> usize {
-        let n = self.shared.route.share(self.shared.id, ty, make);
-        self.shared.post_office.count_shared(n);
+        let Some(outlet) = self.shared.outlet.for_type(ty) else {
+            let n = self.shared.route.share(self.shared.id, ty, make);
+            self.shared.post_office.count_shared(n);
+            return n;
+        };
+        // Somebody elsewhere wants it: build it even if nobody here does, and send it out
+        // after the local delivery.
+        let mut built: Option<MsgRef> = None;
+        let n = self
+            .shared
+            .route
+            .share(self.shared.id, ty, &mut || built.get_or_insert_with(&mut *make).clone());
+        let msg = built.get_or_insert_with(make);
+        outlet.send(msg);
         n
     }
 

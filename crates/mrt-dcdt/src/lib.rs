@@ -91,6 +91,7 @@ mod error;
 mod executor;
 mod member;
 mod msg;
+pub mod outlet;
 mod policy;
 mod pool;
 mod postoffice;
@@ -110,6 +111,7 @@ pub use mrt_core::{AgoraId, MemberId, MsgType, Time};
 pub use msg::{
     DeliveryWarranty, Message, Msg, MsgHeader, MsgRef, Payload, RawPayload, RESERVED_TYPES_START,
 };
+pub use outlet::{AgoraPort, Outlet};
 pub use policy::RequestType;
 pub use postoffice::{InnerLinkManager, PostOffice, PostOfficeStats};
 

@@ -62,6 +62,15 @@ impl PostOffice {
             .collect()
     }
 
+    /// The message types some Member here subscribed to from other Agoras (`Remote` or `All`).
+    pub fn remote_interest(&self) -> Vec<MsgType> {
+        let subs = self.policy.subscriptions();
+        subs.iter()
+            .filter(|(_, s)| s.iter().any(|&(_, mask)| mask & REMOTE != 0))
+            .map(|(t, _)| t)
+            .collect()
+    }
+
     /// Messages waiting in a Member's mailbox.
     pub fn pending(&self, member: MemberId) -> usize {
         self.policy.pending(member.0 as usize)
@@ -113,6 +122,16 @@ impl Route {
                 .load()
                 .iter()
                 .any(|po| po.policy.has_subscribers(ty, po.origin(from))),
+        }
+    }
+
+    /// The types some Member of the route subscribed to from other Agoras.
+    pub(crate) fn remote_interest(&self) -> Vec<MsgType> {
+        match self {
+            Route::Alone(po) => po.remote_interest(),
+            Route::Community(c) => {
+                c.post_offices.load().iter().flat_map(|po| po.remote_interest()).collect()
+            }
         }
     }
 
