@@ -1,0 +1,151 @@
+//! From the manual's Agora configuration file (§3.3.1) to zenoh endpoints.
+
+use mrt_dcdt::config::{AgoraConfig, Channel, ChannelMode};
+use std::net::IpAddr;
+
+/// How an Agora joins the network.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct NetConfig {
+    /// zenoh endpoints to listen on (`tcp/127.0.0.1:7447`).
+    pub listen: Vec<String>,
+    /// zenoh endpoints to connect to.
+    pub connect: Vec<String>,
+    /// Multicast scouting group (`224.0.0.224:7446`); `None`: no multicast scouting.
+    pub multicast: Option<String>,
+    /// Whether peers learn of each other through the peers they know (gossip) and connect to
+    /// them directly. Off for static links across networks that cannot reach each other.
+    pub gossip: bool,
+    /// A bridge: forwards what it receives (a zenoh router).
+    pub bridge: bool,
+}
+
+/// Why the network cannot be joined.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum NetError {
+    /// A `ser` channel: this build has no serial transport.
+    #[error("serial channel {0}: this build of mrt-net has no serial transport (zenoh's `transport_serial`)")]
+    NoSerial(String),
+    /// zenoh refused the configuration or could not open the session.
+    #[error("zenoh: {0}")]
+    Zenoh(String),
+}
+
+fn endpoint(ip: IpAddr, port: u16) -> String {
+    match ip {
+        IpAddr::V4(v4) => format!("tcp/{v4}:{port}"),
+        IpAddr::V6(v6) => format!("tcp/[{v6}]:{port}"),
+    }
+}
+
+impl NetConfig {
+    /// The endpoints of a configuration file (module table in the crate doc).
+    pub fn from_agora_config(cfg: &AgoraConfig) -> Result<NetConfig, NetError> {
+        let mut net = NetConfig {
+            listen: vec![endpoint(cfg.local_ip, cfg.port)],
+            connect: Vec::new(),
+            multicast: Some(match cfg.multicast {
+                IpAddr::V4(m) => format!("{m}:{}", cfg.port),
+                IpAddr::V6(m) => format!("[{m}]:{}", cfg.port),
+            }),
+            gossip: true,
+            bridge: false,
+        };
+        for c in &cfg.channels {
+            match c {
+                Channel::Ip { mode, local_addr, local_port, remote_addr, remote_port, .. } => {
+                    let l = endpoint(*local_addr, *local_port);
+                    if !net.listen.contains(&l) {
+                        net.listen.push(l);
+                    }
+                    net.connect.push(endpoint(*remote_addr, *remote_port));
+                    net.bridge |= *mode == ChannelMode::Bridge;
+                }
+                Channel::Serial { device, .. } => return Err(NetError::NoSerial(device.clone())),
+            }
+        }
+        // Static links are for networks that cannot see each other: the named peers only.
+        if !net.connect.is_empty() {
+            net.gossip = false;
+        }
+        Ok(net)
+    }
+
+    /// An Agora on this machine listening on `port` and connecting to `peers` (ports), without
+    /// multicast or gossip: tests, benchmarks and the distributed simulator.
+    pub fn loopback(port: u16, peers: &[u16]) -> NetConfig {
+        NetConfig {
+            listen: vec![format!("tcp/127.0.0.1:{port}")],
+            connect: peers.iter().map(|p| format!("tcp/127.0.0.1:{p}")).collect(),
+            multicast: None,
+            gossip: false,
+            bridge: false,
+        }
+    }
+
+    /// The zenoh configuration (peer, or router for a bridge; endpoints; scouting).
+    pub fn zenoh_config(&self) -> Result<zenoh::Config, NetError> {
+        let mut c = zenoh::Config::default();
+        let json = |v: &Vec<String>| {
+            let items: Vec<String> = v.iter().map(|e| format!("\"{e}\"")).collect();
+            format!("[{}]", items.join(","))
+        };
+        let set = |c: &mut zenoh::Config, k: &str, v: &str| {
+            c.insert_json5(k, v).map_err(|e| NetError::Zenoh(format!("{k} = {v}: {e}")))
+        };
+        set(&mut c, "mode", if self.bridge { "\"router\"" } else { "\"peer\"" })?;
+        set(&mut c, "listen/endpoints", &json(&self.listen))?;
+        set(&mut c, "connect/endpoints", &json(&self.connect))?;
+        set(
+            &mut c,
+            "scouting/multicast/enabled",
+            if self.multicast.is_some() { "true" } else { "false" },
+        )?;
+        if let Some(m) = &self.multicast {
+            set(&mut c, "scouting/multicast/address", &format!("\"{m}\""))?;
+        }
+        set(&mut c, "scouting/gossip/enabled", if self.gossip { "true" } else { "false" })?;
+        // Keep trying the static peers: a restarted robot is found again.
+        set(&mut c, "connect/timeout_ms", "-1")?;
+        set(
+            &mut c,
+            "connect/retry",
+            "{period_init_ms: 100, period_max_ms: 500, period_increase_factor: 2}",
+        )?;
+        set(&mut c, "connect/exit_on_failure", "false")?;
+        set(&mut c, "listen/exit_on_failure", "true")?;
+        Ok(c)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_manual_example_becomes_endpoints() {
+        let text = "192.168.0.1 225.0.0.1 2003\n\
+                    PostOffice: SLWB\n\
+                    ip link 0 192.168.0.1 3000 192.168.1.1 3000\n";
+        let cfg = AgoraConfig::parse(text, "dcdt.cfg").unwrap();
+        let net = NetConfig::from_agora_config(&cfg).unwrap();
+        assert_eq!(net.listen, ["tcp/192.168.0.1:2003", "tcp/192.168.0.1:3000"]);
+        assert_eq!(net.connect, ["tcp/192.168.1.1:3000"]);
+        assert_eq!(net.multicast.as_deref(), Some("225.0.0.1:2003"));
+        assert!(!net.bridge && !net.gossip);
+        net.zenoh_config().unwrap();
+        let bridge = AgoraConfig::parse(
+            "10.0.0.1 224.0.0.5 2003\nip bridge 1 10.0.0.1 3001 10.0.1.1 3001\n",
+            "b.cfg",
+        )
+        .unwrap();
+        assert!(NetConfig::from_agora_config(&bridge).unwrap().bridge);
+        let lan = AgoraConfig::parse("10.0.0.1 224.0.0.5 2003\n", "lan.cfg").unwrap();
+        let lan = NetConfig::from_agora_config(&lan).unwrap();
+        assert!(lan.gossip && lan.connect.is_empty(), "discovery on the LAN");
+        let ser = AgoraConfig::parse("10.0.0.1 224.0.0.5 2003\nser link 0 /dev/ttyS0\n", "s.cfg")
+            .unwrap();
+        let e = NetConfig::from_agora_config(&ser).unwrap_err().to_string();
+        assert!(e.contains("/dev/ttyS0") && e.contains("serial"), "{e}");
+    }
+}
