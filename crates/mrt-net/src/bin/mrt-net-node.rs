@@ -1,0 +1,178 @@
+//! `mrt-net-node`: one Agora on the network, for the multi-process tests and for trying links
+//! by hand. It prints what happens, one line each: `up <ids>` when the Finder's view changes,
+//! `got <agora> <seq>` per Ping received, `stats ...` at the end.
+//!
+//! ```text
+//! mrt-net-node --id 1 --listen 7451 --send 100           # sends 100 Pings once somebody wants them
+//! mrt-net-node --id 2 --listen 7452 --connect 7451 --recv
+//! mrt-net-node --id 3 --config configs/dcdt/same_machine_2.cfg --recv
+//! ```
+#![allow(clippy::print_stdout)]
+
+use mrt_core::SimClock;
+use mrt_dcdt::config::AgoraConfig;
+use mrt_dcdt::prelude::*;
+use mrt_net::{NetConfig, NetLink};
+use std::io::Write;
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+/// The test message: who sent it and its sequence number.
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
+struct Ping {
+    seq: u64,
+}
+
+impl Message for Ping {
+    const TYPE: MsgType = MsgType(0x4E45_5401);
+    const NAME: &'static str = "NetPing";
+}
+
+struct Sender {
+    left: Arc<AtomicU64>,
+    seq: u64,
+    period_ticks: u64,
+    tick: u64,
+}
+
+impl Member for Sender {
+    fn do_your_job(&mut self, ctx: &mut Context<'_>) -> Result<(), MemberError> {
+        self.tick += 1;
+        if self.tick % self.period_ticks != 0 || !ctx.has_subscribers(Ping::TYPE) {
+            return Ok(());
+        }
+        if self.left.load(Ordering::Relaxed) > 0 {
+            self.left.fetch_sub(1, Ordering::Relaxed);
+            self.seq += 1;
+            ctx.publish_with(Ping { seq: self.seq }, DeliveryWarranty::Reliable, 0);
+        }
+        Ok(())
+    }
+}
+
+struct Receiver;
+
+impl Member for Receiver {
+    fn init(&mut self, ctx: &mut Context<'_>) -> Result<(), MemberError> {
+        ctx.subscribe_to::<Ping>(RequestType::Remote);
+        Ok(())
+    }
+
+    fn do_your_job(&mut self, ctx: &mut Context<'_>) -> Result<(), MemberError> {
+        let mut out = std::io::stdout().lock();
+        while let Some(m) = ctx.receive_msg() {
+            let p = m.get::<Ping>()?;
+            let _ = writeln!(out, "got {} {}", m.agora_id().0, p.seq);
+        }
+        let _ = out.flush();
+        Ok(())
+    }
+}
+
+struct Args {
+    id: u32,
+    net: NetConfig,
+    send: u64,
+    every_ms: u64,
+    recv: bool,
+    duration: Duration,
+}
+
+fn parse() -> Result<Args, String> {
+    let mut a = std::env::args().skip(1);
+    let (mut id, mut listen, mut connect, mut config) = (None, None, Vec::new(), None);
+    let (mut send, mut every_ms, mut recv, mut bridge, mut secs) = (0, 10, false, false, 10.0);
+    let num = |v: Option<String>, what: &str| -> Result<u64, String> {
+        v.ok_or(format!("{what} needs a value"))?.parse().map_err(|e| format!("{what}: {e}"))
+    };
+    while let Some(flag) = a.next() {
+        match flag.as_str() {
+            "--id" => id = Some(num(a.next(), "--id")? as u32),
+            "--listen" => listen = Some(num(a.next(), "--listen")? as u16),
+            "--connect" => connect.push(num(a.next(), "--connect")? as u16),
+            "--config" => config = Some(a.next().ok_or("--config needs a file")?),
+            "--send" => send = num(a.next(), "--send")?,
+            "--every-ms" => every_ms = num(a.next(), "--every-ms")?.max(1),
+            "--recv" => recv = true,
+            "--bridge" => bridge = true,
+            "--seconds" => {
+                secs = a
+                    .next()
+                    .ok_or("--seconds needs a value")?
+                    .parse()
+                    .map_err(|e| format!("--seconds: {e}"))?
+            }
+            other => return Err(format!("unknown option {other}")),
+        }
+    }
+    let id = id.ok_or("--id is required")?;
+    let mut net = match (config, listen) {
+        (Some(file), _) => {
+            let cfg = AgoraConfig::from_file(&file).map_err(|e| e.to_string())?;
+            NetConfig::from_agora_config(&cfg).map_err(|e| e.to_string())?
+        }
+        (None, Some(port)) => NetConfig::loopback(port, &connect),
+        (None, None) => return Err("--listen PORT or --config FILE is required".into()),
+    };
+    net.bridge |= bridge;
+    Ok(Args { id, net, send, every_ms, recv, duration: Duration::from_secs_f64(secs) })
+}
+
+fn main() {
+    let args = match parse() {
+        Ok(a) => a,
+        Err(e) => {
+            eprintln!("mrt-net-node: {e}");
+            std::process::exit(2);
+        }
+    };
+    if let Err(e) = run(&args) {
+        eprintln!("mrt-net-node: {e}");
+        std::process::exit(1);
+    }
+}
+
+fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
+    let tick = Duration::from_millis(1);
+    let mut exec = SteppedExecutor::new(SimClock::new(), tick);
+    let mut agora = exec.agora_builder(args.id).build()?;
+    let left = Arc::new(AtomicU64::new(args.send));
+    if args.send > 0 {
+        let s = Sender { left: left.clone(), seq: 0, period_ticks: args.every_ms, tick: 0 };
+        let m = agora.add_member(s, Activation::Periodic(tick));
+        agora.activate_member(m)?;
+    }
+    if args.recv {
+        let m = agora.add_member(Receiver, Activation::OnMessage);
+        agora.activate_member(m)?;
+    }
+    let link = NetLink::attach(&agora, &args.net)?;
+    exec.add_agora(agora)?;
+    let start = Instant::now();
+    let mut seen = Vec::new();
+    let mut drained_at: Option<Instant> = None;
+    while start.elapsed() < args.duration {
+        exec.run_for(tick);
+        let up = link.agoras();
+        if up != seen {
+            let ids: Vec<String> = up.iter().map(|a| a.0.to_string()).collect();
+            println!("up {}", ids.join(" "));
+            seen = up;
+        }
+        // A sender stops half a second after its last message.
+        if args.send > 0 && !args.recv && left.load(Ordering::Relaxed) == 0 {
+            let t = *drained_at.get_or_insert_with(Instant::now);
+            if t.elapsed() > Duration::from_millis(500) {
+                break;
+            }
+        }
+        std::thread::sleep(tick);
+    }
+    let s = link.stats();
+    println!(
+        "stats sent={} delivered={} malformed={} unwanted={} duplicates={}",
+        s.sent, s.delivered, s.malformed, s.unwanted, s.duplicates
+    );
+    Ok(())
+}
