@@ -41,8 +41,11 @@ fn endpoint(ip: IpAddr, port: u16) -> String {
 impl NetConfig {
     /// The endpoints of a configuration file (module table in the crate doc).
     pub fn from_agora_config(cfg: &AgoraConfig) -> Result<NetConfig, NetError> {
+        // The network line's port is the discovery port (§3.3.1): the Agora itself listens
+        // on an ephemeral port that scouting advertises, so that several Agoras of one
+        // machine can share the line. `ip` channels add their fixed ports.
         let mut net = NetConfig {
-            listen: vec![endpoint(cfg.local_ip, cfg.port)],
+            listen: vec![endpoint(cfg.local_ip, 0)],
             connect: Vec::new(),
             multicast: Some(match cfg.multicast {
                 IpAddr::V4(m) => format!("{m}:{}", cfg.port),
@@ -129,7 +132,7 @@ mod tests {
                     ip link 0 192.168.0.1 3000 192.168.1.1 3000\n";
         let cfg = AgoraConfig::parse(text, "dcdt.cfg").unwrap();
         let net = NetConfig::from_agora_config(&cfg).unwrap();
-        assert_eq!(net.listen, ["tcp/192.168.0.1:2003", "tcp/192.168.0.1:3000"]);
+        assert_eq!(net.listen, ["tcp/192.168.0.1:0", "tcp/192.168.0.1:3000"]);
         assert_eq!(net.connect, ["tcp/192.168.1.1:3000"]);
         assert_eq!(net.multicast.as_deref(), Some("225.0.0.1:2003"));
         assert!(!net.bridge && !net.gossip);

@@ -7,7 +7,7 @@
 //!
 //! | manual | here |
 //! |---|---|
-//! | network line `<ip> <multicast> <port>` | zenoh listens on `tcp/<ip>:<port>`; multicast scouting on `<multicast>:<port>` |
+//! | network line `<ip> <multicast> <port>` | multicast scouting on `<multicast>:<port>` (the Finder); the Agora listens on `tcp/<ip>:<ephemeral port>`, which scouting advertises (so that several Agoras of one machine share the line) |
 //! | `ip link/bridge <lev> <laddr> <lport> <raddr> <rport>` | listen on `tcp/<laddr>:<lport>`, connect to `tcp/<raddr>:<rport>` |
 //! | `link` | a zenoh **peer**: sends what its Members create, forwards nothing |
 //! | `bridge` | a zenoh **router**: zenoh forwards data and declarations between the networks it joins, over a loop-free route |

