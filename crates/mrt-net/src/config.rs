@@ -26,6 +26,9 @@ pub enum NetError {
     /// A `ser` channel: this build has no serial transport.
     #[error("serial channel {0}: this build of mrt-net has no serial transport (zenoh's `transport_serial`)")]
     NoSerial(String),
+    /// The Agora was not built from a configuration file.
+    #[error("Agora {0} is STANDALONE: build it with Agora::from_config(file, id) to put it on a network")]
+    Standalone(u32),
     /// zenoh refused the configuration or could not open the session.
     #[error("zenoh: {0}")]
     Zenoh(String),

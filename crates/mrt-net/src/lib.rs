@@ -39,3 +39,20 @@ mod link;
 
 pub use config::{NetConfig, NetError};
 pub use link::{NetLink, NetStats};
+
+/// Joins a NETWORK Agora (built by `Agora::from_config(file, id)`) to the network its
+/// configuration file describes.
+///
+/// ```no_run
+/// let agora = mrt_dcdt::Agora::from_config("configs/dcdt/same_machine.cfg", 1)?;
+/// let link = mrt_net::connect(&agora)?;
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
+pub fn connect(agora: &mrt_dcdt::Agora) -> Result<NetLink, NetError> {
+    match agora.mode() {
+        mrt_dcdt::AgoraMode::Network(cfg) => {
+            NetLink::attach(agora, &NetConfig::from_agora_config(cfg)?)
+        }
+        mrt_dcdt::AgoraMode::Standalone => Err(NetError::Standalone(agora.id().0)),
+    }
+}

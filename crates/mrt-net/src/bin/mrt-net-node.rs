@@ -5,7 +5,8 @@
 //! ```text
 //! mrt-net-node --id 1 --listen 7451 --send 100           # sends 100 Pings once somebody wants them
 //! mrt-net-node --id 2 --listen 7452 --connect 7451 --recv
-//! mrt-net-node --id 3 --config configs/dcdt/same_machine_2.cfg --recv
+//! mrt-net-node --id 3 --config configs/dcdt/same_machine.cfg --recv
+//! mrt-net-node --id 9 --listen 7459 --connect 7451 --echo     # the benchmark's echo
 //! ```
 #![allow(clippy::print_stdout)]
 
@@ -70,7 +71,73 @@ impl Member for Receiver {
     }
 }
 
+/// The benchmark's probe and its echo (payload as given).
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
+struct Probe(Vec<u8>);
+
+impl Message for Probe {
+    const TYPE: MsgType = MsgType(0x4E45_5402);
+    const NAME: &'static str = "NetProbe";
+}
+
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
+struct Echo(Vec<u8>);
+
+impl Message for Echo {
+    const TYPE: MsgType = MsgType(0x4E45_5403);
+    const NAME: &'static str = "NetEcho";
+}
+
+/// Sends every Probe back as an Echo.
+struct Echoer;
+
+impl Member for Echoer {
+    fn init(&mut self, ctx: &mut Context<'_>) -> Result<(), MemberError> {
+        ctx.subscribe_to::<Probe>(RequestType::Remote);
+        Ok(())
+    }
+
+    fn do_your_job(&mut self, ctx: &mut Context<'_>) -> Result<(), MemberError> {
+        while let Some(m) = ctx.receive_msg() {
+            let p = m.get::<Probe>()?;
+            ctx.publish(Echo(p.0.clone()));
+        }
+        Ok(())
+    }
+}
+
+/// The echo side of the benchmark: an Agora echoing Probes (threaded executor: a Member wakes
+/// as a message arrives), and a plain zenoh subscriber echoing `raw/ping` to `raw/pong` on
+/// the same session, for comparison.
+fn echo(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
+    use zenoh::Wait;
+    let mut agora = mrt_dcdt::Agora::builder(args.id).build()?;
+    let m = agora.add_member(Echoer, Activation::OnMessage);
+    agora.activate_member(m)?;
+    let link = NetLink::attach(&agora, &args.net)?;
+    let session = link.session().clone();
+    let z = |e: zenoh::Error| e.to_string();
+    let publisher = session.declare_publisher("raw/pong").express(true).wait().map_err(z)?;
+    let _raw = session
+        .declare_subscriber("raw/ping")
+        .callback(move |s| {
+            let _ = publisher.put(s.payload().clone()).wait();
+        })
+        .wait()
+        .map_err(z)?;
+    println!("echo ready");
+    let stop = agora.shutdown_handle();
+    let duration = args.duration;
+    std::thread::spawn(move || {
+        std::thread::sleep(duration);
+        stop.shutdown();
+    });
+    agora.lets_work()?;
+    Ok(())
+}
+
 struct Args {
+    echo: bool,
     id: u32,
     net: NetConfig,
     send: u64,
@@ -83,6 +150,7 @@ fn parse() -> Result<Args, String> {
     let mut a = std::env::args().skip(1);
     let (mut id, mut listen, mut connect, mut config) = (None, None, Vec::new(), None);
     let (mut send, mut every_ms, mut recv, mut bridge, mut secs) = (0, 10, false, false, 10.0);
+    let mut echo = false;
     let num = |v: Option<String>, what: &str| -> Result<u64, String> {
         v.ok_or(format!("{what} needs a value"))?.parse().map_err(|e| format!("{what}: {e}"))
     };
@@ -96,6 +164,7 @@ fn parse() -> Result<Args, String> {
             "--every-ms" => every_ms = num(a.next(), "--every-ms")?.max(1),
             "--recv" => recv = true,
             "--bridge" => bridge = true,
+            "--echo" => echo = true,
             "--seconds" => {
                 secs = a
                     .next()
@@ -116,7 +185,7 @@ fn parse() -> Result<Args, String> {
         (None, None) => return Err("--listen PORT or --config FILE is required".into()),
     };
     net.bridge |= bridge;
-    Ok(Args { id, net, send, every_ms, recv, duration: Duration::from_secs_f64(secs) })
+    Ok(Args { echo, id, net, send, every_ms, recv, duration: Duration::from_secs_f64(secs) })
 }
 
 fn main() {
@@ -127,7 +196,8 @@ fn main() {
             std::process::exit(2);
         }
     };
-    if let Err(e) = run(&args) {
+    let result = if args.echo { echo(&args) } else { run(&args) };
+    if let Err(e) = result {
         eprintln!("mrt-net-node: {e}");
         std::process::exit(1);
     }

@@ -1,0 +1,122 @@
+//! Two Agoras in two processes over zenoh on loopback, against a plain zenoh
+//! publisher/subscriber pair on the same sessions, in the same run: round-trip latency
+//! (one probe, wait for its echo) and throughput (100 probes in flight, then their echoes),
+//! for 64-byte and 1 KiB payloads. The echo process is `mrt-net-node --echo`.
+#![allow(missing_docs, clippy::unwrap_used, clippy::expect_used)]
+
+use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
+use mrt_dcdt::prelude::*;
+use mrt_net::{NetConfig, NetLink};
+use std::io::{BufRead, BufReader};
+use std::process::{Command, Stdio};
+use std::time::Duration;
+use zenoh::Wait;
+
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
+struct Probe(Vec<u8>);
+impl Message for Probe {
+    const TYPE: MsgType = MsgType(0x4E45_5402);
+    const NAME: &'static str = "NetProbe";
+}
+
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
+struct Echo(Vec<u8>);
+impl Message for Echo {
+    const TYPE: MsgType = MsgType(0x4E45_5403);
+    const NAME: &'static str = "NetEcho";
+}
+
+const WINDOW: u64 = 100;
+
+fn free_port() -> u16 {
+    std::net::TcpListener::bind("127.0.0.1:0").unwrap().local_addr().unwrap().port()
+}
+
+fn bench(c: &mut Criterion) {
+    let (p1, p2) = (free_port(), free_port());
+    let mut agora = mrt_dcdt::Agora::builder(1).build().unwrap();
+    let mut ep = agora.endpoint();
+    ep.subscribe_to::<Echo>(RequestType::Remote);
+    let link = NetLink::attach(&agora, &NetConfig::loopback(p1, &[])).unwrap();
+    let node = env!("CARGO_BIN_EXE_mrt-net-node");
+    let (p1s, p2s) = (p1.to_string(), p2.to_string());
+    let mut echo = Command::new(node)
+        .args(["--id", "2", "--listen", &p2s, "--connect", &p1s, "--echo", "--seconds", "3600"])
+        .stdout(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut ready = String::new();
+    BufReader::new(echo.stdout.take().unwrap()).read_line(&mut ready).unwrap();
+    assert!(link.wait_until(Duration::from_secs(10), |l| l.remote_wants(Probe::TYPE)));
+    // Raw zenoh on the same session.
+    let session = link.session().clone();
+    let raw_pub = session.declare_publisher("raw/ping").express(true).wait().unwrap();
+    let (tx, rx) = std::sync::mpsc::channel::<usize>();
+    let _raw_sub = session
+        .declare_subscriber("raw/pong")
+        .callback(move |s| {
+            let _ = tx.send(s.payload().len());
+        })
+        .wait()
+        .unwrap();
+    // Warm both paths up.
+    loop {
+        raw_pub.put(vec![0u8; 8]).wait().unwrap();
+        if rx.recv_timeout(Duration::from_millis(100)).is_ok() {
+            break;
+        }
+    }
+    ep.publish(Probe(vec![0; 8]));
+    assert!(ep.wait_msg(Duration::from_secs(5)) && ep.receive_msg().is_some(), "no echo");
+
+    let mrt_round = |ep: &mut mrt_dcdt::Endpoint, payload: &[u8], n: u64| {
+        for _ in 0..n {
+            ep.publish(Probe(payload.to_vec()));
+        }
+        let mut got = 0;
+        while got < n {
+            while ep.receive_msg().is_some() {
+                got += 1;
+            }
+            if got < n {
+                assert!(ep.wait_msg(Duration::from_secs(5)), "echo lost");
+            }
+        }
+    };
+    let raw_round = |payload: &[u8], n: u64| {
+        for _ in 0..n {
+            raw_pub.put(payload.to_vec()).wait().unwrap();
+        }
+        for _ in 0..n {
+            rx.recv_timeout(Duration::from_secs(5)).expect("echo lost");
+        }
+    };
+    for size in [64usize, 1024] {
+        let payload = vec![7u8; size];
+        let mut g = c.benchmark_group(format!("round_trip_{size}B"));
+        g.bench_function(BenchmarkId::new("mrt", size), |b| {
+            b.iter(|| mrt_round(&mut ep, &payload, 1))
+        });
+        g.bench_function(BenchmarkId::new("zenoh", size), |b| b.iter(|| raw_round(&payload, 1)));
+        g.finish();
+        let mut g = c.benchmark_group(format!("throughput_{size}B"));
+        g.throughput(Throughput::Elements(WINDOW));
+        g.bench_function(BenchmarkId::new("mrt", size), |b| {
+            b.iter(|| mrt_round(&mut ep, &payload, WINDOW))
+        });
+        g.bench_function(BenchmarkId::new("zenoh", size), |b| {
+            b.iter(|| raw_round(&payload, WINDOW))
+        });
+        g.finish();
+    }
+    let _ = echo.kill();
+    let _ = echo.wait();
+    drop(agora);
+}
+
+criterion_group! {
+    name = benches;
+    config = Criterion::default().sample_size(30).warm_up_time(Duration::from_millis(500)).measurement_time(Duration::from_secs(3));
+    targets = bench
+}
+criterion_main!(benches);
