@@ -31,7 +31,8 @@
 //! the Chaos robots `WorldState` measures distances from the robot's edge and `Guide` scales the
 //! behaviors' AIBO-sized set-points before guiding them (see [`crate::teams`]).
 
-use crate::drivers::{Base, MotorDriver, SimulatedAirboard};
+use crate::devices::{Devices, PitchDevices, SharedDevices};
+use crate::drivers::Base;
 use crate::game::{guide, Brain, MatchReport, Pitch};
 use crate::referee::Call;
 use crate::sensor::{merge_team, CameraFrame, Odometry};
@@ -40,14 +41,14 @@ use crate::worldstate::WorldModel;
 use mrt_core::robot::{RobotCommand, WorldSnapshot};
 use mrt_core::SimClock;
 use mrt_dcdt::{
-    Activation, Context, InnerLinkManager, Member, MemberError, Message, MsgType, RequestType,
-    SteppedExecutor, RESERVED_TYPES_START,
+    Activation, Agora, Context, InnerLinkManager, Member, MemberError, Message, MsgType,
+    RequestType, RunReport, SteppedExecutor, RESERVED_TYPES_START,
 };
 use mrt_plan::guidance::Sonar;
 use mrt_plan::guide::Guidance;
 use mrt_script::member::{BehaviorMember, BehaviorStatus};
 use std::collections::BTreeMap;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex, MutexGuard};
 use std::time::Duration;
 
@@ -97,13 +98,13 @@ fn lock_pitch(p: &Shared) -> Result<MutexGuard<'_, Pitch>, String> {
     p.lock().map_err(|_| "the pitch lock is poisoned".to_string())
 }
 
-fn lock(p: &Shared) -> Result<MutexGuard<'_, Pitch>, MemberError> {
-    p.lock().map_err(|_| MemberError::from("the pitch lock is poisoned"))
+fn lock(d: &SharedDevices) -> Result<MutexGuard<'_, dyn Devices + 'static>, MemberError> {
+    d.lock().map_err(|_| MemberError::from("the devices lock is poisoned"))
 }
 
 /// The odometry driver of one robot: the mice and the wheels since the last cycle.
 struct OdometryDriver {
-    pitch: Shared,
+    devices: SharedDevices,
     robot: usize,
 }
 
@@ -113,7 +114,7 @@ impl Member for OdometryDriver {
     }
 
     fn do_your_job(&mut self, ctx: &mut Context<'_>) -> Result<(), MemberError> {
-        let odometry = lock(&self.pitch)?.odometry(self.robot);
+        let odometry = lock(&self.devices)?.odometry()?;
         ctx.publish(odometry);
         Ok(())
     }
@@ -121,7 +122,7 @@ impl Member for OdometryDriver {
 
 /// The camera driver of one robot (the object sensor), with the game controller's news.
 struct CameraDriver {
-    pitch: Shared,
+    devices: SharedDevices,
     robot: usize,
 }
 
@@ -131,7 +132,7 @@ impl Member for CameraDriver {
     }
 
     fn do_your_job(&mut self, ctx: &mut Context<'_>) -> Result<(), MemberError> {
-        let frame = lock(&self.pitch)?.camera(self.robot);
+        let frame = lock(&self.devices)?.camera()?;
         ctx.publish(frame);
         Ok(())
     }
@@ -187,7 +188,7 @@ impl Member for WorldState {
 
 /// The sonar ring's driver of one robot.
 struct Sonars {
-    pitch: Shared,
+    devices: SharedDevices,
     robot: usize,
 }
 
@@ -197,7 +198,7 @@ impl Member for Sonars {
     }
 
     fn do_your_job(&mut self, ctx: &mut Context<'_>) -> Result<(), MemberError> {
-        let sonars = lock(&self.pitch)?.sonar(self.robot);
+        let sonars = lock(&self.devices)?.sonars()?;
         ctx.publish(SonarScan { sonars });
         Ok(())
     }
@@ -247,10 +248,9 @@ impl Member for Guide {
 /// The motor and kicker driver of one robot: commands become duty cycles for its motor
 /// driver (the processing side of the AIRBoard), kick requests fire the kicker.
 struct Motor {
-    pitch: Shared,
+    devices: SharedDevices,
     robot: usize,
     base: Base,
-    driver: Box<dyn MotorDriver>,
 }
 
 impl Member for Motor {
@@ -269,9 +269,10 @@ impl Member for Motor {
             last = Some(m.get::<MotorCommand>()?.0.clone());
         }
         if let Some(cmd) = last {
-            self.driver.set_duty(&self.base.duties(&cmd)).map_err(|e| e.to_string())?;
+            let mut devices = lock(&self.devices)?;
+            devices.set_duty(&self.base.duties(&cmd))?;
             if cmd.kick.is_some() {
-                lock(&self.pitch)?.kick(self.robot);
+                devices.kick()?;
             }
         }
         Ok(())
@@ -281,7 +282,7 @@ impl Member for Motor {
 /// Books a robot's script errors (its behavior Member's `BehaviorStatus`) against the robot,
 /// as a referee's assistant would note a robot that stopped.
 struct FaultBook {
-    pitch: Shared,
+    devices: SharedDevices,
     robot: usize,
 }
 
@@ -298,7 +299,7 @@ impl Member for FaultBook {
     fn do_your_job(&mut self, ctx: &mut Context<'_>) -> Result<(), MemberError> {
         while let Some(m) = ctx.receive_msg() {
             if let Some(e) = m.get::<BehaviorStatus>()?.errors.first() {
-                lock(&self.pitch)?.fault(self.robot, 1, e);
+                lock(&self.devices)?.fault(e)?;
             }
         }
         Ok(())
@@ -335,6 +336,130 @@ impl Member for BrainMember {
     }
 }
 
+/// One robot of a match: which robot it is (0 .. 2 × team size: home, then away), whether it
+/// keeps goal and which behavior stack drives it. Its Agora's id is `robot + 1`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct RobotSpec {
+    /// The robot.
+    pub robot: usize,
+    /// Keeps goal (robot 0 of each team).
+    pub keeper: bool,
+    /// What drives it.
+    pub stack: Stack,
+}
+
+impl RobotSpec {
+    /// Robot `robot` of a match with `team_size` robots a side, the home team playing `home`
+    /// and the away team `away`.
+    pub fn of(robot: usize, team_size: usize, (home, away): (Stack, Stack)) -> RobotSpec {
+        let n = team_size.max(1);
+        RobotSpec { robot, keeper: robot % n == 0, stack: if robot < n { home } else { away } }
+    }
+
+    /// The id of the robot's Agora.
+    pub fn agora_id(&self) -> Result<u32, String> {
+        u32::try_from(self.robot + 1).map_err(|e| e.to_string())
+    }
+}
+
+/// Puts one robot's Members into `agora`, activated: the drivers of its `devices`, its world
+/// state, its behaviors (the TeamChaos files of `behaviors` for the Chaos stack), guidance,
+/// motor and fault book (module doc). The same robot code runs on a pitch in this process
+/// ([`BusMatch`]) and on a simulator in another one ([`crate::remote::RemoteRobot`]).
+pub fn add_robot(
+    agora: &mut Agora,
+    cfg: &crate::config::SimConfig,
+    spec: &RobotSpec,
+    behaviors: &Path,
+    devices: SharedDevices,
+) -> Result<(), String> {
+    let RobotSpec { robot, keeper, stack } = *spec;
+    let period = Duration::from_secs_f64(cfg.rules.control_period);
+    let every = Activation::Periodic(period);
+    let body = if stack == Stack::Chaos { Body::chaos(cfg) } else { Body::PLAIN };
+    let model = WorldModel::of_config(cfg)?;
+    let base = Base::parse(&cfg.robot.base)?;
+    let dev = || devices.clone();
+    let mut ids = vec![
+        agora.add_member(OdometryDriver { devices: dev(), robot }, every),
+        agora.add_member(CameraDriver { devices: dev(), robot }, every),
+        agora.add_member(WorldState { robot, keeper, body, model, mates: BTreeMap::new() }, every),
+        agora.add_member(Sonars { devices: dev(), robot }, every),
+    ];
+    ids.push(match stack {
+        Stack::Chaos if keeper => {
+            agora.add_member(BehaviorMember::hbm(behaviors, CHAOS_KEEPER), every)
+        }
+        Stack::Chaos => {
+            agora.add_member(BehaviorMember::hfsm(behaviors, behaviors.join(CHAOS_PLAYER)), every)
+        }
+        other => agora.add_member(BrainMember::new(send_brain(other, keeper, cfg)?), every),
+    });
+    let guidance = cfg.guidance()?;
+    let scan = SonarScan::default();
+    let guide = Guide { robot, body, guidance, world: WorldSnapshot::default(), scan };
+    ids.push(agora.add_member(guide, Activation::OnMessage));
+    ids.push(agora.add_member(Motor { devices: dev(), robot, base }, Activation::OnMessage));
+    ids.push(agora.add_member(FaultBook { devices, robot }, Activation::OnMessage));
+    for m in ids {
+        agora.activate_member(m).map_err(|e| e.to_string())?;
+    }
+    Ok(())
+}
+
+/// The TeamChaos files robots of `stacks` run: `behaviors`, or the compiled-in ones when the
+/// Chaos stack plays (nothing otherwise).
+pub fn behaviors_dir(stacks: &[Stack], behaviors: Option<&Path>) -> Result<PathBuf, String> {
+    match behaviors {
+        Some(d) => Ok(d.to_path_buf()),
+        None if stacks.contains(&Stack::Chaos) => embedded_teamchaos(),
+        None => Ok(PathBuf::new()),
+    }
+}
+
+/// A Member of a robot's Agora that failed to start, failed jobs or panicked (each time it was
+/// restarted), from its executor's report; booked against the robot when the match ends.
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct MemberFault {
+    /// The Member's name.
+    pub name: String,
+    /// Errors, panics and restarts (at least 1).
+    pub count: u64,
+    /// Whether it never completed a cycle (it failed from the start).
+    pub never_ran: bool,
+    /// Its last error.
+    pub error: String,
+}
+
+impl MemberFault {
+    /// The faulty Members of one Agora's report.
+    pub fn of_report(report: &RunReport) -> Vec<MemberFault> {
+        report
+            .members
+            .iter()
+            .filter_map(|m| {
+                Some(MemberFault {
+                    name: m.name.clone(),
+                    count: m.errors + m.panics + m.restarts.max(1),
+                    never_ran: m.cycles == 0,
+                    error: m.last_error.clone()?,
+                })
+            })
+            .collect()
+    }
+
+    /// Books it against robot `robot`.
+    pub fn book(&self, pitch: &mut Pitch, robot: usize) {
+        let first_at = self.never_ran.then_some(0.0);
+        pitch.fault_at(
+            robot,
+            first_at,
+            self.count,
+            &format!("member {}: {}", self.name, self.error),
+        );
+    }
+}
+
 /// A match whose robots are Agoras on the bus.
 pub struct BusMatch {
     pitch: Shared,
@@ -359,70 +484,22 @@ impl BusMatch {
         let pitch = Arc::new(Mutex::new(pitch));
         let period = Duration::from_secs_f64(cfg.rules.control_period);
         let mut exec = SteppedExecutor::new(SimClock::new(), period);
-        let chaos_plays = home == Stack::Chaos || away == Some(Stack::Chaos);
-        let dir = match behaviors {
-            Some(d) => d.to_path_buf(),
-            None if chaos_plays => embedded_teamchaos()?,
-            None => std::path::PathBuf::new(),
-        };
-        let chaos_body = Body::chaos(cfg);
+        let stacks: Vec<Stack> = [Some(home), away].into_iter().flatten().collect();
+        let dir = behaviors_dir(&stacks, behaviors)?;
         let mut links = Vec::new();
-        for (t, stack) in [Some(home), away].into_iter().enumerate() {
-            let Some(stack) = stack else { continue };
+        for _ in &stacks {
             let team_link = InnerLinkManager::new();
             links.push(team_link.clone());
-            for k in 0..n {
-                let robot = t * n + k;
-                let id = u32::try_from(robot + 1).map_err(|e| e.to_string())?;
+            for _ in 0..n {
+                let robot = exec.agoras().count();
+                let spec = RobotSpec::of(robot, n, (home, away.unwrap_or(home)));
                 let mut agora = exec
-                    .agora_builder(id)
+                    .agora_builder(spec.agora_id()?)
                     .inner_link(&team_link)
                     .build()
                     .map_err(|e| e.to_string())?;
-                let every = Activation::Periodic(period);
-                let body = if stack == Stack::Chaos { chaos_body } else { Body::PLAIN };
-                let model = lock_pitch(&pitch)?.world_model();
-                let odometry = OdometryDriver { pitch: pitch.clone(), robot };
-                let camera = CameraDriver { pitch: pitch.clone(), robot };
-                let state =
-                    WorldState { robot, keeper: k == 0, body, model, mates: BTreeMap::new() };
-                let mut ids = vec![
-                    agora.add_member(odometry, every),
-                    agora.add_member(camera, every),
-                    agora.add_member(state, every),
-                ];
-                ids.push(agora.add_member(Sonars { pitch: pitch.clone(), robot }, every));
-                ids.push(match stack {
-                    Stack::Chaos if k == 0 => {
-                        agora.add_member(BehaviorMember::hbm(&dir, CHAOS_KEEPER), every)
-                    }
-                    Stack::Chaos => {
-                        agora.add_member(BehaviorMember::hfsm(&dir, dir.join(CHAOS_PLAYER)), every)
-                    }
-                    other => {
-                        agora.add_member(BrainMember::new(send_brain(other, k == 0, cfg)?), every)
-                    }
-                });
-                let (base, guidance) = {
-                    let p = lock_pitch(&pitch)?;
-                    (p.base(), p.guidance())
-                };
-                let guide = Guide {
-                    robot,
-                    body,
-                    guidance,
-                    world: WorldSnapshot::default(),
-                    scan: SonarScan::default(),
-                };
-                ids.push(agora.add_member(guide, Activation::OnMessage));
-                let driver = Box::new(SimulatedAirboard::new(pitch.clone(), robot, base));
-                let motor = Motor { pitch: pitch.clone(), robot, base, driver };
-                ids.push(agora.add_member(motor, Activation::OnMessage));
-                let book = FaultBook { pitch: pitch.clone(), robot };
-                ids.push(agora.add_member(book, Activation::OnMessage));
-                for m in ids {
-                    agora.activate_member(m).map_err(|e| e.to_string())?;
-                }
+                let devices = Arc::new(Mutex::new(PitchDevices::new(pitch.clone(), robot)?));
+                add_robot(&mut agora, cfg, &spec, &dir, devices)?;
                 exec.add_agora(agora).map_err(|e| e.to_string())?;
             }
         }
@@ -466,14 +543,9 @@ impl BusMatch {
             let mut pitch = lock_pitch(&self.pitch)?;
             for r in &reports {
                 let robot = usize::try_from(r.agora.0).unwrap_or(usize::MAX).wrapping_sub(1);
-                if robot >= pitch.world().robot_count() {
-                    continue; // a monitoring Agora, not a robot
-                }
-                for m in r.members.iter().filter(|m| m.last_error.is_some()) {
-                    let count = m.errors + m.panics + m.restarts.max(1);
-                    let why = m.last_error.as_deref().unwrap_or_default();
-                    let first_at = (m.cycles == 0).then_some(0.0);
-                    pitch.fault_at(robot, first_at, count, &format!("member {}: {why}", m.name));
+                if robot < pitch.world().robot_count() {
+                    // (not a monitoring Agora)
+                    MemberFault::of_report(r).iter().for_each(|f| f.book(&mut pitch, robot));
                 }
             }
         }

@@ -135,6 +135,8 @@ pub struct Pitch {
     frames: Vec<Frame>,
     record: bool,
     faults: Vec<RobotFault>,
+    /// Kicks asked this cycle, fired when the physics runs.
+    kicks: Vec<usize>,
 }
 
 const FNV_OFFSET: u64 = 0xcbf2_9ce4_8422_2325;
@@ -171,12 +173,7 @@ impl Pitch {
             })
             .collect();
         let mice = cfg.odometry.mice()?;
-        let model = WorldModel::new(
-            cfg.field.map(),
-            mice,
-            cfg.sensor.distance_noise,
-            cfg.sensor.bearing_noise,
-        );
+        let model = WorldModel::of_config(cfg)?;
         Ok(Pitch {
             cfg: cfg.clone(),
             base: Base::parse(&cfg.robot.base)?,
@@ -195,6 +192,7 @@ impl Pitch {
             frames: Vec::new(),
             record: false,
             faults: Vec::new(),
+            kicks: Vec::new(),
         })
     }
 
@@ -296,13 +294,23 @@ impl Pitch {
         self.world.drive(i, if moving { drive } else { Drive::default() });
     }
 
-    /// Fires robot `i`'s kicker (only while `PLAYING`); a kick that reaches the ball counts as
-    /// a shot.
+    /// Fires robot `i`'s kicker (only while `PLAYING`) as the cycle's physics starts: every
+    /// robot senses the same world in a cycle, whichever acted before it, so a match does not
+    /// depend on the order in which robots run (in one process or in several; kicks of one
+    /// cycle fire in the order asked). A kick that reaches the ball counts as a shot.
     pub fn kick(&mut self, i: usize) {
-        if self.referee.state() == GameState::Playing && self.world.kick(i) {
-            let team = self.referee.team_of(i);
-            self.stats[team.index()].shots += 1;
-            self.shots.push((self.world.time(), i, self.world.ball()));
+        if !self.kicks.contains(&i) {
+            self.kicks.push(i);
+        }
+    }
+
+    fn fire_kicks(&mut self) {
+        for i in std::mem::take(&mut self.kicks) {
+            if self.referee.state() == GameState::Playing && self.world.kick(i) {
+                let team = self.referee.team_of(i);
+                self.stats[team.index()].shots += 1;
+                self.shots.push((self.world.time(), i, self.world.ball()));
+            }
         }
     }
 
@@ -320,6 +328,7 @@ impl Pitch {
     /// Returns the referee's calls.
     pub fn advance(&mut self) -> Vec<Call> {
         self.account();
+        self.fire_kicks();
         let steps =
             (self.cfg.rules.control_period / self.cfg.rules.physics_step).round().max(1.0) as usize;
         let mut calls = Vec::new();

@@ -24,10 +24,12 @@
 
 pub mod bus;
 pub mod config;
+pub mod devices;
 pub mod drivers;
 pub mod game;
 pub mod plot;
 pub mod referee;
+pub mod remote;
 pub mod sensor;
 pub mod teams;
 pub mod world;

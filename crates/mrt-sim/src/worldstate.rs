@@ -98,6 +98,18 @@ pub struct WorldModel {
 }
 
 impl WorldModel {
+    /// A robot's world model as it starts a match on the configured field: the field map, the
+    /// mice's geometry and the camera's noise from `cfg`, the pose unknown until it is put
+    /// down.
+    pub fn of_config(cfg: &crate::config::SimConfig) -> Result<WorldModel, String> {
+        Ok(WorldModel::new(
+            cfg.field.map(),
+            cfg.odometry.mice()?,
+            cfg.sensor.distance_noise,
+            cfg.sensor.bearing_noise,
+        ))
+    }
+
     /// A robot on `field` (the map, mm) with two mice `mice`, whose camera has the relative
     /// distance error `distance_noise` and the bearing error `bearing_noise` (rad), that does
     /// not know yet where it is.

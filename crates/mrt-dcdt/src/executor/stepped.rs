@@ -113,10 +113,11 @@ impl SteppedExecutor {
         }
     }
 
-    /// One tick. Returns `false` once every Agora has ended.
-    pub fn step(&mut self) -> bool {
+    /// Runs `init` of the Members of every Agora added since the last tick, now, without
+    /// running any job or moving the clock (the next [`step`](Self::step) does it otherwise).
+    /// For a robot whose subscriptions must be known to the network before its first cycle.
+    pub fn start(&mut self) {
         let now = self.clock.now();
-        // Members of newly added Agoras run `init` before any job of this tick.
         for i in 0..self.entries.len() {
             if !self.entries[i].started {
                 self.entries[i].started = true;
@@ -127,6 +128,13 @@ impl SteppedExecutor {
                 Self::dispatch_all(&self.entries);
             }
         }
+    }
+
+    /// One tick. Returns `false` once every Agora has ended.
+    pub fn step(&mut self) -> bool {
+        let now = self.clock.now();
+        // Members of newly added Agoras run `init` before any job of this tick.
+        self.start();
         for i in 0..self.entries.len() {
             if self.entries[i].exit.is_some() {
                 continue;

@@ -1,0 +1,684 @@
+//! The simulator and its robots in separate executors (processes, or machines) that talk over
+//! the bus: the distributed wiring of `mrt sim --distributed`.
+//!
+//! A robot runs exactly the Members of [`crate::bus`] ([`add_robot`]); only its devices
+//! differ: [`LinkedDevices`] instead of the pitch. The simulator ([`PitchServer`]) publishes one
+//! [`DeviceFrame`] per robot and control cycle (its odometry, camera frame and sonar ring, read
+//! in that order as the drivers would), each robot ([`RemoteRobot`]) runs one cycle on it and
+//! answers with a [`DeviceAct`] (the duty cycles its motor driver set, whether it kicked, the
+//! faults its fault book noted); when every robot answered, the simulator applies them in robot
+//! order and runs the physics up to the next cycle. At the final whistle ([`FinalWhistle`])
+//! each robot closes its Members and sends their faults ([`RobotEnd`]).
+//!
+//! **Same match as one process.** Every robot senses the world of the cycle's start (kicks
+//! fire when the physics runs, [`Pitch::kick`]), so the robots of a cycle may run in any order
+//! — but teammates' reports must arrive as they do on one bus, where robot `i` hears in cycle
+//! `k` the reports its lower-numbered teammates sent in cycle `k` and the others' of cycle
+//! `k − 1`. A [`RemoteRobot`] waits for exactly those reports (by their creation time) before it
+//! runs a cycle. With every robot answering in time the match is the single-process one, hash
+//! for hash; a robot that stays silent (killed, far too slow) is booked, left standing while it
+//! is silent, and not waited for again until it speaks: from then on the matches differ.
+//!
+//! The network is not here: each team's Agora of the simulator and each robot's Agora are
+//! given a link by the caller (`mrt-net` over zenoh in `mrt sim --distributed`). Each team is a
+//! network of its own, as on a real field, so a robot never hears the other team.
+
+use crate::bus::{add_robot, MateReport, MemberFault, RobotSpec};
+use crate::config::SimConfig;
+use crate::devices::LinkedDevices;
+use crate::drivers::Base;
+use crate::game::{MatchReport, Pitch};
+use crate::referee::Call;
+use crate::sensor::{CameraFrame, Odometry};
+use mrt_core::{SimClock, Time};
+use mrt_dcdt::config::AgoraConfig;
+use mrt_dcdt::{
+    Agora, DeliveryWarranty, Endpoint, InnerLinkManager, Message, MsgType, RequestType,
+    SteppedExecutor, RESERVED_TYPES_START,
+};
+use mrt_plan::guidance::Sonar;
+use std::collections::BTreeMap;
+use std::path::Path;
+use std::sync::{Arc, Mutex};
+use std::time::{Duration, Instant};
+
+/// What robot `robot`'s devices read at the start of control cycle `cycle`.
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct DeviceFrame {
+    /// The robot (0 .. 2 × team size).
+    pub robot: u32,
+    /// The control cycle (0 at kickoff of the first half).
+    pub cycle: u64,
+    /// The mice and wheels since the last cycle.
+    pub odometry: Odometry,
+    /// The object sensor's frame.
+    pub camera: CameraFrame,
+    /// The sonar ring.
+    pub sonars: Vec<Sonar>,
+}
+
+impl Message for DeviceFrame {
+    const TYPE: MsgType = MsgType(RESERVED_TYPES_START + 0x45);
+    const NAME: &'static str = "DeviceFrame";
+}
+
+/// What robot `robot`'s drivers did in control cycle `cycle`.
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct DeviceAct {
+    /// The robot.
+    pub robot: u32,
+    /// The control cycle answered.
+    pub cycle: u64,
+    /// The duty cycles the motor driver set last, if any.
+    pub duty: Option<Vec<f64>>,
+    /// Whether the kicker fired.
+    pub kick: bool,
+    /// Faults of the robot's software noted this cycle.
+    pub faults: Vec<String>,
+}
+
+impl Message for DeviceAct {
+    const TYPE: MsgType = MsgType(RESERVED_TYPES_START + 0x46);
+    const NAME: &'static str = "DeviceAct";
+}
+
+/// The match is over: robots close their Members and answer with a [`RobotEnd`].
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct FinalWhistle {
+    /// Control cycles played.
+    pub cycles: u64,
+}
+
+impl Message for FinalWhistle {
+    const TYPE: MsgType = MsgType(RESERVED_TYPES_START + 0x47);
+    const NAME: &'static str = "FinalWhistle";
+}
+
+/// A robot's last word: its Members that failed to start, failed jobs or panicked.
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct RobotEnd {
+    /// The robot.
+    pub robot: u32,
+    /// Its Members' faults.
+    pub faults: Vec<MemberFault>,
+}
+
+impl Message for RobotEnd {
+    const TYPE: MsgType = MsgType(RESERVED_TYPES_START + 0x48);
+    const NAME: &'static str = "RobotEnd";
+}
+
+/// How long the simulator waits for the robots.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Patience {
+    /// For every robot's answer to a cycle (a robot that misses it is booked as silent).
+    pub cycle: Duration,
+    /// For a robot that was silent, in each later cycle until it answers again.
+    pub silent: Duration,
+    /// For the robots' last words after the final whistle.
+    pub end: Duration,
+}
+
+impl Default for Patience {
+    fn default() -> Self {
+        Patience {
+            cycle: Duration::from_secs(5),
+            silent: Duration::from_millis(20),
+            end: Duration::from_secs(5),
+        }
+    }
+}
+
+/// The simulator's side: the pitch, and one endpoint on each team's Agora (module doc).
+pub struct PitchServer {
+    pitch: Arc<Mutex<Pitch>>,
+    /// One per team (home, away), with the team's Agora kept alive.
+    teams: Vec<(Agora, Endpoint)>,
+    base: Base,
+    robots: usize,
+    team_size: usize,
+    cycle: u64,
+    silent: Vec<bool>,
+    patience: Patience,
+}
+
+fn lock(p: &Arc<Mutex<Pitch>>) -> Result<std::sync::MutexGuard<'_, Pitch>, String> {
+    p.lock().map_err(|_| "the pitch lock is poisoned".to_string())
+}
+
+fn robot_index(id: u32) -> usize {
+    usize::try_from(id).unwrap_or(usize::MAX)
+}
+
+impl PitchServer {
+    /// A match from `seed` whose robots are reached through `teams`' Agoras (home, then away;
+    /// one Agora only: home alone on the field). Each Agora must be linked to the network of
+    /// its team's robots by the caller.
+    pub fn new(
+        cfg: &SimConfig,
+        seed: u64,
+        teams: Vec<Agora>,
+        patience: Patience,
+    ) -> Result<PitchServer, String> {
+        let n = cfg.rules.team_size;
+        if teams.is_empty() || teams.len() > 2 {
+            return Err(format!("a match has one or two teams, not {}", teams.len()));
+        }
+        let pitch = Pitch::new(cfg, seed, n, if teams.len() == 2 { n } else { 0 })?;
+        let base = Base::parse(&cfg.robot.base)?;
+        let pitch = Arc::new(Mutex::new(pitch));
+        let robots = n * teams.len();
+        let teams = teams
+            .into_iter()
+            .map(|mut agora| {
+                let ep = agora.endpoint();
+                ep.subscribe_to::<DeviceAct>(RequestType::Remote);
+                ep.subscribe_to::<RobotEnd>(RequestType::Remote);
+                (agora, ep)
+            })
+            .collect();
+        Ok(PitchServer {
+            pitch,
+            teams,
+            base,
+            robots,
+            team_size: n,
+            cycle: 0,
+            silent: vec![false; robots],
+            patience,
+        })
+    }
+
+    /// The robots of the match.
+    pub fn robots(&self) -> usize {
+        self.robots
+    }
+
+    /// Keeps one frame per control cycle for drawings.
+    pub fn record_frames(&mut self, on: bool) {
+        if let Ok(mut p) = self.pitch.lock() {
+            p.record_frames(on);
+        }
+    }
+
+    /// Whether the match is over.
+    pub fn finished(&self) -> Result<bool, String> {
+        Ok(lock(&self.pitch)?.finished())
+    }
+
+    /// Simulated time, s.
+    pub fn time(&self) -> Result<f64, String> {
+        Ok(lock(&self.pitch)?.world().time())
+    }
+
+    fn team_of(&self, robot: usize) -> usize {
+        robot / self.team_size.max(1)
+    }
+
+    /// One control cycle: every robot's frame out, every robot's answer in (or its silence
+    /// booked), the answers applied in robot order, the physics up to the next cycle. Returns
+    /// the referee's calls.
+    pub fn cycle(&mut self) -> Result<Vec<Call>, String> {
+        let k = self.cycle;
+        {
+            let mut pitch = lock(&self.pitch)?;
+            for i in 0..self.robots() {
+                let frame = DeviceFrame {
+                    robot: u32::try_from(i).map_err(|e| e.to_string())?,
+                    cycle: k,
+                    odometry: pitch.odometry(i),
+                    camera: pitch.camera(i),
+                    sonars: pitch.sonar(i),
+                };
+                let (_, ep) = &self.teams[self.team_of(i)];
+                ep.publish_with(frame, DeliveryWarranty::Reliable, 128);
+            }
+        }
+        let acts = self.gather(k)?;
+        let mut pitch = lock(&self.pitch)?;
+        for (i, act) in acts.into_iter().enumerate() {
+            let Some(act) = act else {
+                if !self.silent[i] {
+                    self.silent[i] = true;
+                    pitch.fault(i, 1, &format!("robot process silent from cycle {k}"));
+                }
+                continue;
+            };
+            self.silent[i] = false;
+            if let Some(duty) = &act.duty {
+                // What the robot's SimulatedAirboard does in one process.
+                match self.base.drive_for(duty) {
+                    Ok(drive) => pitch.drive(i, drive),
+                    Err(e) => pitch.fault(i, 1, &format!("motor driver: {e}")),
+                }
+            }
+            if act.kick {
+                pitch.kick(i);
+            }
+            for f in &act.faults {
+                pitch.fault(i, 1, f);
+            }
+        }
+        self.cycle += 1;
+        Ok(pitch.advance())
+    }
+
+    /// Every robot's answer to cycle `k`, waiting as [`Patience`] says.
+    fn gather(&mut self, k: u64) -> Result<Vec<Option<DeviceAct>>, String> {
+        let mut acts: Vec<Option<DeviceAct>> = vec![None; self.robots()];
+        let start = Instant::now();
+        loop {
+            for (_, ep) in &mut self.teams {
+                while let Some(m) = ep.receive_msg() {
+                    let Ok(act) = m.get::<DeviceAct>() else { continue };
+                    let i = robot_index(act.robot);
+                    if act.cycle == k && i < acts.len() {
+                        acts[i] = Some(act.clone());
+                    }
+                }
+            }
+            let waited = start.elapsed();
+            let missing: Vec<usize> = (0..acts.len()).filter(|&i| acts[i].is_none()).collect();
+            let patient = |i: &usize| {
+                waited < if self.silent[*i] { self.patience.silent } else { self.patience.cycle }
+            };
+            if !missing.iter().any(patient) {
+                return Ok(acts);
+            }
+            // Wait on the team of the first robot still awaited.
+            let (_, ep) = &self.teams[self.team_of(missing[0])];
+            ep.wait_msg(Duration::from_millis(2));
+        }
+    }
+
+    /// Blows the final whistle, gathers the robots' last words and returns the report.
+    pub fn finish(mut self) -> Result<MatchReport, String> {
+        let whistle = FinalWhistle { cycles: self.cycle };
+        for (_, ep) in &self.teams {
+            ep.publish_with(whistle, DeliveryWarranty::Reliable, 128);
+        }
+        let mut ends: BTreeMap<usize, RobotEnd> = BTreeMap::new();
+        let start = Instant::now();
+        while ends.len() < self.robots() && start.elapsed() < self.patience.end {
+            for (_, ep) in &mut self.teams {
+                while let Some(m) = ep.receive_msg() {
+                    if let Ok(end) = m.get::<RobotEnd>() {
+                        ends.insert(robot_index(end.robot), end.clone());
+                    }
+                }
+            }
+            if let Some((_, ep)) = self.teams.first() {
+                ep.wait_msg(Duration::from_millis(5));
+            }
+        }
+        let mut pitch = lock(&self.pitch)?;
+        for (i, end) in &ends {
+            for f in &end.faults {
+                f.book(&mut pitch, *i);
+            }
+        }
+        for i in (0..self.silent.len()).filter(|i| !ends.contains_key(i)) {
+            pitch.fault(i, 1, "robot process did not answer the final whistle");
+        }
+        drop(pitch);
+        let pitch = Arc::try_unwrap(self.pitch).map_err(|_| "the pitch is still shared")?;
+        Ok(pitch.into_inner().map_err(|_| "the pitch lock is poisoned")?.report())
+    }
+
+    /// Plays until the end, calling `progress` with the simulated time after each cycle.
+    pub fn play(mut self, mut progress: impl FnMut(f64)) -> Result<MatchReport, String> {
+        while !self.finished()? {
+            self.cycle()?;
+            progress(self.time()?);
+        }
+        self.finish()
+    }
+}
+
+/// One robot whose simulator runs elsewhere: its Agora with the Members of [`add_robot`] on a
+/// [`SteppedExecutor`], and the runner's own endpoints (module doc).
+pub struct RemoteRobot {
+    spec: RobotSpec,
+    exec: SteppedExecutor,
+    devices: Arc<Mutex<LinkedDevices>>,
+    /// On a second Agora of the robot's in-process community, joined after the robot's:
+    /// a teammate's report reaches the robot's Members before this endpoint sees it.
+    inbox: Endpoint,
+    _runner: Agora,
+    /// On the robot's Agora, whose link sends what it publishes.
+    outbox: Endpoint,
+    /// Teammates (robot numbers), and the creation time of each one's latest report.
+    mates: BTreeMap<u32, Option<Time>>,
+    /// Teammates not waited for (silent once, until they speak again).
+    absent: Vec<u32>,
+    period: Duration,
+    /// How long to wait for a teammate's report before running without it.
+    mate_wait: Duration,
+}
+
+/// How a robot's match went, seen from the robot.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct RobotRun {
+    /// Cycles run.
+    pub cycles: u64,
+    /// Cycles in which some teammate's report came too late (the match may differ from the
+    /// single-process one from then on).
+    pub late_mates: u64,
+}
+
+impl RemoteRobot {
+    /// Robot `spec` of a match played under `cfg`, its Agora configured by `net` (a NETWORK
+    /// Agora: the caller links it, see [`RemoteRobot::agora`]), Chaos behaviors from
+    /// `behaviors`. Its Members start (subscribe) at once.
+    pub fn new(
+        cfg: &SimConfig,
+        spec: RobotSpec,
+        behaviors: &Path,
+        net: Option<AgoraConfig>,
+    ) -> Result<RemoteRobot, String> {
+        let period = Duration::from_secs_f64(cfg.rules.control_period);
+        let mut exec = SteppedExecutor::new(SimClock::new(), period);
+        let community = InnerLinkManager::new();
+        let mut builder = exec.agora_builder(spec.agora_id()?).inner_link(&community);
+        if let Some(net) = net {
+            builder = builder.config(net);
+        }
+        let mut agora = builder.build().map_err(|e| e.to_string())?;
+        let devices = Arc::new(Mutex::new(LinkedDevices::default()));
+        add_robot(&mut agora, cfg, &spec, behaviors, devices.clone())?;
+        let outbox = agora.endpoint();
+        exec.add_agora(agora).map_err(|e| e.to_string())?;
+        let runner_id = 1000 + spec.agora_id()?;
+        let mut runner = exec
+            .agora_builder(runner_id)
+            .inner_link(&community)
+            .build()
+            .map_err(|e| e.to_string())?;
+        let inbox = runner.endpoint();
+        inbox.subscribe_to::<MateReport>(RequestType::Remote);
+        exec.start();
+        let n = cfg.rules.team_size.max(1);
+        let first = spec.robot / n * n;
+        let mates = (first..first + n)
+            .filter(|&j| j != spec.robot)
+            .filter_map(|j| u32::try_from(j).ok())
+            .map(|j| (j, None))
+            .collect();
+        Ok(RemoteRobot {
+            spec,
+            exec,
+            devices,
+            inbox,
+            _runner: runner,
+            outbox,
+            mates,
+            absent: Vec::new(),
+            period,
+            mate_wait: Duration::from_secs(2),
+        })
+    }
+
+    /// The robot's Agora (to link it to its team's network).
+    pub fn agora(&self) -> Option<&Agora> {
+        self.exec.agoras().next()
+    }
+
+    /// The Agora ids of the robot's teammates.
+    pub fn mate_agoras(&self) -> Vec<u32> {
+        self.mates.keys().map(|j| j + 1).collect()
+    }
+
+    /// How long to wait for a teammate's report before running a cycle without it (default
+    /// 2 s).
+    pub fn set_mate_wait(&mut self, wait: Duration) {
+        self.mate_wait = wait;
+    }
+
+    /// Ready for the match: from now on the simulator's frames reach this robot (they are
+    /// sent once every robot subscribed).
+    pub fn open(&self) {
+        self.inbox.subscribe_to::<DeviceFrame>(RequestType::Remote);
+        self.inbox.subscribe_to::<FinalWhistle>(RequestType::Remote);
+    }
+
+    fn note(&mut self, m: &mrt_dcdt::MsgRef) -> Option<Event> {
+        if let Ok(r) = m.get::<MateReport>() {
+            if let Some(t) = self.mates.get_mut(&r.id) {
+                *t = Some(m.header().creation_time);
+                self.absent.retain(|&j| j != r.id);
+            }
+            None
+        } else if let Ok(f) = m.get::<DeviceFrame>() {
+            (robot_index(f.robot) == self.spec.robot).then(|| Event::Frame(Box::new(f.clone())))
+        } else {
+            m.get::<FinalWhistle>().ok().map(|_| Event::Whistle)
+        }
+    }
+
+    /// Whether teammate `j`'s report that this robot would have on one bus at `now` is here:
+    /// the report of this cycle from a lower-numbered teammate, of the previous cycle from a
+    /// higher-numbered one (none in the first cycle). Absent teammates are not waited for.
+    fn mate_ready(&self, j: u32, now: Time) -> bool {
+        if self.absent.contains(&j) {
+            return true;
+        }
+        let period = u64::try_from(self.period.as_nanos()).unwrap_or(u64::MAX);
+        let needed = if robot_index(j) < self.spec.robot {
+            now.as_nanos()
+        } else if let Some(t) = now.as_nanos().checked_sub(period) {
+            t
+        } else {
+            return true;
+        };
+        self.mates.get(&j).copied().flatten().is_some_and(|t| t.as_nanos() >= needed)
+    }
+
+    fn mates_ready(&self, now: Time) -> bool {
+        self.mates.keys().all(|&j| self.mate_ready(j, now))
+    }
+
+    /// Runs cycles as the simulator's frames come, until the final whistle (then the Members
+    /// close and their faults are sent) or `silence` without any frame.
+    pub fn run(mut self, silence: Duration) -> Result<RobotRun, String> {
+        let mut run = RobotRun::default();
+        let mut last = Instant::now();
+        loop {
+            let mut frame = None;
+            let mut whistle = false;
+            while let Some(m) = self.inbox.receive_msg() {
+                match self.note(&m) {
+                    Some(Event::Frame(f)) => frame = Some(f),
+                    Some(Event::Whistle) => whistle = true,
+                    None => {}
+                }
+            }
+            if whistle {
+                return self.end(run);
+            }
+            let Some(frame) = frame else {
+                if last.elapsed() > silence {
+                    return Err(format!("no frame from the simulator for {silence:?}"));
+                }
+                self.inbox.wait_msg(Duration::from_millis(50));
+                continue;
+            };
+            last = Instant::now();
+            // The clock of cycle k, also for a robot restarted in the middle of a match.
+            let period = u64::try_from(self.period.as_nanos()).unwrap_or(u64::MAX);
+            let t = Time(frame.cycle.saturating_mul(period));
+            if t > self.exec.now() {
+                self.exec.clock().set(t);
+            }
+            let now = self.exec.now();
+            if !self.wait_for_mates(now) {
+                run.late_mates += 1;
+            }
+            if let Ok(mut d) = self.devices.lock() {
+                d.load(frame.odometry, frame.camera, frame.sonars);
+            }
+            self.exec.run_for(self.period);
+            let act = self.devices.lock().map_err(|_| "the devices lock is poisoned")?.take();
+            let answer = DeviceAct {
+                robot: frame.robot,
+                cycle: frame.cycle,
+                duty: act.duty,
+                kick: act.kick,
+                faults: act.faults,
+            };
+            self.outbox.publish_with(answer, DeliveryWarranty::Reliable, 128);
+            run.cycles += 1;
+        }
+    }
+
+    /// Waits for the teammates' reports due at `now`; `false` if some came too late (those
+    /// teammates are not waited for again until they speak).
+    fn wait_for_mates(&mut self, now: Time) -> bool {
+        let start = Instant::now();
+        while !self.mates_ready(now) {
+            if start.elapsed() > self.mate_wait {
+                let late: Vec<u32> =
+                    self.mates.keys().copied().filter(|&j| !self.mate_ready(j, now)).collect();
+                tracing::warn!(
+                    robot = self.spec.robot,
+                    "reports of teammates {late:?} late at {now}"
+                );
+                self.absent.extend(late);
+                return false;
+            }
+            self.inbox.wait_msg(Duration::from_millis(2));
+            while let Some(m) = self.inbox.receive_msg() {
+                // Only reports can come now: the next frame waits for this cycle's answer.
+                let _ = self.note(&m);
+            }
+        }
+        true
+    }
+
+    fn end(self, run: RobotRun) -> Result<RobotRun, String> {
+        let id = self.spec.agora_id()?;
+        let reports = self.exec.finish();
+        let faults =
+            reports.iter().filter(|r| r.agora.0 == id).flat_map(MemberFault::of_report).collect();
+        let robot = u32::try_from(self.spec.robot).map_err(|e| e.to_string())?;
+        self.outbox.publish_with(RobotEnd { robot, faults }, DeliveryWarranty::Reliable, 128);
+        Ok(run)
+    }
+}
+
+enum Event {
+    Frame(Box<DeviceFrame>),
+    Whistle,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::bus::BusMatch;
+    use crate::teams::Stack;
+    use mrt_dcdt::{AgoraPort, MsgRef, Outlet};
+
+    /// An in-process stand-in for one team's network: what an Agora shares goes to every other
+    /// Agora of the net whose Members want its type from elsewhere (what mrt-net does over
+    /// zenoh).
+    #[derive(Clone, Default)]
+    struct Net(Arc<Mutex<Vec<AgoraPort>>>);
+
+    struct NetOutlet(Net, mrt_core::AgoraId);
+
+    impl Outlet for NetOutlet {
+        fn wants(&self, ty: MsgType) -> bool {
+            let ports = self.0 .0.lock().unwrap();
+            ports.iter().any(|p| p.id() != self.1 && p.remote_interest().contains(&ty))
+        }
+        fn send(&self, msg: &MsgRef) {
+            let ports: Vec<AgoraPort> = self.0 .0.lock().unwrap().clone();
+            for p in ports.iter().filter(|p| p.id() != self.1) {
+                if p.remote_interest().contains(&msg.msg_type()) {
+                    p.deliver(msg);
+                }
+            }
+        }
+    }
+
+    impl Net {
+        fn join(&self, agora: &Agora) {
+            let port = agora.port();
+            port.set_outlet(Some(Box::new(NetOutlet(self.clone(), port.id()))));
+            self.0.lock().unwrap().push(port);
+        }
+    }
+
+    fn short(seconds: f64, team: usize) -> SimConfig {
+        let mut cfg = SimConfig::default();
+        cfg.rules.half_duration = seconds;
+        cfg.rules.team_size = team;
+        cfg
+    }
+
+    /// The simulator and each robot in executors of their own (threads here, processes in
+    /// `mrt sim --distributed`), each team on a network of its own: the same match as one bus,
+    /// hash for hash, teammates' reports included.
+    #[test]
+    fn robots_in_their_own_executors_play_the_single_process_match() {
+        let cfg = short(6.0, 3);
+        let stacks = (Stack::Chaos, Stack::Milan);
+        let dir = crate::bus::behaviors_dir(&[Stack::Chaos], None).unwrap();
+        let nets = [Net::default(), Net::default()];
+        let mut teams = Vec::new();
+        for (t, net) in nets.iter().enumerate() {
+            let agora = Agora::builder(200 + t as u32).build().unwrap();
+            net.join(&agora);
+            teams.push(agora);
+        }
+        let server = PitchServer::new(&cfg, 5, teams, Patience::default()).unwrap();
+        let mut robots = Vec::new();
+        for i in 0..6 {
+            let spec = RobotSpec::of(i, 3, stacks);
+            let robot = RemoteRobot::new(&cfg, spec, &dir, None).unwrap();
+            nets[i / 3].join(robot.agora().unwrap());
+            robot.open();
+            robots.push(std::thread::spawn(move || robot.run(Duration::from_secs(20))));
+        }
+        let distributed = server.play(|_| {}).unwrap();
+        let runs: Vec<RobotRun> = robots.into_iter().map(|h| h.join().unwrap().unwrap()).collect();
+        assert!(runs.iter().all(|r| r.cycles == 120 && r.late_mates == 0), "{runs:?}");
+        let bus =
+            BusMatch::new(&cfg, 5, stacks.0, Some(stacks.1), None).unwrap().play(|_| {}).unwrap();
+        assert_eq!(
+            (distributed.score, distributed.trajectory_hash, &distributed.stats),
+            (bus.score, bus.trajectory_hash, &bus.stats)
+        );
+        assert!(distributed.faults.is_empty(), "{:?}", distributed.faults);
+    }
+
+    /// A robot that never answers is booked once and the match goes on without waiting for it
+    /// every cycle; the others play on.
+    #[test]
+    fn a_silent_robot_is_booked_and_the_match_goes_on() {
+        let cfg = short(2.0, 1);
+        let nets = [Net::default(), Net::default()];
+        let mut teams = Vec::new();
+        for (t, net) in nets.iter().enumerate() {
+            let agora = Agora::builder(200 + t as u32).build().unwrap();
+            net.join(&agora);
+            teams.push(agora);
+        }
+        let patience = Patience { cycle: Duration::from_millis(200), ..Patience::default() };
+        let patience = Patience { end: Duration::from_millis(300), ..patience };
+        let server = PitchServer::new(&cfg, 1, teams, patience).unwrap();
+        // Only the home robot runs.
+        let spec = RobotSpec::of(0, 1, (Stack::Chaser, Stack::Chaser));
+        let robot = RemoteRobot::new(&cfg, spec, Path::new(""), None).unwrap();
+        nets[0].join(robot.agora().unwrap());
+        robot.open();
+        let home = std::thread::spawn(move || robot.run(Duration::from_secs(20)));
+        let started = Instant::now();
+        let report = server.play(|_| {}).unwrap();
+        assert!(started.elapsed() < Duration::from_secs(10), "not 200 ms every cycle");
+        assert_eq!(home.join().unwrap().unwrap().cycles, 40);
+        assert_eq!(report.faults.len(), 1, "{:?}", report.faults);
+        assert_eq!(report.faults[0].robot, 1);
+        assert!(report.faults[0].message.contains("silent from cycle 0"), "{:?}", report.faults);
+        assert!((report.duration - 4.0).abs() < 0.011);
+    }
+}
