@@ -1,6 +1,7 @@
 //! `mrt`: the MRT command line.
 //!
-//! - `mrt sim [--seed N] [--matches N] [--plot match.svg]` plays a simulated match;
+//! - `mrt sim [--seed N] [--matches N] [--plot match.svg] [--distributed]` plays a simulated
+//!   match (with `--distributed`, each robot in a process of its own over zenoh);
 //! - `mrt bb serve|get|set|watch|list` serves a blackboard with its relay, or talks to one;
 //! - `mrt demo [hello-agora|two-agoras]` runs a numbered example and prints what happens;
 //! - `mrt behave FILE [--world world.json] [--cycles N]` runs a Lua behavior or HFSM offline;
@@ -20,6 +21,8 @@ macro_rules! outln {
 mod bb;
 mod behave;
 mod brian;
+#[cfg(feature = "net")]
+mod distributed;
 mod sim;
 
 use anyhow::{Context as _, Result};
@@ -38,6 +41,10 @@ struct Cli {
 enum Command {
     /// Play a simulated robot-soccer match on the embedded default world (or a series).
     Sim(sim::SimArgs),
+    /// One robot of `mrt sim --distributed` (started by it).
+    #[cfg(feature = "net")]
+    #[command(hide = true)]
+    SimRobot(distributed::RobotArgs),
     /// The blackboard: serve one with its relay, or get, set, watch and list variables
     /// through a relay (docs/relay-protocol.md).
     Bb {
@@ -162,7 +169,7 @@ fn main() -> Result<()> {
     tracing_subscriber::fmt()
         .with_env_filter(
             tracing_subscriber::EnvFilter::try_from_default_env()
-                .unwrap_or_else(|_| tracing_subscriber::EnvFilter::new("warn")),
+                .unwrap_or_else(|_| tracing_subscriber::EnvFilter::new("warn,zenoh=error")),
         )
         .with_writer(std::io::stderr)
         .init();
@@ -187,6 +194,8 @@ fn run(command: Command) -> Result<()> {
             BrianCommand::Plot { dir, out } => brian::plot(&dir, &out)?,
         },
         Command::Sim(args) => sim::run(&args)?,
+        #[cfg(feature = "net")]
+        Command::SimRobot(args) => distributed::robot(&args)?,
         Command::Bb { command } => bb::run(command)?,
         Command::Behave { file, world, cycles, period_ms } => {
             behave::behave(&file, world.as_deref(), cycles, period_ms)?

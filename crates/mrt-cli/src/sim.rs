@@ -45,6 +45,11 @@ pub struct SimArgs {
     /// its Members on the bus (faster; the default shows the real MRT wiring).
     #[arg(long)]
     pub direct: bool,
+    /// Run each robot's Agora in a process of its own, talking to the simulator and its
+    /// teammates over zenoh on loopback (the same match as in one process; see
+    /// docs/network.md).
+    #[arg(long, conflicts_with = "direct")]
+    pub distributed: bool,
     /// Measure: play `--matches` full matches (3 if not given) one after the other on one
     /// core, headless, and report how many times faster than real time they ran.
     #[arg(long)]
@@ -71,9 +76,50 @@ fn play_one(
     record: bool,
     progress: impl FnMut(f64),
 ) -> Result<MatchReport> {
+    if args.distributed {
+        return distributed(cfg, seed, stacks, args, record, progress);
+    }
     let wiring = if args.direct { Wiring::Direct } else { Wiring::Bus };
     play(cfg, seed, stacks, wiring, args.behaviors.as_deref(), record, progress)
         .map_err(|e| anyhow!("{e}"))
+}
+
+#[cfg(feature = "net")]
+fn distributed(
+    cfg: &SimConfig,
+    seed: u64,
+    stacks: (Stack, Stack),
+    args: &SimArgs,
+    record: bool,
+    progress: impl FnMut(f64),
+) -> Result<MatchReport> {
+    crate::distributed::play(cfg, seed, stacks, args.behaviors.as_deref(), record, progress)
+}
+
+#[cfg(not(feature = "net"))]
+fn distributed(
+    _: &SimConfig,
+    _: u64,
+    _: (Stack, Stack),
+    _: &SimArgs,
+    _: bool,
+    _: impl FnMut(f64),
+) -> Result<MatchReport> {
+    anyhow::bail!(
+        "this mrt was built without networking: build it with the default features \
+         (cargo run --release -p mrt-cli -- sim --distributed)"
+    )
+}
+
+/// How the robots were wired, for the report.
+fn wiring_name(args: &SimArgs) -> &'static str {
+    if args.distributed {
+        "each robot an Agora in its own process, over zenoh"
+    } else if args.direct {
+        "brains called directly"
+    } else {
+        "each robot an Agora on the bus"
+    }
 }
 
 /// Runs `mrt sim`.
@@ -87,6 +133,9 @@ pub fn run(args: &SimArgs) -> Result<()> {
         return bench(args, &cfg, stacks);
     }
     if args.matches > 1 {
+        if args.distributed {
+            anyhow::bail!("--distributed plays one match at a time: use --bench for several");
+        }
         return series(args, &cfg, stacks);
     }
     let length = 2.0 * cfg.rules.half_duration;
@@ -145,7 +194,7 @@ pub fn run(args: &SimArgs) -> Result<()> {
         "  {:.0} s of play simulated in {:.1} s ({}); trajectory hash {:016x}",
         report.duration,
         started.elapsed().as_secs_f64(),
-        if args.direct { "brains called directly" } else { "each robot an Agora on the bus" },
+        wiring_name(args),
         report.trajectory_hash
     );
     if let Some(p) = &args.plot {
@@ -159,7 +208,7 @@ pub fn run(args: &SimArgs) -> Result<()> {
 /// `mrt sim --bench`: full matches one after the other, speed as times real time.
 fn bench(args: &SimArgs, cfg: &SimConfig, stacks: (Stack, Stack)) -> Result<()> {
     let n = if args.matches > 1 { args.matches } else { 3 };
-    let wiring = if args.direct { "brains called directly" } else { "each robot an Agora" };
+    let wiring = wiring_name(args);
     outln!(
         "{n} matches of 2 x {:.0} s, {} v {}, {} ({wiring}), one core:",
         cfg.rules.half_duration,

@@ -82,3 +82,57 @@ fn a_closed_standard_output_ends_the_program_quietly() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(out.status.success() && !err.contains("panicked"), "{:?}: {err}", out.status);
 }
+
+/// Everything but the line that says how long it took and how the robots were wired.
+fn result_lines(stdout: &str) -> Vec<String> {
+    stdout.lines().map(|l| l.split(" simulated in ").next().unwrap_or(l).to_string()).collect()
+}
+
+/// `--distributed`: the simulator here, each robot in a process of its own over zenoh on
+/// loopback; the same match as in one process, hash for hash.
+#[test]
+fn a_distributed_match_is_the_single_process_match() {
+    let args = ["--half", "8", "--seed", "4", "--home", "chaos", "--away", "milan"];
+    let (ok, one, err) = run(&args);
+    assert!(ok, "{err}");
+    let (ok, many, err) = run(&[&args[..], &["--distributed"]].concat());
+    assert!(ok, "{err}");
+    assert!(many.contains("each robot an Agora in its own process, over zenoh"), "{many}");
+    assert_eq!(result_lines(&one), result_lines(&many));
+    assert_eq!(hash_of(&one), hash_of(&many));
+}
+
+/// A robot whose behaviors do not load stands still and is reported with the file and line,
+/// across processes as in one.
+#[test]
+fn a_distributed_robot_with_broken_behaviors_is_reported() {
+    let src = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../behaviors/teamchaos");
+    let dir = std::env::temp_dir().join(format!("mrt-cli-broken-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    for e in std::fs::read_dir(&src).unwrap() {
+        let p = e.unwrap().path();
+        if p.is_file() {
+            std::fs::copy(&p, dir.join(p.file_name().unwrap())).unwrap();
+        }
+    }
+    let go2ball = dir.join("go2ball.lua");
+    let text = std::fs::read_to_string(&go2ball).unwrap();
+    std::fs::write(&go2ball, format!("{text}rule(ballSeen(, 'go')\n")).unwrap();
+    let line = text.lines().count() + 1;
+    let (ok, out, err) = run(&[
+        "--half",
+        "2",
+        "--home",
+        "chaser",
+        "--away",
+        "chaos",
+        "--distributed",
+        "--behaviors",
+        dir.to_str().unwrap(),
+    ]);
+    std::fs::remove_dir_all(&dir).unwrap();
+    assert!(ok, "{err}");
+    let faulted: Vec<&str> = out.lines().filter(|l| l.contains("faulted")).collect();
+    assert_eq!(faulted.len(), 4, "the four Chaos robots: {out}");
+    assert!(faulted.iter().all(|l| l.contains(&format!("go2ball.lua:{line}:"))), "{out}");
+}

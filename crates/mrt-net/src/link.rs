@@ -339,6 +339,15 @@ impl NetLink {
         self.shared.wanted.load().contains(&ty.0)
     }
 
+    /// The other Agoras whose Members subscribed to `ty` (the Finder's view), sorted.
+    pub fn subscribers(&self, ty: MsgType) -> Vec<AgoraId> {
+        let interest = lock(&self.shared.interest);
+        let mut ids: Vec<AgoraId> =
+            interest.iter().filter(|(_, t)| t.contains(&ty.0)).map(|(&a, _)| AgoraId(a)).collect();
+        ids.sort();
+        ids
+    }
+
     /// Whether this Agora receives messages of `ty` from the network now.
     pub fn receives(&self, ty: MsgType) -> bool {
         self.shared.subscribed.load().contains(&ty.0)

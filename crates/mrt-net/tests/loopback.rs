@@ -96,6 +96,10 @@ fn messages_cross_between_two_sessions_only_where_wanted() {
     assert!(link2.wait_until(Duration::from_secs(5), |l| l.agoras() == [AgoraId(1)]));
     assert!(link1.wait_until(Duration::from_secs(5), |l| l.remote_wants(Ping::TYPE)));
     assert!(!link1.remote_wants(Unwanted::TYPE));
+    assert_eq!(
+        (link1.subscribers(Ping::TYPE), link1.subscribers(Unwanted::TYPE)),
+        (vec![AgoraId(2)], vec![])
+    );
     assert!(
         link2.receives(Ping::TYPE) && !link1.receives(Ping::TYPE),
         "1 has only a Local listener"

@@ -386,6 +386,12 @@ impl SimConfig {
         SimConfig::from_toml(&text, &file)
     }
 
+    /// The configuration as a TOML file that [`SimConfig::from_toml`] reads back (what the
+    /// robots of a distributed match are given).
+    pub fn to_toml(&self) -> Result<String, String> {
+        toml::to_string(self).map_err(|e| e.to_string())
+    }
+
     /// Checks that every value makes sense.
     pub fn validate(&self) -> Result<(), String> {
         let positive = [
@@ -570,5 +576,10 @@ mod shipped {
     fn the_shipped_default_file_equals_the_built_in_defaults() {
         let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../configs/sim/default.toml");
         assert_eq!(SimConfig::from_file(path).unwrap(), SimConfig::default());
+        let mut odd = SimConfig::default();
+        odd.rules.half_duration = 12.5;
+        odd.rules.team_size = 2;
+        let text = odd.to_toml().unwrap();
+        assert_eq!(SimConfig::from_toml(&text, "written").unwrap(), odd, "written and read back");
     }
 }

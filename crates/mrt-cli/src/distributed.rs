@@ -1,0 +1,273 @@
+//! `mrt sim --distributed`: the simulator in this process, each robot's Agora in a process of
+//! its own (`mrt sim-robot`), talking over zenoh on loopback (`mrt-net`).
+//!
+//! The robots run the same Members as in one process (`mrt_sim::remote`); only configuration
+//! differs. Each team is a network of its own: for team `t` this process writes one
+//! MRT-manual §3.3.1 file per robot into a temporary directory, with the team's discovery port
+//! on the network line and static `ip link` lines to the simulator and to the lower-numbered
+//! teammates, so no robot depends on multicast and no robot hears the other team.
+
+use anyhow::{anyhow, bail, Context as _, Result};
+use mrt_core::AgoraId;
+use mrt_dcdt::config::AgoraConfig;
+use mrt_dcdt::Message;
+use mrt_net::{NetConfig, NetLink};
+use mrt_sim::bus::{behaviors_dir, MateReport, RobotSpec};
+use mrt_sim::config::SimConfig;
+use mrt_sim::game::MatchReport;
+use mrt_sim::remote::{DeviceAct, DeviceFrame, Patience, PitchServer, RemoteRobot};
+use mrt_sim::teams::Stack;
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Stdio};
+use std::time::{Duration, Instant};
+
+/// How long robots may take to start (load behaviors, join the network).
+const START: Duration = Duration::from_secs(120);
+/// A robot without a frame for this long gives up (the simulator is gone).
+const SILENCE: Duration = Duration::from_secs(60);
+
+/// The Agora id of the simulator's side of team `t`'s network.
+fn sim_agora(t: usize) -> u32 {
+    201 + t as u32
+}
+
+/// What `mrt sim-robot` is given (written by `mrt sim --distributed`).
+#[derive(clap::Args)]
+pub struct RobotArgs {
+    /// The robot (0 .. 2 × team size: home, then away).
+    #[arg(long)]
+    pub robot: usize,
+    /// The home team's stack.
+    #[arg(long)]
+    pub home: String,
+    /// The away team's stack.
+    #[arg(long)]
+    pub away: String,
+    /// The simulator configuration of the match (TOML).
+    #[arg(long)]
+    pub sim_config: PathBuf,
+    /// The robot's Agora configuration file (MRT manual §3.3.1).
+    #[arg(long)]
+    pub net: PathBuf,
+    /// TeamChaos behaviors to run instead of the built-in ones.
+    #[arg(long)]
+    pub behaviors: Option<PathBuf>,
+}
+
+fn free_tcp_port() -> Result<u16> {
+    Ok(std::net::TcpListener::bind("127.0.0.1:0")?.local_addr()?.port())
+}
+
+fn free_udp_port() -> Result<u16> {
+    Ok(std::net::UdpSocket::bind("127.0.0.1:0")?.local_addr()?.port())
+}
+
+/// The robot processes and their directory; killed and removed on drop.
+struct Robots {
+    dir: PathBuf,
+    children: Vec<(usize, Child)>,
+}
+
+impl Robots {
+    fn log(&self, robot: usize) -> PathBuf {
+        self.dir.join(format!("robot-{robot}.log"))
+    }
+
+    /// The end of a robot's log, for error messages.
+    fn tail(&self, robot: usize) -> String {
+        let text = std::fs::read_to_string(self.log(robot)).unwrap_or_default();
+        let lines: Vec<&str> = text.lines().collect();
+        lines[lines.len().saturating_sub(8)..].join("\n")
+    }
+
+    /// A robot process that ended already, with its status.
+    fn exited(&mut self) -> Option<(usize, std::process::ExitStatus)> {
+        self.children
+            .iter_mut()
+            .find_map(|(i, c)| c.try_wait().ok().flatten().map(|status| (*i, status)))
+    }
+
+    /// Waits up to `grace` for every robot to end by itself.
+    fn wait(&mut self, grace: Duration) {
+        let end = Instant::now() + grace;
+        while Instant::now() < end
+            && self.children.iter_mut().any(|(_, c)| matches!(c.try_wait(), Ok(None)))
+        {
+            std::thread::sleep(Duration::from_millis(20));
+        }
+    }
+}
+
+impl Drop for Robots {
+    fn drop(&mut self) {
+        for (_, c) in &mut self.children {
+            let _ = c.kill();
+            let _ = c.wait();
+        }
+        let _ = std::fs::remove_dir_all(&self.dir);
+    }
+}
+
+/// The §3.3.1 file of robot `i`: its team's discovery port, static links to the simulator's
+/// port and to the lower-numbered teammates' ports.
+fn robot_net_file(i: usize, first: usize, discovery: u16, sim: u16, ports: &[u16]) -> String {
+    let mut text = format!(
+        "# Robot {i} of a distributed match (written by mrt sim --distributed).\n\
+         # Network line: this machine, the team's multicast group and discovery port.\n\
+         127.0.0.1 224.0.0.224 {discovery}\n\
+         # Static links: the simulator, then the teammates numbered below this robot\n\
+         # (they link back, so each team is a full mesh).\n\
+         ip link 0 127.0.0.1 {} 127.0.0.1 {sim}\n",
+        ports[i]
+    );
+    for &p in &ports[first..i] {
+        text.push_str(&format!("ip link 0 127.0.0.1 {} 127.0.0.1 {p}\n", ports[i]));
+    }
+    text
+}
+
+/// Plays one match with every robot in a process of its own; `progress` gets the simulated
+/// time after each cycle.
+pub fn play(
+    cfg: &SimConfig,
+    seed: u64,
+    (home, away): (Stack, Stack),
+    behaviors: Option<&Path>,
+    record: bool,
+    progress: impl FnMut(f64),
+) -> Result<MatchReport> {
+    let n = cfg.rules.team_size;
+    let robots = 2 * n;
+    let dir = std::env::temp_dir().join(format!("mrt-distributed-{}-{seed}", std::process::id()));
+    std::fs::create_dir_all(&dir).with_context(|| format!("cannot create {}", dir.display()))?;
+    let mut procs = Robots { dir: dir.clone(), children: Vec::new() };
+    let sim_config = dir.join("sim.toml");
+    std::fs::write(&sim_config, cfg.to_toml().map_err(|e| anyhow!("{e}"))?)?;
+    let ports = (0..robots).map(|_| free_tcp_port()).collect::<Result<Vec<_>>>()?;
+    let sim_ports = [free_tcp_port()?, free_tcp_port()?];
+    let exe = std::env::current_exe().context("cannot find the mrt executable")?;
+    // The simulator's side of each team's network, listening for the robots.
+    let mut agoras = Vec::new();
+    let mut links = Vec::new();
+    for (t, &port) in sim_ports.iter().enumerate() {
+        let agora = mrt_dcdt::Agora::builder(sim_agora(t)).build()?;
+        links.push(NetLink::attach(&agora, &NetConfig::loopback(port, &[]))?);
+        agoras.push(agora);
+    }
+    for (t, sim_port) in sim_ports.iter().enumerate() {
+        let discovery = free_udp_port()?;
+        for i in t * n..(t + 1) * n {
+            let net = dir.join(format!("robot-{i}.cfg"));
+            std::fs::write(&net, robot_net_file(i, t * n, discovery, *sim_port, &ports))?;
+            let log = std::fs::File::create(procs.log(i))?;
+            let mut cmd = Command::new(&exe);
+            cmd.arg("sim-robot")
+                .args(["--robot", &i.to_string(), "--home", home.name(), "--away", away.name()])
+                .arg("--sim-config")
+                .arg(&sim_config)
+                .arg("--net")
+                .arg(&net)
+                .stdin(Stdio::null())
+                .stdout(Stdio::null())
+                .stderr(log);
+            if let Some(b) = behaviors {
+                cmd.arg("--behaviors").arg(b);
+            }
+            let child = cmd.spawn().with_context(|| format!("cannot start robot {i}"))?;
+            procs.children.push((i, child));
+        }
+    }
+    // The simulator subscribes to the robots' answers before any robot is ready.
+    let mut server =
+        PitchServer::new(cfg, seed, agoras, Patience::default()).map_err(|e| anyhow!("{e}"))?;
+    server.record_frames(record);
+    // Every robot subscribed to its frames: the match can start.
+    let start = Instant::now();
+    for (t, link) in links.iter().enumerate() {
+        let want: Vec<AgoraId> =
+            (t * n..(t + 1) * n).map(|i| AgoraId(i as u32 + 1)).collect::<Vec<_>>();
+        while link.subscribers(DeviceFrame::TYPE) != want {
+            if let Some((i, status)) = procs.exited() {
+                bail!("robot {i} ended before the match ({status}):\n{}", procs.tail(i));
+            }
+            if start.elapsed() > START {
+                bail!(
+                    "robots {:?} of team {t} were not ready after {START:?} (ready: {:?}); \
+                     robot {}'s log:\n{}",
+                    want,
+                    link.subscribers(DeviceFrame::TYPE),
+                    t * n,
+                    procs.tail(t * n)
+                );
+            }
+            std::thread::sleep(Duration::from_millis(10));
+        }
+    }
+    let report = server.play(progress).map_err(|e| anyhow!("{e}"))?;
+    procs.wait(Duration::from_secs(5));
+    drop(links);
+    Ok(report)
+}
+
+/// `mrt sim-robot`: one robot of a distributed match, until the final whistle.
+pub fn robot(args: &RobotArgs) -> Result<()> {
+    let cfg = SimConfig::from_file(&args.sim_config).map_err(|e| anyhow!("{e}"))?;
+    let net = AgoraConfig::from_file(&args.net).map_err(|e| anyhow!("{e}"))?;
+    let stacks = (
+        Stack::parse(&args.home).map_err(|e| anyhow!("--home: {e}"))?,
+        Stack::parse(&args.away).map_err(|e| anyhow!("--away: {e}"))?,
+    );
+    let n = cfg.rules.team_size.max(1);
+    if args.robot >= 2 * n {
+        bail!("--robot {}: a match has robots 0 to {}", args.robot, 2 * n - 1);
+    }
+    let spec = RobotSpec::of(args.robot, n, stacks);
+    let dir =
+        behaviors_dir(&[spec.stack], args.behaviors.as_deref()).map_err(|e| anyhow!("{e}"))?;
+    let robot = RemoteRobot::new(&cfg, spec, &dir, Some(net)).map_err(|e| anyhow!("{e}"))?;
+    let agora = robot.agora().ok_or_else(|| anyhow!("the robot has no Agora"))?;
+    let link = mrt_net::connect(agora)?;
+    // Ready when the simulator hears this robot's answers and every teammate its reports.
+    let sim = AgoraId(sim_agora(args.robot / n));
+    let mates: Vec<AgoraId> = robot.mate_agoras().into_iter().map(AgoraId).collect();
+    let ready = link.wait_until(START, |l| {
+        l.subscribers(DeviceAct::TYPE).contains(&sim)
+            && mates.iter().all(|m| l.subscribers(MateReport::TYPE).contains(m))
+    });
+    if !ready {
+        bail!(
+            "robot {}: the simulator ({sim}) and teammates {mates:?} not all found after {START:?} \
+             (found: {:?})",
+            args.robot,
+            link.agoras()
+        );
+    }
+    robot.open();
+    let run = robot.run(SILENCE).map_err(|e| anyhow!("robot {}: {e}", args.robot))?;
+    // Let the last word leave before the session closes.
+    std::thread::sleep(Duration::from_millis(300));
+    eprintln!(
+        "robot {}: {} cycles, teammates late in {}; {:?}",
+        args.robot,
+        run.cycles,
+        run.late_mates,
+        link.stats()
+    );
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn robot_files_link_to_the_simulator_and_the_lower_teammates() {
+        let ports = [7000, 7001, 7002, 7003];
+        let text = robot_net_file(3, 2, 9000, 7100, &ports);
+        let cfg = AgoraConfig::parse(&text, "robot-3.cfg").unwrap();
+        let net = NetConfig::from_agora_config(&cfg).unwrap();
+        assert_eq!(net.connect, ["tcp/127.0.0.1:7100", "tcp/127.0.0.1:7002"]);
+        assert!(net.listen.contains(&"tcp/127.0.0.1:7003".to_string()));
+        assert_eq!(net.multicast.as_deref(), Some("224.0.0.224:9000"));
+    }
+}
