@@ -34,6 +34,11 @@ pub enum BbCommand {
         /// The robot's ID.
         #[arg(long, default_value_t = 1)]
         robot: u32,
+        /// Share the `*` and robot-numbered variables with the other robots of the network
+        /// this Agora configuration file describes (MRT manual §3.3.1, docs/network.md): the
+        /// blackboard's Proxy runs in an Agora with id ROBOT on that network.
+        #[arg(long)]
+        net: Option<PathBuf>,
     },
     /// Print a variable: `<Type> <value>` and its age in ms.
     Get {
@@ -76,6 +81,29 @@ pub enum BbCommand {
     },
 }
 
+/// Puts the blackboard's Proxy on the network `file` describes (an Agora with id `robot`,
+/// run on its own threads); the link lives as long as the returned value.
+#[cfg(feature = "net")]
+fn share(bb: &Blackboard, file: &std::path::Path, robot: u32) -> Result<mrt_net::NetLink> {
+    use mrt_dcdt::{Activation, Agora};
+    let mut agora = Agora::from_config(file, robot)?;
+    let every = Activation::Periodic(std::time::Duration::from_millis(10));
+    let proxy = agora.add_member(mrt_blackboard::Proxy::new(bb.clone()), every);
+    agora.activate_member(proxy)?;
+    let link = mrt_net::connect(&agora)?;
+    std::thread::Builder::new().name("mrt-bb-proxy".into()).spawn(move || {
+        if let Err(e) = agora.lets_work() {
+            eprintln!("mrt bb serve: the blackboard's Agora stopped: {e}");
+        }
+    })?;
+    Ok(link)
+}
+
+#[cfg(not(feature = "net"))]
+fn share(_: &Blackboard, _: &std::path::Path, _: u32) -> Result<()> {
+    bail!("--net: this mrt was built without networking (build it with the default features)")
+}
+
 fn connect(t: &Target) -> Result<RelayClient> {
     RelayClient::connect(t.addr, t.token.as_deref()).with_context(|| {
         format!("cannot reach the relay at {} (is `mrt bb serve` or a robot running?)", t.addr)
@@ -85,7 +113,7 @@ fn connect(t: &Target) -> Result<RelayClient> {
 /// Runs one `mrt bb` command.
 pub fn run(command: BbCommand) -> Result<()> {
     match command {
-        BbCommand::Serve { target, config_dir, robot } => {
+        BbCommand::Serve { target, config_dir, robot, net } => {
             let bb = Blackboard::new(robot, Arc::new(mrt_core::WallClock::new()));
             if let Some(dir) = &config_dir {
                 let read = mrt_blackboard::config::load_dir(&bb, dir)?;
@@ -98,6 +126,10 @@ pub fn run(command: BbCommand) -> Result<()> {
             }
             let cfg =
                 RelayConfig { addr: target.addr, token: target.token, ..RelayConfig::default() };
+            let _shared = match &net {
+                Some(file) => Some(share(&bb, file, robot)?),
+                None => None,
+            };
             let relay = Relay::start(bb, cfg)?;
             outln!("relay of robot {robot} listening on {}", relay.local_addr());
             loop {

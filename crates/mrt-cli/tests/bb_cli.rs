@@ -80,3 +80,70 @@ fn no_relay_and_bad_input_give_clear_errors() {
     assert!(!ok && err.contains("config.dat:2:19: `x` is not a Float"), "{err}");
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// Two robots, each `mrt bb serve` in a process of its own with its Proxy on a network of two
+/// Agoras (static links on loopback): a `*` variable set on one robot's relay is read on the
+/// other's; robot 2's own variables (`2.`) reach robot 2; `local` ones stay home.
+#[cfg(feature = "net")]
+#[test]
+fn two_robots_share_their_blackboards_over_the_network() {
+    let ports: Vec<u16> = (0..2)
+        .map(|_| std::net::TcpListener::bind("127.0.0.1:0").unwrap())
+        .collect::<Vec<_>>()
+        .iter()
+        .map(|l| l.local_addr().unwrap().port())
+        .collect();
+    let dir = std::env::temp_dir().join(format!("mrt-bb-net-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let mut servers = Vec::new();
+    for (i, (me, other)) in [(ports[0], ports[1]), (ports[1], ports[0])].into_iter().enumerate() {
+        let cfg = dir.join(format!("robot-{}.cfg", i + 1));
+        // Multicast on a port nobody else uses; the static link does the work.
+        let text =
+            format!("127.0.0.1 224.0.0.224 {me}\nip link 0 127.0.0.1 {me} 127.0.0.1 {other}\n");
+        std::fs::write(&cfg, text).unwrap();
+        let mut child = mrt()
+            .args(["bb", "serve", "--addr", "127.0.0.1:0", "--robot", &(i + 1).to_string()])
+            .arg("--net")
+            .arg(&cfg)
+            .stdout(Stdio::piped())
+            .stderr(Stdio::null())
+            .spawn()
+            .unwrap();
+        let mut line = String::new();
+        BufReader::new(child.stdout.take().unwrap()).read_line(&mut line).unwrap();
+        servers.push((Server(child), line.trim().rsplit(' ').next().unwrap().to_string()));
+    }
+    let (one, two) = (servers[0].1.clone(), servers[1].1.clone());
+    let get = |addr: &str, symbol: &str| run(&["bb", "get", symbol, "--addr", addr]).1;
+    let eventually = |addr: &str, symbol: &str, want: &str| {
+        let end = std::time::Instant::now() + std::time::Duration::from_secs(20);
+        loop {
+            let got = get(addr, symbol);
+            if got.starts_with(want) || std::time::Instant::now() > end {
+                return got;
+            }
+            std::thread::sleep(std::time::Duration::from_millis(50));
+        }
+    };
+    // The link needs a moment: set until robot 2 has it (a set before the link is up is lost,
+    // as on a real network; the next one crosses).
+    let end = std::time::Instant::now() + std::time::Duration::from_secs(20);
+    let mut got = String::new();
+    while std::time::Instant::now() < end && !got.starts_with("Float 1.5 ") {
+        assert!(run(&["bb", "set", "*.var.ball.x", "Float", "1.5", "--addr", &one]).0);
+        std::thread::sleep(std::time::Duration::from_millis(100));
+        got = get(&two, "*.var.ball.x");
+    }
+    assert!(got.starts_with("Float 1.5 "), "robot 2 never saw *.var.ball.x: {got}");
+    assert!(run(&["bb", "set", "2.var.role", "String", "\"keeper\"", "--addr", &one]).0);
+    let got = eventually(&two, "2.var.role", "String \"keeper\" ");
+    assert!(got.starts_with("String \"keeper\" "), "{got}");
+    assert!(run(&["bb", "set", "local.var.secret", "Int", "7", "--addr", &one]).0);
+    assert!(run(&["bb", "set", "*.var.ball.y", "Float", "2.5", "--addr", &one]).0);
+    let got = eventually(&two, "*.var.ball.y", "Float 2.5 ");
+    assert!(got.starts_with("Float 2.5 "), "{got}");
+    assert!(!get(&two, "local.var.secret").starts_with("Int 7"), "local stays on robot 1");
+    drop(servers);
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -1,7 +1,8 @@
 //! Two Agoras in two processes over zenoh on loopback, against a plain zenoh
 //! publisher/subscriber pair on the same sessions, in the same run: round-trip latency
 //! (one probe, wait for its echo) and throughput (100 probes in flight, then their echoes),
-//! for 64-byte and 1 KiB payloads. The echo process is `mrt-net-node --echo`.
+//! for 64-byte and 1 KiB payloads, both with the QoS of a `Reliable` DCDT message (zenoh's
+//! congestion control *block*, batched). The echo process is `mrt-net-node --echo`.
 #![allow(missing_docs, clippy::unwrap_used, clippy::expect_used)]
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
@@ -50,7 +51,12 @@ fn bench(c: &mut Criterion) {
     assert!(link.wait_until(Duration::from_secs(10), |l| l.remote_wants(Probe::TYPE)));
     // Raw zenoh on the same session.
     let session = link.session().clone();
-    let raw_pub = session.declare_publisher("raw/ping").express(true).wait().unwrap();
+    // Both paths with the QoS of a Reliable DCDT message: block when congested, batched.
+    let raw_pub = session
+        .declare_publisher("raw/ping")
+        .congestion_control(zenoh::qos::CongestionControl::Block)
+        .wait()
+        .unwrap();
     let (tx, rx) = std::sync::mpsc::channel::<usize>();
     let _raw_sub = session
         .declare_subscriber("raw/pong")
@@ -66,12 +72,13 @@ fn bench(c: &mut Criterion) {
             break;
         }
     }
-    ep.publish(Probe(vec![0; 8]));
+    ep.publish_with(Probe(vec![0; 8]), DeliveryWarranty::Reliable, 0);
     assert!(ep.wait_msg(Duration::from_secs(5)) && ep.receive_msg().is_some(), "no echo");
 
+    let stats = || link.stats();
     let mrt_round = |ep: &mut mrt_dcdt::Endpoint, payload: &[u8], n: u64| {
         for _ in 0..n {
-            ep.publish(Probe(payload.to_vec()));
+            ep.publish_with(Probe(payload.to_vec()), DeliveryWarranty::Reliable, 0);
         }
         let mut got = 0;
         while got < n {
@@ -79,7 +86,11 @@ fn bench(c: &mut Criterion) {
                 got += 1;
             }
             if got < n {
-                assert!(ep.wait_msg(Duration::from_secs(5)), "echo lost");
+                assert!(
+                    ep.wait_msg(Duration::from_secs(5)),
+                    "echo lost: {got} of {n}, {:?}",
+                    stats()
+                );
             }
         }
     };

@@ -558,14 +558,7 @@ impl BusMatch {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::config::SimConfig;
-
-    fn short(seconds: f64, team: usize) -> SimConfig {
-        let mut cfg = SimConfig::default();
-        cfg.rules.half_duration = seconds;
-        cfg.rules.team_size = team;
-        cfg
-    }
+    use crate::config::short;
 
     #[test]
     fn a_bus_match_is_deterministic_and_both_stacks_play() {

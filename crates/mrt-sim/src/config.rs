@@ -509,6 +509,15 @@ fn line_column(text: &str, offset: usize) -> (usize, usize) {
     (line, column)
 }
 
+/// The default configuration with halves of `seconds` and `team` robots a side (tests).
+#[cfg(test)]
+pub(crate) fn short(seconds: f64, team: usize) -> SimConfig {
+    let mut cfg = SimConfig::default();
+    cfg.rules.half_duration = seconds;
+    cfg.rules.team_size = team;
+    cfg
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

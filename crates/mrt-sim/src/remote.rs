@@ -574,6 +574,7 @@ enum Event {
 mod tests {
     use super::*;
     use crate::bus::BusMatch;
+    use crate::config::short;
     use crate::teams::Stack;
     use mrt_dcdt::{AgoraPort, MsgRef, Outlet};
 
@@ -606,13 +607,6 @@ mod tests {
             port.set_outlet(Some(Box::new(NetOutlet(self.clone(), port.id()))));
             self.0.lock().unwrap().push(port);
         }
-    }
-
-    fn short(seconds: f64, team: usize) -> SimConfig {
-        let mut cfg = SimConfig::default();
-        cfg.rules.half_duration = seconds;
-        cfg.rules.team_size = team;
-        cfg
     }
 
     /// The simulator and each robot in executors of their own (threads here, processes in

@@ -100,7 +100,7 @@ impl Member for Echoer {
     fn do_your_job(&mut self, ctx: &mut Context<'_>) -> Result<(), MemberError> {
         while let Some(m) = ctx.receive_msg() {
             let p = m.get::<Probe>()?;
-            ctx.publish(Echo(p.0.clone()));
+            ctx.publish_with(Echo(p.0.clone()), DeliveryWarranty::Reliable, 0);
         }
         Ok(())
     }
@@ -117,7 +117,12 @@ fn echo(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     let link = NetLink::attach(&agora, &args.net)?;
     let session = link.session().clone();
     let z = |e: zenoh::Error| e.to_string();
-    let publisher = session.declare_publisher("raw/pong").express(true).wait().map_err(z)?;
+    // The same QoS as a Reliable DCDT message: block when congested, batched.
+    let publisher = session
+        .declare_publisher("raw/pong")
+        .congestion_control(zenoh::qos::CongestionControl::Block)
+        .wait()
+        .map_err(z)?;
     let _raw = session
         .declare_subscriber("raw/ping")
         .callback(move |s| {
