@@ -16,11 +16,11 @@
 //! | delivery warranty | `None` → congestion control *drop*, express; `Retransmit` → *drop*, batched; `Reliable` → *block* (TCP links retransmit every frame; what differs is whether a congested queue drops it) |
 //! | priority 0–255 | zenoh priorities: 0 *data* (the default), 1–63 *data-high*, 64–127 *interactive-low*, 128–191 *interactive-high*, 192–255 *real-time* |
 //!
-//! Frames are `mrt-dcdt`'s wire frames ([`mrt_dcdt::wire`]): the header travels, so the
-//! receiver's `agora_id`/`member_id` say where a message came from. A malformed or oversized
-//! frame is counted and dropped; a frame of a type nobody here subscribed to (a newer peer's
-//! type) is dropped with one warning; a message already delivered (same origin, member, type,
-//! time and payload) is not delivered twice.
+//! Frames are `mrt-dcdt`'s wire frames ([`mrt_dcdt::wire`]) in a 16-byte [`envelope`] that
+//! names the send: the header travels, so the receiver's `agora_id`/`member_id` say where a
+//! message came from. A malformed or oversized frame is counted and dropped; a frame of a type
+//! nobody here subscribed to (a newer peer's type) is dropped with one warning; a send already
+//! delivered (the same envelope, by a second route) is not delivered twice.
 //!
 //! ```no_run
 //! use mrt_net::{NetConfig, NetLink};
@@ -38,7 +38,7 @@ mod config;
 mod link;
 
 pub use config::{NetConfig, NetError};
-pub use link::{NetLink, NetStats};
+pub use link::{envelope, NetLink, NetStats, ENVELOPE};
 
 /// Joins a NETWORK Agora (built by `Agora::from_config(file, id)`) to the network its
 /// configuration file describes.

@@ -28,6 +28,22 @@ const MAINTENANCE: Duration = Duration::from_millis(10);
 /// Recently delivered frames remembered to drop duplicates.
 const DEDUP_WINDOW: usize = 4096;
 
+/// Bytes before the DCDT wire frame in every message on the network: see [`envelope`].
+pub const ENVELOPE: usize = 16;
+
+/// A message as it travels: the sending link's tag (from its zenoh session id) and the
+/// link's sequence number, little-endian, then the DCDT wire frame (`mrt_dcdt::wire`). The
+/// pair (tag, sequence) names one send: a copy that reaches an Agora by a second route (a
+/// ring of bridges) is dropped as a duplicate, while two messages that happen to have the same
+/// header and payload (sent within one clock tick) are two messages.
+pub fn envelope(tag: u64, seq: u64, wire: &[u8]) -> Vec<u8> {
+    let mut out = Vec::with_capacity(ENVELOPE + wire.len());
+    out.extend_from_slice(&tag.to_le_bytes());
+    out.extend_from_slice(&seq.to_le_bytes());
+    out.extend_from_slice(wire);
+    out
+}
+
 /// What the link did, counted since it was attached.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct NetStats {
@@ -116,12 +132,15 @@ struct Shared {
     counters: Counters,
     warned_unwanted: AtomicBool,
     warned_malformed: AtomicBool,
+    /// This link's tag and next sequence number ([`envelope`]).
+    tag: u64,
+    seq: AtomicU64,
 }
 
 impl Shared {
     fn send(&self, msg: &MsgRef) {
         let frame = match wire::encode(msg) {
-            Ok(f) => f,
+            Ok(f) => envelope(self.tag, self.seq.fetch_add(1, Ordering::Relaxed), &f),
             Err(e) => {
                 tracing::warn!(agora = %self.id, "cannot encode a {} message: {e}", msg.msg_type());
                 return;
@@ -166,7 +185,13 @@ impl Shared {
     }
 
     fn on_frame(&self, bytes: &[u8]) {
-        let msg = match wire::decode(bytes) {
+        let (sent, frame) = bytes.split_at(bytes.len().min(ENVELOPE));
+        let decoded = if sent.len() < ENVELOPE {
+            Err(format!("{} bytes, shorter than the envelope", bytes.len()))
+        } else {
+            wire::decode(frame).map_err(|e| e.to_string())
+        };
+        let msg = match decoded {
             Ok(m) => m,
             Err(e) => {
                 self.counters.malformed.fetch_add(1, Ordering::Relaxed);
@@ -187,7 +212,7 @@ impl Shared {
             return;
         }
         let mut h = FxHasher::default();
-        h.write(bytes);
+        h.write(sent);
         if lock(&self.dedup).seen(h.finish()) {
             self.counters.duplicates.fetch_add(1, Ordering::Relaxed);
             return;
@@ -292,6 +317,12 @@ impl NetLink {
             counters: Counters::default(),
             warned_unwanted: AtomicBool::new(false),
             warned_malformed: AtomicBool::new(false),
+            tag: {
+                let mut h = FxHasher::default();
+                h.write(session.zid().to_string().as_bytes());
+                h.finish()
+            },
+            seq: AtomicU64::new(0),
         });
         let weak = Arc::downgrade(&shared);
         let finder = session

@@ -1,6 +1,6 @@
 //! Robots as Agoras on the bus (DCDT, MRT manual ch. 3): the simulator's default wiring.
 //!
-//! Each robot is one [`Agora`](mrt_dcdt::Agora) with eight Members, all on the simulated clock
+//! Each robot is one [`Agora`] with eight Members, all on the simulated clock
 //! of one [`SteppedExecutor`] so that the match stays deterministic:
 //!
 //! 1. **`OdometryDriver`** (periodic): publishes the two optical mice's and the wheels'
