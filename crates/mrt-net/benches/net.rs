@@ -7,25 +7,12 @@
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 use mrt_dcdt::prelude::*;
+use mrt_net::probe::{Echo, Probe};
 use mrt_net::{NetConfig, NetLink};
 use std::io::{BufRead, BufReader};
 use std::process::{Command, Stdio};
 use std::time::Duration;
 use zenoh::Wait;
-
-#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
-struct Probe(Vec<u8>);
-impl Message for Probe {
-    const TYPE: MsgType = MsgType(0x4E45_5402);
-    const NAME: &'static str = "NetProbe";
-}
-
-#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
-struct Echo(Vec<u8>);
-impl Message for Echo {
-    const TYPE: MsgType = MsgType(0x4E45_5403);
-    const NAME: &'static str = "NetEcho";
-}
 
 const WINDOW: u64 = 100;
 

@@ -36,6 +36,7 @@
 
 mod config;
 mod link;
+pub mod probe;
 
 pub use config::{NetConfig, NetError};
 pub use link::{envelope, NetLink, NetStats, ENVELOPE};

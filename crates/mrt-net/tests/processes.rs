@@ -1,5 +1,6 @@
 //! Agoras in separate processes on loopback (`mrt-net-node`): bridges forward and links do
-//! not, a ring of bridges neither loops nor duplicates, a killed robot rejoins.
+//! not, a ring of bridges neither loops nor duplicates, the three subscription kinds, a killed
+//! robot rejoins.
 #![allow(clippy::unwrap_used)]
 
 use std::collections::BTreeSet;
@@ -209,6 +210,61 @@ fn a_ring_of_four_bridges_neither_loops_nor_duplicates() {
     assert_eq!(got, (1..=N).collect::<Vec<_>>(), "{}", r.stats());
     assert_eq!(got.iter().collect::<BTreeSet<_>>().len() as u64, N);
     assert!(r.stats().contains(&format!("delivered={N} ")), "{}", r.stats());
+}
+
+#[test]
+fn local_remote_and_all_subscriptions_across_processes() {
+    // Per kind, Agora A (a sender and a receiver subscribed as that kind) linked to Agora B
+    // (a sender only); both send 20 Pings once somebody wants them. All three pairs at once.
+    let p = ports(6);
+    let kinds = ["local", "remote", "all"];
+    let mut pairs = Vec::new();
+    for (k, want) in kinds.iter().enumerate() {
+        let (a, b) = ((71 + 2 * k).to_string(), (70 + 2 * k).to_string());
+        let (pa, pb) = (&p[2 * k], &p[2 * k + 1]);
+        let ra = Node::start(&[
+            "--id",
+            &a,
+            "--listen",
+            pa,
+            "--send",
+            "20",
+            "--recv",
+            "--want",
+            want,
+            "--seconds",
+            "4",
+        ]);
+        let sb = Node::start(&[
+            "--id",
+            &b,
+            "--listen",
+            pb,
+            "--connect",
+            pa,
+            "--send",
+            "20",
+            "--seconds",
+            "4",
+        ]);
+        pairs.push((ra, sb));
+    }
+    for (ra, sb) in &mut pairs {
+        ra.wait();
+        sb.wait();
+    }
+    let all: Vec<u64> = (1..=20).collect();
+    let (local, remote, both) = (&pairs[0], &pairs[1], &pairs[2]);
+    // Local: its own Agora's messages only; B never learns that anybody wants Pings.
+    assert_eq!(local.0.got_from(71), all, "{}", local.0.stats());
+    assert!(local.0.got_from(70).is_empty(), "{}", local.0.stats());
+    assert!(local.1.stats().contains("sent=0"), "{}", local.1.stats());
+    // Remote: the other Agora's only (and nobody wants A's own).
+    assert_eq!(remote.0.got_from(72), all, "{}", remote.0.stats());
+    assert!(remote.0.got_from(73).is_empty(), "{}", remote.0.stats());
+    // All: both.
+    assert_eq!(both.0.got_from(75), all, "{}", both.0.stats());
+    assert_eq!(both.0.got_from(74), all, "{}", both.0.stats());
 }
 
 #[test]

@@ -5,6 +5,7 @@
 //! ```text
 //! mrt-net-node --id 1 --listen 7451 --send 100           # sends 100 Pings once somebody wants them
 //! mrt-net-node --id 2 --listen 7452 --connect 7451 --recv
+//! mrt-net-node --id 4 --listen 7454 --connect 7451 --send 10 --recv --want all   # own Pings too
 //! mrt-net-node --id 3 --config configs/dcdt/same_machine.cfg --recv
 //! mrt-net-node --id 9 --listen 7459 --connect 7451 --echo     # the benchmark's echo
 //! ```
@@ -13,22 +14,12 @@
 use mrt_core::SimClock;
 use mrt_dcdt::config::AgoraConfig;
 use mrt_dcdt::prelude::*;
+use mrt_net::probe::{Echo, Ping, Probe};
 use mrt_net::{NetConfig, NetLink};
 use std::io::Write;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
-
-/// The test message: who sent it and its sequence number.
-#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
-struct Ping {
-    seq: u64,
-}
-
-impl Message for Ping {
-    const TYPE: MsgType = MsgType(0x4E45_5401);
-    const NAME: &'static str = "NetPing";
-}
 
 struct Sender {
     left: Arc<AtomicU64>,
@@ -52,11 +43,12 @@ impl Member for Sender {
     }
 }
 
-struct Receiver;
+/// Prints every Ping it receives; subscribed as `--want local|remote|all` (default remote).
+struct Receiver(RequestType);
 
 impl Member for Receiver {
     fn init(&mut self, ctx: &mut Context<'_>) -> Result<(), MemberError> {
-        ctx.subscribe_to::<Ping>(RequestType::Remote);
+        ctx.subscribe_to::<Ping>(self.0);
         Ok(())
     }
 
@@ -69,23 +61,6 @@ impl Member for Receiver {
         let _ = out.flush();
         Ok(())
     }
-}
-
-/// The benchmark's probe and its echo (payload as given).
-#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
-struct Probe(Vec<u8>);
-
-impl Message for Probe {
-    const TYPE: MsgType = MsgType(0x4E45_5402);
-    const NAME: &'static str = "NetProbe";
-}
-
-#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
-struct Echo(Vec<u8>);
-
-impl Message for Echo {
-    const TYPE: MsgType = MsgType(0x4E45_5403);
-    const NAME: &'static str = "NetEcho";
 }
 
 /// Sends every Probe back as an Echo.
@@ -148,6 +123,7 @@ struct Args {
     send: u64,
     every_ms: u64,
     recv: bool,
+    want: RequestType,
     duration: Duration,
 }
 
@@ -155,7 +131,7 @@ fn parse() -> Result<Args, String> {
     let mut a = std::env::args().skip(1);
     let (mut id, mut listen, mut connect, mut config) = (None, None, Vec::new(), None);
     let (mut send, mut every_ms, mut recv, mut bridge, mut secs) = (0, 10, false, false, 10.0);
-    let mut echo = false;
+    let (mut echo, mut want) = (false, RequestType::Remote);
     let num = |v: Option<String>, what: &str| -> Result<u64, String> {
         v.ok_or(format!("{what} needs a value"))?.parse().map_err(|e| format!("{what}: {e}"))
     };
@@ -168,6 +144,14 @@ fn parse() -> Result<Args, String> {
             "--send" => send = num(a.next(), "--send")?,
             "--every-ms" => every_ms = num(a.next(), "--every-ms")?.max(1),
             "--recv" => recv = true,
+            "--want" => {
+                want = match a.next().as_deref() {
+                    Some("local") => RequestType::Local,
+                    Some("remote") => RequestType::Remote,
+                    Some("all") => RequestType::All,
+                    other => return Err(format!("--want local|remote|all, not {other:?}")),
+                }
+            }
             "--bridge" => bridge = true,
             "--echo" => echo = true,
             "--seconds" => {
@@ -190,7 +174,7 @@ fn parse() -> Result<Args, String> {
         (None, None) => return Err("--listen PORT or --config FILE is required".into()),
     };
     net.bridge |= bridge;
-    Ok(Args { echo, id, net, send, every_ms, recv, duration: Duration::from_secs_f64(secs) })
+    Ok(Args { echo, id, net, send, every_ms, recv, want, duration: Duration::from_secs_f64(secs) })
 }
 
 fn main() {
@@ -219,7 +203,7 @@ fn run(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
         agora.activate_member(m)?;
     }
     if args.recv {
-        let m = agora.add_member(Receiver, Activation::OnMessage);
+        let m = agora.add_member(Receiver(args.want), Activation::OnMessage);
         agora.activate_member(m)?;
     }
     let link = NetLink::attach(&agora, &args.net)?;
