@@ -100,8 +100,9 @@ pub struct MsgHeader {
 pub trait Payload: Any + Send + Sync {
     /// The payload as `Any`, for typed access.
     fn as_any(&self) -> &dyn Any;
-    /// Serializes the payload for the wire (postcard for typed payloads, as-is for raw bytes).
-    fn encode(&self) -> Result<Vec<u8>, DcdtError>;
+    /// Serializes the payload for the wire at the end of `out` (postcard for typed payloads,
+    /// as-is for raw bytes), so that a frame is written in one buffer.
+    fn encode_into(&self, out: &mut Vec<u8>) -> Result<(), DcdtError>;
     /// Size of the payload in bytes: the byte length of raw payloads, the in-memory size of
     /// typed ones (the encoded length is known only when it leaves the process).
     fn len(&self) -> usize;
@@ -121,8 +122,16 @@ impl<T: Message> Payload for T {
     fn as_any(&self) -> &dyn Any {
         self
     }
-    fn encode(&self) -> Result<Vec<u8>, DcdtError> {
-        postcard::to_stdvec(self)
+    fn encode_into(&self, out: &mut Vec<u8>) -> Result<(), DcdtError> {
+        /// Appends to a borrowed buffer (postcard's writer is taken by value).
+        struct Append<'a>(&'a mut Vec<u8>);
+        impl Extend<u8> for Append<'_> {
+            fn extend<I: IntoIterator<Item = u8>>(&mut self, bytes: I) {
+                self.0.extend(bytes)
+            }
+        }
+        postcard::to_extend(self, Append(out))
+            .map(|_| ())
             .map_err(|e| DcdtError::Encode { name: T::NAME, reason: e.to_string() })
     }
     fn len(&self) -> usize {
@@ -181,8 +190,9 @@ impl Payload for RawPayload {
     fn as_any(&self) -> &dyn Any {
         self
     }
-    fn encode(&self) -> Result<Vec<u8>, DcdtError> {
-        Ok(self.bytes.clone())
+    fn encode_into(&self, out: &mut Vec<u8>) -> Result<(), DcdtError> {
+        out.extend_from_slice(&self.bytes);
+        Ok(())
     }
     fn len(&self) -> usize {
         self.bytes.len()

@@ -67,22 +67,36 @@ pub enum WireError {
 
 /// Encodes a message as one frame.
 pub fn encode(msg: &Msg) -> Result<Vec<u8>, DcdtError> {
-    let payload = msg.payload().encode()?;
-    if payload.len() > MAX_PAYLOAD {
-        return Err(WireError::TooLarge(payload.len()).into());
-    }
+    let mut out = Vec::with_capacity(HEADER_LEN + msg.payload().len());
+    encode_into(msg, &mut out)?;
+    Ok(out)
+}
+
+/// Encodes a message as one frame at the end of `out` (after a transport's own prefix, say),
+/// with no intermediate buffer. On error `out` is left as it was.
+pub fn encode_into(msg: &Msg, out: &mut Vec<u8>) -> Result<(), DcdtError> {
+    let start = out.len();
     let h = msg.header();
-    let mut out = Vec::with_capacity(HEADER_LEN + payload.len());
     out.extend_from_slice(&MAGIC);
     out.extend_from_slice(&[VERSION, h.warranty.code(), h.priority, 0]);
     out.extend_from_slice(&h.msg_type.0.to_le_bytes());
     out.extend_from_slice(&h.agora_id.0.to_le_bytes());
     out.extend_from_slice(&h.member_id.0.to_le_bytes());
     out.extend_from_slice(&h.creation_time.as_nanos().to_le_bytes());
+    let len_at = out.len();
+    out.extend_from_slice(&[0; 4]);
+    if let Err(e) = msg.payload().encode_into(out) {
+        out.truncate(start);
+        return Err(e);
+    }
+    let len = out.len() - len_at - 4;
+    if len > MAX_PAYLOAD {
+        out.truncate(start);
+        return Err(WireError::TooLarge(len).into());
+    }
     // Cannot truncate: checked against MAX_PAYLOAD above.
-    out.extend_from_slice(&(payload.len() as u32).to_le_bytes());
-    out.extend_from_slice(&payload);
-    Ok(out)
+    out[len_at..len_at + 4].copy_from_slice(&(len as u32).to_le_bytes());
+    Ok(())
 }
 
 fn u32_at(b: &[u8], at: usize) -> u32 {
@@ -167,6 +181,22 @@ mod tests {
         let back = decode(&frame).unwrap();
         assert_eq!(back.header(), m.header());
         assert_eq!(back.get::<Sonar>().unwrap(), &Sonar { ranges: vec![1.0, 2.5] });
+    }
+
+    #[test]
+    fn a_frame_is_written_after_a_prefix_in_one_buffer_or_not_at_all() {
+        let m = Msg::new(header(), Sonar { ranges: vec![1.0, 2.5] }).into_ref();
+        let mut out = b"envelope".to_vec();
+        encode_into(&m, &mut out).unwrap();
+        assert_eq!(&out[..8], b"envelope");
+        assert_eq!(out[8..], encode(&m).unwrap()[..]);
+        // Payload length field: postcard's Vec<f32> of two = 1 length byte + 2 × 4 bytes.
+        assert_eq!(out[8 + 28..8 + 32], 9u32.to_le_bytes());
+        let huge = Msg::new(header(), RawPayload::new(vec![0; MAX_PAYLOAD + 1])).into_ref();
+        let mut out = b"envelope".to_vec();
+        let e = encode_into(&huge, &mut out);
+        assert!(e.is_err(), "{e:?}");
+        assert_eq!(out, b"envelope", "a failed encode leaves the buffer as it was");
     }
 
     #[test]

@@ -37,10 +37,16 @@ pub const ENVELOPE: usize = 16;
 /// ring of bridges) is dropped as a duplicate, while two messages that happen to have the same
 /// header and payload (sent within one clock tick) are two messages.
 pub fn envelope(tag: u64, seq: u64, wire: &[u8]) -> Vec<u8> {
-    let mut out = Vec::with_capacity(ENVELOPE + wire.len());
+    let mut out = open_envelope(tag, seq, wire.len());
+    out.extend_from_slice(wire);
+    out
+}
+
+/// A buffer holding the envelope, with room for a frame of about `frame_len` bytes after it.
+fn open_envelope(tag: u64, seq: u64, frame_len: usize) -> Vec<u8> {
+    let mut out = Vec::with_capacity(ENVELOPE + frame_len);
     out.extend_from_slice(&tag.to_le_bytes());
     out.extend_from_slice(&seq.to_le_bytes());
-    out.extend_from_slice(wire);
     out
 }
 
@@ -139,23 +145,21 @@ struct Shared {
 
 impl Shared {
     fn send(&self, msg: &MsgRef) {
-        let frame = match wire::encode(msg) {
-            Ok(f) => envelope(self.tag, self.seq.fetch_add(1, Ordering::Relaxed), &f),
-            Err(e) => {
-                tracing::warn!(agora = %self.id, "cannot encode a {} message: {e}", msg.msg_type());
-                return;
-            }
-        };
+        // The envelope, then the frame, written in one buffer that zenoh takes without a copy.
+        let seq = self.seq.fetch_add(1, Ordering::Relaxed);
+        let mut frame = open_envelope(self.tag, seq, wire::HEADER_LEN + msg.payload().len());
+        if let Err(e) = wire::encode_into(msg, &mut frame) {
+            tracing::warn!(agora = %self.id, "cannot encode a {} message: {e}", msg.msg_type());
+            return;
+        }
         let h = msg.header();
         let (cc, express) = qos(h.warranty);
         let key = (h.msg_type.0, h.priority, cc as u8);
-        let sent = {
-            let pubs = self.publishers.read().unwrap_or_else(PoisonError::into_inner);
-            pubs.get(&key).map(|p| p.put(frame.clone()).wait())
-        };
-        let sent = match sent {
-            Some(r) => r,
+        let publishers = self.publishers.read().unwrap_or_else(PoisonError::into_inner);
+        let sent = match publishers.get(&key) {
+            Some(p) => p.put(frame).wait(),
             None => {
+                drop(publishers);
                 let p = self
                     .session
                     .declare_publisher(format!("{ROOT}/m/{}", h.msg_type.0))
@@ -163,17 +167,11 @@ impl Shared {
                     .congestion_control(cc)
                     .express(express)
                     .wait();
-                match p {
-                    Ok(p) => {
-                        let r = p.put(frame).wait();
-                        self.publishers
-                            .write()
-                            .unwrap_or_else(PoisonError::into_inner)
-                            .insert(key, p);
-                        r
-                    }
-                    Err(e) => Err(e),
-                }
+                p.and_then(|p| {
+                    let r = p.put(frame).wait();
+                    self.publishers.write().unwrap_or_else(PoisonError::into_inner).insert(key, p);
+                    r
+                })
             }
         };
         match sent {
