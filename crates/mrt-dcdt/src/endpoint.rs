@@ -246,15 +246,15 @@ impl Endpoint {
         self.shared.post_office.policy.pending(self.index())
     }
 
-    /// Blocks the calling thread until a message is waiting or `timeout` passes (for
-    /// endpoints used outside an executor; Members are woken by their executor). The first
-    /// thread that waits on an endpoint is the one its arrivals wake: keep an endpoint on one
-    /// thread.
+    /// Blocks the calling thread until a message is waiting, `timeout` passes or the Agora
+    /// shuts down (for endpoints used outside an executor; Members are woken by their
+    /// executor); returns whether a message is waiting. The first thread that waits on an
+    /// endpoint is the one its arrivals wake: keep an endpoint on one thread.
     pub fn wait_msg(&self, timeout: std::time::Duration) -> bool {
         let waker = self.shared.waker(self.member);
         if let Some(w) = &waker {
             w.bind_current();
-            w.wait(Some(timeout), &|| self.has_pending());
+            w.wait(Some(timeout), &|| self.has_pending() || self.shared.is_shutting_down());
         }
         self.has_pending()
     }

@@ -8,7 +8,7 @@
 use std::sync::atomic::{fence, AtomicBool, Ordering};
 use std::sync::OnceLock;
 use std::thread::Thread;
-use std::time::Duration;
+use std::time::{Duration, Instant};
 
 /// Wakes one Member's thread.
 #[derive(Debug, Default)]
@@ -58,12 +58,56 @@ impl Waker {
         }
         self.sleeping.store(true, Ordering::Relaxed);
         fence(Ordering::SeqCst);
-        if !has_work() {
-            match timeout {
-                Some(t) => std::thread::park_timeout(t),
+        // `park` may return with no work: an `unpark` meant for an earlier sleep (a producer
+        // that saw `sleeping` just before we woke and left its token behind) or a spurious
+        // wake-up. Sleep again until there is work or the time is up.
+        let deadline = timeout.map(|t| Instant::now() + t);
+        while !has_work() {
+            match deadline {
+                Some(d) => match d.checked_duration_since(Instant::now()) {
+                    Some(left) if !left.is_zero() => std::thread::park_timeout(left),
+                    _ => break,
+                },
                 None => std::thread::park(),
             }
         }
         self.sleeping.store(false, Ordering::Relaxed);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::sync::atomic::AtomicBool;
+    use std::sync::Arc;
+
+    #[test]
+    fn a_stale_unpark_token_does_not_end_the_wait_early() {
+        let waker = Arc::new(Waker::default());
+        waker.bind_current();
+        let work = Arc::new(AtomicBool::new(false));
+        // A token left behind by an earlier wake-up: the first park returns at once.
+        std::thread::current().unpark();
+        let producer = {
+            let (waker, work) = (waker.clone(), work.clone());
+            std::thread::spawn(move || {
+                std::thread::sleep(Duration::from_millis(30));
+                work.store(true, Ordering::SeqCst);
+                waker.wake();
+            })
+        };
+        waker.wait(Some(Duration::from_secs(10)), &|| work.load(Ordering::SeqCst));
+        assert!(work.load(Ordering::SeqCst), "woke before the work arrived");
+        producer.join().unwrap();
+    }
+
+    #[test]
+    fn a_wait_with_a_timeout_and_no_work_returns_after_it() {
+        let waker = Waker::default();
+        waker.bind_current();
+        std::thread::current().unpark();
+        let t = Instant::now();
+        waker.wait(Some(Duration::from_millis(20)), &|| false);
+        assert!(t.elapsed() >= Duration::from_millis(20), "{:?}", t.elapsed());
     }
 }

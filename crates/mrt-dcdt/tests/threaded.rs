@@ -179,3 +179,31 @@ fn one_community_cannot_have_two_agoras_with_one_id() {
     drop(_a);
     assert!(mrt_dcdt::Agora::builder(4).inner_link(&ilm).build().is_ok(), "a dropped Agora leaves");
 }
+
+#[test]
+fn wait_msg_returns_only_with_a_message_or_at_its_timeout() {
+    // A thread's park token can be left over from an earlier wake-up (a producer that saw the
+    // consumer about to sleep): `wait_msg` used to return `false` at once then, long before its
+    // timeout, and a caller took that for a lost message.
+    let mut agora = mrt_dcdt::Agora::builder(1).build().unwrap();
+    let mut ep = agora.endpoint();
+    ep.subscribe_to::<Count>(RequestType::All);
+    for round in 0..20u32 {
+        let sender = agora.endpoint();
+        std::thread::current().unpark(); // the stale token
+        let s = std::thread::spawn(move || {
+            std::thread::sleep(Duration::from_millis(2));
+            sender.publish(Count(round));
+        });
+        assert!(
+            ep.wait_msg(Duration::from_secs(10)),
+            "round {round}: returned without the message"
+        );
+        assert_eq!(ep.receive_msg().unwrap().get::<Count>().unwrap().0, round);
+        s.join().unwrap();
+    }
+    let t = Instant::now();
+    std::thread::current().unpark();
+    assert!(!ep.wait_msg(Duration::from_millis(20)));
+    assert!(t.elapsed() >= Duration::from_millis(20), "{:?}", t.elapsed());
+}
