@@ -1,13 +1,19 @@
 //! Two Agoras in two processes over zenoh on loopback, against a plain zenoh
-//! publisher/subscriber pair on the same sessions, in the same run: round-trip latency
-//! (one probe, wait for its echo) and throughput (100 probes in flight, then their echoes),
-//! for 64-byte and 1 KiB payloads, both with the QoS of a `Reliable` DCDT message (zenoh's
-//! congestion control *block*, batched). The echo process is `mrt-net-node --echo`.
+//! publisher/subscriber pair on the same sessions, in the same run, for 64-byte and 1 KiB
+//! payloads, both with the QoS of a `Reliable` DCDT message (zenoh's congestion control
+//! *block*, batched). The other process is `mrt-net-node --echo`.
+//!
+//! - `round_trip`: one probe, wait for its echo (latency).
+//! - `stream`: 1000 messages one way, then the receiver's single acknowledgement
+//!   (throughput: how many messages a second one Agora delivers to another).
+//! - `echo_window`: 100 probes in flight, then their 100 echoes (request/response throughput;
+//!   here every message crosses a Member's thread on the far side, while the raw echo answers
+//!   in zenoh's receive callback).
 #![allow(missing_docs, clippy::unwrap_used, clippy::expect_used)]
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 use mrt_dcdt::prelude::*;
-use mrt_net::probe::{Echo, Probe};
+use mrt_net::probe::{flood_payload, Echo, Flood, Probe};
 use mrt_net::{NetConfig, NetLink};
 use std::io::{BufRead, BufReader};
 use std::process::{Command, Stdio};
@@ -15,6 +21,7 @@ use std::time::Duration;
 use zenoh::Wait;
 
 const WINDOW: u64 = 100;
+const STREAM: u32 = 1000;
 
 fn free_port() -> u16 {
     std::net::TcpListener::bind("127.0.0.1:0").unwrap().local_addr().unwrap().port()
@@ -89,6 +96,25 @@ fn bench(c: &mut Criterion) {
             rx.recv_timeout(Duration::from_secs(5)).expect("echo lost");
         }
     };
+    let mrt_stream = |ep: &mut mrt_dcdt::Endpoint, payload: &[u8]| {
+        for _ in 0..STREAM {
+            ep.publish_with(Flood(payload.to_vec()), DeliveryWarranty::Reliable, 0);
+        }
+        while ep.receive_msg().is_none() {
+            assert!(ep.wait_msg(Duration::from_secs(5)), "no acknowledgement, {:?}", stats());
+        }
+    };
+    let raw_flood = session
+        .declare_publisher("raw/flood")
+        .congestion_control(zenoh::qos::CongestionControl::Block)
+        .wait()
+        .unwrap();
+    let raw_stream = |payload: &[u8]| {
+        for _ in 0..STREAM {
+            raw_flood.put(payload.to_vec()).wait().unwrap();
+        }
+        rx.recv_timeout(Duration::from_secs(5)).expect("no acknowledgement");
+    };
     for size in [64usize, 1024] {
         let payload = vec![7u8; size];
         let mut g = c.benchmark_group(format!("round_trip_{size}B"));
@@ -97,7 +123,13 @@ fn bench(c: &mut Criterion) {
         });
         g.bench_function(BenchmarkId::new("zenoh", size), |b| b.iter(|| raw_round(&payload, 1)));
         g.finish();
-        let mut g = c.benchmark_group(format!("throughput_{size}B"));
+        let flood = flood_payload(STREAM, size);
+        let mut g = c.benchmark_group(format!("stream_{size}B"));
+        g.throughput(Throughput::Elements(STREAM.into()));
+        g.bench_function(BenchmarkId::new("mrt", size), |b| b.iter(|| mrt_stream(&mut ep, &flood)));
+        g.bench_function(BenchmarkId::new("zenoh", size), |b| b.iter(|| raw_stream(&flood)));
+        g.finish();
+        let mut g = c.benchmark_group(format!("echo_window_{size}B"));
         g.throughput(Throughput::Elements(WINDOW));
         g.bench_function(BenchmarkId::new("mrt", size), |b| {
             b.iter(|| mrt_round(&mut ep, &payload, WINDOW))

@@ -14,7 +14,7 @@
 use mrt_core::SimClock;
 use mrt_dcdt::config::AgoraConfig;
 use mrt_dcdt::prelude::*;
-use mrt_net::probe::{Echo, Ping, Probe};
+use mrt_net::probe::{Echo, Flood, FloodCounter, Ping, Probe};
 use mrt_net::{NetConfig, NetLink};
 use std::io::Write;
 use std::sync::atomic::{AtomicU64, Ordering};
@@ -63,19 +63,24 @@ impl Member for Receiver {
     }
 }
 
-/// Sends every Probe back as an Echo.
-struct Echoer;
+/// Sends every Probe back as an Echo, and one empty Echo per complete batch of Floods.
+#[derive(Default)]
+struct Echoer(FloodCounter);
 
 impl Member for Echoer {
     fn init(&mut self, ctx: &mut Context<'_>) -> Result<(), MemberError> {
         ctx.subscribe_to::<Probe>(RequestType::Remote);
+        ctx.subscribe_to::<Flood>(RequestType::Remote);
         Ok(())
     }
 
     fn do_your_job(&mut self, ctx: &mut Context<'_>) -> Result<(), MemberError> {
         while let Some(m) = ctx.receive_msg() {
-            let p = m.get::<Probe>()?;
-            ctx.publish_with(Echo(p.0.clone()), DeliveryWarranty::Reliable, 0);
+            if let Ok(p) = m.get::<Probe>() {
+                ctx.publish_with(Echo(p.0.clone()), DeliveryWarranty::Reliable, 0);
+            } else if self.0.count(&m.get::<Flood>()?.0) {
+                ctx.publish_with(Echo(Vec::new()), DeliveryWarranty::Reliable, 0);
+            }
         }
         Ok(())
     }
@@ -87,7 +92,7 @@ impl Member for Echoer {
 fn echo(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     use zenoh::Wait;
     let mut agora = mrt_dcdt::Agora::builder(args.id).build()?;
-    let m = agora.add_member(Echoer, Activation::OnMessage);
+    let m = agora.add_member(Echoer::default(), Activation::OnMessage);
     agora.activate_member(m)?;
     let link = NetLink::attach(&agora, &args.net)?;
     let session = link.session().clone();
@@ -98,10 +103,22 @@ fn echo(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
         .congestion_control(zenoh::qos::CongestionControl::Block)
         .wait()
         .map_err(z)?;
+    let publisher = Arc::new(publisher);
+    let pong = publisher.clone();
     let _raw = session
         .declare_subscriber("raw/ping")
         .callback(move |s| {
-            let _ = publisher.put(s.payload().clone()).wait();
+            let _ = pong.put(s.payload().clone()).wait();
+        })
+        .wait()
+        .map_err(z)?;
+    let flood = FloodCounter::default();
+    let _raw_flood = session
+        .declare_subscriber("raw/flood")
+        .callback(move |s| {
+            if flood.count(&s.payload().to_bytes()) {
+                let _ = publisher.put(Vec::new()).wait();
+            }
         })
         .wait()
         .map_err(z)?;
