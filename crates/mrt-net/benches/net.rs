@@ -1,7 +1,9 @@
 //! Two Agoras in two processes over zenoh on loopback, against a plain zenoh
 //! publisher/subscriber pair on the same sessions, in the same run, for 64-byte and 1 KiB
 //! payloads, both with the QoS of a `Reliable` DCDT message (zenoh's congestion control
-//! *block*, batched). The other process is `mrt-net-node --echo`.
+//! *block*, batched). The other process is `mrt-net-node --echo`. Each MRT iteration is
+//! followed by an untimed raw one and the other way round ([`compare`]), so that the two
+//! sides of a ratio are measured under the same load.
 //!
 //! - `round_trip`: one probe, wait for its echo (latency).
 //! - `stream`: 1000 messages one way, then the receiver's single acknowledgement
@@ -17,7 +19,7 @@ use mrt_net::probe::{flood_payload, Echo, Flood, Probe};
 use mrt_net::{NetConfig, NetLink};
 use std::io::{BufRead, BufReader};
 use std::process::{Command, Stdio};
-use std::time::Duration;
+use std::time::{Duration, Instant};
 use zenoh::Wait;
 
 const WINDOW: u64 = 100;
@@ -117,31 +119,70 @@ fn bench(c: &mut Criterion) {
     };
     for size in [64usize, 1024] {
         let payload = vec![7u8; size];
-        let mut g = c.benchmark_group(format!("round_trip_{size}B"));
-        g.bench_function(BenchmarkId::new("mrt", size), |b| {
-            b.iter(|| mrt_round(&mut ep, &payload, 1))
-        });
-        g.bench_function(BenchmarkId::new("zenoh", size), |b| b.iter(|| raw_round(&payload, 1)));
-        g.finish();
         let flood = flood_payload(STREAM, size);
-        let mut g = c.benchmark_group(format!("stream_{size}B"));
-        g.throughput(Throughput::Elements(STREAM.into()));
-        g.bench_function(BenchmarkId::new("mrt", size), |b| b.iter(|| mrt_stream(&mut ep, &flood)));
-        g.bench_function(BenchmarkId::new("zenoh", size), |b| b.iter(|| raw_stream(&flood)));
-        g.finish();
-        let mut g = c.benchmark_group(format!("echo_window_{size}B"));
-        g.throughput(Throughput::Elements(WINDOW));
-        g.bench_function(BenchmarkId::new("mrt", size), |b| {
-            b.iter(|| mrt_round(&mut ep, &payload, WINDOW))
-        });
-        g.bench_function(BenchmarkId::new("zenoh", size), |b| {
-            b.iter(|| raw_round(&payload, WINDOW))
-        });
-        g.finish();
+        let ep = std::cell::RefCell::new(&mut ep);
+        compare(
+            c,
+            &format!("round_trip_{size}B"),
+            size,
+            1,
+            &mut || mrt_round(&mut ep.borrow_mut(), &payload, 1),
+            &mut || raw_round(&payload, 1),
+        );
+        compare(
+            c,
+            &format!("stream_{size}B"),
+            size,
+            STREAM.into(),
+            &mut || mrt_stream(&mut ep.borrow_mut(), &flood),
+            &mut || raw_stream(&flood),
+        );
+        compare(
+            c,
+            &format!("echo_window_{size}B"),
+            size,
+            WINDOW,
+            &mut || mrt_round(&mut ep.borrow_mut(), &payload, WINDOW),
+            &mut || raw_round(&payload, WINDOW),
+        );
     }
     let _ = echo.kill();
     let _ = echo.wait();
     drop(agora);
+}
+
+/// One comparison: `mrt` and `zenoh` each timed with the other run (untimed) right after every
+/// iteration, so that both see the same load on this machine over the same minutes (timed one
+/// after the other, a drift in the machine's load showed up as a 15 % difference either way).
+fn compare(
+    c: &mut Criterion,
+    group: &str,
+    size: usize,
+    elements: u64,
+    mrt: &mut dyn FnMut(),
+    raw: &mut dyn FnMut(),
+) {
+    fn timed_beside(iters: u64, timed: &mut dyn FnMut(), beside: &mut dyn FnMut()) -> Duration {
+        let mut total = Duration::ZERO;
+        for _ in 0..iters {
+            let t = Instant::now();
+            timed();
+            total += t.elapsed();
+            beside();
+        }
+        total
+    }
+    let mut g = c.benchmark_group(group);
+    if elements > 1 {
+        g.throughput(Throughput::Elements(elements));
+    }
+    g.bench_function(BenchmarkId::new("mrt", size), |b| {
+        b.iter_custom(|n| timed_beside(n, &mut *mrt, &mut *raw))
+    });
+    g.bench_function(BenchmarkId::new("zenoh", size), |b| {
+        b.iter_custom(|n| timed_beside(n, &mut *raw, &mut *mrt))
+    });
+    g.finish();
 }
 
 criterion_group! {
