@@ -1,15 +1,17 @@
 //! The relay over real TCP on loopback: every command, watches pushed at the refresh rate, a
 //! Python socket client, and bad clients (garbage, a 10 MB line, a thousand connections at
-//! once) that get errors or are refused while the robot's blackboard keeps its pace.
+//! once) that get errors or are refused while a robot (an Agora using the blackboard every
+//! millisecond) keeps its cycle rate.
 #![allow(clippy::unwrap_used)]
 
 use mrt_blackboard::relay::{ClientError, RelayConfig};
-use mrt_blackboard::{Blackboard, Relay, RelayClient};
+use mrt_blackboard::{Blackboard, Proxy, Relay, RelayClient};
+use mrt_dcdt::{Activation, Agora, Context, Member, MemberError, ShutdownHandle};
 use std::io::{BufRead, BufReader, Read, Write};
 use std::net::{SocketAddr, TcpStream};
-use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::Arc;
-use std::time::Duration;
+use std::time::{Duration, Instant};
 
 fn relay(cfg: RelayConfig) -> (Blackboard, Relay) {
     let bb = Blackboard::new(1, Arc::new(mrt_core::WallClock::new()));
@@ -132,60 +134,109 @@ fn garbage_and_huge_lines_get_errors_and_others_are_served() {
     assert_eq!(line(&mut r), "OK LSTW 0");
 }
 
+/// Uses the blackboard every millisecond, as a robot's behavior would.
+struct Pace {
+    bb: Blackboard,
+    cycles: Arc<AtomicU64>,
+}
+
+impl Member for Pace {
+    fn do_your_job(&mut self, _: &mut Context<'_>) -> Result<(), MemberError> {
+        let n = self.cycles.fetch_add(1, Ordering::Relaxed) + 1;
+        self.bb.set("local.var.machine.cycle", n as i64)?;
+        self.bb.get::<i64>("local.var.machine.cycle")?;
+        Ok(())
+    }
+}
+
+/// A robot: an Agora on its own threads (`lets_work`) with the blackboard's Proxy and a
+/// Member running every millisecond.
+struct Robot {
+    cycles: Arc<AtomicU64>,
+    stop: ShutdownHandle,
+    thread: std::thread::JoinHandle<()>,
+}
+
+impl Robot {
+    fn start(bb: &Blackboard) -> Robot {
+        let mut agora = Agora::builder(1).build().unwrap();
+        let cycles = Arc::new(AtomicU64::new(0));
+        let every_ms = Activation::Periodic(Duration::from_millis(1));
+        let pace = agora.add_member(Pace { bb: bb.clone(), cycles: cycles.clone() }, every_ms);
+        let proxy = agora.add_member(Proxy::new(bb.clone()), every_ms);
+        agora.activate_member(pace).unwrap();
+        agora.activate_member(proxy).unwrap();
+        let stop = agora.shutdown_handle();
+        let thread = std::thread::spawn(move || {
+            agora.lets_work().unwrap();
+        });
+        Robot { cycles, stop, thread }
+    }
+
+    /// Cycles per second while `f` runs.
+    fn rate_during(&self, f: impl FnOnce()) -> f64 {
+        let (n0, t0) = (self.cycles.load(Ordering::Relaxed), Instant::now());
+        f();
+        (self.cycles.load(Ordering::Relaxed) - n0) as f64 / t0.elapsed().as_secs_f64()
+    }
+
+    fn stop(self) {
+        self.stop.shutdown();
+        self.thread.join().unwrap();
+    }
+}
+
 #[test]
-fn a_thousand_connections_at_once_are_refused_beyond_the_limit_and_the_robot_keeps_its_pace() {
+fn garbage_a_huge_line_and_a_thousand_connections_leave_the_robot_at_its_cycle_rate() {
     let (bb, relay) = relay(RelayConfig { max_clients: 16, ..RelayConfig::default() });
-    // The robot: a Member setting and reading its blackboard every millisecond.
-    let running = Arc::new(AtomicBool::new(true));
-    let cycles = Arc::new(AtomicU64::new(0));
-    let robot = {
-        let (bb, running, cycles) = (bb.clone(), running.clone(), cycles.clone());
-        std::thread::spawn(move || {
-            while running.load(Ordering::Relaxed) {
-                let n = cycles.fetch_add(1, Ordering::Relaxed);
-                bb.set("local.var.machine.cycle", n as i64).unwrap();
-                bb.get::<i64>("local.var.machine.cycle").unwrap();
-                std::thread::sleep(Duration::from_millis(1));
-            }
-        })
-    };
-    let start = std::time::Instant::now();
+    let robot = Robot::start(&bb);
+    std::thread::sleep(Duration::from_millis(100));
+    let quiet = robot.rate_during(|| std::thread::sleep(Duration::from_millis(500)));
     let mut conns = Vec::new();
-    for _ in 0..1000 {
-        match TcpStream::connect(relay.local_addr()) {
-            Ok(s) => conns.push(s),
-            Err(e) => {
-                eprintln!("stopped opening connections at {}: {e}", conns.len());
-                break;
+    let abused = robot.rate_during(|| {
+        // A thousand connections at once.
+        for _ in 0..1000 {
+            match TcpStream::connect(relay.local_addr()) {
+                Ok(s) => conns.push(s),
+                Err(e) => {
+                    eprintln!("stopped opening connections at {}: {e}", conns.len());
+                    break;
+                }
             }
         }
-    }
-    assert!(conns.len() >= 500, "{}", conns.len());
-    // Every connection beyond the first 16 is told so and closed.
-    let mut refused = 0;
-    for s in conns.iter_mut().skip(16) {
-        s.set_read_timeout(Some(Duration::from_secs(5))).unwrap();
-        let mut r = BufReader::new(s.try_clone().unwrap());
-        if line(&mut r) == "ERR 503 too many clients" {
-            refused += 1;
+        // Every connection beyond the first 16 is told so and closed.
+        let mut refused = 0;
+        for s in conns.iter_mut().skip(16) {
+            s.set_read_timeout(Some(Duration::from_secs(5))).unwrap();
+            let mut r = BufReader::new(s.try_clone().unwrap());
+            if line(&mut r) == "ERR 503 too many clients" {
+                refused += 1;
+            }
         }
-    }
-    assert_eq!(refused, conns.len() - 16);
-    assert_eq!(relay.stats().refused.load(Ordering::Relaxed), refused as u64);
-    // The 16 served ones still answer.
+        assert_eq!(refused, conns.len() - 16);
+        assert_eq!(relay.stats().refused.load(Ordering::Relaxed), refused as u64);
+        // Garbage, then a 10 MB line, from two of the served clients.
+        let (mut r, mut w) = (BufReader::new(conns[0].try_clone().unwrap()), &conns[0]);
+        w.set_read_timeout(Some(Duration::from_secs(5))).unwrap();
+        w.write_all(b"\x00\x01 GETV\xff\n").unwrap();
+        assert!(line(&mut r).starts_with("ERR 400"));
+        let (mut r, mut w) = (BufReader::new(conns[1].try_clone().unwrap()), &conns[1]);
+        w.set_read_timeout(Some(Duration::from_secs(5))).unwrap();
+        let _ = w.write_all(&vec![b'A'; 10 * 1024 * 1024]); // closed before the end of it
+        assert!(line(&mut r).starts_with("ERR 413"));
+    });
+    assert!(conns.len() >= 500, "{}", conns.len());
+    // The 16 served ones still answer, with the robot's latest cycle.
     let (mut r, mut w) =
         (BufReader::new(conns[3].try_clone().unwrap()), conns[3].try_clone().unwrap());
     w.set_read_timeout(Some(Duration::from_secs(5))).unwrap();
-    w.write_all(b"GETV local.var.machine.role\n").unwrap();
-    assert!(line(&mut r).starts_with("OK GETV"));
-    let elapsed = start.elapsed();
-    running.store(false, Ordering::Relaxed);
-    robot.join().unwrap();
-    // The robot thread sleeps 1 ms a cycle: it got through at least a third of the cycles it
-    // would have done alone (a loose bound: this checks that it was never blocked, not speed).
-    let expected = elapsed.as_secs_f64() * 1000.0;
-    let done = cycles.load(Ordering::Relaxed) as f64;
-    assert!(done > expected / 3.0, "{done} cycles in {elapsed:?}");
+    w.write_all(b"GETV local.var.machine.cycle\n").unwrap();
+    assert!(line(&mut r).starts_with("OK GETV local.var.machine.cycle Int "));
+    // Measured here: 990-1000 cycles/s quiet and under abuse alike. Half is the bound: a robot
+    // blocked by the relay, even briefly, falls far below it; a busy test machine does not.
+    eprintln!("robot: {quiet:.0} cycles/s quiet, {abused:.0} cycles/s while the relay was abused");
+    assert!(abused >= 0.5 * quiet, "{abused:.0} cycles/s under abuse, {quiet:.0} quiet");
+    robot.stop();
     drop(conns);
     // Slots free again: a new client is served.
     std::thread::sleep(Duration::from_millis(300));
