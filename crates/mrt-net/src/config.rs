@@ -23,15 +23,52 @@ pub struct NetConfig {
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
 pub enum NetError {
-    /// A `ser` channel: this build has no serial transport.
-    #[error("serial channel {0}: this build of mrt-net has no serial transport (zenoh's `transport_serial`)")]
-    NoSerial(String),
+    /// A `ser` channel's device field is not `<path>[,baudrate=<n>][,connect]`.
+    #[error("serial channel `{device}`: {reason}")]
+    Serial {
+        /// The device field as written.
+        device: String,
+        /// What is wrong with it.
+        reason: String,
+    },
     /// The Agora was not built from a configuration file.
     #[error("Agora {0} is STANDALONE: build it with Agora::from_config(file, id) to put it on a network")]
     Standalone(u32),
     /// zenoh refused the configuration or could not open the session.
     #[error("zenoh: {0}")]
     Zenoh(String),
+}
+
+/// The baud rate of a serial line unless its device field says otherwise.
+pub const DEFAULT_BAUD_RATE: u32 = 115_200;
+
+/// zenoh's endpoint for a `ser` line's device field `<path>[,baudrate=<n>][,connect]`, and
+/// whether this end opens the line (`connect`) or waits for the other end to open it (the
+/// default). A serial line joins exactly two Agoras; zenoh needs one end of it to listen and
+/// the other to connect, which the manual's line does not say: write `connect` on one end.
+fn serial_endpoint(device: &str) -> Result<(String, bool), NetError> {
+    let bad = |reason: String| NetError::Serial { device: device.to_string(), reason };
+    let mut fields = device.split(',');
+    let path = fields.next().unwrap_or_default();
+    if path.is_empty() {
+        return Err(bad("no device path before the options".into()));
+    }
+    let (mut baud, mut connect) = (DEFAULT_BAUD_RATE, false);
+    for option in fields {
+        match option.split_once('=') {
+            None if option == "connect" => connect = true,
+            None if option == "listen" => connect = false,
+            Some(("baudrate", n)) => {
+                baud = n.parse().map_err(|_| bad(format!("baudrate `{n}` is not a number")))?
+            }
+            _ => {
+                return Err(bad(format!(
+                    "unknown option `{option}` (known: baudrate=<n>, connect, listen)"
+                )))
+            }
+        }
+    }
+    Ok((format!("serial/{path}#baudrate={baud}"), connect))
 }
 
 fn endpoint(ip: IpAddr, port: u16) -> String {
@@ -67,7 +104,15 @@ impl NetConfig {
                     net.connect.push(endpoint(*remote_addr, *remote_port));
                     net.bridge |= *mode == ChannelMode::Bridge;
                 }
-                Channel::Serial { device, .. } => return Err(NetError::NoSerial(device.clone())),
+                Channel::Serial { mode, device, .. } => {
+                    let (e, connect) = serial_endpoint(device)?;
+                    if connect {
+                        net.connect.push(e);
+                    } else {
+                        net.listen.push(e);
+                    }
+                    net.bridge |= *mode == ChannelMode::Bridge;
+                }
             }
         }
         // Static links are for networks that cannot see each other: the named peers only.
@@ -118,6 +163,12 @@ impl NetConfig {
             "connect/retry",
             "{period_init_ms: 100, period_max_ms: 500, period_increase_factor: 2}",
         )?;
+        // The end that opens a serial line sends one greeting and waits for the answer; if the
+        // other end was not listening yet, only zenoh's open timeout (10 s by default) ends the
+        // wait and lets the retry greet again. Agoras start in any order: retry every second.
+        if self.connect.iter().any(|e| e.starts_with("serial/")) {
+            set(&mut c, "transport/unicast/open_timeout", "1000")?;
+        }
         set(&mut c, "connect/exit_on_failure", "false")?;
         set(&mut c, "listen/exit_on_failure", "true")?;
         Ok(c)
@@ -149,9 +200,30 @@ mod tests {
         let lan = AgoraConfig::parse("10.0.0.1 224.0.0.5 2003\n", "lan.cfg").unwrap();
         let lan = NetConfig::from_agora_config(&lan).unwrap();
         assert!(lan.gossip && lan.connect.is_empty(), "discovery on the LAN");
-        let ser = AgoraConfig::parse("10.0.0.1 224.0.0.5 2003\nser link 0 /dev/ttyS0\n", "s.cfg")
-            .unwrap();
-        let e = NetConfig::from_agora_config(&ser).unwrap_err().to_string();
-        assert!(e.contains("/dev/ttyS0") && e.contains("serial"), "{e}");
+    }
+
+    fn serial(device: &str) -> Result<NetConfig, NetError> {
+        let text = format!("10.0.0.1 224.0.0.5 2003\nser link 0 {device}\n");
+        NetConfig::from_agora_config(&AgoraConfig::parse(&text, "s.cfg").unwrap())
+    }
+
+    #[test]
+    fn a_serial_line_listens_at_one_end_and_connects_at_the_other() {
+        let waits = serial("/dev/ttyS0").unwrap();
+        assert_eq!(waits.listen, ["tcp/10.0.0.1:0", "serial//dev/ttyS0#baudrate=115200"]);
+        assert!(waits.connect.is_empty() && waits.gossip);
+        let opens = serial("/dev/ttyUSB1,baudrate=57600,connect").unwrap();
+        assert_eq!(opens.connect, ["serial//dev/ttyUSB1#baudrate=57600"]);
+        assert!(!opens.gossip, "a static link: the named peer only");
+        opens.zenoh_config().unwrap();
+        waits.zenoh_config().unwrap();
+        for (bad, says) in [
+            ("/dev/ttyS0,baudrate=fast", "`fast` is not a number"),
+            ("/dev/ttyS0,parity=odd", "unknown option `parity=odd`"),
+            (",connect", "no device path"),
+        ] {
+            let e = serial(bad).unwrap_err().to_string();
+            assert!(e.contains(bad) && e.contains(says), "{e}");
+        }
     }
 }

@@ -9,6 +9,7 @@
 //! |---|---|
 //! | network line `<ip> <multicast> <port>` | multicast scouting on `<multicast>:<port>` (the Finder); the Agora listens on `tcp/<ip>:<ephemeral port>`, which scouting advertises (so that several Agoras of one machine share the line) |
 //! | `ip link/bridge <lev> <laddr> <lport> <raddr> <rport>` | listen on `tcp/<laddr>:<lport>`, connect to `tcp/<raddr>:<rport>` |
+//! | `ser link/bridge <lev> <device>` | zenoh's serial transport on `<device>`: this end waits, or opens the line when the device field ends in `,connect` (docs/network.md) |
 //! | `link` | a zenoh **peer**: sends what its Members create, forwards nothing |
 //! | `bridge` | a zenoh **router**: zenoh forwards data and declarations between the networks it joins, over a loop-free route |
 //! | Finder | scouting (multicast, gossip) finds the Agoras; a liveliness token `mrt/agora/<id>` says which are up |

@@ -1,6 +1,6 @@
 //! Agoras in separate processes on loopback (`mrt-net-node`): bridges forward and links do
 //! not, a ring of bridges neither loops nor duplicates, the three subscription kinds, a killed
-//! robot rejoins.
+//! robot rejoins, two Agoras talk over a serial line (a pair of pseudo-terminals).
 #![allow(clippy::unwrap_used)]
 
 use std::collections::BTreeSet;
@@ -328,4 +328,84 @@ fn agoras_sharing_a_network_line_find_each_other_by_multicast() {
         return;
     }
     assert_eq!(r.got_from(60), (1..=20).collect::<Vec<_>>(), "{}", r.stats());
+}
+
+/// Two pseudo-terminals whose masters a Python loop joins: a null-modem cable between the two
+/// slave devices. Prints the two device paths, then, when its stdin closes, how many bytes it
+/// carried.
+const NULL_MODEM: &str = r#"
+import os, pty, select, sys, tty
+a_m, a_s = pty.openpty()
+b_m, b_s = pty.openpty()
+for fd in (a_s, b_s):
+    tty.setraw(fd)
+print(os.ttyname(a_s), os.ttyname(b_s), flush=True)
+carried = 0
+while True:
+    r, _, _ = select.select([a_m, b_m, sys.stdin], [], [])
+    if sys.stdin in r and not os.read(sys.stdin.fileno(), 1):
+        break
+    for src, dst in ((a_m, b_m), (b_m, a_m)):
+        if src in r:
+            try:
+                data = os.read(src, 65536)
+            except OSError:
+                continue
+            os.write(dst, data)
+            carried += len(data)
+print("carried", carried, flush=True)
+"#;
+
+#[test]
+fn two_agoras_talk_over_a_serial_line() {
+    let Ok(mut cable) = Command::new("python3")
+        .args(["-c", NULL_MODEM])
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .spawn()
+    else {
+        eprintln!("SKIPPED: no python3 to make a null-modem pair of pseudo-terminals");
+        return;
+    };
+    let mut out = BufReader::new(cable.stdout.take().unwrap());
+    let mut ptys = String::new();
+    out.read_line(&mut ptys).unwrap();
+    let (a, b) = ptys.trim().split_once(' ').unwrap();
+    // Each end in a Finder group of its own (different discovery ports): the serial line is
+    // the only way between them. One end waits, the other opens the line (`connect`).
+    let p = ports(2);
+    let dir = std::env::temp_dir();
+    let (fa, fb) = (
+        dir.join(format!("mrt-ser-a-{}.cfg", std::process::id())),
+        dir.join(format!("mrt-ser-b-{}.cfg", std::process::id())),
+    );
+    std::fs::write(&fa, format!("127.0.0.1 224.0.0.224 {}\nser link 0 {a}\n", p[0])).unwrap();
+    std::fs::write(&fb, format!("127.0.0.1 224.0.0.224 {}\nser link 0 {b},connect\n", p[1]))
+        .unwrap();
+    // The end that opens the line starts first: it must greet again once the other listens.
+    let mut s = Node::start(&[
+        "--id",
+        "80",
+        "--config",
+        fb.to_str().unwrap(),
+        "--send",
+        "20",
+        "--seconds",
+        "6",
+    ]);
+    std::thread::sleep(Duration::from_millis(300));
+    let mut r =
+        Node::start(&["--id", "81", "--config", fa.to_str().unwrap(), "--recv", "--seconds", "6"]);
+    s.wait();
+    r.wait();
+    drop(cable.stdin.take()); // the cable's loop ends
+    let mut carried = String::new();
+    out.read_line(&mut carried).unwrap();
+    let _ = cable.wait();
+    let _ = std::fs::remove_file(&fa);
+    let _ = std::fs::remove_file(&fb);
+    assert_eq!(r.got_from(80), (1..=20).collect::<Vec<_>>(), "{}", r.stats());
+    let bytes: u64 = carried.trim().strip_prefix("carried ").unwrap().parse().unwrap();
+    // 20 Pings of 16 + 32 + 1 bytes each at least, plus zenoh's handshake and declarations.
+    assert!(bytes > 20 * 49, "the serial line carried {bytes} bytes");
 }
