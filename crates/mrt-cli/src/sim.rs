@@ -77,38 +77,24 @@ fn play_one(
     progress: impl FnMut(f64),
 ) -> Result<MatchReport> {
     if args.distributed {
-        return distributed(cfg, seed, stacks, args, record, progress);
+        #[cfg(feature = "net")]
+        return crate::distributed::play(
+            cfg,
+            seed,
+            stacks,
+            args.behaviors.as_deref(),
+            record,
+            progress,
+        );
+        #[cfg(not(feature = "net"))]
+        anyhow::bail!(
+            "this mrt was built without networking: build it with the default features \
+             (cargo run --release -p mrt-cli -- sim --distributed)"
+        );
     }
     let wiring = if args.direct { Wiring::Direct } else { Wiring::Bus };
     play(cfg, seed, stacks, wiring, args.behaviors.as_deref(), record, progress)
         .map_err(|e| anyhow!("{e}"))
-}
-
-#[cfg(feature = "net")]
-fn distributed(
-    cfg: &SimConfig,
-    seed: u64,
-    stacks: (Stack, Stack),
-    args: &SimArgs,
-    record: bool,
-    progress: impl FnMut(f64),
-) -> Result<MatchReport> {
-    crate::distributed::play(cfg, seed, stacks, args.behaviors.as_deref(), record, progress)
-}
-
-#[cfg(not(feature = "net"))]
-fn distributed(
-    _: &SimConfig,
-    _: u64,
-    _: (Stack, Stack),
-    _: &SimArgs,
-    _: bool,
-    _: impl FnMut(f64),
-) -> Result<MatchReport> {
-    anyhow::bail!(
-        "this mrt was built without networking: build it with the default features \
-         (cargo run --release -p mrt-cli -- sim --distributed)"
-    )
 }
 
 /// How the robots were wired, for the report.

@@ -354,6 +354,9 @@ pub struct RemoteRobot {
     period: Duration,
     /// How long to wait for a teammate's report before running without it.
     mate_wait: Duration,
+    /// A frame or the whistle that arrived while waiting for teammates (the simulator gave up
+    /// on this robot's answer and went on): handled first in the next round.
+    early: Vec<Event>,
 }
 
 /// How a robot's match went, seen from the robot.
@@ -415,6 +418,7 @@ impl RemoteRobot {
             absent: Vec::new(),
             period,
             mate_wait: Duration::from_secs(2),
+            early: Vec::new(),
         })
     }
 
@@ -485,11 +489,14 @@ impl RemoteRobot {
         loop {
             let mut frame = None;
             let mut whistle = false;
+            let mut events = std::mem::take(&mut self.early);
             while let Some(m) = self.inbox.receive_msg() {
-                match self.note(&m) {
-                    Some(Event::Frame(f)) => frame = Some(f),
-                    Some(Event::Whistle) => whistle = true,
-                    None => {}
+                events.extend(self.note(&m));
+            }
+            for e in events {
+                match e {
+                    Event::Frame(f) => frame = Some(f),
+                    Event::Whistle => whistle = true,
                 }
             }
             if whistle {
@@ -547,8 +554,11 @@ impl RemoteRobot {
             }
             self.inbox.wait_msg(Duration::from_millis(2));
             while let Some(m) = self.inbox.receive_msg() {
-                // Only reports can come now: the next frame waits for this cycle's answer.
-                let _ = self.note(&m);
+                // Reports, as a rule: the next frame waits for this cycle's answer, unless
+                // the simulator stopped waiting for it.
+                if let Some(e) = self.note(&m) {
+                    self.early.push(e);
+                }
             }
         }
         true
@@ -674,5 +684,33 @@ mod tests {
         assert_eq!(report.faults[0].robot, 1);
         assert!(report.faults[0].message.contains("silent from cycle 0"), "{:?}", report.faults);
         assert!((report.duration - 4.0).abs() < 0.011);
+    }
+
+    /// What comes while a robot waits for a late teammate (the simulator stopped waiting for
+    /// this robot's answer and went on) is kept for the next round, not lost: here the whole
+    /// match ends while robot 0 waits for its silent teammate, and it still hears the whistle.
+    #[test]
+    fn the_whistle_blown_while_a_robot_waits_for_its_teammate_is_heard() {
+        let cfg = short(0.5, 2);
+        let nets = [Net::default(), Net::default()];
+        let mut teams = Vec::new();
+        for (t, net) in nets.iter().enumerate() {
+            let agora = Agora::builder(200 + t as u32).build().unwrap();
+            net.join(&agora);
+            teams.push(agora);
+        }
+        let patience = Patience { cycle: Duration::from_millis(200), ..Patience::default() };
+        let patience = Patience { end: Duration::from_millis(300), ..patience };
+        let server = PitchServer::new(&cfg, 1, teams, patience).unwrap();
+        // Robot 0 runs, its teammate robot 1 never does: from cycle 1 on robot 0 waits 2 s for
+        // the teammate's report, and the 10-cycle match is over long before that.
+        let spec = RobotSpec::of(0, 2, (Stack::Chaser, Stack::Chaser));
+        let robot = RemoteRobot::new(&cfg, spec, Path::new(""), None).unwrap();
+        nets[0].join(robot.agora().unwrap());
+        robot.open();
+        let home = std::thread::spawn(move || robot.run(Duration::from_secs(3)));
+        server.play(|_| {}).unwrap();
+        let run = home.join().unwrap().expect("the robot heard the final whistle");
+        assert_eq!(run.late_mates, 1, "{run:?}");
     }
 }

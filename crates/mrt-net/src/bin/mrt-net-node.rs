@@ -76,8 +76,8 @@ impl Member for Echoer {
 
     fn do_your_job(&mut self, ctx: &mut Context<'_>) -> Result<(), MemberError> {
         while let Some(m) = ctx.receive_msg() {
-            if let Ok(p) = m.get::<Probe>() {
-                ctx.publish_with(Echo(p.0.clone()), DeliveryWarranty::Reliable, 0);
+            if m.msg_type() == Probe::TYPE {
+                ctx.publish_with(Echo(m.get::<Probe>()?.0.clone()), DeliveryWarranty::Reliable, 0);
             } else if self.0.count(&m.get::<Flood>()?.0) {
                 ctx.publish_with(Echo(Vec::new()), DeliveryWarranty::Reliable, 0);
             }
@@ -86,9 +86,9 @@ impl Member for Echoer {
     }
 }
 
-/// The echo side of the benchmark: an Agora echoing Probes (threaded executor: a Member wakes
-/// as a message arrives), and a plain zenoh subscriber echoing `raw/ping` to `raw/pong` on
-/// the same session, for comparison.
+/// The far side of the benchmark: an Agora echoing Probes and acknowledging batches of Floods
+/// (threaded executor: a Member wakes as a message arrives), and plain zenoh subscribers doing
+/// the same on `raw/ping` and `raw/flood` (answers on `raw/pong`) on the same session.
 fn echo(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     use zenoh::Wait;
     let mut agora = mrt_dcdt::Agora::builder(args.id).build()?;
