@@ -17,11 +17,12 @@ fn mrt() -> Command {
     Command::new(env!("CARGO_BIN_EXE_mrt"))
 }
 
-/// Starts `mrt bb serve` on a free port with the shipped configs/bb; returns it and its address.
-fn serve() -> (Server, String) {
-    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../../configs/bb");
+/// Starts `mrt bb serve` for `robot` on a free port with more `args`; returns it and its
+/// relay's address.
+fn serve_robot(robot: u32, args: &[&std::ffi::OsStr]) -> (Server, String) {
     let mut child = mrt()
-        .args(["bb", "serve", "--addr", "127.0.0.1:0", "--robot", "1", "--config-dir", dir])
+        .args(["bb", "serve", "--addr", "127.0.0.1:0", "--robot", &robot.to_string()])
+        .args(args)
         .stdout(Stdio::piped())
         .stderr(Stdio::null())
         .spawn()
@@ -29,8 +30,15 @@ fn serve() -> (Server, String) {
     let mut line = String::new();
     BufReader::new(child.stdout.take().unwrap()).read_line(&mut line).unwrap();
     let addr = line.trim().rsplit(' ').next().unwrap().to_string();
-    assert!(line.starts_with("relay of robot 1 listening on 127.0.0.1:"), "{line}");
+    let expected = format!("relay of robot {robot} listening on 127.0.0.1:");
+    assert!(line.starts_with(&expected), "{line}");
     (Server(child), addr)
+}
+
+/// `mrt bb serve` for robot 1 with the shipped configs/bb.
+fn serve() -> (Server, String) {
+    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../../configs/bb");
+    serve_robot(1, &["--config-dir".as_ref(), dir.as_ref()])
 }
 
 fn run(args: &[&str]) -> (bool, String, String) {
@@ -102,17 +110,7 @@ fn two_robots_share_their_blackboards_over_the_network() {
         let text =
             format!("127.0.0.1 224.0.0.224 {me}\nip link 0 127.0.0.1 {me} 127.0.0.1 {other}\n");
         std::fs::write(&cfg, text).unwrap();
-        let mut child = mrt()
-            .args(["bb", "serve", "--addr", "127.0.0.1:0", "--robot", &(i + 1).to_string()])
-            .arg("--net")
-            .arg(&cfg)
-            .stdout(Stdio::piped())
-            .stderr(Stdio::null())
-            .spawn()
-            .unwrap();
-        let mut line = String::new();
-        BufReader::new(child.stdout.take().unwrap()).read_line(&mut line).unwrap();
-        servers.push((Server(child), line.trim().rsplit(' ').next().unwrap().to_string()));
+        servers.push(serve_robot(i as u32 + 1, &["--net".as_ref(), cfg.as_os_str()]));
     }
     let (one, two) = (servers[0].1.clone(), servers[1].1.clone());
     let get = |addr: &str, symbol: &str| run(&["bb", "get", symbol, "--addr", addr]).1;

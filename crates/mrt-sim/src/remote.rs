@@ -619,6 +619,39 @@ mod tests {
         }
     }
 
+    /// The simulator of a match, each team on a network of its own.
+    fn pitch(cfg: &SimConfig, seed: u64, patience: Patience) -> ([Net; 2], PitchServer) {
+        let nets = [Net::default(), Net::default()];
+        let mut teams = Vec::new();
+        for (t, net) in nets.iter().enumerate() {
+            let agora = Agora::builder(200 + t as u32).build().unwrap();
+            net.join(&agora);
+            teams.push(agora);
+        }
+        (nets, PitchServer::new(cfg, seed, teams, patience).unwrap())
+    }
+
+    /// A robot on its team's network, running (until the whistle or `silence`) on a thread.
+    fn start_robot(
+        cfg: &SimConfig,
+        nets: &[Net; 2],
+        spec: RobotSpec,
+        behaviors: &Path,
+        silence: Duration,
+    ) -> std::thread::JoinHandle<Result<RobotRun, String>> {
+        let team = spec.robot / cfg.rules.team_size.max(1);
+        let robot = RemoteRobot::new(cfg, spec, behaviors, None).unwrap();
+        nets[team].join(robot.agora().unwrap());
+        robot.open();
+        std::thread::spawn(move || robot.run(silence))
+    }
+
+    /// Patience for tests where robots stay silent: 200 ms a cycle, 300 ms for last words.
+    fn short_patience() -> Patience {
+        let patience = Patience { cycle: Duration::from_millis(200), ..Patience::default() };
+        Patience { end: Duration::from_millis(300), ..patience }
+    }
+
     /// The simulator and each robot in executors of their own (threads here, processes in
     /// `mrt sim --distributed`), each team on a network of its own: the same match as one bus,
     /// hash for hash, teammates' reports included.
@@ -627,22 +660,12 @@ mod tests {
         let cfg = short(6.0, 3);
         let stacks = (Stack::Chaos, Stack::Milan);
         let dir = crate::bus::behaviors_dir(&[Stack::Chaos], None).unwrap();
-        let nets = [Net::default(), Net::default()];
-        let mut teams = Vec::new();
-        for (t, net) in nets.iter().enumerate() {
-            let agora = Agora::builder(200 + t as u32).build().unwrap();
-            net.join(&agora);
-            teams.push(agora);
-        }
-        let server = PitchServer::new(&cfg, 5, teams, Patience::default()).unwrap();
-        let mut robots = Vec::new();
-        for i in 0..6 {
-            let spec = RobotSpec::of(i, 3, stacks);
-            let robot = RemoteRobot::new(&cfg, spec, &dir, None).unwrap();
-            nets[i / 3].join(robot.agora().unwrap());
-            robot.open();
-            robots.push(std::thread::spawn(move || robot.run(Duration::from_secs(20))));
-        }
+        let (nets, server) = pitch(&cfg, 5, Patience::default());
+        let robots: Vec<_> = (0..6)
+            .map(|i| {
+                start_robot(&cfg, &nets, RobotSpec::of(i, 3, stacks), &dir, Duration::from_secs(20))
+            })
+            .collect();
         let distributed = server.play(|_| {}).unwrap();
         let runs: Vec<RobotRun> = robots.into_iter().map(|h| h.join().unwrap().unwrap()).collect();
         assert!(runs.iter().all(|r| r.cycles == 120 && r.late_mates == 0), "{runs:?}");
@@ -660,22 +683,10 @@ mod tests {
     #[test]
     fn a_silent_robot_is_booked_and_the_match_goes_on() {
         let cfg = short(2.0, 1);
-        let nets = [Net::default(), Net::default()];
-        let mut teams = Vec::new();
-        for (t, net) in nets.iter().enumerate() {
-            let agora = Agora::builder(200 + t as u32).build().unwrap();
-            net.join(&agora);
-            teams.push(agora);
-        }
-        let patience = Patience { cycle: Duration::from_millis(200), ..Patience::default() };
-        let patience = Patience { end: Duration::from_millis(300), ..patience };
-        let server = PitchServer::new(&cfg, 1, teams, patience).unwrap();
+        let (nets, server) = pitch(&cfg, 1, short_patience());
         // Only the home robot runs.
         let spec = RobotSpec::of(0, 1, (Stack::Chaser, Stack::Chaser));
-        let robot = RemoteRobot::new(&cfg, spec, Path::new(""), None).unwrap();
-        nets[0].join(robot.agora().unwrap());
-        robot.open();
-        let home = std::thread::spawn(move || robot.run(Duration::from_secs(20)));
+        let home = start_robot(&cfg, &nets, spec, Path::new(""), Duration::from_secs(20));
         let started = Instant::now();
         let report = server.play(|_| {}).unwrap();
         assert!(started.elapsed() < Duration::from_secs(10), "not 200 ms every cycle");
@@ -692,23 +703,11 @@ mod tests {
     #[test]
     fn the_whistle_blown_while_a_robot_waits_for_its_teammate_is_heard() {
         let cfg = short(0.5, 2);
-        let nets = [Net::default(), Net::default()];
-        let mut teams = Vec::new();
-        for (t, net) in nets.iter().enumerate() {
-            let agora = Agora::builder(200 + t as u32).build().unwrap();
-            net.join(&agora);
-            teams.push(agora);
-        }
-        let patience = Patience { cycle: Duration::from_millis(200), ..Patience::default() };
-        let patience = Patience { end: Duration::from_millis(300), ..patience };
-        let server = PitchServer::new(&cfg, 1, teams, patience).unwrap();
+        let (nets, server) = pitch(&cfg, 1, short_patience());
         // Robot 0 runs, its teammate robot 1 never does: from cycle 1 on robot 0 waits 2 s for
         // the teammate's report, and the 10-cycle match is over long before that.
         let spec = RobotSpec::of(0, 2, (Stack::Chaser, Stack::Chaser));
-        let robot = RemoteRobot::new(&cfg, spec, Path::new(""), None).unwrap();
-        nets[0].join(robot.agora().unwrap());
-        robot.open();
-        let home = std::thread::spawn(move || robot.run(Duration::from_secs(3)));
+        let home = start_robot(&cfg, &nets, spec, Path::new(""), Duration::from_secs(3));
         server.play(|_| {}).unwrap();
         let run = home.join().unwrap().expect("the robot heard the final whistle");
         assert_eq!(run.late_mates, 1, "{run:?}");
