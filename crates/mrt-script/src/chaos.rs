@@ -40,6 +40,8 @@ pub struct RobotIo {
     /// What the behaviors asked for this cycle.
     pub command: RobotCommand,
     globals: HashMap<String, GlobalValue>,
+    /// What `globals` holds, in bytes (see [`global_size`]).
+    globals_bytes: usize,
     /// The behaviors `setBehavior` may name; `None` accepts any name.
     pub known_behaviors: Option<std::collections::BTreeSet<String>>,
     behavior: Option<String>,
@@ -109,6 +111,24 @@ impl RobotIo {
     /// A persistent global (`getGlobal`), for tests and monitors.
     pub fn global(&self, key: &str) -> Option<&GlobalValue> {
         self.globals.get(key)
+    }
+}
+
+/// The bytes a persistent global takes: its key, its value and the table's bookkeeping.
+fn global_size(key: &str, v: &GlobalValue) -> usize {
+    let value = match v {
+        GlobalValue::String(s) => s.len(),
+        GlobalValue::Integer(_) | GlobalValue::Float(_) => 0,
+    };
+    key.len() + value + std::mem::size_of::<(String, GlobalValue)>()
+}
+
+/// `v` when finite, else a Lua error naming the API function.
+fn finite(f: &str, v: f64) -> mlua::Result<f64> {
+    if v.is_finite() {
+        Ok(v)
+    } else {
+        Err(mlua::Error::runtime(format!("bad argument: chaos.{f} needs a finite number, not {v}")))
     }
 }
 
@@ -200,10 +220,10 @@ impl CycleTable {
 
 /// Installs `chaos.*` and its constants in the runtime, bound to `io`.
 pub fn install(rt: &LuaRuntime, io: Rc<RefCell<RobotIo>>) -> Result<(), ScriptError> {
-    install_inner(&rt.lua, io).map_err(ScriptError::setup)
+    install_inner(&rt.lua, io, rt.sandbox().memory_limit).map_err(ScriptError::setup)
 }
 
-fn install_inner(lua: &Lua, io: Rc<RefCell<RobotIo>>) -> mlua::Result<()> {
+fn install_inner(lua: &Lua, io: Rc<RefCell<RobotIo>>, memory_limit: usize) -> mlua::Result<()> {
     let chaos = lua.create_table()?;
     let g = lua.globals();
     for (name, v) in [("BALL", lps::BALL), ("NET1", lps::NET1), ("NET2", lps::NET2)] {
@@ -326,16 +346,18 @@ fn install_inner(lua: &Lua, io: Rc<RefCell<RobotIo>>) -> mlua::Result<()> {
             Some(mrt_core::robot::Target { pose, avoid: avoid.unwrap_or(true) });
         Ok(())
     });
+    // A set-point that is not a finite number is the script's fault, reported as one: NaN
+    // would silently stop the robot and infinity saturate it.
     func!("setVlin", io, |_lua, v: f64| {
-        io.borrow_mut().command.vlin = v;
+        io.borrow_mut().command.vlin = finite("setVlin", v)?;
         Ok(())
     });
     func!("setVrot", io, |_lua, v: f64| {
-        io.borrow_mut().command.vrot = v;
+        io.borrow_mut().command.vrot = finite("setVrot", v)?;
         Ok(())
     });
     func!("setVlat", io, |_lua, v: f64| {
-        io.borrow_mut().command.vlat = v;
+        io.borrow_mut().command.vlat = finite("setVlat", v)?;
         Ok(())
     });
     func!("setKick", io, |_lua, id: i64| {
@@ -344,7 +366,13 @@ fn install_inner(lua: &Lua, io: Rc<RefCell<RobotIo>>) -> mlua::Result<()> {
     });
     func!("setNeeded", io, |_lua, (i, v): (i64, f64)| {
         let i = check_index("setNeeded", i)?;
-        io.borrow_mut().command.needs.push((i, v.clamp(0.0, 1.0)));
+        let v = finite("setNeeded", v)?.clamp(0.0, 1.0);
+        // The largest need per object wins: keep one entry per object, not one per call.
+        let needs = &mut io.borrow_mut().command.needs;
+        match needs.iter_mut().find(|(j, _)| *j == i) {
+            Some((_, old)) => *old = old.max(v),
+            None => needs.push((i, v)),
+        }
         Ok(())
     });
     func!("trackLandMarks", io, |_lua, (): ()| {
@@ -398,7 +426,7 @@ fn install_inner(lua: &Lua, io: Rc<RefCell<RobotIo>>) -> mlua::Result<()> {
         t.set("isNew", i64::from(is_new))?;
         Ok(t)
     });
-    func!("setGlobal", io, |_lua, (key, ty, value): (String, i64, Value)| {
+    func!("setGlobal", io, |lua, (key, ty, value): (String, i64, Value)| {
         let v = match (ty, &value) {
             (INTEGER, Value::Integer(i)) => GlobalValue::Integer(*i),
             (INTEGER, Value::Number(n)) if n.fract() == 0.0 && n.is_finite() => GlobalValue::Integer(*n as i64),
@@ -412,7 +440,19 @@ fn install_inner(lua: &Lua, io: Rc<RefCell<RobotIo>>) -> mlua::Result<()> {
                 )))
             }
         };
-        io.borrow_mut().globals.insert(key, v);
+        // What the globals hold counts against the script's memory limit.
+        let mut io = io.borrow_mut();
+        let old = io.globals.get(&key).map_or(0, |old| global_size(&key, old));
+        let total = io.globals_bytes - old + global_size(&key, &v);
+        if total + lua.used_memory() > memory_limit {
+            return Err(mlua::Error::runtime(format!(
+                "chaos.setGlobal(\"{}\"): not enough memory: the globals would take {total} bytes \
+                 of the {memory_limit}-byte memory limit",
+                crate::runtime::clip(&key, 80)
+            )));
+        }
+        io.globals_bytes = total;
+        io.globals.insert(key, v);
         Ok(())
     });
     func!("getGlobal", io, |lua, key: String| {

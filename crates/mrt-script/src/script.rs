@@ -1,6 +1,6 @@
 //! A behavior script: loading strategies, calls with budgets, hot reload with fallback.
 
-use crate::runtime::{LuaRuntime, BUDGET_EXCEEDED};
+use crate::runtime::{clip, LuaRuntime, MAX_TEXT};
 use crate::watch::Compiled;
 use mlua::chunk::ChunkMode;
 use mlua::{FromLuaMulti, Function};
@@ -47,6 +47,15 @@ pub enum ScriptError {
         /// The budget.
         budget: u64,
     },
+    /// The watchdog stopped the behavior: its cycle did not end within the deadline (a C
+    /// function or an API call that blocks, or anything else the budget does not see).
+    #[error("{file}: stopped by the watchdog: the cycle did not end within {deadline_ms} ms")]
+    Watchdog {
+        /// The script (or the behavior Member) that was running.
+        file: String,
+        /// The deadline.
+        deadline_ms: u64,
+    },
     /// The Lua state ran out of its memory limit.
     #[error("{file}: aborted: memory limit of {limit} bytes exceeded")]
     Memory {
@@ -90,25 +99,30 @@ impl ScriptError {
         match e {
             mlua::Error::SyntaxError { message, .. } => {
                 let (line, msg) = split_position(message);
-                ScriptError::Syntax { file: file.into(), line, message: msg }
+                ScriptError::Syntax { file: file.into(), line, message: clip(&msg, MAX_TEXT) }
             }
-            other => ScriptError::Setup(format!("{file}: {other}")),
+            other => ScriptError::Setup(clip(&format!("{file}: {other}"), MAX_TEXT)),
         }
     }
 
     pub(crate) fn from_lua(file: &str, rt: &LuaRuntime, e: mlua::Error) -> ScriptError {
-        let text = e.to_string();
-        if matches!(e, mlua::Error::MemoryError(_)) || text.contains("not enough memory") {
-            return ScriptError::Memory { file: file.into(), limit: rt.sandbox().memory_limit };
-        }
-        if text.contains(BUDGET_EXCEEDED) {
-            let (file, line) = rt.take_overrun().unwrap_or_else(|| (file.into(), 0));
-            return ScriptError::Budget { file, line, budget: rt.sandbox().instruction_budget };
-        }
         if let mlua::Error::SyntaxError { message, .. } = &e {
             // Lua says `[string "name"]:LINE: message` or `name:LINE: message`.
             let (line, msg) = split_position(message);
-            return ScriptError::Syntax { file: file.into(), line, message: msg };
+            return ScriptError::Syntax { file: file.into(), line, message: clip(&msg, MAX_TEXT) };
+        }
+        // An overrun is told by the meter, not by the error's text: a message handler may
+        // have replaced the text on its way out.
+        if rt.interrupted() {
+            return ScriptError::Watchdog { file: file.into(), deadline_ms: 0 };
+        }
+        if rt.overran() {
+            let (file, line) = rt.take_overrun().unwrap_or_else(|| (file.into(), 0));
+            return ScriptError::Budget { file, line, budget: rt.sandbox().instruction_budget };
+        }
+        let text = e.to_string();
+        if matches!(e, mlua::Error::MemoryError(_)) || text.contains("not enough memory") {
+            return ScriptError::Memory { file: file.into(), limit: rt.sandbox().memory_limit };
         }
         runtime_error(file, &text)
     }
@@ -145,6 +159,8 @@ fn runtime_error(file: &str, text: &str) -> ScriptError {
         Some((f, l, _)) => (f.to_string(), l),
         None => (file.to_string(), 0),
     };
+    // A script chooses its error text: keep what a person reads, not megabytes.
+    let (message, traceback) = (clip(&message, MAX_TEXT), clip(&traceback, 4 * MAX_TEXT));
     ScriptError::Runtime { file, line, message, traceback }
 }
 
@@ -264,6 +280,7 @@ impl Script {
     /// Runs the script once (one behavior tick) within the sandbox's budget, returning what
     /// the chunk returns. A failed call leaves the runtime and the script usable.
     pub fn call<R: FromLuaMulti>(&self, rt: &LuaRuntime) -> Result<R, ScriptError> {
+        rt.reset_budget();
         let fresh = match (self.strategy, &self.path) {
             (LoadStrategy::ReloadFromFile, Some(p)) => Some(compile(rt, &self.name, &read(p)?)?),
             (LoadStrategy::Source, _) | (LoadStrategy::ReloadFromFile, None) => {
@@ -271,7 +288,6 @@ impl Script {
             }
             (LoadStrategy::Compiled, _) => None,
         };
-        rt.reset_budget();
         let result = match fresh {
             Some(f) => f.call::<R>(()),
             // No clone of the kept function (a registry reference each time): call it in place.

@@ -171,3 +171,72 @@ fn kickoff_pose_and_targets() {
     let (r, _) = run(WorldSnapshot::default(), "chaos.setTarget(0/0, 0, 0)");
     assert!(r.unwrap_err().to_string().contains("setTarget needs finite numbers"));
 }
+
+#[test]
+fn a_set_point_that_is_not_finite_is_a_reported_fault() {
+    let (rt, io) = setup();
+    for call in [
+        "chaos.setVlin(0/0)",
+        "chaos.setVrot(math.huge)",
+        "chaos.setVlat(-math.huge)",
+        "chaos.setNeeded(BALL, 0/0)",
+    ] {
+        io.borrow_mut().begin_cycle(WorldSnapshot::default(), "b");
+        let s = Script::from_source(&rt, "nan.lua", call, LoadStrategy::Compiled).unwrap();
+        let e = s.call::<()>(&rt).unwrap_err();
+        assert!(
+            matches!(e, ScriptError::Runtime { .. }) && e.to_string().contains("finite number"),
+            "{call}: {e}"
+        );
+        let c = &io.borrow().command;
+        assert!(c.vlin.is_finite() && c.vrot.is_finite() && c.vlat.is_finite());
+        assert!(c.needs.is_empty());
+    }
+}
+
+#[test]
+fn needs_keep_one_entry_per_object_however_often_they_are_set() {
+    let (rt, io) = setup();
+    io.borrow_mut().begin_cycle(WorldSnapshot::default(), "b");
+    let s = Script::from_source(
+        &rt,
+        "needs.lua",
+        "for i = 1, 100000 do chaos.setNeeded(BALL, (i % 10) / 10) end chaos.setNeeded(NET1, 0.2)",
+        LoadStrategy::Compiled,
+    )
+    .unwrap();
+    s.call::<()>(&rt).unwrap();
+    let io = io.borrow();
+    assert_eq!(io.command.needs.len(), 2);
+    assert_eq!(io.command.need(lps::BALL), 0.9);
+    assert_eq!(io.command.need(lps::NET1), 0.2);
+}
+
+#[test]
+fn set_global_counts_against_the_memory_limit() {
+    // The tester's loop of 1 MB strings reached 2.4 GB outside Lua's limit.
+    let rt = LuaRuntime::new(Sandbox { memory_limit: 8 << 20, ..Sandbox::default() }).unwrap();
+    let io = Rc::new(RefCell::new(RobotIo::default()));
+    install(&rt, io.clone()).unwrap();
+    let s = Script::from_source(
+        &rt,
+        "hoard.lua",
+        "local mb = string.rep('x', 1 << 20) \
+         for i = 1, 10000 do chaos.setGlobal('k' .. i, STRING, mb .. i) end",
+        LoadStrategy::Compiled,
+    )
+    .unwrap();
+    let e = s.call::<()>(&rt).unwrap_err();
+    assert!(matches!(e, ScriptError::Memory { limit, .. } if limit == 8 << 20), "{e}");
+    // Fewer than 8 of them were kept; overwriting one does not grow the total.
+    assert!(io.borrow().global("k8").is_none());
+    let again = Script::from_source(
+        &rt,
+        "again.lua",
+        "for i = 1, 1000 do chaos.setGlobal('k1', STRING, string.rep('y', 1000)) end",
+        LoadStrategy::Compiled,
+    )
+    .unwrap();
+    again.call::<()>(&rt).unwrap();
+    assert_eq!(io.borrow().global("k1"), Some(&GlobalValue::String("y".repeat(1000))));
+}
