@@ -8,6 +8,10 @@
 //! error, give the safe command (stand still) for the cycle; a file that no longer compiles
 //! keeps its running version. The next cycle runs normally. Every error is reported in
 //! [`Cycle::errors`].
+//!
+//! A behavior that runs away [`RUNAWAY_LIMIT`] cycles in a row is hostile, not unlucky: the
+//! robot is **stopped** (the safe command, no Lua run, so it costs nothing) until a file is
+//! reloaded, and [`ScriptError::Stopped`] says so once.
 
 use crate::chaos::{self, RobotIo};
 use crate::hbm::Hbm;
@@ -20,6 +24,10 @@ use mrt_core::robot::{RobotCommand, WorldSnapshot};
 use std::cell::RefCell;
 use std::path::{Path, PathBuf};
 use std::rc::Rc;
+
+/// Runaway cycles (budget or memory overruns) in a row after which the robot is stopped until
+/// a behavior file is reloaded.
+pub const RUNAWAY_LIMIT: u32 = 3;
 
 /// What one cycle did.
 #[derive(Debug)]
@@ -52,6 +60,8 @@ pub struct ThinkingCap {
     top: Top,
     last_good: Option<String>,
     watcher: Option<ScriptWatcher>,
+    /// Runaway cycles in a row.
+    runaways: u32,
 }
 
 impl ThinkingCap {
@@ -85,7 +95,7 @@ impl ThinkingCap {
         let hfsm = Hfsm::from_file(&rt, machine.as_ref(), io.clone())?;
         let top =
             Top::Hfsm(Box::new(hfsm), std::path::absolute(machine.as_ref()).unwrap_or_default());
-        Ok(ThinkingCap { rt, io, hbm, top, last_good: None, watcher: None })
+        Ok(ThinkingCap { rt, io, hbm, top, last_good: None, watcher: None, runaways: 0 })
     }
 
     /// [`ThinkingCap::with_behavior`] with `bb.*` bound to the robot's `blackboard`.
@@ -104,7 +114,7 @@ impl ThinkingCap {
             )));
         }
         let top = Top::Behavior(behavior.to_string());
-        Ok(ThinkingCap { rt, io, hbm, top, last_good: None, watcher: None })
+        Ok(ThinkingCap { rt, io, hbm, top, last_good: None, watcher: None, runaways: 0 })
     }
 
     fn base(
@@ -201,6 +211,19 @@ impl ThinkingCap {
         self.io.borrow_mut().known_behaviors = Some(self.hbm.names().into_iter().collect());
     }
 
+    /// Whether the robot is stopped for running away (see the module documentation).
+    pub fn stopped(&self) -> bool {
+        self.runaways >= RUNAWAY_LIMIT
+    }
+
+    /// What the top of the stack is called in errors (the HFSM file or the behavior).
+    fn top_name(&self) -> String {
+        match &self.top {
+            Top::Hfsm(h, _) => h.file().to_string(),
+            Top::Behavior(b) => b.clone(),
+        }
+    }
+
     fn reload_hfsm(
         &mut self,
         touched: &[PathBuf],
@@ -226,6 +249,10 @@ impl ThinkingCap {
                 Err(e) => errors.push(e),
             }
         }
+        if !done.is_empty() {
+            // An edited behavior gets a fresh start.
+            self.runaways = 0;
+        }
         (done, errors)
     }
 
@@ -237,6 +264,11 @@ impl ThinkingCap {
             (reloaded, errors) = self.apply(changes);
         }
         self.io.borrow_mut().new_cycle(world);
+        if self.stopped() {
+            let command = RobotCommand::default();
+            let path = self.hfsm().map(Hfsm::path).unwrap_or_default();
+            return Cycle { command, path, behavior: None, taken: None, reloaded, errors };
+        }
         let mut taken = None;
         let (chosen, path) = match &mut self.top {
             Top::Behavior(name) => (Some(name.clone()), String::new()),
@@ -276,6 +308,13 @@ impl ThinkingCap {
         let mut command = self.io.borrow().command.clone();
         if command.behavior.is_none() {
             command.behavior = behavior.clone();
+        }
+        let runaway = errors
+            .iter()
+            .any(|e| matches!(e, ScriptError::Budget { .. } | ScriptError::Memory { .. }));
+        self.runaways = if runaway { self.runaways + 1 } else { 0 };
+        if self.stopped() {
+            errors.push(ScriptError::Stopped { file: self.top_name(), runaways: self.runaways });
         }
         Cycle { command, path, behavior, taken, reloaded, errors }
     }

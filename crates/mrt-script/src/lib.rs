@@ -48,8 +48,10 @@ pub mod member;
 mod runtime;
 mod script;
 mod watch;
+mod watchdog;
 
-pub use cap::{Cycle, ThinkingCap};
-pub use runtime::{LuaRuntime, Sandbox};
+pub use cap::{Cycle, ThinkingCap, RUNAWAY_LIMIT};
+pub use runtime::{Interrupt, LuaRuntime, Sandbox, MAX_TEXT, PRINT_LINES_PER_CALL};
 pub use script::{LoadStrategy, Script, ScriptError};
 pub use watch::{Change, Compiled, ScriptWatcher};
+pub use watchdog::{Watchdog, DEFAULT_DEADLINE, LOAD_DEADLINE, MAX_RESTARTS};

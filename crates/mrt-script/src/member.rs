@@ -2,23 +2,23 @@
 //!
 //! A [`BehaviorMember`] reads the latest [`WorldSnapshot`] from the bus, runs one cycle of an
 //! HFSM (the "HFSM Member") or of one HBM behavior (the "HBM Member") per activation (every
-//! 100 ms by default, as in the seed: [`DEFAULT_PERIOD`]), and publishes the [`RobotCommand`]
+//! 100 ms by default, as in the seed: [`DEFAULT_PERIOD`]), and publishes the [`RobotCommand`](mrt_core::robot::RobotCommand)
 //! and a [`BehaviorStatus`] (active path, behavior, errors) for monitors. A
 //! [`ReloadRequest`] on the bus reloads the edited scripts at the next cycle boundary, like the
 //! seed's editor sending a behavior to a running robot.
 //!
 //! A Lua state belongs to one thread, and Members may move between threads, so the scripts run
-//! on a worker thread owned by the Member; each cycle is one synchronous round trip (a few
-//! microseconds), so the stepped executor stays deterministic.
+//! on a worker thread owned by the Member, under the [`Watchdog`]: each cycle is one
+//! synchronous round trip (a few microseconds), so the stepped executor stays deterministic,
+//! and a cycle that does not end within the deadline stops the behavior, not the robot.
 
 use crate::cap::ThinkingCap;
 use crate::runtime::Sandbox;
-use mrt_core::robot::{RobotCommand, WorldSnapshot};
+use crate::watchdog::{Watchdog, DEFAULT_DEADLINE};
+use mrt_core::robot::WorldSnapshot;
 use mrt_dcdt::{Context, Member, MemberError, Message, MsgType, RequestType, RESERVED_TYPES_START};
 use serde::{Deserialize, Serialize};
 use std::path::PathBuf;
-use std::sync::mpsc::{channel, Receiver, Sender};
-use std::thread::JoinHandle;
 use std::time::Duration;
 
 /// The seed's control period: "both a low-level and a high-level behavior are executed every
@@ -59,17 +59,6 @@ enum Top {
     Behavior(String),
 }
 
-enum Job {
-    Cycle(Box<WorldSnapshot>),
-    Reload,
-}
-
-struct Worker {
-    jobs: Sender<Job>,
-    replies: Receiver<(RobotCommand, BehaviorStatus)>,
-    thread: JoinHandle<()>,
-}
-
 /// An HFSM or HBM Member (see the module documentation).
 pub struct BehaviorMember {
     name: String,
@@ -77,7 +66,8 @@ pub struct BehaviorMember {
     top: Top,
     sandbox: Sandbox,
     watch: bool,
-    worker: Option<Worker>,
+    deadline: Duration,
+    worker: Option<Watchdog>,
     world: WorldSnapshot,
     blackboard: Option<mrt_blackboard::Blackboard>,
 }
@@ -104,6 +94,7 @@ impl BehaviorMember {
             top,
             sandbox: Sandbox::default(),
             watch: false,
+            deadline: DEFAULT_DEADLINE,
             worker: None,
             world: WorldSnapshot::default(),
             blackboard: None,
@@ -128,67 +119,26 @@ impl BehaviorMember {
         self
     }
 
-    fn spawn(&self) -> Result<Worker, MemberError> {
-        let (jobs, job_rx) = channel::<Job>();
-        let (reply_tx, replies) = channel();
-        let (ready_tx, ready_rx) = channel::<Result<(), String>>();
+    /// Sets the watchdog's deadline for one cycle ([`DEFAULT_DEADLINE`] by default).
+    pub fn with_deadline(mut self, deadline: Duration) -> Self {
+        self.deadline = deadline;
+        self
+    }
+
+    fn spawn(&self) -> Result<Watchdog, MemberError> {
         let (dir, top, sandbox, watch, bb) =
             (self.dir.clone(), self.top.clone(), self.sandbox, self.watch, self.blackboard.clone());
-        let thread = std::thread::Builder::new()
-            .name(self.name.clone())
-            .spawn(move || {
-                let loaded = match &top {
-                    Top::Hfsm(file) => ThinkingCap::load_hfsm(&dir, file, sandbox, bb),
-                    Top::Behavior(name) => ThinkingCap::load_behavior(&dir, name, sandbox, bb),
-                };
-                let mut cap = match loaded.and_then(|mut c| {
-                    if watch {
-                        c.watch(&dir)?;
-                    }
-                    Ok(c)
-                }) {
-                    Ok(c) => {
-                        let _ = ready_tx.send(Ok(()));
-                        c
-                    }
-                    Err(e) => {
-                        let _ = ready_tx.send(Err(e.to_string()));
-                        return;
-                    }
-                };
-                let mut pending_reload = false;
-                while let Ok(job) = job_rx.recv() {
-                    match job {
-                        Job::Reload => pending_reload = true,
-                        Job::Cycle(world) => {
-                            let mut reloaded = Vec::new();
-                            let mut early = Vec::new();
-                            if std::mem::take(&mut pending_reload) {
-                                (reloaded, early) = cap.reload_requested();
-                            }
-                            let c = cap.cycle(*world);
-                            reloaded.extend(c.reloaded);
-                            let errors =
-                                early.iter().chain(&c.errors).map(ToString::to_string).collect();
-                            let status = BehaviorStatus {
-                                path: c.path,
-                                behavior: c.behavior,
-                                reloaded,
-                                errors,
-                            };
-                            if reply_tx.send((c.command, status)).is_err() {
-                                return;
-                            }
-                        }
-                    }
-                }
-            })
-            .map_err(|e| format!("cannot start the Lua thread: {e}"))?;
-        match ready_rx.recv() {
-            Ok(Ok(())) => Ok(Worker { jobs, replies, thread }),
-            Ok(Err(e)) => Err(e.into()),
-            Err(_) => Err("the Lua thread stopped while loading".into()),
-        }
+        let load = move || {
+            let mut cap = match &top {
+                Top::Hfsm(file) => ThinkingCap::load_hfsm(&dir, file, sandbox, bb.clone()),
+                Top::Behavior(name) => ThinkingCap::load_behavior(&dir, name, sandbox, bb.clone()),
+            }?;
+            if watch {
+                cap.watch(&dir)?;
+            }
+            Ok(cap)
+        };
+        Watchdog::start(&self.name, self.deadline, load).map_err(|e| e.to_string().into())
     }
 }
 
@@ -206,31 +156,32 @@ impl Member for BehaviorMember {
     }
 
     fn do_your_job(&mut self, ctx: &mut Context<'_>) -> Result<(), MemberError> {
-        let Some(worker) = &self.worker else { return Err("not initialized".into()) };
+        let Some(worker) = &mut self.worker else { return Err("not initialized".into()) };
+        let mut early = Vec::new();
         while let Some(m) = ctx.receive_msg() {
             if m.msg_type() == WorldSnapshot::TYPE {
                 self.world = m.get::<WorldSnapshot>()?.clone();
             } else if m.msg_type() == ReloadRequest::TYPE {
-                worker.jobs.send(Job::Reload).map_err(|_| "the Lua thread stopped")?;
+                if let Err(e) = worker.reload_requested() {
+                    early.push(e.to_string());
+                }
             }
         }
-        worker
-            .jobs
-            .send(Job::Cycle(Box::new(self.world.clone())))
-            .map_err(|_| "the Lua thread stopped")?;
-        let (command, status) = worker.replies.recv().map_err(|_| "the Lua thread stopped")?;
-        for e in &status.errors {
+        let c = worker.cycle(self.world.clone());
+        let errors: Vec<String> =
+            early.into_iter().chain(c.errors.iter().map(ToString::to_string)).collect();
+        for e in &errors {
             tracing::warn!(member = %self.name, "{e}");
         }
-        ctx.publish(command);
+        let status =
+            BehaviorStatus { path: c.path, behavior: c.behavior, reloaded: c.reloaded, errors };
+        ctx.publish(c.command);
         ctx.publish(status);
         Ok(())
     }
 
     fn close(&mut self, _ctx: &mut Context<'_>) {
-        if let Some(w) = self.worker.take() {
-            drop(w.jobs);
-            let _ = w.thread.join();
-        }
+        // The worker ends when its job channel closes.
+        self.worker = None;
     }
 }

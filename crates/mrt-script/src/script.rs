@@ -56,6 +56,15 @@ pub enum ScriptError {
         /// The deadline.
         deadline_ms: u64,
     },
+    /// The robot was stopped: its behaviors ran away (budget or memory) this many cycles in a
+    /// row. It stands still, running no Lua, until a behavior file is reloaded.
+    #[error("{file}: stopped after {runaways} runaway cycles in a row; the robot stands still until a behavior file is reloaded")]
+    Stopped {
+        /// The HFSM file or the behavior at the top.
+        file: String,
+        /// Runaway cycles in a row.
+        runaways: u32,
+    },
     /// The Lua state ran out of its memory limit.
     #[error("{file}: aborted: memory limit of {limit} bytes exceeded")]
     Memory {

@@ -755,3 +755,167 @@ fn a_used_behavior_has_its_own_behavior_info() {
     info(&mut cap, 2000.0, 500);
     assert_eq!(info(&mut cap, 500.0, 600), (1.0, Some(0)));
 }
+
+#[test]
+fn a_behavior_that_keeps_running_away_is_stopped_until_a_file_is_reloaded() {
+    let dir = Dir::new("stopped");
+    dir.write("hbm.lua", SINGLETON_HBM);
+    dir.write("spin.lua", r#"always("go", "FAST") while true do end"#);
+    let sandbox = Sandbox { instruction_budget: 1_000_000, ..Default::default() };
+    let mut cap = ThinkingCap::with_behavior(dir.path(), "spin", sandbox).unwrap();
+    for t in 1..mrt_script::RUNAWAY_LIMIT {
+        let c = cap.cycle(ball_at(500.0, u64::from(t) * 100));
+        assert!(matches!(c.errors[..], [ScriptError::Budget { .. }]), "{:?}", c.errors);
+        assert!(!cap.stopped());
+    }
+    let c = cap.cycle(ball_at(500.0, 1000));
+    assert!(
+        matches!(
+            c.errors[..],
+            [ScriptError::Budget { .. }, ScriptError::Stopped { runaways: 3, .. }]
+        ),
+        "{:?}",
+        c.errors
+    );
+    assert!(cap.stopped());
+    // Stopped: the safe command, no error repeated, no Lua run (the budget is not spent).
+    for t in 11..20 {
+        let c = cap.cycle(ball_at(500.0, t * 100));
+        assert!(c.errors.is_empty(), "{:?}", c.errors);
+        assert_eq!(c.command, RobotCommand::default());
+    }
+    // A fixed behavior is reloaded: the robot runs again.
+    dir.edit("spin.lua", r#"always("go", "FAST")"#);
+    let (done, errors) = cap.reload_changed();
+    assert!(errors.is_empty() && done.len() == 1, "{done:?} {errors:?}");
+    let c = cap.cycle(ball_at(500.0, 3000));
+    assert!(c.errors.is_empty(), "{:?}", c.errors);
+    assert_eq!(c.command.vlin, 300.0);
+}
+
+/// A behavior directory whose `blocker` calls `block()`, a Rust function the factory adds to
+/// the robot API: it sleeps while `hold` is set, where no instruction hook can see it.
+fn blocking_robot(
+    dir: &Dir,
+    hold: std::sync::Arc<std::sync::atomic::AtomicBool>,
+) -> impl Fn() -> Result<ThinkingCap, ScriptError> + Send + Sync + 'static {
+    dir.write("hbm.lua", SINGLETON_HBM);
+    dir.write("blocker.lua", r#"always("go", "FAST") block()"#);
+    let path = dir.path().to_path_buf();
+    move || {
+        let cap = ThinkingCap::with_behavior(&path, "blocker", Sandbox::default())?;
+        let hold = hold.clone();
+        let block = cap
+            .runtime()
+            .lua()
+            .create_function(move |_, ()| {
+                while hold.load(std::sync::atomic::Ordering::Relaxed) {
+                    std::thread::sleep(Duration::from_millis(5));
+                }
+                Ok(())
+            })
+            .map_err(|e| ScriptError::Setup(e.to_string()))?;
+        cap.runtime()
+            .lua()
+            .globals()
+            .set("block", block)
+            .map_err(|e| ScriptError::Setup(e.to_string()))?;
+        Ok(cap)
+    }
+}
+
+#[test]
+fn the_watchdog_stops_a_behavior_that_blocks_where_the_hook_cannot_see() {
+    use mrt_script::Watchdog;
+    use std::sync::atomic::{AtomicBool, Ordering};
+    use std::sync::Arc;
+    let dir = Dir::new("watchdog");
+    let hold = Arc::new(AtomicBool::new(false));
+    let deadline = Duration::from_millis(100);
+    let mut robot =
+        Watchdog::start("blocker", deadline, blocking_robot(&dir, hold.clone())).unwrap();
+    // A teammate with an ordinary behavior, in a watchdog of its own.
+    let mate_dir = Dir::new("watchdog-mate");
+    mate_dir.write("hbm.lua", SINGLETON_HBM);
+    mate_dir.write("walker.lua", r#"always("go", "SLOW")"#);
+    let mate_path = mate_dir.path().to_path_buf();
+    let mut mate = Watchdog::start("mate", deadline, move || {
+        ThinkingCap::with_behavior(&mate_path, "walker", Sandbox::default())
+    })
+    .unwrap();
+    let c = robot.cycle(ball_at(500.0, 0));
+    assert!(c.errors.is_empty(), "{:?}", c.errors);
+    assert_eq!(c.command.vlin, 300.0);
+
+    // The behavior blocks (until the end of the test): the cycle ends at the deadline with the
+    // safe command and the watchdog's error, and the robot is stopped.
+    hold.store(true, Ordering::Relaxed);
+    let started = std::time::Instant::now();
+    let c = robot.cycle(ball_at(500.0, 100));
+    let took = started.elapsed();
+    assert!(took >= deadline, "{took:?}");
+    assert!(
+        matches!(&c.errors[..], [ScriptError::Watchdog { deadline_ms: 100, file }] if file == "blocker"),
+        "{:?}",
+        c.errors
+    );
+    assert_eq!(c.command, RobotCommand::default());
+    assert!(robot.stopped());
+    // Later cycles do not wait for it: the safe command at once, the error not repeated;
+    // the teammate runs normally all the while.
+    for t in 2..50 {
+        let c = robot.cycle(ball_at(500.0, t * 100));
+        assert!(c.errors.is_empty() && c.command == RobotCommand::default());
+        let m = mate.cycle(ball_at(500.0, t * 100));
+        assert!(m.errors.is_empty(), "{:?}", m.errors);
+        assert_eq!(m.command.vlin, 100.0);
+    }
+    // A reload request starts a fresh worker from the files: the robot runs again.
+    hold.store(false, Ordering::Relaxed);
+    robot.reload_requested().unwrap();
+    assert!(!robot.stopped());
+    let c = robot.cycle(ball_at(500.0, 6000));
+    assert!(c.errors.is_empty(), "{:?}", c.errors);
+    assert_eq!(c.command.vlin, 300.0);
+}
+
+#[test]
+fn a_panicking_behavior_thread_is_reported_and_restarted() {
+    use mrt_script::Watchdog;
+    let dir = Dir::new("panics");
+    dir.write("hbm.lua", SINGLETON_HBM);
+    dir.write("bomb.lua", r#"always("go", "FAST") if boom then boom() end"#);
+    let path = dir.path().to_path_buf();
+    let armed = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(true));
+    let arm = armed.clone();
+    let mut robot = Watchdog::start("bomb", Duration::from_secs(5), move || {
+        let cap = ThinkingCap::with_behavior(&path, "bomb", Sandbox::default())?;
+        // A faulty extension of the robot API panics on the first call after each start.
+        let arm = arm.clone();
+        let boom = cap
+            .runtime()
+            .lua()
+            .create_function(move |_, ()| {
+                if arm.swap(false, std::sync::atomic::Ordering::Relaxed) {
+                    panic!("a bug in a Rust extension");
+                }
+                Ok(())
+            })
+            .map_err(|e| ScriptError::Setup(e.to_string()))?;
+        cap.runtime()
+            .lua()
+            .globals()
+            .set("boom", boom)
+            .map_err(|e| ScriptError::Setup(e.to_string()))?;
+        Ok(cap)
+    })
+    .unwrap();
+    let c = robot.cycle(ball_at(500.0, 0));
+    assert!(c.errors[0].to_string().contains("restart 1 of"), "{:?}", c.errors);
+    assert_eq!(c.command, RobotCommand::default());
+    assert!(!robot.stopped(), "restarted");
+    let c = robot.cycle(ball_at(500.0, 100));
+    assert!(c.errors.is_empty(), "{:?}", c.errors);
+    assert_eq!(c.command.vlin, 300.0);
+    assert!(!armed.load(std::sync::atomic::Ordering::Relaxed));
+}
