@@ -33,6 +33,7 @@
 
 use crate::devices::{Devices, PitchDevices, SharedDevices};
 use crate::drivers::Base;
+use crate::embedded::FilesDir;
 use crate::game::{guide, Brain, MatchReport, Pitch};
 use crate::referee::Call;
 use crate::sensor::{merge_team, CameraFrame, Odometry};
@@ -409,11 +410,12 @@ pub fn add_robot(
 
 /// The TeamChaos files robots of `stacks` run: `behaviors`, or the compiled-in ones when the
 /// Chaos stack plays (nothing otherwise).
-pub fn behaviors_dir(stacks: &[Stack], behaviors: Option<&Path>) -> Result<PathBuf, String> {
+/// Keep the handle while the robots may read them: compiled-in files are removed with it.
+pub fn behaviors_dir(stacks: &[Stack], behaviors: Option<&Path>) -> Result<FilesDir, String> {
     match behaviors {
-        Some(d) => Ok(d.to_path_buf()),
+        Some(d) => Ok(FilesDir::user(d)),
         None if stacks.contains(&Stack::Chaos) => embedded_teamchaos(),
-        None => Ok(PathBuf::new()),
+        None => Ok(FilesDir::user(PathBuf::new())),
     }
 }
 
@@ -467,6 +469,8 @@ pub struct BusMatch {
     period: Duration,
     /// Each team's community of Agoras (home, then away).
     links: Vec<InnerLinkManager>,
+    /// The behavior files, kept while the robots may reload them.
+    _files: FilesDir,
 }
 
 impl BusMatch {
@@ -503,7 +507,7 @@ impl BusMatch {
                 exec.add_agora(agora).map_err(|e| e.to_string())?;
             }
         }
-        Ok(BusMatch { pitch, exec, period, links })
+        Ok(BusMatch { pitch, exec, period, links, _files: dir })
     }
 
     /// A team's community of Agoras (0 home, 1 away), to attach monitors to.

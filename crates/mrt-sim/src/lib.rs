@@ -26,6 +26,7 @@ pub mod bus;
 pub mod config;
 pub mod devices;
 pub mod drivers;
+pub mod embedded;
 pub mod game;
 pub mod plot;
 pub mod referee;

@@ -12,14 +12,14 @@
 //! League base the Chaos brain scales the behaviors' set-points, as the seed's Commander
 //! Module turned set-points into a walking style for its own body.
 
+use crate::embedded::FilesDir;
 use crate::game::{Brain, Chaser, Stopped};
 use mrt_core::robot::{lps, Lpo, RobotCommand, WorldSnapshot};
 use mrt_core::{Point2, Pose2};
 use mrt_fuzzy::brian::Brian;
 use mrt_plan::guidance::behind_ball;
-use mrt_script::{Sandbox, ThinkingCap};
-use std::path::{Path, PathBuf};
-use std::sync::OnceLock;
+use mrt_script::{Sandbox, ThinkingCap, Watchdog, DEFAULT_DEADLINE};
+use std::path::Path;
 
 /// A behavior stack.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -183,32 +183,14 @@ impl Body {
     }
 }
 
-fn materialize(name: &str, files: &[(&str, &str)]) -> Result<PathBuf, String> {
-    let dir = std::env::temp_dir().join(format!("mrt-{name}-{}", std::process::id()));
-    // A directory left by an earlier process with the same id must not add stale files.
-    if dir.exists() {
-        std::fs::remove_dir_all(&dir).map_err(|e| format!("{}: {e}", dir.display()))?;
-    }
-    for (file, text) in files {
-        let path = dir.join(file);
-        if let Some(parent) = path.parent() {
-            std::fs::create_dir_all(parent).map_err(|e| format!("{}: {e}", parent.display()))?;
-        }
-        std::fs::write(&path, text).map_err(|e| format!("{}: {e}", path.display()))?;
-    }
-    Ok(dir)
+/// The compiled-in TeamChaos files, as a directory while the handle (or a clone) lives.
+pub fn embedded_teamchaos() -> Result<FilesDir, String> {
+    crate::embedded::embedded("teamchaos", TEAMCHAOS)
 }
 
-/// Writes the compiled-in TeamChaos files to a directory of this process (once) and returns it.
-pub fn embedded_teamchaos() -> Result<PathBuf, String> {
-    static DIR: OnceLock<Result<PathBuf, String>> = OnceLock::new();
-    DIR.get_or_init(|| materialize("teamchaos", TEAMCHAOS)).clone()
-}
-
-/// Writes the compiled-in Team Milan configuration to a directory of this process (once).
-pub fn embedded_milan() -> Result<PathBuf, String> {
-    static DIR: OnceLock<Result<PathBuf, String>> = OnceLock::new();
-    DIR.get_or_init(|| materialize("milan", MILAN)).clone()
+/// The compiled-in Team Milan configuration, as a directory while the handle lives.
+pub fn embedded_milan() -> Result<FilesDir, String> {
+    crate::embedded::embedded("milan", MILAN)
 }
 
 /// The Chaos goalkeeper's behavior.
@@ -216,31 +198,39 @@ pub const CHAOS_KEEPER: &str = "goalkeeper";
 /// The Chaos field players' machine file.
 pub const CHAOS_PLAYER: &str = "player.hfsm.lua";
 
-/// A robot driven by ThinkingCap.
+/// A robot driven by ThinkingCap, under the [`Watchdog`]: a behavior that blocks past the
+/// deadline stops this robot (reported), never the match.
 pub struct ChaosBrain {
-    cap: ThinkingCap,
+    cap: Watchdog,
     body: Body,
     faults: Vec<String>,
+    /// Keeps compiled-in files on disk while the robot may reload them.
+    _files: FilesDir,
 }
 
 impl ChaosBrain {
     /// The goalkeeper (`goalkeeper.lua`) or a field player (`player.hfsm.lua`) of `dir`, on
     /// the robot of `cfg`.
     pub fn new(
-        dir: &Path,
+        dir: &FilesDir,
         keeper: bool,
         cfg: &crate::config::SimConfig,
     ) -> Result<ChaosBrain, String> {
         let sandbox = Sandbox::default();
-        let cap = if keeper {
-            ThinkingCap::with_behavior(dir, CHAOS_KEEPER, sandbox)
-        } else {
-            ThinkingCap::with_hfsm(dir, dir.join(CHAOS_PLAYER), sandbox)
-        };
+        let path = dir.path().to_path_buf();
+        let name = if keeper { CHAOS_KEEPER } else { CHAOS_PLAYER };
+        let cap = Watchdog::start(name, DEFAULT_DEADLINE, move || {
+            if keeper {
+                ThinkingCap::with_behavior(&path, CHAOS_KEEPER, sandbox)
+            } else {
+                ThinkingCap::with_hfsm(&path, path.join(CHAOS_PLAYER), sandbox)
+            }
+        });
         Ok(ChaosBrain {
             cap: cap.map_err(|e| e.to_string())?,
             body: Body::chaos(cfg),
             faults: Vec::new(),
+            _files: dir.clone(),
         })
     }
 }
@@ -362,7 +352,7 @@ pub fn team(
         return (0..size).map(|i| Ok(send_brain(stack, i == 0, cfg)? as Box<dyn Brain>)).collect();
     }
     let dir = match behaviors {
-        Some(d) => d.to_path_buf(),
+        Some(d) => FilesDir::user(d),
         None => embedded_teamchaos()?,
     };
     // A robot whose behaviors do not load stands still and is reported; the match goes on.
