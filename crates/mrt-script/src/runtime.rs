@@ -398,6 +398,9 @@ pub(crate) fn clip(text: &str, max: usize) -> String {
     format!("{}… [{} more bytes]", &text[..end], text.len() - end)
 }
 
+/// The chunk name of the sandbox's own Lua, as errors and tracebacks show it.
+pub(crate) const PRELUDE_NAME: &str = "sandbox";
+
 /// The message a budget overrun raises inside Lua.
 pub(crate) const BUDGET_EXCEEDED: &str = "instruction budget exceeded";
 

@@ -178,7 +178,9 @@ fn script_position(s: &str) -> Option<(&str, usize, &str)> {
     let (name, after) = s.split_once(':')?;
     let (line, rest) = after.split_once(':')?;
     let line = line.parse().ok()?;
-    (!name.is_empty() && !name.starts_with('[')).then_some((name, line, rest))
+    // `sandbox` is the runtime's own wrappers (`string.find`...): the script is further out.
+    (!name.is_empty() && !name.starts_with('[') && name != crate::runtime::PRELUDE_NAME)
+        .then_some((name, line, rest))
 }
 
 fn split_position(message: &str) -> (usize, String) {
