@@ -1168,6 +1168,25 @@ mod tests {
         assert_eq!(p("QUIT"), Request::Quit);
         assert_eq!(p("AUTH s3cret"), Request::Auth("s3cret".into()));
         assert_eq!(parse_request("   ").unwrap(), None);
+        assert_eq!(p("LSTV *"), Request::Lstv(None));
+        assert_eq!(p("LSTV * -"), Request::LstvPage(None, None));
+        assert_eq!(
+            p("LSTV local.* local.var.a"),
+            Request::LstvPage(Some(Pattern::parse("local.*").unwrap()), Some("local.var.a".into()))
+        );
+    }
+
+    #[test]
+    fn tokens_are_one_word_and_compared_whole() {
+        assert!(check_token("s3cret-ä").is_ok());
+        assert_eq!(check_token(""), Err("it is empty"));
+        assert!(check_token("a b").is_err() && check_token("a\u{1b}").is_err());
+        assert!(check_token(&"x".repeat(MAX_TOKEN_LEN + 1)).is_err());
+        assert!(same_token("s3cret", "s3cret"));
+        for wrong in ["", "s3cre", "s3cret2", "S3cret"] {
+            assert!(!same_token(wrong, "s3cret"), "{wrong}");
+        }
+        assert!(parse_request("LSTV a b c").is_err());
     }
 
     #[test]
