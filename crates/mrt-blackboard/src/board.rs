@@ -1,12 +1,22 @@
 //! The blackboard itself: a thread-safe table of symbols, typed values with their time stamps,
 //! watchers, and the outbox of shared changes for the [`crate::Proxy`].
+//!
+//! # Limits
+//!
+//! A blackboard holds at most [`BbLimits::max_symbols`] symbols and
+//! [`BbLimits::max_bytes`] accounted bytes, and a `String` value is at most
+//! [`BbLimits::max_string`] bytes; a set past a limit is refused ([`BbError::Full`],
+//! [`BbError::TooLong`]) and changes nothing. *Guests* — the relay ([`Blackboard::set_as_guest`])
+//! and other robots ([`Blackboard::apply`]) — create new symbols only while fewer than
+//! [`BbLimits::max_guest_symbols`] exist, so that they cannot take the room the robot's own
+//! Members need.
 
 use crate::symbol::{Kind, Pattern, Symbol, SymbolError};
 use crate::value::{FromValue, Value, ValueType};
 use crossbeam_channel::{Receiver, Sender, TrySendError};
 use mrt_core::{SharedClock, Time};
 use rustc_hash::FxHashMap;
-use std::collections::VecDeque;
+use std::collections::{BTreeMap, VecDeque};
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{Arc, Mutex, RwLock, Weak};
 use std::time::Duration;
@@ -20,6 +30,60 @@ pub const WATCH_CAPACITY: usize = 1024;
 /// Shared changes waiting for the proxy; more are dropped (and counted).
 pub const OUTBOX_CAPACITY: usize = 4096;
 
+/// Default [`BbLimits::max_symbols`].
+pub const DEFAULT_MAX_SYMBOLS: usize = 16_384;
+
+/// Default [`BbLimits::max_guest_symbols`].
+pub const DEFAULT_MAX_GUEST_SYMBOLS: usize = 8_192;
+
+/// Default [`BbLimits::max_string`], bytes.
+pub const DEFAULT_MAX_STRING: usize = 1_024;
+
+/// Default [`BbLimits::max_bytes`]: 32 MiB.
+pub const DEFAULT_MAX_BYTES: usize = 32 << 20;
+
+/// Bytes accounted for each symbol besides its name (its slot, index entry and log entry).
+pub const SYMBOL_OVERHEAD: usize = 128;
+
+/// Bytes accounted for each value held besides a string's text (the value and its stamp).
+pub const VALUE_OVERHEAD: usize = 48;
+
+/// How much a blackboard holds. A set that would go past a limit is refused and changes
+/// nothing.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct BbLimits {
+    /// Symbols on the blackboard, at most (default [`DEFAULT_MAX_SYMBOLS`]).
+    pub max_symbols: usize,
+    /// A guest (the relay, another robot) creates a symbol only while fewer than this many
+    /// exist (default [`DEFAULT_MAX_GUEST_SYMBOLS`]); it still sets the existing ones.
+    pub max_guest_symbols: usize,
+    /// Longest `String` value, bytes of UTF-8 (default [`DEFAULT_MAX_STRING`]).
+    pub max_string: usize,
+    /// Accounted bytes held, at most (default [`DEFAULT_MAX_BYTES`]): each symbol counts its
+    /// name plus [`SYMBOL_OVERHEAD`], each value held (a `var`'s, every one waiting in a
+    /// `talk` queue) [`VALUE_OVERHEAD`] plus a string's text.
+    pub max_bytes: usize,
+}
+
+impl Default for BbLimits {
+    fn default() -> Self {
+        BbLimits {
+            max_symbols: DEFAULT_MAX_SYMBOLS,
+            max_guest_symbols: DEFAULT_MAX_GUEST_SYMBOLS,
+            max_string: DEFAULT_MAX_STRING,
+            max_bytes: DEFAULT_MAX_BYTES,
+        }
+    }
+}
+
+fn value_bytes(v: &Value) -> usize {
+    VALUE_OVERHEAD
+        + match v {
+            Value::String(s) => s.len(),
+            _ => 0,
+        }
+}
+
 /// A value with the time it was set, on this robot's clock (for a value received from
 /// another robot: when it arrived, so that clock skew between robots does not matter).
 #[derive(Clone, Debug, PartialEq)]
@@ -31,6 +95,9 @@ pub struct Stamped {
     /// The robot it came from, when it came over the network.
     pub from: Option<u32>,
 }
+
+/// A symbol with its latest value (a `talk` queue: its oldest waiting value, if any).
+pub type Current = (Arc<str>, Option<Stamped>);
 
 /// One change, as a watcher receives it.
 #[derive(Clone, Debug, PartialEq)]
@@ -83,6 +150,24 @@ pub enum BbError {
     /// A change from another robot for a `local` symbol.
     #[error("`{0}` is local: it does not travel between robots")]
     NotShared(String),
+    /// A new symbol, or a value, past the blackboard's room ([`BbLimits`]).
+    #[error("the blackboard is full: `{symbol}` does not fit ({what})")]
+    Full {
+        /// The symbol.
+        symbol: String,
+        /// Which limit, and its value.
+        what: String,
+    },
+    /// A `String` value longer than [`BbLimits::max_string`].
+    #[error("`{symbol}`: a string is at most {max} bytes, this one has {len}")]
+    TooLong {
+        /// The symbol.
+        symbol: String,
+        /// The string's length, bytes.
+        len: usize,
+        /// The limit, bytes.
+        max: usize,
+    },
 }
 
 enum Entry {
@@ -94,12 +179,49 @@ struct Slot {
     symbol: Arc<str>,
     ty: ValueType,
     entry: Entry,
+    /// The table's version when this slot last changed (its key in [`Table::log`]).
+    version: u64,
+}
+
+impl Slot {
+    fn current(&self) -> Option<Stamped> {
+        match &self.entry {
+            Entry::Var(v) => Some(v.clone()),
+            Entry::Talk(q) => q.front().cloned(),
+        }
+    }
 }
 
 #[derive(Default)]
 struct Table {
     index: FxHashMap<Arc<str>, usize>,
     slots: Vec<Slot>,
+    /// Accounted bytes held ([`BbLimits::max_bytes`]).
+    bytes: usize,
+    /// Counts changes (sets, pushes, pops).
+    version: u64,
+    /// Each slot under the version of its last change: the changes since a version are a
+    /// range, whatever the number of symbols.
+    log: BTreeMap<u64, usize>,
+}
+
+impl Table {
+    fn touch(&mut self, i: usize) {
+        self.version += 1;
+        let v = self.version;
+        if let Some(slot) = self.slots.get_mut(i) {
+            self.log.remove(&slot.version);
+            slot.version = v;
+            self.log.insert(v, i);
+        }
+    }
+}
+
+/// Who sets a value: the robot itself, or a guest (relay client or other robot).
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Origin {
+    Own,
+    Guest,
 }
 
 struct Watcher {
@@ -111,6 +233,7 @@ struct Watcher {
 struct Inner {
     robot: u32,
     clock: SharedClock,
+    limits: BbLimits,
     table: RwLock<Table>,
     watchers: RwLock<Vec<Watcher>>,
     next_watch: AtomicU64,
@@ -148,12 +271,18 @@ fn write<T>(l: &RwLock<T>) -> std::sync::RwLockWriteGuard<'_, T> {
 }
 
 impl Blackboard {
-    /// The blackboard of robot `robot`, stamping with `clock`.
+    /// The blackboard of robot `robot`, stamping with `clock`, with the default [`BbLimits`].
     pub fn new(robot: u32, clock: SharedClock) -> Blackboard {
+        Blackboard::with_limits(robot, clock, BbLimits::default())
+    }
+
+    /// The blackboard of robot `robot`, stamping with `clock`, holding at most `limits`.
+    pub fn with_limits(robot: u32, clock: SharedClock, limits: BbLimits) -> Blackboard {
         Blackboard {
             inner: Arc::new(Inner {
                 robot,
                 clock,
+                limits,
                 table: RwLock::default(),
                 watchers: RwLock::default(),
                 next_watch: AtomicU64::new(0),
@@ -166,6 +295,26 @@ impl Blackboard {
     /// This robot's ID.
     pub fn robot(&self) -> u32 {
         self.inner.robot
+    }
+
+    /// What it holds at most.
+    pub fn limits(&self) -> BbLimits {
+        self.inner.limits
+    }
+
+    /// Symbols on the blackboard.
+    pub fn len(&self) -> usize {
+        read(&self.inner.table).slots.len()
+    }
+
+    /// Whether no symbol is bound.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Accounted bytes held ([`BbLimits::max_bytes`]).
+    pub fn bytes(&self) -> usize {
+        read(&self.inner.table).bytes
     }
 
     /// The latest value of the `var` symbol `symbol`, as a `T`.
@@ -199,32 +348,46 @@ impl Blackboard {
     /// Binds `value` to the `var` symbol `symbol`, stamped now. The first set fixes the
     /// symbol's type; later sets must keep it. A shared symbol's change goes to the proxy.
     pub fn set(&self, symbol: &str, value: impl Into<Value>) -> Result<(), BbError> {
-        self.store(symbol, value.into(), None, Kind::Var)
+        self.store(symbol, value.into(), None, Kind::Var, Origin::Own)
+    }
+
+    /// [`Blackboard::set`] for a guest (the relay): a new symbol only while fewer than
+    /// [`BbLimits::max_guest_symbols`] exist.
+    pub fn set_as_guest(&self, symbol: &str, value: impl Into<Value>) -> Result<(), BbError> {
+        self.store(symbol, value.into(), None, Kind::Var, Origin::Guest)
     }
 
     /// Appends `value` to the `talk` queue `symbol`.
     pub fn push(&self, symbol: &str, value: impl Into<Value>) -> Result<(), BbError> {
-        self.store(symbol, value.into(), None, Kind::Talk)
+        self.store(symbol, value.into(), None, Kind::Talk, Origin::Own)
     }
 
     /// Takes the oldest value of the `talk` queue `symbol` (`None` when it is empty).
     pub fn pop(&self, symbol: &str) -> Result<Option<Stamped>, BbError> {
         let mut table = write(&self.inner.table);
         let Some(&i) = table.index.get(symbol) else { return Err(unknown(symbol)) };
-        match &mut table.slots[i].entry {
-            Entry::Talk(q) => Ok(q.pop_front()),
-            Entry::Var(_) => Err(BbError::Kind { symbol: symbol.to_string(), kind: Kind::Var }),
+        let popped = match &mut table.slots[i].entry {
+            Entry::Talk(q) => q.pop_front(),
+            Entry::Var(_) => {
+                return Err(BbError::Kind { symbol: symbol.to_string(), kind: Kind::Var })
+            }
+        };
+        if let Some(p) = &popped {
+            table.bytes = table.bytes.saturating_sub(value_bytes(&p.value));
+            table.touch(i);
         }
+        Ok(popped)
     }
 
-    /// Applies a change received from another robot: checked like a local one, stamped on
-    /// this robot's clock, not sent on again.
+    /// Applies a change received from another robot: checked like a local one and against
+    /// the limits of a guest, stamped on this robot's clock, not sent on again.
     pub fn apply(&self, update: &Update) -> Result<(), BbError> {
         let parsed = Symbol::parse(&update.symbol)?;
         if !parsed.scope().is_shared() {
             return Err(BbError::NotShared(update.symbol.clone()));
         }
-        self.store(&update.symbol, update.value.clone(), Some(update.from), parsed.kind())
+        let value = update.value.clone();
+        self.store(&update.symbol, value, Some(update.from), parsed.kind(), Origin::Guest)
     }
 
     fn store(
@@ -233,7 +396,19 @@ impl Blackboard {
         value: Value,
         from: Option<u32>,
         kind: Kind,
+        origin: Origin,
     ) -> Result<(), BbError> {
+        let limits = &self.inner.limits;
+        if let Value::String(s) = &value {
+            if s.len() > limits.max_string {
+                return Err(BbError::TooLong {
+                    symbol: shown(symbol),
+                    len: s.len(),
+                    max: limits.max_string,
+                });
+            }
+        }
+        let full = |what: String| BbError::Full { symbol: shown(symbol), what };
         if let Value::Float(x) = value {
             if !x.is_finite() {
                 return Err(BbError::Type {
@@ -257,17 +432,35 @@ impl Blackboard {
                             kind: parsed.kind(),
                         });
                     }
+                    let cap = match origin {
+                        Origin::Own => limits.max_symbols,
+                        Origin::Guest => limits.max_guest_symbols.min(limits.max_symbols),
+                    };
+                    if table.slots.len() >= cap {
+                        let who = if origin == Origin::Guest { " from a guest" } else { "" };
+                        return Err(full(format!("at most {cap} symbols{who}")));
+                    }
+                    let add = SYMBOL_OVERHEAD + symbol.len();
+                    if table.bytes + add + value_bytes(&stamped.value) > limits.max_bytes {
+                        return Err(full(format!("at most {} bytes", limits.max_bytes)));
+                    }
                     let name: Arc<str> = Arc::from(symbol);
                     let entry = match kind {
                         Kind::Var => Entry::Var(stamped.clone()),
                         Kind::Talk => Entry::Talk(VecDeque::new()),
                     };
+                    table.bytes += add
+                        + match kind {
+                            Kind::Var => value_bytes(&stamped.value),
+                            Kind::Talk => 0,
+                        };
                     let i = table.slots.len();
-                    table.slots.push(Slot { symbol: name.clone(), ty, entry });
+                    table.slots.push(Slot { symbol: name.clone(), ty, entry, version: 0 });
                     table.index.insert(name, i);
                     i
                 }
             };
+            let held = table.bytes;
             let slot = &mut table.slots[i];
             if slot.ty != ty {
                 return Err(BbError::Type {
@@ -276,13 +469,31 @@ impl Blackboard {
                     wanted: ty,
                 });
             }
-            match &mut slot.entry {
-                Entry::Var(v) if kind == Kind::Var => *v = stamped.clone(),
+            let new = value_bytes(&stamped.value);
+            let over = |old: usize| held - old.min(held) + new > limits.max_bytes;
+            let bytes = match &mut slot.entry {
+                Entry::Var(v) if kind == Kind::Var => {
+                    let old = value_bytes(&v.value);
+                    if over(old) {
+                        return Err(full(format!("at most {} bytes", limits.max_bytes)));
+                    }
+                    *v = stamped.clone();
+                    held - old.min(held) + new
+                }
                 Entry::Talk(q) if kind == Kind::Talk => {
+                    let old = if q.len() >= TALK_CAPACITY {
+                        q.front().map_or(0, |f| value_bytes(&f.value))
+                    } else {
+                        0
+                    };
+                    if over(old) {
+                        return Err(full(format!("at most {} bytes", limits.max_bytes)));
+                    }
                     if q.len() >= TALK_CAPACITY {
                         q.pop_front();
                     }
                     q.push_back(stamped.clone());
+                    held - old.min(held) + new
                 }
                 Entry::Var(_) => {
                     return Err(BbError::Kind { symbol: symbol.to_string(), kind: Kind::Var })
@@ -290,9 +501,12 @@ impl Blackboard {
                 Entry::Talk(_) => {
                     return Err(BbError::Kind { symbol: symbol.to_string(), kind: Kind::Talk })
                 }
-            }
+            };
             let shared = from.is_none() && !symbol.starts_with("local.");
-            (slot.symbol.clone(), shared)
+            let name = slot.symbol.clone();
+            table.bytes = bytes;
+            table.touch(i);
+            (name, shared)
         };
         if shared {
             self.send_out(symbol, &stamped.value);
@@ -340,16 +554,65 @@ impl Blackboard {
             .slots
             .iter()
             .filter(|s| pattern.is_none_or(|p| p.matches(&s.symbol)))
-            .map(|s| {
-                let v = match &s.entry {
-                    Entry::Var(v) => Some(v.clone()),
-                    Entry::Talk(q) => q.front().cloned(),
-                };
-                (s.symbol.clone(), v)
-            })
+            .map(|s| (s.symbol.clone(), s.current()))
             .collect();
         out.sort_by(|a, b| a.0.cmp(&b.0));
         out
+    }
+
+    /// The symbols `pattern` covers (all for `None`) that sort after `after` (all for
+    /// `None`), in order, at most `max` of them, and whether more follow.
+    pub fn symbols(
+        &self,
+        pattern: Option<&Pattern>,
+        after: Option<&str>,
+        max: usize,
+    ) -> (Vec<Arc<str>>, bool) {
+        let mut out: Vec<Arc<str>> = {
+            let table = read(&self.inner.table);
+            table
+                .slots
+                .iter()
+                .filter(|s| pattern.is_none_or(|p| p.matches(&s.symbol)))
+                .filter(|s| after.is_none_or(|a| &*s.symbol > a))
+                .map(|s| s.symbol.clone())
+                .collect()
+        };
+        out.sort_unstable();
+        let more = out.len() > max;
+        out.truncate(max);
+        (out, more)
+    }
+
+    /// The blackboard's version: it grows with every change.
+    pub fn version(&self) -> u64 {
+        read(&self.inner.table).version
+    }
+
+    /// The symbols changed after version `since` that `wanted` keeps, with their latest
+    /// value (a `talk` queue: its oldest waiting value, if any), in the order they last
+    /// changed, and the version they bring the caller to. The cost grows with the changes,
+    /// not with the symbols on the blackboard.
+    pub fn changed_since(
+        &self,
+        since: u64,
+        mut wanted: impl FnMut(&str) -> bool,
+    ) -> (u64, Vec<Current>) {
+        let table = read(&self.inner.table);
+        let out = table
+            .log
+            .range(since.saturating_add(1)..)
+            .filter_map(|(_, &i)| table.slots.get(i))
+            .filter(|s| wanted(&s.symbol))
+            .map(|s| (s.symbol.clone(), s.current()))
+            .collect();
+        (table.version, out)
+    }
+
+    /// The latest value of `symbol` (a `talk` queue: its oldest waiting value), if any.
+    pub fn peek(&self, symbol: &str) -> Option<Stamped> {
+        let table = read(&self.inner.table);
+        table.index.get(symbol).and_then(|&i| table.slots.get(i)).and_then(Slot::current)
     }
 
     /// The shared changes made here from now on, for the proxy to send (one receiver: a second
@@ -369,6 +632,11 @@ impl Blackboard {
     pub fn now(&self) -> Time {
         self.inner.clock.now()
     }
+}
+
+/// A symbol as an error shows it: at most [`crate::symbol::MAX_SYMBOL_LEN`] characters.
+fn shown(symbol: &str) -> String {
+    symbol.chars().take(crate::symbol::MAX_SYMBOL_LEN).collect()
 }
 
 fn unknown(symbol: &str) -> BbError {
@@ -531,5 +799,100 @@ mod tests {
         assert_eq!(all, ["*.var.c", "local.var.a", "local.var.b"]);
         let local = Pattern::parse("local.*").unwrap();
         assert_eq!(bb.list(Some(&local)).len(), 2);
+    }
+
+    fn limited(limits: BbLimits) -> Blackboard {
+        Blackboard::with_limits(1, Arc::new(SimClock::new()), limits)
+    }
+
+    /// Issue 17: a million `SETV`s of new names took 343 MB. Now the symbols are capped, and
+    /// guests (relay, other robots) stop earlier, leaving room for the robot's own Members.
+    #[test]
+    fn symbols_are_capped_and_guests_leave_room_for_the_robot() {
+        let limits = BbLimits { max_symbols: 4, max_guest_symbols: 2, ..BbLimits::default() };
+        let bb = limited(limits);
+        bb.set_as_guest("local.var.g1", 1).unwrap();
+        bb.set_as_guest("local.var.g2", 1).unwrap();
+        let e = bb.set_as_guest("local.var.g3", 1).unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "the blackboard is full: `local.var.g3` does not fit (at most 2 symbols from a guest)"
+        );
+        let remote = Update { from: 2, symbol: "2.var.x".into(), value: 1.into() };
+        assert!(matches!(bb.apply(&remote), Err(BbError::Full { .. })));
+        bb.set_as_guest("local.var.g1", 2).unwrap(); // existing symbols are still set
+        bb.set("local.var.own1", 1).unwrap();
+        bb.push("local.talk.own2", 1).unwrap();
+        assert!(matches!(bb.set("local.var.own3", 1), Err(BbError::Full { .. })));
+        assert_eq!(bb.len(), 4);
+        assert!(bb.get::<i64>("local.var.g3").is_err(), "a refused set changes nothing");
+    }
+
+    #[test]
+    fn strings_are_capped() {
+        let bb = limited(BbLimits { max_string: 8, ..BbLimits::default() });
+        bb.set("local.var.s", "12345678").unwrap();
+        let e = bb.set("local.var.s", "123456789").unwrap_err();
+        assert_eq!(e.to_string(), "`local.var.s`: a string is at most 8 bytes, this one has 9");
+        assert!(matches!(bb.push("local.talk.q", "x".repeat(9)), Err(BbError::TooLong { .. })));
+        let remote = Update { from: 2, symbol: "*.var.s".into(), value: "y".repeat(9).into() };
+        assert!(matches!(bb.apply(&remote), Err(BbError::TooLong { .. })));
+        assert_eq!(bb.get::<String>("local.var.s").unwrap(), "12345678");
+    }
+
+    /// Talk queues are bounded each; the byte budget bounds them all together.
+    #[test]
+    fn the_byte_budget_bounds_talk_queues_and_frees_on_pop() {
+        let max = 4 * (SYMBOL_OVERHEAD + 12) + 40 * (VALUE_OVERHEAD + 100);
+        let bb = limited(BbLimits { max_bytes: max, ..BbLimits::default() });
+        let s = "x".repeat(100);
+        let mut pushed = 0;
+        'fill: for q in 0..4 {
+            for _ in 0..TALK_CAPACITY {
+                match bb.push(&format!("local.talk.q{q}"), s.as_str()) {
+                    Ok(()) => pushed += 1,
+                    Err(BbError::Full { .. }) => break 'fill,
+                    Err(e) => panic!("{e}"),
+                }
+            }
+        }
+        assert!((40..=43).contains(&pushed), "{pushed}");
+        assert!(bb.bytes() <= max);
+        assert!(matches!(bb.set("local.var.more", s.as_str()), Err(BbError::Full { .. })));
+        bb.pop("local.talk.q0").unwrap().unwrap();
+        bb.push("local.talk.q0", s.as_str()).unwrap();
+        // A var replaced by a value of the same size fits again and again.
+        let bb = limited(BbLimits {
+            max_bytes: 2 * (SYMBOL_OVERHEAD + 20 + VALUE_OVERHEAD),
+            ..BbLimits::default()
+        });
+        for i in 0..100 {
+            bb.set("local.var.counter", i).unwrap();
+        }
+        assert_eq!(bb.bytes(), SYMBOL_OVERHEAD + "local.var.counter".len() + VALUE_OVERHEAD);
+    }
+
+    #[test]
+    fn changes_since_a_version_are_the_ones_made_after_it() {
+        let (bb, _) = board();
+        bb.set("local.var.a", 1).unwrap();
+        bb.set("local.var.b", 1).unwrap();
+        let (v, all) = bb.changed_since(0, |_| true);
+        assert_eq!(all.len(), 2);
+        assert_eq!(v, bb.version());
+        bb.set("local.var.b", 2).unwrap();
+        bb.set("local.var.b", 3).unwrap();
+        bb.set("*.var.c", 1).unwrap();
+        let (_, changed) = bb.changed_since(v, |s| s.starts_with("local."));
+        assert_eq!(changed.len(), 1, "b once, with its latest value; c filtered out");
+        assert_eq!(changed[0].0.as_ref(), "local.var.b");
+        assert_eq!(changed[0].1.as_ref().map(|s| s.value.clone()), Some(Value::Int(3)));
+        let (syms, more) = bb.symbols(None, Some("local.var.a"), 10);
+        assert_eq!((syms.len(), more), (1, false));
+        let (syms, more) = bb.symbols(None, None, 2);
+        assert_eq!(
+            (syms.iter().map(|s| s.to_string()).collect::<Vec<_>>(), more),
+            (vec!["*.var.c".to_string(), "local.var.a".to_string()], true)
+        );
     }
 }

@@ -32,7 +32,7 @@ pub mod relay;
 pub mod symbol;
 pub mod value;
 
-pub use board::{BbError, Blackboard, Change, Stamped, Update, Watch};
+pub use board::{BbError, BbLimits, Blackboard, Change, Stamped, Update, Watch};
 pub use proxy::{BbUpdate, Proxy};
 pub use relay::{Relay, RelayClient, RelayConfig};
 pub use symbol::{Kind, Pattern, Scope, Symbol, SymbolError};

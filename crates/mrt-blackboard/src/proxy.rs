@@ -6,9 +6,11 @@
 //! connect Agoras in other processes.
 //!
 //! A malformed update (not a symbol, a `local` symbol, a type that contradicts the stored
-//! one) is counted and dropped: it never disturbs the blackboard.
+//! one) is counted and dropped: it never disturbs the blackboard. So is an update past the
+//! blackboard's limits ([`crate::board::BbLimits`]: a string too long, a new symbol when
+//! guests may create no more, the byte budget), counted also in [`Proxy::over_limit`].
 
-use crate::board::{Blackboard, Update};
+use crate::board::{BbError, Blackboard, Update};
 use crossbeam_channel::Receiver;
 use mrt_dcdt::{Context, Member, MemberError, Message, MsgType, RequestType, RESERVED_TYPES_START};
 use std::sync::atomic::{AtomicU64, Ordering};
@@ -28,19 +30,26 @@ pub struct Proxy {
     bb: Blackboard,
     outbox: Receiver<Update>,
     rejected: Arc<AtomicU64>,
+    over_limit: Arc<AtomicU64>,
 }
 
 impl Proxy {
     /// The proxy of `bb` (it takes the blackboard's outbox).
     pub fn new(bb: Blackboard) -> Proxy {
         let outbox = bb.outbox();
-        Proxy { bb, outbox, rejected: Arc::default() }
+        Proxy { bb, outbox, rejected: Arc::default(), over_limit: Arc::default() }
     }
 
     /// A counter of the updates received and dropped as malformed, readable after the Member
     /// is handed to its Agora.
     pub fn rejected(&self) -> Arc<AtomicU64> {
         self.rejected.clone()
+    }
+
+    /// A counter of the received updates dropped because they broke the blackboard's limits
+    /// (also counted in [`Proxy::rejected`]).
+    pub fn over_limit(&self) -> Arc<AtomicU64> {
+        self.over_limit.clone()
     }
 }
 
@@ -57,6 +66,9 @@ impl Member for Proxy {
     fn do_your_job(&mut self, ctx: &mut Context<'_>) -> Result<(), MemberError> {
         while let Some(m) = ctx.receive_msg() {
             let applied = m.get::<BbUpdate>().map(|u| self.bb.apply(&u.0));
+            if let Ok(Err(BbError::Full { .. } | BbError::TooLong { .. })) = &applied {
+                self.over_limit.fetch_add(1, Ordering::Relaxed);
+            }
             if !matches!(applied, Ok(Ok(()))) {
                 let n = self.rejected.fetch_add(1, Ordering::Relaxed);
                 if n == 0 {

@@ -3,42 +3,89 @@
 //! the replies are in `docs/relay-protocol.md`; [`parse_request`] is its parser.
 //!
 //! Safety: the relay listens on 127.0.0.1 unless told otherwise, and any other address needs
-//! a shared token (`AUTH <token>` first). Lines are at most [`RelayConfig::max_line`] bytes,
-//! at most [`RelayConfig::max_clients`] clients are served at once (more are told `ERR 503`
-//! and closed), each with at most [`RelayConfig::max_watches`] watches; a client silent for
-//! [`RelayConfig::idle_timeout`] is closed. Each client has its own thread; the robot's
-//! Members never wait for the relay beyond one blackboard access.
+//! a shared token (`AUTH <token>` first; [`check_token`] says which tokens are good). Every
+//! limit is a [`RelayConfig`] field, listed with its default and what a client sees in the
+//! protocol's *Limits* section: lines ([`RelayConfig::max_line`]) that must end within
+//! [`RelayConfig::line_timeout`], clients at once in total and per address, watches per
+//! client and in total, a shortest refresh period, pushes per period and per second, the
+//! size of a reply, a client that does not read its replies, wrong tokens. Each client has its
+//! own thread with a small stack; the robot's Members never wait for the relay beyond one
+//! blackboard access, and what a client can make the relay do per second is bounded.
 
 use crate::board::{BbError, Blackboard, Stamped};
 use crate::symbol::Pattern;
 use crate::value::Value;
-use std::collections::HashMap;
-use std::io::{ErrorKind, Read, Write};
-use std::net::{Shutdown, SocketAddr, TcpListener, TcpStream};
+use std::collections::{HashMap, HashSet, VecDeque};
+use std::io::{BufRead, ErrorKind, Read, Write};
+use std::net::{IpAddr, Shutdown, SocketAddr, TcpListener, TcpStream};
 use std::sync::atomic::{AtomicBool, AtomicU64, AtomicUsize, Ordering};
-use std::sync::Arc;
+use std::sync::{Arc, Mutex, MutexGuard};
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
 /// The relay's TCP port in ISocRob.
 pub const DEFAULT_PORT: u16 = 2001;
 
-/// How the relay listens and what it allows.
+/// Longest shared token, bytes.
+pub const MAX_TOKEN_LEN: usize = 256;
+
+/// Stack of a client's thread, bytes: a client parses and formats lines, nothing deep.
+pub const CLIENT_STACK: usize = 256 * 1024;
+
+/// Longest a client's thread waits in a read before it looks at the stop flag again.
+pub const STOP_POLL: Duration = Duration::from_millis(250);
+
+/// Source addresses whose wrong tokens the relay remembers; past this, the ones whose window
+/// has passed are forgotten, and then all of them.
+pub const MAX_AUTH_ADDRESSES: usize = 4096;
+
+/// How the relay listens and what it allows. Every limit of the relay is here.
 #[derive(Clone, Debug)]
 pub struct RelayConfig {
     /// Where to listen (default `127.0.0.1:2001`; port 0 picks a free one).
     pub addr: SocketAddr,
     /// The shared token clients must send first (`AUTH <token>`); required when `addr` is
-    /// not a loopback address.
+    /// not a loopback address. It must pass [`check_token`].
     pub token: Option<String>,
-    /// Clients served at once.
+    /// Clients served at once (default 256); one more is told `ERR 503` and closed.
     pub max_clients: usize,
-    /// Longest request line, bytes (the newline included).
+    /// Clients served at once from one source address (default 64).
+    pub max_clients_per_address: usize,
+    /// Longest request line, bytes, the newline included (default 4096).
     pub max_line: usize,
-    /// Watches per client.
-    pub max_watches: usize,
-    /// A client that sends nothing for this long is closed.
+    /// A request line must end this long after its first byte arrived (default 10 s): a
+    /// client that trickles bytes is told `ERR 408` and closed.
+    pub line_timeout: Duration,
+    /// With a token, a client must authenticate this long after connecting (default 10 s).
+    pub auth_timeout: Duration,
+    /// A client that sends nothing for this long is closed (default 10 min).
     pub idle_timeout: Duration,
+    /// A reply or push the client does not take within this (its socket stays full) drops
+    /// the client (default 5 s): a client that does not read cannot make the relay buffer.
+    pub write_timeout: Duration,
+    /// Watches per client (default 256).
+    pub max_watches: usize,
+    /// Watches of all clients together (default 4096).
+    pub max_total_watches: usize,
+    /// Shortest refresh period (default 100 ms): `REFR` below it gets this period, and says so.
+    pub min_refresh: Duration,
+    /// `WATCH` lines one client is sent per period, at most (default 512).
+    pub max_pushes: usize,
+    /// `WATCH` lines all clients together are sent per second, at most (default 20000).
+    pub max_pushes_per_second: usize,
+    /// Changed symbols a client's pushes may wait for (default 4096): the changes over the
+    /// push budgets wait for the next periods; past this many they are dropped and counted.
+    pub max_deferred: usize,
+    /// Longest reply line, bytes (default 65536): `LSTV` past it is refused, paged `LSTV`
+    /// fills pages up to it.
+    pub max_reply: usize,
+    /// A wrong token is answered after this delay (default 1 s).
+    pub auth_delay: Duration,
+    /// Wrong tokens from one source address within [`RelayConfig::auth_window`] after which
+    /// that address's `AUTH`s are refused unchecked until the window has passed (default 10).
+    pub max_auth_failures: u32,
+    /// See [`RelayConfig::max_auth_failures`] (default 60 s).
+    pub auth_window: Duration,
 }
 
 impl Default for RelayConfig {
@@ -46,10 +93,23 @@ impl Default for RelayConfig {
         RelayConfig {
             addr: SocketAddr::from(([127, 0, 0, 1], DEFAULT_PORT)),
             token: None,
-            max_clients: 32,
+            max_clients: 256,
+            max_clients_per_address: 64,
             max_line: 4096,
-            max_watches: 256,
+            line_timeout: Duration::from_secs(10),
+            auth_timeout: Duration::from_secs(10),
             idle_timeout: Duration::from_secs(600),
+            write_timeout: Duration::from_secs(5),
+            max_watches: 256,
+            max_total_watches: 4096,
+            min_refresh: Duration::from_millis(100),
+            max_pushes: 512,
+            max_pushes_per_second: 20_000,
+            max_deferred: 4096,
+            max_reply: 65_536,
+            auth_delay: Duration::from_secs(1),
+            max_auth_failures: 10,
+            auth_window: Duration::from_secs(60),
         }
     }
 }
@@ -61,6 +121,9 @@ pub enum RelayError {
     /// Listening beyond this machine without a token.
     #[error("the relay listens on {0}, beyond this machine: give it a shared token")]
     TokenRequired(SocketAddr),
+    /// The token cannot be used ([`check_token`]).
+    #[error("the relay's shared token is unusable: {0}")]
+    BadToken(&'static str),
     /// The socket could not be opened.
     #[error("the relay cannot listen on {addr}: {source}")]
     Bind {
@@ -70,6 +133,32 @@ pub enum RelayError {
         #[source]
         source: std::io::Error,
     },
+}
+
+/// Whether `token` can be a shared token: 1 to [`MAX_TOKEN_LEN`] bytes, no whitespace, no
+/// control character (`AUTH` takes one word, so a token with a space could never be sent).
+/// `Err` says why not.
+pub fn check_token(token: &str) -> Result<(), &'static str> {
+    if token.is_empty() {
+        Err("it is empty")
+    } else if token.len() > MAX_TOKEN_LEN {
+        Err("it is longer than 256 bytes")
+    } else if token.chars().any(|c| c.is_whitespace() || c.is_control()) {
+        Err("it has a space or a control character (AUTH takes one word)")
+    } else {
+        Ok(())
+    }
+}
+
+/// Compares without stopping at the first difference, so that the time an answer takes does
+/// not tell how much of a guess was right.
+fn same_token(given: &str, token: &str) -> bool {
+    let (a, b) = (given.as_bytes(), token.as_bytes());
+    let mut diff = u8::from(a.len() != b.len() || a.is_empty());
+    for (i, x) in b.iter().enumerate() {
+        diff |= x ^ a.get(i).copied().unwrap_or(0);
+    }
+    diff == 0
 }
 
 /// One request, as [`parse_request`] reads it.
@@ -91,8 +180,10 @@ pub enum Request {
     Setv(String, Value),
     /// `GETV <symbol>`.
     Getv(String),
-    /// `LSTV [<pattern>]` (an MRT addition: the symbols on the blackboard).
+    /// `LSTV [<pattern>]` (an MRT addition: the symbols on the blackboard; `*` for all).
     Lstv(Option<Pattern>),
+    /// `LSTV <pattern> <after>`: one page, the symbols after `<after>` (`-`: from the first).
+    LstvPage(Option<Pattern>, Option<String>),
     /// `QUIT`.
     Quit,
 }
@@ -100,8 +191,9 @@ pub enum Request {
 /// A request that cannot be served: the code and reason of its `ERR` reply.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Refusal {
-    /// 400 bad request, 401 not authorised, 404 unknown, 408 idle too long, 409 conflicting
-    /// type or kind, 413 line too long, 429 too many watches, 503 too many clients.
+    /// 400 bad request, 401 not authorised, 404 unknown, 408 too slow or idle too long, 409
+    /// conflicting type or kind, 413 too large, 429 too many (watches, wrong tokens), 503 too
+    /// many clients, 507 the blackboard is full.
     pub code: u16,
     /// Why, one line.
     pub reason: String,
@@ -119,7 +211,8 @@ impl Refusal {
     }
 }
 
-/// Shortest and longest refresh period, ms.
+/// Shortest and longest refresh period a `REFR` may ask for, ms (the relay then applies
+/// [`RelayConfig::min_refresh`]).
 pub const REFRESH_RANGE: (u64, u64) = (10, 60_000);
 
 /// Parses one request line (without its newline; a trailing `\r` is ignored). `Ok(None)` for
@@ -167,8 +260,17 @@ pub fn parse_request(line: &str) -> Result<Option<Request>, Refusal> {
             crate::Symbol::parse(symbol).map_err(|e| Refusal::new(400, e.to_string()))?;
             Request::Getv(symbol.to_string())
         }
-        "LSTV" if rest.is_empty() => Request::Lstv(None),
-        "LSTV" => Request::Lstv(Some(pattern(one_arg("LSTV")?)?)),
+        "LSTV" => {
+            let words: Vec<&str> = rest.split_whitespace().collect();
+            let any = |w: &str| if w == "*" { Ok(None) } else { pattern(w).map(Some) };
+            match words.as_slice() {
+                [] => Request::Lstv(None),
+                [p] => Request::Lstv(any(p)?),
+                [p, "-"] => Request::LstvPage(any(p)?, None),
+                [p, after] => Request::LstvPage(any(p)?, Some((*after).to_string())),
+                _ => return Err(Refusal::new(400, "LSTV takes a pattern and a symbol at most")),
+            }
+        }
         "SETV" => {
             let (symbol, value) = rest
                 .split_once(char::is_whitespace)
@@ -190,43 +292,169 @@ pub fn parse_request(line: &str) -> Result<Option<Request>, Refusal> {
 pub struct RelayStats {
     /// Clients accepted.
     pub accepted: AtomicU64,
-    /// Clients refused (too many at once).
+    /// Clients refused (too many at once, in total or from their address).
     pub refused: AtomicU64,
     /// Requests served with `OK`.
     pub ok: AtomicU64,
     /// Requests answered with `ERR`.
     pub errors: AtomicU64,
+    /// Clients closed because a request line did not end within
+    /// [`RelayConfig::line_timeout`], or `AUTH` did not come within
+    /// [`RelayConfig::auth_timeout`].
+    pub too_slow: AtomicU64,
+    /// Clients dropped because they did not take their replies or pushes
+    /// ([`RelayConfig::write_timeout`]).
+    pub not_reading: AtomicU64,
+    /// `WATCH` lines sent.
+    pub pushed: AtomicU64,
+    /// Changes not pushed because a client had [`RelayConfig::max_deferred`] waiting.
+    pub push_dropped: AtomicU64,
+    /// Wrong tokens.
+    pub auth_failures: AtomicU64,
+    /// `AUTH`s refused unchecked (too many wrong tokens from their address).
+    pub auth_locked: AtomicU64,
+}
+
+fn count(c: &AtomicU64) {
+    c.fetch_add(1, Ordering::Relaxed);
+}
+
+fn lock<T>(m: &Mutex<T>) -> MutexGuard<'_, T> {
+    // Every critical section below is a few assignments: a poisoned lock is still consistent.
+    m.lock().unwrap_or_else(std::sync::PoisonError::into_inner)
+}
+
+/// The push budget of all clients together: a token bucket refilled at
+/// [`RelayConfig::max_pushes_per_second`], holding at most one second's worth.
+struct Bucket {
+    tokens: f64,
+    last: Instant,
+}
+
+/// Wrong tokens per source address: how many since when.
+#[derive(Default)]
+struct AuthBook {
+    failures: HashMap<IpAddr, (u32, Instant)>,
+}
+
+impl AuthBook {
+    fn locked(&mut self, ip: IpAddr, cfg: &RelayConfig) -> bool {
+        match self.failures.get(&ip) {
+            Some(&(_, since)) if since.elapsed() >= cfg.auth_window => {
+                self.failures.remove(&ip);
+                false
+            }
+            Some(&(n, _)) => n >= cfg.max_auth_failures,
+            None => false,
+        }
+    }
+
+    fn fail(&mut self, ip: IpAddr, cfg: &RelayConfig) {
+        if self.failures.len() >= MAX_AUTH_ADDRESSES && !self.failures.contains_key(&ip) {
+            self.failures.retain(|_, (_, since)| since.elapsed() < cfg.auth_window);
+            if self.failures.len() >= MAX_AUTH_ADDRESSES {
+                self.failures.clear();
+            }
+        }
+        self.failures.entry(ip).or_insert((0, Instant::now())).0 += 1;
+    }
+}
+
+/// What the acceptor and the clients share.
+struct Shared {
+    bb: Blackboard,
+    cfg: RelayConfig,
+    stop: AtomicBool,
+    stats: RelayStats,
+    active: AtomicUsize,
+    per_address: Mutex<HashMap<IpAddr, usize>>,
+    watches: AtomicUsize,
+    bucket: Mutex<Bucket>,
+    auth: Mutex<AuthBook>,
+}
+
+impl Shared {
+    /// Takes a client's place, if one is free (in total and for its address).
+    fn admit(&self, ip: IpAddr) -> Result<(), Refusal> {
+        let mut per = lock(&self.per_address);
+        if self.active.load(Ordering::SeqCst) >= self.cfg.max_clients {
+            return Err(Refusal::new(503, "too many clients"));
+        }
+        let n = per.entry(ip).or_insert(0);
+        if *n >= self.cfg.max_clients_per_address {
+            return Err(Refusal::new(503, format!("too many clients from {ip}")));
+        }
+        *n += 1;
+        self.active.fetch_add(1, Ordering::SeqCst);
+        Ok(())
+    }
+
+    fn leave(&self, ip: IpAddr) {
+        let mut per = lock(&self.per_address);
+        if let Some(n) = per.get_mut(&ip) {
+            *n = n.saturating_sub(1);
+            if *n == 0 {
+                per.remove(&ip);
+            }
+        }
+        self.active.fetch_sub(1, Ordering::SeqCst);
+    }
+
+    /// Up to `wanted` pushes from the budget of all clients.
+    fn take_pushes(&self, wanted: usize) -> usize {
+        let rate = self.cfg.max_pushes_per_second as f64;
+        let mut b = lock(&self.bucket);
+        let now = Instant::now();
+        b.tokens = (b.tokens + now.duration_since(b.last).as_secs_f64() * rate).min(rate);
+        b.last = now;
+        let granted = (wanted as f64).min(b.tokens.floor()).max(0.0);
+        b.tokens -= granted;
+        granted as usize
+    }
 }
 
 /// A running relay. Dropping it stops it.
 pub struct Relay {
     addr: SocketAddr,
-    stop: Arc<AtomicBool>,
-    stats: Arc<RelayStats>,
+    shared: Arc<Shared>,
     acceptor: Option<JoinHandle<()>>,
 }
 
 impl Relay {
     /// Starts serving `bb` as `cfg` says.
     pub fn start(bb: Blackboard, cfg: RelayConfig) -> Result<Relay, RelayError> {
-        if !cfg.addr.ip().is_loopback() && cfg.token.is_none() {
-            return Err(RelayError::TokenRequired(cfg.addr));
+        match &cfg.token {
+            Some(t) => check_token(t).map_err(RelayError::BadToken)?,
+            None if !cfg.addr.ip().is_loopback() => {
+                return Err(RelayError::TokenRequired(cfg.addr))
+            }
+            None => {}
         }
         let listener = TcpListener::bind(cfg.addr)
             .map_err(|source| RelayError::Bind { addr: cfg.addr, source })?;
         let addr =
             listener.local_addr().map_err(|source| RelayError::Bind { addr: cfg.addr, source })?;
-        let stop = Arc::new(AtomicBool::new(false));
-        let stats = Arc::new(RelayStats::default());
+        let rate = cfg.max_pushes_per_second as f64;
+        let shared = Arc::new(Shared {
+            bb,
+            cfg,
+            stop: AtomicBool::new(false),
+            stats: RelayStats::default(),
+            active: AtomicUsize::new(0),
+            per_address: Mutex::default(),
+            watches: AtomicUsize::new(0),
+            bucket: Mutex::new(Bucket { tokens: rate, last: Instant::now() }),
+            auth: Mutex::default(),
+        });
         let acceptor = {
-            let (stop, stats) = (stop.clone(), stats.clone());
+            let shared = shared.clone();
             std::thread::Builder::new()
                 .name("mrt-relay".into())
-                .spawn(move || accept_loop(&listener, &bb, &cfg, &stop, &stats))
+                .spawn(move || accept_loop(&listener, &shared))
                 .map_err(|source| RelayError::Bind { addr, source })?
         };
         tracing::info!(%addr, "relay listening");
-        Ok(Relay { addr, stop, stats, acceptor: Some(acceptor) })
+        Ok(Relay { addr, shared, acceptor: Some(acceptor) })
     }
 
     /// The address it listens on.
@@ -236,7 +464,17 @@ impl Relay {
 
     /// Its counters.
     pub fn stats(&self) -> &RelayStats {
-        &self.stats
+        &self.shared.stats
+    }
+
+    /// Clients connected now.
+    pub fn clients(&self) -> usize {
+        self.shared.active.load(Ordering::SeqCst)
+    }
+
+    /// Watches of all clients now.
+    pub fn watches(&self) -> usize {
+        self.shared.watches.load(Ordering::SeqCst)
     }
 
     /// Stops accepting clients (the ones connected finish their current request and close).
@@ -245,7 +483,7 @@ impl Relay {
     }
 
     fn shutdown(&mut self) {
-        self.stop.store(true, Ordering::SeqCst);
+        self.shared.stop.store(true, Ordering::SeqCst);
         // Wake the acceptor up.
         let _ = TcpStream::connect_timeout(&self.addr, Duration::from_millis(200));
         if let Some(h) = self.acceptor.take() {
@@ -260,37 +498,35 @@ impl Drop for Relay {
     }
 }
 
-fn accept_loop(
-    listener: &TcpListener,
-    bb: &Blackboard,
-    cfg: &RelayConfig,
-    stop: &Arc<AtomicBool>,
-    stats: &Arc<RelayStats>,
-) {
-    let active = Arc::new(AtomicUsize::new(0));
+fn accept_loop(listener: &TcpListener, shared: &Arc<Shared>) {
     for stream in listener.incoming() {
-        if stop.load(Ordering::SeqCst) {
+        if shared.stop.load(Ordering::SeqCst) {
             break;
         }
         let Ok(mut stream) = stream else { continue };
-        if active.load(Ordering::SeqCst) >= cfg.max_clients {
-            stats.refused.fetch_add(1, Ordering::Relaxed);
+        let Ok(peer) = stream.peer_addr() else { continue };
+        if let Err(refusal) = shared.admit(peer.ip()) {
+            count(&shared.stats.refused);
             let _ = stream.set_write_timeout(Some(Duration::from_millis(100)));
-            let _ = writeln!(stream, "{}", Refusal::new(503, "too many clients").line());
+            let _ = writeln!(stream, "{}", refusal.line());
             let _ = stream.shutdown(Shutdown::Both);
             continue;
         }
-        stats.accepted.fetch_add(1, Ordering::Relaxed);
-        active.fetch_add(1, Ordering::SeqCst);
-        let (bb, cfg, stop, stats, active) =
-            (bb.clone(), cfg.clone(), stop.clone(), stats.clone(), active.clone());
-        let spawned =
-            std::thread::Builder::new().name("mrt-relay-client".into()).spawn(move || {
-                let _ = Client::new(stream, &bb, &cfg).serve(&stop, &stats);
-                active.fetch_sub(1, Ordering::SeqCst);
+        count(&shared.stats.accepted);
+        let client_shared = shared.clone();
+        let spawned = std::thread::Builder::new()
+            .name("mrt-relay-client".into())
+            .stack_size(CLIENT_STACK)
+            .spawn(move || {
+                let mut client = Client::new(stream, peer.ip(), &client_shared);
+                if let Err(e) = client.serve() {
+                    tracing::debug!(%peer, "relay client: {e}");
+                }
+                client.close();
             });
         if spawned.is_err() {
             tracing::warn!("relay: cannot start a client thread");
+            shared.leave(peer.ip());
         }
     }
 }
@@ -298,15 +534,24 @@ fn accept_loop(
 /// One connected client.
 struct Client<'a> {
     stream: TcpStream,
+    ip: IpAddr,
+    shared: &'a Shared,
     bb: &'a Blackboard,
     cfg: &'a RelayConfig,
     authorised: bool,
     refresh: Duration,
     watches: Vec<Pattern>,
-    /// The stamp of each watched symbol last pushed.
-    pushed: HashMap<Arc<str>, mrt_core::Time>,
+    /// Watches added since the last push: their first push sends every value they cover.
+    fresh: Vec<Pattern>,
+    /// The blackboard's version at the last push.
+    seen: u64,
+    /// Changed symbols waiting for a push, oldest first, each once.
+    deferred: VecDeque<Arc<str>>,
+    waiting: HashSet<Arc<str>>,
     /// A wrong token was sent: the connection ends after the reply.
     rejected: bool,
+    /// Its place among the clients is given back.
+    left: bool,
 }
 
 enum Flow {
@@ -315,68 +560,123 @@ enum Flow {
 }
 
 impl<'a> Client<'a> {
-    fn new(stream: TcpStream, bb: &'a Blackboard, cfg: &'a RelayConfig) -> Client<'a> {
+    fn new(stream: TcpStream, ip: IpAddr, shared: &'a Shared) -> Client<'a> {
         Client {
             stream,
-            bb,
-            cfg,
-            authorised: cfg.token.is_none(),
-            refresh: Duration::from_millis(500),
+            ip,
+            shared,
+            bb: &shared.bb,
+            cfg: &shared.cfg,
+            authorised: shared.cfg.token.is_none(),
+            refresh: Duration::from_millis(500).max(shared.cfg.min_refresh),
             watches: Vec::new(),
-            pushed: HashMap::new(),
+            fresh: Vec::new(),
+            seen: shared.bb.version(),
+            deferred: VecDeque::new(),
+            waiting: HashSet::new(),
             rejected: false,
+            left: false,
         }
     }
 
-    fn serve(mut self, stop: &AtomicBool, stats: &RelayStats) -> std::io::Result<()> {
-        self.stream.set_write_timeout(Some(Duration::from_secs(5)))?;
+    fn serve(&mut self) -> std::io::Result<()> {
+        self.stream.set_write_timeout(Some(self.cfg.write_timeout))?;
         self.stream.set_nodelay(true)?;
+        let connected = Instant::now();
         let mut buf: Vec<u8> = Vec::with_capacity(256);
         let mut chunk = [0u8; 4096];
-        let mut last_input = Instant::now();
-        let mut next_push = Instant::now() + self.refresh;
-        while !stop.load(Ordering::SeqCst) {
-            let wait = next_push.saturating_duration_since(Instant::now());
-            self.stream.set_read_timeout(Some(
-                wait.clamp(Duration::from_millis(5), Duration::from_millis(100)),
-            ))?;
+        let mut last_input = connected;
+        // When the first byte of the unfinished line in `buf` arrived.
+        let mut line_started: Option<Instant> = None;
+        let mut next_push = connected + self.refresh;
+        while !self.shared.stop.load(Ordering::SeqCst) {
+            let now = Instant::now();
+            let mut until = (now + STOP_POLL).min(last_input + self.cfg.idle_timeout);
+            if !self.watches.is_empty() {
+                until = until.min(next_push);
+            }
+            if let Some(t) = line_started {
+                until = until.min(t + self.cfg.line_timeout);
+            }
+            if !self.authorised {
+                until = until.min(connected + self.cfg.auth_timeout);
+            }
+            let wait = until.saturating_duration_since(now).max(Duration::from_millis(1));
+            self.stream.set_read_timeout(Some(wait))?;
             match self.stream.read(&mut chunk) {
                 Ok(0) => return Ok(()),
                 Ok(n) => {
-                    last_input = Instant::now();
+                    let now = Instant::now();
+                    last_input = now;
+                    let ended = chunk[..n].contains(&b'\n');
                     buf.extend_from_slice(&chunk[..n]);
                     while let Some(end) = buf.iter().position(|&b| b == b'\n') {
                         let line: Vec<u8> = buf.drain(..=end).collect();
-                        if let Flow::Close = self.handle(&line[..line.len() - 1], stats)? {
-                            return self.close();
+                        if let Flow::Close = self.handle(&line[..line.len() - 1])? {
+                            return Ok(());
                         }
                     }
+                    line_started = match (buf.is_empty(), ended) {
+                        (true, _) => None,
+                        (false, true) => Some(now),
+                        (false, false) => line_started.or(Some(now)),
+                    };
                     if buf.len() >= self.cfg.max_line {
-                        stats.errors.fetch_add(1, Ordering::Relaxed);
+                        count(&self.shared.stats.errors);
                         let why = format!("a request line is at most {} bytes", self.cfg.max_line);
-                        self.reply(&Refusal::new(413, why).line())?;
-                        return self.close();
+                        return self.reply(&Refusal::new(413, why).line());
                     }
                 }
                 Err(e) if matches!(e.kind(), ErrorKind::WouldBlock | ErrorKind::TimedOut) => {}
                 Err(e) if e.kind() == ErrorKind::Interrupted => {}
                 Err(e) => return Err(e),
             }
-            if last_input.elapsed() >= self.cfg.idle_timeout {
-                let _ = self.reply(&Refusal::new(408, "idle for too long").line());
-                return self.close();
+            let now = Instant::now();
+            if line_started.is_some_and(|t| now >= t + self.cfg.line_timeout) {
+                count(&self.shared.stats.too_slow);
+                let secs = self.cfg.line_timeout.as_secs_f64();
+                let why = format!("a request line must end within {secs} s of its first byte");
+                return self.reply(&Refusal::new(408, why).line());
             }
-            if Instant::now() >= next_push {
+            if !self.authorised && now >= connected + self.cfg.auth_timeout {
+                count(&self.shared.stats.too_slow);
+                let secs = self.cfg.auth_timeout.as_secs_f64();
+                let why = format!("no AUTH <token> within {secs} s");
+                return self.reply(&Refusal::new(401, why).line());
+            }
+            if now >= last_input + self.cfg.idle_timeout {
+                return self.reply(&Refusal::new(408, "idle for too long").line());
+            }
+            if now >= next_push {
                 self.push_watches()?;
                 next_push = Instant::now() + self.refresh;
             }
         }
-        self.close()
+        Ok(())
     }
 
-    fn close(&mut self) -> std::io::Result<()> {
+    /// Gives its place and its watches back, then closes the connection (in this order, so
+    /// that a client that sees the connection end finds the place free).
+    fn close(&mut self) {
+        if !self.left {
+            self.left = true;
+            self.shared.watches.fetch_sub(self.watches.len(), Ordering::SeqCst);
+            self.watches.clear();
+            self.shared.leave(self.ip);
+        }
         let _ = self.stream.shutdown(Shutdown::Both);
-        Ok(())
+    }
+
+    /// Writes `bytes`; a client that does not take them within the write timeout is dropped
+    /// (counted).
+    fn send(&mut self, bytes: &[u8]) -> std::io::Result<()> {
+        let sent = self.stream.write_all(bytes);
+        if let Err(e) = &sent {
+            if matches!(e.kind(), ErrorKind::WouldBlock | ErrorKind::TimedOut) {
+                count(&self.shared.stats.not_reading);
+            }
+        }
+        sent
     }
 
     fn reply(&mut self, line: &str) -> std::io::Result<()> {
@@ -384,10 +684,10 @@ impl<'a> Client<'a> {
         let mut bytes = Vec::with_capacity(line.len() + 1);
         bytes.extend_from_slice(line.as_bytes());
         bytes.push(b'\n');
-        self.stream.write_all(&bytes)
+        self.send(&bytes)
     }
 
-    fn handle(&mut self, raw: &[u8], stats: &RelayStats) -> std::io::Result<Flow> {
+    fn handle(&mut self, raw: &[u8]) -> std::io::Result<Flow> {
         let outcome = match std::str::from_utf8(raw) {
             Err(_) => Err(Refusal::new(400, "a request is UTF-8 text")),
             Ok(text) => match parse_request(text) {
@@ -398,28 +698,43 @@ impl<'a> Client<'a> {
         };
         match outcome {
             Ok((line, flow)) => {
-                stats.ok.fetch_add(1, Ordering::Relaxed);
+                count(&self.shared.stats.ok);
                 self.reply(&line)?;
                 Ok(flow)
             }
             Err(e) => {
-                stats.errors.fetch_add(1, Ordering::Relaxed);
+                count(&self.shared.stats.errors);
                 self.reply(&e.line())?;
                 Ok(if self.rejected { Flow::Close } else { Flow::Continue })
             }
         }
     }
 
+    fn authenticate(&mut self, given: &str) -> Result<(String, Flow), Refusal> {
+        let Some(token) = self.cfg.token.as_deref() else {
+            return Ok(("OK AUTH".into(), Flow::Continue));
+        };
+        if lock(&self.shared.auth).locked(self.ip, self.cfg) {
+            count(&self.shared.stats.auth_locked);
+            self.rejected = true;
+            let why = format!("too many wrong tokens from {}: try again later", self.ip);
+            return Err(Refusal::new(429, why));
+        }
+        if same_token(given, token) {
+            self.authorised = true;
+            return Ok(("OK AUTH".into(), Flow::Continue));
+        }
+        lock(&self.shared.auth).fail(self.ip, self.cfg);
+        count(&self.shared.stats.auth_failures);
+        // A wrong token is answered late, then ends the connection.
+        std::thread::sleep(self.cfg.auth_delay);
+        self.rejected = true;
+        Err(Refusal::new(401, "wrong token"))
+    }
+
     fn serve_request(&mut self, r: Request) -> Result<(String, Flow), Refusal> {
         if let Request::Auth(token) = &r {
-            return if self.cfg.token.as_deref().is_none_or(|t| t == token) {
-                self.authorised = true;
-                Ok(("OK AUTH".into(), Flow::Continue))
-            } else {
-                // A wrong token ends the connection.
-                self.rejected = true;
-                Err(Refusal::new(401, "wrong token"))
-            };
+            return self.authenticate(token);
         }
         if !self.authorised && r != Request::Quit {
             return Err(Refusal::new(401, "send AUTH <token> first"));
@@ -429,8 +744,8 @@ impl<'a> Client<'a> {
             Request::Auth(_) => ok("OK AUTH".into()),
             Request::Quit => Ok(("OK QUIT".into(), Flow::Close)),
             Request::Refr(ms) => {
-                self.refresh = Duration::from_millis(ms);
-                ok(format!("OK REFR {ms}"))
+                self.refresh = Duration::from_millis(ms).max(self.cfg.min_refresh);
+                ok(format!("OK REFR {}", self.refresh.as_millis()))
             }
             Request::Addw(p) => {
                 if !self.watches.contains(&p) {
@@ -440,22 +755,41 @@ impl<'a> Client<'a> {
                             format!("at most {} watches", self.cfg.max_watches),
                         ));
                     }
+                    let max = self.cfg.max_total_watches;
+                    let all = &self.shared.watches;
+                    if all
+                        .fetch_update(Ordering::SeqCst, Ordering::SeqCst, |n| {
+                            (n < max).then_some(n + 1)
+                        })
+                        .is_err()
+                    {
+                        return Err(Refusal::new(
+                            429,
+                            format!("the relay holds at most {max} watches of all clients"),
+                        ));
+                    }
                     self.watches.push(p.clone());
+                    self.fresh.push(p.clone());
                 }
                 ok(format!("OK ADDW {p}"))
             }
             Request::Delw(p) => {
                 let before = self.watches.len();
                 self.watches.retain(|w| *w != p);
+                self.fresh.retain(|w| *w != p);
                 if self.watches.len() == before {
                     return Err(Refusal::new(404, format!("not watched: {p}")));
                 }
+                self.shared.watches.fetch_sub(1, Ordering::SeqCst);
                 ok(format!("OK DELW {p}"))
             }
             Request::Clrw => {
                 let n = self.watches.len();
+                self.shared.watches.fetch_sub(n, Ordering::SeqCst);
                 self.watches.clear();
-                self.pushed.clear();
+                self.fresh.clear();
+                self.deferred.clear();
+                self.waiting.clear();
                 ok(format!("OK CLRW {n}"))
             }
             Request::Lstw => {
@@ -466,11 +800,13 @@ impl<'a> Client<'a> {
                 }
                 ok(line)
             }
-            Request::Setv(symbol, value) => match self.bb.set(&symbol, value) {
+            Request::Setv(symbol, value) => match self.bb.set_as_guest(&symbol, value) {
                 Ok(()) => ok(format!("OK SETV {symbol}")),
                 Err(e @ (BbError::Type { .. } | BbError::Kind { .. })) => {
                     Err(Refusal::new(409, e.to_string()))
                 }
+                Err(e @ BbError::TooLong { .. }) => Err(Refusal::new(413, e.to_string())),
+                Err(e @ BbError::Full { .. }) => Err(Refusal::new(507, e.to_string())),
                 Err(e) => Err(Refusal::new(400, e.to_string())),
             },
             Request::Getv(symbol) => match self.bb.get_stamped(&symbol) {
@@ -481,15 +817,44 @@ impl<'a> Client<'a> {
                 Err(e) => Err(Refusal::new(409, e.to_string())),
             },
             Request::Lstv(p) => {
-                let list = self.bb.list(p.as_ref());
-                let mut line = format!("OK LSTV {}", list.len());
-                for (s, _) in list {
-                    line.push(' ');
-                    line.push_str(&s);
+                let (line, more) = self.list_page(p.as_ref(), None);
+                if more {
+                    let shown = p.map_or_else(|| "*".to_string(), |p| p.to_string());
+                    return Err(Refusal::new(
+                        413,
+                        format!(
+                            "the symbols do not fit in one reply of {} bytes: page them with \
+                             LSTV {shown} - and then LSTV {shown} <last symbol received>",
+                            self.cfg.max_reply
+                        ),
+                    ));
                 }
                 ok(line)
             }
+            Request::LstvPage(p, after) => ok(self.list_page(p.as_ref(), after.as_deref()).0),
         }
+    }
+
+    /// `OK LSTV <n> <symbol>…` with as many symbols as fit in a reply, and whether more follow.
+    fn list_page(&self, p: Option<&Pattern>, after: Option<&str>) -> (String, bool) {
+        let (symbols, _) = self.bb.symbols(p, after, usize::MAX);
+        // Room for `OK LSTV <n>`: the count has at most 20 digits.
+        let room = self.cfg.max_reply.saturating_sub("OK LSTV ".len() + 20);
+        let (mut used, mut n) = (0, 0);
+        for s in &symbols {
+            if used + 1 + s.len() > room {
+                break;
+            }
+            used += 1 + s.len();
+            n += 1;
+        }
+        let mut line = String::with_capacity(used + 30);
+        line.push_str(&format!("OK LSTV {n}"));
+        for s in &symbols[..n] {
+            line.push(' ');
+            line.push_str(s);
+        }
+        (line, n < symbols.len())
     }
 
     /// `<symbol> <Type> <value> <age ms>`.
@@ -498,37 +863,113 @@ impl<'a> Client<'a> {
         format!("{symbol} {} {age}", s.value.to_typed_text())
     }
 
-    /// One `WATCH` line for each watched symbol changed since its last push.
+    /// Queues a changed symbol for a push (once), or drops it (counted) when the queue is full.
+    fn defer(&mut self, symbol: Arc<str>) {
+        if self.waiting.contains(&symbol) {
+            return;
+        }
+        if self.deferred.len() >= self.cfg.max_deferred {
+            count(&self.shared.stats.push_dropped);
+            return;
+        }
+        self.waiting.insert(symbol.clone());
+        self.deferred.push_back(symbol);
+    }
+
+    /// One `WATCH` line for each watched symbol changed since its last push, within the
+    /// budgets; the rest wait for the next periods, in the order they changed.
     fn push_watches(&mut self) -> std::io::Result<()> {
         if self.watches.is_empty() {
             return Ok(());
         }
-        let mut lines = Vec::new();
-        for w in &self.watches {
-            for (symbol, value) in self.bb.list(Some(w)) {
-                let Some(value) = value else { continue };
-                if self.pushed.get(&symbol) == Some(&value.time) {
-                    continue;
-                }
-                lines.push(format!("WATCH {}", self.describe(&symbol, &value)));
-                self.pushed.insert(symbol, value.time);
+        let watches = &self.watches;
+        let (version, changed) =
+            self.bb.changed_since(self.seen, |s| watches.iter().any(|w| w.matches(s)));
+        self.seen = version;
+        let mut candidates: Vec<Arc<str>> = changed.into_iter().map(|(s, _)| s).collect();
+        for p in std::mem::take(&mut self.fresh) {
+            candidates.extend(self.bb.symbols(Some(&p), None, usize::MAX).0);
+        }
+        // Overlapping watches cover a symbol once.
+        let mut once = HashSet::with_capacity(candidates.len());
+        for symbol in candidates {
+            if once.insert(symbol.clone()) {
+                self.defer(symbol);
             }
         }
-        for l in lines {
-            self.reply(&l)?;
+        let wanted = self.deferred.len().min(self.cfg.max_pushes);
+        let granted = self.shared.take_pushes(wanted);
+        let mut out = Vec::new();
+        let mut sent = 0u64;
+        for _ in 0..granted {
+            let Some(symbol) = self.deferred.pop_front() else { break };
+            self.waiting.remove(&symbol);
+            if !self.watches.iter().any(|w| w.matches(&symbol)) {
+                continue;
+            }
+            let Some(value) = self.bb.peek(&symbol) else { continue };
+            out.extend_from_slice(b"WATCH ");
+            out.extend_from_slice(self.describe(&symbol, &value).as_bytes());
+            out.push(b'\n');
+            sent += 1;
         }
-        Ok(())
+        self.shared.stats.pushed.fetch_add(sent, Ordering::Relaxed);
+        if out.is_empty() {
+            return Ok(());
+        }
+        self.send(&out)
+    }
+}
+
+impl Drop for Client<'_> {
+    fn drop(&mut self) {
+        self.close();
+    }
+}
+
+/// Default [`ClientOptions::connect_timeout`].
+pub const DEFAULT_CONNECT_TIMEOUT: Duration = Duration::from_secs(5);
+
+/// Default [`ClientOptions::reply_timeout`].
+pub const DEFAULT_REPLY_TIMEOUT: Duration = Duration::from_secs(5);
+
+/// Default [`ClientOptions::max_line`]: 1 MiB, far above what a relay sends (its replies are
+/// at most [`RelayConfig::max_reply`] bytes).
+pub const DEFAULT_CLIENT_MAX_LINE: usize = 1 << 20;
+
+/// How long a [`RelayClient`] waits, and how long a line it accepts.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ClientOptions {
+    /// Longest wait for the connection (default [`DEFAULT_CONNECT_TIMEOUT`]).
+    pub connect_timeout: Duration,
+    /// Longest wait for a reply to a request (default [`DEFAULT_REPLY_TIMEOUT`]).
+    pub reply_timeout: Duration,
+    /// Longest line accepted from the relay, bytes (default [`DEFAULT_CLIENT_MAX_LINE`]).
+    pub max_line: usize,
+}
+
+impl Default for ClientOptions {
+    fn default() -> Self {
+        ClientOptions {
+            connect_timeout: DEFAULT_CONNECT_TIMEOUT,
+            reply_timeout: DEFAULT_REPLY_TIMEOUT,
+            max_line: DEFAULT_CLIENT_MAX_LINE,
+        }
     }
 }
 
 /// A relay client: one request at a time, `WATCH` pushes kept aside (`mrt bb` uses it).
 pub struct RelayClient {
+    addr: SocketAddr,
+    options: ClientOptions,
     reader: std::io::BufReader<TcpStream>,
     writer: TcpStream,
-    pushes: std::collections::VecDeque<String>,
+    pushes: VecDeque<String>,
+    /// The start of a line whose end has not arrived yet.
+    partial: Vec<u8>,
 }
 
-/// A client's failure.
+/// A client's failure; each names the relay's address.
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
 pub enum ClientError {
@@ -541,25 +982,78 @@ pub enum ClientError {
         #[source]
         source: std::io::Error,
     },
+    /// No connection, or no reply, in time.
+    #[error("relay at {addr}: no {what} within {} s", after.as_secs_f64())]
+    Timeout {
+        /// The relay's address.
+        addr: SocketAddr,
+        /// `connection` or `reply`.
+        what: &'static str,
+        /// The time waited.
+        after: Duration,
+    },
+    /// A line from the relay longer than [`ClientOptions::max_line`].
+    #[error("relay at {addr}: a line longer than {max} bytes")]
+    LineTooLong {
+        /// The relay's address.
+        addr: SocketAddr,
+        /// The limit, bytes.
+        max: usize,
+    },
+    /// The token cannot be sent ([`check_token`]).
+    #[error("the relay token is unusable: {0}")]
+    BadToken(&'static str),
     /// The relay answered `ERR`.
-    #[error("relay: {0}")]
-    Refused(String),
+    #[error("relay at {addr}: {reply}")]
+    Refused {
+        /// The relay's address.
+        addr: SocketAddr,
+        /// The `ERR` line.
+        reply: String,
+    },
     /// The relay closed the connection.
-    #[error("the relay closed the connection")]
-    Closed,
+    #[error("the relay at {0} closed the connection")]
+    Closed(SocketAddr),
+}
+
+fn timed_out(e: &std::io::Error) -> bool {
+    matches!(e.kind(), ErrorKind::WouldBlock | ErrorKind::TimedOut)
 }
 
 impl RelayClient {
-    /// Connects to `addr` (and authenticates with `token`, if given).
+    /// Connects to `addr` (and authenticates with `token`, if given), with the default
+    /// [`ClientOptions`].
     pub fn connect(addr: SocketAddr, token: Option<&str>) -> Result<RelayClient, ClientError> {
+        RelayClient::connect_with(addr, token, ClientOptions::default())
+    }
+
+    /// Connects to `addr` (and authenticates with `token`, if given), waiting as `options`
+    /// says.
+    pub fn connect_with(
+        addr: SocketAddr,
+        token: Option<&str>,
+        options: ClientOptions,
+    ) -> Result<RelayClient, ClientError> {
+        if let Some(t) = token {
+            check_token(t).map_err(ClientError::BadToken)?;
+        }
         let io = |source| ClientError::Io { addr, source };
-        let stream = TcpStream::connect_timeout(&addr, Duration::from_secs(3)).map_err(io)?;
+        let stream = TcpStream::connect_timeout(&addr, options.connect_timeout).map_err(|e| {
+            if timed_out(&e) {
+                ClientError::Timeout { addr, what: "connection", after: options.connect_timeout }
+            } else {
+                io(e)
+            }
+        })?;
         stream.set_nodelay(true).map_err(io)?;
         let writer = stream.try_clone().map_err(io)?;
         let mut c = RelayClient {
+            addr,
+            options,
             reader: std::io::BufReader::new(stream),
             writer,
-            pushes: Default::default(),
+            pushes: VecDeque::new(),
+            partial: Vec::new(),
         };
         if let Some(t) = token {
             c.request(&format!("AUTH {t}"))?;
@@ -567,49 +1061,85 @@ impl RelayClient {
         Ok(c)
     }
 
-    /// Sends one request line and returns the `OK` reply (without `OK `); `WATCH` lines that
-    /// arrive meanwhile are kept for [`RelayClient::next_push`].
+    /// The relay's address.
+    pub fn addr(&self) -> SocketAddr {
+        self.addr
+    }
+
+    /// Sends one request line and returns the `OK` reply (without `OK `), waiting at most
+    /// [`ClientOptions::reply_timeout`]; `WATCH` lines that arrive meanwhile are kept for
+    /// [`RelayClient::next_push`].
     pub fn request(&mut self, line: &str) -> Result<String, ClientError> {
-        let addr = self.writer.peer_addr().map_err(|source| ClientError::Io {
-            addr: SocketAddr::from(([0, 0, 0, 0], 0)),
-            source,
-        })?;
+        let addr = self.addr;
         let io = |source| ClientError::Io { addr, source };
         let mut bytes = Vec::with_capacity(line.len() + 1);
         bytes.extend_from_slice(line.as_bytes());
         bytes.push(b'\n');
+        self.writer.set_write_timeout(Some(self.options.reply_timeout)).map_err(io)?;
         self.writer.write_all(&bytes).map_err(io)?;
+        let deadline = Instant::now() + self.options.reply_timeout;
         loop {
-            let reply = self.read_line()?;
+            let reply = self.read_line(Some(deadline))?;
             if reply.starts_with("WATCH ") {
                 self.pushes.push_back(reply);
             } else if let Some(ok) = reply.strip_prefix("OK") {
                 return Ok(ok.trim_start().to_string());
             } else {
-                return Err(ClientError::Refused(reply));
+                return Err(ClientError::Refused { addr, reply });
             }
         }
     }
 
-    /// The next `WATCH` line (waiting for it).
+    /// The next `WATCH` line, waiting for it as long as it takes (a watched variable may stay
+    /// unchanged for hours).
     pub fn next_push(&mut self) -> Result<String, ClientError> {
         if let Some(p) = self.pushes.pop_front() {
             return Ok(p);
         }
-        self.read_line()
+        self.read_line(None)
     }
 
-    fn read_line(&mut self) -> Result<String, ClientError> {
-        use std::io::BufRead;
-        let mut line = String::new();
-        let n = self.reader.read_line(&mut line).map_err(|source| ClientError::Io {
-            addr: SocketAddr::from(([0, 0, 0, 0], 0)),
-            source,
-        })?;
-        if n == 0 {
-            return Err(ClientError::Closed);
+    /// One line (without its end), at most [`ClientOptions::max_line`] bytes, by `deadline`.
+    fn read_line(&mut self, deadline: Option<Instant>) -> Result<String, ClientError> {
+        let addr = self.addr;
+        let max = self.options.max_line;
+        loop {
+            let timeout = match deadline {
+                Some(d) => {
+                    let left = d.saturating_duration_since(Instant::now());
+                    if left.is_zero() {
+                        let after = self.options.reply_timeout;
+                        return Err(ClientError::Timeout { addr, what: "reply", after });
+                    }
+                    Some(left)
+                }
+                None => None,
+            };
+            let io = |source| ClientError::Io { addr, source };
+            self.reader.get_ref().set_read_timeout(timeout).map_err(io)?;
+            let available = match self.reader.fill_buf() {
+                Ok(b) => b,
+                Err(e) if timed_out(&e) || e.kind() == ErrorKind::Interrupted => continue,
+                Err(e) => return Err(io(e)),
+            };
+            if available.is_empty() {
+                return Err(ClientError::Closed(addr));
+            }
+            let (taken, done) = match available.iter().position(|&b| b == b'\n') {
+                Some(end) => (end + 1, true),
+                None => (available.len(), false),
+            };
+            if self.partial.len() + taken > max + 1 {
+                return Err(ClientError::LineTooLong { addr, max });
+            }
+            self.partial.extend_from_slice(&available[..taken]);
+            self.reader.consume(taken);
+            if done {
+                let line = String::from_utf8_lossy(&self.partial).trim_end().to_string();
+                self.partial.clear();
+                return Ok(line);
+            }
         }
-        Ok(line.trim_end().to_string())
     }
 }
 
@@ -638,6 +1168,25 @@ mod tests {
         assert_eq!(p("QUIT"), Request::Quit);
         assert_eq!(p("AUTH s3cret"), Request::Auth("s3cret".into()));
         assert_eq!(parse_request("   ").unwrap(), None);
+        assert_eq!(p("LSTV *"), Request::Lstv(None));
+        assert_eq!(p("LSTV * -"), Request::LstvPage(None, None));
+        assert_eq!(
+            p("LSTV local.* local.var.a"),
+            Request::LstvPage(Some(Pattern::parse("local.*").unwrap()), Some("local.var.a".into()))
+        );
+    }
+
+    #[test]
+    fn tokens_are_one_word_and_compared_whole() {
+        assert!(check_token("s3cret-ä").is_ok());
+        assert_eq!(check_token(""), Err("it is empty"));
+        assert!(check_token("a b").is_err() && check_token("a\u{1b}").is_err());
+        assert!(check_token(&"x".repeat(MAX_TOKEN_LEN + 1)).is_err());
+        assert!(same_token("s3cret", "s3cret"));
+        for wrong in ["", "s3cre", "s3cret2", "S3cret"] {
+            assert!(!same_token(wrong, "s3cret"), "{wrong}");
+        }
+        assert!(parse_request("LSTV a b c").is_err());
     }
 
     #[test]

@@ -2,6 +2,7 @@
 //! with a blackboard and its Proxy Member, on a stepped simulated clock.
 #![allow(clippy::unwrap_used)]
 
+use mrt_blackboard::board::BbLimits;
 use mrt_blackboard::{BbUpdate, Blackboard, Proxy, Update, Value};
 use mrt_core::SimClock;
 use mrt_dcdt::{Activation, Context, InnerLinkManager, Member, MemberError, SteppedExecutor};
@@ -25,18 +26,24 @@ struct Team {
     exec: SteppedExecutor,
     boards: Vec<Blackboard>,
     rejected: Vec<Arc<AtomicU64>>,
+    over_limit: Vec<Arc<AtomicU64>>,
 }
 
 fn team(robots: u32, inject: Vec<Update>) -> Team {
+    team_with(robots, inject, BbLimits::default())
+}
+
+fn team_with(robots: u32, inject: Vec<Update>, limits: BbLimits) -> Team {
     let tick = Duration::from_millis(10);
     let mut exec = SteppedExecutor::new(SimClock::new(), tick);
     let link = InnerLinkManager::new();
-    let (mut boards, mut rejected) = (Vec::new(), Vec::new());
+    let (mut boards, mut rejected, mut over_limit) = (Vec::new(), Vec::new(), Vec::new());
     for id in 1..=robots {
         let mut agora = exec.agora_builder(id).inner_link(&link).build().unwrap();
-        let bb = Blackboard::new(id, agora.clock().clone());
+        let bb = Blackboard::with_limits(id, agora.clock().clone(), limits);
         let proxy = Proxy::new(bb.clone());
         rejected.push(proxy.rejected());
+        over_limit.push(proxy.over_limit());
         let m = agora.add_member(proxy, Activation::Periodic(tick));
         agora.activate_member(m).unwrap();
         exec.add_agora(agora).unwrap();
@@ -46,7 +53,7 @@ fn team(robots: u32, inject: Vec<Update>) -> Team {
     let m = agora.add_member(Injector(inject), Activation::Periodic(tick));
     agora.activate_member(m).unwrap();
     exec.add_agora(agora).unwrap();
-    Team { exec, boards, rejected }
+    Team { exec, boards, rejected, over_limit }
 }
 
 #[test]
@@ -103,4 +110,34 @@ fn malformed_updates_are_counted_and_dropped() {
         assert_eq!(bb.get::<String>("*.var.team.formation").unwrap(), "diamond");
         assert!(bb.get::<i64>("local.var.machine.role").is_err());
     }
+}
+
+/// Issue 17: the limits of the relay hold for updates from the network too. A teammate (or
+/// a forged frame) sending a string past `max_string` or more new symbols than a guest may
+/// create has them counted and dropped; the robot's own sets still work.
+#[test]
+fn updates_past_the_limits_are_counted_and_dropped() {
+    let limits =
+        BbLimits { max_symbols: 8, max_guest_symbols: 4, max_string: 16, ..BbLimits::default() };
+    let mut flood: Vec<Update> = (0..10)
+        .map(|i| Update { from: 7, symbol: format!("7.var.flood{i}"), value: Value::Int(i) })
+        .collect();
+    flood.push(Update {
+        from: 7,
+        symbol: "*.var.big".into(),
+        value: Value::String("x".repeat(17)),
+    });
+    let mut t = team_with(1, flood, limits);
+    t.exec.run_for(Duration::from_millis(50));
+    let bb = &t.boards[0];
+    // 4 new symbols from a guest, then 6 refused, and the long string.
+    assert_eq!(bb.len(), 4);
+    assert_eq!(t.over_limit[0].load(Ordering::Relaxed), 7);
+    assert_eq!(t.rejected[0].load(Ordering::Relaxed), 7);
+    assert!(bb.get::<String>("*.var.big").is_err());
+    // The robot's own Members still have room.
+    for i in 0..4 {
+        bb.set(&format!("local.var.own{i}"), i).unwrap();
+    }
+    assert!(bb.set("local.var.one-too-many", 0).is_err());
 }

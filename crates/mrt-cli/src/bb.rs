@@ -1,9 +1,9 @@
 //! `mrt bb`: a blackboard with its relay (`serve`), and the relay's client (`get`, `set`,
 //! `watch`, `list`). The protocol: `docs/relay-protocol.md`.
 
-use anyhow::{bail, Context as _, Result};
+use anyhow::{anyhow, bail, Context as _, Result};
 use clap::{Args, Subcommand};
-use mrt_blackboard::relay::{RelayClient, RelayConfig, DEFAULT_PORT};
+use mrt_blackboard::relay::{ClientOptions, RelayClient, RelayConfig, DEFAULT_PORT};
 use mrt_blackboard::{Blackboard, Relay};
 use std::net::SocketAddr;
 use std::path::PathBuf;
@@ -18,6 +18,33 @@ pub struct Target {
     /// The relay's shared token (needed when it listens beyond this machine).
     #[arg(long, env = "MRT_RELAY_TOKEN", hide_env_values = true)]
     token: Option<String>,
+    /// Longest wait for the connection and for each reply, seconds (a watch waits for
+    /// changes as long as it takes).
+    #[arg(long, default_value_t = 5.0, value_parser = seconds)]
+    timeout: f64,
+}
+
+/// A positive, finite number of seconds.
+fn seconds(text: &str) -> Result<f64, String> {
+    match text.parse::<f64>() {
+        Ok(s) if s.is_finite() && s > 0.0 && s <= 86_400.0 => Ok(s),
+        _ => Err(format!("`{text}` is not a number of seconds between 0 and 86400")),
+    }
+}
+
+/// `text` safe to print on a terminal: control characters (escape sequences, bells, C1
+/// controls) and bidirectional overrides are shown as `\u{..}` instead of acting.
+pub fn printable(text: &str) -> String {
+    let mut out = String::with_capacity(text.len());
+    for c in text.chars() {
+        let bidi = matches!(c, '\u{200e}' | '\u{200f}' | '\u{202a}'..='\u{202e}' | '\u{2066}'..='\u{2069}');
+        if c.is_control() || bidi {
+            out.push_str(&format!("\\u{{{:x}}}", u32::from(c)));
+        } else {
+            out.push(c);
+        }
+    }
+    out
 }
 
 /// `mrt bb` commands.
@@ -105,13 +132,21 @@ fn share(_: &Blackboard, _: &std::path::Path, _: u32) -> Result<()> {
 }
 
 fn connect(t: &Target) -> Result<RelayClient> {
-    RelayClient::connect(t.addr, t.token.as_deref()).with_context(|| {
+    let wait = std::time::Duration::from_secs_f64(t.timeout);
+    let options =
+        ClientOptions { connect_timeout: wait, reply_timeout: wait, ..Default::default() };
+    RelayClient::connect_with(t.addr, t.token.as_deref(), options).with_context(|| {
         format!("cannot reach the relay at {} (is `mrt bb serve` or a robot running?)", t.addr)
     })
 }
 
-/// Runs one `mrt bb` command.
+/// Runs one `mrt bb` command. What comes from the relay, errors included, is printed with
+/// its control characters escaped ([`printable`]).
 pub fn run(command: BbCommand) -> Result<()> {
+    run_command(command).map_err(|e| anyhow!(printable(&format!("{e:#}"))))
+}
+
+fn run_command(command: BbCommand) -> Result<()> {
     match command {
         BbCommand::Serve { target, config_dir, robot, net } => {
             let bb = Blackboard::new(robot, Arc::new(mrt_core::WallClock::new()));
@@ -139,7 +174,7 @@ pub fn run(command: BbCommand) -> Result<()> {
         BbCommand::Get { symbol, target } => {
             let reply = connect(&target)?.request(&format!("GETV {symbol}"))?;
             let rest = reply.strip_prefix("GETV ").and_then(|r| r.strip_prefix(symbol.as_str()));
-            outln!("{}", rest.unwrap_or(&reply).trim());
+            outln!("{}", printable(rest.unwrap_or(&reply).trim()));
         }
         BbCommand::Set { symbol, value_type, value, target } => {
             connect(&target)?.request(&format!("SETV {symbol} {value_type} {value}"))?;
@@ -153,20 +188,30 @@ pub fn run(command: BbCommand) -> Result<()> {
             let mut seen = 0;
             while count.is_none_or(|n| seen < n) {
                 let line = c.next_push()?;
-                outln!("{}", line.strip_prefix("WATCH ").unwrap_or(&line));
+                outln!("{}", printable(line.strip_prefix("WATCH ").unwrap_or(&line)));
                 seen += 1;
             }
         }
         BbCommand::List { pattern, target } => {
             let mut c = connect(&target)?;
-            let reply = c.request(&format!("LSTV {}", pattern.as_deref().unwrap_or("")))?;
-            for symbol in reply.split_whitespace().skip(2) {
-                let v = c.request(&format!("GETV {symbol}"));
-                let shown = match &v {
-                    Ok(r) => r.strip_prefix("GETV ").unwrap_or(r).to_string(),
-                    Err(_) => format!("{symbol} (talk queue)"),
-                };
-                outln!("{shown}");
+            // Page by page (`LSTV <pattern> <after>`), so any number of symbols is listed
+            // within the relay's reply size.
+            let pattern = pattern.as_deref().unwrap_or("*");
+            let mut after = "-".to_string();
+            loop {
+                let reply = c.request(&format!("LSTV {pattern} {after}"))?;
+                let symbols: Vec<String> =
+                    reply.split_whitespace().skip(2).map(str::to_string).collect();
+                let Some(last) = symbols.last().cloned() else { break };
+                for symbol in symbols {
+                    let v = c.request(&format!("GETV {symbol}"));
+                    let shown = match &v {
+                        Ok(r) => r.strip_prefix("GETV ").unwrap_or(r).to_string(),
+                        Err(_) => format!("{symbol} (talk queue)"),
+                    };
+                    outln!("{}", printable(&shown));
+                }
+                after = last;
             }
         }
     }

@@ -145,3 +145,78 @@ fn two_robots_share_their_blackboards_over_the_network() {
     drop(servers);
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// Issue 17: a value with escape sequences was printed raw by `mrt bb get` (a relay, or a
+/// client that set the value, could drive the terminal). Control characters are escaped now,
+/// in `get`, `list` and `watch` alike.
+#[test]
+fn control_characters_from_the_relay_are_escaped_when_printed() {
+    use std::io::Write;
+    let (_server, addr) = serve();
+    // An escape sequence (set the window title, clear the screen), a bell and a C1 CSI,
+    // inside a string value: the relay stores them as they came.
+    let mut s = std::net::TcpStream::connect(&addr).unwrap();
+    s.set_read_timeout(Some(std::time::Duration::from_secs(10))).unwrap();
+    s.write_all(
+        "SETV local.var.evil String \"\x1b]0;pwned\x07\x1b[2J\u{9b}31m\u{202e}\"\n".as_bytes(),
+    )
+    .unwrap();
+    let mut reply = String::new();
+    BufReader::new(&s).read_line(&mut reply).unwrap();
+    assert_eq!(reply, "OK SETV local.var.evil\n");
+    let a = addr.as_str();
+    let want = r#"\u{1b}]0;pwned\u{7}\u{1b}[2J\u{9b}31m\u{202e}"#;
+    for args in [
+        &["bb", "get", "local.var.evil", "--addr", a][..],
+        &["bb", "list", "local.var.evil", "--addr", a],
+        &["bb", "watch", "local.var.evil", "--count", "1", "--addr", a],
+    ] {
+        let (ok, out, err) = run(args);
+        assert!(ok, "{args:?}: {err}");
+        assert!(!out.contains(['\x1b', '\x07', '\u{9b}', '\u{202e}']), "{args:?}: {out:?}");
+        assert!(out.contains(want), "{args:?}: {out}");
+    }
+}
+
+/// Issue 17: `mrt bb get` waited forever on a relay that never answers, buffered an endless
+/// line without limit, and named the relay `0.0.0.0:0` in its errors. It gives up after
+/// `--timeout` now, refuses a line past 1 MiB, and names the real address.
+#[test]
+fn a_silent_or_babbling_relay_gives_a_clear_error_in_bounded_time() {
+    use std::io::Write;
+    let silent = std::net::TcpListener::bind("127.0.0.1:0").unwrap();
+    let addr = silent.local_addr().unwrap().to_string();
+    let held = std::thread::spawn(move || silent.accept().map(|(s, _)| s));
+    let (ok, _, err) = run(&["bb", "get", "local.var.x", "--addr", &addr, "--timeout", "0.5"]);
+    assert!(!ok && err.contains(&format!("relay at {addr}: no reply within 0.5 s")), "{err}");
+    drop(held.join());
+
+    let babbling = std::net::TcpListener::bind("127.0.0.1:0").unwrap();
+    let addr = babbling.local_addr().unwrap().to_string();
+    let talker = std::thread::spawn(move || {
+        let (mut s, _) = babbling.accept().unwrap();
+        let chunk = vec![b'A'; 64 * 1024];
+        // 4 MiB at most, no newline; stops when the client hangs up.
+        for _ in 0..64 {
+            if s.write_all(&chunk).is_err() {
+                break;
+            }
+        }
+    });
+    let (ok, _, err) = run(&["bb", "get", "local.var.x", "--addr", &addr, "--timeout", "10"]);
+    assert!(
+        !ok && err.contains(&format!("relay at {addr}: a line longer than 1048576 bytes")),
+        "{err}"
+    );
+    talker.join().unwrap();
+}
+
+/// Issue 17: `--token ""` passed the check for serving beyond loopback, and a token with a
+/// space could never authenticate. `mrt bb serve` refuses both at startup.
+#[test]
+fn serve_refuses_unusable_tokens() {
+    let (ok, _, err) = run(&["bb", "serve", "--addr", "0.0.0.0:0", "--token", ""]);
+    assert!(!ok && err.contains("the relay's shared token is unusable: it is empty"), "{err}");
+    let (ok, _, err) = run(&["bb", "serve", "--addr", "127.0.0.1:0", "--token", "two words"]);
+    assert!(!ok && err.contains("it has a space or a control character"), "{err}");
+}
