@@ -100,21 +100,8 @@ pub fn hfsm_dot(file: &Path, dot: Option<&Path>, svg: Option<&Path>) -> Result<(
         }
     }
     if let Some(p) = svg {
-        let drawing = render_svg(&hfsm.to_dot(false))?;
-        std::fs::write(p, drawing).with_context(|| format!("cannot write {}", p.display()))?;
+        std::fs::write(p, hfsm.to_svg())
+            .with_context(|| format!("cannot write {}", p.display()))?;
     }
     Ok(())
-}
-
-/// Lays out and draws a dot graph with `layout-rs` (no Graphviz needed).
-fn render_svg(dot: &str) -> Result<String> {
-    use layout::backends::svg::SVGWriter;
-    use layout::gv::{DotParser, GraphBuilder};
-    let graph = DotParser::new(dot).process().map_err(|e| anyhow::anyhow!("dot: {e}"))?;
-    let mut builder = GraphBuilder::new();
-    builder.visit_graph(&graph);
-    let mut visual = builder.get();
-    let mut svg = SVGWriter::new();
-    visual.do_it(false, false, false, &mut svg);
-    Ok(svg.finalize())
 }

@@ -47,6 +47,8 @@ use std::cell::RefCell;
 use std::collections::HashMap;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
+
+mod draw;
 use std::rc::Rc;
 
 /// A state of a machine.

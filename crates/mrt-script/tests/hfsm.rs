@@ -768,3 +768,37 @@ fn include_reuses_machines_from_another_file() {
     }
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn a_large_machine_is_drawn_whole_as_well_formed_svg() {
+    let (_rt, _io, h) = load(include_str!("data/chain200.hfsm.lua"));
+    let svg = h.to_svg();
+    // Every state and every transition is drawn, once.
+    assert_eq!(svg.matches(r#"<g class="state">"#).count(), 200 + 2);
+    let transitions = 1 + 198 + 198 / 10 + 2;
+    assert_eq!(svg.matches(r#"<g class="transition">"#).count(), transitions);
+    assert!(svg.contains(">S198<") && svg.contains(">M [Inner]<") && svg.contains("Big (root)"));
+    // Well-formed: every element closed, in order.
+    let mut reader = quick_xml::Reader::from_str(&svg);
+    let mut depth = 0usize;
+    loop {
+        match reader.read_event().unwrap() {
+            quick_xml::events::Event::Start(_) => depth += 1,
+            quick_xml::events::Event::End(_) => depth -= 1,
+            quick_xml::events::Event::Eof => break,
+            _ => {}
+        }
+    }
+    assert_eq!(depth, 0);
+}
+
+#[test]
+fn state_names_are_escaped_in_the_drawing() {
+    let (_rt, _io, h) = load(
+        r#"machine "M<&>" { initial = "a<b", states = { ["a<b"] = function() end, ["c&d"] = function() end },
+           transitions = { { name = "x\"y", from = "a<b", to = "c&d", test = "true" } } }"#,
+    );
+    let svg = h.to_svg();
+    assert!(svg.contains("a&lt;b") && svg.contains("c&amp;d") && svg.contains("M&lt;&amp;&gt;"));
+    assert!(!svg.contains("a<b"));
+}
