@@ -90,10 +90,10 @@ pub enum BbCommand {
         /// Symbols or prefixes ending in `.*`.
         #[arg(required = true)]
         patterns: Vec<String>,
-        /// Refresh period, ms.
+        /// Refresh period, 10 to 60000 ms.
         #[arg(long, default_value_t = 500)]
         refresh: u64,
-        /// Stop after this many changes.
+        /// Stop after this many changes (at least 1).
         #[arg(long)]
         count: Option<usize>,
         #[command(flatten)]
@@ -180,6 +180,13 @@ fn run_command(command: BbCommand) -> Result<()> {
             connect(&target)?.request(&format!("SETV {symbol} {value_type} {value}"))?;
         }
         BbCommand::Watch { patterns, refresh, count, target } => {
+            // Checked here, before connecting, with the relay's own limits.
+            if !(10..=60_000).contains(&refresh) {
+                bail!("--refresh must be 10 to 60000 ms, not {refresh}");
+            }
+            if count == Some(0) {
+                bail!("--count must be at least 1 (without it, watch until interrupted)");
+            }
             let mut c = connect(&target)?;
             c.request(&format!("REFR {refresh}"))?;
             for p in &patterns {

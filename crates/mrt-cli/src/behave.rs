@@ -11,30 +11,59 @@ use std::io::Write as _;
 use std::path::Path;
 use std::rc::Rc;
 
-/// The worlds to run: a JSON array gives one world per cycle; one object is used every cycle.
-fn worlds(path: Option<&Path>, cycles: Option<usize>) -> Result<Vec<WorldSnapshot>> {
-    let Some(path) = path else {
-        return Ok(vec![WorldSnapshot::default(); cycles.unwrap_or(1)]);
-    };
-    let text =
-        std::fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))?;
-    let value: serde_json::Value = serde_json::from_str(&text)
-        .map_err(|e| anyhow::anyhow!("{}:{}:{}: {e}", path.display(), e.line(), e.column()))?;
-    let parse = |v: serde_json::Value| -> Result<WorldSnapshot> {
-        serde_json::from_value(v)
-            .with_context(|| format!("{}: not a world snapshot", path.display()))
-    };
-    Ok(match value {
-        serde_json::Value::Array(list) => {
-            let mut v = list.into_iter().map(parse).collect::<Result<Vec<_>>>()?;
-            if let Some(n) = cycles {
-                let last = v.last().cloned().unwrap_or_default();
-                v.resize(n, last);
+/// The most cycles `mrt behave` runs (at 100 ms a cycle, more than three years simulated).
+pub const MAX_CYCLES: u64 = 1_000_000_000;
+/// The longest simulated time between cycles, ms (one hour).
+pub const MAX_PERIOD_MS: u64 = 3_600_000;
+
+/// The worlds to run, one per cycle, produced as the cycles go: nothing is allocated per cycle
+/// up front (issue 17: `--cycles 100000000` allocated every world first, 23 GB).
+struct Worlds {
+    /// The snapshots of the file: one (used every cycle) or one per cycle, the last one
+    /// repeated when `--cycles` asks for more.
+    list: Vec<WorldSnapshot>,
+    cycles: u64,
+}
+
+impl Worlds {
+    /// Reads the worlds; `cycles` defaults to 1, or to the array's length.
+    fn load(path: Option<&Path>, cycles: Option<u64>) -> Result<Worlds> {
+        if let Some(n) = cycles {
+            if !(1..=MAX_CYCLES).contains(&n) {
+                bail!("--cycles must be 1 to {MAX_CYCLES}, not {n}");
             }
-            v
         }
-        one => vec![parse(one)?; cycles.unwrap_or(1)],
-    })
+        let Some(path) = path else {
+            return Ok(Worlds {
+                list: vec![WorldSnapshot::default()],
+                cycles: cycles.unwrap_or(1),
+            });
+        };
+        let text = std::fs::read_to_string(path)
+            .with_context(|| format!("cannot read {}", path.display()))?;
+        let value: serde_json::Value = serde_json::from_str(&text)
+            .map_err(|e| anyhow::anyhow!("{}:{}:{}: {e}", path.display(), e.line(), e.column()))?;
+        let parse = |v: serde_json::Value| -> Result<WorldSnapshot> {
+            serde_json::from_value(v)
+                .with_context(|| format!("{}: not a world snapshot", path.display()))
+        };
+        let (list, default) = match value {
+            serde_json::Value::Array(list) => {
+                let n = list.len() as u64;
+                (list.into_iter().map(parse).collect::<Result<Vec<_>>>()?, n)
+            }
+            one => (vec![parse(one)?], 1),
+        };
+        // An empty array runs no cycle, or `--cycles` empty worlds.
+        let list = if list.is_empty() { vec![WorldSnapshot::default()] } else { list };
+        Ok(Worlds { list, cycles: cycles.unwrap_or(default) })
+    }
+
+    /// The world of cycle `k`.
+    fn get(&self, k: u64) -> WorldSnapshot {
+        let i = usize::try_from(k).unwrap_or(usize::MAX).min(self.list.len().saturating_sub(1));
+        self.list.get(i).cloned().unwrap_or_default()
+    }
 }
 
 /// Runs `file` (a behavior, or an HFSM when it ends in `.hfsm.lua`) against the worlds, one
@@ -42,9 +71,13 @@ fn worlds(path: Option<&Path>, cycles: Option<usize>) -> Result<Vec<WorldSnapsho
 pub fn behave(
     file: &Path,
     world: Option<&Path>,
-    cycles: Option<usize>,
+    cycles: Option<u64>,
     period_ms: u64,
 ) -> Result<()> {
+    if !(1..=MAX_PERIOD_MS).contains(&period_ms) {
+        bail!("--period-ms must be 1 to {MAX_PERIOD_MS}, not {period_ms}");
+    }
+    let worlds = Worlds::load(world, cycles)?;
     let dir = file.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new("."));
     let name = file.file_name().and_then(|n| n.to_str()).unwrap_or_default();
     let mut cap = if name.ends_with(".hfsm.lua") {
@@ -54,10 +87,11 @@ pub fn behave(
         ThinkingCap::with_behavior(dir, stem, Sandbox::default())
     }
     .map_err(|e| anyhow::anyhow!("{e}"))?;
-    let mut failed = 0;
+    let mut failed: u64 = 0;
     let stdout = std::io::stdout();
-    let mut out = stdout.lock();
-    for (k, mut w) in worlds(world, cycles)?.into_iter().enumerate() {
+    let mut out = std::io::BufWriter::new(stdout.lock());
+    for k in 0..worlds.cycles {
+        let mut w = worlds.get(k);
         if w.time == Time::ZERO {
             w.time = Time::from_secs_f64(k as f64 * period_ms as f64 / 1000.0);
         }
@@ -66,7 +100,7 @@ pub fn behave(
         for e in &c.errors {
             eprintln!("error: cycle {k}: {e}");
         }
-        failed += usize::from(!c.errors.is_empty());
+        failed += u64::from(!c.errors.is_empty());
         let line = serde_json::json!({
             "cycle": k,
             "time_ms": time_ms,
@@ -77,6 +111,7 @@ pub fn behave(
         });
         writeln!(out, "{line}")?;
     }
+    out.flush()?;
     if failed > 0 {
         bail!("{failed} cycle(s) had script errors");
     }

@@ -113,7 +113,9 @@ impl Drop for Robots {
 fn robot_net_file(i: usize, first: usize, discovery: u16, sim: u16, ports: &[u16]) -> String {
     let mut text = format!(
         "# Robot {i} of a distributed match (written by mrt sim --distributed).\n\
-         # Network line: this machine, the team's multicast group and discovery port.\n\
+         # Network line: this machine (loopback), the team's multicast group and discovery\n\
+         # port. On loopback with static links to loopback only, mrt-net does not scout: no\n\
+         # socket is bound beyond 127.0.0.1.\n\
          127.0.0.1 224.0.0.224 {discovery}\n\
          # Static links: the simulator, then the teammates numbered below this robot\n\
          # (they link back, so each team is a full mesh).\n\
@@ -268,6 +270,8 @@ mod tests {
         let net = NetConfig::from_agora_config(&cfg).unwrap();
         assert_eq!(net.connect, ["tcp/127.0.0.1:7100", "tcp/127.0.0.1:7002"]);
         assert!(net.listen.contains(&"tcp/127.0.0.1:7003".to_string()));
-        assert_eq!(net.multicast.as_deref(), Some("224.0.0.224:9000"));
+        // Loopback only: no multicast scouting, whose sockets bind 0.0.0.0 (issue 17).
+        assert_eq!(net.multicast, None);
+        assert!(net.listen.iter().chain(&net.connect).all(|e| e.starts_with("tcp/127.0.0.1:")));
     }
 }

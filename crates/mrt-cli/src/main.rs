@@ -71,10 +71,11 @@ enum Command {
         /// Without it the world is empty: nothing seen.
         #[arg(long)]
         world: Option<PathBuf>,
-        /// Cycles to run (default: 1, or the array's length).
+        /// Cycles to run, 1 to 1 000 000 000 (default: 1, or the array's length). Cycles
+        /// are run as they come: a long run needs no more memory than a short one.
         #[arg(long)]
-        cycles: Option<usize>,
-        /// Simulated time between cycles, for worlds without a time.
+        cycles: Option<u64>,
+        /// Simulated time between cycles, for worlds without a time, 1 to 3 600 000 ms.
         #[arg(long, default_value_t = 100)]
         period_ms: u64,
     },

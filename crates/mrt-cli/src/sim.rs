@@ -15,7 +15,8 @@ pub struct SimArgs {
     /// Simulator configuration (TOML; see configs/sim/default.toml). Default: built in.
     #[arg(long)]
     pub config: Option<PathBuf>,
-    /// Seed of all randomness: the same seed gives the same match.
+    /// Seed of all randomness: the same seed gives the same match. A series uses seed,
+    /// seed + 1, ..., which must not pass 18446744073709551615.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
     /// The home team's stack: milan (Mr. BRIAN fuzzy behaviors), chaos (TeamChaos' Lua
@@ -25,10 +26,10 @@ pub struct SimArgs {
     /// The away team's stack (same choices).
     #[arg(long, default_value = "chaos")]
     pub away: String,
-    /// Play this many matches (seeds seed, seed+1, ...) on all cores and report
-    /// win/draw/loss with confidence intervals.
+    /// Play this many matches, 1 to 1 000 000 (seeds seed, seed+1, ...) on all cores and
+    /// report win/draw/loss with confidence intervals.
     #[arg(long, default_value_t = 1)]
-    pub matches: usize,
+    pub matches: u64,
     /// Draw the match (field, trajectories, shots) to this SVG file.
     #[arg(long)]
     pub plot: Option<PathBuf>,
@@ -108,8 +109,30 @@ fn wiring_name(args: &SimArgs) -> &'static str {
     }
 }
 
+/// The most matches of a series or a benchmark.
+pub const MAX_MATCHES: u64 = 1_000_000;
+
+/// Checks `--matches` and `--seed`: a series' seeds `seed ..= seed + n − 1` must exist (they
+/// wrapped around to 0 before).
+fn check_counts(args: &SimArgs) -> Result<()> {
+    if !(1..=MAX_MATCHES).contains(&args.matches) {
+        anyhow::bail!("--matches must be 1 to {MAX_MATCHES}, not {}", args.matches);
+    }
+    let n = if args.bench && args.matches == 1 { 3 } else { args.matches };
+    if args.seed.checked_add(n - 1).is_none() {
+        anyhow::bail!(
+            "--seed {} with {n} matches: the last seed would pass {} (use --seed {} or less)",
+            args.seed,
+            u64::MAX,
+            u64::MAX - (n - 1)
+        );
+    }
+    Ok(())
+}
+
 /// Runs `mrt sim`.
 pub fn run(args: &SimArgs) -> Result<()> {
+    check_counts(args)?;
     let cfg = config(args)?;
     let stacks = (
         Stack::parse(&args.home).map_err(|e| anyhow!("--home: {e}"))?,
@@ -194,6 +217,7 @@ pub fn run(args: &SimArgs) -> Result<()> {
 /// `mrt sim --bench`: full matches one after the other, speed as times real time.
 fn bench(args: &SimArgs, cfg: &SimConfig, stacks: (Stack, Stack)) -> Result<()> {
     let n = if args.matches > 1 { args.matches } else { 3 };
+    let capacity = usize::try_from(n).unwrap_or(usize::MAX);
     let wiring = wiring_name(args);
     outln!(
         "{n} matches of 2 x {:.0} s, {} v {}, {} ({wiring}), one core:",
@@ -202,10 +226,11 @@ fn bench(args: &SimArgs, cfg: &SimConfig, stacks: (Stack, Stack)) -> Result<()> 
         cfg.rules.team_size,
         format_args!("{} vs {}", stacks.0.name(), stacks.1.name()),
     );
-    let bar = ProgressBar::new(n as u64);
-    let mut speeds = Vec::with_capacity(n);
-    for k in 0..n as u64 {
-        let seed = args.seed.wrapping_add(k);
+    let bar = ProgressBar::new(n);
+    let mut speeds = Vec::with_capacity(capacity);
+    for k in 0..n {
+        // check_counts: no overflow.
+        let seed = args.seed.saturating_add(k);
         let started = std::time::Instant::now();
         let r = play_one(cfg, seed, stacks, args, false, |_| {})?;
         let wall = started.elapsed().as_secs_f64();
@@ -241,15 +266,17 @@ fn wilson(k: usize, n: usize) -> (f64, f64) {
 }
 
 fn series(args: &SimArgs, cfg: &SimConfig, stacks: (Stack, Stack)) -> Result<()> {
-    let threads = std::thread::available_parallelism().map_or(1, usize::from).min(args.matches);
-    let bar = ProgressBar::new(args.matches as u64).with_style(
+    let matches = usize::try_from(args.matches)?;
+    let threads = std::thread::available_parallelism().map_or(1, usize::from).min(matches);
+    let bar = ProgressBar::new(args.matches).with_style(
         ProgressStyle::with_template(
             "{spinner} matches {pos}/{len} [{bar:40}] ({elapsed}, eta {eta})",
         )
         .map_err(|e| anyhow!("{e}"))?
         .progress_chars("=> "),
     );
-    let seeds: Vec<u64> = (0..args.matches as u64).map(|k| args.seed.wrapping_add(k)).collect();
+    // check_counts: seed + matches − 1 does not overflow.
+    let seeds: Vec<u64> = (0..args.matches).map(|k| args.seed.saturating_add(k)).collect();
     let results = std::sync::Mutex::new(Vec::new());
     std::thread::scope(|s| {
         for chunk in seeds.chunks(seeds.len().div_ceil(threads)) {
@@ -280,7 +307,7 @@ fn series(args: &SimArgs, cfg: &SimConfig, stacks: (Stack, Stack)) -> Result<()>
     outln!(
         "{n} matches, {h} (home) against {a} (away), seeds {}..={}",
         args.seed,
-        args.seed.wrapping_add(n as u64).wrapping_sub(1)
+        args.seed.saturating_add((n as u64).saturating_sub(1))
     );
     for (label, k) in [("wins", wins), ("draws", draws), ("losses", losses)] {
         let (lo, hi) = wilson(k, n);

@@ -220,3 +220,13 @@ fn serve_refuses_unusable_tokens() {
     let (ok, _, err) = run(&["bb", "serve", "--addr", "127.0.0.1:0", "--token", "two words"]);
     assert!(!ok && err.contains("it has a space or a control character"), "{err}");
 }
+
+/// Issue 17: every count is range-checked before anything is contacted: `--count 0` watched
+/// nothing and `--refresh 5` was left for the relay to refuse.
+#[test]
+fn watch_counts_are_range_checked() {
+    let (ok, _, err) = run(&["bb", "watch", "local.*", "--refresh", "5"]);
+    assert!(!ok && err.contains("--refresh must be 10 to 60000 ms, not 5"), "{err}");
+    let (ok, _, err) = run(&["bb", "watch", "local.*", "--count", "0"]);
+    assert!(!ok && err.contains("--count must be at least 1"), "{err}");
+}

@@ -112,3 +112,42 @@ fn hfsm_dot_writes_dot_and_svg() {
     assert!(svg.contains("<svg") && svg.contains("DoKick") && svg.contains("BallAway"));
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// Issue 17: `--cycles 18446744073709551615` panicked (capacity overflow) and
+/// `--cycles 100000000` aborted allocating 23 GB, every world being made before the first
+/// cycle. Counts are range-checked, and cycles are streamed: the largest count allowed prints
+/// its first cycles at once (the child is then stopped).
+#[test]
+fn behave_counts_are_range_checked_and_cycles_are_streamed() {
+    use std::io::BufRead as _;
+    for (arg, value, says) in [
+        ("--cycles", "18446744073709551615", "--cycles must be 1 to 1000000000"),
+        ("--cycles", "0", "--cycles must be 1 to 1000000000, not 0"),
+        ("--period-ms", "0", "--period-ms must be 1 to 3600000, not 0"),
+    ] {
+        let out = mrt()
+            .arg("behave")
+            .arg(teamchaos("goalkeeper.lua"))
+            .args([arg, value])
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success() && err.contains(says) && !err.contains("panicked"), "{err}");
+    }
+    let mut child = mrt()
+        .arg("behave")
+        .arg(teamchaos("goalkeeper.lua"))
+        .args(["--cycles", "1000000000"])
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .unwrap();
+    let mut lines = std::io::BufReader::new(child.stdout.take().unwrap()).lines();
+    for k in 0..3 {
+        let line: serde_json::Value =
+            serde_json::from_str(&lines.next().unwrap().unwrap()).unwrap();
+        assert_eq!(line["cycle"], k);
+    }
+    child.kill().unwrap();
+    child.wait().unwrap();
+}

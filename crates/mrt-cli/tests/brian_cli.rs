@@ -190,3 +190,38 @@ fn check_eval_and_plot_work_on_the_shipped_harvester() {
     assert!(std::fs::read_to_string(&svg).unwrap().contains("TargetDistance"));
     std::fs::remove_file(&svg).unwrap();
 }
+
+/// Issue 17: `mrt brian check` said only "stream did not contain valid UTF-8" for a file with
+/// a bad byte, and a `behavior.txt` naming a file outside the directory printed that file's
+/// first token.
+#[test]
+fn check_reports_bad_utf8_at_its_place_and_refuses_foreign_rule_files() {
+    let Some(dir) = bench("brian40-hier") else { return };
+    let broken = std::env::temp_dir().join(format!("mrt-brian-issue17-{}", std::process::id()));
+    copy_dir(&dir, &broken);
+    let rul = broken.join("behaviors/ApproachBall.rul");
+    let mut bytes = std::fs::read(&rul).unwrap();
+    bytes.splice(0..0, b"\n\n   \xFF".iter().copied());
+    std::fs::write(&rul, bytes).unwrap();
+    let out = mrt().args(["brian", "check"]).arg(&broken).output().unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(err.contains("ApproachBall.rul at line 3: invalid UTF-8 (byte 0xFF)"), "{err}");
+    assert!(err.trim_end().ends_with("ApproachBall.rul:3:4"), "{err}");
+
+    let secret = broken.with_extension("secret");
+    std::fs::write(&secret, "TOP-SECRET first token").unwrap();
+    let list = broken.join("behavior.txt");
+    let text = std::fs::read_to_string(&list).unwrap();
+    let text = text.replacen("behaviors/ApproachBall.rul", secret.to_str().unwrap(), 1);
+    std::fs::write(&list, text).unwrap();
+    let out = mrt().args(["brian", "check"]).arg(&broken).output().unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(
+        err.contains("is outside the configuration directory") && !err.contains("TOP-SECRET"),
+        "{err}"
+    );
+    std::fs::remove_file(&secret).unwrap();
+    std::fs::remove_dir_all(&broken).unwrap();
+}

@@ -136,3 +136,42 @@ fn a_distributed_robot_with_broken_behaviors_is_reported() {
     assert_eq!(faulted.len(), 4, "the four Chaos robots: {out}");
     assert!(faulted.iter().all(|l| l.contains(&format!("go2ball.lua:{line}:"))), "{out}");
 }
+
+/// Issue 17: `--matches 0` silently played one match, and `--seed 18446744073709551615
+/// --matches 3` wrapped around to seeds 0 and 1. Both are errors now; the last seeds play.
+#[test]
+fn match_counts_and_seeds_are_range_checked() {
+    let (ok, _, err) = run(&["--matches", "0"]);
+    assert!(!ok && err.contains("--matches must be 1 to 1000000, not 0"), "{err}");
+    let (ok, _, err) = run(&["--matches", "1000001"]);
+    assert!(!ok && err.contains("--matches must be 1 to 1000000"), "{err}");
+    let (ok, _, err) = run(&["--seed", "18446744073709551615", "--matches", "3"]);
+    assert!(!ok && err.contains("the last seed would pass 18446744073709551615"), "{err}");
+    assert!(err.contains("use --seed 18446744073709551613 or less"), "{err}");
+    let (ok, _, err) = run(&["--seed", "18446744073709551615", "--bench", "--half", "1"]);
+    assert!(!ok && err.contains("with 3 matches"), "{err}");
+    let (ok, out, err) = run(&[
+        "--seed",
+        "18446744073709551613",
+        "--matches",
+        "3",
+        "--half",
+        "1",
+        "--home",
+        "chaser",
+        "--away",
+        "chaser",
+        "--direct",
+    ]);
+    assert!(ok, "{err}");
+    assert!(out.contains("seeds 18446744073709551613..=18446744073709551615"), "{out}");
+    // A robot radius that used to pass validation and panic in the referee.
+    let cfg = std::env::temp_dir().join(format!("mrt-sim-radius-{}.toml", std::process::id()));
+    std::fs::write(&cfg, "[robot]\nradius = 0.6\n").unwrap();
+    let (ok, _, err) = run(&["--config", cfg.to_str().unwrap()]);
+    std::fs::remove_file(&cfg).unwrap();
+    assert!(
+        !ok && err.contains("robot.radius must be at most 0.575 m") && !err.contains("panicked"),
+        "{err}"
+    );
+}

@@ -7,13 +7,37 @@
 //! is above the threshold, each rule proposing its actions with value = precondition value ×
 //! reliability, weighted once by the behavior's WANT; compose by max per (action, label); apply
 //! `&DEL` to lower levels → defuzzify each action (`s_ftoc.txt`, formula 10.6).
+//!
+//! # Opposite proposals
+//!
+//! When two behaviors propose opposite values for the same output (the manual's
+//! *AvoidObstaclesFromLeft* and *AvoidObstaclesFromRight* facing one obstacle, §10.2.4):
+//!
+//! - **The manual's composition** (formula 10.3, singletons by formula 10.6) is a weighted
+//!   mean: each proposed singleton counts with max over behaviors of WANT × rule value. Unequal
+//!   wishes give a value between the two, nearer the stronger (turn rates −30 and +30 with
+//!   weights 0.64 and 0.36 give −8.4); equal wishes cancel (0: straight on, into the obstacle).
+//!   The manual knows it ("the vectorial combination of two actions may produce undesired
+//!   effects") and leaves it to the WANT conditions never to let incompatible behaviors run
+//!   together, or to the alternative of formula 10.5 (take the best behavior's actions only).
+//! - **This engine** computes the same weighted mean for every output (both behaviors' weights
+//!   are applied once, proposals of the same label combined by [`Composer`]), with one
+//!   difference: outputs whose name contains `Angle` are averaged on the circle. There the
+//!   manual's arithmetic mean of 90° and 270° is 180°, a heading nobody proposed; the engine
+//!   gives the stronger wish's heading when the weights differ and, when they cancel exactly
+//!   (the mean direction is undefined), 0°. Levels do not change this: a higher level
+//!   overrides a lower one only through `&DEL`; otherwise all levels' proposals are composed
+//!   together. Formula 10.5 is not implemented: design the WANTs so that opposite behaviors
+//!   do not run at once, or let the higher one `&DEL` the other's action.
+//!
+//! `tests/opposite_proposals.rs` checks both cases against a hand computation.
 
 use crate::error::BrianError;
 use crate::expr::{parse_definitions, parse_expr, Expr, RawExpr};
 use crate::lexer::{tokenize, Cursor, Span, Tok};
 use crate::set::{FuzzySet, FuzzyValue};
 use crate::shapes::{defuzzify, parse_associations, parse_shapes, resolve, Shape};
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, HashMap, HashSet};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
@@ -115,9 +139,12 @@ impl BrianFiles {
     }
 }
 
+/// Reads a file as UTF-8 text; invalid UTF-8 is an error at the line and column of the first
+/// invalid byte.
 fn read(path: &Path) -> Result<String, BrianError> {
-    std::fs::read_to_string(path)
-        .map_err(|source| BrianError::Io { file: path.to_path_buf(), source })
+    let bytes = std::fs::read(path)
+        .map_err(|source| BrianError::Io { file: path.to_path_buf(), source })?;
+    crate::lexer::utf8(bytes, path)
 }
 
 /// A crisp input of `ctof.txt`.
@@ -207,6 +234,8 @@ pub struct Brian {
     feedback: Vec<Option<usize>>,
     /// Inputs that carry `Proposed<Action>` data (set by the engine, not by callers).
     is_proposed: Vec<bool>,
+    /// Input name → slot.
+    input_index: HashMap<String, usize>,
     outputs: Vec<Option<f64>>,
 }
 
@@ -302,11 +331,25 @@ impl std::fmt::Debug for Commands {
     }
 }
 
+/// Name → index tables of what is defined so far, so that every reference resolves in
+/// constant time: loading is linear in the size of the configuration (issue 17: it was
+/// quadratic, 200 000 definitions never finished).
+#[derive(Default)]
+struct Index {
+    /// Crisp input name → its index in the inputs.
+    inputs: HashMap<String, usize>,
+    /// For each input, its shape's label → the label's position in the shape.
+    labels: Vec<Arc<HashMap<String, usize>>>,
+    /// Predicate name → index, for those defined so far.
+    predicates: HashMap<String, usize>,
+    /// Predicate action name → index, for those defined so far.
+    predicate_actions: HashMap<String, usize>,
+}
+
 #[derive(Clone, Copy)]
 struct Names<'a> {
     inputs: &'a [Input],
-    predicates: &'a [(String, Expr)],
-    predicate_actions: &'a [(String, Expr)],
+    index: &'a Index,
     file: &'a Path,
 }
 
@@ -317,14 +360,19 @@ impl Names<'_> {
             RawExpr::Or(a, b) => Expr::Or(Box::new(self.resolve(a)?), Box::new(self.resolve(b)?)),
             RawExpr::Not(a) => Expr::Not(Box::new(self.resolve(a)?)),
             RawExpr::Data(d, l, span, label_span) => {
-                let Some(input) = self.inputs.iter().find(|i| i.name == *d) else {
+                let found = self
+                    .index
+                    .inputs
+                    .get(d.as_str())
+                    .and_then(|&i| Some((self.inputs.get(i)?, self.index.labels.get(i)?)));
+                let Some((input, labels)) = found else {
                     return Err(BrianError::at(
                         self.file,
                         *span,
                         format!("unknown datum `{d}` (not in ctof.txt)"),
                     ));
                 };
-                let Some(k) = input.shape.sets.iter().position(|(label, _)| label == l) else {
+                let Some(&k) = labels.get(l.as_str()) else {
                     let known: Vec<&str> =
                         input.shape.sets.iter().map(|(l, _)| l.as_str()).collect();
                     return Err(BrianError::at(
@@ -340,9 +388,9 @@ impl Names<'_> {
                 Expr::Data(input.offset + k)
             }
             RawExpr::Pred(n, span) => {
-                if let Some(i) = self.predicates.iter().position(|(p, _)| p == n) {
+                if let Some(&i) = self.index.predicates.get(n.as_str()) {
                     Expr::Pred(i)
-                } else if let Some(i) = self.predicate_actions.iter().position(|(p, _)| p == n) {
+                } else if let Some(&i) = self.index.predicate_actions.get(n.as_str()) {
                     Expr::Action(i)
                 } else {
                     return Err(BrianError::at(
@@ -356,14 +404,86 @@ impl Names<'_> {
     }
 }
 
+/// The output actions of `s_ftoc.txt` with name and label tables, for the rule parser.
+struct Outputs<'a> {
+    actions: &'a [Action],
+    /// Action name → index.
+    by_name: HashMap<&'a str, usize>,
+    /// For each action, label → position.
+    labels: Vec<HashMap<&'a str, usize>>,
+}
+
+impl<'a> Outputs<'a> {
+    fn new(actions: &'a [Action]) -> Self {
+        Outputs {
+            actions,
+            by_name: actions.iter().enumerate().map(|(i, a)| (a.name.as_str(), i)).collect(),
+            labels: actions
+                .iter()
+                .map(|a| a.labels.iter().enumerate().map(|(k, (l, _))| (l.as_str(), k)).collect())
+                .collect(),
+        }
+    }
+}
+
 fn parse_file<T>(
     path: &Path,
     f: impl FnOnce(&mut Cursor<'_>) -> Result<T, BrianError>,
 ) -> Result<T, BrianError> {
-    let text = read(path)?;
-    let toks = tokenize(&text, path)?;
-    let mut c = Cursor::new(&toks, path, &text);
+    parse_text(&read(path)?, path, f)
+}
+
+fn parse_text<T>(
+    text: &str,
+    path: &Path,
+    f: impl FnOnce(&mut Cursor<'_>) -> Result<T, BrianError>,
+) -> Result<T, BrianError> {
+    let toks = tokenize(text, path)?;
+    let mut c = Cursor::new(&toks, path, text);
     f(&mut c)
+}
+
+/// The highest level of `behavior.txt`: far beyond any hierarchy, and every level up to it is
+/// a whole number an `f64` holds exactly (a larger one was silently read as `i64::MAX`).
+pub const MAX_LEVEL: i64 = u32::MAX as i64;
+
+/// One line of `behavior.txt`.
+struct Listed {
+    name: String,
+    level: i64,
+    path: String,
+    /// Where the name is written.
+    span: Span,
+    /// Where the path is written.
+    path_span: Span,
+}
+
+/// The rule file a `behavior.txt` line names, canonicalized, when it lies inside the
+/// configuration directory `root` (canonical). Outside, or unreadable, it is an error at the
+/// path in `behavior.txt` that never shows the file's content (issue 17: any file of the
+/// machine could be named, and its first token was printed).
+fn rule_file(root: &Path, base: &Path, list: &Path, b: &Listed) -> Result<PathBuf, BrianError> {
+    let canon = base.join(&b.path).canonicalize().map_err(|e| {
+        BrianError::at(
+            list,
+            b.path_span,
+            format!("cannot open the rule file `{}` of behavior `{}`: {e}", b.path, b.name),
+        )
+    })?;
+    if !canon.starts_with(root) {
+        return Err(BrianError::at(
+            list,
+            b.path_span,
+            format!(
+                "the rule file `{}` of behavior `{}` is outside the configuration directory {}: \
+                 rule files must be inside it",
+                b.path,
+                b.name,
+                root.display()
+            ),
+        ));
+    }
+    Ok(canon)
 }
 
 impl Brian {
@@ -373,23 +493,36 @@ impl Brian {
     }
 
     /// Loads from explicit file paths (the manual's `Brian(...)` constructor); behavior paths
-    /// in the behavior list are relative to `base`.
+    /// in the behavior list are relative to `base`, and must lead (after following links)
+    /// to files inside `base`.
+    ///
+    /// Loading takes time linear in the size of the files.
     pub fn from_files(files: &BrianFiles, base: &Path) -> Result<Brian, BrianError> {
         let shapes = parse_shapes(&read(&files.shape_ctof)?, &files.shape_ctof)?;
         let assocs = parse_associations(&read(&files.ctof)?, &files.ctof)?;
         let idx = resolve(&assocs, &shapes, &files.ctof)?;
+        let shape_labels: Vec<Arc<HashMap<String, usize>>> = shapes
+            .iter()
+            .map(|s| {
+                Arc::new(s.sets.iter().enumerate().map(|(k, (l, _))| (l.clone(), k)).collect())
+            })
+            .collect();
+        let mut index = Index::default();
         let mut inputs = Vec::new();
         let mut offset = 0;
         for (a, i) in assocs.iter().zip(idx) {
             let shape = shapes[i].clone();
             let n = shape.sets.len();
+            index.inputs.insert(a.name.clone(), inputs.len());
+            index.labels.push(shape_labels[i].clone());
             inputs.push(Input { name: a.name.clone(), shape, offset, now: None, previous: None });
             offset += n;
         }
         let fuzzy_data_len = offset;
 
         let mut warnings = Vec::new();
-        for shape in shapes.iter().filter(|s| !assocs.iter().any(|a| a.shape == s.name)) {
+        let used_shapes: HashSet<&str> = assocs.iter().map(|a| a.shape.as_str()).collect();
+        for shape in shapes.iter().filter(|s| !used_shapes.contains(s.name.as_str())) {
             warnings.push(warning(
                 &files.shape_ctof,
                 shape.span,
@@ -401,33 +534,25 @@ impl Brian {
         let mut predicates: Vec<(String, Expr)> = Vec::new();
         for (name, span, raw) in parse_file(&files.predicates, parse_definitions)? {
             pred_spans.push(span);
-            let e = Names {
-                inputs: &inputs,
-                predicates: &predicates,
-                predicate_actions: &[],
-                file: &files.predicates,
-            }
-            .resolve(&raw)?;
+            let e =
+                Names { inputs: &inputs, index: &index, file: &files.predicates }.resolve(&raw)?;
+            index.predicates.insert(name.clone(), predicates.len());
             predicates.push((name, e));
         }
         let mut predicate_actions: Vec<(String, Expr)> = Vec::new();
         if files.predicate_actions.exists() {
             for (name, span, raw) in parse_file(&files.predicate_actions, parse_definitions)? {
-                if predicates.iter().any(|(p, _)| *p == name) {
+                if index.predicates.contains_key(&name) {
                     return Err(BrianError::at(
                         &files.predicate_actions,
                         span,
                         format!("`{name}` is already a predicate"),
                     ));
                 }
-                let e = Names {
-                    inputs: &inputs,
-                    predicates: &predicates,
-                    predicate_actions: &predicate_actions,
-                    file: &files.predicate_actions,
-                }
-                .resolve(&raw)?;
+                let e = Names { inputs: &inputs, index: &index, file: &files.predicate_actions }
+                    .resolve(&raw)?;
                 pact_spans.push(span);
+                index.predicate_actions.insert(name.clone(), predicate_actions.len());
                 predicate_actions.push((name, e));
             }
         }
@@ -452,7 +577,19 @@ impl Brian {
                     }
                 }
             }
-            let proposed = inputs.iter().position(|inp| inp.name == format!("Proposed{}", a.name));
+            // Formula 10.6 sums weight × singleton (weights at most 1): the sum must stay a
+            // number, or the command would be infinite or NaN.
+            if !labels.iter().map(|(_, v)| v.abs()).sum::<f64>().is_finite() {
+                return Err(BrianError::at(
+                    &files.s_shape,
+                    s_shapes[i].span,
+                    format!(
+                        "the singletons of output shape `{}` are too large: their sum is not a finite number",
+                        s_shapes[i].name
+                    ),
+                ));
+            }
+            let proposed = index.inputs.get(&format!("Proposed{}", a.name)).copied();
             let n = labels.len();
             actions.push(Action {
                 name: a.name.clone(),
@@ -463,41 +600,81 @@ impl Brian {
             });
             offset += n;
         }
+        let outputs = Outputs::new(&actions);
 
-        let names = Names {
-            inputs: &inputs,
-            predicates: &predicates,
-            predicate_actions: &predicate_actions,
-            file: &files.cando,
-        };
+        let names = Names { inputs: &inputs, index: &index, file: &files.cando };
         let cando = parse_file(&files.cando, parse_definitions)?;
         let want = parse_file(&files.want, parse_definitions)?;
-        let mut behaviors = Vec::new();
-        for (name, level, path, span) in parse_file(&files.behaviors, parse_behavior_list)? {
-            let rul = base.join(&path);
-            if behaviors.iter().any(|b: &Behavior| b.name == name) {
+        // Names are unique in each file (parse_definitions refuses duplicates).
+        let cando_of: HashMap<&str, &RawExpr> =
+            cando.iter().map(|(n, _, raw)| (n.as_str(), raw)).collect();
+        let want_of: HashMap<&str, &RawExpr> =
+            want.iter().map(|(n, _, raw)| (n.as_str(), raw)).collect();
+        let root = base
+            .canonicalize()
+            .map_err(|source| BrianError::Io { file: base.to_path_buf(), source })?;
+        let listed = parse_file(&files.behaviors, parse_behavior_list)?;
+        let mut seen: HashSet<&str> = HashSet::with_capacity(listed.len());
+        // Behaviors often share a rule file: each file is read and resolved once.
+        let mut rule_files: HashMap<PathBuf, Vec<Rule>> = HashMap::new();
+        // Path as written → the checked file it leads to.
+        let mut checked: HashMap<&str, PathBuf> = HashMap::new();
+        let mut behaviors = Vec::with_capacity(listed.len());
+        for b in &listed {
+            if !seen.insert(b.name.as_str()) {
                 return Err(BrianError::at(
                     &files.behaviors,
-                    span,
-                    format!("behavior `{name}` is listed twice"),
+                    b.span,
+                    format!("behavior `{}` is listed twice", b.name),
                 ));
             }
-            let rules =
-                parse_file(&rul, |c| parse_rules(c, &Names { file: &rul, ..names }, &actions))?;
-            let cando = match cando.iter().find(|(n, _, _)| *n == name) {
-                Some((_, _, raw)) => Some(Names { file: &files.cando, ..names }.resolve(raw)?),
+            let canon = match checked.get(b.path.as_str()) {
+                Some(canon) => canon.clone(),
+                None => {
+                    let canon = rule_file(&root, base, &files.behaviors, b)?;
+                    checked.insert(b.path.as_str(), canon.clone());
+                    canon
+                }
+            };
+            let rules = match rule_files.get(&canon) {
+                Some(rules) => rules.clone(),
+                None => {
+                    // Read the checked file; report places under the path as written.
+                    let rul = base.join(&b.path);
+                    let text = read(&canon).map_err(|e| match e {
+                        BrianError::Io { source, .. } => {
+                            BrianError::Io { file: rul.clone(), source }
+                        }
+                        BrianError::At { line, column, message, .. } => {
+                            BrianError::At { file: rul.clone(), line, column, message }
+                        }
+                    })?;
+                    let rules = parse_text(&text, &rul, |c| {
+                        parse_rules(c, &Names { file: &rul, ..names }, &outputs)
+                    })?;
+                    rule_files.insert(canon, rules.clone());
+                    rules
+                }
+            };
+            let cando = match cando_of.get(b.name.as_str()) {
+                Some(raw) => Some(Names { file: &files.cando, ..names }.resolve(raw)?),
                 None => None,
             };
-            let want = match want.iter().find(|(n, _, _)| *n == name) {
-                Some((_, _, raw)) => Some(Names { file: &files.want, ..names }.resolve(raw)?),
+            let want = match want_of.get(b.name.as_str()) {
+                Some(raw) => Some(Names { file: &files.want, ..names }.resolve(raw)?),
                 None => None,
             };
-            behaviors.push(Behavior { name, span, level, cando, want, rules });
+            behaviors.push(Behavior {
+                name: b.name.clone(),
+                span: b.span,
+                level: b.level,
+                cando,
+                want,
+                rules,
+            });
         }
         for (file, defs) in [(&files.cando, &cando), (&files.want, &want)] {
-            if let Some((n, span, _)) =
-                defs.iter().find(|(n, _, _)| !behaviors.iter().any(|b| b.name == *n))
-            {
+            if let Some((n, span, _)) = defs.iter().find(|(n, _, _)| !seen.contains(n.as_str())) {
                 return Err(BrianError::at(
                     file,
                     *span,
@@ -505,6 +682,7 @@ impl Brian {
                 ));
             }
         }
+        drop(seen);
         behaviors.sort_by(|a, b| (a.level, &a.name).cmp(&(b.level, &b.name)));
 
         // Definitions nobody uses are legal but usually a mistake: warn.
@@ -551,10 +729,15 @@ impl Brian {
         }
 
         let slots = actions.iter().map(|a| a.labels.len()).sum();
-        let is_proposed =
-            (0..inputs.len()).map(|i| actions.iter().any(|a| a.proposed == Some(i))).collect();
+        let mut is_proposed = vec![false; inputs.len()];
+        for p in actions.iter().filter_map(|a| a.proposed) {
+            if let Some(flag) = is_proposed.get_mut(p) {
+                *flag = true;
+            }
+        }
         let feedback =
-            inputs.iter().map(|i| actions.iter().position(|a| a.name == i.name)).collect();
+            inputs.iter().map(|i| outputs.by_name.get(i.name.as_str()).copied()).collect();
+        drop(outputs);
         let mut sorted: Vec<(Arc<str>, usize)> =
             actions.iter().enumerate().map(|(i, a)| (Arc::from(a.name.as_str()), i)).collect();
         sorted.sort();
@@ -565,6 +748,7 @@ impl Brian {
             shared_outputs: Arc::new(vec![None; actions.len()]),
             feedback,
             warnings,
+            input_index: index.inputs,
             activity: vec![None; behaviors.len()],
             is_proposed,
             outputs: vec![None; actions.len()],
@@ -659,7 +843,7 @@ impl Brian {
 
     /// The slot of a crisp input, for [`set_input`](Self::set_input).
     pub fn input_slot(&self, name: &str) -> Option<usize> {
-        self.inputs.iter().position(|i| i.name == name)
+        self.input_index.get(name).copied()
     }
 
     /// Sets an input for the next [`step`](Self::step). Reliability is clamped to `[0, 1]`; a
@@ -815,8 +999,12 @@ impl Brian {
                     RuleAction::Propose(slot) if weight * value > 0.0 => {
                         self.level_acc[slot].add(weight * value);
                         if self.tracing {
-                            let ai =
-                                self.actions.iter().rposition(|a| a.offset <= slot).unwrap_or(0);
+                            // Actions are in offset order: the last one starting at or
+                            // before `slot` holds it.
+                            let ai = self
+                                .actions
+                                .partition_point(|a| a.offset <= slot)
+                                .saturating_sub(1);
                             let label = slot - self.actions[ai].offset;
                             self.traced.push((b, ai, Some(label), Some(weight * value)));
                         }
@@ -868,7 +1056,7 @@ fn mark_used(e: &Expr, preds: &mut [bool], acts: &mut [bool]) {
 }
 
 /// `(level <n> <name> <path>)` lines.
-fn parse_behavior_list(c: &mut Cursor<'_>) -> Result<Vec<(String, i64, String, Span)>, BrianError> {
+fn parse_behavior_list(c: &mut Cursor<'_>) -> Result<Vec<Listed>, BrianError> {
     let mut out = Vec::new();
     while !c.at_end() {
         c.punct(Tok::Open, "`(` to start a behavior line")?;
@@ -878,17 +1066,20 @@ fn parse_behavior_list(c: &mut Cursor<'_>) -> Result<Vec<(String, i64, String, S
         }
         let lspan = c.span();
         let level = c.number("the level number")?;
-        if level.fract() != 0.0 || level < 1.0 {
+        // Compared as f64: `MAX_LEVEL` is exact in an f64, and a NaN fails the test.
+        if !(level.fract() == 0.0 && (1.0..=MAX_LEVEL as f64).contains(&level)) {
             return Err(BrianError::at(
                 c.file(),
                 lspan,
-                format!("the level must be a whole number from 1, found {level}"),
+                format!("the level must be a whole number from 1 to {MAX_LEVEL}, found {level}"),
             ));
         }
         let (name, nspan) = c.word("the behavior name")?;
+        let path_span = c.span();
         let (path, _) = c.word("the path of the behavior's rule file")?;
         c.punct(Tok::Close, "`)` to close the behavior line")?;
-        out.push((name, level as i64, path, nspan));
+        // In range and whole: the conversion is exact.
+        out.push(Listed { name, level: level as i64, path, span: nspan, path_span });
     }
     Ok(out)
 }
@@ -897,7 +1088,7 @@ fn parse_behavior_list(c: &mut Cursor<'_>) -> Result<Vec<(String, i64, String, S
 fn parse_rules(
     c: &mut Cursor<'_>,
     names: &Names<'_>,
-    actions: &[Action],
+    outputs: &Outputs<'_>,
 ) -> Result<Vec<Rule>, BrianError> {
     let mut rules = Vec::new();
     while !c.at_end() {
@@ -914,7 +1105,7 @@ fn parse_rules(
         while c.peek() == Some(&Tok::Open) {
             // `(` followed by something that is not an action starts the next rule: the `;`
             // of this one is missing.
-            let is_action = matches!(c.peek_at(1), Some(Tok::Word(w)) if w.starts_with("&DEL.") || actions.iter().any(|a| a.name == *w));
+            let is_action = matches!(c.peek_at(1), Some(Tok::Word(w)) if w.starts_with("&DEL.") || outputs.by_name.contains_key(w.as_str()));
             if !acts.is_empty() && !is_action {
                 return Err(c.expected("`;` at the end of the rule"));
             }
@@ -926,15 +1117,18 @@ fn parse_rules(
                 Some(t) => (t, true),
                 None => (name.as_str(), false),
             };
-            let Some(ai) = actions.iter().position(|a| a.name == target) else {
+            let found = outputs
+                .by_name
+                .get(target)
+                .and_then(|&ai| Some((ai, outputs.actions.get(ai)?, outputs.labels.get(ai)?)));
+            let Some((ai, a, labels)) = found else {
                 return Err(BrianError::at(
                     c.file(),
                     span,
                     format!("unknown action `{target}` (not in s_ftoc.txt)"),
                 ));
             };
-            let a = &actions[ai];
-            let k = a.labels.iter().position(|(l, _)| *l == label);
+            let k = labels.get(label.as_str()).copied();
             acts.push(match (delete, k) {
                 (true, _) if label == "ANY" => RuleAction::Delete { action: ai, label: None },
                 (true, Some(k)) => RuleAction::Delete { action: ai, label: Some(k) },
@@ -1001,7 +1195,8 @@ mod tests {
     fn try_all(text: &str) {
         let file = Path::new("x");
         let Ok(toks) = tokenize(text, file) else { return };
-        let names = Names { inputs: &[], predicates: &[], predicate_actions: &[], file };
+        let index = Index::default();
+        let names = Names { inputs: &[], index: &index, file };
         let actions = [Action {
             name: "Out".into(),
             labels: vec![("HIGH".into(), 1.0)],
@@ -1009,7 +1204,7 @@ mod tests {
             proposed: None,
             offset: 0,
         }];
-        let _ = parse_rules(&mut Cursor::new(&toks, file, text), &names, &actions);
+        let _ = parse_rules(&mut Cursor::new(&toks, file, text), &names, &Outputs::new(&actions));
         let _ = parse_behavior_list(&mut Cursor::new(&toks, file, text));
         let _ = parse_definitions(&mut Cursor::new(&toks, file, text));
     }

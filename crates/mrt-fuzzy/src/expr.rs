@@ -11,6 +11,7 @@
 use crate::error::BrianError;
 use crate::lexer::{Cursor, Span, Tok};
 use crate::set::FuzzyValue;
+use std::collections::HashMap;
 
 /// A predicate as written, names not yet resolved.
 #[derive(Clone, Debug, PartialEq)]
@@ -117,18 +118,21 @@ impl Expr {
 /// Parses a definitions file: `Name = <predicate>;` lines.
 pub fn parse_definitions(c: &mut Cursor<'_>) -> Result<Vec<(String, Span, RawExpr)>, BrianError> {
     let mut out: Vec<(String, Span, RawExpr)> = Vec::new();
+    // Name → where it was defined: the duplicate check takes constant time (issue 17).
+    let mut defined: HashMap<String, Span> = HashMap::new();
     while !c.at_end() {
         let (name, span) = c.word("a name at the start of a definition")?;
         c.punct(Tok::Eq, &format!("`=` after `{name}`"))?;
         let e = parse_expr(c)?;
         c.punct(Tok::Semi, &format!("`;` at the end of the definition of `{name}`"))?;
-        if let Some((_, prev, _)) = out.iter().find(|(n, _, _)| *n == name) {
+        if let Some(prev) = defined.get(&name) {
             return Err(BrianError::at(
                 c.file(),
                 span,
                 format!("`{name}` is already defined at line {}", prev.line),
             ));
         }
+        defined.insert(name.clone(), span);
         out.push((name, span, e));
     }
     Ok(out)

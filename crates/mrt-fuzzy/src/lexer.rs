@@ -55,6 +55,25 @@ fn is_number(w: &str) -> bool {
         && frac.is_none_or(|f| !f.is_empty() && f.bytes().all(|b| b.is_ascii_digit()))
 }
 
+/// `bytes` as text, or an error at the line and column (1-based, in characters) of the first
+/// byte that is not valid UTF-8, naming that byte.
+pub fn utf8(bytes: Vec<u8>, file: &Path) -> Result<String, BrianError> {
+    String::from_utf8(bytes).map_err(|e| {
+        let err = e.utf8_error();
+        let bytes = e.as_bytes();
+        let good = bytes.get(..err.valid_up_to()).unwrap_or_default();
+        // Everything before the bad byte is valid UTF-8: count lines and characters in it.
+        let before = std::str::from_utf8(good).unwrap_or_default();
+        let line = before.matches('\n').count() + 1;
+        let column = before.rsplit('\n').next().map_or(0, |l| l.chars().count()) + 1;
+        let what = match bytes.get(err.valid_up_to()) {
+            Some(b) => format!("invalid UTF-8 (byte 0x{b:02X}): Mr. BRIAN files are UTF-8 text"),
+            None => "invalid UTF-8: Mr. BRIAN files are UTF-8 text".to_string(),
+        };
+        BrianError::at(file, Span { line, column }, what)
+    })
+}
+
 /// Splits `text` into tokens with their positions. Fails on a number too large for an `f64`
 /// (it would become infinite).
 pub fn tokenize(text: &str, file: &Path) -> Result<Vec<(Tok, Span)>, BrianError> {
@@ -216,6 +235,24 @@ mod tests {
         let text = format!("(S (SNG (A 1{})))", "0".repeat(400));
         let e = tokenize(&text, Path::new("f")).unwrap_err().to_string();
         assert!(e.starts_with("error in file f at line 1: `1000") && e.ends_with("f:1:12"), "{e}");
+    }
+
+    /// Issue 17: invalid UTF-8 was reported without its place.
+    #[test]
+    fn invalid_utf8_names_the_line_and_column_of_the_first_bad_byte() {
+        let f = Path::new("f");
+        let e = utf8(b"(A\n  (B \xC3\xA9\xFF x)".to_vec(), f).unwrap_err().to_string();
+        // Line 2: two blanks, `(B `, `é` (one character, two bytes), then 0xFF: column 7.
+        assert_eq!(
+            e,
+            "error in file f at line 2: invalid UTF-8 (byte 0xFF): Mr. BRIAN files are UTF-8 text\n  --> f:2:7"
+        );
+        let e = utf8(b"\xFE".to_vec(), f).unwrap_err().to_string();
+        assert!(e.ends_with("f:1:1") && e.contains("0xFE"), "{e}");
+        // A sequence cut short at the end of the file.
+        let e = utf8(b"ab\n\xE2\x82".to_vec(), f).unwrap_err().to_string();
+        assert!(e.ends_with("f:2:1") && e.contains("0xE2"), "{e}");
+        assert_eq!(utf8("ok é".as_bytes().to_vec(), f).unwrap(), "ok é");
     }
 
     #[test]

@@ -14,6 +14,7 @@
 use crate::error::BrianError;
 use crate::lexer::{tokenize, Cursor, Span, Tok};
 use crate::set::{FuzzySet, FuzzyValue};
+use std::collections::{HashMap, HashSet};
 use std::path::Path;
 
 /// A shape: a named list of labelled fuzzy sets.
@@ -63,17 +64,21 @@ pub fn parse_shapes(text: &str, file: &Path) -> Result<Vec<Shape>, BrianError> {
     let toks = tokenize(text, file)?;
     let mut c = Cursor::new(&toks, file, text);
     let mut shapes: Vec<Shape> = Vec::new();
+    // Hash tables for the duplicate checks: linear time however many shapes and labels.
+    let mut defined: HashMap<String, Span> = HashMap::new();
     while !c.at_end() {
         c.punct(Tok::Open, "`(` to start a shape")?;
         let (name, span) = c.word("a shape name")?;
-        if let Some(prev) = shapes.iter().find(|s| s.name == name) {
+        if let Some(prev) = defined.get(&name) {
             return Err(BrianError::at(
                 file,
                 span,
-                format!("shape `{name}` is already defined at line {}", prev.span.line),
+                format!("shape `{name}` is already defined at line {}", prev.line),
             ));
         }
+        defined.insert(name.clone(), span);
         let mut sets: Vec<(String, FuzzySet)> = Vec::new();
+        let mut labels: HashSet<String> = HashSet::new();
         while c.peek() == Some(&Tok::Open) {
             c.punct(Tok::Open, "`(`")?;
             let id_span = c.span();
@@ -107,7 +112,16 @@ pub fn parse_shapes(text: &str, file: &Path) -> Result<Vec<Shape>, BrianError> {
                     format!("the values of {id} `{label}` must not decrease: {params:?}"),
                 ));
             }
-            if sets.iter().any(|(l, _)| *l == label) {
+            // Each side's width (b − a, ...) must be a number: a difference that overflows
+            // to ∞ would make memberships NaN.
+            if params.windows(2).any(|w| !(w[1] - w[0]).is_finite()) {
+                return Err(BrianError::at(
+                    file,
+                    label_span,
+                    format!("the values of {id} `{label}` are too far apart: {params:?}"),
+                ));
+            }
+            if !labels.insert(label.clone()) {
                 return Err(BrianError::at(
                     file,
                     label_span,
@@ -127,18 +141,20 @@ pub fn parse_associations(text: &str, file: &Path) -> Result<Vec<Association>, B
     let toks = tokenize(text, file)?;
     let mut c = Cursor::new(&toks, file, text);
     let mut out: Vec<Association> = Vec::new();
+    let mut defined: HashMap<String, Span> = HashMap::new();
     while !c.at_end() {
         c.punct(Tok::Open, "`(` to start an association")?;
         let (name, span) = c.word("a datum or action name")?;
         let (shape, _) = c.word(&format!("the name of the shape for `{name}`"))?;
         c.punct(Tok::Close, "`)` to close the association")?;
-        if let Some(prev) = out.iter().find(|a| a.name == name) {
+        if let Some(prev) = defined.get(&name) {
             return Err(BrianError::at(
                 file,
                 span,
-                format!("`{name}` is already associated at line {}", prev.span.line),
+                format!("`{name}` is already associated at line {}", prev.line),
             ));
         }
+        defined.insert(name.clone(), span);
         out.push(Association { name, shape, span });
     }
     Ok(out)
@@ -150,10 +166,12 @@ pub fn resolve(
     shapes: &[Shape],
     file: &Path,
 ) -> Result<Vec<usize>, BrianError> {
+    let by_name: HashMap<&str, usize> =
+        shapes.iter().enumerate().map(|(i, s)| (s.name.as_str(), i)).collect();
     assocs
         .iter()
         .map(|a| {
-            shapes.iter().position(|s| s.name == a.shape).ok_or_else(|| {
+            by_name.get(a.shape.as_str()).copied().ok_or_else(|| {
                 let known: Vec<&str> = shapes.iter().map(|s| s.name.as_str()).collect();
                 BrianError::at(
                     file,
@@ -195,7 +213,12 @@ pub fn defuzzify(weighted: impl IntoIterator<Item = (f64, f64)>, circular: bool)
     }
     if circular {
         // Opposite proposals of equal weight cancel out and the mean direction is undefined:
-        // atan2(0, 0) is 0, so the output is 0° then, still a number in [0, 360).
+        // the output is 0° then, still a number in [0, 360). The sums are tested against a
+        // tolerance: cos 90° is not exactly 0 in floating point, and the rounding left over
+        // from 90° against 270° would otherwise point anywhere (180° for that pair).
+        if sx.hypot(sy) <= 1e-9 * sw {
+            return Some(0.0);
+        }
         let deg = sy.atan2(sx).to_degrees();
         let deg = if deg < 0.0 { deg + 360.0 } else { deg };
         Some(if deg >= 360.0 { 0.0 } else { deg })
@@ -280,6 +303,9 @@ mod tests {
         assert!((out - expect).abs() < 1e-9, "{out} vs {expect}");
         let out = defuzzify([(270.0, 1.0)], true).unwrap();
         assert!((out - 270.0).abs() < 1e-9);
+        // Exactly opposite and equally weighted: undefined, 0° (not the rounding's 180°).
+        assert_eq!(defuzzify([(90.0, 0.49), (270.0, 0.49)], true), Some(0.0));
+        assert_eq!(defuzzify([(0.0, 0.3), (180.0, 0.3)], true), Some(0.0));
     }
 
     #[test]

@@ -306,5 +306,5 @@ fn error_predicate_used_before_its_definition() {
 
 #[test]
 fn error_behavior_listed_twice() {
-    check("behavior_twice", "behavior.txt", 3, 10, "behavior `Probe` is listed twice");
+    check("behavior_twice", "behavior.txt", 4, 10, "behavior `Probe` is listed twice");
 }

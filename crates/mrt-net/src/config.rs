@@ -78,6 +78,19 @@ fn endpoint(ip: IpAddr, port: u16) -> String {
     }
 }
 
+/// Whether the file's Agora lives on loopback and talks only to loopback peers, all named by
+/// static `ip` lines (at least one; a `ser` line leaves the machine).
+fn loopback_only(cfg: &AgoraConfig) -> bool {
+    cfg.local_ip.is_loopback()
+        && !cfg.channels.is_empty()
+        && cfg.channels.iter().all(|c| match c {
+            Channel::Ip { local_addr, remote_addr, .. } => {
+                local_addr.is_loopback() && remote_addr.is_loopback()
+            }
+            Channel::Serial { .. } => false,
+        })
+}
+
 impl NetConfig {
     /// The endpoints of a configuration file (module table in the crate doc).
     pub fn from_agora_config(cfg: &AgoraConfig) -> Result<NetConfig, NetError> {
@@ -118,6 +131,13 @@ impl NetConfig {
         // Static links are for networks that cannot see each other: the named peers only.
         if !net.connect.is_empty() {
             net.gossip = false;
+        }
+        // On loopback with static links to loopback only (the distributed simulator's robots),
+        // every peer is named and nothing beyond this machine may be reached: no scouting.
+        // zenoh's scouting binds UDP sockets on every interface (0.0.0.0) and joins the group
+        // on the LAN's interfaces, which a loopback-only Agora must not do.
+        if loopback_only(cfg) {
+            net.multicast = None;
         }
         Ok(net)
     }
@@ -200,6 +220,29 @@ mod tests {
         let lan = AgoraConfig::parse("10.0.0.1 224.0.0.5 2003\n", "lan.cfg").unwrap();
         let lan = NetConfig::from_agora_config(&lan).unwrap();
         assert!(lan.gossip && lan.connect.is_empty(), "discovery on the LAN");
+    }
+
+    /// Issue 17: the distributed simulator's robots (loopback, static links to loopback
+    /// peers) scouted by multicast, which binds UDP sockets on 0.0.0.0. They do not scout any
+    /// more; an Agora on loopback without static links still discovers its peers by scouting,
+    /// and so does one whose links leave the machine.
+    #[test]
+    fn loopback_with_static_loopback_links_does_not_scout() {
+        let net = |text: &str| {
+            NetConfig::from_agora_config(&AgoraConfig::parse(text, "l.cfg").unwrap()).unwrap()
+        };
+        let robot = net("127.0.0.1 224.0.0.224 9000\nip link 0 127.0.0.1 7001 127.0.0.1 7100\n");
+        assert_eq!(robot.multicast, None);
+        assert_eq!(robot.listen, ["tcp/127.0.0.1:0", "tcp/127.0.0.1:7001"]);
+        assert_eq!(robot.connect, ["tcp/127.0.0.1:7100"]);
+        let c = robot.zenoh_config().unwrap();
+        assert_eq!(c.get_json("scouting/multicast/enabled").unwrap(), "false");
+        let same_machine = net("127.0.0.1 224.0.0.224 7446\n");
+        assert_eq!(same_machine.multicast.as_deref(), Some("224.0.0.224:7446"));
+        let leaves = net("127.0.0.1 224.0.0.224 9000\nip link 0 127.0.0.1 7001 10.0.0.2 7100\n");
+        assert!(leaves.multicast.is_some());
+        let lan = net("10.0.0.1 224.0.0.224 9000\nip link 0 127.0.0.1 7001 127.0.0.1 7100\n");
+        assert!(lan.multicast.is_some());
     }
 
     fn serial(device: &str) -> Result<NetConfig, NetError> {

@@ -495,11 +495,108 @@ impl SimConfig {
                 self.sonar.count
             ));
         }
+        self.check_derived()?;
         self.guidance()?;
         self.odometry.mice()?;
         Ok(())
     }
+
+    /// The quantities the simulator derives from several values (issue 17: `[robot] radius =
+    /// 0.6` passed validation, then the referee panicked on a `clamp` whose minimum exceeded
+    /// its maximum). Each error names the field to change.
+    fn check_derived(&self) -> Result<(), String> {
+        let (f, r, b) = (&self.field, self.robot.radius, self.ball.radius);
+        let (hl, hw) = (f.length / 2.0, f.width / 2.0);
+        // Physics: bodies of these sizes and masses must have a density an f32 holds.
+        if !(MIN_BODY_RADIUS..=1.0).contains(&r) || !(MIN_BODY_RADIUS..=1.0).contains(&b) {
+            return Err(format!(
+                "robot.radius and ball.radius must be {MIN_BODY_RADIUS} to 1 m, not {r} and {b}"
+            ));
+        }
+        if self.robot.mass > MAX_MASS || self.ball.mass > MAX_MASS {
+            return Err(format!("robot.mass and ball.mass must be at most {MAX_MASS} kg"));
+        }
+        if self.rules.half_duration > MAX_HALF_DURATION {
+            return Err(format!(
+                "rules.half_duration must be at most {MAX_HALF_DURATION} s (one day), not {}",
+                self.rules.half_duration
+            ));
+        }
+        // The referee lets a team enter on its side line with robots 2r + 0.05 m apart, at
+        // most ENTRY_SPACING apart.
+        if 2.0 * r + 0.05 > ENTRY_SPACING {
+            return Err(format!(
+                "robot.radius must be at most {} m (robots enter the field 2 × radius + 0.05 m \
+                 apart, at most {ENTRY_SPACING} m), not {r}",
+                (ENTRY_SPACING - 0.05) / 2.0
+            ));
+        }
+        // Kickoff: a robot stands at most hl − r − 0.1 from the centre; the kicker stands
+        // 2r + ball radius from it, on its own side of the ball.
+        let farthest = hl - r - 0.1;
+        if 2.0 * r + b > farthest {
+            return Err(format!(
+                "field.length must be at least {:.3} m for robots of robot.radius {r} m: at \
+                 kickoff the kicker stands 2 × robot.radius + ball.radius = {:.3} m from the \
+                 centre spot, and no robot may stand farther than field.length / 2 − \
+                 robot.radius − 0.1 m = {farthest:.3} m from it",
+                2.0 * (3.0 * r + b + 0.1),
+                2.0 * r + b
+            ));
+        }
+        // Kickoff: a team's field players spread over field.width in team_size − 1 lanes.
+        let lanes = self.rules.team_size.max(2) - 1;
+        let lane_width = f.width / (lanes as f64 + 1.0);
+        if lane_width < 2.0 * r {
+            return Err(format!(
+                "rules.team_size {} does not fit across field.width {} m: the {lanes} field \
+                 players of a team line up {lane_width:.3} m apart at kickoff, less than a \
+                 robot's width (2 × robot.radius = {} m)",
+                self.rules.team_size,
+                f.width,
+                2.0 * r
+            ));
+        }
+        // Goals: the ball must fit in; both stacks' goalkeepers stand 0.1 m inside the posts.
+        if f.goal_width < MIN_GOAL_WIDTH || f.goal_width <= 2.0 * b {
+            return Err(format!(
+                "field.goal_width must be at least {MIN_GOAL_WIDTH} m (goalkeepers keep 0.1 m \
+                 inside the posts) and wider than the ball (2 × ball.radius = {} m), not {}",
+                2.0 * b,
+                f.goal_width
+            ));
+        }
+        if f.penalty_area_width < f.goal_width {
+            return Err(format!(
+                "field.penalty_area_width ({}) must be at least field.goal_width ({}): the area \
+                 surrounds the goal",
+                f.penalty_area_width, f.goal_width
+            ));
+        }
+        if f.centre_circle_radius >= hl.min(hw) {
+            return Err(format!(
+                "field.centre_circle_radius must be less than half the field's length and \
+                 width ({} m), not {}",
+                hl.min(hw),
+                f.centre_circle_radius
+            ));
+        }
+        Ok(())
+    }
 }
+
+/// The smallest radius of the robots and the ball, m: smaller bodies would have densities
+/// (mass / area) beyond what the physics engine's `f32` holds.
+pub const MIN_BODY_RADIUS: f64 = 0.01;
+/// The heaviest robot or ball, kg.
+pub const MAX_MASS: f64 = 1e4;
+/// The longest half, s (one day): a match is simulated cycle by cycle, and a drawing keeps
+/// every cycle's frame.
+pub const MAX_HALF_DURATION: f64 = 86_400.0;
+/// The widest spacing of a team entering on its side line, m (`referee`).
+pub const ENTRY_SPACING: f64 = 1.2;
+/// The narrowest goal, m: the goalkeepers of every stack keep 0.1 m inside the posts.
+pub const MIN_GOAL_WIDTH: f64 = 0.2;
 
 /// Line and column (from 1) of a byte offset.
 fn line_column(text: &str, offset: usize) -> (usize, usize) {

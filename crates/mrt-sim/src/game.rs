@@ -545,7 +545,9 @@ impl Brain for Chaser {
         let a = me.theta + ball.theta;
         let (bx, by) = crate::teams::Geometry::ball_at(me, &ball);
         if self.keeper {
-            let target = (-(hl - 300.0), by.clamp(-(gw - 100.0), gw - 100.0));
+            // `validate` keeps goals at least 0.2 m wide; max(0) keeps clamp from panicking.
+            let lim = (gw - 100.0).max(0.0);
+            let target = (-(hl - 300.0), by.clamp(-lim, lim));
             Chaser::go(me, target, a, &mut c);
         } else {
             let behind = self.field.behind_ball((bx, by), 500.0);

@@ -145,7 +145,10 @@ impl Referee {
         let cfg = world.config().clone();
         let (hl, hw) = (cfg.field.length / 2.0, cfg.field.width / 2.0);
         let n = self.team_size.max(1);
-        let step = ((hl - 1.0) / n as f64).clamp(2.0 * cfg.robot.radius + 0.05, 1.2);
+        // `validate` keeps 2r + 0.05 ≤ ENTRY_SPACING; max/min (not clamp) cannot panic even so.
+        let step = ((hl - 1.0) / n as f64)
+            .min(crate::config::ENTRY_SPACING)
+            .max(2.0 * cfg.robot.radius + 0.05);
         for i in 0..world.robot_count() {
             let t = self.team_of(i);
             let k = if t == Team::Home { i } else { i - self.team_size };
@@ -179,7 +182,9 @@ impl Referee {
                     (-dir * (cfg.field.centre_circle_radius + 0.5 + lane * 0.8), y)
                 };
                 // Many robots on a small field: never behind the own goal line.
-                let x = x.clamp(-(hl - r - 0.1), hl - r - 0.1);
+                // `validate` keeps hl − r − 0.1 > 0; max(0) keeps clamp from panicking even so.
+                let lim = (hl - r - 0.1).max(0.0);
+                let x = x.clamp(-lim, lim);
                 Pose2::new(x, y, if dir > 0.0 { 0.0 } else { PI })
             })
             .collect();
