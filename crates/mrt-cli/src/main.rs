@@ -6,6 +6,7 @@
 //! - `mrt demo [hello-agora|two-agoras]` runs a numbered example and prints what happens;
 //! - `mrt behave FILE [--world world.json] [--cycles N]` runs a Lua behavior or HFSM offline;
 //! - `mrt hfsm dot FILE [--dot out.dot] [--svg out.svg]` draws an HFSM;
+//! - `mrt soak matches|hour` runs the soak campaigns of `docs/reliability.md`;
 //! - `mrt check FILE...` checks DCDT Agora configuration files (MRT manual §3.3.1) and
 //!   prints each in canonical form, or the first error with file, line and column.
 //!
@@ -24,6 +25,7 @@ mod brian;
 #[cfg(feature = "net")]
 mod distributed;
 mod sim;
+mod soak;
 
 use anyhow::{Context as _, Result};
 use clap::{Parser, Subcommand, ValueEnum};
@@ -89,6 +91,12 @@ enum Command {
         /// Configuration files.
         #[arg(required = true)]
         files: Vec<PathBuf>,
+    },
+    /// Soak campaigns: many random matches, or one robot for a simulated hour
+    /// (docs/reliability.md).
+    Soak {
+        #[command(subcommand)]
+        command: soak::SoakCommand,
     },
 }
 
@@ -203,6 +211,7 @@ fn run(command: Command) -> Result<()> {
             BrianCommand::Plot { dir, out } => brian::plot(&dir, &out)?,
         },
         Command::Sim(args) => sim::run(&args)?,
+        Command::Soak { command } => soak::run(&command)?,
         #[cfg(feature = "net")]
         Command::SimRobot(args) => distributed::robot(&args)?,
         Command::Bb { command } => bb::run(command)?,

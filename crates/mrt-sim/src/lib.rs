@@ -32,6 +32,7 @@ pub mod plot;
 pub mod referee;
 pub mod remote;
 pub mod sensor;
+pub mod soak;
 pub mod teams;
 pub mod world;
 pub mod worldstate;
