@@ -129,16 +129,22 @@ fn robot_net_file(i: usize, first: usize, discovery: u16, sim: u16, ports: &[u16
 }
 
 /// Plays one match with every robot in a process of its own; `progress` gets the simulated
-/// time after each cycle.
+/// time after each cycle; `restart` kills a robot's process mid-match and starts it again.
 pub fn play(
     cfg: &SimConfig,
     seed: u64,
     (home, away): (Stack, Stack),
     behaviors: Option<&Path>,
     record: bool,
+    restart: Option<Restart>,
     progress: impl FnMut(f64),
-) -> Result<MatchReport> {
+) -> Result<(MatchReport, Option<Rejoined>)> {
     let n = cfg.rules.team_size;
+    if let Some(r) = restart {
+        if r.robot >= 2 * n {
+            bail!("--restart-robot {}: a match has robots 0 to {}", r.robot, 2 * n - 1);
+        }
+    }
     let robots = 2 * n;
     let dir = std::env::temp_dir().join(format!("mrt-distributed-{}-{seed}", std::process::id()));
     std::fs::create_dir_all(&dir).with_context(|| format!("cannot create {}", dir.display()))?;
@@ -156,28 +162,19 @@ pub fn play(
         links.push(NetLink::attach(&agora, &NetConfig::loopback(port, &[]))?);
         agoras.push(agora);
     }
+    let mut nets = Vec::new();
     for (t, sim_port) in sim_ports.iter().enumerate() {
         let discovery = free_udp_port()?;
         for i in t * n..(t + 1) * n {
             let net = dir.join(format!("robot-{i}.cfg"));
             std::fs::write(&net, robot_net_file(i, t * n, discovery, *sim_port, &ports))?;
-            let log = std::fs::File::create(procs.log(i))?;
-            let mut cmd = Command::new(&exe);
-            cmd.arg("sim-robot")
-                .args(["--robot", &i.to_string(), "--home", home.name(), "--away", away.name()])
-                .arg("--sim-config")
-                .arg(&sim_config)
-                .arg("--net")
-                .arg(&net)
-                .stdin(Stdio::null())
-                .stdout(Stdio::null())
-                .stderr(log);
-            if let Some(b) = behaviors {
-                cmd.arg("--behaviors").arg(b);
-            }
-            let child = cmd.spawn().with_context(|| format!("cannot start robot {i}"))?;
-            procs.children.push((i, child));
+            nets.push(net);
         }
+    }
+    let launch = Launch { exe, stacks: (home, away), sim_config, behaviors };
+    for (i, net) in nets.iter().enumerate() {
+        let child = launch.robot(i, net, &procs.log(i))?;
+        procs.children.push((i, child));
     }
     // The simulator subscribes to the robots' answers before any robot is ready.
     let mut server =
@@ -205,14 +202,133 @@ pub fn play(
             std::thread::sleep(Duration::from_millis(10));
         }
     }
-    let report = server.play(progress).map_err(|e| anyhow!("{e}"))?;
+    let mut progress = progress;
+    let mut restarted: Option<(Instant, PathBuf)> = None;
+    let mut failed_restart = None;
+    // A robot whose link closed (its process ended) is not waited for: the network's
+    // liveliness says so as soon as its session drops.
+    let presence = server.presence();
+    let report = server
+        .play(|t| {
+            progress(t);
+            for (team, link) in links.iter().enumerate() {
+                let here = link.subscribers(DeviceFrame::TYPE);
+                for i in team * n..(team + 1) * n {
+                    if !here.contains(&AgoraId(i as u32 + 1)) {
+                        presence.mark_gone(i);
+                    }
+                }
+            }
+            let Some(r) = restart else { return };
+            if restarted.is_some() || failed_restart.is_some() || t < r.at {
+                return;
+            }
+            // Kill the robot's process and start it again at once, as a crash and a
+            // supervisor's restart would.
+            let log = procs.dir.join(format!("robot-{}.restart.log", r.robot));
+            if let Some((_, c)) = procs.children.iter_mut().find(|(i, _)| *i == r.robot) {
+                let _ = c.kill();
+                let _ = c.wait();
+            }
+            presence.mark_gone(r.robot);
+            match launch.robot(r.robot, &nets[r.robot], &log) {
+                Ok(child) => {
+                    restarted = Some((Instant::now(), log));
+                    procs.children.push((r.robot, child));
+                }
+                Err(e) => failed_restart = Some(e),
+            }
+        })
+        .map_err(|e| anyhow!("{e}"))?;
     procs.wait(Duration::from_secs(5));
     drop(links);
-    Ok(report)
+    if let Some(e) = failed_restart {
+        return Err(e.context("cannot restart the robot"));
+    }
+    let rejoined = match (restart, restarted) {
+        (Some(r), Some((_, log))) => {
+            let text = std::fs::read_to_string(&log).unwrap_or_default();
+            let after = text.lines().find_map(|l| {
+                l.split_once(FIRST_ANSWER)
+                    .and_then(|(_, rest)| rest.split_whitespace().next()?.parse().ok())
+            });
+            let phases: Vec<&str> = text
+                .lines()
+                .filter_map(|l| l.split_once(PHASES).or_else(|| l.split_once(FIRST_ANSWER)))
+                .map(|(_, rest)| rest)
+                .collect();
+            let phases = phases.join("; ");
+            Some(Rejoined {
+                robot: r.robot,
+                at: r.at,
+                after: after.map(Duration::from_secs_f64),
+                phases,
+            })
+        }
+        _ => None,
+    };
+    Ok((report, rejoined))
 }
+
+/// How the robot processes are started (also again, mid-match).
+struct Launch<'a> {
+    exe: PathBuf,
+    stacks: (Stack, Stack),
+    sim_config: PathBuf,
+    behaviors: Option<&'a Path>,
+}
+
+impl Launch<'_> {
+    fn robot(&self, i: usize, net: &Path, log: &Path) -> Result<Child> {
+        let log = std::fs::File::create(log)?;
+        let mut cmd = Command::new(&self.exe);
+        cmd.arg("sim-robot")
+            .args(["--robot", &i.to_string(), "--home", self.stacks.0.name()])
+            .args(["--away", self.stacks.1.name()])
+            .arg("--sim-config")
+            .arg(&self.sim_config)
+            .arg("--net")
+            .arg(net)
+            .stdin(Stdio::null())
+            .stdout(Stdio::null())
+            .stderr(log);
+        if let Some(b) = self.behaviors {
+            cmd.arg("--behaviors").arg(b);
+        }
+        cmd.spawn().with_context(|| format!("cannot start robot {i}"))
+    }
+}
+
+/// A robot process to kill and start again during the match.
+#[derive(Clone, Copy, Debug)]
+pub struct Restart {
+    /// The robot.
+    pub robot: usize,
+    /// When, in simulated seconds from the kickoff.
+    pub at: f64,
+}
+
+/// What became of the restarted robot.
+#[derive(Clone, Debug)]
+pub struct Rejoined {
+    /// The robot.
+    pub robot: usize,
+    /// When it was killed and started again, simulated seconds.
+    pub at: f64,
+    /// From its start to its first answer to the simulator (`None`: it never answered).
+    pub after: Option<Duration>,
+    /// Where the time went, as the robot wrote it (`loaded 0.2 s, ready 0.4 s after start`).
+    pub phases: String,
+}
+
+/// What a robot process writes to its log when it answers for the first time.
+const FIRST_ANSWER: &str = "first answer ";
+/// What a robot process writes to its log when it is ready to play.
+const PHASES: &str = "phases: ";
 
 /// `mrt sim-robot`: one robot of a distributed match, until the final whistle.
 pub fn robot(args: &RobotArgs) -> Result<()> {
+    let started = Instant::now();
     let cfg = SimConfig::from_file(&args.sim_config).map_err(|e| anyhow!("{e}"))?;
     let net = AgoraConfig::from_file(&args.net).map_err(|e| anyhow!("{e}"))?;
     let stacks = (
@@ -226,9 +342,12 @@ pub fn robot(args: &RobotArgs) -> Result<()> {
     let spec = RobotSpec::of(args.robot, n, stacks);
     let dir =
         behaviors_dir(&[spec.stack], args.behaviors.as_deref()).map_err(|e| anyhow!("{e}"))?;
-    let robot = RemoteRobot::new(&cfg, spec, &dir, Some(net)).map_err(|e| anyhow!("{e}"))?;
+    let mut robot = RemoteRobot::new(&cfg, spec, &dir, Some(net)).map_err(|e| anyhow!("{e}"))?;
     let agora = robot.agora().ok_or_else(|| anyhow!("the robot has no Agora"))?;
     let link = mrt_net::connect(agora)?;
+    let online = link.presence();
+    robot.set_presence(move |j| online.contains(AgoraId(j + 1)));
+    let linked = Instant::now();
     // Ready when the simulator hears this robot's answers and every teammate its reports.
     let sim = AgoraId(sim_agora(args.robot / n));
     let mates: Vec<AgoraId> = robot.mate_agoras().into_iter().map(AgoraId).collect();
@@ -244,8 +363,22 @@ pub fn robot(args: &RobotArgs) -> Result<()> {
             link.agoras()
         );
     }
+    eprintln!(
+        "robot {}: {PHASES}loaded {:.3} s, ready {:.3} s after start",
+        args.robot,
+        (linked - started).as_secs_f64(),
+        started.elapsed().as_secs_f64()
+    );
     robot.open();
     let run = robot.run(SILENCE).map_err(|e| anyhow!("robot {}: {e}", args.robot))?;
+    if let (Some(f), Some(t)) = (run.first_frame, run.first_answer) {
+        eprintln!(
+            "robot {}: {FIRST_ANSWER}{:.3} s after start (first frame {:.3} s)",
+            args.robot,
+            (t - started).as_secs_f64(),
+            (f - started).as_secs_f64()
+        );
+    }
     // Let the last word leave before the session closes.
     std::thread::sleep(Duration::from_millis(300));
     eprintln!(

@@ -51,6 +51,14 @@ pub struct SimArgs {
     /// docs/network.md).
     #[arg(long, conflicts_with = "direct")]
     pub distributed: bool,
+    /// With --distributed: kill this robot's process mid-match and start it again at once
+    /// (a crash and a supervisor's restart); the report says when it answered again.
+    #[arg(long, requires = "distributed")]
+    pub restart_robot: Option<usize>,
+    /// When to restart it, in simulated seconds from the kickoff (default: half the first
+    /// half).
+    #[arg(long, requires = "restart_robot")]
+    pub restart_at: Option<f64>,
     /// Measure: play `--matches` full matches (3 if not given) one after the other on one
     /// core, headless, and report how many times faster than real time they ran.
     #[arg(long)]
@@ -76,17 +84,42 @@ fn play_one(
     args: &SimArgs,
     record: bool,
     progress: impl FnMut(f64),
-) -> Result<MatchReport> {
+) -> Result<(MatchReport, Vec<String>)> {
     if args.distributed {
         #[cfg(feature = "net")]
-        return crate::distributed::play(
-            cfg,
-            seed,
-            stacks,
-            args.behaviors.as_deref(),
-            record,
-            progress,
-        );
+        {
+            let restart = match args.restart_robot {
+                Some(robot) => {
+                    let at = args.restart_at.unwrap_or(cfg.rules.half_duration / 2.0);
+                    if !(at.is_finite() && at >= 0.0) {
+                        anyhow::bail!("--restart-at must be a time in the match, not {at}");
+                    }
+                    Some(crate::distributed::Restart { robot, at })
+                }
+                None => None,
+            };
+            let behaviors = args.behaviors.as_deref();
+            let (report, rejoined) =
+                crate::distributed::play(cfg, seed, stacks, behaviors, record, restart, progress)?;
+            let notes = rejoined
+                .map(|r| match r.after {
+                    Some(d) => format!(
+                        "robot {} killed at {:.1} s of play and started again: answering {:.2} s \
+                         after its restart (goal: 1 s or less; {})",
+                        r.robot,
+                        r.at,
+                        d.as_secs_f64(),
+                        r.phases
+                    ),
+                    None => format!(
+                        "robot {} killed at {:.1} s of play and started again: it never answered",
+                        r.robot, r.at
+                    ),
+                })
+                .into_iter()
+                .collect();
+            return Ok((report, notes));
+        }
         #[cfg(not(feature = "net"))]
         anyhow::bail!(
             "this mrt was built without networking: build it with the default features \
@@ -94,8 +127,9 @@ fn play_one(
         );
     }
     let wiring = if args.direct { Wiring::Direct } else { Wiring::Bus };
-    play(cfg, seed, stacks, wiring, args.behaviors.as_deref(), record, progress)
-        .map_err(|e| anyhow!("{e}"))
+    let report = play(cfg, seed, stacks, wiring, args.behaviors.as_deref(), record, progress)
+        .map_err(|e| anyhow!("{e}"))?;
+    Ok((report, Vec::new()))
 }
 
 /// How the robots were wired, for the report.
@@ -157,7 +191,7 @@ pub fn run(args: &SimArgs) -> Result<()> {
     );
     let started = std::time::Instant::now();
     let realtime = args.realtime;
-    let report = play_one(&cfg, args.seed, stacks, args, args.plot.is_some(), |t| {
+    let (report, notes) = play_one(&cfg, args.seed, stacks, args, args.plot.is_some(), |t| {
         bar.set_position(t as u64);
         if realtime {
             let ahead = t - started.elapsed().as_secs_f64();
@@ -206,6 +240,9 @@ pub fn run(args: &SimArgs) -> Result<()> {
         wiring_name(args),
         report.trajectory_hash
     );
+    for note in notes {
+        outln!("  {note}");
+    }
     if let Some(p) = &args.plot {
         std::fs::write(p, report.to_svg(&cfg, (h, a)))
             .with_context(|| format!("cannot write {}", p.display()))?;
@@ -232,7 +269,7 @@ fn bench(args: &SimArgs, cfg: &SimConfig, stacks: (Stack, Stack)) -> Result<()> 
         // check_counts: no overflow.
         let seed = args.seed.saturating_add(k);
         let started = std::time::Instant::now();
-        let r = play_one(cfg, seed, stacks, args, false, |_| {})?;
+        let (r, _) = play_one(cfg, seed, stacks, args, false, |_| {})?;
         let wall = started.elapsed().as_secs_f64();
         speeds.push(r.duration / wall.max(1e-9));
         bar.suspend(|| {
@@ -283,7 +320,7 @@ fn series(args: &SimArgs, cfg: &SimConfig, stacks: (Stack, Stack)) -> Result<()>
             let (bar, results) = (&bar, &results);
             s.spawn(move || {
                 for &seed in chunk {
-                    let r = play_one(cfg, seed, stacks, args, false, |_| {});
+                    let r = play_one(cfg, seed, stacks, args, false, |_| {}).map(|(r, _)| r);
                     if let Ok(mut v) = results.lock() {
                         v.push(r.map(|r| (seed, r.score)));
                     }

@@ -283,6 +283,18 @@ struct Declared {
     tokens: FxHashMap<u32, LivelinessToken>,
 }
 
+/// Which Agoras are on the network now, by their liveliness tokens: an Agora whose process
+/// ended leaves as soon as its session closes ([`NetLink::presence`]).
+#[derive(Clone)]
+pub struct NetPresence(Arc<Shared>);
+
+impl NetPresence {
+    /// Whether Agora `id` is on the network.
+    pub fn contains(&self, id: AgoraId) -> bool {
+        lock(&self.0.agoras).contains(&id.0)
+    }
+}
+
 /// An Agora joined to the network. Dropping it leaves the network.
 pub struct NetLink {
     shared: Arc<Shared>,
@@ -361,6 +373,11 @@ impl NetLink {
     /// The other Agoras up on the network (the Finder's view).
     pub fn agoras(&self) -> Vec<AgoraId> {
         lock(&self.shared.agoras).iter().map(|&a| AgoraId(a)).collect()
+    }
+
+    /// A handle that tells, from any thread, whether an Agora is on the network now.
+    pub fn presence(&self) -> NetPresence {
+        NetPresence(self.shared.clone())
     }
 
     /// Whether some other Agora wants messages of `ty`.

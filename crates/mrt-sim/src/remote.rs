@@ -140,6 +140,38 @@ pub struct PitchServer {
     cycle: u64,
     silent: Vec<bool>,
     patience: Patience,
+    gone: Presence,
+}
+
+/// Which robots are known to be gone (their process ended, their link closed): the
+/// simulator waits for their answers only as long as for a silent robot's
+/// ([`Patience::silent`]) until they speak again. Shared with whoever
+/// watches the robots (a supervisor, the network's liveliness), see [`PitchServer::presence`].
+#[derive(Clone, Debug)]
+pub struct Presence(Arc<Vec<std::sync::atomic::AtomicBool>>);
+
+impl Presence {
+    fn new(robots: usize) -> Presence {
+        Presence(Arc::new((0..robots).map(|_| std::sync::atomic::AtomicBool::new(false)).collect()))
+    }
+
+    /// Robot `i` is gone: its answers get the short patience until it answers again.
+    pub fn mark_gone(&self, i: usize) {
+        if let Some(g) = self.0.get(i) {
+            g.store(true, std::sync::atomic::Ordering::Relaxed);
+        }
+    }
+
+    /// Whether robot `i` is marked gone.
+    pub fn is_gone(&self, i: usize) -> bool {
+        self.0.get(i).is_some_and(|g| g.load(std::sync::atomic::Ordering::Relaxed))
+    }
+
+    fn back(&self, i: usize) {
+        if let Some(g) = self.0.get(i) {
+            g.store(false, std::sync::atomic::Ordering::Relaxed);
+        }
+    }
 }
 
 fn lock(p: &Arc<Mutex<Pitch>>) -> Result<std::sync::MutexGuard<'_, Pitch>, String> {
@@ -186,7 +218,14 @@ impl PitchServer {
             cycle: 0,
             silent: vec![false; robots],
             patience,
+            gone: Presence::new(robots),
         })
+    }
+
+    /// The handle that marks robots gone (a robot's process ended): the simulator waits for
+    /// them [`Patience::silent`] from the next cycle on, instead of [`Patience::cycle`] once.
+    pub fn presence(&self) -> Presence {
+        self.gone.clone()
     }
 
     /// The robots of the match.
@@ -245,6 +284,7 @@ impl PitchServer {
                 continue;
             };
             self.silent[i] = false;
+            self.gone.back(i);
             if let Some(duty) = &act.duty {
                 // What the robot's SimulatedAirboard does in one process.
                 match self.base.drive_for(duty) {
@@ -279,8 +319,11 @@ impl PitchServer {
             }
             let waited = start.elapsed();
             let missing: Vec<usize> = (0..acts.len()).filter(|&i| acts[i].is_none()).collect();
+            // A robot silent before, or known gone, gets the short patience: a restarted
+            // one is heard again as soon as it answers in time.
             let patient = |i: &usize| {
-                waited < if self.silent[*i] { self.patience.silent } else { self.patience.cycle }
+                let short = self.silent[*i] || self.gone.is_gone(*i);
+                waited < if short { self.patience.silent } else { self.patience.cycle }
             };
             if !missing.iter().any(patient) {
                 return Ok(acts);
@@ -357,6 +400,11 @@ pub struct RemoteRobot {
     /// A frame or the whistle that arrived while waiting for teammates (the simulator gave up
     /// on this robot's answer and went on): handled first in the next round.
     early: Vec<Event>,
+    /// Whether teammate `j` (robot index) is on the network at all (default: assumed).
+    on_network: Box<dyn Fn(u32) -> bool + Send>,
+    /// Whether this robot ran a cycle yet (a robot started mid-match has no reports from the
+    /// previous cycle to wait for).
+    ran: bool,
 }
 
 /// How a robot's match went, seen from the robot.
@@ -367,6 +415,11 @@ pub struct RobotRun {
     /// Cycles in which some teammate's report came too late (the match may differ from the
     /// single-process one from then on).
     pub late_mates: u64,
+    /// When the first frame came.
+    pub first_frame: Option<Instant>,
+    /// When the robot sent its first answer (for a robot restarted mid-match: when it
+    /// rejoined).
+    pub first_answer: Option<Instant>,
 }
 
 impl RemoteRobot {
@@ -419,6 +472,8 @@ impl RemoteRobot {
             period,
             mate_wait: Duration::from_secs(2),
             early: Vec::new(),
+            on_network: Box::new(|_| true),
+            ran: false,
         })
     }
 
@@ -436,6 +491,13 @@ impl RemoteRobot {
     /// 2 s).
     pub fn set_mate_wait(&mut self, wait: Duration) {
         self.mate_wait = wait;
+    }
+
+    /// Tells which teammates (by robot index) are on the network at all: one whose process
+    /// ended is not waited for (without this, for [`RemoteRobot::set_mate_wait`] each cycle
+    /// until it is booked late).
+    pub fn set_presence(&mut self, on_network: impl Fn(u32) -> bool + Send + 'static) {
+        self.on_network = Box::new(on_network);
     }
 
     /// Ready for the match: from now on the simulator's frames reach this robot (they are
@@ -469,9 +531,11 @@ impl RemoteRobot {
         let period = u64::try_from(self.period.as_nanos()).unwrap_or(u64::MAX);
         let needed = if robot_index(j) < self.spec.robot {
             now.as_nanos()
-        } else if let Some(t) = now.as_nanos().checked_sub(period) {
+        } else if let (Some(t), true) = (now.as_nanos().checked_sub(period), self.ran) {
             t
         } else {
+            // The first cycle of the match, or of this robot (started again mid-match): no
+            // report of a previous cycle to wait for.
             return true;
         };
         self.mates.get(&j).copied().flatten().is_some_and(|t| t.as_nanos() >= needed)
@@ -510,6 +574,7 @@ impl RemoteRobot {
                 continue;
             };
             last = Instant::now();
+            run.first_frame.get_or_insert(last);
             // The clock of cycle k, also for a robot restarted in the middle of a match.
             let period = u64::try_from(self.period.as_nanos()).unwrap_or(u64::MAX);
             let t = Time(frame.cycle.saturating_mul(period));
@@ -533,6 +598,8 @@ impl RemoteRobot {
                 faults: act.faults,
             };
             self.outbox.publish_with(answer, DeliveryWarranty::Reliable, 128);
+            run.first_answer.get_or_insert_with(Instant::now);
+            self.ran = true;
             run.cycles += 1;
         }
     }
@@ -541,7 +608,19 @@ impl RemoteRobot {
     /// teammates are not waited for again until they speak).
     fn wait_for_mates(&mut self, now: Time) -> bool {
         let start = Instant::now();
-        while !self.mates_ready(now) {
+        loop {
+            // A teammate off the network (its process ended) is absent until it speaks
+            // again: started anew, it reports only once it has had a frame itself.
+            let gone: Vec<u32> = self
+                .mates
+                .keys()
+                .copied()
+                .filter(|&j| !self.absent.contains(&j) && !(self.on_network)(j))
+                .collect();
+            self.absent.extend(gone);
+            if self.mates_ready(now) {
+                break;
+            }
             if start.elapsed() > self.mate_wait {
                 let late: Vec<u32> =
                     self.mates.keys().copied().filter(|&j| !self.mate_ready(j, now)).collect();
