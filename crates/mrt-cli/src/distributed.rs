@@ -317,7 +317,7 @@ pub struct Rejoined {
     pub at: f64,
     /// From its start to its first answer to the simulator (`None`: it never answered).
     pub after: Option<Duration>,
-    /// Where the time went, as the robot wrote it (`loaded 0.2 s, ready 0.4 s after start`).
+    /// Where the time went, as the robot wrote it (`behaviors loaded and linked 0.2 s, ready 0.4 s after start`).
     pub phases: String,
 }
 
@@ -364,7 +364,7 @@ pub fn robot(args: &RobotArgs) -> Result<()> {
         );
     }
     eprintln!(
-        "robot {}: {PHASES}loaded {:.3} s, ready {:.3} s after start",
+        "robot {}: {PHASES}behaviors loaded and linked {:.3} s, ready {:.3} s after start",
         args.robot,
         (linked - started).as_secs_f64(),
         started.elapsed().as_secs_f64()

@@ -55,6 +55,9 @@ pub struct DeviceFrame {
     pub camera: CameraFrame,
     /// The sonar ring.
     pub sonars: Vec<Sonar>,
+    /// Robots the simulator is not waiting for (silent, or known gone): teammates do not wait
+    /// for their reports either, until they speak again.
+    pub not_awaited: Vec<u32>,
 }
 
 impl Message for DeviceFrame {
@@ -260,6 +263,10 @@ impl PitchServer {
     pub fn cycle(&mut self) -> Result<Vec<Call>, String> {
         let k = self.cycle;
         {
+            let not_awaited: Vec<u32> = (0..self.robots())
+                .filter(|&i| self.silent[i] || self.gone.is_gone(i))
+                .filter_map(|i| u32::try_from(i).ok())
+                .collect();
             let mut pitch = lock(&self.pitch)?;
             for i in 0..self.robots() {
                 let frame = DeviceFrame {
@@ -268,6 +275,7 @@ impl PitchServer {
                     odometry: pitch.odometry(i),
                     camera: pitch.camera(i),
                     sonars: pitch.sonar(i),
+                    not_awaited: not_awaited.clone(),
                 };
                 let (_, ep) = &self.teams[self.team_of(i)];
                 ep.publish_with(frame, DeliveryWarranty::Reliable, 128);
@@ -582,7 +590,17 @@ impl RemoteRobot {
                 self.exec.clock().set(t);
             }
             let now = self.exec.now();
-            if !self.wait_for_mates(now) {
+            // Teammates the simulator gave up on are not waited for here either (a process
+            // killed and started again may not even be seen to leave the network).
+            for &j in &frame.not_awaited {
+                if self.mates.contains_key(&j) && !self.absent.contains(&j) {
+                    self.absent.push(j);
+                }
+            }
+            // A robot started in the middle of the match waits for no teammate in its first
+            // cycle: their reports of this cycle may have left before it subscribed.
+            let late_joiner = !self.ran && frame.cycle > 0;
+            if !late_joiner && !self.wait_for_mates(now) {
                 run.late_mates += 1;
             }
             if let Ok(mut d) = self.devices.lock() {
