@@ -181,7 +181,8 @@ impl Fuzzer {
         &self.seeds
     }
 
-    /// Input `k`: the seed it mutates (index) and its bytes. One input in 64 is a seed as is.
+    /// Input `k`: the seed it mutates (index) and its bytes. One input in 64 is a seed as is;
+    /// half of the others come from the target's own structured mutation, if it has one.
     pub fn input(&self, k: u64) -> (usize, Vec<u8>) {
         let mut rng = ChaCha8Rng::seed_from_u64(self.seed ^ fnv(self.target.name.as_bytes()));
         rng.set_stream(k);
@@ -189,6 +190,13 @@ impl Fuzzer {
         let seed = &self.seeds[i].bytes;
         if rng.random_range(0..64) == 0 {
             return (i, seed.clone());
+        }
+        if let Some(structured) = self.target.structured {
+            if rng.random_bool(0.5) {
+                if let Some(mutant) = structured(&mut rng, seed) {
+                    return (i, mutant);
+                }
+            }
         }
         let other = &self.seeds[rng.random_range(0..self.seeds.len())].bytes;
         (i, self.mutator.mutate(&mut rng, seed, other))

@@ -517,3 +517,255 @@ mod tests {
         }
     }
 }
+
+/// Structure-aware mutation of a JSON document: the seed is parsed, one to three of its
+/// values are changed (a number to an extreme, a string to an empty, long or odd one, an
+/// array's elements repeated up to a thousand times or dropped, a key removed or a foreign
+/// one added, a value's type changed), and the document written back, so that the input stays
+/// JSON and reaches what reads it. `None` when the seed is not JSON.
+pub fn mutate_json(rng: &mut impl Rng, seed: &[u8]) -> Option<Vec<u8>> {
+    let mut value: serde_json::Value = serde_json::from_slice(seed).ok()?;
+    for _ in 0..rng.random_range(1..=3) {
+        let n = count_nodes(&value);
+        let target = rng.random_range(0..n);
+        let mut seen = 0;
+        mutate_node(rng, &mut value, target, &mut seen);
+    }
+    serde_json::to_vec(&value).ok()
+}
+
+fn count_nodes(v: &serde_json::Value) -> usize {
+    1 + match v {
+        serde_json::Value::Array(a) => a.iter().map(count_nodes).sum(),
+        serde_json::Value::Object(o) => o.values().map(count_nodes).sum(),
+        _ => 0,
+    }
+}
+
+/// JSON numbers at the edges: what `f64`, `i64` and `u64` hold, and a little past.
+fn extreme_json_number(rng: &mut impl Rng) -> serde_json::Value {
+    use serde_json::json;
+    match rng.random_range(0..14) {
+        0 => json!(0),
+        1 => json!(-1),
+        2 => json!(1e308),
+        3 => json!(-1e308),
+        4 => json!(f64::MIN_POSITIVE),
+        5 => json!(5e-324),
+        6 => json!(u64::MAX),
+        7 => json!(i64::MIN),
+        8 => json!(i64::MAX),
+        9 => json!(u32::MAX),
+        10 => json!(1e19),
+        11 => json!(-1e19),
+        12 => json!(0.5),
+        _ => json!(1_000_000_000),
+    }
+}
+
+fn mutate_node(
+    rng: &mut impl Rng,
+    v: &mut serde_json::Value,
+    target: usize,
+    seen: &mut usize,
+) -> bool {
+    use serde_json::Value;
+    if *seen == target {
+        change(rng, v);
+        return true;
+    }
+    *seen += 1;
+    match v {
+        Value::Array(a) => a.iter_mut().any(|x| mutate_node(rng, x, target, seen)),
+        Value::Object(o) => o.values_mut().any(|x| mutate_node(rng, x, target, seen)),
+        _ => false,
+    }
+}
+
+fn change(rng: &mut impl Rng, v: &mut serde_json::Value) {
+    use serde_json::Value;
+    match v {
+        Value::Number(_) if rng.random_bool(0.8) => *v = extreme_json_number(rng),
+        Value::String(s) if rng.random_bool(0.8) => {
+            *s = match rng.random_range(0..5) {
+                0 => String::new(),
+                1 => "x".repeat(10_000),
+                2 => "\u{202e}\u{0}\n\"".to_string(),
+                3 => s.to_uppercase(),
+                _ => s.to_lowercase(),
+            };
+        }
+        Value::Array(a) if !a.is_empty() && rng.random_bool(0.8) => {
+            if rng.random_bool(0.5) {
+                let times = [2usize, 10, 100, 1000][rng.random_range(0..4)];
+                let i = rng.random_range(0..a.len());
+                let item = a[i].clone();
+                a.extend(std::iter::repeat_n(item, times));
+            } else {
+                a.truncate(rng.random_range(0..a.len()));
+            }
+        }
+        Value::Object(o) if !o.is_empty() && rng.random_bool(0.8) => {
+            if rng.random_bool(0.6) {
+                let i = rng.random_range(0..o.len());
+                if let Some(k) = o.keys().nth(i).cloned() {
+                    o.remove(&k);
+                }
+            } else {
+                o.insert("unknown_key".to_string(), Value::Bool(true));
+            }
+        }
+        _ => {
+            *v = match rng.random_range(0..6) {
+                0 => Value::Null,
+                1 => Value::Bool(true),
+                2 => extreme_json_number(rng),
+                3 => Value::String("PLAYING".to_string()),
+                4 => Value::Array(Vec::new()),
+                _ => Value::Object(serde_json::Map::new()),
+            };
+        }
+    }
+}
+
+#[cfg(test)]
+mod json_tests {
+    use super::*;
+    use rand::SeedableRng;
+    use rand_chacha::ChaCha8Rng;
+
+    #[test]
+    fn json_mutants_stay_json_and_change() {
+        let seed = br#"{"lps": [{"rho": 3000, "theta": 1.0}], "role": "attacker", "mates": []}"#;
+        let mut rng = ChaCha8Rng::seed_from_u64(3);
+        let mutants: Vec<Vec<u8>> = (0..500).filter_map(|_| mutate_json(&mut rng, seed)).collect();
+        assert_eq!(mutants.len(), 500);
+        assert!(mutants.iter().all(|m| serde_json::from_slice::<serde_json::Value>(m).is_ok()));
+        assert!(mutants.iter().filter(|m| m.as_slice() != seed.as_slice()).count() > 400);
+        assert!(mutate_json(&mut rng, b"not json").is_none());
+    }
+}
+
+/// Structure-aware mutation of a TOML document, as [`mutate_json`] does for JSON: integers
+/// and floats to extremes (NaN and infinities included, which TOML can write), booleans
+/// flipped, arrays repeated or cut, keys removed or foreign ones added, a value's type
+/// changed. `None` when the seed is not TOML.
+pub fn mutate_toml(rng: &mut impl Rng, seed: &[u8]) -> Option<Vec<u8>> {
+    let text = std::str::from_utf8(seed).ok()?;
+    let mut table: toml::Table = text.parse().ok()?;
+    for _ in 0..rng.random_range(1..=3) {
+        let n = table.values().map(count_toml).sum::<usize>().max(1);
+        let target = rng.random_range(0..n);
+        let mut seen = 0;
+        for (_, v) in table.iter_mut() {
+            if mutate_toml_node(rng, v, target, &mut seen) {
+                break;
+            }
+        }
+    }
+    toml::to_string(&table).ok().map(String::into_bytes)
+}
+
+fn count_toml(v: &toml::Value) -> usize {
+    1 + match v {
+        toml::Value::Array(a) => a.iter().map(count_toml).sum(),
+        toml::Value::Table(t) => t.values().map(count_toml).sum(),
+        _ => 0,
+    }
+}
+
+fn mutate_toml_node(
+    rng: &mut impl Rng,
+    v: &mut toml::Value,
+    target: usize,
+    seen: &mut usize,
+) -> bool {
+    use toml::Value;
+    if *seen == target {
+        change_toml(rng, v);
+        return true;
+    }
+    *seen += 1;
+    match v {
+        Value::Array(a) => a.iter_mut().any(|x| mutate_toml_node(rng, x, target, seen)),
+        Value::Table(t) => t.iter_mut().any(|(_, x)| mutate_toml_node(rng, x, target, seen)),
+        _ => false,
+    }
+}
+
+const TOML_FLOATS: [f64; 14] = [
+    0.0,
+    -0.0,
+    -1.0,
+    1e-9,
+    5e-324,
+    1e308,
+    -1e308,
+    f64::MAX,
+    f64::NAN,
+    f64::INFINITY,
+    f64::NEG_INFINITY,
+    1e19,
+    0.5,
+    1e9,
+];
+const TOML_INTS: [i64; 10] =
+    [0, -1, 1, i64::MAX, i64::MIN, u32::MAX as i64, 1 << 53, 1_000_000_000, 255, 65536];
+
+fn change_toml(rng: &mut impl Rng, v: &mut toml::Value) {
+    use toml::Value;
+    let float = |rng: &mut dyn rand::RngCore| TOML_FLOATS[rng.random_range(0..TOML_FLOATS.len())];
+    let int = |rng: &mut dyn rand::RngCore| TOML_INTS[rng.random_range(0..TOML_INTS.len())];
+    match v {
+        Value::Float(f) if rng.random_bool(0.8) => *f = float(rng),
+        Value::Integer(i) if rng.random_bool(0.8) => *i = int(rng),
+        Value::Boolean(b) if rng.random_bool(0.8) => *b = !*b,
+        Value::Array(a) if !a.is_empty() && rng.random_bool(0.8) => {
+            if rng.random_bool(0.5) {
+                let times = [2usize, 10, 100, 1000][rng.random_range(0..4)];
+                let item = a[rng.random_range(0..a.len())].clone();
+                a.extend(std::iter::repeat_n(item, times));
+            } else {
+                a.truncate(rng.random_range(0..a.len()));
+            }
+        }
+        Value::Table(t) if !t.is_empty() && rng.random_bool(0.8) => {
+            if rng.random_bool(0.6) {
+                let i = rng.random_range(0..t.len());
+                if let Some(k) = t.keys().nth(i).cloned() {
+                    t.remove(&k);
+                }
+            } else {
+                t.insert("unknown_key".to_string(), Value::Boolean(true));
+            }
+        }
+        _ => {
+            *v = match rng.random_range(0..5) {
+                0 => Value::Float(float(rng)),
+                1 => Value::Integer(int(rng)),
+                2 => Value::String(String::new()),
+                3 => Value::Boolean(false),
+                _ => Value::Array(Vec::new()),
+            };
+        }
+    }
+}
+
+#[cfg(test)]
+mod toml_tests {
+    use super::*;
+    use rand::SeedableRng;
+    use rand_chacha::ChaCha8Rng;
+
+    #[test]
+    fn toml_mutants_stay_toml_and_change() {
+        let seed = b"[field]\nlength = 18.0\nwidth = 12.0\n[match]\nrobots = 4\nhalves = [1, 2]\n";
+        let mut rng = ChaCha8Rng::seed_from_u64(3);
+        let mutants: Vec<Vec<u8>> = (0..500).filter_map(|_| mutate_toml(&mut rng, seed)).collect();
+        assert_eq!(mutants.len(), 500);
+        assert!(mutants
+            .iter()
+            .all(|m| std::str::from_utf8(m).unwrap().parse::<toml::Table>().is_ok()));
+        assert!(mutants.iter().filter(|m| m.as_slice() != seed.as_slice()).count() > 400);
+    }
+}

@@ -68,6 +68,7 @@ static PICKY: Target = Target {
     name: "picky",
     about: "panics on !",
     keywords: &["!"],
+    structured: None,
     seeds: |_| Ok(vec![Seed::new("a/b.txt", "hello world 12"), Seed::new("c", "x y")]),
     harness: |_| Ok(Box::new(Picky)),
 };

@@ -19,6 +19,7 @@ pub(super) const DCDT_CONFIG: Target = Target {
     name: "dcdt-config",
     about: "DCDT Agora configuration files: AgoraConfig::parse_bytes, then the canonical form must parse back to the same value",
     keywords: &["PostOffice:", "SLWB", "SLWDWCV", "SLWSM", "PMQ", "ip", "ser", "link", "bridge", "::1", "ff02::1", "224.0.0.1", "/dev/ttyS0"],
+    structured: None,
     seeds: |root| files_under(&root.join("configs/dcdt"), |_| true),
     harness: |_| Ok(Box::new(DcdtConfig)),
 };
@@ -44,6 +45,7 @@ pub(super) const BRIAN: Target = Target {
     name: "brian",
     about: "Mr. BRIAN configurations (every file of configs/brian/*, one mutated at a time): Brian::from_sources, then cycles on extreme inputs",
     keywords: &["TRI", "TOL", "TOR", "DIV", "TRA", "REC", "SNG", "AND", "OR", "NOT", "P", "D", "&DEL", "level", "=>", "=", ";", "(", ")"],
+    structured: None,
     seeds: |root| {
         files_under(&root.join("configs/brian"), |slot| !slot.ends_with(".md") && slot.contains('/'))
     },
@@ -100,6 +102,7 @@ pub(super) const SIM_CONFIG: Target = Target {
     name: "sim-config",
     about: "the simulator's TOML configuration: SimConfig::from_toml (parse + validate), the derived objects, and to_toml read back",
     keywords: &["[field]", "[ball]", "[robot]", "[match]", "[sensor]", "[sonar]", "[odometry]", "[guidance]", "=", "true", "false", "\"\"", "[]", "{}", "nan", "inf", "-inf", "1e400"],
+    structured: Some(crate::mutate::mutate_toml),
     seeds: |root| files_under(&root.join("configs/sim"), |s| s.ends_with(".toml")),
     harness: |_| Ok(Box::new(SimToml)),
 };
@@ -132,6 +135,7 @@ pub(super) const BB_CONFIG: Target = Target {
     name: "bb-config",
     about: "blackboard config.dat files: config::parse, then every binding set on a blackboard as load_file does",
     keywords: &["Int", "Float", "Bool", "String", "true", "false", "local", "var", "talk", "*", "\"", "\\\"", "\\n", "\\u{0}"],
+    structured: None,
     seeds: |root| files_under(&root.join("configs/bb"), |s| s.ends_with(".dat")),
     harness: |_| Ok(Box::new(BbConfig)),
 };
@@ -158,6 +162,7 @@ pub(super) const RELAY_LINE: Target = Target {
     name: "relay-line",
     about: "relay request lines: UTF-8 check and parse_request per line as the relay's client thread does, SETV/GETV/LSTV served on a small blackboard",
     keywords: &["AUTH", "REFR", "ADDW", "DELW", "CLRW", "LSTW", "SETV", "GETV", "LSTV", "QUIT", "Int", "Float", "Bool", "String", "local.var.", "*.var.", "*", "-", "\r"],
+    structured: None,
     seeds: relay_seeds,
     harness: |_| Ok(Box::new(RelayLines)),
 };

@@ -157,6 +157,7 @@ pub(super) const LUA_SCRIPT: Target = Target {
     name: "lua-script",
     about: "Lua behavior scripts (behaviors/teamchaos/*.lua): Script::from_source and two calls in a small sandbox with chaos.* installed",
     keywords: LUA_WORDS,
+    structured: None,
     seeds: |root| lua_seeds(root, |s| s.ends_with(".lua")),
     harness: |_| Ok(Box::new(Scripts { runtime: None })),
 };
@@ -186,6 +187,7 @@ pub(super) const HBM: Target = Target {
     name: "hbm",
     about: "HBM behaviors (hbm.lua and each behavior of behaviors/teamchaos): Hbm::from_sources, then the behavior run for two cycles",
     keywords: LUA_WORDS,
+    structured: None,
     seeds: |root| lua_seeds(root, |s| s.ends_with(".lua") && !s.ends_with(".hfsm.lua")),
     harness: |root| {
         let files = lua_seeds(root, |s| s.ends_with(".lua") && !s.ends_with(".hfsm.lua"))?;
@@ -250,6 +252,7 @@ pub(super) const HFSM: Target = Target {
     name: "hfsm",
     about: "HFSM files (behaviors/teamchaos/*.hfsm.lua): Hfsm::from_source, five steps, dot and SVG drawings",
     keywords: LUA_WORDS,
+    structured: None,
     seeds: |root| lua_seeds(root, |s| s.ends_with(".hfsm.lua")),
     harness: |_| Ok(Box::new(Machines { runtime: None })),
 };
@@ -281,6 +284,7 @@ pub(super) const WORLD: Target = Target {
     name: "world",
     about: "world snapshots as mrt behave reads them (JSON → WorldSnapshot, one or an array), then run through the Attacker's ThinkingCap cycles",
     keywords: &["lps", "rho", "theta", "reliability", "seen_ago", "my_pos", "pose", "quality", "ball_vel", "global_ball", "mates", "id", "at", "keeper", "role", "ball_booked", "game_state", "field", "half_length", "half_width", "goal_half_width", "penalty_area_depth", "kickoff_pose", "time", "x", "y", "null", "true", "false", "[]", "{}", "\"PLAYING\"", "\"Playing\"", ":", ","],
+    structured: Some(crate::mutate::mutate_json),
     seeds: |root| {
         let mut seeds = files_under(&teamchaos(root).join("worlds"), |s| s.ends_with(".json"))?;
         let json = |w: &WorldSnapshot| serde_json::to_string_pretty(w).unwrap_or_default();

@@ -34,6 +34,9 @@ pub trait Harness {
     fn exec(&mut self, seed: &Seed, input: &[u8]) -> bool;
 }
 
+/// A format's own mutation: the seed's bytes to a mutant, or `None` (not of the format).
+pub type Structured = fn(&mut rand_chacha::ChaCha8Rng, &[u8]) -> Option<Vec<u8>>;
+
 /// A fuzz target.
 pub struct Target {
     /// Its name on the command line.
@@ -42,6 +45,9 @@ pub struct Target {
     pub about: &'static str,
     /// Words of the format worth inserting (the seeds' own words are added).
     pub keywords: &'static [&'static str],
+    /// A mutation of the format's own, used for half of the inputs besides the byte-level
+    /// ones: the seed's bytes to a mutant, or `None` to fall back to the byte level.
+    pub structured: Option<Structured>,
     /// Reads the seed corpus under the repository root.
     pub seeds: fn(&Path) -> Result<Vec<Seed>, FuzzError>,
     /// Builds a harness (the repository root is where it finds the files it needs besides the

@@ -14,6 +14,7 @@ pub(super) const WIRE: Target = Target {
     name: "wire",
     about: "DCDT wire frames: wire::decode, the payload read as every standard message type, a decoded frame re-encoded to the same bytes",
     keywords: &["DCDT"],
+    structured: None,
     seeds: wire_seeds,
     harness: |_| Ok(Box::new(Frames)),
 };
@@ -147,6 +148,7 @@ pub(super) const XML: Target = Target {
     name: "xml",
     about: "self-describing XML messages: SelfDescribing::from_xml, and a parsed message's to_xml read back the same",
     keywords: &["<message", "</message>", "<object", "</object>", "<attribute", "/>", "timestamp=", "name=", "class=", "value=", "symbol=", "variability=", "reliability=", "&amp;", "&lt;", "&#0;", "&#x1F600;", "<!DOCTYPE message>", "<?xml version=\"1.0\"?>", "<!--", "-->", "<![CDATA[", "]]>"],
+    structured: None,
     seeds: |_| {
         Ok(vec![
             Seed::new("sample", sample_describing().to_xml()),
