@@ -147,6 +147,205 @@ fn read(path: &Path) -> Result<String, BrianError> {
     crate::lexer::utf8(bytes, path)
 }
 
+/// Where a configuration's files come from: the disk, or memory ([`BrianSources`]).
+trait Source {
+    /// The text of a file (UTF-8 checked, errors located).
+    fn read(&self, path: &Path) -> Result<String, BrianError>;
+    /// Whether an optional file is there.
+    fn exists(&self, path: &Path) -> bool;
+    /// The root every rule file must lie in (the disk's: `base` canonicalized).
+    fn root(&self, base: &Path) -> Result<PathBuf, BrianError>;
+    /// The checked file a `behavior.txt` line names (see [`rule_file`]).
+    fn rule_file(
+        &self,
+        root: &Path,
+        base: &Path,
+        list: &Path,
+        b: &Listed,
+    ) -> Result<PathBuf, BrianError>;
+}
+
+/// The files of a directory on disk.
+struct Disk;
+
+impl Source for Disk {
+    fn read(&self, path: &Path) -> Result<String, BrianError> {
+        read(path)
+    }
+
+    fn exists(&self, path: &Path) -> bool {
+        path.exists()
+    }
+
+    fn root(&self, base: &Path) -> Result<PathBuf, BrianError> {
+        base.canonicalize().map_err(|source| BrianError::Io { file: base.to_path_buf(), source })
+    }
+
+    fn rule_file(
+        &self,
+        root: &Path,
+        base: &Path,
+        list: &Path,
+        b: &Listed,
+    ) -> Result<PathBuf, BrianError> {
+        rule_file(root, base, list, b)
+    }
+}
+
+/// A configuration held in memory: each file's bytes under its name in the configuration
+/// directory (`shape_ctof.txt`, `ctof.txt`, `Predicate.ini`, `PredicateActions.ini` (optional),
+/// `Cando.ini`, `want.txt`, `behavior.txt`, `s_shape.txt`, `s_ftoc.txt`) and each rule file
+/// under the path `behavior.txt` gives it (`behaviors/GoToBall.rul`). For tools, tests and
+/// fuzzers that have no directory; [`Brian::from_sources`] loads it exactly as
+/// [`Brian::from_dir`] loads a directory holding the same files.
+///
+/// ```
+/// use mrt_fuzzy::brian::{Brian, BrianSources};
+///
+/// let mut files = BrianSources::new();
+/// files.insert("shape_ctof.txt", "(Distance (TOL (NEAR 10 50)) (TOR (FAR 10 50)))");
+/// files.insert("ctof.txt", "(TargetDistance Distance)");
+/// files.insert("Predicate.ini", "Far = (D TargetDistance FAR);");
+/// files.insert("s_shape.txt", "(SPEED (SNG (SLOW 10)) (SNG (FAST 100)))");
+/// files.insert("s_ftoc.txt", "(Speed SPEED)");
+/// files.insert("behavior.txt", "(level 1 Go behaviors/Go.rul)");
+/// files.insert("Cando.ini", "Go = (P Far);");
+/// files.insert("want.txt", "Go = (P Far);");
+/// files.insert("behaviors/Go.rul", "(Far) => (Speed FAST);");
+/// let mut brian = Brian::from_sources(&files)?;
+/// let commands = brian.run(&[("TargetDistance", 100.0, 1.0)]);
+/// assert_eq!(commands["Speed"], 100.0);
+/// # Ok::<(), mrt_fuzzy::BrianError>(())
+/// ```
+#[derive(Clone, Debug, Default)]
+pub struct BrianSources {
+    files: BTreeMap<PathBuf, Vec<u8>>,
+}
+
+impl BrianSources {
+    /// No files.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Adds (or replaces) the file `name`, a path relative to the configuration directory.
+    pub fn insert(&mut self, name: impl Into<PathBuf>, bytes: impl Into<Vec<u8>>) {
+        self.files.insert(name.into(), bytes.into());
+    }
+
+    /// Removes the file `name`, returning its bytes.
+    pub fn remove(&mut self, name: impl AsRef<Path>) -> Option<Vec<u8>> {
+        self.files.remove(name.as_ref())
+    }
+
+    /// The file `name`'s bytes.
+    pub fn get(&self, name: impl AsRef<Path>) -> Option<&[u8]> {
+        self.files.get(name.as_ref()).map(Vec::as_slice)
+    }
+
+    /// The files' names, sorted.
+    pub fn names(&self) -> impl Iterator<Item = &Path> {
+        self.files.keys().map(PathBuf::as_path)
+    }
+
+    /// Reads every regular file of a configuration directory and of its subdirectories (at
+    /// most [`SOURCES_DEPTH`] deep; links are not followed) into memory.
+    pub fn read_dir(dir: impl AsRef<Path>) -> Result<BrianSources, BrianError> {
+        let mut out = BrianSources::new();
+        out.read_under(dir.as_ref(), Path::new(""), 0)?;
+        Ok(out)
+    }
+
+    fn read_under(&mut self, dir: &Path, rel: &Path, depth: usize) -> Result<(), BrianError> {
+        let io = |file: &Path| {
+            let file = file.to_path_buf();
+            move |source| BrianError::Io { file, source }
+        };
+        for entry in std::fs::read_dir(dir).map_err(io(dir))? {
+            let entry = entry.map_err(io(dir))?;
+            let path = entry.path();
+            let kind = entry.file_type().map_err(io(&path))?;
+            let name = rel.join(entry.file_name());
+            if kind.is_file() {
+                let bytes = std::fs::read(&path).map_err(io(&path))?;
+                self.files.insert(name, bytes);
+            } else if kind.is_dir() && depth < SOURCES_DEPTH {
+                self.read_under(&path, &name, depth + 1)?;
+            }
+        }
+        Ok(())
+    }
+}
+
+/// How deep [`BrianSources::read_dir`] descends into subdirectories.
+pub const SOURCES_DEPTH: usize = 8;
+
+impl Source for BrianSources {
+    fn read(&self, path: &Path) -> Result<String, BrianError> {
+        match self.files.get(path) {
+            Some(bytes) => crate::lexer::utf8(bytes.clone(), path),
+            None => Err(BrianError::Io {
+                file: path.to_path_buf(),
+                source: std::io::ErrorKind::NotFound.into(),
+            }),
+        }
+    }
+
+    fn exists(&self, path: &Path) -> bool {
+        self.files.contains_key(path)
+    }
+
+    fn root(&self, _base: &Path) -> Result<PathBuf, BrianError> {
+        Ok(PathBuf::new())
+    }
+
+    /// The path as written, `.` and `..` taken lexically; leaving the configuration (`..` past
+    /// its top, an absolute path) is an error, as on disk.
+    fn rule_file(
+        &self,
+        _root: &Path,
+        _base: &Path,
+        list: &Path,
+        b: &Listed,
+    ) -> Result<PathBuf, BrianError> {
+        use std::path::Component;
+        let mut name = PathBuf::new();
+        let mut inside = true;
+        for part in Path::new(&b.path).components() {
+            match part {
+                Component::Normal(p) => name.push(p),
+                Component::CurDir => {}
+                Component::ParentDir => inside &= name.pop(),
+                Component::RootDir | Component::Prefix(_) => inside = false,
+            }
+        }
+        if !inside {
+            return Err(BrianError::at(
+                list,
+                b.path_span,
+                format!(
+                    "the rule file `{}` of behavior `{}` is outside the configuration directory: \
+                     rule files must be inside it",
+                    b.path, b.name
+                ),
+            ));
+        }
+        if !self.files.contains_key(&name) {
+            return Err(BrianError::at(
+                list,
+                b.path_span,
+                format!(
+                    "cannot open the rule file `{}` of behavior `{}`: {}",
+                    b.path,
+                    b.name,
+                    std::io::Error::from(std::io::ErrorKind::NotFound)
+                ),
+            ));
+        }
+        Ok(name)
+    }
+}
+
 /// A crisp input of `ctof.txt`.
 #[derive(Clone, Debug)]
 struct Input {
@@ -427,10 +626,11 @@ impl<'a> Outputs<'a> {
 }
 
 fn parse_file<T>(
+    src: &dyn Source,
     path: &Path,
     f: impl FnOnce(&mut Cursor<'_>) -> Result<T, BrianError>,
 ) -> Result<T, BrianError> {
-    parse_text(&read(path)?, path, f)
+    parse_text(&src.read(path)?, path, f)
 }
 
 fn parse_text<T>(
@@ -498,6 +698,19 @@ impl Brian {
     ///
     /// Loading takes time linear in the size of the files.
     pub fn from_files(files: &BrianFiles, base: &Path) -> Result<Brian, BrianError> {
+        Brian::load(&Disk, files, base)
+    }
+
+    /// Loads a configuration held in memory (see [`BrianSources`]): the same checks and the
+    /// same errors as [`Brian::from_dir`] on a directory holding these files, with file names
+    /// relative to the configuration.
+    pub fn from_sources(sources: &BrianSources) -> Result<Brian, BrianError> {
+        let base = Path::new("");
+        Brian::load(sources, &BrianFiles::in_dir(base), base)
+    }
+
+    fn load(src: &dyn Source, files: &BrianFiles, base: &Path) -> Result<Brian, BrianError> {
+        let read = |path: &Path| src.read(path);
         let shapes = parse_shapes(&read(&files.shape_ctof)?, &files.shape_ctof)?;
         let assocs = parse_associations(&read(&files.ctof)?, &files.ctof)?;
         let idx = resolve(&assocs, &shapes, &files.ctof)?;
@@ -532,7 +745,7 @@ impl Brian {
         let mut pred_spans = Vec::new();
         let mut pact_spans = Vec::new();
         let mut predicates: Vec<(String, Expr)> = Vec::new();
-        for (name, span, raw) in parse_file(&files.predicates, parse_definitions)? {
+        for (name, span, raw) in parse_file(src, &files.predicates, parse_definitions)? {
             pred_spans.push(span);
             let e =
                 Names { inputs: &inputs, index: &index, file: &files.predicates }.resolve(&raw)?;
@@ -540,8 +753,8 @@ impl Brian {
             predicates.push((name, e));
         }
         let mut predicate_actions: Vec<(String, Expr)> = Vec::new();
-        if files.predicate_actions.exists() {
-            for (name, span, raw) in parse_file(&files.predicate_actions, parse_definitions)? {
+        if src.exists(&files.predicate_actions) {
+            for (name, span, raw) in parse_file(src, &files.predicate_actions, parse_definitions)? {
                 if index.predicates.contains_key(&name) {
                     return Err(BrianError::at(
                         &files.predicate_actions,
@@ -603,17 +816,15 @@ impl Brian {
         let outputs = Outputs::new(&actions);
 
         let names = Names { inputs: &inputs, index: &index, file: &files.cando };
-        let cando = parse_file(&files.cando, parse_definitions)?;
-        let want = parse_file(&files.want, parse_definitions)?;
+        let cando = parse_file(src, &files.cando, parse_definitions)?;
+        let want = parse_file(src, &files.want, parse_definitions)?;
         // Names are unique in each file (parse_definitions refuses duplicates).
         let cando_of: HashMap<&str, &RawExpr> =
             cando.iter().map(|(n, _, raw)| (n.as_str(), raw)).collect();
         let want_of: HashMap<&str, &RawExpr> =
             want.iter().map(|(n, _, raw)| (n.as_str(), raw)).collect();
-        let root = base
-            .canonicalize()
-            .map_err(|source| BrianError::Io { file: base.to_path_buf(), source })?;
-        let listed = parse_file(&files.behaviors, parse_behavior_list)?;
+        let root = src.root(base)?;
+        let listed = parse_file(src, &files.behaviors, parse_behavior_list)?;
         let mut seen: HashSet<&str> = HashSet::with_capacity(listed.len());
         // Behaviors often share a rule file: each file is read and resolved once.
         let mut rule_files: HashMap<PathBuf, Vec<Rule>> = HashMap::new();
@@ -631,7 +842,7 @@ impl Brian {
             let canon = match checked.get(b.path.as_str()) {
                 Some(canon) => canon.clone(),
                 None => {
-                    let canon = rule_file(&root, base, &files.behaviors, b)?;
+                    let canon = src.rule_file(&root, base, &files.behaviors, b)?;
                     checked.insert(b.path.as_str(), canon.clone());
                     canon
                 }

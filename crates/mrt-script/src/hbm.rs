@@ -105,7 +105,8 @@ struct Shared {
 
 /// A directory of HBM behaviors loaded into one Lua runtime.
 pub struct Hbm {
-    dir: PathBuf,
+    /// The behavior directory; `None` for behaviors given as text ([`Hbm::from_sources`]).
+    dir: Option<PathBuf>,
     shared: Rc<Shared>,
     drives: Vec<Option<Drives>>,
     setup: Option<Script>,
@@ -122,6 +123,67 @@ impl Hbm {
         io: Rc<RefCell<RobotIo>>,
     ) -> Result<Hbm, ScriptError> {
         let dir = dir.as_ref().to_path_buf();
+        let setup_path = dir.join("hbm.lua");
+        let setup = |rt: &LuaRuntime| {
+            setup_path
+                .is_file()
+                .then(|| Script::from_file(rt, &setup_path, LoadStrategy::Compiled))
+                .transpose()
+        };
+        let hbm = Hbm::prepare(rt, Some(dir.clone()), io, setup)?;
+        for (name, path) in behavior_files(&dir)? {
+            let script = Script::from_file(rt, &path, LoadStrategy::Compiled)?;
+            hbm.shared.behaviors.borrow_mut().insert(name, script);
+        }
+        Ok(hbm)
+    }
+
+    /// [`Hbm::load_dir`] on behaviors given as text, for tools, tests and fuzzers without a
+    /// directory: `setup` is the text of `hbm.lua` (if any), `behaviors` are (name, text)
+    /// pairs; errors name `hbm.lua` and `<name>.lua`. The same checks as from a directory;
+    /// reloading finds nothing to reload.
+    ///
+    /// ```
+    /// use mrt_script::chaos::{self, RobotIo};
+    /// use mrt_script::hbm::Hbm;
+    /// use mrt_script::{LuaRuntime, Sandbox};
+    /// use std::{cell::RefCell, rc::Rc};
+    ///
+    /// let rt = LuaRuntime::new(Sandbox::default())?;
+    /// let io = Rc::new(RefCell::new(RobotIo::default()));
+    /// chaos::install(&rt, io.clone())?;
+    /// let hbm = Hbm::from_sources(&rt, None, &[("stop", r#"always("go", "STAY")"#)], io.clone())?;
+    /// hbm.run(&rt, "stop")?;
+    /// assert_eq!(io.borrow().command.vlin, 0.0);
+    /// # Ok::<(), mrt_script::ScriptError>(())
+    /// ```
+    pub fn from_sources(
+        rt: &LuaRuntime,
+        setup: Option<&str>,
+        behaviors: &[(&str, &str)],
+        io: Rc<RefCell<RobotIo>>,
+    ) -> Result<Hbm, ScriptError> {
+        let setup = |rt: &LuaRuntime| {
+            setup
+                .map(|text| Script::from_source(rt, "hbm.lua", text, LoadStrategy::Compiled))
+                .transpose()
+        };
+        let hbm = Hbm::prepare(rt, None, io, setup)?;
+        for (name, text) in behaviors {
+            let script =
+                Script::from_source(rt, &format!("{name}.lua"), text, LoadStrategy::Compiled)?;
+            hbm.shared.behaviors.borrow_mut().insert((*name).to_string(), script);
+        }
+        Ok(hbm)
+    }
+
+    /// Installs the rule language, runs the default variables, then the setup script.
+    fn prepare(
+        rt: &LuaRuntime,
+        dir: Option<PathBuf>,
+        io: Rc<RefCell<RobotIo>>,
+        setup: impl FnOnce(&LuaRuntime) -> Result<Option<Script>, ScriptError>,
+    ) -> Result<Hbm, ScriptError> {
         let shared = Rc::new(Shared {
             behaviors: RefCell::new(BTreeMap::new()),
             cdb: RefCell::new(Blender::new(Vec::new(), lps::COUNT)),
@@ -133,20 +195,12 @@ impl Hbm {
         let defaults =
             Script::from_source(rt, "hbm_defaults.lua", DEFAULT_VARIABLES, LoadStrategy::Compiled)?;
         defaults.call::<()>(rt)?;
-        let setup_path = dir.join("hbm.lua");
-        let setup = if setup_path.is_file() {
-            let s = Script::from_file(rt, &setup_path, LoadStrategy::Compiled)?;
+        let setup = setup(rt)?;
+        if let Some(s) = &setup {
             s.call::<()>(rt)?;
-            Some(s)
-        } else {
-            None
-        };
+        }
         let mut hbm = Hbm { dir, shared, drives: Vec::new(), setup, io };
         hbm.rebuild_blender();
-        for (name, path) in behavior_files(&hbm.dir)? {
-            let script = Script::from_file(rt, &path, LoadStrategy::Compiled)?;
-            hbm.shared.behaviors.borrow_mut().insert(name, script);
-        }
         Ok(hbm)
     }
 
@@ -218,7 +272,11 @@ impl Hbm {
     }
 
     fn file_of(&self, name: &str) -> String {
-        self.dir.join(format!("{name}.lua")).display().to_string()
+        let file = format!("{name}.lua");
+        match &self.dir {
+            Some(dir) => dir.join(file).display().to_string(),
+            None => file,
+        }
     }
 
     /// Applies changes reported by a [`ScriptWatcher`](crate::ScriptWatcher): a behavior
@@ -307,7 +365,8 @@ impl Hbm {
                 Err(e) => errors.push(e),
             }
         }
-        let files = match behavior_files(&self.dir) {
+        let Some(dir) = &self.dir else { return (done, errors) };
+        let files = match behavior_files(dir) {
             Ok(f) => f,
             Err(e) => {
                 errors.push(e);
