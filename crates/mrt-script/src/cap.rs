@@ -9,9 +9,11 @@
 //! keeps its running version. The next cycle runs normally. Every error is reported in
 //! [`Cycle::errors`].
 //!
-//! A behavior that runs away [`RUNAWAY_LIMIT`] cycles in a row is hostile, not unlucky: the
-//! robot is **stopped** (the safe command, no Lua run, so it costs nothing) until a file is
-//! reloaded, and [`ScriptError::Stopped`] says so once.
+//! Behaviors that run away [`RUNAWAY_LIMIT`] cycles in a row, or fail for any reason
+//! [`FAULT_LIMIT`] cycles in a row, are broken, not unlucky (the robot stood still in each of
+//! those cycles anyway): the robot is **stopped** (the safe command, no Lua run, so a hostile
+//! behavior costs its match nothing from then on) until a file is reloaded, and
+//! [`ScriptError::Stopped`] says so once.
 
 use crate::chaos::{self, RobotIo};
 use crate::hbm::Hbm;
@@ -28,6 +30,10 @@ use std::rc::Rc;
 /// Runaway cycles (budget or memory overruns) in a row after which the robot is stopped until
 /// a behavior file is reloaded.
 pub const RUNAWAY_LIMIT: u32 = 3;
+
+/// Failing cycles (any error of the HFSM or the behavior) in a row after which the robot is
+/// stopped until a behavior file is reloaded: 2 s of the seed's 100 ms cycle.
+pub const FAULT_LIMIT: u32 = 20;
 
 /// What one cycle did.
 #[derive(Debug)]
@@ -62,6 +68,8 @@ pub struct ThinkingCap {
     watcher: Option<ScriptWatcher>,
     /// Runaway cycles in a row.
     runaways: u32,
+    /// Failing cycles in a row (runaways included).
+    failing: u32,
 }
 
 impl ThinkingCap {
@@ -95,7 +103,16 @@ impl ThinkingCap {
         let hfsm = Hfsm::from_file(&rt, machine.as_ref(), io.clone())?;
         let top =
             Top::Hfsm(Box::new(hfsm), std::path::absolute(machine.as_ref()).unwrap_or_default());
-        Ok(ThinkingCap { rt, io, hbm, top, last_good: None, watcher: None, runaways: 0 })
+        Ok(ThinkingCap {
+            rt,
+            io,
+            hbm,
+            top,
+            last_good: None,
+            watcher: None,
+            runaways: 0,
+            failing: 0,
+        })
     }
 
     /// [`ThinkingCap::with_behavior`] with `bb.*` bound to the robot's `blackboard`.
@@ -114,7 +131,16 @@ impl ThinkingCap {
             )));
         }
         let top = Top::Behavior(behavior.to_string());
-        Ok(ThinkingCap { rt, io, hbm, top, last_good: None, watcher: None, runaways: 0 })
+        Ok(ThinkingCap {
+            rt,
+            io,
+            hbm,
+            top,
+            last_good: None,
+            watcher: None,
+            runaways: 0,
+            failing: 0,
+        })
     }
 
     fn base(
@@ -213,7 +239,7 @@ impl ThinkingCap {
 
     /// Whether the robot is stopped for running away (see the module documentation).
     pub fn stopped(&self) -> bool {
-        self.runaways >= RUNAWAY_LIMIT
+        self.runaways >= RUNAWAY_LIMIT || self.failing >= FAULT_LIMIT
     }
 
     /// What the top of the stack is called in errors (the HFSM file or the behavior).
@@ -251,7 +277,7 @@ impl ThinkingCap {
         }
         if !done.is_empty() {
             // An edited behavior gets a fresh start.
-            self.runaways = 0;
+            (self.runaways, self.failing) = (0, 0);
         }
         (done, errors)
     }
@@ -263,6 +289,7 @@ impl ThinkingCap {
         if !changes.is_empty() {
             (reloaded, errors) = self.apply(changes);
         }
+        let rejected = errors.len();
         self.io.borrow_mut().new_cycle(world);
         if self.stopped() {
             let command = RobotCommand::default();
@@ -309,12 +336,20 @@ impl ThinkingCap {
         if command.behavior.is_none() {
             command.behavior = behavior.clone();
         }
-        let runaway = errors
+        // What ran this cycle failed (a rejected reload is not the running behavior's fault).
+        let failed = &errors[rejected..];
+        let runaway = failed
             .iter()
             .any(|e| matches!(e, ScriptError::Budget { .. } | ScriptError::Memory { .. }));
         self.runaways = if runaway { self.runaways + 1 } else { 0 };
+        self.failing = if failed.is_empty() { 0 } else { self.failing + 1 };
         if self.stopped() {
-            errors.push(ScriptError::Stopped { file: self.top_name(), runaways: self.runaways });
+            let (cycles, why) = if self.runaways >= RUNAWAY_LIMIT {
+                (self.runaways, "running away")
+            } else {
+                (self.failing, "with errors")
+            };
+            errors.push(ScriptError::Stopped { file: self.top_name(), cycles, why });
         }
         Cycle { command, path, behavior, taken, reloaded, errors }
     }

@@ -50,7 +50,7 @@ mod script;
 mod watch;
 mod watchdog;
 
-pub use cap::{Cycle, ThinkingCap, RUNAWAY_LIMIT};
+pub use cap::{Cycle, ThinkingCap, FAULT_LIMIT, RUNAWAY_LIMIT};
 pub use runtime::{Interrupt, LuaRuntime, Sandbox, MAX_TEXT, PRINT_LINES_PER_CALL};
 pub use script::{LoadStrategy, Script, ScriptError};
 pub use watch::{Change, Compiled, ScriptWatcher};

@@ -56,14 +56,16 @@ pub enum ScriptError {
         /// The deadline.
         deadline_ms: u64,
     },
-    /// The robot was stopped: its behaviors ran away (budget or memory) this many cycles in a
-    /// row. It stands still, running no Lua, until a behavior file is reloaded.
-    #[error("{file}: stopped after {runaways} runaway cycles in a row; the robot stands still until a behavior file is reloaded")]
+    /// The robot was stopped: its behaviors ran away (budget or memory) or failed this many
+    /// cycles in a row. It stands still, running no Lua, until a behavior file is reloaded.
+    #[error("{file}: stopped after {cycles} cycles in a row {why}; the robot stands still until a behavior file is reloaded")]
     Stopped {
         /// The HFSM file or the behavior at the top.
         file: String,
-        /// Runaway cycles in a row.
-        runaways: u32,
+        /// Failing cycles in a row.
+        cycles: u32,
+        /// How they failed: `running away` or `with errors`.
+        why: &'static str,
     },
     /// The Lua state ran out of its memory limit.
     #[error("{file}: aborted: memory limit of {limit} bytes exceeded")]

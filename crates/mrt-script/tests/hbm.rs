@@ -757,6 +757,45 @@ fn a_used_behavior_has_its_own_behavior_info() {
 }
 
 #[test]
+fn a_behavior_that_keeps_failing_is_stopped_until_a_file_is_reloaded() {
+    // The issue's `error(string.rep("E", 4e6))`: every cycle pays for 4 MB of error text.
+    let dir = Dir::new("failing");
+    dir.write("hbm.lua", SINGLETON_HBM);
+    dir.write("shout.lua", r#"always("go", "FAST") error(string.rep("E", 4e5))"#);
+    let mut cap = ThinkingCap::with_behavior(dir.path(), "shout", Sandbox::default()).unwrap();
+    for t in 1..mrt_script::FAULT_LIMIT {
+        let c = cap.cycle(ball_at(500.0, u64::from(t) * 100));
+        assert!(matches!(c.errors[..], [ScriptError::Runtime { .. }]), "{:?}", c.errors);
+    }
+    let c = cap.cycle(ball_at(500.0, 3000));
+    assert!(
+        matches!(
+            c.errors[..],
+            [
+                ScriptError::Runtime { .. },
+                ScriptError::Stopped { cycles: 20, why: "with errors", .. }
+            ]
+        ),
+        "{:?}",
+        c.errors
+    );
+    let c = cap.cycle(ball_at(500.0, 3100));
+    assert!(c.errors.is_empty() && c.command == RobotCommand::default());
+    // A cycle that works in between starts the count again.
+    dir.edit(
+        "shout.lua",
+        r#"always("go", "FAST") if chaos.lps_getLpo(BALL).rho > 1000 then error("far") end"#,
+    );
+    assert!(cap.reload_changed().1.is_empty());
+    for t in 0..100 {
+        let rho = if t % 10 == 0 { 500.0 } else { 2000.0 };
+        let c = cap.cycle(ball_at(rho, 4000 + t * 100));
+        assert!(!c.errors.iter().any(|e| matches!(e, ScriptError::Stopped { .. })));
+    }
+    assert!(!cap.stopped());
+}
+
+#[test]
 fn a_behavior_that_keeps_running_away_is_stopped_until_a_file_is_reloaded() {
     let dir = Dir::new("stopped");
     dir.write("hbm.lua", SINGLETON_HBM);
@@ -772,7 +811,7 @@ fn a_behavior_that_keeps_running_away_is_stopped_until_a_file_is_reloaded() {
     assert!(
         matches!(
             c.errors[..],
-            [ScriptError::Budget { .. }, ScriptError::Stopped { runaways: 3, .. }]
+            [ScriptError::Budget { .. }, ScriptError::Stopped { cycles: 3, .. }]
         ),
         "{:?}",
         c.errors

@@ -798,15 +798,17 @@ mod tests {
     /// this robot's answer and went on) is kept for the next round, not lost: here the whole
     /// match ends while robot 0 waits for its silent teammate, and it still hears the whistle.
     #[test]
-    fn the_whistle_blown_while_a_robot_waits_for_its_teammate_is_heard() {
+    fn a_teammate_the_simulator_gave_up_on_is_not_waited_for_and_the_whistle_is_heard() {
         let cfg = short(0.5, 2);
         let (nets, server) = pitch(&cfg, 1, short_patience());
-        // Robot 0 runs, its teammate robot 1 never does: from cycle 1 on robot 0 waits 2 s for
-        // the teammate's report, and the 10-cycle match is over long before that.
+        // Robot 0 runs, its teammate robot 1 never does. The simulator books robot 1 silent in
+        // cycle 0 and says so in every frame after: robot 0 does not wait for its reports
+        // either (it waited 2 s from cycle 1 on, long past this 10-cycle match), plays every
+        // cycle and hears the final whistle.
         let spec = RobotSpec::of(0, 2, (Stack::Chaser, Stack::Chaser));
         let home = start_robot(&cfg, &nets, spec, Path::new(""), Duration::from_secs(3));
         server.play(|_| {}).unwrap();
         let run = home.join().unwrap().expect("the robot heard the final whistle");
-        assert_eq!(run.late_mates, 1, "{run:?}");
+        assert_eq!((run.cycles, run.late_mates), (10, 0), "{run:?}");
     }
 }
