@@ -2,9 +2,9 @@
 
 use anyhow::{bail, Context as _, Result};
 use mrt_core::robot::WorldSnapshot;
-use mrt_core::Time;
 use mrt_script::chaos::{self, RobotIo};
 use mrt_script::hfsm::Hfsm;
+use mrt_script::offline::{cycle_line, parse_worlds, world_at, WorldsError};
 use mrt_script::{LuaRuntime, Sandbox, ThinkingCap};
 use std::cell::RefCell;
 use std::io::Write as _;
@@ -41,28 +41,12 @@ impl Worlds {
         };
         let text = std::fs::read_to_string(path)
             .with_context(|| format!("cannot read {}", path.display()))?;
-        let value: serde_json::Value = serde_json::from_str(&text)
-            .map_err(|e| anyhow::anyhow!("{}:{}:{}: {e}", path.display(), e.line(), e.column()))?;
-        let parse = |v: serde_json::Value| -> Result<WorldSnapshot> {
-            serde_json::from_value(v)
-                .with_context(|| format!("{}: not a world snapshot", path.display()))
-        };
-        let (list, default) = match value {
-            serde_json::Value::Array(list) => {
-                let n = list.len() as u64;
-                (list.into_iter().map(parse).collect::<Result<Vec<_>>>()?, n)
-            }
-            one => (vec![parse(one)?], 1),
-        };
-        // An empty array runs no cycle, or `--cycles` empty worlds.
-        let list = if list.is_empty() { vec![WorldSnapshot::default()] } else { list };
-        Ok(Worlds { list, cycles: cycles.unwrap_or(default) })
-    }
-
-    /// The world of cycle `k`.
-    fn get(&self, k: u64) -> WorldSnapshot {
-        let i = usize::try_from(k).unwrap_or(usize::MAX).min(self.list.len().saturating_sub(1));
-        self.list.get(i).cloned().unwrap_or_default()
+        let list = parse_worlds(&text).map_err(|e| match e {
+            WorldsError::Syntax { .. } => anyhow::anyhow!("{}:{e}", path.display()),
+            other => anyhow::anyhow!("{}: {other}", path.display()),
+        })?;
+        // One world a cycle: an object is one, an empty array none.
+        Ok(Worlds { cycles: cycles.unwrap_or(list.len() as u64), list })
     }
 }
 
@@ -91,24 +75,14 @@ pub fn behave(
     let stdout = std::io::stdout();
     let mut out = std::io::BufWriter::new(stdout.lock());
     for k in 0..worlds.cycles {
-        let mut w = worlds.get(k);
-        if w.time == Time::ZERO {
-            w.time = Time::from_secs_f64(k as f64 * period_ms as f64 / 1000.0);
-        }
-        let time_ms = (w.time.as_secs_f64() * 1e6).round() / 1e3;
+        let w = world_at(&worlds.list, k, period_ms);
+        let time = w.time;
         let c = cap.cycle(w);
         for e in &c.errors {
             eprintln!("error: cycle {k}: {e}");
         }
         failed += u64::from(!c.errors.is_empty());
-        let line = serde_json::json!({
-            "cycle": k,
-            "time_ms": time_ms,
-            "path": c.path,
-            "behavior": c.behavior,
-            "transition": c.taken.map(|t| t.name),
-            "command": c.command,
-        });
+        let line = cycle_line(k, time, &c);
         writeln!(out, "{line}")?;
     }
     out.flush()?;

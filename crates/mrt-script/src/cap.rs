@@ -103,16 +103,7 @@ impl ThinkingCap {
         let hfsm = Hfsm::from_file(&rt, machine.as_ref(), io.clone())?;
         let top =
             Top::Hfsm(Box::new(hfsm), std::path::absolute(machine.as_ref()).unwrap_or_default());
-        Ok(ThinkingCap {
-            rt,
-            io,
-            hbm,
-            top,
-            last_good: None,
-            watcher: None,
-            runaways: 0,
-            failing: 0,
-        })
+        Ok(Self::assemble(rt, io, hbm, top))
     }
 
     /// [`ThinkingCap::with_behavior`] with `bb.*` bound to the robot's `blackboard`.
@@ -131,16 +122,13 @@ impl ThinkingCap {
             )));
         }
         let top = Top::Behavior(behavior.to_string());
-        Ok(ThinkingCap {
-            rt,
-            io,
-            hbm,
-            top,
-            last_good: None,
-            watcher: None,
-            runaways: 0,
-            failing: 0,
-        })
+        Ok(Self::assemble(rt, io, hbm, top))
+    }
+
+    /// A cap that has run nothing yet.
+    fn assemble(rt: LuaRuntime, io: Rc<RefCell<RobotIo>>, hbm: Hbm, top: Top) -> ThinkingCap {
+        let (last_good, watcher, runaways, failing) = (None, None, 0, 0);
+        ThinkingCap { rt, io, hbm, top, last_good, watcher, runaways, failing }
     }
 
     fn base(

@@ -45,6 +45,7 @@ pub mod chaos;
 pub mod hbm;
 pub mod hfsm;
 pub mod member;
+pub mod offline;
 mod runtime;
 mod script;
 mod watch;

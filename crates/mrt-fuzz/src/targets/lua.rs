@@ -13,6 +13,7 @@ use mrt_core::{Pose2, Time};
 use mrt_script::chaos::{self, RobotIo};
 use mrt_script::hbm::Hbm;
 use mrt_script::hfsm::Hfsm;
+use mrt_script::offline::{cycle_line, parse_worlds, world_at};
 use mrt_script::{LoadStrategy, LuaRuntime, Sandbox, Script, ThinkingCap};
 use std::cell::RefCell;
 use std::path::{Path, PathBuf};
@@ -312,48 +313,24 @@ struct Worlds {
     uses: u32,
 }
 
-/// The worlds of a `--world` file, as `mrt behave` reads them (`crates/mrt-cli/src/behave.rs`,
-/// `Worlds::load`): the text as JSON, then one snapshot or an array of them.
-fn parse_worlds(text: &str) -> Option<Vec<WorldSnapshot>> {
-    let value: serde_json::Value = serde_json::from_str(text).ok()?;
-    let parse = |v: serde_json::Value| serde_json::from_value::<WorldSnapshot>(v).ok();
-    let list = match value {
-        serde_json::Value::Array(list) => {
-            list.into_iter().map(parse).collect::<Option<Vec<_>>>()?
-        }
-        one => vec![parse(one)?],
-    };
-    Some(if list.is_empty() { vec![WorldSnapshot::default()] } else { list })
-}
-
 impl Harness for Worlds {
     fn exec(&mut self, _seed: &Seed, input: &[u8]) -> bool {
         // `mrt behave` reads the file as UTF-8 text.
         let Ok(text) = std::str::from_utf8(input) else { return false };
-        let Some(worlds) = parse_worlds(text) else { return false };
+        let Ok(worlds) = parse_worlds(text) else { return false };
         self.uses += 1;
         if self.uses > 8 * RENEW_EVERY || self.cap.stopped() {
             let Ok(cap) = attacker(&self.dir) else { return false };
             self.cap = cap;
             self.uses = 0;
         }
-        let period_ms: u64 = 100;
-        for (k, mut w) in worlds.into_iter().take(MAX_WORLD_CYCLES).enumerate() {
-            // As `mrt behave`: a world without a time gets the cycle's.
-            if w.time == Time::ZERO {
-                w.time = Time::from_secs_f64(k as f64 * period_ms as f64 / 1000.0);
-            }
-            let time_ms = (w.time.as_secs_f64() * 1e6).round() / 1e3;
+        // As `mrt behave` runs them, one world a cycle, at most a few.
+        let cycles = worlds.len().min(MAX_WORLD_CYCLES) as u64;
+        for k in 0..cycles {
+            let w = world_at(&worlds, k, 100);
+            let time = w.time;
             let c = self.cap.cycle(w);
-            let line = serde_json::json!({
-                "cycle": k,
-                "time_ms": time_ms,
-                "path": c.path,
-                "behavior": c.behavior,
-                "transition": c.taken.map(|t| t.name),
-                "command": c.command,
-            });
-            let _ = line.to_string();
+            let _ = cycle_line(k, time, &c);
         }
         true
     }
