@@ -194,14 +194,21 @@ fn a_silent_or_babbling_relay_gives_a_clear_error_in_bounded_time() {
     let babbling = std::net::TcpListener::bind("127.0.0.1:0").unwrap();
     let addr = babbling.local_addr().unwrap().to_string();
     let talker = std::thread::spawn(move || {
+        use std::io::Read;
         let (mut s, _) = babbling.accept().unwrap();
+        // Read the request first: a socket closed with unread input is reset, and a reset
+        // discards what the client has not read yet (the test then saw ECONNRESET).
+        let mut request = String::new();
+        BufReader::new(&s).read_line(&mut request).unwrap();
         let chunk = vec![b'A'; 64 * 1024];
         // 4 MiB at most, no newline; stops when the client hangs up.
         for _ in 0..64 {
             if s.write_all(&chunk).is_err() {
-                break;
+                return;
             }
         }
+        // Stay until the client hangs up.
+        let _ = s.read_to_end(&mut Vec::new());
     });
     let (ok, _, err) = run(&["bb", "get", "local.var.x", "--addr", &addr, "--timeout", "10"]);
     assert!(
