@@ -81,7 +81,7 @@ impl AgoraBuilder {
     }
 
     /// The bounds of every subscription's buffer in this Agora, unless the subscription gives
-    /// its own (default: [`MailboxBounds::default`], 4096 messages, 65 536 when `Reliable`).
+    /// its own (default: [`MailboxBounds::default`], 2048 messages, 32 768 when `Reliable`).
     /// Checked by [`build`](Self::build).
     pub fn mailbox_bounds(mut self, bounds: MailboxBounds) -> Self {
         self.bounds = bounds;

@@ -53,7 +53,7 @@ impl RequestType {
 }
 
 /// Messages one subscription buffers by default: [`MailboxBounds::capacity`].
-pub const DEFAULT_MAILBOX_CAPACITY: usize = 4096;
+pub const DEFAULT_MAILBOX_CAPACITY: usize = 2048;
 /// Messages one subscription holds at most when they are `Reliable`, by default:
 /// [`MailboxBounds::reliable_limit`].
 pub const DEFAULT_RELIABLE_LIMIT: usize = 16 * DEFAULT_MAILBOX_CAPACITY;
@@ -92,9 +92,8 @@ pub const DEFAULT_RELIABLE_LIMIT: usize = 16 * DEFAULT_MAILBOX_CAPACITY;
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct MailboxBounds {
     /// Messages a subscription buffers before its overflow policy applies (at least 1;
-    /// default [`DEFAULT_MAILBOX_CAPACITY`]). Under `PMQ` the first 1024 of them wait in a
-    /// ring allocated once, when the Member subscribes, the rest in an overflow queue
-    /// allocated only when the Member falls that far behind.
+    /// default [`DEFAULT_MAILBOX_CAPACITY`]). Under `PMQ` this is a ring allocated once, when
+    /// the Member subscribes: 32 bytes a message, 64 KiB by default.
     pub capacity: usize,
     /// Messages a subscription that carries `Reliable` messages holds at most (at least
     /// `capacity`; default [`DEFAULT_RELIABLE_LIMIT`]).

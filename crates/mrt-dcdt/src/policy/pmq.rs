@@ -6,14 +6,13 @@
 //! rebuilds the table under a writer mutex: subscriptions change rarely, messages flow
 //! constantly.
 //!
-//! A lane is a bounded lock-free ring allocated once, when the Member first subscribes to the
-//! type (`crossbeam_queue::ArrayQueue`, [`RING_SLOTS`] slots at most): no allocation per
-//! message while the Member keeps up. A Member further behind than the ring puts the lane in
-//! its slow path: messages wait in a *spill* queue under a mutex, up to the lane's bound, and
-//! the overflow policy of [`MailboxBounds`] applies: a lane that only ever carried best-effort
-//! messages drops its oldest message; a lane that carried a `Reliable` one never drops a
-//! `Reliable` message and keeps up to [`MailboxBounds::reliable_limit`], past which it refuses
-//! (counts, logs).
+//! A lane is a bounded lock-free ring of [`MailboxBounds::capacity`] slots, allocated once,
+//! when the Member first subscribes to the type (`crossbeam_queue::ArrayQueue`): no allocation
+//! per message. When it is full the overflow policy of [`MailboxBounds`] applies: a lane that
+//! only ever carried best-effort messages drops its oldest message (lock-free, one
+//! `force_push`); a lane that carried a `Reliable` one never drops a `Reliable` message: the
+//! excess waits in a *spill* queue under a mutex, allocated only then, up to
+//! [`MailboxBounds::reliable_limit`], past which it refuses (counts, logs).
 //!
 //! A Member's lanes share one sequence counter: every message gets the Member's next number when
 //! it is pushed, and the Member's endpoint takes the waiting message with the lowest number, so
@@ -33,11 +32,18 @@ use std::sync::{Arc, Mutex, MutexGuard};
 /// A message in a lane, with its number in the Member's arrival order.
 type Entry = (u64, MsgRef);
 
-/// Slots of a lane's preallocated ring: [`MailboxBounds::capacity`] when it is smaller. A
-/// subscription whose Member falls further behind keeps the rest, up to its bound, in an
-/// overflow queue allocated only then; the ring is what messages go through while the Member
-/// keeps up, and it costs 32 bytes a slot whether used or not.
-pub(crate) const RING_SLOTS: usize = 1024;
+/// Where [`Lane::push`] put a message.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Pushed {
+    /// In the ring, by a sequentially consistent read-modify-write of its tail or head.
+    Ring,
+    /// In the spill queue, under its lock.
+    Spill,
+    /// Nowhere: a best-effort message dropped at the lane's `Reliable` limit (counted).
+    Dropped,
+    /// Nowhere: a `Reliable` message refused at the lane's limit (counted).
+    Refused,
+}
 
 /// One subscription's buffer: a preallocated ring, and an overflow queue for the excess.
 pub(crate) struct Lane {
@@ -50,7 +56,7 @@ pub(crate) struct Lane {
     /// the ring is older than everything in the spill).
     spilled: AtomicBool,
     spill: Mutex<VecDeque<Entry>>,
-    /// Messages held, ring and spill together, before the overflow policy applies.
+    /// The ring's size: messages held before the overflow policy applies.
     capacity: usize,
     /// The same for a lane that carried a `Reliable` message.
     reliable_limit: usize,
@@ -63,7 +69,7 @@ impl Lane {
         let capacity = bounds.capacity.max(1);
         Self {
             ty,
-            ring: ArrayQueue::new(capacity.min(RING_SLOTS)),
+            ring: ArrayQueue::new(capacity),
             reliable: AtomicBool::new(false),
             spilled: AtomicBool::new(false),
             spill: Mutex::new(VecDeque::new()),
@@ -79,9 +85,9 @@ impl Lane {
         self.spill.lock().unwrap_or_else(|e| e.into_inner())
     }
 
-    /// Puts a message in the lane, applying the overflow policy. `false` when it was refused.
+    /// Puts a message in the lane, applying the overflow policy.
     #[inline]
-    fn push(&self, entry: Entry) -> bool {
+    fn push(&self, entry: Entry) -> Pushed {
         if entry.1.header().warranty == DeliveryWarranty::Reliable
             && !self.reliable.load(Ordering::Acquire)
         {
@@ -92,38 +98,38 @@ impl Lane {
             return self.push_spill(entry);
         }
         match self.ring.push(entry) {
-            Ok(()) => true,
+            Ok(()) => Pushed::Ring,
             Err(entry) => self.push_spill(entry),
         }
     }
 
     /// The ring is full or the lane is spilled: the slow path, under the lock.
     #[cold]
-    fn push_spill(&self, mut entry: Entry) -> bool {
+    fn push_spill(&self, mut entry: Entry) -> Pushed {
         let mut spill = self.spill();
         if spill.is_empty() {
             // The Member may have caught up meanwhile.
             match self.ring.push(entry) {
-                Ok(()) => return true,
+                Ok(()) => return Pushed::Ring,
                 Err(e) => entry = e,
             }
         }
         let reliable_lane = self.reliable.load(Ordering::Acquire);
-        if !reliable_lane && spill.is_empty() && self.ring.capacity() >= self.capacity {
-            // The whole bound is the ring: the oldest message makes room, atomically. (No
+        if !reliable_lane {
+            // Best-effort lane (never spilled): the oldest message makes room, atomically. (No
             // `Reliable` message can be in the ring: its producer marks the lane under this
             // lock before pushing it.)
             if self.ring.force_push(entry).is_some() {
                 self.dropped.fetch_add(1, Ordering::Relaxed);
             }
-            return true;
+            return Pushed::Ring;
         }
         if reliable_lane && self.ring.len() + spill.len() >= self.reliable_limit {
             if entry.1.header().warranty != DeliveryWarranty::Reliable {
                 // A best-effort message in a lane that must not drop `Reliable` ones: the
                 // newest goes.
                 self.dropped.fetch_add(1, Ordering::Relaxed);
-                return true;
+                return Pushed::Dropped;
             }
             let before = self.refused.fetch_add(1, Ordering::Relaxed);
             if before == 0 {
@@ -135,20 +141,11 @@ impl Lane {
                     self.reliable_limit
                 );
             }
-            return false;
+            return Pushed::Refused;
         }
         spill.push_back(entry);
         self.spilled.store(true, Ordering::Release);
-        if !reliable_lane {
-            // Best-effort lane: the oldest waiting messages make room.
-            while self.ring.len() + spill.len() > self.capacity {
-                if self.ring.pop().or_else(|| spill.pop_front()).is_none() {
-                    break;
-                }
-                self.dropped.fetch_add(1, Ordering::Relaxed);
-            }
-        }
-        true
+        Pushed::Spill
     }
 
     #[inline]
@@ -169,7 +166,7 @@ impl Lane {
         if spill.is_empty() {
             self.spilled.store(false, Ordering::Release);
             // Give a large overflow's memory back: a spill is the exception, not the rule.
-            if spill.capacity() > RING_SLOTS {
+            if spill.capacity() > self.capacity {
                 spill.shrink_to_fit();
             }
         }
@@ -202,6 +199,8 @@ impl Lane {
 #[derive(Default)]
 pub(crate) struct Mailbox {
     next: AtomicU64,
+    /// It has more than one lane: messages need arrival numbers.
+    multi: AtomicBool,
     waker: Arc<Waker>,
     /// Lanes in creation order. Only grows: a lane stays after `unsubscribe`, so messages
     /// already waiting are still received, and a new subscription to the type reuses it.
@@ -214,12 +213,24 @@ pub(crate) struct Mailbox {
 }
 
 impl Mailbox {
+    /// Delivers into one of its lanes and wakes the Member; `false` when the lane refused.
     #[inline]
     fn push(&self, lane: &Lane, msg: MsgRef) -> bool {
-        let seq = self.next.fetch_add(1, Ordering::Relaxed);
-        let accepted = lane.push((seq, msg));
-        self.waker.wake();
-        accepted
+        // Arrival numbers only order lanes against each other: a Member with one lane needs
+        // none. Messages numbered 0 before its second lane came are older than all the new
+        // lane's, and the merge takes the first lane on a tie.
+        let seq = if self.multi.load(Ordering::Relaxed) {
+            self.next.fetch_add(1, Ordering::Relaxed)
+        } else {
+            0
+        };
+        match lane.push((seq, msg)) {
+            Pushed::Ring => self.waker.wake_after_seqcst_push(),
+            Pushed::Spill => self.waker.wake(),
+            Pushed::Dropped => {}
+            Pushed::Refused => return false,
+        }
+        true
     }
 
     fn pending(&self) -> usize {
@@ -387,6 +398,8 @@ impl Pmq {
                 if !lanes.iter().any(|l| l.ty == ty) {
                     let mut next = (**lanes).clone();
                     next.push(Arc::new(Lane::new(ty, bounds.unwrap_or(self.bounds))));
+                    // Before any producer can see the new lane (the table is stored below).
+                    mailbox.multi.store(next.len() > 1, Ordering::Release);
                     mailbox.lanes.store(Arc::new(next));
                     mailbox.generation.fetch_add(1, Ordering::Release);
                 }
