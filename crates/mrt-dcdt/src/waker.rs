@@ -33,18 +33,6 @@ impl Waker {
         }
     }
 
-    /// [`wake`](Self::wake) for a producer whose push was a sequentially consistent
-    /// read-modify-write that the consumer's `has_work` reads with sequentially consistent
-    /// loads (a PMQ ring's tail): that operation orders the push before the load of `sleeping`
-    /// as the fence would (either the consumer's check after its fence sees the push, or this
-    /// load sees it sleeping), so the fence, the costliest instruction of a delivery, is saved.
-    #[inline]
-    pub(crate) fn wake_after_seqcst_push(&self) {
-        if self.sleeping.load(Ordering::SeqCst) {
-            self.force_wake();
-        }
-    }
-
     /// Wakes the thread whatever it is doing (shutdown).
     pub(crate) fn force_wake(&self) {
         if let Some(t) = self.thread.get() {

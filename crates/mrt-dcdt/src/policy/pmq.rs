@@ -35,7 +35,7 @@ type Entry = (u64, MsgRef);
 /// Where [`Lane::push`] put a message.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum Pushed {
-    /// In the ring, by a sequentially consistent read-modify-write of its tail or head.
+    /// In the ring.
     Ring,
     /// In the spill queue, under its lock.
     Spill,
@@ -225,8 +225,7 @@ impl Mailbox {
             0
         };
         match lane.push((seq, msg)) {
-            Pushed::Ring => self.waker.wake_after_seqcst_push(),
-            Pushed::Spill => self.waker.wake(),
+            Pushed::Ring | Pushed::Spill => self.waker.wake(),
             Pushed::Dropped => {}
             Pushed::Refused => return false,
         }
