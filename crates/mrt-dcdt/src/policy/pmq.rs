@@ -14,9 +14,10 @@
 //! excess waits in a *spill* queue under a mutex, allocated only then, up to
 //! [`MailboxBounds::reliable_limit`], past which it refuses (counts, logs).
 //!
-//! A Member's lanes share one sequence counter: every message gets the Member's next number when
-//! it is pushed, and the Member's endpoint takes the waiting message with the lowest number, so
-//! a Member reads messages of all its subscriptions in the order they arrived, as with one queue.
+//! A Member's lanes share one sequence counter: once it has two lanes or more, every message gets
+//! the Member's next number when it is pushed, and the Member's endpoint takes the waiting
+//! message with the lowest number, so a Member reads messages of all its subscriptions in the
+//! order they arrived, as with one queue. (A Member with one lane needs no number.)
 
 use super::{MailboxBounds, MailboxReport, Subscriptions};
 use crate::msg::{DeliveryWarranty, MsgRef};
@@ -50,7 +51,7 @@ pub(crate) struct Lane {
     ty: MsgType,
     ring: ArrayQueue<Entry>,
     /// Set once a `Reliable` message entered (under the `spill` lock, so an overflowing
-    /// producer never misses it): the lane never drops from then on.
+    /// producer never misses it): from then on the lane never drops a `Reliable` message.
     reliable: AtomicBool,
     /// `spill` is not empty: producers append there, to keep the lane's order (everything in
     /// the ring is older than everything in the spill).
