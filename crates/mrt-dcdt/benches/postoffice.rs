@@ -11,9 +11,9 @@
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 use crossbeam_channel::{unbounded, Receiver, Sender};
 use mrt_dcdt::prelude::*;
-use mrt_dcdt::{Endpoint, ShutdownHandle};
+use mrt_dcdt::{Endpoint, MailboxBounds, ShutdownHandle};
 use serde::{Deserialize, Serialize};
-use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
 use std::sync::Arc;
 use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
@@ -38,11 +38,15 @@ impl Message for Echo {
     const NAME: &'static str = "Echo";
 }
 
+/// Members that finished `init` (subscribed) in the Agora being started.
+static READY: AtomicUsize = AtomicUsize::new(0);
+
 /// Answers each Sample with an Echo.
 struct Ponger;
 impl Member for Ponger {
     fn init(&mut self, ctx: &mut Context<'_>) -> Result<(), MemberError> {
         ctx.subscribe_to::<Sample>(RequestType::All);
+        READY.fetch_add(1, Ordering::AcqRel);
         Ok(())
     }
     fn do_your_job(&mut self, ctx: &mut Context<'_>) -> Result<(), MemberError> {
@@ -54,11 +58,14 @@ impl Member for Ponger {
     }
 }
 
-/// Records the highest sequence number seen.
+/// Records the highest sequence number seen. Its buffer holds a whole batch (a preallocated
+/// ring of `BATCH` slots under PMQ), so that, like the unbounded baseline, it never loses a
+/// message however far behind it falls within a batch (`Running` reports any loss).
 struct Sink(Arc<AtomicU64>);
 impl Member for Sink {
     fn init(&mut self, ctx: &mut Context<'_>) -> Result<(), MemberError> {
-        ctx.subscribe_to::<Sample>(RequestType::All);
+        ctx.subscribe_bounded(Sample::TYPE, RequestType::All, MailboxBounds::new(BATCH as usize))?;
+        READY.fetch_add(1, Ordering::AcqRel);
         Ok(())
     }
     fn do_your_job(&mut self, ctx: &mut Context<'_>) -> Result<(), MemberError> {
@@ -72,13 +79,16 @@ impl Member for Sink {
 }
 
 struct Running {
+    policy: PolicyKind,
     endpoint: Endpoint,
     stop: ShutdownHandle,
-    thread: Option<JoinHandle<()>>,
+    thread: Option<JoinHandle<mrt_dcdt::RunReport>>,
 }
 
 impl Running {
     fn start(policy: PolicyKind, members: Vec<Box<dyn Member>>) -> Self {
+        READY.store(0, Ordering::Release);
+        let count = members.len();
         let mut agora = Agora::builder(1).policy(policy).build().unwrap();
         for m in members {
             let id = agora.add_boxed_member(m, Activation::OnMessage);
@@ -86,14 +96,14 @@ impl Running {
         }
         let endpoint = agora.endpoint();
         let stop = agora.shutdown_handle();
-        let thread = Some(std::thread::spawn(move || {
-            agora.lets_work().unwrap();
-        }));
-        // Let every Member run init and subscribe.
-        while !endpoint.has_subscribers(Sample::TYPE) {
+        let thread = Some(std::thread::spawn(move || agora.lets_work().unwrap()));
+        // Let every Member run init and subscribe. (Waiting for the first subscriber only, as
+        // before, let a batch go out before a slow-starting consumer subscribed: it then never
+        // saw that batch's last message and the run hung.)
+        while READY.load(Ordering::Acquire) < count {
             std::thread::sleep(Duration::from_millis(1));
         }
-        Self { endpoint, stop, thread }
+        Self { policy, endpoint, stop, thread }
     }
 }
 
@@ -101,7 +111,17 @@ impl Drop for Running {
     fn drop(&mut self) {
         self.stop.shutdown();
         if let Some(t) = self.thread.take() {
-            t.join().unwrap();
+            // A throughput figure counts messages published: say if the consumers lost some
+            // to their mailbox bounds (none may be lost for the figure to stand).
+            let report = t.join().unwrap();
+            if report.dropped() + report.refused() > 0 {
+                eprintln!(
+                    "{}: the consumers' mailboxes dropped {} and refused {} messages",
+                    self.policy,
+                    report.dropped(),
+                    report.refused()
+                );
+            }
         }
     }
 }

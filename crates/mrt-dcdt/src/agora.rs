@@ -6,6 +6,7 @@ use crate::endpoint::Endpoint;
 use crate::error::DcdtError;
 use crate::executor::{RunReport, ThreadedExecutor};
 use crate::member::{Activation, Member, MemberState, Runner, SharedState};
+use crate::policy::MailboxBounds;
 use crate::postoffice::{InnerLinkManager, PostOffice, Route};
 use crate::waker::Waker;
 use mrt_core::{AgoraId, MemberId, SharedClock, WallClock};
@@ -63,6 +64,7 @@ pub struct AgoraBuilder {
     policy: Option<PolicyKind>,
     inner_link: Option<InnerLinkManager>,
     config: Option<AgoraConfig>,
+    bounds: MailboxBounds,
 }
 
 impl AgoraBuilder {
@@ -78,6 +80,14 @@ impl AgoraBuilder {
         self
     }
 
+    /// The bounds of every subscription's buffer in this Agora, unless the subscription gives
+    /// its own (default: [`MailboxBounds::default`], 2048 messages, 32 768 when `Reliable`).
+    /// Checked by [`build`](Self::build).
+    pub fn mailbox_bounds(mut self, bounds: MailboxBounds) -> Self {
+        self.bounds = bounds;
+        self
+    }
+
     /// Joins the in-process community of `ilm` (several Agoras in one process).
     pub fn inner_link(mut self, ilm: &InnerLinkManager) -> Self {
         self.inner_link = Some(ilm.clone());
@@ -90,11 +100,13 @@ impl AgoraBuilder {
         self
     }
 
-    /// Builds the Agora. Fails when the community already has an Agora with this id.
+    /// Builds the Agora. Fails when the community already has an Agora with this id, or the
+    /// mailbox bounds are not `1 <= capacity <= reliable_limit`.
     pub fn build(self) -> Result<Agora, DcdtError> {
         let policy =
             self.policy.or_else(|| self.config.as_ref().and_then(|c| c.policy)).unwrap_or_default();
-        let post_office = Arc::new(PostOffice::new(self.id, policy));
+        let bounds = self.bounds.check(self.id)?;
+        let post_office = Arc::new(PostOffice::new(self.id, policy, bounds));
         let route = match &self.inner_link {
             Some(ilm) => {
                 ilm.join(post_office.clone())?;
@@ -163,12 +175,20 @@ pub struct Agora {
 impl Agora {
     /// Starts building an Agora with this id.
     pub fn builder(id: impl Into<AgoraId>) -> AgoraBuilder {
-        AgoraBuilder { id: id.into(), clock: None, policy: None, inner_link: None, config: None }
+        AgoraBuilder {
+            id: id.into(),
+            clock: None,
+            policy: None,
+            inner_link: None,
+            config: None,
+            bounds: MailboxBounds::default(),
+        }
     }
 
     /// A STANDALONE Agora with id 0, a wall clock and the default policy.
     pub fn standalone() -> Agora {
-        let post_office = Arc::new(PostOffice::new(AgoraId(0), PolicyKind::default()));
+        let post_office =
+            Arc::new(PostOffice::new(AgoraId(0), PolicyKind::default(), MailboxBounds::default()));
         let route = Route::Alone(post_office.clone());
         Agora::builder(0).assemble(post_office, route)
     }

@@ -5,8 +5,9 @@
 //! `unsubscribe_all`, `create_msg`, `share_msg`, `receive_msg`, `remove_curr_msg`.
 
 use crate::agora::AgoraShared;
+use crate::error::DcdtError;
 use crate::msg::{DeliveryWarranty, Message, Msg, MsgHeader, MsgRef, RawPayload};
-use crate::policy::{MailboxRef, RequestType};
+use crate::policy::{MailboxBounds, MailboxRef, RequestType};
 use crate::pool::MsgPool;
 use mrt_core::{AgoraId, MemberId, MsgType, Time};
 use std::ops::{Deref, DerefMut};
@@ -85,7 +86,23 @@ impl Endpoint {
     /// Subscribes to a message type (`SubscribeMsgType`). Subscribing twice with different
     /// request types subscribes to both.
     pub fn subscribe(&self, ty: MsgType, req: RequestType) {
-        self.shared.post_office.policy.subscribe(self.index(), ty, req.mask())
+        self.shared.post_office.policy.subscribe(self.index(), ty, req.mask(), None)
+    }
+
+    /// Subscribes with this subscription's own buffer bounds instead of the Agora's
+    /// ([`MailboxBounds`], with its overflow policy). The bounds are fixed when the buffer is
+    /// created, at the first subscription to `ty`; later calls (and a subscription again after
+    /// `unsubscribe`, which keeps the buffer and the messages waiting in it) keep them.
+    /// Fails, subscribing nothing, unless `1 <= capacity <= reliable_limit`.
+    pub fn subscribe_bounded(
+        &self,
+        ty: MsgType,
+        req: RequestType,
+        bounds: MailboxBounds,
+    ) -> Result<(), DcdtError> {
+        let bounds = bounds.check(self.shared.id)?;
+        self.shared.post_office.policy.subscribe(self.index(), ty, req.mask(), Some(bounds));
+        Ok(())
     }
 
     /// Subscribes to the typed message `T`.
@@ -209,7 +226,7 @@ impl Endpoint {
     /// Takes the next message from this Member's mailbox (`ReceiveMsg`); it also becomes the
     /// current message until the next call or [`remove_curr_msg`](Self::remove_curr_msg).
     pub fn receive_msg(&mut self) -> Option<MsgRef> {
-        self.current = self.shared.post_office.policy.pop(&self.mailbox);
+        self.current = self.shared.post_office.policy.pop(&mut self.mailbox);
         self.current.clone()
     }
 
@@ -244,6 +261,12 @@ impl Endpoint {
     /// Number of messages waiting in the mailbox.
     pub fn pending(&self) -> usize {
         self.shared.post_office.policy.pending(self.index())
+    }
+
+    /// What each of this endpoint's subscription buffers did so far: bounds, messages dropped
+    /// or refused by the overflow policy ([`MailboxBounds`]).
+    pub fn mailbox_reports(&self) -> Vec<crate::MailboxReport> {
+        self.shared.post_office.policy.reports(self.index())
     }
 
     /// Blocks the calling thread until a message is waiting, `timeout` passes or the Agora

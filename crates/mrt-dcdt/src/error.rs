@@ -48,6 +48,19 @@ pub enum DcdtError {
         /// Why the clock does not suit the executor.
         reason: &'static str,
     },
+    /// Mailbox bounds that cannot work: a capacity of 0, or a `Reliable` limit below it.
+    #[error(
+        "{agora}: mailbox bounds need 1 <= capacity <= reliable_limit, got capacity {capacity} \
+         and reliable_limit {reliable_limit}"
+    )]
+    MailboxBounds {
+        /// The Agora.
+        agora: AgoraId,
+        /// The capacity asked for.
+        capacity: usize,
+        /// The limit for `Reliable` messages asked for.
+        reliable_limit: usize,
+    },
     /// Two Agoras of one community have the same id.
     #[error("an Agora with id {0} is already part of this community")]
     DuplicateAgora(AgoraId),

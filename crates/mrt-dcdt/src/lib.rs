@@ -73,6 +73,7 @@
 //! | `TERMINATING` and other states | [`MemberState`] |
 //! | `SubscribeMsgType`, `UnSubscribeMsgType`, `UnSubscribeAll` | [`Endpoint::subscribe`], [`Endpoint::unsubscribe`], [`Endpoint::unsubscribe_all`] |
 //! | `DCDT_LOCAL_MSG`, `DCDT_REMOTE_MSG`, `DCDT_ALL_MSG` | [`RequestType`] |
+//! | a Member's message queue (§3.1), bounded per subscription | [`MailboxBounds`], [`MailboxReport`] in [`MemberReport`] |
 //! | `CreateMsg`, `ShareMsg`, `ReceiveMsg`, `RemoveCurrMsg` | [`Endpoint::create_msg`], [`Endpoint::share_msg`], [`Endpoint::receive_msg`], [`Endpoint::remove_curr_msg`] |
 //! | `DCDT_Msg`, header, payload | [`Msg`], [`MsgHeader`], [`Payload`]; typed: [`Message`], [`Endpoint::publish`], [`Msg::get`] |
 //! | PostOffice policies `SLWB`, `SLWDWCV`, `SLWSM` | [`PolicyKind`] (plus the default `PMQ`) |
@@ -112,7 +113,9 @@ pub use msg::{
     DeliveryWarranty, Message, Msg, MsgHeader, MsgRef, Payload, RawPayload, RESERVED_TYPES_START,
 };
 pub use outlet::{AgoraPort, Outlet};
-pub use policy::RequestType;
+pub use policy::{
+    MailboxBounds, MailboxReport, RequestType, DEFAULT_MAILBOX_CAPACITY, DEFAULT_RELIABLE_LIMIT,
+};
 pub use postoffice::{InnerLinkManager, PostOffice, PostOfficeStats};
 
 /// The names a Member implementation needs, for `use mrt_dcdt::prelude::*`.

@@ -1,7 +1,8 @@
 //! Members (MRT manual §3.1, §3.3.2): the units of work an Agora runs, and how they run.
 
 use crate::endpoint::{Context, Endpoint};
-use mrt_core::{MemberId, Time};
+use crate::policy::MailboxReport;
+use mrt_core::{MemberId, MsgType, Time};
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::sync::atomic::{AtomicU8, Ordering};
 use std::sync::Arc;
@@ -132,6 +133,26 @@ pub struct MemberReport {
     pub state: MemberState,
     /// The last failure (`init` error, job error or panic), for reports.
     pub last_error: Option<String>,
+    /// Its subscriptions' buffers, in subscription order: bounds, and the messages their
+    /// overflow policy dropped or refused ([`MailboxBounds`](crate::MailboxBounds)).
+    pub mailboxes: Vec<MailboxReport>,
+}
+
+impl MemberReport {
+    /// Best-effort messages dropped from its mailbox, all subscriptions together.
+    pub fn dropped(&self) -> u64 {
+        self.mailboxes.iter().map(|m| m.dropped).sum()
+    }
+
+    /// `Reliable` messages its mailbox refused, all subscriptions together.
+    pub fn refused(&self) -> u64 {
+        self.mailboxes.iter().map(|m| m.refused).sum()
+    }
+
+    /// The report of its subscription to `ty`, if it ever subscribed to it.
+    pub fn mailbox(&self, ty: MsgType) -> Option<&MailboxReport> {
+        self.mailboxes.iter().find(|m| m.msg_type == ty)
+    }
 }
 
 /// First restart delay after a crash; doubles with every consecutive crash up to
@@ -355,6 +376,7 @@ impl Runner {
             restarts: self.restarts,
             state: self.state.get(),
             last_error: self.last_error.clone(),
+            mailboxes: self.endpoint.mailbox_reports(),
         }
     }
 }

@@ -3,7 +3,7 @@
 
 use crate::config::PolicyKind;
 use crate::msg::MsgRef;
-use crate::policy::{Policy, RequestType, LOCAL, REMOTE};
+use crate::policy::{MailboxBounds, MailboxReport, Policy, RequestType, LOCAL, REMOTE};
 use crate::waker::Waker;
 use arc_swap::ArcSwap;
 use mrt_core::{AgoraId, MemberId, MsgType};
@@ -29,13 +29,20 @@ pub struct PostOfficeStats {
 pub struct PostOffice {
     agora: AgoraId,
     kind: PolicyKind,
+    bounds: MailboxBounds,
     pub(crate) policy: Policy,
     unsubscribed: AtomicU64,
 }
 
 impl PostOffice {
-    pub(crate) fn new(agora: AgoraId, kind: PolicyKind) -> Self {
-        Self { agora, kind, policy: Policy::new(kind), unsubscribed: AtomicU64::new(0) }
+    pub(crate) fn new(agora: AgoraId, kind: PolicyKind, bounds: MailboxBounds) -> Self {
+        Self {
+            agora,
+            kind,
+            bounds,
+            policy: Policy::new(kind, bounds),
+            unsubscribed: AtomicU64::new(0),
+        }
     }
 
     /// The Agora this PostOffice belongs to.
@@ -46,6 +53,12 @@ impl PostOffice {
     /// The policy in use.
     pub fn policy(&self) -> PolicyKind {
         self.kind
+    }
+
+    /// The bounds of a subscription's buffer when its Member gives none
+    /// ([`Endpoint::subscribe_bounded`](crate::Endpoint::subscribe_bounded) does).
+    pub fn mailbox_bounds(&self) -> MailboxBounds {
+        self.bounds
     }
 
     /// Counters since the Agora was created.
@@ -71,9 +84,18 @@ impl PostOffice {
             .collect()
     }
 
-    /// Messages waiting in a Member's mailbox.
+    /// Messages waiting in a Member's mailbox, all its subscriptions together. Under `PMQ`
+    /// this includes the (at most one per subscription) messages its endpoint has taken out to
+    /// put them in arrival order.
     pub fn pending(&self, member: MemberId) -> usize {
         self.policy.pending(member.0 as usize)
+    }
+
+    /// What each of a Member's subscription buffers did so far (bounds, messages dropped or
+    /// refused by the overflow policy of [`MailboxBounds`]), in subscription order; also in
+    /// every [`MemberReport`](crate::MemberReport).
+    pub fn mailbox_reports(&self, member: MemberId) -> Vec<MailboxReport> {
+        self.policy.reports(member.0 as usize)
     }
 
     pub(crate) fn register(&self, member: MemberId, waker: Arc<Waker>) {

@@ -420,7 +420,9 @@ pub fn behaviors_dir(stacks: &[Stack], behaviors: Option<&Path>) -> Result<Files
 }
 
 /// A Member of a robot's Agora that failed to start, failed jobs or panicked (each time it was
-/// restarted), from its executor's report; booked against the robot when the match ends.
+/// restarted), or whose mailbox lost messages (its bus bounds dropped or refused some: a
+/// Member that fell thousands of messages behind), from its executor's report; booked against
+/// the robot when the match ends.
 #[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct MemberFault {
     /// The Member's name.
@@ -439,13 +441,24 @@ impl MemberFault {
         report
             .members
             .iter()
-            .filter_map(|m| {
-                Some(MemberFault {
+            .flat_map(|m| {
+                let failed = m.last_error.clone().map(|error| MemberFault {
                     name: m.name.clone(),
                     count: m.errors + m.panics + m.restarts.max(1),
                     never_ran: m.cycles == 0,
-                    error: m.last_error.clone()?,
-                })
+                    error,
+                });
+                let lost =
+                    m.mailboxes.iter().filter(|b| b.dropped + b.refused > 0).map(|b| MemberFault {
+                        name: m.name.clone(),
+                        count: b.dropped + b.refused,
+                        never_ran: false,
+                        error: format!(
+                            "its mailbox for {} dropped {} and refused {} messages (capacity {})",
+                            b.msg_type, b.dropped, b.refused, b.capacity
+                        ),
+                    });
+                failed.into_iter().chain(lost)
             })
             .collect()
     }
@@ -581,6 +594,39 @@ mod tests {
             "{:?}",
             a.stats
         );
+    }
+
+    /// A Member whose mailbox lost messages is booked like a failing one, with the type and
+    /// the counts; one whose mailboxes lost nothing is not.
+    #[test]
+    fn a_mailbox_that_lost_messages_is_a_member_fault() {
+        use mrt_dcdt::{ExitReason, MailboxReport, MemberReport, MemberState, MsgType};
+        let member = |name: &str, dropped, refused| MemberReport {
+            id: mrt_dcdt::MemberId(0),
+            name: name.into(),
+            cycles: 10,
+            errors: 0,
+            panics: 0,
+            restarts: 0,
+            state: MemberState::Terminated,
+            last_error: None,
+            mailboxes: vec![MailboxReport {
+                msg_type: MsgType(7),
+                capacity: 4096,
+                reliable_limit: 65_536,
+                dropped,
+                refused,
+            }],
+        };
+        let report = RunReport {
+            agora: mrt_dcdt::AgoraId(1),
+            exit: ExitReason::TimeLimit,
+            members: vec![member("Fine", 0, 0), member("Slow", 3, 1)],
+        };
+        let faults = MemberFault::of_report(&report);
+        assert_eq!(faults.len(), 1, "{faults:?}");
+        assert_eq!((faults[0].name.as_str(), faults[0].count), ("Slow", 4));
+        assert!(faults[0].error.contains("dropped 3 and refused 1"), "{}", faults[0].error);
     }
 
     /// The same robot code gives the same match whether the brains run as Members on the bus

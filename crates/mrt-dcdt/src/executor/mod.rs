@@ -45,4 +45,17 @@ impl RunReport {
     pub fn member(&self, id: MemberId) -> Option<&MemberReport> {
         self.members.iter().find(|m| m.id == id)
     }
+
+    /// Best-effort messages dropped from the Members' mailboxes, all together (see
+    /// [`MemberReport::mailboxes`] for who and which subscription).
+    pub fn dropped(&self) -> u64 {
+        self.members.iter().map(MemberReport::dropped).sum()
+    }
+
+    /// `Reliable` messages the Members' mailboxes refused, all together: not zero means a
+    /// Member fell [`MailboxBounds::reliable_limit`](crate::MailboxBounds::reliable_limit)
+    /// messages behind.
+    pub fn refused(&self) -> u64 {
+        self.members.iter().map(MemberReport::refused).sum()
+    }
 }

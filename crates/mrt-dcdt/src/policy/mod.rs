@@ -9,7 +9,11 @@
 //! | `SLWB` | **S**ingle **L**ock **W**ith **B**uffer: one mutex guards the subscription table and every Member's FIFO buffer; the producer writes into each buffer itself | every message, in order |
 //! | `SLWDWCV` | **S**ingle **L**ock **W**ith **D**ispatcher **W**ith **C**ondition **V**ariable: the producer appends to one main queue under the lock and signals a condition variable; a dispatcher (the manual's *MsgManager* system Member) moves messages to the Members' buffers | every message, in order, one hand-off later |
 //! | `SLWSM` | **S**ingle **L**ock **W**ith **S**ingle **M**essage: one mutex; each Member keeps only the latest message of each type | the latest message of each type; older unread ones are overwritten |
-//! | `PMQ` (default) | **P**er-**M**ember **Q**ueues: the subscription table is an immutable snapshot swapped on (rare) changes, read without locks; each Member has a lock-free queue | every message, in order |
+//! | `PMQ` (default) | **P**er-**M**ember **Q**ueues: the subscription table is an immutable snapshot swapped on (rare) changes, read without locks; each subscription has a preallocated lock-free ring | every message, in order |
+//!
+//! Under `SLWB`, `SLWDWCV` and `PMQ` every subscription's buffer is bounded by
+//! [`MailboxBounds`]; what a full one does is its overflow policy (see there). `SLWSM` keeps one
+//! message per type by definition.
 
 mod pmq;
 mod single_lock;
@@ -18,9 +22,10 @@ pub(crate) use pmq::Pmq;
 pub(crate) use single_lock::SingleLock;
 
 use crate::config::PolicyKind;
+use crate::error::DcdtError;
 use crate::msg::MsgRef;
 use crate::waker::Waker;
-use mrt_core::MsgType;
+use mrt_core::{AgoraId, MsgType};
 use rustc_hash::FxHashMap;
 use std::sync::atomic::AtomicBool;
 use std::sync::Arc;
@@ -45,6 +50,103 @@ impl RequestType {
             RequestType::All => LOCAL | REMOTE,
         }
     }
+}
+
+/// Messages one subscription buffers by default: [`MailboxBounds::capacity`].
+pub const DEFAULT_MAILBOX_CAPACITY: usize = 2048;
+/// Messages one subscription holds at most when they are `Reliable`, by default:
+/// [`MailboxBounds::reliable_limit`].
+pub const DEFAULT_RELIABLE_LIMIT: usize = 16 * DEFAULT_MAILBOX_CAPACITY;
+
+/// How many messages one subscription's buffer (a Member's mailbox for one message type) holds
+/// while they wait for the Member to receive them, and so how much memory a slow Member can
+/// make the bus keep. Set per Agora ([`AgoraBuilder::mailbox_bounds`](crate::AgoraBuilder::mailbox_bounds))
+/// or per subscription ([`Endpoint::subscribe_bounded`](crate::Endpoint::subscribe_bounded)).
+///
+/// **Overflow policy** (policies `PMQ`, `SLWB`, `SLWDWCV`), when a message arrives for a
+/// subscription that already holds `capacity` messages:
+///
+/// - *best-effort* messages ([`DeliveryWarranty::None`](crate::DeliveryWarranty::None) and
+///   `Retransmit`): the **oldest** waiting message of the subscription is dropped to make room,
+///   and counted ([`MailboxReport::dropped`]). A robot wants the freshest sensor reading, not
+///   the one from a second ago.
+/// - once a subscription has received a [`DeliveryWarranty::Reliable`](crate::DeliveryWarranty::Reliable)
+///   message, it **never drops**: messages beyond `capacity` wait in an overflow queue,
+///   allocated only then, up to `reliable_limit` messages in all. The producer is not blocked:
+///   under the [`SteppedExecutor`](crate::SteppedExecutor) every Member shares one thread, so a
+///   producer waiting for its consumer would wait forever, and a Member must behave the same
+///   under both executors. Past `reliable_limit` a `Reliable` message is **refused** for that
+///   subscription (not delivered, counted in [`MailboxReport::refused`], logged as an error
+///   once per subscription, and not counted in `publish`'s return value), and a best-effort one
+///   is dropped (counted). A subscriber that far behind is a fault to fix, not a load to absorb.
+///
+/// Order is kept: a Member receives the messages of all its subscriptions in the order they
+/// arrived, minus those dropped.
+///
+/// ```
+/// use mrt_dcdt::{Agora, MailboxBounds};
+/// let robot = Agora::builder(1).mailbox_bounds(MailboxBounds::new(256)).build()?;
+/// assert_eq!(robot.post_office().mailbox_bounds().capacity, 256);
+/// # Ok::<(), mrt_dcdt::DcdtError>(())
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct MailboxBounds {
+    /// Messages a subscription buffers before its overflow policy applies (at least 1;
+    /// default [`DEFAULT_MAILBOX_CAPACITY`]). Under `PMQ` this is a ring allocated once, when
+    /// the Member subscribes: 32 bytes a message, 64 KiB by default.
+    pub capacity: usize,
+    /// Messages a subscription that carries `Reliable` messages holds at most (at least
+    /// `capacity`; default [`DEFAULT_RELIABLE_LIMIT`]).
+    pub reliable_limit: usize,
+}
+
+impl Default for MailboxBounds {
+    fn default() -> Self {
+        Self { capacity: DEFAULT_MAILBOX_CAPACITY, reliable_limit: DEFAULT_RELIABLE_LIMIT }
+    }
+}
+
+impl MailboxBounds {
+    /// `capacity` messages, and 16 times as many for `Reliable` messages.
+    pub fn new(capacity: usize) -> Self {
+        Self { capacity, reliable_limit: capacity.saturating_mul(16) }
+    }
+
+    /// The same, with another limit for `Reliable` messages.
+    pub fn with_reliable_limit(mut self, reliable_limit: usize) -> Self {
+        self.reliable_limit = reliable_limit;
+        self
+    }
+
+    /// Checks `1 <= capacity <= reliable_limit`.
+    pub(crate) fn check(self, agora: AgoraId) -> Result<Self, DcdtError> {
+        if self.capacity == 0 || self.reliable_limit < self.capacity {
+            return Err(DcdtError::MailboxBounds {
+                agora,
+                capacity: self.capacity,
+                reliable_limit: self.reliable_limit,
+            });
+        }
+        Ok(self)
+    }
+}
+
+/// What one subscription's buffer did: its bounds and the messages its overflow policy lost
+/// (see [`MailboxBounds`]). Part of every [`MemberReport`](crate::MemberReport).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct MailboxReport {
+    /// The subscribed message type.
+    pub msg_type: MsgType,
+    /// Its [`MailboxBounds::capacity`] (1 under `SLWSM`, which keeps the latest message only).
+    pub capacity: usize,
+    /// Its [`MailboxBounds::reliable_limit`].
+    pub reliable_limit: usize,
+    /// Best-effort messages dropped because the Member was `capacity` messages behind (under
+    /// `SLWSM`: unread messages replaced by a newer one of their type).
+    pub dropped: u64,
+    /// `Reliable` messages not delivered because the Member was `reliable_limit` messages
+    /// behind: an error.
+    pub refused: u64,
 }
 
 /// Origin bit of a message as seen by a receiving PostOffice.
@@ -102,9 +204,9 @@ impl Subscriptions {
     }
 }
 
-/// Where a Member's messages wait: its own queue under `PMQ`, a slot index otherwise.
+/// Where a Member's messages wait: its mailbox's reader under `PMQ`, a slot index otherwise.
 pub(crate) enum MailboxRef {
-    Pmq(Arc<pmq::Mailbox>),
+    Pmq(pmq::Reader),
     Index(usize),
 }
 
@@ -124,18 +226,26 @@ macro_rules! each {
 }
 
 impl Policy {
-    pub(crate) fn new(kind: PolicyKind) -> Self {
+    pub(crate) fn new(kind: PolicyKind, bounds: MailboxBounds) -> Self {
         match kind {
-            PolicyKind::Pmq => Policy::Pmq(Pmq::default()),
-            other => Policy::SingleLock(SingleLock::new(other)),
+            PolicyKind::Pmq => Policy::Pmq(Pmq::new(bounds)),
+            other => Policy::SingleLock(SingleLock::new(other, bounds)),
         }
     }
 
     pub(crate) fn register(&self, member: usize, waker: Arc<Waker>) {
         each!(self, p => p.register(member, waker))
     }
-    pub(crate) fn subscribe(&self, member: usize, ty: MsgType, mask: u8) {
-        each!(self, p => p.update(|s| s.subscribe(member, ty, mask)))
+    /// Subscribes; `bounds` (else the PostOffice's) bound the subscription's buffer when it is
+    /// created, i.e. at the Member's first subscription to `ty`.
+    pub(crate) fn subscribe(
+        &self,
+        member: usize,
+        ty: MsgType,
+        mask: u8,
+        bounds: Option<MailboxBounds>,
+    ) {
+        each!(self, p => p.subscribe(member, ty, mask, bounds))
     }
     pub(crate) fn unsubscribe(&self, member: usize, ty: MsgType, mask: u8) {
         each!(self, p => p.update(|s| s.unsubscribe(member, ty, mask)))
@@ -159,26 +269,31 @@ impl Policy {
     /// A handle on one Member's mailbox, for its endpoint to receive without looking it up.
     pub(crate) fn mailbox(&self, member: usize) -> MailboxRef {
         match self {
-            Policy::Pmq(p) => p.mailbox(member).map_or(MailboxRef::Index(member), MailboxRef::Pmq),
+            Policy::Pmq(p) => p.reader(member).map_or(MailboxRef::Index(member), MailboxRef::Pmq),
             Policy::SingleLock(_) => MailboxRef::Index(member),
         }
     }
-    pub(crate) fn pop(&self, mailbox: &MailboxRef) -> Option<MsgRef> {
+    pub(crate) fn pop(&self, mailbox: &mut MailboxRef) -> Option<MsgRef> {
         match (self, mailbox) {
-            (_, MailboxRef::Pmq(b)) => b.pop(),
+            (_, MailboxRef::Pmq(r)) => r.pop(),
             (Policy::SingleLock(p), MailboxRef::Index(i)) => p.pop(*i),
-            (Policy::Pmq(p), MailboxRef::Index(i)) => p.pop(*i),
+            // A PMQ endpoint always has a reader: its mailbox is registered before it exists.
+            (Policy::Pmq(_), MailboxRef::Index(_)) => None,
         }
     }
     pub(crate) fn has_pending(&self, mailbox: &MailboxRef) -> bool {
         match (self, mailbox) {
-            (_, MailboxRef::Pmq(b)) => b.has_pending(),
+            (_, MailboxRef::Pmq(r)) => r.has_pending(),
             (Policy::SingleLock(p), MailboxRef::Index(i)) => p.has_pending(*i),
-            (Policy::Pmq(p), MailboxRef::Index(i)) => p.has_pending(*i),
+            (Policy::Pmq(_), MailboxRef::Index(_)) => false,
         }
     }
     pub(crate) fn pending(&self, member: usize) -> usize {
         each!(self, p => p.pending(member))
+    }
+    /// What each of a Member's subscription buffers did, in subscription order.
+    pub(crate) fn reports(&self, member: usize) -> Vec<MailboxReport> {
+        each!(self, p => p.reports(member))
     }
     /// Whether a dispatcher must run ([`PolicyKind::Slwdwcv`]).
     pub(crate) fn needs_dispatcher(&self) -> bool {

@@ -2,16 +2,33 @@
 //!
 //! One mutex guards the subscription table and every mailbox. They differ in what the
 //! producer does under the lock (see the table in the parent module).
+//!
+//! `SLWB` and `SLWDWCV` keep one FIFO per Member and count, per subscription, the messages of
+//! its type waiting there; a full subscription applies the overflow policy of
+//! [`MailboxBounds`] (dropping its oldest message means taking it out of the middle of the
+//! FIFO: a scan, paid only on overflow).
 
-use super::Subscriptions;
+use super::{MailboxBounds, MailboxReport, Subscriptions};
 use crate::config::PolicyKind;
-use crate::msg::MsgRef;
+use crate::msg::{DeliveryWarranty, MsgRef};
 use crate::waker::Waker;
 use mrt_core::MsgType;
 use rustc_hash::FxHashMap;
 use std::collections::VecDeque;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Condvar, Mutex, MutexGuard};
+
+/// The bookkeeping of one subscription's messages in a Member's FIFO.
+struct Lane {
+    ty: MsgType,
+    bounds: MailboxBounds,
+    /// Messages of `ty` waiting in the FIFO.
+    waiting: usize,
+    /// A `Reliable` message came: the lane never drops from then on.
+    reliable: bool,
+    dropped: u64,
+    refused: u64,
+}
 
 /// A Member's mailbox under a single-lock policy.
 #[derive(Default)]
@@ -22,7 +39,59 @@ struct Mailbox {
     latest: FxHashMap<MsgType, MsgRef>,
     /// ...and the order in which types got a fresh message.
     fresh: VecDeque<MsgType>,
+    /// One per type the Member ever subscribed to, in subscription order.
+    lanes: Vec<Lane>,
     waker: Arc<Waker>,
+}
+
+impl Mailbox {
+    /// Appends `msg` to the FIFO under the overflow policy; `false` when it was refused.
+    fn enqueue(&mut self, msg: MsgRef) -> bool {
+        let ty = msg.msg_type();
+        let reliable = msg.header().warranty == DeliveryWarranty::Reliable;
+        let Some(lane) = self.lanes.iter_mut().find(|l| l.ty == ty) else {
+            // Every subscription has its lane; a message without one is not expected.
+            self.queue.push_back(msg);
+            return true;
+        };
+        lane.reliable |= reliable;
+        if lane.waiting >= lane.bounds.capacity {
+            if !lane.reliable {
+                if let Some(i) = self.queue.iter().position(|m| m.msg_type() == ty) {
+                    self.queue.remove(i);
+                    lane.waiting -= 1;
+                    lane.dropped += 1;
+                }
+            } else if lane.waiting >= lane.bounds.reliable_limit {
+                if reliable {
+                    lane.refused += 1;
+                    if lane.refused == 1 {
+                        tracing::error!(
+                            msg_type = %ty,
+                            limit = lane.bounds.reliable_limit,
+                            "a mailbox refused a Reliable message: its subscriber is {} messages \
+                             behind (counted in the run report; further refusals are only counted)",
+                            lane.bounds.reliable_limit
+                        );
+                    }
+                    return false;
+                }
+                lane.dropped += 1;
+                return true;
+            }
+        }
+        lane.waiting += 1;
+        self.queue.push_back(msg);
+        true
+    }
+
+    fn dequeue(&mut self) -> Option<MsgRef> {
+        let msg = self.queue.pop_front()?;
+        if let Some(lane) = self.lanes.iter_mut().find(|l| l.ty == msg.msg_type()) {
+            lane.waiting = lane.waiting.saturating_sub(1);
+        }
+        Some(msg)
+    }
 }
 
 #[derive(Default)]
@@ -35,14 +104,15 @@ struct State {
 
 pub(crate) struct SingleLock {
     kind: PolicyKind,
+    bounds: MailboxBounds,
     state: Mutex<State>,
     /// `SLWDWCV`: signalled when `main` gets a message.
     cv: Condvar,
 }
 
 impl SingleLock {
-    pub(crate) fn new(kind: PolicyKind) -> Self {
-        Self { kind, state: Mutex::new(State::default()), cv: Condvar::new() }
+    pub(crate) fn new(kind: PolicyKind, bounds: MailboxBounds) -> Self {
+        Self { kind, bounds, state: Mutex::new(State::default()), cv: Condvar::new() }
     }
 
     fn lock(&self) -> MutexGuard<'_, State> {
@@ -61,6 +131,46 @@ impl SingleLock {
 
     pub(crate) fn update(&self, f: impl FnOnce(&mut Subscriptions)) {
         f(&mut self.lock().subs)
+    }
+
+    pub(crate) fn subscribe(
+        &self,
+        member: usize,
+        ty: MsgType,
+        mask: u8,
+        bounds: Option<MailboxBounds>,
+    ) {
+        let mut s = self.lock();
+        if let Some(b) = s.boxes.get_mut(member) {
+            if !b.lanes.iter().any(|l| l.ty == ty) {
+                b.lanes.push(Lane {
+                    ty,
+                    bounds: bounds.unwrap_or(self.bounds),
+                    waiting: 0,
+                    reliable: false,
+                    dropped: 0,
+                    refused: 0,
+                });
+            }
+        }
+        s.subs.subscribe(member, ty, mask);
+    }
+
+    pub(crate) fn reports(&self, member: usize) -> Vec<MailboxReport> {
+        let s = self.lock();
+        let slwsm = self.kind == PolicyKind::Slwsm;
+        s.boxes.get(member).map_or_else(Vec::new, |b| {
+            b.lanes
+                .iter()
+                .map(|l| MailboxReport {
+                    msg_type: l.ty,
+                    capacity: if slwsm { 1 } else { l.bounds.capacity },
+                    reliable_limit: if slwsm { 1 } else { l.bounds.reliable_limit },
+                    dropped: l.dropped,
+                    refused: l.refused,
+                })
+                .collect()
+        })
     }
 
     pub(crate) fn subscriptions(&self) -> Subscriptions {
@@ -97,9 +207,11 @@ impl SingleLock {
             if self.kind == PolicyKind::Slwsm {
                 if b.latest.insert(ty, m).is_none() {
                     b.fresh.push_back(ty);
+                } else if let Some(lane) = b.lanes.iter_mut().find(|l| l.ty == ty) {
+                    lane.dropped += 1;
                 }
-            } else {
-                b.queue.push_back(m);
+            } else if !b.enqueue(m) {
+                continue;
             }
             b.waker.wake();
             n += 1;
@@ -114,7 +226,7 @@ impl SingleLock {
             let ty = b.fresh.pop_front()?;
             b.latest.remove(&ty)
         } else {
-            b.queue.pop_front()
+            b.dequeue()
         }
     }
 
@@ -142,8 +254,9 @@ impl SingleLock {
             let State { subs, boxes, .. } = &mut *s;
             for member in subs.matching(msg.msg_type(), origin) {
                 if let Some(b) = boxes.get_mut(member) {
-                    b.queue.push_back(msg.clone());
-                    b.waker.wake();
+                    if b.enqueue(msg.clone()) {
+                        b.waker.wake();
+                    }
                 }
             }
         }
