@@ -12,7 +12,7 @@ mod common;
 use common::*;
 use mrt_core::SimClock;
 use mrt_dcdt::prelude::*;
-use mrt_dcdt::{DcdtError, Endpoint, MailboxBounds, MailboxReport, RunReport};
+use mrt_dcdt::{DcdtError, Endpoint, MailboxBounds, MailboxReport, MemberId, RunReport};
 
 const QUEUEING: [PolicyKind; 3] = [PolicyKind::Pmq, PolicyKind::Slwb, PolicyKind::Slwdwcv];
 
@@ -84,6 +84,27 @@ impl Member for Sleeper {
         }
         Ok(())
     }
+}
+
+/// One Agora of `policy` with `bounds`: `flood`, and a Recorder `s` of `subs` that sleeps
+/// until its `wake_at`-th cycle. Returns the recorder's id.
+fn flood_a_sleeper(
+    exec: &mut SteppedExecutor,
+    (policy, bounds): (PolicyKind, MailboxBounds),
+    flood: Flood,
+    (wake_at, subs): (u32, &[(MsgType, RequestType)]),
+    log: &Log,
+) -> MemberId {
+    let mut a = exec.agora_builder(1).policy(policy).mailbox_bounds(bounds).build().unwrap();
+    let p = a.add_member(flood, Activation::Cyclic);
+    let s = a.add_member(
+        Sleeper { cycle: 0, wake_at, inner: Recorder::new("s", subs, log) },
+        Activation::Cyclic,
+    );
+    a.activate_member(p).unwrap();
+    a.activate_member(s).unwrap();
+    exec.add_agora(a).unwrap();
+    s
 }
 
 fn counts(log: &Log, receiver: &str) -> Vec<u32> {
@@ -192,23 +213,11 @@ fn after_drops_the_newest_messages_arrive_in_order_across_subscriptions() {
     for policy in QUEUEING {
         let log = log();
         let mut exec = SteppedExecutor::new(SimClock::new(), MS);
-        let mut a = exec
-            .agora_builder(1)
-            .policy(policy)
-            .mailbox_bounds(MailboxBounds::new(4))
-            .build()
-            .unwrap();
         let mut flood = Flood::new(3, DeliveryWarranty::None);
         flood.status_every = 2;
-        let p = a.add_member(flood, Activation::Cyclic);
         let subs = [(Count::TYPE, RequestType::All), (Status::TYPE, RequestType::All)];
-        let s = a.add_member(
-            Sleeper { cycle: 0, wake_at: 4, inner: Recorder::new("s", &subs, &log) },
-            Activation::Cyclic,
-        );
-        a.activate_member(p).unwrap();
-        a.activate_member(s).unwrap();
-        exec.add_agora(a).unwrap();
+        let bounds = MailboxBounds::new(4);
+        flood_a_sleeper(&mut exec, (policy, bounds), flood, (4, &subs), &log);
         // Ticks 0..3 send Counts 1..12 and Status at 2, 4, .., 12; the sleeper reads in tick 3,
         // after the producer: the 4 newest of each type are left, in the order they came.
         exec.run_for(4 * MS);
@@ -236,23 +245,11 @@ fn reliable_messages_are_not_dropped_and_keep_their_order() {
     for policy in QUEUEING {
         let log = log();
         let mut exec = SteppedExecutor::new(SimClock::new(), MS);
-        let mut a = exec
-            .agora_builder(1)
-            .policy(policy)
-            .mailbox_bounds(MailboxBounds::new(8).with_reliable_limit(1000))
-            .build()
-            .unwrap();
         let mut flood = Flood::new(10, DeliveryWarranty::Reliable);
         flood.status_every = 4;
-        let p = a.add_member(flood, Activation::Cyclic);
         let subs = [(Count::TYPE, RequestType::All), (Status::TYPE, RequestType::All)];
-        let s = a.add_member(
-            Sleeper { cycle: 0, wake_at: 30, inner: Recorder::new("s", &subs, &log) },
-            Activation::Cyclic,
-        );
-        a.activate_member(p).unwrap();
-        a.activate_member(s).unwrap();
-        exec.add_agora(a).unwrap();
+        let bounds = MailboxBounds::new(8).with_reliable_limit(1000);
+        let s = flood_a_sleeper(&mut exec, (policy, bounds), flood, (30, &subs), &log);
         let mut most = 0;
         for _ in 0..29 {
             exec.step();
@@ -472,21 +469,10 @@ fn a_large_bound_holds_and_keeps_the_order() {
     for policy in QUEUEING {
         let log = log();
         let mut exec = SteppedExecutor::new(SimClock::new(), MS);
-        let mut a = exec
-            .agora_builder(1)
-            .policy(policy)
-            .mailbox_bounds(MailboxBounds::new(3000))
-            .build()
-            .unwrap();
-        let p = a.add_member(Flood::new(500, DeliveryWarranty::None), Activation::Cyclic);
+        let flood = Flood::new(500, DeliveryWarranty::None);
         let subs = [(Count::TYPE, RequestType::All)];
-        let s = a.add_member(
-            Sleeper { cycle: 0, wake_at: 10, inner: Recorder::new("s", &subs, &log) },
-            Activation::Cyclic,
-        );
-        a.activate_member(p).unwrap();
-        a.activate_member(s).unwrap();
-        exec.add_agora(a).unwrap();
+        let bounds = MailboxBounds::new(3000);
+        let s = flood_a_sleeper(&mut exec, (policy, bounds), flood, (10, &subs), &log);
         for _ in 0..9 {
             exec.step();
             assert!(exec.agoras().next().unwrap().post_office().pending(s) <= 3000, "{policy}");
