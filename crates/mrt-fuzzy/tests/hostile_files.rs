@@ -16,6 +16,8 @@
 
 #![allow(clippy::unwrap_used)]
 
+mod common;
+
 use mrt_fuzzy::brian::{Brian, MAX_LEVEL};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -24,21 +26,7 @@ use std::path::{Path, PathBuf};
 fn config(tag: &str) -> PathBuf {
     let d = std::env::temp_dir().join(format!("mrt-fuzzy-issue17-{tag}-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(d.join("behaviors")).unwrap();
-    let files = [
-        ("shape_ctof.txt", "(Dist (TOL (NEAR 10 20)) (TOR (FAR 10 20)))"),
-        ("ctof.txt", "(D Dist)"),
-        ("Predicate.ini", "Near = (D D NEAR);\nFar = (D D FAR);"),
-        ("Cando.ini", "Go = (OR (P Near) (P Far));"),
-        ("want.txt", "Go = (OR (P Near) (P Far));"),
-        ("behavior.txt", "(level 1 Go behaviors/Go.rul)"),
-        ("behaviors/Go.rul", "(Near) => (Speed SLOW);\n(Far) => (Speed FAST);"),
-        ("s_shape.txt", "(SPEED (SNG (SLOW 10)) (SNG (FAST 100)))"),
-        ("s_ftoc.txt", "(Speed SPEED)"),
-    ];
-    for (f, t) in files {
-        std::fs::write(d.join(f), t).unwrap();
-    }
+    common::write_one_behavior(&d);
     d
 }
 
