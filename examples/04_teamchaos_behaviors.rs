@@ -19,8 +19,8 @@
 #![allow(clippy::print_stdout)] // examples talk to the user
 
 use anyhow::{Context as _, Result};
-use mrt_core::robot::{lps, Estimate, Lpo, WorldSnapshot};
 use mrt_core::{Pose2, Time};
+use mrt_msgs::robot::{lps, Estimate, Lpo, WorldSnapshot};
 use mrt_script::{Sandbox, ThinkingCap};
 use std::path::{Path, PathBuf};
 

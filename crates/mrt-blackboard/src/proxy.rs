@@ -12,7 +12,7 @@
 
 use crate::board::{BbError, Blackboard, Update};
 use crossbeam_channel::Receiver;
-use mrt_dcdt::{Context, Member, MemberError, Message, MsgType, RequestType, RESERVED_TYPES_START};
+use mrt_dcdt::{Context, Member, MemberError, Message, MsgType, RequestType};
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::Arc;
 
@@ -21,7 +21,7 @@ use std::sync::Arc;
 pub struct BbUpdate(pub Update);
 
 impl Message for BbUpdate {
-    const TYPE: MsgType = MsgType(RESERVED_TYPES_START + 0x50);
+    const TYPE: MsgType = mrt_msgs::ids::BB_UPDATE;
     const NAME: &'static str = "BbUpdate";
 }
 

@@ -1,7 +1,7 @@
 //! `mrt behave` and `mrt hfsm dot`: try a Lua behavior or HFSM offline, draw an HFSM.
 
 use anyhow::{bail, Context as _, Result};
-use mrt_core::robot::WorldSnapshot;
+use mrt_msgs::robot::WorldSnapshot;
 use mrt_script::chaos::{self, RobotIo};
 use mrt_script::hfsm::Hfsm;
 use mrt_script::offline::{cycle_line, parse_worlds, world_at, WorldsError};

@@ -3,7 +3,8 @@
 //! MRT (Modular Robotic Toolkit) is built of small modules that talk over one message bus
 //! (DCDT, MRT manual chapter 3). This crate holds what all of them agree on:
 //!
-//! - **identifiers** of the DCDT vocabulary: [`AgoraId`], [`MemberId`], [`MsgType`];
+//! - **identifiers** of the DCDT vocabulary: [`AgoraId`], [`MemberId`], [`MsgType`], and the
+//!   [`Message`] trait that makes a Rust type a message;
 //! - **time**: the [`Clock`] trait with a [`WallClock`] for real robots and a manually advanced
 //!   [`SimClock`] for the simulator. Everything in DCDT reads time only through a `Clock`, so a
 //!   simulated match runs as fast as the CPU allows and is reproducible;
@@ -32,16 +33,17 @@
 //! | Member ID | [`MemberId`] |
 //! | Message type | [`MsgType`] |
 //! | `DCDT_TIME` | [`Time`] |
-//! | ThinkingCap LPS, LPO, GS, commands (seed 001 §3.3) | [`robot::WorldSnapshot`], [`robot::Lpo`], [`robot::RobotCommand`] |
+//! | a typed DCDT message (§3.2) | [`Message`] (the standard ones: crate `mrt-msgs`) |
 #![deny(missing_docs)]
 
 mod geometry;
 mod ids;
-pub mod robot;
+mod message;
 mod time;
 
 pub use geometry::{angle_diff, normalize_angle, normalize_angle_positive, Point2, Pose2, Vec2};
 pub use ids::{AgoraId, MemberId, MsgType};
+pub use message::{Message, RESERVED_TYPES_START};
 pub use time::{Clock, SharedClock, SimClock, Time, WallClock};
 
 /// The names most MRT code needs, for `use mrt_core::prelude::*`.

@@ -79,13 +79,14 @@
 //! | PostOffice policies `SLWB`, `SLWDWCV`, `SLWSM` | [`PolicyKind`] (plus the default `PMQ`) |
 //! | InnerLinkManager | [`InnerLinkManager`] |
 //! | Agora configuration file (§3.3.1) | [`config::AgoraConfig`] |
-//! | XML self-describing message (§3.2) | [`describe::SelfDescribing`] |
+//! | XML self-describing message (§3.2) | `describe::SelfDescribing` (feature `describe`) |
 //!
 //! Start with [`Agora`], [`Member`] and [`Context`]; for simulation, [`SteppedExecutor`].
 #![deny(missing_docs)]
 
 mod agora;
 pub mod config;
+#[cfg(feature = "describe")]
 pub mod describe;
 mod endpoint;
 mod error;
@@ -96,7 +97,6 @@ pub mod outlet;
 mod policy;
 mod pool;
 mod postoffice;
-pub mod robot_msgs;
 mod waker;
 pub mod wire;
 

@@ -8,38 +8,11 @@
 
 use crate::error::DcdtError;
 use mrt_core::{AgoraId, MemberId, MsgType, Time};
-use serde::{de::DeserializeOwned, Deserialize, Serialize};
+pub use mrt_core::{Message, RESERVED_TYPES_START};
+use serde::{Deserialize, Serialize};
 use std::any::Any;
 use std::fmt;
 use std::sync::{Arc, OnceLock};
-
-/// A Rust type that travels on the bus as a DCDT message.
-///
-/// The type declares its stable [`MsgType`] once; Members then publish and receive values of
-/// the type without casts. All Agoras of a community must agree on the ids (§3.2). Ids from
-/// `0xFFFF_0000` up are reserved for MRT's own standard messages.
-///
-/// ```
-/// use mrt_dcdt::{Message, MsgType};
-/// use serde::{Deserialize, Serialize};
-///
-/// #[derive(Debug, Serialize, Deserialize)]
-/// struct BallSeen { distance: f32, bearing: f32 }
-///
-/// impl Message for BallSeen {
-///     const TYPE: MsgType = MsgType(100);
-///     const NAME: &'static str = "BallSeen";
-/// }
-/// ```
-pub trait Message: Serialize + DeserializeOwned + Send + Sync + 'static {
-    /// The stable, community-wide type id.
-    const TYPE: MsgType;
-    /// A short human-readable name, used in logs and error messages.
-    const NAME: &'static str;
-}
-
-/// The first message type id reserved for MRT's own standard messages.
-pub const RESERVED_TYPES_START: u32 = 0xFFFF_0000;
 
 /// Delivery warranty of a message (§3.2): how hard the network layer must try.
 ///

@@ -16,7 +16,7 @@ pub struct Ping {
 }
 
 impl Message for Ping {
-    const TYPE: MsgType = MsgType(0x4E45_5401);
+    const TYPE: MsgType = mrt_msgs::ids::NET_PING;
     const NAME: &'static str = "NetPing";
 }
 
@@ -25,7 +25,7 @@ impl Message for Ping {
 pub struct Probe(#[serde(with = "serde_bytes")] pub Vec<u8>);
 
 impl Message for Probe {
-    const TYPE: MsgType = MsgType(0x4E45_5402);
+    const TYPE: MsgType = mrt_msgs::ids::NET_PROBE;
     const NAME: &'static str = "NetProbe";
 }
 
@@ -34,7 +34,7 @@ impl Message for Probe {
 pub struct Echo(#[serde(with = "serde_bytes")] pub Vec<u8>);
 
 impl Message for Echo {
-    const TYPE: MsgType = MsgType(0x4E45_5403);
+    const TYPE: MsgType = mrt_msgs::ids::NET_ECHO;
     const NAME: &'static str = "NetEcho";
 }
 
@@ -45,7 +45,7 @@ impl Message for Echo {
 pub struct Flood(#[serde(with = "serde_bytes")] pub Vec<u8>);
 
 impl Message for Flood {
-    const TYPE: MsgType = MsgType(0x4E45_5404);
+    const TYPE: MsgType = mrt_msgs::ids::NET_FLOOD;
     const NAME: &'static str = "NetFlood";
 }
 

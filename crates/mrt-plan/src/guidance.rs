@@ -26,30 +26,7 @@ use mrt_core::{angle_diff, Point2, Pose2, Vec2};
 use serde::{Deserialize, Serialize};
 use std::f64::consts::{FRAC_PI_2, PI};
 
-/// One sonar reading: where the sonar looks and how far the echo is.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
-pub struct Sonar {
-    /// Direction of the sonar in the robot frame, rad (0 = forward, counter-clockwise).
-    pub bearing: f64,
-    /// Distance from the robot centre to the echo, m. NaN or infinite means no echo.
-    pub range: f64,
-}
-
-impl Sonar {
-    /// A reading.
-    pub const fn new(bearing: f64, range: f64) -> Self {
-        Self { bearing, range }
-    }
-
-    /// The bearing of sonar `i` of `n` equally spaced around the body, sonar 0 forward (the
-    /// ISocRob robots have sixteen, seed `003` §2).
-    pub fn ring_bearing(i: usize, n: usize) -> f64 {
-        if n == 0 {
-            return 0.0;
-        }
-        2.0 * PI * (i % n) as f64 / n as f64
-    }
-}
+pub use mrt_msgs::Sonar;
 
 /// What a guidance mode asks of the base.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]

@@ -15,7 +15,7 @@
 //! the team frame in mm), inside they are [`crate::guidance`]'s (m, rad).
 //!
 //! ```
-//! use mrt_core::robot::{RobotCommand, Target};
+//! use mrt_msgs::robot::{RobotCommand, Target};
 //! use mrt_core::{Point2, Pose2};
 //! use mrt_plan::guidance::Sonar;
 //! use mrt_plan::guide::{Guidance, Mode};
@@ -44,8 +44,8 @@ use crate::guidance::{
     GuidanceCommand, Obstacle, PositionMode, PotentialField, Sonar, VelocityGuard,
 };
 use crate::kinematics::Twist;
-use mrt_core::robot::{RobotCommand, Target};
 use mrt_core::{Point2, Pose2};
+use mrt_msgs::robot::{RobotCommand, Target};
 
 /// The mode guidance ran in one cycle.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]

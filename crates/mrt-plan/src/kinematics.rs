@@ -518,7 +518,7 @@ pub(crate) fn arc_velocity(dx: f64, dy: f64, dtheta: f64) -> (f64, f64) {
 /// during a sampling period can be approximated by an arc of circumference").
 ///
 /// A non-finite `twist` or `dt` returns `pose` unchanged. Units are the caller's: metres and
-/// m/s here (note that [`mrt_core::robot`] snapshots use millimetres).
+/// m/s here (note that [`mrt_msgs::robot`] snapshots use millimetres).
 ///
 /// ```
 /// use mrt_core::Pose2;

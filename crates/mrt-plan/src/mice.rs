@@ -52,57 +52,7 @@ use mrt_core::Pose2;
 use serde::{Deserialize, Serialize};
 use std::f64::consts::FRAC_PI_2;
 
-/// The four numbers the two mice give for one sampling period, metres, each in its own frame
-/// (`x̄` along the joining line, positive to the robot's right; `ȳ` forward).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
-pub struct MiceReadings {
-    /// `x̄_l`: left mouse, lateral.
-    pub x_left: f64,
-    /// `ȳ_l`: left mouse, longitudinal.
-    pub y_left: f64,
-    /// `x̄_r`: right mouse, lateral.
-    pub x_right: f64,
-    /// `ȳ_r`: right mouse, longitudinal.
-    pub y_right: f64,
-}
-
-impl MiceReadings {
-    /// Readings `(x̄_l, ȳ_l, x̄_r, ȳ_r)`.
-    pub const fn new(x_left: f64, y_left: f64, x_right: f64, y_right: f64) -> Self {
-        Self { x_left, y_left, x_right, y_right }
-    }
-
-    fn is_finite(&self) -> bool {
-        self.x_left.is_finite()
-            && self.y_left.is_finite()
-            && self.x_right.is_finite()
-            && self.y_right.is_finite()
-    }
-}
-
-/// The robot's motion over one sampling period, in the robot frame at the start of the period:
-/// `(Δx, Δy)` metres, `Δθ` radians counter-clockwise.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
-pub struct Displacement {
-    /// `Δx`, forward, m.
-    pub dx: f64,
-    /// `Δy`, to the left, m.
-    pub dy: f64,
-    /// `Δθ`, rad.
-    pub dtheta: f64,
-}
-
-impl Displacement {
-    /// A displacement.
-    pub const fn new(dx: f64, dy: f64, dtheta: f64) -> Self {
-        Self { dx, dy, dtheta }
-    }
-
-    /// As a relative pose, to [`Pose2::compose`] onto the previous pose.
-    pub fn as_pose(&self) -> Pose2 {
-        Pose2::new(self.dx, self.dy, self.dtheta)
-    }
-}
+pub use mrt_msgs::{Displacement, MiceReadings};
 
 /// The intermediate quantities of the manual's derivation (§4.1), for inspection and tests.
 #[derive(Clone, Copy, Debug, PartialEq)]

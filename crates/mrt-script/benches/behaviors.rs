@@ -7,8 +7,8 @@
 #![allow(missing_docs, clippy::unwrap_used)]
 
 use criterion::{criterion_group, criterion_main, BatchSize, Criterion};
-use mrt_core::robot::{lps, Lpo, WorldSnapshot};
 use mrt_core::Time;
+use mrt_msgs::robot::{lps, Lpo, WorldSnapshot};
 use mrt_script::chaos::{self, RobotIo};
 use mrt_script::hfsm::Hfsm;
 use mrt_script::{LuaRuntime, Sandbox, ThinkingCap};

@@ -48,7 +48,7 @@ fn bench(c: &mut Criterion) {
     let rt4 = LuaRuntime::new(Sandbox::default()).unwrap();
     let io = std::rc::Rc::new(std::cell::RefCell::new(mrt_script::chaos::RobotIo::default()));
     mrt_script::chaos::install(&rt4, io.clone()).unwrap();
-    io.borrow_mut().begin_cycle(mrt_core::robot::WorldSnapshot::default(), "tick");
+    io.borrow_mut().begin_cycle(mrt_msgs::robot::WorldSnapshot::default(), "tick");
     let four = Script::from_source(
         &rt4,
         "four.lua",

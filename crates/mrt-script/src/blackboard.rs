@@ -182,7 +182,7 @@ mod tests {
                 .unwrap();
         assert!(bb.get::<bool>("local.var.behavior.loaded").unwrap());
         for _ in 0..3 {
-            let c = cap.cycle(mrt_core::robot::WorldSnapshot::default());
+            let c = cap.cycle(mrt_msgs::robot::WorldSnapshot::default());
             assert!(c.errors.is_empty(), "{:?}", c.errors);
             assert_eq!(c.command.vlin, 250.0);
         }

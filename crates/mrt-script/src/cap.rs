@@ -22,7 +22,7 @@ use crate::runtime::{LuaRuntime, Sandbox};
 use crate::script::ScriptError;
 use crate::watch::ScriptWatcher;
 use mrt_blackboard::Blackboard;
-use mrt_core::robot::{RobotCommand, WorldSnapshot};
+use mrt_msgs::robot::{RobotCommand, WorldSnapshot};
 use std::cell::RefCell;
 use std::path::{Path, PathBuf};
 use std::rc::Rc;

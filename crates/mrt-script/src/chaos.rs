@@ -14,8 +14,8 @@
 use crate::runtime::LuaRuntime;
 use crate::script::ScriptError;
 use mlua::{Lua, LuaString, Table, Value};
-use mrt_core::robot::{lps, RobotCommand, WorldSnapshot};
 use mrt_core::Time;
+use mrt_msgs::robot::{lps, RobotCommand, WorldSnapshot};
 use std::cell::RefCell;
 use std::collections::HashMap;
 use std::rc::Rc;
@@ -343,7 +343,7 @@ fn install_inner(lua: &Lua, io: Rc<RefCell<RobotIo>>, memory_limit: usize) -> ml
         }
         let pose = mrt_core::Pose2::new(x, y, theta);
         io.borrow_mut().command.target =
-            Some(mrt_core::robot::Target { pose, avoid: avoid.unwrap_or(true) });
+            Some(mrt_msgs::robot::Target { pose, avoid: avoid.unwrap_or(true) });
         Ok(())
     });
     // A set-point that is not a finite number is the script's fault, reported as one: NaN

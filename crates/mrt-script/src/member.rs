@@ -2,7 +2,7 @@
 //!
 //! A [`BehaviorMember`] reads the latest [`WorldSnapshot`] from the bus, runs one cycle of an
 //! HFSM (the "HFSM Member") or of one HBM behavior (the "HBM Member") per activation (every
-//! 100 ms by default, as in the seed: [`DEFAULT_PERIOD`]), and publishes the [`RobotCommand`](mrt_core::robot::RobotCommand)
+//! 100 ms by default, as in the seed: [`DEFAULT_PERIOD`]), and publishes the [`RobotCommand`](mrt_msgs::robot::RobotCommand)
 //! and a [`BehaviorStatus`] (active path, behavior, errors) for monitors. A
 //! [`ReloadRequest`] on the bus reloads the edited scripts at the next cycle boundary, like the
 //! seed's editor sending a behavior to a running robot.
@@ -15,9 +15,8 @@
 use crate::cap::ThinkingCap;
 use crate::runtime::Sandbox;
 use crate::watchdog::{Watchdog, DEFAULT_DEADLINE};
-use mrt_core::robot::WorldSnapshot;
-use mrt_dcdt::{Context, Member, MemberError, Message, MsgType, RequestType, RESERVED_TYPES_START};
-use serde::{Deserialize, Serialize};
+use mrt_dcdt::{Context, Member, MemberError, Message, RequestType};
+use mrt_msgs::robot::WorldSnapshot;
 use std::path::PathBuf;
 use std::time::Duration;
 
@@ -25,32 +24,7 @@ use std::time::Duration;
 /// 100 ms" (§3.2).
 pub const DEFAULT_PERIOD: Duration = Duration::from_millis(100);
 
-/// What a behavior Member did in its last cycle, for monitors.
-#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
-pub struct BehaviorStatus {
-    /// The HFSM's active path (`Attacker/Score/Align`), empty for an HBM Member.
-    pub path: String,
-    /// The behavior that ran.
-    pub behavior: Option<String>,
-    /// Files reloaded before this cycle.
-    pub reloaded: Vec<String>,
-    /// Errors of this cycle (the robot went on regardless).
-    pub errors: Vec<String>,
-}
-
-impl Message for BehaviorStatus {
-    const TYPE: MsgType = MsgType(RESERVED_TYPES_START + 0x30);
-    const NAME: &'static str = "BehaviorStatus";
-}
-
-/// Asks behavior Members to reload their changed scripts at the next cycle boundary.
-#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
-pub struct ReloadRequest;
-
-impl Message for ReloadRequest {
-    const TYPE: MsgType = MsgType(RESERVED_TYPES_START + 0x31);
-    const NAME: &'static str = "ReloadRequest";
-}
+pub use mrt_msgs::{BehaviorStatus, ReloadRequest};
 
 /// What the Member runs.
 #[derive(Clone, Debug)]

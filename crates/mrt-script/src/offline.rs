@@ -14,8 +14,8 @@
 //! ```
 
 use crate::cap::Cycle;
-use mrt_core::robot::WorldSnapshot;
 use mrt_core::Time;
+use mrt_msgs::robot::WorldSnapshot;
 
 /// A `--world` file that is not one snapshot or an array of them.
 #[derive(Debug, thiserror::Error)]

@@ -30,7 +30,7 @@
 use crate::cap::{Cycle, ThinkingCap};
 use crate::runtime::Interrupt;
 use crate::script::ScriptError;
-use mrt_core::robot::{RobotCommand, WorldSnapshot};
+use mrt_msgs::robot::{RobotCommand, WorldSnapshot};
 use std::sync::mpsc::{channel, Receiver, RecvTimeoutError, Sender};
 use std::sync::Arc;
 use std::time::{Duration, Instant};

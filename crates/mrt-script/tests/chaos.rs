@@ -2,8 +2,8 @@
 
 #![allow(clippy::unwrap_used)]
 
-use mrt_core::robot::{lps, Estimate, GameState, Lpo, Mate, WorldSnapshot};
 use mrt_core::{Pose2, Time};
+use mrt_msgs::robot::{lps, Estimate, GameState, Lpo, Mate, WorldSnapshot};
 use mrt_script::chaos::{install, GlobalValue, RobotIo};
 use mrt_script::{LoadStrategy, LuaRuntime, Sandbox, Script, ScriptError};
 use std::cell::RefCell;
@@ -142,7 +142,7 @@ fn wrong_arguments_are_lua_errors_naming_the_script_line_and_function_not_panics
 /// guidance a posture, avoiding obstacles unless told not to; bad numbers are Lua errors.
 #[test]
 fn kickoff_pose_and_targets() {
-    use mrt_core::robot::Target;
+    use mrt_msgs::robot::Target;
     let rt = LuaRuntime::new(Sandbox::default()).unwrap();
     let io = Rc::new(RefCell::new(RobotIo::default()));
     install(&rt, io.clone()).unwrap();

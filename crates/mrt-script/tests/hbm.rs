@@ -5,9 +5,9 @@
 
 #![allow(clippy::unwrap_used)]
 
-use mrt_core::robot::{lps, Lpo, RobotCommand, WorldSnapshot};
 use mrt_core::Time;
 use mrt_fuzzy::hbm::Defuzzification;
+use mrt_msgs::robot::{lps, Lpo, RobotCommand, WorldSnapshot};
 use mrt_script::chaos::{install, GlobalValue, RobotIo};
 use mrt_script::hbm::Hbm;
 use mrt_script::{LoadStrategy, LuaRuntime, Sandbox, Script, ScriptError, ThinkingCap};

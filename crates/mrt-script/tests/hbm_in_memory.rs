@@ -3,7 +3,7 @@
 
 #![allow(clippy::unwrap_used)]
 
-use mrt_core::robot::{lps, Lpo, WorldSnapshot};
+use mrt_msgs::robot::{lps, Lpo, WorldSnapshot};
 use mrt_script::chaos::{install, RobotIo};
 use mrt_script::hbm::{behavior_files, Hbm};
 use mrt_script::{LuaRuntime, Sandbox, ScriptError};

@@ -5,8 +5,8 @@
 
 #![allow(clippy::unwrap_used)]
 
-use mrt_core::robot::{lps, Lpo, WorldSnapshot};
 use mrt_core::Time;
+use mrt_msgs::robot::{lps, Lpo, WorldSnapshot};
 use mrt_script::chaos::{install, GlobalValue, RobotIo};
 use mrt_script::hfsm::{Hfsm, Taken};
 use mrt_script::{LoadStrategy, LuaRuntime, Sandbox, Script, ScriptError};

@@ -3,9 +3,9 @@
 
 #![allow(clippy::unwrap_used)]
 
-use mrt_core::robot::{lps, Lpo, RobotCommand, WorldSnapshot};
 use mrt_core::SimClock;
 use mrt_dcdt::{Activation, Context, Member, MemberError, RequestType, SteppedExecutor};
+use mrt_msgs::robot::{lps, Lpo, RobotCommand, WorldSnapshot};
 use mrt_script::member::{BehaviorMember, BehaviorStatus, DEFAULT_PERIOD};
 use std::sync::{Arc, Mutex};
 use std::time::Duration;

@@ -12,8 +12,8 @@
 
 #![allow(clippy::unwrap_used)]
 
-use mrt_core::robot::{lps, Estimate, GameState, Lpo, WorldSnapshot};
 use mrt_core::{Pose2, Time};
+use mrt_msgs::robot::{lps, Estimate, GameState, Lpo, WorldSnapshot};
 use mrt_script::{Cycle, Sandbox, ScriptError, ThinkingCap};
 use std::path::{Path, PathBuf};
 
@@ -68,13 +68,13 @@ impl World {
     /// A teammate at (x, y) (mm), facing the opponent's net.
     fn mate(mut self, id: u32, x: f64, y: f64, keeper: bool) -> World {
         let at = Estimate { pose: Pose2::new(x, y, 0.0), quality: 0.9 };
-        self.0.mates.push(mrt_core::robot::Mate { id, at, keeper });
+        self.0.mates.push(mrt_msgs::robot::Mate { id, at, keeper });
         self
     }
 
     /// The game state.
     fn playing(mut self) -> World {
-        self.0.game_state = mrt_core::robot::GameState::Playing;
+        self.0.game_state = mrt_msgs::robot::GameState::Playing;
         self
     }
 
@@ -763,7 +763,7 @@ fn in_ready_the_players_and_the_goalkeeper_walk_to_their_kickoff_places() {
         w.0.kickoff_pose = Some(place);
         w
     };
-    let want = Some(mrt_core::robot::Target { pose: place, avoid: true });
+    let want = Some(mrt_msgs::robot::Target { pose: place, avoid: true });
     let mut player =
         ThinkingCap::with_hfsm(dir(), dir().join("player.hfsm.lua"), Sandbox::default()).unwrap();
     let c = player.cycle(ready(World::at(0).me(-5000.0, -5000.0, 1.57, 0.9).ball(4000.0, 0.5)).0);

@@ -39,13 +39,12 @@ use crate::referee::Call;
 use crate::sensor::{merge_team, CameraFrame, Odometry};
 use crate::teams::{embedded_teamchaos, send_brain, Body, Stack, CHAOS_KEEPER, CHAOS_PLAYER};
 use crate::worldstate::WorldModel;
-use mrt_core::robot::{RobotCommand, WorldSnapshot};
 use mrt_core::SimClock;
 use mrt_dcdt::{
-    Activation, Agora, Context, InnerLinkManager, Member, MemberError, Message, MsgType,
-    RequestType, RunReport, SteppedExecutor, RESERVED_TYPES_START,
+    Activation, Agora, Context, InnerLinkManager, Member, MemberError, RequestType, RunReport,
+    SteppedExecutor,
 };
-use mrt_plan::guidance::Sonar;
+use mrt_msgs::robot::{RobotCommand, WorldSnapshot};
 use mrt_plan::guide::Guidance;
 use mrt_script::member::{BehaviorMember, BehaviorStatus};
 use std::collections::BTreeMap;
@@ -53,45 +52,7 @@ use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex, MutexGuard};
 use std::time::Duration;
 
-pub use crate::sensor::MateReport;
-
-impl Message for MateReport {
-    const TYPE: MsgType = MsgType(RESERVED_TYPES_START + 0x40);
-    const NAME: &'static str = "MateReport";
-}
-
-impl Message for Odometry {
-    const TYPE: MsgType = MsgType(RESERVED_TYPES_START + 0x43);
-    const NAME: &'static str = "Odometry";
-}
-
-impl Message for CameraFrame {
-    const TYPE: MsgType = MsgType(RESERVED_TYPES_START + 0x44);
-    const NAME: &'static str = "CameraFrame";
-}
-
-/// One reading of the sonar ring (robot frame, m from the centre, ring order; no echo is an
-/// infinite range), published by the sonar driver every cycle.
-#[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
-pub struct SonarScan {
-    /// The sonars.
-    pub sonars: Vec<Sonar>,
-}
-
-impl Message for SonarScan {
-    const TYPE: MsgType = MsgType(RESERVED_TYPES_START + 0x41);
-    const NAME: &'static str = "SonarScan";
-}
-
-/// What guidance asks of the motor and kicker driver: the velocities to drive (mm/s, deg/s)
-/// and the kick.
-#[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
-pub struct MotorCommand(pub RobotCommand);
-
-impl Message for MotorCommand {
-    const TYPE: MsgType = MsgType(RESERVED_TYPES_START + 0x42);
-    const NAME: &'static str = "MotorCommand";
-}
+pub use mrt_msgs::{MateReport, MemberFault, MotorCommand, SonarScan};
 
 type Shared = Arc<Mutex<Pitch>>;
 
@@ -419,60 +380,44 @@ pub fn behaviors_dir(stacks: &[Stack], behaviors: Option<&Path>) -> Result<Files
     }
 }
 
-/// A Member of a robot's Agora that failed to start, failed jobs or panicked (each time it was
-/// restarted), or whose mailbox lost messages (its bus bounds dropped or refused some: a
-/// Member that fell thousands of messages behind), from its executor's report; booked against
-/// the robot when the match ends.
-#[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
-pub struct MemberFault {
-    /// The Member's name.
-    pub name: String,
-    /// Errors, panics and restarts (at least 1).
-    pub count: u64,
-    /// Whether it never completed a cycle (it failed from the start).
-    pub never_ran: bool,
-    /// Its last error.
-    pub error: String,
+/// The faulty Members of one Agora's report: failed starts, jobs and panics, and mailboxes
+/// that lost messages (their bus bounds dropped or refused some: a Member that fell thousands
+/// of messages behind).
+pub fn member_faults(report: &RunReport) -> Vec<MemberFault> {
+    report
+        .members
+        .iter()
+        .flat_map(|m| {
+            let failed = m.last_error.clone().map(|error| MemberFault {
+                name: m.name.clone(),
+                count: m.errors + m.panics + m.restarts.max(1),
+                never_ran: m.cycles == 0,
+                error,
+            });
+            let lost =
+                m.mailboxes.iter().filter(|b| b.dropped + b.refused > 0).map(|b| MemberFault {
+                    name: m.name.clone(),
+                    count: b.dropped + b.refused,
+                    never_ran: false,
+                    error: format!(
+                        "its mailbox for {} dropped {} and refused {} messages (capacity {})",
+                        b.msg_type, b.dropped, b.refused, b.capacity
+                    ),
+                });
+            failed.into_iter().chain(lost)
+        })
+        .collect()
 }
 
-impl MemberFault {
-    /// The faulty Members of one Agora's report.
-    pub fn of_report(report: &RunReport) -> Vec<MemberFault> {
-        report
-            .members
-            .iter()
-            .flat_map(|m| {
-                let failed = m.last_error.clone().map(|error| MemberFault {
-                    name: m.name.clone(),
-                    count: m.errors + m.panics + m.restarts.max(1),
-                    never_ran: m.cycles == 0,
-                    error,
-                });
-                let lost =
-                    m.mailboxes.iter().filter(|b| b.dropped + b.refused > 0).map(|b| MemberFault {
-                        name: m.name.clone(),
-                        count: b.dropped + b.refused,
-                        never_ran: false,
-                        error: format!(
-                            "its mailbox for {} dropped {} and refused {} messages (capacity {})",
-                            b.msg_type, b.dropped, b.refused, b.capacity
-                        ),
-                    });
-                failed.into_iter().chain(lost)
-            })
-            .collect()
-    }
-
-    /// Books it against robot `robot`.
-    pub fn book(&self, pitch: &mut Pitch, robot: usize) {
-        let first_at = self.never_ran.then_some(0.0);
-        pitch.fault_at(
-            robot,
-            first_at,
-            self.count,
-            &format!("member {}: {}", self.name, self.error),
-        );
-    }
+/// Books a Member's fault against robot `robot`.
+pub fn book_fault(fault: &MemberFault, pitch: &mut Pitch, robot: usize) {
+    let first_at = fault.never_ran.then_some(0.0);
+    pitch.fault_at(
+        robot,
+        first_at,
+        fault.count,
+        &format!("member {}: {}", fault.name, fault.error),
+    );
 }
 
 /// A match whose robots are Agoras on the bus.
@@ -562,7 +507,7 @@ impl BusMatch {
                 let robot = usize::try_from(r.agora.0).unwrap_or(usize::MAX).wrapping_sub(1);
                 if robot < pitch.world().robot_count() {
                     // (not a monitoring Agora)
-                    MemberFault::of_report(r).iter().for_each(|f| f.book(&mut pitch, robot));
+                    member_faults(r).iter().for_each(|f| book_fault(f, &mut pitch, robot));
                 }
             }
         }
@@ -623,7 +568,7 @@ mod tests {
             exit: ExitReason::TimeLimit,
             members: vec![member("Fine", 0, 0), member("Slow", 3, 1)],
         };
-        let faults = MemberFault::of_report(&report);
+        let faults = member_faults(&report);
         assert_eq!(faults.len(), 1, "{faults:?}");
         assert_eq!((faults[0].name.as_str(), faults[0].count), ("Slow", 4));
         assert!(faults[0].error.contains("dropped 3 and refused 1"), "{}", faults[0].error);

@@ -31,8 +31,8 @@ pub struct FieldConfig {
 
 impl FieldConfig {
     /// The field as the robots' world model knows it (millimetres, half sizes).
-    pub fn map(&self) -> mrt_core::robot::Field {
-        mrt_core::robot::Field {
+    pub fn map(&self) -> mrt_msgs::robot::Field {
+        mrt_msgs::robot::Field {
             half_length: self.length * 500.0,
             half_width: self.width * 500.0,
             goal_half_width: self.goal_width * 500.0,

@@ -7,7 +7,7 @@
 //! is scaled down as a whole, keeping its direction).
 
 use crate::world::Drive;
-use mrt_core::robot::RobotCommand;
+use mrt_msgs::robot::RobotCommand;
 use mrt_plan::kinematics::{
     duty_cycle, DiffDrive, Kinematics, Omni3, OmniWheels, Twist, WheelSpeeds,
 };

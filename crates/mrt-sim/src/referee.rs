@@ -10,8 +10,8 @@
 
 use crate::config::READY_TOLERANCE;
 use crate::world::World;
-use mrt_core::robot::GameState;
 use mrt_core::Pose2;
+use mrt_msgs::robot::GameState;
 use std::f64::consts::PI;
 
 /// A side of the match.

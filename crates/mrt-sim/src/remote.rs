@@ -23,93 +23,21 @@
 //! given a link by the caller (`mrt-net` over zenoh in `mrt sim --distributed`). Each team is a
 //! network of its own, as on a real field, so a robot never hears the other team.
 
-use crate::bus::{add_robot, MateReport, MemberFault, RobotSpec};
+use crate::bus::{add_robot, member_faults, MateReport, RobotSpec};
 use crate::config::SimConfig;
 use crate::devices::LinkedDevices;
 use crate::drivers::Base;
 use crate::game::{MatchReport, Pitch};
 use crate::referee::Call;
-use crate::sensor::{CameraFrame, Odometry};
 use mrt_core::{SimClock, Time};
 use mrt_dcdt::config::AgoraConfig;
-use mrt_dcdt::{
-    Agora, DeliveryWarranty, Endpoint, InnerLinkManager, Message, MsgType, RequestType,
-    SteppedExecutor, RESERVED_TYPES_START,
-};
-use mrt_plan::guidance::Sonar;
+use mrt_dcdt::{Agora, DeliveryWarranty, Endpoint, InnerLinkManager, RequestType, SteppedExecutor};
 use std::collections::BTreeMap;
 use std::path::Path;
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
-/// What robot `robot`'s devices read at the start of control cycle `cycle`.
-#[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
-pub struct DeviceFrame {
-    /// The robot (0 .. 2 × team size).
-    pub robot: u32,
-    /// The control cycle (0 at kickoff of the first half).
-    pub cycle: u64,
-    /// The mice and wheels since the last cycle.
-    pub odometry: Odometry,
-    /// The object sensor's frame.
-    pub camera: CameraFrame,
-    /// The sonar ring.
-    pub sonars: Vec<Sonar>,
-    /// Robots the simulator is not waiting for (silent, or known gone): teammates do not wait
-    /// for their reports either, until they speak again.
-    pub not_awaited: Vec<u32>,
-}
-
-impl Message for DeviceFrame {
-    const TYPE: MsgType = MsgType(RESERVED_TYPES_START + 0x45);
-    const NAME: &'static str = "DeviceFrame";
-}
-
-/// What robot `robot`'s drivers did in control cycle `cycle`.
-#[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
-pub struct DeviceAct {
-    /// The robot.
-    pub robot: u32,
-    /// The control cycle answered.
-    pub cycle: u64,
-    /// The duty cycles the motor driver set last, if any.
-    pub duty: Option<Vec<f64>>,
-    /// Whether the kicker fired.
-    pub kick: bool,
-    /// Faults of the robot's software noted this cycle.
-    pub faults: Vec<String>,
-}
-
-impl Message for DeviceAct {
-    const TYPE: MsgType = MsgType(RESERVED_TYPES_START + 0x46);
-    const NAME: &'static str = "DeviceAct";
-}
-
-/// The match is over: robots close their Members and answer with a [`RobotEnd`].
-#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
-pub struct FinalWhistle {
-    /// Control cycles played.
-    pub cycles: u64,
-}
-
-impl Message for FinalWhistle {
-    const TYPE: MsgType = MsgType(RESERVED_TYPES_START + 0x47);
-    const NAME: &'static str = "FinalWhistle";
-}
-
-/// A robot's last word: its Members that failed to start, failed jobs or panicked.
-#[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
-pub struct RobotEnd {
-    /// The robot.
-    pub robot: u32,
-    /// Its Members' faults.
-    pub faults: Vec<MemberFault>,
-}
-
-impl Message for RobotEnd {
-    const TYPE: MsgType = MsgType(RESERVED_TYPES_START + 0x48);
-    const NAME: &'static str = "RobotEnd";
-}
+pub use mrt_msgs::{DeviceAct, DeviceFrame, FinalWhistle, RobotEnd};
 
 /// How long the simulator waits for the robots.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -365,7 +293,7 @@ impl PitchServer {
         let mut pitch = lock(&self.pitch)?;
         for (i, end) in &ends {
             for f in &end.faults {
-                f.book(&mut pitch, *i);
+                crate::bus::book_fault(f, &mut pitch, *i);
             }
         }
         for i in (0..self.silent.len()).filter(|i| !ends.contains_key(i)) {
@@ -664,8 +592,7 @@ impl RemoteRobot {
     fn end(self, run: RobotRun) -> Result<RobotRun, String> {
         let id = self.spec.agora_id()?;
         let reports = self.exec.finish();
-        let faults =
-            reports.iter().filter(|r| r.agora.0 == id).flat_map(MemberFault::of_report).collect();
+        let faults = reports.iter().filter(|r| r.agora.0 == id).flat_map(member_faults).collect();
         let robot = u32::try_from(self.spec.robot).map_err(|e| e.to_string())?;
         self.outbox.publish_with(RobotEnd { robot, faults }, DeliveryWarranty::Reliable, 128);
         Ok(run)
@@ -683,7 +610,7 @@ mod tests {
     use crate::bus::BusMatch;
     use crate::config::short;
     use crate::teams::Stack;
-    use mrt_dcdt::{AgoraPort, MsgRef, Outlet};
+    use mrt_dcdt::{AgoraPort, MsgRef, MsgType, Outlet};
 
     /// An in-process stand-in for one team's network: what an Agora shares goes to every other
     /// Agora of the net whose Members want its type from elsewhere (what mrt-net does over

@@ -13,37 +13,18 @@
 use crate::config::{OdometryConfig, SensorConfig, SonarConfig};
 use crate::referee::Referee;
 use crate::world::World;
-use mrt_core::robot::{lps, Estimate, GameState, Mate, WorldSnapshot};
 use mrt_core::{normalize_angle, Pose2};
+use mrt_msgs::robot::{lps, Estimate, Mate, WorldSnapshot};
 use mrt_plan::guidance::Sonar;
 use mrt_plan::kinematics::{integrate, Twist};
-use mrt_plan::mice::{Displacement, MiceOdometry, MiceReadings};
+use mrt_plan::mice::{Displacement, MiceOdometry};
 use rand::{Rng, RngCore};
 
 /// A teammate's ball counts this much of its own quality: a second-hand sighting, one cycle
 /// old, is trusted a little less than one's own.
 pub const SHARED_BALL: f64 = 0.9;
 
-/// What a robot tells its teammates every cycle (team frame, mm): its own pose and its own
-/// sighting of the ball (never what it heard from others, so stale news does not circulate).
-#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
-pub struct MateReport {
-    /// The robot's player number.
-    pub id: u32,
-    /// Whether it keeps goal.
-    pub keeper: bool,
-    /// Where it believes it is.
-    pub pose: Estimate,
-    /// Where it believes the ball is (quality 0 when it has no idea).
-    pub ball: Estimate,
-}
-
-impl MateReport {
-    /// The report of robot `id` on its world snapshot (before [`merge_team`]).
-    pub fn of(id: u32, keeper: bool, w: &WorldSnapshot) -> MateReport {
-        MateReport { id, keeper, pose: w.my_pos, ball: w.global_ball }
-    }
-}
+pub use mrt_msgs::MateReport;
 
 /// The team side of the world state: `w.mates` from the teammates' reports (in their order),
 /// and the global ball replaced by a teammate's sighting when that is better than one's own
@@ -118,43 +99,7 @@ fn blocks(a: (f64, f64), b: (f64, f64), c: (f64, f64), radius: f64) -> bool {
     t > 0.0 && t < 1.0 && (px - c.0).hypot(py - c.1) < radius
 }
 
-/// How many objects the camera knows: the ball, two nets, six landmarks (as many as LPS slots).
-pub const FIELD_OBJECTS: usize = lps::COUNT;
-
-/// One object detected in one frame: distance (m) and bearing (rad, counter-clockwise from
-/// the robot's heading), with the sensor's noise.
-#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
-pub struct Sighting {
-    /// Distance, m.
-    pub distance: f64,
-    /// Bearing, rad.
-    pub bearing: f64,
-}
-
-/// What the game controller tells every robot each cycle (field frame, m).
-#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
-pub struct GameInfo {
-    /// The referee's state.
-    pub state: GameState,
-    /// The direction the robot's team attacks: +1 east, −1 west.
-    pub attack: f64,
-    /// The robot's place in the kickoff formation, in READY.
-    pub kickoff_pose: Option<Pose2>,
-}
-
-/// One frame of the object sensor, published by the camera driver.
-#[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
-pub struct CameraFrame {
-    /// Simulated time of the frame, s.
-    pub time: f64,
-    /// What was seen, in [`FIELD_OBJECTS`] order (`None`: not seen this frame).
-    pub sightings: [Option<Sighting>; FIELD_OBJECTS],
-    /// The ball's velocity in the robot's frame (m/s), when the ball is seen: the stand-in
-    /// for a ball tracker.
-    pub ball_velocity: Option<(f64, f64)>,
-    /// The game controller's news.
-    pub game: GameInfo,
-}
+pub use mrt_msgs::{CameraFrame, GameInfo, Sighting, FIELD_OBJECTS};
 
 /// What the camera of robot `robot` sees now (the object sensor): every object within its
 /// range and field of view, not hidden behind another robot (the ball) and not missed, as
@@ -205,18 +150,7 @@ pub fn look(
     frame
 }
 
-/// What the odometry sensors read over one control cycle, published by the odometry driver.
-#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
-pub struct Odometry {
-    /// The two optical mice, each in its own frame (MRT manual ch. 4), m.
-    pub mice: MiceReadings,
-    /// The wheel encoders' motion, in the robot frame at the start of the cycle.
-    pub wheels: Displacement,
-    /// The robot was put down by hand at this pose (field frame, m) since the last reading:
-    /// the motion above counts from there. The operator tells the robot, as a team does when
-    /// it places its robots before a match.
-    pub placed: Option<Pose2>,
-}
+pub use mrt_msgs::Odometry;
 
 /// The odometry driver of one simulated robot: mice and wheels since its last reading.
 #[derive(Clone, Debug)]
@@ -282,6 +216,7 @@ impl Odometer {
 mod tests {
     use super::*;
     use crate::config::SimConfig;
+    use mrt_msgs::GameState;
     use rand::SeedableRng;
     use rand_chacha::ChaCha8Rng;
 

@@ -14,9 +14,9 @@
 
 use crate::embedded::FilesDir;
 use crate::game::{Brain, Chaser, Stopped};
-use mrt_core::robot::{lps, Lpo, RobotCommand, WorldSnapshot};
 use mrt_core::{Point2, Pose2};
 use mrt_fuzzy::brian::Brian;
+use mrt_msgs::robot::{lps, Lpo, RobotCommand, WorldSnapshot};
 use mrt_plan::guidance::behind_ball;
 use mrt_script::{Sandbox, ThinkingCap, Watchdog, DEFAULT_DEADLINE};
 use std::path::Path;

@@ -25,8 +25,8 @@
 //! robot sees the landmarks, falling as it goes without them.
 
 use crate::sensor::{CameraFrame, Odometry, Sighting, FIELD_OBJECTS};
-use mrt_core::robot::{lps, Estimate, Field, Lpo, WorldSnapshot};
 use mrt_core::{normalize_angle, Pose2, Time, Vec2};
+use mrt_msgs::robot::{lps, Estimate, Field, Lpo, WorldSnapshot};
 use mrt_plan::mice::{Displacement, MiceOdometry, MiceReadings};
 use mrt_plan::PlanError;
 use nalgebra::{Matrix2, Matrix2x3, Matrix3, Vector2, Vector3};
@@ -373,7 +373,7 @@ impl WorldModel {
 mod tests {
     use super::*;
     use crate::sensor::GameInfo;
-    use mrt_core::robot::GameState;
+    use mrt_msgs::robot::GameState;
 
     fn model() -> WorldModel {
         // The default field: 18 m × 12 m. Mice 0.2 m apart, 3 mm tolerance.

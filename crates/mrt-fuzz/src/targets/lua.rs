@@ -8,8 +8,8 @@
 
 use super::{files_under, Harness, Seed, Target};
 use crate::FuzzError;
-use mrt_core::robot::{lps, Estimate, GameState, Lpo, Mate, WorldSnapshot};
 use mrt_core::{Pose2, Time};
+use mrt_msgs::robot::{lps, Estimate, GameState, Lpo, Mate, WorldSnapshot};
 use mrt_script::chaos::{self, RobotIo};
 use mrt_script::hbm::Hbm;
 use mrt_script::hfsm::Hfsm;

@@ -2,11 +2,11 @@
 
 use super::{Harness, Seed, Target};
 use crate::FuzzError;
-use mrt_core::robot::{RobotCommand, WorldSnapshot};
 use mrt_core::{AgoraId, MemberId, MsgType, Time};
 use mrt_dcdt::describe::{Attribute, Object, SelfDescribing};
 use mrt_dcdt::wire::{decode, encode, HEADER_LEN};
 use mrt_dcdt::{DeliveryWarranty, Message, Msg, MsgHeader, RawPayload};
+use mrt_msgs::robot::{RobotCommand, WorldSnapshot};
 use std::path::Path;
 
 /// DCDT wire frames.

@@ -1,9 +1,9 @@
-//! What a robot's behaviors read and write each cycle (ThinkingCap, seed 001 §3.3): a typed
+//! What a robot's behaviors read and write each cycle (ThinkingCap, seed `001` §3.3): a typed
 //! [`WorldSnapshot`] (local perceptual space, global state, team, game state) and a
 //! [`RobotCommand`] (velocities, kick, perceptual needs, behavior selection). The world model
 //! and the simulator fill the snapshot; behaviors (Lua or fuzzy) fill the command.
 
-use crate::{Pose2, Time, Vec2};
+use mrt_core::{Pose2, Time, Vec2};
 use serde::{Deserialize, Serialize};
 
 /// Indices of the local perceptual space (LPS) objects (`BALL`, `NET1`, ... of chaoslib).

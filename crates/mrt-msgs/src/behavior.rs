@@ -1,0 +1,21 @@
+//! What the behavior Members say and hear besides the command (ThinkingCap, seed `001` §3.2:
+//! behaviors changed while the robot runs).
+
+use serde::{Deserialize, Serialize};
+
+/// What a behavior Member did in its last cycle, for monitors.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct BehaviorStatus {
+    /// The HFSM's active path (`Attacker/Score/Align`), empty for an HBM Member.
+    pub path: String,
+    /// The behavior that ran.
+    pub behavior: Option<String>,
+    /// Files reloaded before this cycle.
+    pub reloaded: Vec<String>,
+    /// Errors of this cycle (the robot went on regardless).
+    pub errors: Vec<String>,
+}
+
+/// Asks behavior Members to reload their changed scripts at the next cycle boundary.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct ReloadRequest;

@@ -1,0 +1,104 @@
+//! # mrt-msgs: MRT's standard messages
+//!
+//! The MRT manual builds a robot out of sensing, reasoning and acting modules that talk over
+//! one bus (§2.1). This crate is the one catalogue of what they say to each other, so that
+//! drivers, world models, behaviors (Lua, fuzzy, Rust) and motor drivers written by different
+//! people plug together: every standard message's Rust type, with its [`Message`] id taken
+//! from one table ([`ids`]). It depends on `mrt-core` and `serde` only: a tool that reads
+//! recordings or a driver for a new robot needs no bus, no engine and no simulator.
+//!
+//! | message | from → to | seed |
+//! |---|---|---|
+//! | [`Odometry`] (mice readings, wheels, placement) | odometry driver → world model | manual ch. 4 |
+//! | [`CameraFrame`] (sightings of ball, nets, landmarks) | camera driver → world model | ISocRob `003` §3.2.1 |
+//! | [`SonarScan`] of [`Sonar`]s | sonar driver → guidance | ISocRob `003` §2, §3.2.3 |
+//! | [`GameInfo`] | game controller → world model | TeamChaos `001` §3.3 (`getCurrentState`) |
+//! | [`MateReport`] | world model → teammates' world models | ISocRob `003` §3.1 |
+//! | [`WorldSnapshot`] | world model → behaviors, guidance | TeamChaos `001` §3.3 (LPS, GS) |
+//! | [`RobotCommand`] | behaviors → guidance | TeamChaos `001` §3.3 |
+//! | [`MotorCommand`] | guidance → motor and kicker driver | ISocRob `003` §3.2.3 |
+//! | [`BehaviorStatus`], [`ReloadRequest`] | behavior Member ↔ monitors, editors | TeamChaos `001` §3.2 |
+//! | [`DeviceFrame`], [`DeviceAct`], [`FinalWhistle`], [`RobotEnd`] | distributed simulator ↔ robot | MRT's own |
+//!
+//! Three standard messages live with their engine and take their id from [`ids`] too: the
+//! blackboard's `BbUpdate` (`mrt-blackboard`), the bus's XML `SelfDescribing` message
+//! (`mrt-dcdt`, feature `describe`) and `mrt-net`'s probes.
+//!
+//! ```
+//! use mrt_msgs::{ids, Message, MateReport, WorldSnapshot};
+//!
+//! let w = WorldSnapshot::default();
+//! let report = MateReport::of(2, false, &w);
+//! assert_eq!(MateReport::TYPE, ids::MATE_REPORT);
+//! assert_eq!(ids::name_of(MateReport::TYPE), Some(MateReport::NAME));
+//! assert_eq!(report.ball.quality, 0.0, "nothing seen yet");
+//! ```
+#![deny(missing_docs)]
+
+mod acting;
+mod behavior;
+mod device;
+pub mod ids;
+pub mod robot;
+mod sensing;
+mod team;
+
+pub use acting::MotorCommand;
+pub use behavior::{BehaviorStatus, ReloadRequest};
+pub use device::{DeviceAct, DeviceFrame, FinalWhistle, MemberFault, RobotEnd};
+pub use mrt_core::{Message, MsgType};
+pub use robot::{lps, Estimate, Field, GameState, Lpo, Mate, RobotCommand, Target, WorldSnapshot};
+pub use sensing::{
+    CameraFrame, Displacement, GameInfo, MiceReadings, Odometry, Sighting, Sonar, SonarScan,
+    FIELD_OBJECTS,
+};
+pub use team::MateReport;
+
+/// Declares the [`Message`] impls of the catalogue, each with its id from [`ids`] and its name
+/// as the table gives it.
+macro_rules! messages {
+    ($($ty:ty => $id:ident),* $(,)?) => {
+        $(impl Message for $ty {
+            const TYPE: MsgType = ids::$id;
+            const NAME: &'static str = stringify!($ty);
+        })*
+
+        /// The catalogue's types as `(id, name)`, for the table test.
+        #[cfg(test)]
+        const CATALOGUE: &[(MsgType, &str)] = &[$((ids::$id, stringify!($ty))),*];
+    };
+}
+
+messages! {
+    WorldSnapshot => WORLD_SNAPSHOT,
+    RobotCommand => ROBOT_COMMAND,
+    BehaviorStatus => BEHAVIOR_STATUS,
+    ReloadRequest => RELOAD_REQUEST,
+    MateReport => MATE_REPORT,
+    SonarScan => SONAR_SCAN,
+    MotorCommand => MOTOR_COMMAND,
+    Odometry => ODOMETRY,
+    CameraFrame => CAMERA_FRAME,
+    DeviceFrame => DEVICE_FRAME,
+    DeviceAct => DEVICE_ACT,
+    FinalWhistle => FINAL_WHISTLE,
+    RobotEnd => ROBOT_END,
+    GameInfo => GAME_INFO,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every type of the catalogue has the id and the name the table gives it, and so does the
+    /// bus's self-describing message.
+    #[test]
+    fn the_catalogue_agrees_with_the_table() {
+        for (ty, name) in CATALOGUE {
+            assert_eq!(ids::name_of(*ty), Some(*name), "{ty}");
+        }
+        use mrt_dcdt::describe::SelfDescribing;
+        assert_eq!(SelfDescribing::TYPE, ids::SELF_DESCRIBING);
+        assert_eq!(ids::name_of(SelfDescribing::TYPE), Some(SelfDescribing::NAME));
+    }
+}

@@ -1,0 +1,152 @@
+//! What the sensor drivers publish (MRT manual §2.1: sensing modules): the optical mice and
+//! wheels ([`Odometry`], manual ch. 4), the camera's object detections ([`CameraFrame`]), the
+//! sonar ring ([`SonarScan`], ISocRob seed `003` §2), and the game controller's news
+//! ([`GameInfo`]).
+
+use crate::robot::{lps, GameState};
+use mrt_core::Pose2;
+use serde::{Deserialize, Serialize};
+use std::f64::consts::PI;
+
+/// One sonar reading: where the sonar looks and how far the echo is (ISocRob seed `003` §2,
+/// §3.2.3).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Sonar {
+    /// Direction of the sonar in the robot frame, rad (0 = forward, counter-clockwise).
+    pub bearing: f64,
+    /// Distance from the robot centre to the echo, m. NaN or infinite means no echo.
+    pub range: f64,
+}
+
+impl Sonar {
+    /// A reading.
+    pub const fn new(bearing: f64, range: f64) -> Self {
+        Self { bearing, range }
+    }
+
+    /// The bearing of sonar `i` of `n` equally spaced around the body, sonar 0 forward (the
+    /// ISocRob robots have sixteen, seed `003` §2).
+    pub fn ring_bearing(i: usize, n: usize) -> f64 {
+        if n == 0 {
+            return 0.0;
+        }
+        2.0 * PI * (i % n) as f64 / n as f64
+    }
+}
+
+/// One reading of the sonar ring (robot frame, m from the centre, ring order; no echo is an
+/// infinite range), published by the sonar driver every cycle.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct SonarScan {
+    /// The sonars.
+    pub sonars: Vec<Sonar>,
+}
+
+/// The four numbers the two mice give for one sampling period, metres, each in its own frame
+/// (`x̄` along the joining line, positive to the robot's right; `ȳ` forward; manual §4.1).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct MiceReadings {
+    /// `x̄_l`: left mouse, lateral.
+    pub x_left: f64,
+    /// `ȳ_l`: left mouse, longitudinal.
+    pub y_left: f64,
+    /// `x̄_r`: right mouse, lateral.
+    pub x_right: f64,
+    /// `ȳ_r`: right mouse, longitudinal.
+    pub y_right: f64,
+}
+
+impl MiceReadings {
+    /// Readings `(x̄_l, ȳ_l, x̄_r, ȳ_r)`.
+    pub const fn new(x_left: f64, y_left: f64, x_right: f64, y_right: f64) -> Self {
+        Self { x_left, y_left, x_right, y_right }
+    }
+
+    /// Whether all four numbers are finite.
+    pub fn is_finite(&self) -> bool {
+        self.x_left.is_finite()
+            && self.y_left.is_finite()
+            && self.x_right.is_finite()
+            && self.y_right.is_finite()
+    }
+}
+
+/// The robot's motion over one sampling period, in the robot frame at the start of the period:
+/// `(Δx, Δy)` metres, `Δθ` radians counter-clockwise (manual §4.1).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Displacement {
+    /// `Δx`, forward, m.
+    pub dx: f64,
+    /// `Δy`, to the left, m.
+    pub dy: f64,
+    /// `Δθ`, rad.
+    pub dtheta: f64,
+}
+
+impl Displacement {
+    /// A displacement.
+    pub const fn new(dx: f64, dy: f64, dtheta: f64) -> Self {
+        Self { dx, dy, dtheta }
+    }
+
+    /// As a relative pose, to [`Pose2::compose`] onto the previous pose.
+    pub fn as_pose(&self) -> Pose2 {
+        Pose2::new(self.dx, self.dy, self.dtheta)
+    }
+}
+
+/// What the odometry sensors read over one control cycle, published by the odometry driver
+/// (manual ch. 4).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Odometry {
+    /// The two optical mice, each in its own frame (MRT manual ch. 4), m.
+    pub mice: MiceReadings,
+    /// The wheel encoders' motion, in the robot frame at the start of the cycle.
+    pub wheels: Displacement,
+    /// The robot was put down by hand at this pose (field frame, m) since the last reading:
+    /// the motion above counts from there. The operator tells the robot, as a team does when
+    /// it places its robots before a match.
+    pub placed: Option<Pose2>,
+}
+
+/// How many objects the camera knows: the ball, two nets, six landmarks (as many as LPS slots).
+pub const FIELD_OBJECTS: usize = lps::COUNT;
+
+/// One object detected in one frame: distance (m) and bearing (rad, counter-clockwise from
+/// the robot's heading), with the sensor's noise.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Sighting {
+    /// Distance, m.
+    pub distance: f64,
+    /// Bearing, rad.
+    pub bearing: f64,
+}
+
+/// What the game controller tells every robot each cycle (field frame, m): the referee's
+/// state of TeamChaos' `getCurrentState()` (seed `001` §3.3) and the robot's place in the
+/// kickoff formation.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct GameInfo {
+    /// The referee's state.
+    pub state: GameState,
+    /// The direction the robot's team attacks: +1 east, −1 west.
+    pub attack: f64,
+    /// The robot's place in the kickoff formation, in READY.
+    pub kickoff_pose: Option<Pose2>,
+}
+
+/// One frame of the object sensor, published by the camera driver: distance and bearing of the
+/// ball, the nets and the landmarks, told apart by colour (ISocRob seed `003` §3.2.1).
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct CameraFrame {
+    /// Time of the frame, s.
+    pub time: f64,
+    /// What was seen, in [`FIELD_OBJECTS`] order: ball, east net, west net, then the
+    /// landmarks of the field map (`None`: not seen this frame).
+    pub sightings: [Option<Sighting>; FIELD_OBJECTS],
+    /// The ball's velocity in the robot's frame (m/s), when the ball is seen: the stand-in
+    /// for a ball tracker.
+    pub ball_velocity: Option<(f64, f64)>,
+    /// The game controller's news.
+    pub game: GameInfo,
+}
