@@ -127,6 +127,40 @@ impl Pose2 {
     }
 }
 
+/// `sin(x) / x`, with its Taylor series near 0 (no 0/0).
+///
+/// ```
+/// assert_eq!(mrt_core::sinc(0.0), 1.0);
+/// assert!((mrt_core::sinc(1.0) - 1f64.sin()).abs() < 1e-15);
+/// ```
+pub fn sinc(x: f64) -> f64 {
+    if x.abs() < 1e-4 {
+        let x2 = x * x;
+        1.0 - x2 / 6.0 + x2 * x2 / 120.0
+    } else {
+        x.sin() / x
+    }
+}
+
+/// The displacement `(dx, dy)` in the starting robot frame after moving with the constant body
+/// velocity `(vx, vy)` (per unit time) while turning by `dtheta`: `sinc(dθ/2) · R(dθ/2) · (vx,
+/// vy)`. The robot follows an arc of circle, the motion model of the MRT manual §4.1 ("the
+/// robot movement during a sampling period can be approximated by an arc of circumference"),
+/// shared by the kinematics (`mrt-plan`) and the two-mice odometry (`mrt-perception`).
+pub fn arc_displacement(vx: f64, vy: f64, dtheta: f64) -> (f64, f64) {
+    let (s, c) = (0.5 * dtheta).sin_cos();
+    let k = sinc(0.5 * dtheta);
+    (k * (c * vx - s * vy), k * (s * vx + c * vy))
+}
+
+/// The inverse of [`arc_displacement`]: the constant body velocity (per unit time) that moves
+/// the robot by `(dx, dy)` while it turns by `dtheta`. Valid for `|dtheta| < 2π`.
+pub fn arc_velocity(dx: f64, dy: f64, dtheta: f64) -> (f64, f64) {
+    let (s, c) = (0.5 * dtheta).sin_cos();
+    let k = 1.0 / sinc(0.5 * dtheta);
+    (k * (c * dx + s * dy), k * (-s * dx + c * dy))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -164,6 +198,14 @@ mod tests {
     }
 
     proptest! {
+        #[test]
+        fn arc_velocity_inverts_arc_displacement(vx in -1.0f64..1.0, vy in -1.0f64..1.0,
+                                                 dth in -3.0f64..3.0) {
+            let (dx, dy) = arc_displacement(vx, vy, dth);
+            let (bx, by) = arc_velocity(dx, dy, dth);
+            prop_assert!(close(bx, vx) && close(by, vy));
+        }
+
         #[test]
         fn normalize_angle_is_in_range_and_equivalent(a in -1e4f64..1e4) {
             let n = normalize_angle(a);

@@ -41,7 +41,10 @@ mod ids;
 mod message;
 mod time;
 
-pub use geometry::{angle_diff, normalize_angle, normalize_angle_positive, Point2, Pose2, Vec2};
+pub use geometry::{
+    angle_diff, arc_displacement, arc_velocity, normalize_angle, normalize_angle_positive, sinc,
+    Point2, Pose2, Vec2,
+};
 pub use ids::{AgoraId, MemberId, MsgType};
 pub use message::{Message, RESERVED_TYPES_START};
 pub use time::{Clock, SharedClock, SimClock, Time, WallClock};

@@ -1,5 +1,6 @@
 //! The per-cycle costs of `mrt-plan`: inverse kinematics plus limit for both bases, one
-//! two-mice displacement, one potential-field step among a few obstacles.
+//! potential-field step among a few obstacles. (The two-mice displacement is benchmarked in
+//! `mrt-perception`.)
 //!
 //! Run: `cargo bench -p mrt-plan --bench kinematics`.
 #![allow(missing_docs, clippy::unwrap_used)]
@@ -8,7 +9,6 @@ use criterion::{black_box, criterion_group, criterion_main, Criterion};
 use mrt_core::Pose2;
 use mrt_plan::guidance::{behind_ball, Obstacle, PositionParams, PotentialField, PotentialParams};
 use mrt_plan::kinematics::{DiffDrive, Kinematics, Omni3, Twist};
-use mrt_plan::mice::{MiceOdometry, MiceReadings};
 
 fn bench(c: &mut Criterion) {
     let mut g = c.benchmark_group("plan");
@@ -23,12 +23,6 @@ fn bench(c: &mut Criterion) {
     let triskar = Omni3::triskar();
     g.bench_function("inverse_limit_omni3", |b| {
         b.iter(|| triskar.inverse(&triskar.limit(black_box(&twist))))
-    });
-
-    let mice = MiceOdometry::new(0.2, 1e-4).unwrap();
-    let readings: MiceReadings = mice.readings_for(0.02, 0.005, 0.03);
-    g.bench_function("mice_displacement", |b| {
-        b.iter(|| mice.displacement(black_box(&readings)).unwrap())
     });
 
     // Five robots and the ball on the field; the target is behind the ball.

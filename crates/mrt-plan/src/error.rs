@@ -31,28 +31,6 @@ pub enum PlanError {
         /// Which input.
         name: &'static str,
     },
-    /// The two mice disagree along the line that joins them (MRT manual §4.1: `x̄_r = x̄_l`).
-    /// At least one of the four readings is wrong (§4.2).
-    #[error(
-        "mice readings inconsistent: x_left = {x_left}, x_right = {x_right} differ by more than {tolerance}"
-    )]
-    MiceInconsistent {
-        /// `x̄_l`, metres.
-        x_left: f64,
-        /// `x̄_r`, metres.
-        x_right: f64,
-        /// The tolerance of the check, metres.
-        tolerance: f64,
-    },
-    /// The error reduction of §4.2 cannot restore the constraint: the two lateral readings
-    /// have opposite signs, or the short one is zero (its direction is lost).
-    #[error("mice readings cannot be reduced: x_left = {x_left}, x_right = {x_right}")]
-    MiceIrreducible {
-        /// `x̄_l`, metres.
-        x_left: f64,
-        /// `x̄_r`, metres.
-        x_right: f64,
-    },
     /// "Behind the ball" needs a line from the goal through the ball.
     #[error("ball and goal coincide at ({x}, {y}): no line to stand behind")]
     BallOnGoal {
@@ -69,14 +47,5 @@ pub(crate) fn positive(name: &'static str, value: f64) -> Result<f64, PlanError>
         Ok(value)
     } else {
         Err(PlanError::InvalidParameter { name, value, expected: "a finite value > 0" })
-    }
-}
-
-/// Checks that `value` is finite and `>= 0`.
-pub(crate) fn non_negative(name: &'static str, value: f64) -> Result<f64, PlanError> {
-    if value.is_finite() && value >= 0.0 {
-        Ok(value)
-    } else {
-        Err(PlanError::InvalidParameter { name, value, expected: "a finite value >= 0" })
     }
 }

@@ -476,6 +476,17 @@ mod tests {
         (a - b).abs() < 1e-9
     }
 
+    /// Reading a guard from a file checks it like `new` does.
+    #[test]
+    fn deserializing_checks_the_parameters() {
+        let guard: Result<VelocityGuard, _> =
+            serde_json::from_str(r#"{"safety_distance": -1.0, "half_cone": 0.5}"#);
+        assert!(guard.is_err());
+        let guard: Result<VelocityGuard, _> =
+            serde_json::from_str(r#"{"safety_distance": 0.5, "half_cone": 0.5}"#);
+        assert!(guard.is_ok());
+    }
+
     #[test]
     fn velocity_guard_by_hand() {
         let g = VelocityGuard::default(); // 0.5 m, ±30°

@@ -16,7 +16,7 @@
 //! for an omni wheel).
 
 use crate::error::{positive, PlanError};
-use mrt_core::Pose2;
+use mrt_core::{arc_displacement, Pose2};
 use nalgebra::{Matrix3, Vector3};
 use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
@@ -486,32 +486,6 @@ pub fn duty_cycle(speed: f64, max_wheel_speed: f64) -> f64 {
     (speed / max_wheel_speed).clamp(-1.0, 1.0)
 }
 
-/// `sin(x) / x`, with its Taylor series near 0 (no 0/0).
-pub(crate) fn sinc(x: f64) -> f64 {
-    if x.abs() < 1e-4 {
-        let x2 = x * x;
-        1.0 - x2 / 6.0 + x2 * x2 / 120.0
-    } else {
-        x.sin() / x
-    }
-}
-
-/// The displacement `(dx, dy)` in the starting robot frame after moving with the constant body
-/// velocity `(vx, vy)` while turning by `dtheta`: `sinc(dθ/2) · R(dθ/2) · (vx, vy)`.
-pub(crate) fn arc_displacement(vx: f64, vy: f64, dtheta: f64) -> (f64, f64) {
-    let (s, c) = (0.5 * dtheta).sin_cos();
-    let k = sinc(0.5 * dtheta);
-    (k * (c * vx - s * vy), k * (s * vx + c * vy))
-}
-
-/// The inverse of [`arc_displacement`]: the constant body velocity (per unit time) that moves
-/// the robot by `(dx, dy)` while it turns by `dtheta`. Valid for `|dtheta| < 2π`.
-pub(crate) fn arc_velocity(dx: f64, dy: f64, dtheta: f64) -> (f64, f64) {
-    let (s, c) = (0.5 * dtheta).sin_cos();
-    let k = 1.0 / sinc(0.5 * dtheta);
-    (k * (c * dx + s * dy), k * (-s * dx + c * dy))
-}
-
 /// The pose reached from `pose` (field frame) after `dt` seconds at the constant `twist`
 /// (robot frame), integrated exactly: the robot follows an arc of circle (a straight line when
 /// `omega = 0`), the same motion model as the mice sensor (manual §4.1: "the robot movement
@@ -742,14 +716,6 @@ mod tests {
             prop_assert!(close_twist(&l, &t.scaled(k)));
             let d = DiffDrive::ianus3();
             prop_assert!(d.inverse(&d.limit(&t)).max_abs() <= d.max_wheel_speed() + 1e-9);
-        }
-
-        #[test]
-        fn arc_velocity_inverts_arc_displacement(vx in -1.0f64..1.0, vy in -1.0f64..1.0,
-                                                 dth in -3.0f64..3.0) {
-            let (dx, dy) = arc_displacement(vx, vy, dth);
-            let (bx, by) = arc_velocity(dx, dy, dth);
-            prop_assert!(close(bx, vx) && close(by, vy));
         }
     }
 

@@ -1,16 +1,14 @@
-//! # mrt-plan: kinematics, two-mice odometry and guidance
+//! # mrt-plan: kinematics and guidance
 //!
 //! The acting end of an MRT robot as a plain library (no bus, no Lua): from a wanted velocity
 //! to wheel speeds for the two MRT bases (MRT manual ch. 12: IANUS3, Triskar; the AIRBoard of
-//! ch. 5 takes one set point per motor), the dead-reckoning sensor made of two optical mice
-//! (manual ch. 4), and the three guidance modes of the ISocRob Guidance µAgent (seed `003`
+//! ch. 5 takes one set point per motor), and the three guidance modes of the ISocRob Guidance µAgent (seed `003`
 //! §3.2.3): velocity with a sonar stop, go-to-posture, and potential fields around obstacles,
 //! including "behind the ball" targets.
 //!
 //! ```
 //! use mrt_core::Pose2;
 //! use mrt_plan::kinematics::{integrate, DiffDrive, Kinematics, Twist};
-//! use mrt_plan::mice::MiceOdometry;
 //!
 //! // IANUS3 asked for 2 m/s while turning at 1 rad/s: the right wheel would need
 //! // (2 + 0.2) / 0.05 = 44 rad/s > 24, so the whole twist is scaled by 24/44 (curvature kept).
@@ -20,18 +18,15 @@
 //! let wheels = ianus.inverse(&twist); // rad/s, [left, right]
 //! assert!(wheels.right() > wheels.left());
 //!
-//! // The mice see that motion for 20 ms and give it back.
+//! // 20 ms of that motion: an arc of circle, integrated exactly.
 //! let after = integrate(Pose2::identity(), &twist, 0.02);
-//! let mice = MiceOdometry::new(0.2, 1e-4)?;
-//! let readings = mice.readings_for(after.x, after.y, after.theta);
-//! let d = mice.displacement(&readings)?;
-//! assert!((d.dx - after.x).abs() < 1e-12 && (d.dtheta - after.theta).abs() < 1e-12);
-//! # Ok::<(), mrt_plan::PlanError>(())
+//! assert!((after.theta - 0.02 * twist.omega).abs() < 1e-12);
 //! ```
 //!
 //! Start with [`kinematics::Kinematics`] and [`kinematics::integrate`] (exact dead reckoning
 //! over one period; `mrt-sim` moves its robots with rapier2d and uses the kinematics to turn
-//! commands into wheel duty cycles and back), [`mice::MiceOdometry`], and [`guidance::PotentialField`].
+//! commands into wheel duty cycles and back) and [`guidance::PotentialField`]. The two-mice
+//! odometry that complements the kinematics is `mrt-perception`'s.
 //!
 //! | seed name | Rust |
 //! |---|---|
@@ -39,23 +34,17 @@
 //! | Triskar base, three omni wheels at 120° (manual §12.6) | [`kinematics::Omni3`], [`kinematics::Omni3Params::TRISKAR`] |
 //! | AIRBoard set points, PWM (manual ch. 5) | [`kinematics::WheelSpeeds`], [`kinematics::duty_cycle`] |
 //! | arc of circumference per sampling period (manual §4.1) | [`kinematics::integrate`] |
-//! | mice readings `x̄_l, ȳ_l, x̄_r, ȳ_r` (manual §4.1) | [`mice::MiceReadings`] |
-//! | eq. (4.1), (4.2) and the mid-point of the mice | [`mice::MiceOdometry::displacement`], [`mice::MiceArcs`] |
-//! | eq. (4.3)–(4.5) | [`mice::update_pose`] |
-//! | `x̄_r = x̄_l` error detection, error reduction (manual §4.2) | [`mice::MiceOdometry::check`], [`mice::MiceOdometry::reduce`] |
 //! | velocity mode, halted by the sonars (ISocRob §3.2.3) | [`guidance::VelocityGuard`], [`guidance::Sonar`] |
 //! | position mode | [`guidance::PositionMode`] |
 //! | the Guidance µAgent: the mode a command asks for, sonar echoes, ball echoes told apart | [`guide::Guidance`] |
 //! | potential field mode, ball as a repelling obstacle | [`guidance::PotentialField`], [`guidance::Obstacle`], [`guidance::behind_ball`], [`guidance::sonar_obstacles`] |
 //!
-//! The manual's mice equations have typos; [`mice`] lists each one with the corrected formula,
-//! and a test pins each fix. No feature flags. Errors: [`PlanError`].
+//! No feature flags. Errors: [`PlanError`].
 #![deny(missing_docs)]
 
 mod error;
 pub mod guidance;
 pub mod guide;
 pub mod kinematics;
-pub mod mice;
 
 pub use error::PlanError;

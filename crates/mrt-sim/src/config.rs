@@ -252,8 +252,8 @@ impl Default for OdometryConfig {
 
 impl OdometryConfig {
     /// The two-mice sensor these settings describe.
-    pub fn mice(&self) -> Result<mrt_plan::mice::MiceOdometry, String> {
-        mrt_plan::mice::MiceOdometry::new(self.mice_distance, self.mice_tolerance)
+    pub fn mice(&self) -> Result<mrt_perception::mice::MiceOdometry, String> {
+        mrt_perception::mice::MiceOdometry::new(self.mice_distance, self.mice_tolerance)
             .map_err(|e| format!("odometry: {e}"))
     }
 }

@@ -15,9 +15,9 @@ use crate::referee::Referee;
 use crate::world::World;
 use mrt_core::{normalize_angle, Pose2};
 use mrt_msgs::robot::{lps, Estimate, Mate, WorldSnapshot};
+use mrt_perception::mice::{Displacement, MiceOdometry};
 use mrt_plan::guidance::Sonar;
 use mrt_plan::kinematics::{integrate, Twist};
-use mrt_plan::mice::{Displacement, MiceOdometry};
 use rand::{Rng, RngCore};
 
 /// A teammate's ball counts this much of its own quality: a second-hand sighting, one cycle

@@ -27,8 +27,8 @@
 use crate::sensor::{CameraFrame, Odometry, Sighting, FIELD_OBJECTS};
 use mrt_core::{normalize_angle, Pose2, Time, Vec2};
 use mrt_msgs::robot::{lps, Estimate, Field, Lpo, WorldSnapshot};
-use mrt_plan::mice::{Displacement, MiceOdometry, MiceReadings};
-use mrt_plan::PlanError;
+use mrt_perception::mice::{Displacement, MiceOdometry, MiceReadings};
+use mrt_perception::PerceptionError;
 use nalgebra::{Matrix2, Matrix2x3, Matrix3, Vector2, Vector3};
 use std::f64::consts::PI;
 
@@ -185,7 +185,7 @@ impl WorldModel {
     fn mice_motion(&self, r: &MiceReadings) -> Option<(Displacement, bool)> {
         match self.mice.displacement(r) {
             Ok(d) => Some((d, false)),
-            Err(PlanError::MiceInconsistent { .. }) => {
+            Err(PerceptionError::MiceInconsistent { .. }) => {
                 let fixed = self.mice.reduce(r).ok()?;
                 let grew = |a: f64, b: f64, c: f64, d: f64| a.hypot(b) <= 2.0 * c.hypot(d);
                 let plausible = grew(fixed.x_left, fixed.y_left, r.x_left, r.y_left)

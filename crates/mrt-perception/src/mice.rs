@@ -46,9 +46,8 @@
 //! nearly the same vector (straight runs). The chord of each mouse's arc, `2 r sin(|Δθ|/2)` with
 //! `r = l / |Δθ|`, is evaluated as `l · sinc(Δθ/2)`, finite when `Δθ = 0`.
 
-use crate::error::{non_negative, positive, PlanError};
-use crate::kinematics::{arc_velocity, sinc};
-use mrt_core::Pose2;
+use crate::error::{non_negative, positive, PerceptionError};
+use mrt_core::{arc_velocity, sinc, Pose2};
 use serde::{Deserialize, Serialize};
 use std::f64::consts::FRAC_PI_2;
 
@@ -92,8 +91,8 @@ struct MiceOdometryParams {
 }
 
 impl TryFrom<MiceOdometryParams> for MiceOdometry {
-    type Error = PlanError;
-    fn try_from(p: MiceOdometryParams) -> Result<Self, PlanError> {
+    type Error = PerceptionError;
+    fn try_from(p: MiceOdometryParams) -> Result<Self, PerceptionError> {
         MiceOdometry::new(p.distance, p.tolerance)
     }
 }
@@ -112,7 +111,7 @@ fn sign(x: f64) -> f64 {
 impl MiceOdometry {
     /// A sensor with the mice `distance` metres apart (finite, > 0); readings whose `x̄` differ
     /// by more than `tolerance` metres (finite, ≥ 0) fail [`MiceOdometry::check`].
-    pub fn new(distance: f64, tolerance: f64) -> Result<Self, PlanError> {
+    pub fn new(distance: f64, tolerance: f64) -> Result<Self, PerceptionError> {
         Ok(Self {
             distance: positive("distance", distance)?,
             tolerance: non_negative("tolerance", tolerance)?,
@@ -131,12 +130,12 @@ impl MiceOdometry {
 
     /// The error detection of §4.1/§4.2: the readings are finite and `|x̄_r − x̄_l| <=
     /// tolerance`. Passing does not prove the readings right, only that they fit the model.
-    pub fn check(&self, r: &MiceReadings) -> Result<(), PlanError> {
+    pub fn check(&self, r: &MiceReadings) -> Result<(), PerceptionError> {
         if !r.is_finite() {
-            return Err(PlanError::NonFiniteInput { name: "mice readings" });
+            return Err(PerceptionError::NonFiniteInput { name: "mice readings" });
         }
         if (r.x_right - r.x_left).abs() > self.tolerance {
-            return Err(PlanError::MiceInconsistent {
+            return Err(PerceptionError::MiceInconsistent {
                 x_left: r.x_left,
                 x_right: r.x_right,
                 tolerance: self.tolerance,
@@ -180,7 +179,7 @@ impl MiceOdometry {
     /// does.
     ///
     /// Valid for `|Δθ| < π` per period (the sign rule of eq. 4.2).
-    pub fn displacement(&self, r: &MiceReadings) -> Result<Displacement, PlanError> {
+    pub fn displacement(&self, r: &MiceReadings) -> Result<Displacement, PerceptionError> {
         self.check(r)?;
         Ok(self.displacement_unchecked(r))
     }
@@ -234,13 +233,13 @@ impl MiceOdometry {
     ///
     /// Consistent readings are returned unchanged. Fails on non-finite readings, or when the
     /// two `x̄` have opposite signs or the short one is 0 (no direction to scale along).
-    pub fn reduce(&self, r: &MiceReadings) -> Result<MiceReadings, PlanError> {
+    pub fn reduce(&self, r: &MiceReadings) -> Result<MiceReadings, PerceptionError> {
         match self.check(r) {
             Ok(()) => return Ok(*r),
-            Err(PlanError::MiceInconsistent { .. }) => {}
+            Err(PerceptionError::MiceInconsistent { .. }) => {}
             Err(e) => return Err(e),
         }
-        let irreducible = PlanError::MiceIrreducible { x_left: r.x_left, x_right: r.x_right };
+        let irreducible = PerceptionError::MiceIrreducible { x_left: r.x_left, x_right: r.x_right };
         if r.x_left * r.x_right <= 0.0 {
             return Err(irreducible);
         }
@@ -285,9 +284,6 @@ mod tests {
         assert_eq!(ok, MiceOdometry::new(0.2, 0.001).unwrap());
         assert!(serde_json::from_str::<MiceOdometry>(r#"{"distance": 0.0, "tolerance": 0.001}"#)
             .is_err());
-        let guard: Result<crate::guidance::VelocityGuard, _> =
-            serde_json::from_str(r#"{"safety_distance": -1.0, "half_cone": 0.5}"#);
-        assert!(guard.is_err());
     }
 
     fn close(a: f64, b: f64) -> bool {
@@ -397,13 +393,17 @@ mod tests {
         let bad = MiceReadings::new(0.010, 0.1, 0.012, 0.1);
         assert_eq!(
             m.displacement(&bad),
-            Err(PlanError::MiceInconsistent { x_left: 0.010, x_right: 0.012, tolerance: 1e-3 })
+            Err(PerceptionError::MiceInconsistent {
+                x_left: 0.010,
+                x_right: 0.012,
+                tolerance: 1e-3
+            })
         );
         // 0.5 mm: within tolerance.
         assert!(m.displacement(&MiceReadings::new(0.010, 0.1, 0.0105, 0.1)).is_ok());
         assert!(matches!(
             m.displacement(&MiceReadings::new(f64::NAN, 0.1, 0.0, 0.1)),
-            Err(PlanError::NonFiniteInput { .. })
+            Err(PerceptionError::NonFiniteInput { .. })
         ));
         // The unchecked form still answers (by the manual's formulas as they are).
         let d = m.displacement_unchecked(&bad);
@@ -433,11 +433,11 @@ mod tests {
         assert_eq!(m.reduce(&ok), Ok(ok));
         assert!(matches!(
             m.reduce(&MiceReadings::new(0.01, 0.1, -0.01, 0.1)),
-            Err(PlanError::MiceIrreducible { .. })
+            Err(PerceptionError::MiceIrreducible { .. })
         ));
         assert!(matches!(
             m.reduce(&MiceReadings::new(0.0, 0.0, -0.05, 0.1)),
-            Err(PlanError::MiceIrreducible { .. })
+            Err(PerceptionError::MiceIrreducible { .. })
         ));
     }
 

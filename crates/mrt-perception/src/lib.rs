@@ -1,0 +1,38 @@
+//! # mrt-perception: what a robot makes of its sensors
+//!
+//! The processing side of the MRT manual's sensing modules (§2.1: drivers apart from
+//! processing): readings come in as the standard messages of `mrt-msgs` (from a real robot's
+//! drivers or from the simulator's), and what they mean comes out. Today: the dead-reckoning
+//! sensor made of two optical mice (manual ch. 4), with the manual's formula typos fixed and
+//! its error detection and reduction (§4.2). Colour vision on camera images (ISocRob seed
+//! `003` §3.2.1) comes here next. A plain library: no bus, no simulator.
+//!
+//! ```
+//! use mrt_perception::mice::MiceOdometry;
+//!
+//! // Mice 0.2 m apart, 0.1 mm tolerance on the x̄_r = x̄_l check. The robot moves 20 mm
+//! // forward and 5 mm to the left while turning by 0.03 rad: the mice read that motion
+//! // (the manual's forward model) and give it back.
+//! let mice = MiceOdometry::new(0.2, 1e-4)?;
+//! let readings = mice.readings_for(0.02, 0.005, 0.03);
+//! let d = mice.displacement(&readings)?;
+//! assert!((d.dx - 0.02).abs() < 1e-12 && (d.dy - 0.005).abs() < 1e-12);
+//! assert!((d.dtheta - 0.03).abs() < 1e-12);
+//! # Ok::<(), mrt_perception::PerceptionError>(())
+//! ```
+//!
+//! | seed name | Rust |
+//! |---|---|
+//! | mice readings `x̄_l, ȳ_l, x̄_r, ȳ_r` (manual §4.1) | [`mice::MiceReadings`] (a message field, from `mrt-msgs`) |
+//! | eq. (4.1), (4.2) and the mid-point of the mice | [`mice::MiceOdometry::displacement`], [`mice::MiceArcs`] |
+//! | eq. (4.3)–(4.5) | [`mice::update_pose`] |
+//! | `x̄_r = x̄_l` error detection, error reduction (manual §4.2) | [`mice::MiceOdometry::check`], [`mice::MiceOdometry::reduce`] |
+//!
+//! The manual's mice equations have typos; [`mice`] lists each one with the corrected formula,
+//! and a test pins each fix. Errors: [`PerceptionError`].
+#![deny(missing_docs)]
+
+mod error;
+pub mod mice;
+
+pub use error::PerceptionError;
