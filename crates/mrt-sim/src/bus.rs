@@ -36,17 +36,17 @@ use crate::drivers::Base;
 use crate::embedded::FilesDir;
 use crate::game::{guide, Brain, MatchReport, Pitch};
 use crate::referee::Call;
-use crate::sensor::{merge_team, CameraFrame, Odometry};
 use crate::teams::{embedded_teamchaos, send_brain, Body, Stack, CHAOS_KEEPER, CHAOS_PLAYER};
-use crate::worldstate::WorldModel;
 use mrt_core::SimClock;
 use mrt_dcdt::{
     Activation, Agora, Context, InnerLinkManager, Member, MemberError, RequestType, RunReport,
     SteppedExecutor,
 };
 use mrt_msgs::robot::{RobotCommand, WorldSnapshot};
+use mrt_msgs::{CameraFrame, Odometry};
 use mrt_plan::guide::Guidance;
 use mrt_script::member::{BehaviorMember, BehaviorStatus};
+use mrt_world::{merge_team, WorldModel};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex, MutexGuard};
@@ -339,7 +339,7 @@ pub fn add_robot(
     let period = Duration::from_secs_f64(cfg.rules.control_period);
     let every = Activation::Periodic(period);
     let body = if stack == Stack::Chaos { Body::chaos(cfg) } else { Body::PLAIN };
-    let model = WorldModel::of_config(cfg)?;
+    let model = cfg.world_model()?;
     let base = Base::parse(&cfg.robot.base)?;
     let dev = || devices.clone();
     let mut ids = vec![

@@ -30,13 +30,16 @@ pub struct FieldConfig {
 }
 
 impl FieldConfig {
-    /// The field as the robots' world model knows it (millimetres, half sizes).
-    pub fn map(&self) -> mrt_msgs::robot::Field {
-        mrt_msgs::robot::Field {
-            half_length: self.length * 500.0,
-            half_width: self.width * 500.0,
-            goal_half_width: self.goal_width * 500.0,
-            penalty_area_depth: self.penalty_area_depth * 1000.0,
+    /// The field's map (`mrt-world`): lines, goals and landmarks, what both the simulated
+    /// camera and the robots' world models read.
+    pub fn map(&self) -> mrt_world::FieldMap {
+        mrt_world::FieldMap {
+            length: self.length,
+            width: self.width,
+            goal_width: self.goal_width,
+            penalty_area_depth: self.penalty_area_depth,
+            penalty_area_width: self.penalty_area_width,
+            centre_circle_radius: self.centre_circle_radius,
         }
     }
 }
@@ -218,7 +221,7 @@ impl Default for SonarConfig {
 
 /// The odometry sensors: two optical mice underneath (MRT manual ch. 4) and the wheel
 /// encoders. These numbers describe the *simulated* sensors; the world-state Member's filter
-/// assumes its own (see [`crate::worldstate`]).
+/// assumes its own (see [`mrt_world::model`]).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct OdometryConfig {
@@ -277,6 +280,17 @@ impl Default for GuidanceConfig {
 }
 
 impl SimConfig {
+    /// A robot's world model as it starts a match on this field: the field map, the mice's
+    /// geometry and the camera's noise, the pose unknown until it is put down.
+    pub fn world_model(&self) -> Result<mrt_world::WorldModel, String> {
+        Ok(mrt_world::WorldModel::new(
+            self.field.map(),
+            self.odometry.mice()?,
+            self.sensor.distance_noise,
+            self.sensor.bearing_noise,
+        ))
+    }
+
     /// The Guidance µAgent for these robots (`[guidance]`, the robot's base, speed and size).
     pub fn guidance(&self) -> Result<mrt_plan::guide::Guidance, String> {
         let cfg = self;

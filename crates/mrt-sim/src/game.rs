@@ -9,13 +9,14 @@
 use crate::config::SimConfig;
 use crate::drivers::Base;
 use crate::referee::{Call, Referee, Team};
-use crate::sensor::{self, merge_team, sonar_ring, CameraFrame, MateReport, Odometer, Odometry};
+use crate::sensor::{self, sonar_ring, Odometer};
 use crate::world::{Drive, World};
-use crate::worldstate::WorldModel;
 use mrt_core::Point2;
 use mrt_msgs::robot::{lps, GameState, RobotCommand, Target, WorldSnapshot};
+use mrt_msgs::{CameraFrame, MateReport, Odometry};
 use mrt_plan::guidance::Sonar;
 use mrt_plan::guide::Guidance;
+use mrt_world::{merge_team, WorldModel};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 
@@ -173,7 +174,7 @@ impl Pitch {
             })
             .collect();
         let mice = cfg.odometry.mice()?;
-        let model = WorldModel::of_config(cfg)?;
+        let model = cfg.world_model()?;
         Ok(Pitch {
             cfg: cfg.clone(),
             base: Base::parse(&cfg.robot.base)?,

@@ -5,7 +5,7 @@
 //! ([`referee`]: READY, SET, PLAYING, ...); robots see through an object sensor that reports
 //! what a camera would detect, feel their motion through optical mice and wheel encoders and
 //! hear through a sonar ring ([`sensor`]); each robot's world state fuses odometry and sightings
-//! into its own pose estimate ([`worldstate`]); between their
+//! into its own pose estimate (`mrt-world`'s [`WorldModel`](mrt_world::WorldModel)); between their
 //! behaviors and their motors sits guidance ([`mrt_plan::guide::Guidance`], see [`bus`]).
 //!
 //! ```
@@ -35,7 +35,6 @@ pub mod sensor;
 pub mod soak;
 pub mod teams;
 pub mod world;
-pub mod worldstate;
 
 use std::path::Path;
 

@@ -5,40 +5,18 @@
 //!
 //! The odometry sensors ([`Odometer`]) are two optical mice (MRT manual ch. 4) and the wheel
 //! encoders. Both drivers report raw readings ([`CameraFrame`], [`Odometry`]); the robot's
-//! world-state Member turns them into its world snapshot ([`crate::worldstate`]).
+//! world-state Member turns them into its world snapshot (`mrt-world`).
 //!
-//! The team side of the world state is [`merge_team`]: teammates as their [`MateReport`]s
-//! tell them, and the global ball from the best sighting, one's own or a teammate's.
 
 use crate::config::{OdometryConfig, SensorConfig, SonarConfig};
 use crate::referee::Referee;
 use crate::world::World;
 use mrt_core::{normalize_angle, Pose2};
-use mrt_msgs::robot::{lps, Estimate, Mate, WorldSnapshot};
+use mrt_msgs::robot::lps;
 use mrt_perception::mice::{Displacement, MiceOdometry};
 use mrt_plan::guidance::Sonar;
 use mrt_plan::kinematics::{integrate, Twist};
 use rand::{Rng, RngCore};
-
-/// A teammate's ball counts this much of its own quality: a second-hand sighting, one cycle
-/// old, is trusted a little less than one's own.
-pub const SHARED_BALL: f64 = 0.9;
-
-pub use mrt_msgs::MateReport;
-
-/// The team side of the world state: `w.mates` from the teammates' reports (in their order),
-/// and the global ball replaced by a teammate's sighting when that is better than one's own
-/// (quality × [`SHARED_BALL`]). The LPS stays what the robot itself perceived.
-pub fn merge_team<'a>(w: &mut WorldSnapshot, reports: impl IntoIterator<Item = &'a MateReport>) {
-    w.mates.clear();
-    for r in reports {
-        w.mates.push(Mate { id: r.id, at: r.pose, keeper: r.keeper });
-        let shared = r.ball.quality * SHARED_BALL;
-        if shared > w.global_ball.quality {
-            w.global_ball = Estimate { pose: r.ball.pose, quality: shared };
-        }
-    }
-}
 
 /// What robot `i`'s sonar ring hears (robot frame, m from the centre, ring order; no echo is
 /// an infinite range): [`World::sonar`]'s edge distances plus the radius, with noise.
@@ -66,24 +44,18 @@ fn gauss(rng: &mut dyn RngCore) -> f64 {
     (-2.0 * u1.ln()).sqrt() * (2.0 * std::f64::consts::PI * u2).cos()
 }
 
-/// Field positions (m) of the objects the camera knows, in [`FIELD_OBJECTS`] order: ball,
-/// east net, west net, and six landmarks (the four corners, NE, SE, NW, SW, and the north and
-/// south ends of the half-way line). The camera tells them apart by colour, not by team: the
-/// world-state Member maps them onto the team's LPS slots.
+/// Field positions (m) of the objects the camera knows, in [`FIELD_OBJECTS`] order: the ball,
+/// then the field map's nets and landmarks ([`mrt_world::field`]). The camera tells them apart
+/// by colour, not by team: the world model maps them onto the team's LPS slots.
 fn targets(world: &World) -> [(f64, f64); FIELD_OBJECTS] {
-    let f = &world.config().field;
-    let (hl, hw) = (f.length / 2.0, f.width / 2.0);
-    [
-        world.ball(),
-        (hl, 0.0),
-        (-hl, 0.0),
-        (hl, hw),
-        (hl, -hw),
-        (-hl, hw),
-        (-hl, -hw),
-        (0.0, hw),
-        (0.0, -hw),
-    ]
+    let map = world.config().field.map();
+    let mut at = [world.ball(); FIELD_OBJECTS];
+    for (k, slot) in at.iter_mut().enumerate().skip(1) {
+        if let Some(p) = map.object(k) {
+            *slot = (p.x, p.y);
+        }
+    }
+    at
 }
 
 /// Whether the segment from `a` to `b` passes within `radius` of `c`.
@@ -377,40 +349,6 @@ mod tests {
         // not counted (P = 0.08 of a miss): ≈ 0.75 − 0.06 = 0.69.
         let rate = f64::from(short) / f64::from(total);
         assert!((0.55..0.8).contains(&rate), "{rate}");
-    }
-
-    #[test]
-    fn teammates_and_their_better_ball_sightings_merge_into_the_world_state() {
-        let mut w = WorldSnapshot {
-            global_ball: Estimate { pose: Pose2::new(100.0, 0.0, 0.0), quality: 0.5 },
-            ..Default::default()
-        };
-        let report = |id, q, x| MateReport {
-            id,
-            keeper: id == 0,
-            pose: Estimate { pose: Pose2::new(-1000.0 * f64::from(id), 0.0, 0.0), quality: 0.9 },
-            ball: Estimate { pose: Pose2::new(x, 50.0, 0.0), quality: q },
-        };
-        // 0.9 × 0.5 = 0.45 < 0.5: one's own sighting stays; 0.9 × 0.8 = 0.72 wins.
-        let reports = [report(0, 0.5, 200.0), report(2, 0.8, 300.0), report(3, 0.7, 400.0)];
-        merge_team(&mut w, &reports);
-        assert_eq!(
-            w.mates.iter().map(|m| (m.id, m.keeper)).collect::<Vec<_>>(),
-            [(0, true), (2, false), (3, false)]
-        );
-        assert_eq!(w.mates[1].at.pose.x, -2000.0);
-        assert!((w.global_ball.quality - 0.72).abs() < 1e-12, "{:?}", w.global_ball);
-        assert_eq!((w.global_ball.pose.x, w.global_ball.pose.y), (300.0, 50.0));
-        // A robot that sees the ball well keeps its own estimate.
-        let mut sharp = WorldSnapshot {
-            global_ball: Estimate { quality: 1.0, ..Default::default() },
-            ..Default::default()
-        };
-        merge_team(&mut sharp, &reports);
-        assert_eq!(sharp.global_ball.quality, 1.0);
-        // The report carries the robot's own sighting, not the merged one.
-        let r = MateReport::of(7, false, &w);
-        assert_eq!((r.id, r.ball.quality), (7, w.global_ball.quality));
     }
 
     #[test]

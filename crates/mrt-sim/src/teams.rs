@@ -121,7 +121,7 @@ impl Default for Geometry {
 impl Geometry {
     /// The geometry of a configured field.
     pub fn of(f: &crate::config::FieldConfig) -> Geometry {
-        let m = f.map();
+        let m = f.map().snapshot();
         Geometry { half_length: m.half_length, goal_half_width: m.goal_half_width }
     }
 

@@ -24,9 +24,10 @@
 //! (`σ_xy` the root mean square of the x and y standard deviations): above 0.9 when the
 //! robot sees the landmarks, falling as it goes without them.
 
-use crate::sensor::{CameraFrame, Odometry, Sighting, FIELD_OBJECTS};
+use crate::field::FieldMap;
 use mrt_core::{normalize_angle, Pose2, Time, Vec2};
-use mrt_msgs::robot::{lps, Estimate, Field, Lpo, WorldSnapshot};
+use mrt_msgs::robot::{lps, Estimate, Lpo, WorldSnapshot};
+use mrt_msgs::{CameraFrame, Odometry, Sighting, FIELD_OBJECTS};
 use mrt_perception::mice::{Displacement, MiceOdometry, MiceReadings};
 use mrt_perception::PerceptionError;
 use nalgebra::{Matrix2, Matrix2x3, Matrix3, Vector2, Vector3};
@@ -51,7 +52,7 @@ const FLOOR: (f64, f64) = (0.002, 0.002);
 const PLACED_SIGMA: (f64, f64) = (0.05, 0.05);
 /// Uncertainty added when the filter finds itself lost (m, rad).
 const LOST_SIGMA: (f64, f64) = (1.0, 0.5);
-/// The field map's distances are in mm.
+/// Millimetres per metre: the snapshot's unit (TeamChaos' LPS, seed `001` §3.3).
 const MM: f64 = 1000.0;
 
 /// LPS slot → field object (sensor order) for a team attacking west: its frame is the field
@@ -87,7 +88,7 @@ pub struct FilterCounts {
 /// One robot's world state between cycles.
 #[derive(Clone, Debug)]
 pub struct WorldModel {
-    field: Field,
+    map: FieldMap,
     mice: MiceOdometry,
     distance_noise: f64,
     bearing_noise: f64,
@@ -98,24 +99,12 @@ pub struct WorldModel {
 }
 
 impl WorldModel {
-    /// A robot's world model as it starts a match on the configured field: the field map, the
-    /// mice's geometry and the camera's noise from `cfg`, the pose unknown until it is put
-    /// down.
-    pub fn of_config(cfg: &crate::config::SimConfig) -> Result<WorldModel, String> {
-        Ok(WorldModel::new(
-            cfg.field.map(),
-            cfg.odometry.mice()?,
-            cfg.sensor.distance_noise,
-            cfg.sensor.bearing_noise,
-        ))
-    }
-
-    /// A robot on `field` (the map, mm) with two mice `mice`, whose camera has the relative
+    /// A robot on the field `map` with two mice `mice`, whose camera has the relative
     /// distance error `distance_noise` and the bearing error `bearing_noise` (rad), that does
     /// not know yet where it is.
-    pub fn new(field: Field, mice: MiceOdometry, distance_noise: f64, bearing_noise: f64) -> Self {
+    pub fn new(map: FieldMap, mice: MiceOdometry, distance_noise: f64, bearing_noise: f64) -> Self {
         WorldModel {
-            field,
+            map,
             mice,
             distance_noise,
             bearing_noise,
@@ -226,19 +215,9 @@ impl WorldModel {
     }
 
     /// Field position (m) of field object `k` (1..: nets and landmarks, sensor order).
+    /// Where camera object `k` stands on the map (`None` for the ball).
     fn landmark(&self, k: usize) -> Option<(f64, f64)> {
-        let (hl, hw) = (self.field.half_length / MM, self.field.half_width / MM);
-        let at = [
-            (hl, 0.0),
-            (-hl, 0.0),
-            (hl, hw),
-            (hl, -hw),
-            (-hl, hw),
-            (-hl, -hw),
-            (0.0, hw),
-            (0.0, -hw),
-        ];
-        k.checked_sub(1).and_then(|i| at.get(i).copied())
+        self.map.object(k).map(|p| (p.x, p.y))
     }
 
     /// The EKF correction by one sighting of a landmark at `at`. Returns whether it was
@@ -333,7 +312,7 @@ impl WorldModel {
         let mut w = WorldSnapshot {
             time: Time::from_secs_f64(frame.time),
             game_state: frame.game.state,
-            field: self.field,
+            field: self.map.snapshot(),
             ..Default::default()
         };
         for (slot, lpo) in w.lps.iter_mut().enumerate() {
@@ -372,13 +351,13 @@ impl WorldModel {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::sensor::GameInfo;
     use mrt_msgs::robot::GameState;
+    use mrt_msgs::GameInfo;
 
     fn model() -> WorldModel {
         // The default field: 18 m × 12 m. Mice 0.2 m apart, 3 mm tolerance.
         let mice = MiceOdometry::new(0.2, 0.003).unwrap();
-        WorldModel::new(Field::default(), mice, 0.03, 0.02)
+        WorldModel::new(FieldMap::default(), mice, 0.03, 0.02)
     }
 
     /// Exact sightings, from `at`, of the field objects at `objects` (field frame, m).
@@ -398,19 +377,10 @@ mod tests {
         f
     }
 
-    /// Every landmark of the default field, sensor order (1..=8).
+    /// Every landmark of the default field's map, sensor order (1..=8).
     fn landmarks() -> Vec<(usize, (f64, f64))> {
-        let at = [
-            (9.0, 0.0),
-            (-9.0, 0.0),
-            (9.0, 6.0),
-            (9.0, -6.0),
-            (-9.0, 6.0),
-            (-9.0, -6.0),
-            (0.0, 6.0),
-            (0.0, -6.0),
-        ];
-        at.into_iter().enumerate().map(|(i, p)| (i + 1, p)).collect()
+        let map = FieldMap::default();
+        (1..FIELD_OBJECTS).filter_map(|k| map.object(k).map(|p| (k, (p.x, p.y)))).collect()
     }
 
     fn exact_mice(d: Pose2) -> Odometry {
