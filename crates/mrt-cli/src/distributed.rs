@@ -11,12 +11,15 @@ use anyhow::{anyhow, bail, Context as _, Result};
 use mrt_core::AgoraId;
 use mrt_dcdt::config::AgoraConfig;
 use mrt_dcdt::Message;
+use mrt_msgs::MateReport;
+use mrt_msgs::{DeviceAct, DeviceFrame};
 use mrt_net::{NetConfig, NetLink};
-use mrt_sim::bus::{behaviors_dir, MateReport, RobotSpec};
+use mrt_robot::members::{behaviors_dir, RobotSpec};
+use mrt_robot::remote::RemoteRobot;
+use mrt_robot::stacks::Stack;
 use mrt_sim::config::SimConfig;
 use mrt_sim::game::MatchReport;
-use mrt_sim::remote::{DeviceAct, DeviceFrame, Patience, PitchServer, RemoteRobot};
-use mrt_sim::teams::Stack;
+use mrt_sim::remote::{Patience, PitchServer};
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
@@ -342,7 +345,9 @@ pub fn robot(args: &RobotArgs) -> Result<()> {
     let spec = RobotSpec::of(args.robot, n, stacks);
     let dir =
         behaviors_dir(&[spec.stack], args.behaviors.as_deref()).map_err(|e| anyhow!("{e}"))?;
-    let mut robot = RemoteRobot::new(&cfg, spec, &dir, Some(net)).map_err(|e| anyhow!("{e}"))?;
+    let robot_cfg = cfg.robot().map_err(|e| anyhow!("{e}"))?;
+    let mut robot =
+        RemoteRobot::new(&robot_cfg, spec, &dir, Some(net)).map_err(|e| anyhow!("{e}"))?;
     let agora = robot.agora().ok_or_else(|| anyhow!("the robot has no Agora"))?;
     let link = mrt_net::connect(agora)?;
     let online = link.presence();

@@ -185,7 +185,7 @@ fn main() -> Result<()> {
     // An interrupted run leaves no files behind: the handles that would remove the compiled-in
     // behaviors' directory are not dropped when the process is killed by the signal.
     if let Err(e) = ctrlc::set_handler(|| {
-        mrt_sim::embedded::remove_embedded_dirs();
+        mrt_robot::files::remove_embedded_dirs();
         std::process::exit(130);
     }) {
         eprintln!("warning: cannot install the Ctrl-C handler: {e}");

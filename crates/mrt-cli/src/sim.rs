@@ -2,10 +2,10 @@
 
 use anyhow::{anyhow, Context as _, Result};
 use indicatif::{ProgressBar, ProgressStyle};
+use mrt_robot::stacks::Stack;
 use mrt_sim::config::SimConfig;
 use mrt_sim::game::MatchReport;
 use mrt_sim::referee::{Call, Team};
-use mrt_sim::teams::Stack;
 use mrt_sim::{play, Wiring};
 use std::path::PathBuf;
 

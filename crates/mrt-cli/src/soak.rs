@@ -8,10 +8,10 @@
 
 use anyhow::{anyhow, bail, Result};
 use indicatif::{ProgressBar, ProgressStyle};
+use mrt_robot::stacks::Stack;
 use mrt_sim::bus::BusMatch;
 use mrt_sim::config::SimConfig;
 use mrt_sim::soak::{resident_bytes, slope, SoakMatch};
-use mrt_sim::teams::Stack;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::Mutex;
 use std::time::Instant;

@@ -7,9 +7,9 @@
 #![allow(missing_docs, clippy::unwrap_used)]
 
 use criterion::{criterion_group, criterion_main, Criterion};
+use mrt_robot::stacks::{team, Stack};
 use mrt_sim::config::SimConfig;
 use mrt_sim::game::Match;
-use mrt_sim::teams::{team, Stack};
 use mrt_sim::world::{Drive, World};
 use mrt_sim::Wiring;
 use std::time::Duration;
@@ -32,9 +32,13 @@ fn bench(c: &mut Criterion) {
         ("milan_vs_chaos", Stack::Milan, Stack::Chaos),
     ];
     for (name, home, away) in stacks {
-        let mut m =
-            Match::new(&cfg, 1, team(home, &cfg, None).unwrap(), team(away, &cfg, None).unwrap())
-                .unwrap();
+        let mut m = Match::new(
+            &cfg,
+            1,
+            team(home, &cfg.robot().unwrap(), None).unwrap(),
+            team(away, &cfg.robot().unwrap(), None).unwrap(),
+        )
+        .unwrap();
         c.bench_function(&format!("control_cycle_{name}"), |b| b.iter(|| m.cycle()));
     }
 
@@ -47,8 +51,8 @@ fn bench(c: &mut Criterion) {
             let m = Match::new(
                 &short,
                 1,
-                team(Stack::Chaos, &short, None).unwrap(),
-                team(Stack::Chaser, &short, None).unwrap(),
+                team(Stack::Chaos, &short.robot().unwrap(), None).unwrap(),
+                team(Stack::Chaser, &short.robot().unwrap(), None).unwrap(),
             )
             .unwrap();
             m.play(f64::MAX, |_| {})

@@ -1,412 +1,29 @@
 //! Robots as Agoras on the bus (DCDT, MRT manual ch. 3): the simulator's default wiring.
 //!
-//! Each robot is one [`Agora`] with eight Members, all on the simulated clock
-//! of one [`SteppedExecutor`] so that the match stays deterministic:
-//!
-//! 1. **`OdometryDriver`** (periodic): publishes the two optical mice's and the wheels'
-//!    readings since the last cycle ([`Odometry`]);
-//! 2. **`CameraDriver`** (periodic): publishes what the object sensor sees, as distance and
-//!    bearing, with the game controller's news ([`CameraFrame`]);
-//! 3. **`WorldState`** (periodic): fuses both into the robot's own pose and LPS
-//!    ([`WorldModel`]: an EKF predicted by the mice, or the wheels, and corrected by the
-//!    landmarks), takes its teammates' poses from their reports received over the bus, and
-//!    publishes the [`WorldSnapshot`]; it also publishes a [`MateReport`] (its pose and its
-//!    ball estimate) that the teammates' Agoras receive through their team's
-//!    `InnerLinkManager` — a `RequestType::Remote` subscription, so a robot never hears
-//!    itself.
-//! 4. **`Sonars`** (the sonar ring's driver, periodic): publishes a [`SonarScan`];
-//! 5. **the behaviors**: a [`BehaviorMember`] running the TeamChaos HFSM or goalkeeper for the
-//!    Chaos stack, or a [`BrainMember`] around any `Send` [`Brain`] (Milan, the baseline);
-//! 6. **`Guide`** (guidance, ISocRob §3.2.3, on message): turns the behaviors'
-//!    [`RobotCommand`] into a [`MotorCommand`] with [`mrt_plan::guide::Guidance`]: velocity
-//!    mode halted by the sonars, or position and potential-field modes to a target posture;
-//! 7. **`Motor`** (the motor and kicker driver, on message): turns each [`MotorCommand`] into
-//!    wheel set-points and kicks;
-//! 8. **`FaultBook`** (on message): books the behavior Member's script errors against the
-//!    robot. A Member that fails to start, fails or panics is restarted by its executor and
-//!    booked too when the match ends: the match goes on, the robot stands still meanwhile, and
-//!    [`MatchReport::faults`] says which file and line.
-//!
-//! Body adaptation belongs to the drivers, as the seed's Commander Module did for its legs: on
-//! the Chaos robots `WorldState` measures distances from the robot's edge and `Guide` scales the
-//! behaviors' AIBO-sized set-points before guiding them (see [`crate::teams`]).
+//! Each robot is one [`Agora`](mrt_dcdt::Agora) running the robot program of `mrt-robot`
+//! ([`add_robot`]: its drivers, world state, behaviors, guidance, motor driver and fault
+//! book) on [`PitchDevices`], all on the simulated clock of one [`SteppedExecutor`] so that the
+//! match stays deterministic. Teammates' `MateReport`s cross each team's
+//! [`InnerLinkManager`]. Members that failed to start, failed or panicked are restarted by the
+//! executor and booked against their robot when the match ends ([`MatchReport::faults`]).
 
-use crate::devices::{Devices, PitchDevices, SharedDevices};
-use crate::drivers::Base;
-use crate::embedded::FilesDir;
-use crate::game::{guide, Brain, MatchReport, Pitch};
+use crate::devices::PitchDevices;
+use crate::game::{MatchReport, Pitch};
 use crate::referee::Call;
-use crate::teams::{embedded_teamchaos, send_brain, Body, Stack, CHAOS_KEEPER, CHAOS_PLAYER};
 use mrt_core::SimClock;
-use mrt_dcdt::{
-    Activation, Agora, Context, InnerLinkManager, Member, MemberError, RequestType, RunReport,
-    SteppedExecutor,
-};
-use mrt_msgs::robot::{RobotCommand, WorldSnapshot};
-use mrt_msgs::{CameraFrame, Odometry};
-use mrt_plan::guide::Guidance;
-use mrt_script::member::{BehaviorMember, BehaviorStatus};
-use mrt_world::{merge_team, WorldModel};
-use std::collections::BTreeMap;
-use std::path::{Path, PathBuf};
+use mrt_dcdt::{InnerLinkManager, SteppedExecutor};
+use mrt_msgs::MemberFault;
+use mrt_robot::files::FilesDir;
+use mrt_robot::members::{add_robot, behaviors_dir, member_faults, RobotSpec};
+use mrt_robot::stacks::Stack;
+use std::path::Path;
 use std::sync::{Arc, Mutex, MutexGuard};
 use std::time::Duration;
-
-pub use mrt_msgs::{MateReport, MemberFault, MotorCommand, SonarScan};
 
 type Shared = Arc<Mutex<Pitch>>;
 
 fn lock_pitch(p: &Shared) -> Result<MutexGuard<'_, Pitch>, String> {
     p.lock().map_err(|_| "the pitch lock is poisoned".to_string())
-}
-
-fn lock(d: &SharedDevices) -> Result<MutexGuard<'_, dyn Devices + 'static>, MemberError> {
-    d.lock().map_err(|_| MemberError::from("the devices lock is poisoned"))
-}
-
-/// The odometry driver of one robot: the mice and the wheels since the last cycle.
-struct OdometryDriver {
-    devices: SharedDevices,
-    robot: usize,
-}
-
-impl Member for OdometryDriver {
-    fn name(&self) -> String {
-        format!("odometry-{}", self.robot)
-    }
-
-    fn do_your_job(&mut self, ctx: &mut Context<'_>) -> Result<(), MemberError> {
-        let odometry = lock(&self.devices)?.odometry()?;
-        ctx.publish(odometry);
-        Ok(())
-    }
-}
-
-/// The camera driver of one robot (the object sensor), with the game controller's news.
-struct CameraDriver {
-    devices: SharedDevices,
-    robot: usize,
-}
-
-impl Member for CameraDriver {
-    fn name(&self) -> String {
-        format!("camera-{}", self.robot)
-    }
-
-    fn do_your_job(&mut self, ctx: &mut Context<'_>) -> Result<(), MemberError> {
-        let frame = lock(&self.devices)?.camera()?;
-        ctx.publish(frame);
-        Ok(())
-    }
-}
-
-/// The world-state Member of one robot: odometry and camera frames into its [`WorldModel`],
-/// teammates from their reports over the bus; publishes the [`WorldSnapshot`] and its own
-/// [`MateReport`].
-struct WorldState {
-    robot: usize,
-    keeper: bool,
-    body: Body,
-    model: WorldModel,
-    mates: BTreeMap<u32, MateReport>,
-}
-
-impl Member for WorldState {
-    fn name(&self) -> String {
-        format!("world-state-{}", self.robot)
-    }
-
-    fn init(&mut self, ctx: &mut Context<'_>) -> Result<(), MemberError> {
-        ctx.subscribe_to::<Odometry>(RequestType::Local);
-        ctx.subscribe_to::<CameraFrame>(RequestType::Local);
-        ctx.subscribe_to::<MateReport>(RequestType::Remote);
-        Ok(())
-    }
-
-    fn do_your_job(&mut self, ctx: &mut Context<'_>) -> Result<(), MemberError> {
-        let mut frame = None;
-        while let Some(m) = ctx.receive_msg() {
-            if let Ok(o) = m.get::<Odometry>() {
-                self.model.odometry(o);
-            } else if let Ok(f) = m.get::<CameraFrame>() {
-                frame = Some(f.clone());
-            } else {
-                let r = m.get::<MateReport>()?;
-                self.mates.insert(r.id, *r);
-            }
-        }
-        let Some(frame) = frame else { return Ok(()) };
-        let mut w = self.model.camera(&frame);
-        let id = u32::try_from(self.robot).unwrap_or(u32::MAX);
-        let report = MateReport::of(id, self.keeper, &w);
-        // Teammates and their ball as the bus told them, not as the simulator knows them.
-        merge_team(&mut w, self.mates.values());
-        ctx.publish(report);
-        self.body.perceive(&mut w);
-        ctx.publish(w);
-        Ok(())
-    }
-}
-
-/// The sonar ring's driver of one robot.
-struct Sonars {
-    devices: SharedDevices,
-    robot: usize,
-}
-
-impl Member for Sonars {
-    fn name(&self) -> String {
-        format!("sonars-{}", self.robot)
-    }
-
-    fn do_your_job(&mut self, ctx: &mut Context<'_>) -> Result<(), MemberError> {
-        let sonars = lock(&self.devices)?.sonars()?;
-        ctx.publish(SonarScan { sonars });
-        Ok(())
-    }
-}
-
-/// Guidance of one robot: the behaviors' command, adapted to the body, through the Guidance
-/// µAgent with the latest world state and sonar scan.
-struct Guide {
-    robot: usize,
-    body: Body,
-    guidance: Guidance,
-    world: WorldSnapshot,
-    scan: SonarScan,
-}
-
-impl Member for Guide {
-    fn name(&self) -> String {
-        format!("guide-{}", self.robot)
-    }
-
-    fn init(&mut self, ctx: &mut Context<'_>) -> Result<(), MemberError> {
-        ctx.subscribe_to::<RobotCommand>(RequestType::Local);
-        ctx.subscribe_to::<WorldSnapshot>(RequestType::Local);
-        ctx.subscribe_to::<SonarScan>(RequestType::Local);
-        Ok(())
-    }
-
-    fn do_your_job(&mut self, ctx: &mut Context<'_>) -> Result<(), MemberError> {
-        let mut last = None;
-        while let Some(m) = ctx.receive_msg() {
-            if let Ok(c) = m.get::<RobotCommand>() {
-                last = Some(c.clone());
-            } else if let Ok(w) = m.get::<WorldSnapshot>() {
-                self.world.clone_from(w);
-            } else {
-                self.scan.clone_from(m.get::<SonarScan>()?);
-            }
-        }
-        if let Some(mut cmd) = last {
-            self.body.act(&mut cmd);
-            ctx.publish(MotorCommand(guide(&self.guidance, &cmd, &self.world, &self.scan.sonars)));
-        }
-        Ok(())
-    }
-}
-
-/// The motor and kicker driver of one robot: commands become duty cycles for its motor
-/// driver (the processing side of the AIRBoard), kick requests fire the kicker.
-struct Motor {
-    devices: SharedDevices,
-    robot: usize,
-    base: Base,
-}
-
-impl Member for Motor {
-    fn name(&self) -> String {
-        format!("motor-{}", self.robot)
-    }
-
-    fn init(&mut self, ctx: &mut Context<'_>) -> Result<(), MemberError> {
-        ctx.subscribe_to::<MotorCommand>(RequestType::Local);
-        Ok(())
-    }
-
-    fn do_your_job(&mut self, ctx: &mut Context<'_>) -> Result<(), MemberError> {
-        let mut last = None;
-        while let Some(m) = ctx.receive_msg() {
-            last = Some(m.get::<MotorCommand>()?.0.clone());
-        }
-        if let Some(cmd) = last {
-            let mut devices = lock(&self.devices)?;
-            devices.set_duty(&self.base.duties(&cmd))?;
-            if cmd.kick.is_some() {
-                devices.kick()?;
-            }
-        }
-        Ok(())
-    }
-}
-
-/// Books a robot's script errors (its behavior Member's `BehaviorStatus`) against the robot,
-/// as a referee's assistant would note a robot that stopped.
-struct FaultBook {
-    devices: SharedDevices,
-    robot: usize,
-}
-
-impl Member for FaultBook {
-    fn name(&self) -> String {
-        format!("faults-{}", self.robot)
-    }
-
-    fn init(&mut self, ctx: &mut Context<'_>) -> Result<(), MemberError> {
-        ctx.subscribe_to::<BehaviorStatus>(RequestType::Local);
-        Ok(())
-    }
-
-    fn do_your_job(&mut self, ctx: &mut Context<'_>) -> Result<(), MemberError> {
-        while let Some(m) = ctx.receive_msg() {
-            if let Some(e) = m.get::<BehaviorStatus>()?.errors.first() {
-                lock(&self.devices)?.fault(e)?;
-            }
-        }
-        Ok(())
-    }
-}
-
-/// Runs any `Send` [`Brain`] as a behavior Member: world snapshot in, command out.
-pub struct BrainMember {
-    brain: Box<dyn Brain + Send>,
-    world: Option<WorldSnapshot>,
-}
-
-impl BrainMember {
-    /// A Member around `brain`.
-    pub fn new(brain: Box<dyn Brain + Send>) -> Self {
-        Self { brain, world: None }
-    }
-}
-
-impl Member for BrainMember {
-    fn init(&mut self, ctx: &mut Context<'_>) -> Result<(), MemberError> {
-        ctx.subscribe_to::<WorldSnapshot>(RequestType::Local);
-        Ok(())
-    }
-
-    fn do_your_job(&mut self, ctx: &mut Context<'_>) -> Result<(), MemberError> {
-        while let Some(m) = ctx.receive_msg() {
-            self.world = Some(m.get::<WorldSnapshot>()?.clone());
-        }
-        if let Some(w) = &self.world {
-            ctx.publish(self.brain.cycle(w));
-        }
-        Ok(())
-    }
-}
-
-/// One robot of a match: which robot it is (0 .. 2 × team size: home, then away), whether it
-/// keeps goal and which behavior stack drives it. Its Agora's id is `robot + 1`.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct RobotSpec {
-    /// The robot.
-    pub robot: usize,
-    /// Keeps goal (robot 0 of each team).
-    pub keeper: bool,
-    /// What drives it.
-    pub stack: Stack,
-}
-
-impl RobotSpec {
-    /// Robot `robot` of a match with `team_size` robots a side, the home team playing `home`
-    /// and the away team `away`.
-    pub fn of(robot: usize, team_size: usize, (home, away): (Stack, Stack)) -> RobotSpec {
-        let n = team_size.max(1);
-        RobotSpec { robot, keeper: robot % n == 0, stack: if robot < n { home } else { away } }
-    }
-
-    /// The id of the robot's Agora.
-    pub fn agora_id(&self) -> Result<u32, String> {
-        u32::try_from(self.robot + 1).map_err(|e| e.to_string())
-    }
-}
-
-/// Puts one robot's Members into `agora`, activated: the drivers of its `devices`, its world
-/// state, its behaviors (the TeamChaos files of `behaviors` for the Chaos stack), guidance,
-/// motor and fault book (module doc). The same robot code runs on a pitch in this process
-/// ([`BusMatch`]) and on a simulator in another one ([`crate::remote::RemoteRobot`]).
-pub fn add_robot(
-    agora: &mut Agora,
-    cfg: &crate::config::SimConfig,
-    spec: &RobotSpec,
-    behaviors: &Path,
-    devices: SharedDevices,
-) -> Result<(), String> {
-    let RobotSpec { robot, keeper, stack } = *spec;
-    let period = Duration::from_secs_f64(cfg.rules.control_period);
-    let every = Activation::Periodic(period);
-    let body = if stack == Stack::Chaos { Body::chaos(cfg) } else { Body::PLAIN };
-    let model = cfg.world_model()?;
-    let base = Base::parse(&cfg.robot.base)?;
-    let dev = || devices.clone();
-    let mut ids = vec![
-        agora.add_member(OdometryDriver { devices: dev(), robot }, every),
-        agora.add_member(CameraDriver { devices: dev(), robot }, every),
-        agora.add_member(WorldState { robot, keeper, body, model, mates: BTreeMap::new() }, every),
-        agora.add_member(Sonars { devices: dev(), robot }, every),
-    ];
-    ids.push(match stack {
-        Stack::Chaos if keeper => {
-            agora.add_member(BehaviorMember::hbm(behaviors, CHAOS_KEEPER), every)
-        }
-        Stack::Chaos => {
-            agora.add_member(BehaviorMember::hfsm(behaviors, behaviors.join(CHAOS_PLAYER)), every)
-        }
-        other => agora.add_member(BrainMember::new(send_brain(other, keeper, cfg)?), every),
-    });
-    let guidance = cfg.guidance()?;
-    let scan = SonarScan::default();
-    let guide = Guide { robot, body, guidance, world: WorldSnapshot::default(), scan };
-    ids.push(agora.add_member(guide, Activation::OnMessage));
-    ids.push(agora.add_member(Motor { devices: dev(), robot, base }, Activation::OnMessage));
-    ids.push(agora.add_member(FaultBook { devices, robot }, Activation::OnMessage));
-    for m in ids {
-        agora.activate_member(m).map_err(|e| e.to_string())?;
-    }
-    Ok(())
-}
-
-/// The TeamChaos files robots of `stacks` run: `behaviors`, or the compiled-in ones when the
-/// Chaos stack plays (nothing otherwise).
-/// Keep the handle while the robots may read them: compiled-in files are removed with it.
-pub fn behaviors_dir(stacks: &[Stack], behaviors: Option<&Path>) -> Result<FilesDir, String> {
-    match behaviors {
-        Some(d) => Ok(FilesDir::user(d)),
-        None if stacks.contains(&Stack::Chaos) => embedded_teamchaos(),
-        None => Ok(FilesDir::user(PathBuf::new())),
-    }
-}
-
-/// The faulty Members of one Agora's report: failed starts, jobs and panics, and mailboxes
-/// that lost messages (their bus bounds dropped or refused some: a Member that fell thousands
-/// of messages behind).
-pub fn member_faults(report: &RunReport) -> Vec<MemberFault> {
-    report
-        .members
-        .iter()
-        .flat_map(|m| {
-            let failed = m.last_error.clone().map(|error| MemberFault {
-                name: m.name.clone(),
-                count: m.errors + m.panics + m.restarts.max(1),
-                never_ran: m.cycles == 0,
-                error,
-            });
-            let lost =
-                m.mailboxes.iter().filter(|b| b.dropped + b.refused > 0).map(|b| MemberFault {
-                    name: m.name.clone(),
-                    count: b.dropped + b.refused,
-                    never_ran: false,
-                    error: format!(
-                        "its mailbox for {} dropped {} and refused {} messages (capacity {})",
-                        b.msg_type, b.dropped, b.refused, b.capacity
-                    ),
-                });
-            failed.into_iter().chain(lost)
-        })
-        .collect()
 }
 
 /// Books a Member's fault against robot `robot`.
@@ -442,6 +59,7 @@ impl BusMatch {
         behaviors: Option<&Path>,
     ) -> Result<BusMatch, String> {
         let n = cfg.rules.team_size;
+        let robot_cfg = cfg.robot()?;
         let pitch = Pitch::new(cfg, seed, n, if away.is_some() { n } else { 0 })?;
         let pitch = Arc::new(Mutex::new(pitch));
         let period = Duration::from_secs_f64(cfg.rules.control_period);
@@ -461,7 +79,7 @@ impl BusMatch {
                     .build()
                     .map_err(|e| e.to_string())?;
                 let devices = Arc::new(Mutex::new(PitchDevices::new(pitch.clone(), robot)?));
-                add_robot(&mut agora, cfg, &spec, &dir, devices)?;
+                add_robot(&mut agora, &robot_cfg, &spec, &dir, devices)?;
                 exec.add_agora(agora).map_err(|e| e.to_string())?;
             }
         }
@@ -521,6 +139,8 @@ impl BusMatch {
 mod tests {
     use super::*;
     use crate::config::short;
+    use mrt_dcdt::{Activation, Context, Member, MemberError, RequestType, RunReport};
+    use mrt_msgs::MateReport;
 
     #[test]
     fn a_bus_match_is_deterministic_and_both_stacks_play() {
@@ -584,8 +204,8 @@ mod tests {
             .unwrap()
             .play(|_| {})
             .unwrap();
-        let home = crate::teams::team(Stack::Chaos, &cfg, None).unwrap();
-        let away = crate::teams::team(Stack::Chaser, &cfg, None).unwrap();
+        let home = mrt_robot::stacks::team(Stack::Chaos, &cfg.robot().unwrap(), None).unwrap();
+        let away = mrt_robot::stacks::team(Stack::Chaser, &cfg.robot().unwrap(), None).unwrap();
         let direct = crate::game::Match::new(&cfg, 9, home, away).unwrap().play(f64::MAX, |_| {});
         assert_eq!((bus.score, bus.trajectory_hash), (direct.score, direct.trajectory_hash));
     }
@@ -596,7 +216,7 @@ mod tests {
     #[test]
     fn broken_or_runaway_behaviors_stop_their_robot_and_are_reported() {
         let tmp = std::env::temp_dir().join(format!("mrt-sim-broken-{}", std::process::id()));
-        let src = embedded_teamchaos().unwrap();
+        let src = mrt_robot::stacks::embedded_teamchaos().unwrap();
         let copy = |to: &Path| {
             std::fs::create_dir_all(to).unwrap();
             for e in std::fs::read_dir(&src).unwrap() {
@@ -617,8 +237,9 @@ mod tests {
             .unwrap()
             .play(|_| {})
             .unwrap();
-        let home = crate::teams::team(Stack::Chaos, &cfg, Some(&broken)).unwrap();
-        let away = crate::teams::team(Stack::Chaser, &cfg, None).unwrap();
+        let home =
+            mrt_robot::stacks::team(Stack::Chaos, &cfg.robot().unwrap(), Some(&broken)).unwrap();
+        let away = mrt_robot::stacks::team(Stack::Chaser, &cfg.robot().unwrap(), None).unwrap();
         let direct = crate::game::Match::new(&cfg, 1, home, away).unwrap().play(f64::MAX, |_| {});
         for r in [&bus, &direct] {
             assert!((r.duration - 10.0).abs() < 0.011, "the match went on: {}", r.duration);

@@ -84,7 +84,7 @@ impl Default for BallConfig {
 /// up to 1.2 m/s as its IANUS3, with a pneumatic kicker).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
-pub struct RobotConfig {
+pub struct BodyConfig {
     /// The wheels: `omni` (three omni wheels, the manual's Triskar) or `differential` (two
     /// central wheels, the manual's IANUS3: no sideways motion).
     pub base: String,
@@ -108,7 +108,7 @@ pub struct RobotConfig {
     pub kick_recharge: f64,
 }
 
-impl Default for RobotConfig {
+impl Default for BodyConfig {
     fn default() -> Self {
         Self {
             base: "omni".into(),
@@ -280,27 +280,12 @@ impl Default for GuidanceConfig {
 }
 
 impl SimConfig {
-    /// A robot's world model as it starts a match on this field: the field map, the mice's
-    /// geometry and the camera's noise, the pose unknown until it is put down.
-    pub fn world_model(&self) -> Result<mrt_world::WorldModel, String> {
-        Ok(mrt_world::WorldModel::new(
-            self.field.map(),
-            self.odometry.mice()?,
-            self.sensor.distance_noise,
-            self.sensor.bearing_noise,
-        ))
-    }
-
     /// The Guidance µAgent for these robots (`[guidance]`, the robot's base, speed and size).
     pub fn guidance(&self) -> Result<mrt_plan::guide::Guidance, String> {
         let cfg = self;
         use mrt_plan::guidance::{PositionParams, PotentialField, PotentialParams, VelocityGuard};
-        let steering = match crate::drivers::Base::parse(&cfg.robot.base)? {
-            crate::drivers::Base::Differential(_) => mrt_plan::kinematics::Steering::Differential,
-            crate::drivers::Base::Omni(_) => mrt_plan::kinematics::Steering::Holonomic,
-        };
         let position = PositionParams {
-            steering,
+            steering: mrt_robot::base::Base::parse(&cfg.robot.base)?.steering(),
             max_speed: cfg.robot.max_speed,
             max_omega: cfg.robot.max_turn_rate,
             position_tolerance: 0.05,
@@ -315,6 +300,27 @@ impl SimConfig {
             PotentialField::new(position, obstacles).map_err(|e| format!("guidance: {e}"))?;
         Ok(mrt_plan::guide::Guidance::new(guard, field, cfg.ball.radius))
     }
+
+    /// What each robot of this world is configured with (the robot program's
+    /// [`RobotConfig`](mrt_robot::config::RobotConfig)): its base, size, kicker reach, mice,
+    /// camera noise, guidance and the field it plays on, from this world's sections.
+    pub fn robot(&self) -> Result<mrt_robot::config::RobotConfig, String> {
+        Ok(mrt_robot::config::RobotConfig {
+            control_period: self.rules.control_period,
+            base: mrt_robot::base::Base::parse(&self.robot.base)?,
+            radius: self.robot.radius,
+            kick_reach: self.robot.kick_reach,
+            ball_radius: self.ball.radius,
+            field: self.field.map(),
+            mice: self.odometry.mice()?,
+            camera: mrt_robot::config::CameraNoise {
+                distance: self.sensor.distance_noise,
+                bearing: self.sensor.bearing_noise,
+            },
+            guidance: self.guidance()?,
+            team_size: self.rules.team_size,
+        })
+    }
 }
 
 /// The whole configuration.
@@ -326,7 +332,7 @@ pub struct SimConfig {
     /// The ball.
     pub ball: BallConfig,
     /// The robots (both teams).
-    pub robot: RobotConfig,
+    pub robot: BodyConfig,
     /// The rules.
     pub rules: MatchConfig,
     /// The object sensor.
@@ -493,7 +499,7 @@ impl SimConfig {
                 return Err(format!("{name} must be between 0 and 1, not {v}"));
             }
         }
-        crate::drivers::Base::parse(&self.robot.base)?;
+        mrt_robot::base::Base::parse(&self.robot.base)?;
         if self.field.goal_width >= self.field.width {
             return Err("field.goal_width must be smaller than field.width".into());
         }

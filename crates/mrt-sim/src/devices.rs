@@ -1,39 +1,14 @@
-//! A robot's devices as its driver Members reach them: the object sensor (camera), the
-//! optical mice and wheel encoders, the sonar ring, the motors (AIRBoard-style duty cycles)
-//! and the kicker, plus the referee's assistant who books software faults.
-//!
-//! The driver Members of [`crate::bus`] talk to a [`Devices`] only, so the same robot code
-//! runs on two kinds of hardware:
-//! - [`PitchDevices`]: the simulated pitch in the same process (the default wiring);
-//! - [`LinkedDevices`]: the simulator in another process, reached over the bus: it holds the
-//!   readings of the cycle's [`DeviceFrame`](crate::remote::DeviceFrame) and gathers what the
-//!   drivers did into a [`DeviceAct`](crate::remote::DeviceAct) (see [`crate::remote`]).
+//! The simulated robots' devices: [`PitchDevices`] implement the robot program's
+//! [`Devices`] on the pitch of this process (camera, mice and wheels, sonars from the
+//! simulator's sensor models; motors through the [`SimulatedAirboard`]; faults booked by the
+//! referee's assistant).
 
-use crate::drivers::{MotorDriver, SimulatedAirboard};
+use crate::drivers::SimulatedAirboard;
 use crate::game::Pitch;
-use crate::sensor::{CameraFrame, Odometry};
-use mrt_plan::guidance::Sonar;
+use mrt_msgs::{CameraFrame, Odometry, Sonar};
+use mrt_robot::base::MotorDriver;
+use mrt_robot::devices::Devices;
 use std::sync::{Arc, Mutex};
-
-/// A robot's devices (module doc). Errors are the device's own words; the driver Member
-/// reports them as job errors.
-pub trait Devices: Send {
-    /// The mice and the wheels since the last reading (first in a cycle).
-    fn odometry(&mut self) -> Result<Odometry, String>;
-    /// What the object sensor sees now, with the game controller's news (after the odometry).
-    fn camera(&mut self) -> Result<CameraFrame, String>;
-    /// The sonar ring (after the camera).
-    fn sonars(&mut self) -> Result<Vec<Sonar>, String>;
-    /// Drives the motors: one PWM duty cycle per wheel.
-    fn set_duty(&mut self, duty: &[f64]) -> Result<(), String>;
-    /// Fires the kicker.
-    fn kick(&mut self) -> Result<(), String>;
-    /// Books a fault of the robot's software now (a script error with its file and line).
-    fn fault(&mut self, message: &str) -> Result<(), String>;
-}
-
-/// One robot's devices, shared by its driver Members.
-pub type SharedDevices = Arc<Mutex<dyn Devices>>;
 
 /// The devices of robot `robot` on a pitch in this process.
 pub struct PitchDevices {
@@ -79,105 +54,5 @@ impl Devices for PitchDevices {
 
     fn fault(&mut self, message: &str) -> Result<(), String> {
         self.with(|p, i| p.fault(i, 1, message))
-    }
-}
-
-/// The devices of a robot whose simulator runs elsewhere: the readings of the current cycle
-/// (set by the robot's runner before the cycle) and what the drivers did during it (taken by
-/// the runner after the cycle).
-#[derive(Debug, Default)]
-pub struct LinkedDevices {
-    odometry: Option<Odometry>,
-    camera: Option<CameraFrame>,
-    sonars: Option<Vec<Sonar>>,
-    duty: Option<Vec<f64>>,
-    kick: bool,
-    faults: Vec<String>,
-}
-
-/// What a robot's drivers did in one cycle.
-#[derive(Clone, Debug, Default, PartialEq)]
-pub struct Actuation {
-    /// The last duty cycles set, if any (the motors keep the previous ones otherwise).
-    pub duty: Option<Vec<f64>>,
-    /// Whether the kicker fired.
-    pub kick: bool,
-    /// Faults booked, in order.
-    pub faults: Vec<String>,
-}
-
-impl LinkedDevices {
-    /// The readings of the next cycle (each is read once).
-    pub fn load(&mut self, odometry: Odometry, camera: CameraFrame, sonars: Vec<Sonar>) {
-        self.odometry = Some(odometry);
-        self.camera = Some(camera);
-        self.sonars = Some(sonars);
-    }
-
-    /// What the drivers did since the last call.
-    pub fn take(&mut self) -> Actuation {
-        Actuation {
-            duty: self.duty.take(),
-            kick: std::mem::take(&mut self.kick),
-            faults: std::mem::take(&mut self.faults),
-        }
-    }
-}
-
-fn unread<T>(slot: &mut Option<T>, what: &str) -> Result<T, String> {
-    slot.take().ok_or_else(|| format!("no {what} reading this cycle (the simulator is silent)"))
-}
-
-impl Devices for LinkedDevices {
-    fn odometry(&mut self) -> Result<Odometry, String> {
-        unread(&mut self.odometry, "odometry")
-    }
-
-    fn camera(&mut self) -> Result<CameraFrame, String> {
-        unread(&mut self.camera, "camera")
-    }
-
-    fn sonars(&mut self) -> Result<Vec<Sonar>, String> {
-        unread(&mut self.sonars, "sonar")
-    }
-
-    fn set_duty(&mut self, duty: &[f64]) -> Result<(), String> {
-        self.duty = Some(duty.to_vec());
-        Ok(())
-    }
-
-    fn kick(&mut self) -> Result<(), String> {
-        self.kick = true;
-        Ok(())
-    }
-
-    fn fault(&mut self, message: &str) -> Result<(), String> {
-        self.faults.push(message.to_string());
-        Ok(())
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn linked_devices_give_each_reading_once_and_gather_what_the_drivers_did() {
-        let mut d = LinkedDevices::default();
-        assert!(d.camera().is_err(), "nothing loaded yet");
-        let frame = CameraFrame { time: 1.5, ..CameraFrame::default() };
-        d.load(Odometry::default(), frame.clone(), vec![Sonar::default(); 2]);
-        assert_eq!(d.camera().unwrap(), frame);
-        assert!(d.camera().unwrap_err().contains("no camera reading"), "read once");
-        assert_eq!(d.sonars().unwrap().len(), 2);
-        d.set_duty(&[0.1, -0.2]).unwrap();
-        d.set_duty(&[0.3, 0.4]).unwrap();
-        d.kick().unwrap();
-        d.fault("go2ball.lua:3: boom").unwrap();
-        let act = d.take();
-        assert_eq!(act.duty, Some(vec![0.3, 0.4]), "the last set-point counts");
-        assert!(act.kick);
-        assert_eq!(act.faults, ["go2ball.lua:3: boom"]);
-        assert_eq!(d.take(), Actuation::default(), "taken once");
     }
 }

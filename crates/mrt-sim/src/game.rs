@@ -7,54 +7,19 @@
 //! next control period, with the referee watching every step.
 
 use crate::config::SimConfig;
-use crate::drivers::Base;
 use crate::referee::{Call, Referee, Team};
 use crate::sensor::{self, sonar_ring, Odometer};
 use crate::world::{Drive, World};
-use mrt_core::Point2;
-use mrt_msgs::robot::{lps, GameState, RobotCommand, Target, WorldSnapshot};
+use mrt_msgs::robot::{GameState, RobotCommand, WorldSnapshot};
+use mrt_msgs::Sonar;
 use mrt_msgs::{CameraFrame, MateReport, Odometry};
-use mrt_plan::guidance::Sonar;
 use mrt_plan::guide::Guidance;
+use mrt_robot::base::Base;
+use mrt_robot::brain::Brain;
+use mrt_robot::members::guide;
 use mrt_world::{merge_team, WorldModel};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
-
-/// What drives one robot: a behavior stack (Lua HFSM and HBM, Mr. BRIAN, ...).
-pub trait Brain {
-    /// One control cycle.
-    fn cycle(&mut self, world: &WorldSnapshot) -> RobotCommand;
-
-    /// What went wrong since the last call (a script error with its file and line, ...): the
-    /// match books it against the robot. The robot went on (or stood still) regardless.
-    fn take_faults(&mut self) -> Vec<String> {
-        Vec::new()
-    }
-}
-
-/// A robot whose software could not start (a behavior file that does not load, ...): it stands
-/// still for the whole match, and its reason is booked once.
-#[derive(Debug)]
-pub struct Stopped {
-    reason: Option<String>,
-}
-
-impl Stopped {
-    /// A robot stopped for `reason`.
-    pub fn new(reason: impl Into<String>) -> Stopped {
-        Stopped { reason: Some(reason.into()) }
-    }
-}
-
-impl Brain for Stopped {
-    fn cycle(&mut self, _world: &WorldSnapshot) -> RobotCommand {
-        RobotCommand::default()
-    }
-
-    fn take_faults(&mut self) -> Vec<String> {
-        self.reason.take().into_iter().collect()
-    }
-}
 
 /// What went wrong with one robot's software during a match.
 #[derive(Clone, Debug, PartialEq)]
@@ -174,7 +139,7 @@ impl Pitch {
             })
             .collect();
         let mice = cfg.odometry.mice()?;
-        let model = cfg.world_model()?;
+        let model = cfg.robot()?.world_model();
         Ok(Pitch {
             cfg: cfg.clone(),
             base: Base::parse(&cfg.robot.base)?,
@@ -318,7 +283,8 @@ impl Pitch {
     /// Applies robot `i`'s command (mm/s, deg/s) through its base's kinematics and motor
     /// duty cycles, as its driver would; a kick request fires the kicker.
     pub fn apply(&mut self, i: usize, cmd: &RobotCommand) {
-        let drive = self.base.drive_for(&self.base.duties(cmd)).unwrap_or_default();
+        let drive =
+            self.base.twist_for(&self.base.duties(cmd)).map(Drive::from).unwrap_or_default();
         self.drive(i, drive);
         if cmd.kick.is_some() {
             self.kick(i);
@@ -391,19 +357,6 @@ impl Pitch {
             faults: self.faults,
         }
     }
-}
-
-/// Guidance for one robot's cycle: the behaviors' command `cmd`, the world state the robot
-/// believes (its pose, the ball where it is known) and its sonar ring. Both wirings call this.
-pub fn guide(
-    g: &Guidance,
-    cmd: &RobotCommand,
-    w: &WorldSnapshot,
-    sonars: &[Sonar],
-) -> RobotCommand {
-    let ball = w.global_ball;
-    let ball = (ball.quality >= 0.1).then(|| Point2::new(ball.pose.x, ball.pose.y));
-    g.guide(cmd, &w.my_pos.pose, ball, sonars).command
 }
 
 /// A match whose robots' brains are called directly, in order (the fast mode; see
@@ -490,100 +443,11 @@ impl Match {
     }
 }
 
-/// A simple hand-written player, the baseline: it goes round to a point behind the ball on
-/// the line from the opponent's net, then drives through the ball and kicks when it is lined
-/// up with the net. The goalkeeper (`keeper`) stays on its goal line in front of the ball.
-#[derive(Clone, Debug, Default)]
-pub struct Chaser {
-    /// Plays as goalkeeper.
-    pub keeper: bool,
-    /// The field it plays on.
-    pub field: crate::teams::Geometry,
-}
-
-impl Chaser {
-    /// Velocities towards a target point `(tx, ty)` (team frame, mm), facing `face` (rad).
-    fn go(me: mrt_core::Pose2, (tx, ty): (f64, f64), face: f64, c: &mut RobotCommand) {
-        let (dx, dy) = (tx - me.x, ty - me.y);
-        let err = mrt_core::normalize_angle(face - me.theta);
-        c.vrot = (err.to_degrees() * 3.0).clamp(-200.0, 200.0);
-        // Move in the robot frame (holonomic base): forward and sideways components.
-        let (s, co) = (me.theta.sin(), me.theta.cos());
-        let (fw, left) = (dx * co + dy * s, -dx * s + dy * co);
-        let d = dx.hypot(dy).max(1.0);
-        let speed = (d * 2.0).min(1200.0);
-        c.vlin = fw / d * speed;
-        c.vlat = left / d * speed;
-    }
-}
-
-/// In READY, the command that walks to the kickoff position (guidance's potential-field mode,
-/// round the other robots), watching the ball; `None` in the other states.
-pub fn walk_to_kickoff(w: &WorldSnapshot) -> Option<RobotCommand> {
-    let pose = w.kickoff_pose.filter(|_| w.game_state == GameState::Ready)?;
-    Some(RobotCommand {
-        target: Some(Target { pose, avoid: true }),
-        needs: vec![(lps::BALL, 1.0)],
-        ..RobotCommand::default()
-    })
-}
-
-impl Brain for Chaser {
-    fn cycle(&mut self, w: &WorldSnapshot) -> RobotCommand {
-        if let Some(c) = walk_to_kickoff(w) {
-            return c;
-        }
-        let mut c = RobotCommand::default();
-        let ball = w.lps[lps::BALL];
-        c.needs.push((lps::BALL, 1.0));
-        if ball.reliability < 0.2 {
-            c.vrot = 60.0; // look around
-            return c;
-        }
-        let me = w.my_pos.pose;
-        // Ball in the team frame (mm); x towards the opponent's net at (half length, 0).
-        let (hl, gw) = (self.field.half_length, self.field.goal_half_width);
-        let a = me.theta + ball.theta;
-        let (bx, by) = crate::teams::Geometry::ball_at(me, &ball);
-        if self.keeper {
-            // `validate` keeps goals at least 0.2 m wide; max(0) keeps clamp from panicking.
-            let lim = (gw - 100.0).max(0.0);
-            let target = (-(hl - 300.0), by.clamp(-lim, lim));
-            Chaser::go(me, target, a, &mut c);
-        } else {
-            let behind = self.field.behind_ball((bx, by), 500.0);
-            let shot = behind.theta;
-            let (ux, uy) = (shot.cos(), shot.sin());
-            // Lined up: behind the ball, looking at the net.
-            let (rx, ry) = (bx - me.x, by - me.y);
-            let along = (rx * ux + ry * uy) / rx.hypot(ry).max(1.0);
-            let lined_up = along > 0.9 && ball.rho < 1500.0;
-            if lined_up {
-                Chaser::go(me, (bx + 200.0 * ux, by + 200.0 * uy), shot, &mut c);
-                if ball.rho < 450.0
-                    && ball.theta.abs() < 0.3
-                    && mrt_core::normalize_angle(me.theta - shot).abs() < 0.35
-                {
-                    c.kick = Some(1);
-                }
-            } else {
-                // Go round: to a point behind the ball, stepping aside first when in front.
-                let (mut px, mut py) = (behind.x, behind.y);
-                if along < 0.0 {
-                    let side = if (me.x - bx) * uy - (me.y - by) * ux > 0.0 { 1.0 } else { -1.0 };
-                    px += side * 600.0 * uy;
-                    py -= side * 600.0 * ux;
-                }
-                Chaser::go(me, (px, py), a, &mut c);
-            }
-        }
-        c
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    use mrt_robot::stacks::{team, Chaser, Stack};
 
     fn chasers(n: usize) -> Vec<Box<dyn Brain>> {
         (0..n)
@@ -715,7 +579,7 @@ mod tests {
     #[test]
     fn the_chaos_team_alone_scores_within_two_minutes() {
         let cfg = short(2.0, 2);
-        let home = crate::teams::team(crate::teams::Stack::Chaos, &cfg, None).unwrap();
+        let home = team(Stack::Chaos, &cfg.robot().unwrap(), None).unwrap();
         let report = Match::new(&cfg, 3, home, Vec::new()).unwrap().play(120.0, |_| {});
         assert!(report.score.0 >= 1, "{:?} {:?} {:?}", report.score, report.stats, report.calls);
     }
@@ -723,7 +587,7 @@ mod tests {
     #[test]
     fn the_milan_team_alone_scores_within_two_minutes() {
         let cfg = short(2.0, 2);
-        let home = crate::teams::team(crate::teams::Stack::Milan, &cfg, None).unwrap();
+        let home = team(Stack::Milan, &cfg.robot().unwrap(), None).unwrap();
         let report = Match::new(&cfg, 3, home, Vec::new()).unwrap().play(120.0, |_| {});
         assert!(report.score.0 >= 1, "{:?} {:?} {:?}", report.score, report.stats, report.calls);
     }
@@ -738,8 +602,8 @@ mod tests {
         cfg.field.goal_width = 1.5;
         cfg.field.penalty_area_width = 4.0;
         cfg.field.penalty_area_depth = 1.5;
-        for stack in [crate::teams::Stack::Milan, crate::teams::Stack::Chaser] {
-            let home = crate::teams::team(stack, &cfg, None).unwrap();
+        for stack in [Stack::Milan, Stack::Chaser] {
+            let home = team(stack, &cfg.robot().unwrap(), None).unwrap();
             let report = Match::new(&cfg, 5, home, Vec::new()).unwrap().play(120.0, |_| {});
             assert!(report.score.0 >= 1, "{stack:?}: {:?} {:?}", report.score, report.calls);
         }

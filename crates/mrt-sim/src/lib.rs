@@ -26,16 +26,15 @@ pub mod bus;
 pub mod config;
 pub mod devices;
 pub mod drivers;
-pub mod embedded;
 pub mod game;
 pub mod plot;
 pub mod referee;
 pub mod remote;
 pub mod sensor;
 pub mod soak;
-pub mod teams;
 pub mod world;
 
+use mrt_robot::stacks::{team, Stack};
 use std::path::Path;
 
 /// How the robots' brains are called.
@@ -53,7 +52,7 @@ pub enum Wiring {
 pub fn play(
     cfg: &config::SimConfig,
     seed: u64,
-    (home, away): (teams::Stack, teams::Stack),
+    (home, away): (Stack, Stack),
     wiring: Wiring,
     behaviors: Option<&Path>,
     record: bool,
@@ -66,8 +65,9 @@ pub fn play(
             m.play(&mut progress)
         }
         Wiring::Direct => {
-            let home = teams::team(home, cfg, behaviors).map_err(|e| format!("home team: {e}"))?;
-            let away = teams::team(away, cfg, behaviors).map_err(|e| format!("away team: {e}"))?;
+            let robot = cfg.robot()?;
+            let home = team(home, &robot, behaviors).map_err(|e| format!("home team: {e}"))?;
+            let away = team(away, &robot, behaviors).map_err(|e| format!("away team: {e}"))?;
             let mut m = game::Match::new(cfg, seed, home, away)?;
             m.record_frames(record);
             Ok(m.play(f64::MAX, &mut progress))

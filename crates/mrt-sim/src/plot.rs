@@ -129,7 +129,8 @@ impl MatchReport {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::game::{Chaser, Match};
+    use crate::game::Match;
+    use mrt_robot::stacks::Chaser;
 
     #[test]
     fn the_drawing_shows_the_field_the_paths_and_the_score() {

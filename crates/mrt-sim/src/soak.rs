@@ -7,8 +7,8 @@
 //! are faults the match reports, not crashes.
 
 use crate::config::SimConfig;
-use crate::teams::Stack;
 use crate::Wiring;
+use mrt_robot::stacks::Stack;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use std::panic::AssertUnwindSafe;

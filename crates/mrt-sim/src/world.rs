@@ -20,6 +20,13 @@ pub struct Drive {
     pub turn: f64,
 }
 
+impl From<mrt_plan::kinematics::Twist> for Drive {
+    /// A body velocity (robot frame, m/s and rad/s): what a base does with its duty cycles.
+    fn from(t: mrt_plan::kinematics::Twist) -> Drive {
+        Drive { forward: t.vx, left: t.vy, turn: t.omega }
+    }
+}
+
 struct Robot {
     body: RigidBodyHandle,
     drive: Drive,

@@ -11,8 +11,8 @@
 
 #![allow(clippy::unwrap_used)]
 
+use mrt_robot::stacks::Stack;
 use mrt_sim::config::SimConfig;
-use mrt_sim::teams::Stack;
 use mrt_sim::{play, Wiring};
 use proptest::prelude::*;
 

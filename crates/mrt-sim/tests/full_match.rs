@@ -5,10 +5,10 @@
 
 #![allow(clippy::unwrap_used)]
 
+use mrt_robot::stacks::Stack;
 use mrt_sim::config::SimConfig;
 use mrt_sim::game::MatchReport;
 use mrt_sim::referee::Call;
-use mrt_sim::teams::Stack;
 use mrt_sim::{play, Wiring};
 
 fn default_match(seed: u64) -> MatchReport {

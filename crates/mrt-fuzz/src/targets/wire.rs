@@ -30,15 +30,15 @@ macro_rules! message_types {
         $f!(mrt_fuzzy::member::BrianCommands);
         $f!(mrt_script::member::BehaviorStatus);
         $f!(mrt_script::member::ReloadRequest);
-        $f!(mrt_sim::bus::MateReport);
-        $f!(mrt_sim::sensor::Odometry);
-        $f!(mrt_sim::sensor::CameraFrame);
-        $f!(mrt_sim::bus::SonarScan);
-        $f!(mrt_sim::bus::MotorCommand);
-        $f!(mrt_sim::remote::DeviceFrame);
-        $f!(mrt_sim::remote::DeviceAct);
-        $f!(mrt_sim::remote::FinalWhistle);
-        $f!(mrt_sim::remote::RobotEnd);
+        $f!(mrt_msgs::MateReport);
+        $f!(mrt_msgs::Odometry);
+        $f!(mrt_msgs::CameraFrame);
+        $f!(mrt_msgs::SonarScan);
+        $f!(mrt_msgs::MotorCommand);
+        $f!(mrt_msgs::DeviceFrame);
+        $f!(mrt_msgs::DeviceAct);
+        $f!(mrt_msgs::FinalWhistle);
+        $f!(mrt_msgs::RobotEnd);
     };
 }
 
@@ -82,12 +82,12 @@ fn wire_seeds(_root: &Path) -> Result<Vec<Seed>, FuzzError> {
     default_frame!(mrt_fuzzy::member::BrianInputs);
     default_frame!(mrt_fuzzy::member::BrianCommands);
     default_frame!(mrt_script::member::BehaviorStatus);
-    default_frame!(mrt_sim::sensor::Odometry);
-    default_frame!(mrt_sim::sensor::CameraFrame);
-    default_frame!(mrt_sim::bus::SonarScan);
-    default_frame!(mrt_sim::remote::DeviceFrame);
-    default_frame!(mrt_sim::remote::DeviceAct);
-    default_frame!(mrt_sim::remote::RobotEnd);
+    default_frame!(mrt_msgs::Odometry);
+    default_frame!(mrt_msgs::CameraFrame);
+    default_frame!(mrt_msgs::SonarScan);
+    default_frame!(mrt_msgs::DeviceFrame);
+    default_frame!(mrt_msgs::DeviceAct);
+    default_frame!(mrt_msgs::RobotEnd);
     push("SelfDescribing", Msg::new(header(SelfDescribing::TYPE), sample_describing()).into_ref())?;
     let update = mrt_blackboard::BbUpdate(mrt_blackboard::Update {
         from: 2,

@@ -6,19 +6,21 @@
 //!   setup; `--behaviors DIR` runs edited copies instead.
 //! - **Milan**: the MRT manual's team on Mr. BRIAN (`configs/brian/milan`, compiled in):
 //!   [`MilanBrain`] is the manual's Parser and Messenger around the engine.
-//! - **Chaser**: the hand-written baseline player ([`crate::game::Chaser`]).
+//! - **Chaser**: the hand-written baseline player ([`Chaser`]).
 //!
 //! TeamChaos tuned its behaviors for AIBO walking speeds (about 0.3 m/s); on a Middle Size
-//! League base the Chaos brain scales the behaviors' set-points, as the seed's Commander
-//! Module turned set-points into a walking style for its own body.
+//! League base the Chaos brain's [`Commander`] adapts them to the body.
 
-use crate::embedded::FilesDir;
-use crate::game::{Brain, Chaser, Stopped};
+use crate::brain::{Brain, Stopped};
+use crate::commander::Commander;
+use crate::config::RobotConfig;
+use crate::files::FilesDir;
 use mrt_core::{Point2, Pose2};
 use mrt_fuzzy::brian::Brian;
-use mrt_msgs::robot::{lps, Lpo, RobotCommand, WorldSnapshot};
+use mrt_msgs::robot::{lps, GameState, Lpo, RobotCommand, Target, WorldSnapshot};
 use mrt_plan::guidance::behind_ball;
 use mrt_script::{Sandbox, ThinkingCap, Watchdog, DEFAULT_DEADLINE};
+use mrt_world::FieldMap;
 use std::path::Path;
 
 /// A behavior stack.
@@ -114,14 +116,14 @@ pub struct Geometry {
 impl Default for Geometry {
     /// The default Middle Size League field.
     fn default() -> Self {
-        Geometry::of(&crate::config::FieldConfig::default())
+        Geometry::of(&FieldMap::default())
     }
 }
 
 impl Geometry {
-    /// The geometry of a configured field.
-    pub fn of(f: &crate::config::FieldConfig) -> Geometry {
-        let m = f.map().snapshot();
+    /// The geometry of a field map.
+    pub fn of(map: &FieldMap) -> Geometry {
+        let m = map.snapshot();
         Geometry { half_length: m.half_length, goal_half_width: m.goal_half_width }
     }
 
@@ -140,57 +142,14 @@ impl Geometry {
     }
 }
 
-/// How a team's drivers adapt the behaviors to the robot's body, as the seed's Commander
-/// Module did for its legs: the camera driver shifts distances, the motor driver scales
-/// set-points.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Body {
-    /// Subtracted from every LPS distance (mm).
-    pub edge: f64,
-    /// Multiplies linear set-points.
-    pub linear: f64,
-    /// Multiplies turning set-points.
-    pub turn: f64,
-}
-
-impl Body {
-    /// No adaptation.
-    pub const PLAIN: Body = Body { edge: 0.0, linear: 1.0, turn: 1.0 };
-
-    /// TeamChaos' behaviors on the configured robot: linear set-points ×4.8 (FAST, 250 mm/s,
-    /// becomes the base's 1.2 m/s) and turning ×3 (they were tuned for AIBO walking, about
-    /// 0.3 m/s); distances from a point ahead of the robot's centre chosen so that the
-    /// behaviors' "touching" (`TOUCHING` in `hbm.lua` reaches 0.5 at 250 mm, where `dokick`
-    /// fires) falls 30 mm inside the kicker's reach: a kick never fires at a ball it cannot
-    /// reach and wastes the valve's recharge.
-    pub fn chaos(cfg: &crate::config::SimConfig) -> Body {
-        let reach = (cfg.robot.radius + cfg.ball.radius + cfg.robot.kick_reach) * 1000.0;
-        Body { edge: (reach - 280.0).max(0.0), linear: 4.8, turn: 3.0 }
-    }
-
-    /// The camera driver's side: distances from the robot's edge.
-    pub fn perceive(&self, w: &mut WorldSnapshot) {
-        for o in &mut w.lps {
-            o.rho = (o.rho - self.edge).max(0.0);
-        }
-    }
-
-    /// The motor driver's side: scaled set-points.
-    pub fn act(&self, cmd: &mut RobotCommand) {
-        cmd.vlin *= self.linear;
-        cmd.vlat *= self.linear;
-        cmd.vrot *= self.turn;
-    }
-}
-
 /// The compiled-in TeamChaos files, as a directory while the handle (or a clone) lives.
 pub fn embedded_teamchaos() -> Result<FilesDir, String> {
-    crate::embedded::embedded("teamchaos", TEAMCHAOS)
+    crate::files::embedded("teamchaos", TEAMCHAOS)
 }
 
 /// The compiled-in Team Milan configuration, as a directory while the handle lives.
 pub fn embedded_milan() -> Result<FilesDir, String> {
-    crate::embedded::embedded("milan", MILAN)
+    crate::files::embedded("milan", MILAN)
 }
 
 /// The Chaos goalkeeper's behavior.
@@ -202,7 +161,7 @@ pub const CHAOS_PLAYER: &str = "player.hfsm.lua";
 /// deadline stops this robot (reported), never the match.
 pub struct ChaosBrain {
     cap: Watchdog,
-    body: Body,
+    body: Commander,
     faults: Vec<String>,
     /// Keeps compiled-in files on disk while the robot may reload them.
     _files: FilesDir,
@@ -211,11 +170,7 @@ pub struct ChaosBrain {
 impl ChaosBrain {
     /// The goalkeeper (`goalkeeper.lua`) or a field player (`player.hfsm.lua`) of `dir`, on
     /// the robot of `cfg`.
-    pub fn new(
-        dir: &FilesDir,
-        keeper: bool,
-        cfg: &crate::config::SimConfig,
-    ) -> Result<ChaosBrain, String> {
+    pub fn new(dir: &FilesDir, keeper: bool, cfg: &RobotConfig) -> Result<ChaosBrain, String> {
         let sandbox = Sandbox::default();
         let path = dir.path().to_path_buf();
         let name = if keeper { CHAOS_KEEPER } else { CHAOS_PLAYER };
@@ -228,7 +183,7 @@ impl ChaosBrain {
         });
         Ok(ChaosBrain {
             cap: cap.map_err(|e| e.to_string())?,
-            body: Body::chaos(cfg),
+            body: Commander::chaos(cfg),
             faults: Vec::new(),
             _files: dir.clone(),
         })
@@ -321,7 +276,7 @@ impl MilanBrain {
 impl Brain for MilanBrain {
     fn cycle(&mut self, w: &WorldSnapshot) -> RobotCommand {
         // The game state is the Messenger's: in READY, walk to the kickoff position.
-        if let Some(c) = crate::game::walk_to_kickoff(w) {
+        if let Some(c) = walk_to_kickoff(w) {
             return c;
         }
         let inputs = self.inputs(w);
@@ -344,10 +299,10 @@ impl Brain for MilanBrain {
 /// compiled-in TeamChaos files.
 pub fn team(
     stack: Stack,
-    cfg: &crate::config::SimConfig,
+    cfg: &RobotConfig,
     behaviors: Option<&Path>,
 ) -> Result<Vec<Box<dyn Brain>>, String> {
-    let size = cfg.rules.team_size;
+    let size = cfg.team_size;
     if stack != Stack::Chaos {
         return (0..size).map(|i| Ok(send_brain(stack, i == 0, cfg)? as Box<dyn Brain>)).collect();
     }
@@ -370,7 +325,7 @@ pub fn team(
 pub fn send_brain(
     stack: Stack,
     keeper: bool,
-    cfg: &crate::config::SimConfig,
+    cfg: &RobotConfig,
 ) -> Result<Box<dyn Brain + Send>, String> {
     let field = Geometry::of(&cfg.field);
     match stack {
@@ -379,5 +334,96 @@ pub fn send_brain(
         Stack::Chaos => {
             Err("the Chaos stack runs in a Lua state (ChaosBrain, BehaviorMember)".into())
         }
+    }
+}
+
+/// A simple hand-written player, the baseline: it goes round to a point behind the ball on
+/// the line from the opponent's net, then drives through the ball and kicks when it is lined
+/// up with the net. The goalkeeper (`keeper`) stays on its goal line in front of the ball.
+#[derive(Clone, Debug, Default)]
+pub struct Chaser {
+    /// Plays as goalkeeper.
+    pub keeper: bool,
+    /// The field it plays on.
+    pub field: Geometry,
+}
+
+impl Chaser {
+    /// Velocities towards a target point `(tx, ty)` (team frame, mm), facing `face` (rad).
+    fn go(me: mrt_core::Pose2, (tx, ty): (f64, f64), face: f64, c: &mut RobotCommand) {
+        let (dx, dy) = (tx - me.x, ty - me.y);
+        let err = mrt_core::normalize_angle(face - me.theta);
+        c.vrot = (err.to_degrees() * 3.0).clamp(-200.0, 200.0);
+        // Move in the robot frame (holonomic base): forward and sideways components.
+        let (s, co) = (me.theta.sin(), me.theta.cos());
+        let (fw, left) = (dx * co + dy * s, -dx * s + dy * co);
+        let d = dx.hypot(dy).max(1.0);
+        let speed = (d * 2.0).min(1200.0);
+        c.vlin = fw / d * speed;
+        c.vlat = left / d * speed;
+    }
+}
+
+/// In READY, the command that walks to the kickoff position (guidance's potential-field mode,
+/// round the other robots), watching the ball; `None` in the other states.
+pub fn walk_to_kickoff(w: &WorldSnapshot) -> Option<RobotCommand> {
+    let pose = w.kickoff_pose.filter(|_| w.game_state == GameState::Ready)?;
+    Some(RobotCommand {
+        target: Some(Target { pose, avoid: true }),
+        needs: vec![(lps::BALL, 1.0)],
+        ..RobotCommand::default()
+    })
+}
+
+impl Brain for Chaser {
+    fn cycle(&mut self, w: &WorldSnapshot) -> RobotCommand {
+        if let Some(c) = walk_to_kickoff(w) {
+            return c;
+        }
+        let mut c = RobotCommand::default();
+        let ball = w.lps[lps::BALL];
+        c.needs.push((lps::BALL, 1.0));
+        if ball.reliability < 0.2 {
+            c.vrot = 60.0; // look around
+            return c;
+        }
+        let me = w.my_pos.pose;
+        // Ball in the team frame (mm); x towards the opponent's net at (half length, 0).
+        let (hl, gw) = (self.field.half_length, self.field.goal_half_width);
+        let a = me.theta + ball.theta;
+        let (bx, by) = Geometry::ball_at(me, &ball);
+        if self.keeper {
+            // `validate` keeps goals at least 0.2 m wide; max(0) keeps clamp from panicking.
+            let lim = (gw - 100.0).max(0.0);
+            let target = (-(hl - 300.0), by.clamp(-lim, lim));
+            Chaser::go(me, target, a, &mut c);
+        } else {
+            let behind = self.field.behind_ball((bx, by), 500.0);
+            let shot = behind.theta;
+            let (ux, uy) = (shot.cos(), shot.sin());
+            // Lined up: behind the ball, looking at the net.
+            let (rx, ry) = (bx - me.x, by - me.y);
+            let along = (rx * ux + ry * uy) / rx.hypot(ry).max(1.0);
+            let lined_up = along > 0.9 && ball.rho < 1500.0;
+            if lined_up {
+                Chaser::go(me, (bx + 200.0 * ux, by + 200.0 * uy), shot, &mut c);
+                if ball.rho < 450.0
+                    && ball.theta.abs() < 0.3
+                    && mrt_core::normalize_angle(me.theta - shot).abs() < 0.35
+                {
+                    c.kick = Some(1);
+                }
+            } else {
+                // Go round: to a point behind the ball, stepping aside first when in front.
+                let (mut px, mut py) = (behind.x, behind.y);
+                if along < 0.0 {
+                    let side = if (me.x - bx) * uy - (me.y - by) * ux > 0.0 { 1.0 } else { -1.0 };
+                    px += side * 600.0 * uy;
+                    py -= side * 600.0 * ux;
+                }
+                Chaser::go(me, (px, py), a, &mut c);
+            }
+        }
+        c
     }
 }

@@ -1,0 +1,72 @@
+//! The [`Brain`] of a robot: what turns its world snapshot into a command each cycle (a
+//! behavior stack: Lua HFSM and HBM, Mr. BRIAN, hand-written Rust), and [`BrainMember`], which
+//! puts any `Send` brain on the bus.
+
+use mrt_dcdt::{Context, Member, MemberError, RequestType};
+use mrt_msgs::{RobotCommand, WorldSnapshot};
+
+/// What drives one robot: a behavior stack (Lua HFSM and HBM, Mr. BRIAN, ...).
+pub trait Brain {
+    /// One control cycle.
+    fn cycle(&mut self, world: &WorldSnapshot) -> RobotCommand;
+
+    /// What went wrong since the last call (a script error with its file and line, ...): the
+    /// match books it against the robot. The robot went on (or stood still) regardless.
+    fn take_faults(&mut self) -> Vec<String> {
+        Vec::new()
+    }
+}
+
+/// A robot whose software could not start (a behavior file that does not load, ...): it stands
+/// still for the whole match, and its reason is booked once.
+#[derive(Debug)]
+pub struct Stopped {
+    reason: Option<String>,
+}
+
+impl Stopped {
+    /// A robot stopped for `reason`.
+    pub fn new(reason: impl Into<String>) -> Stopped {
+        Stopped { reason: Some(reason.into()) }
+    }
+}
+
+impl Brain for Stopped {
+    fn cycle(&mut self, _world: &WorldSnapshot) -> RobotCommand {
+        RobotCommand::default()
+    }
+
+    fn take_faults(&mut self) -> Vec<String> {
+        self.reason.take().into_iter().collect()
+    }
+}
+
+/// Runs any `Send` [`Brain`] as a behavior Member: world snapshot in, command out.
+pub struct BrainMember {
+    brain: Box<dyn Brain + Send>,
+    world: Option<WorldSnapshot>,
+}
+
+impl BrainMember {
+    /// A Member around `brain`.
+    pub fn new(brain: Box<dyn Brain + Send>) -> Self {
+        Self { brain, world: None }
+    }
+}
+
+impl Member for BrainMember {
+    fn init(&mut self, ctx: &mut Context<'_>) -> Result<(), MemberError> {
+        ctx.subscribe_to::<WorldSnapshot>(RequestType::Local);
+        Ok(())
+    }
+
+    fn do_your_job(&mut self, ctx: &mut Context<'_>) -> Result<(), MemberError> {
+        while let Some(m) = ctx.receive_msg() {
+            self.world = Some(m.get::<WorldSnapshot>()?.clone());
+        }
+        if let Some(w) = &self.world {
+            ctx.publish(self.brain.cycle(w));
+        }
+        Ok(())
+    }
+}

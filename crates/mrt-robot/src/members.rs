@@ -1,0 +1,360 @@
+//! The robot program: the Members of one robot's cycle, put into its Agora by [`add_robot`]
+//! (DCDT, MRT manual ch. 3; sensing, reasoning and acting modules over one bus, §2.1). The
+//! simulator's in-process match, its distributed match and a real robot (`mrt robot`) all run
+//! these Members; only the [`Devices`] behind the drivers differ.
+//!
+//! 1. **drivers** (periodic, one generic [`Member`] reading one device each): `odometry-<n>`
+//!    publishes the mice's and the wheels' readings since the last cycle ([`Odometry`]),
+//!    `camera-<n>` what the camera (object sensor) sees with the game controller's news
+//!    ([`CameraFrame`]), `sonars-<n>` the sonar ring ([`SonarScan`]);
+//! 2. **`WorldState`** (periodic): fuses odometry and camera into the robot's own pose and LPS
+//!    ([`WorldModel`]), takes its teammates' poses from their reports received over the bus,
+//!    and publishes the [`WorldSnapshot`]; it also publishes a [`MateReport`] (its pose and its
+//!    ball estimate) that the teammates' Agoras receive through their team's link — a
+//!    `RequestType::Remote` subscription, so a robot never hears itself;
+//! 3. **the behaviors**: a [`BehaviorMember`] running the TeamChaos HFSM or goalkeeper for the
+//!    Chaos stack, or a [`BrainMember`] around any `Send` [`Brain`](crate::brain::Brain)
+//!    (Milan, the baseline);
+//! 4. **`Guide`** (guidance, ISocRob §3.2.3, on message): turns the behaviors'
+//!    [`RobotCommand`] into a [`MotorCommand`] with [`mrt_plan::guide::Guidance`]: velocity
+//!    mode halted by the sonars, or position and potential-field modes to a target posture;
+//! 5. **`Motor`** (the motor and kicker driver, on message): turns each [`MotorCommand`] into
+//!    wheel duty cycles (the AIRBoard's processing side, [`Base::duties`]) and kicks;
+//! 6. **`FaultBook`** (on message): books the behavior Member's script errors against the
+//!    robot. A Member that fails to start, fails or panics is restarted by its executor and
+//!    listed by [`member_faults`] when the robot stops.
+//!
+//! Body adaptation is the [`Commander`]'s: on the Chaos robots `WorldState` measures distances
+//! from the robot's edge and `Guide` scales the behaviors' AIBO-sized set-points before
+//! guiding them.
+
+use crate::base::Base;
+use crate::brain::BrainMember;
+use crate::commander::Commander;
+use crate::config::RobotConfig;
+use crate::devices::{Devices, SharedDevices};
+use crate::files::FilesDir;
+use crate::stacks::{embedded_teamchaos, send_brain, Stack, CHAOS_KEEPER, CHAOS_PLAYER};
+use mrt_core::Point2;
+use mrt_dcdt::{Activation, Agora, Context, Member, MemberError, Message, RequestType, RunReport};
+use mrt_msgs::{
+    BehaviorStatus, CameraFrame, MateReport, MemberFault, MotorCommand, Odometry, RobotCommand,
+    Sonar, SonarScan, WorldSnapshot,
+};
+use mrt_plan::guide::Guidance;
+use mrt_script::member::BehaviorMember;
+use mrt_world::{merge_team, WorldModel};
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::sync::MutexGuard;
+
+fn lock(d: &SharedDevices) -> Result<MutexGuard<'_, dyn Devices + 'static>, MemberError> {
+    d.lock().map_err(|_| MemberError::from("the devices lock is poisoned"))
+}
+
+/// A driver Member (MRT manual §2.1: drivers apart from processing): each cycle it reads one
+/// of the robot's devices and publishes what it read. The odometry, camera and sonar drivers
+/// are this one Member with a different reading.
+struct Driver<M> {
+    /// `odometry`, `camera`, `sonars`: the Member is named `<kind>-<robot>`.
+    kind: &'static str,
+    robot: usize,
+    devices: SharedDevices,
+    read: fn(&mut dyn Devices) -> Result<M, String>,
+}
+
+impl<M: Message> Member for Driver<M> {
+    fn name(&self) -> String {
+        format!("{}-{}", self.kind, self.robot)
+    }
+
+    fn do_your_job(&mut self, ctx: &mut Context<'_>) -> Result<(), MemberError> {
+        let reading = (self.read)(&mut *lock(&self.devices)?)?;
+        ctx.publish(reading);
+        Ok(())
+    }
+}
+
+/// The world-state Member of one robot: odometry and camera frames into its [`WorldModel`],
+/// teammates from their reports over the bus; publishes the [`WorldSnapshot`] and its own
+/// [`MateReport`].
+struct WorldState {
+    robot: usize,
+    keeper: bool,
+    body: Commander,
+    model: WorldModel,
+    mates: BTreeMap<u32, MateReport>,
+}
+
+impl Member for WorldState {
+    fn name(&self) -> String {
+        format!("world-state-{}", self.robot)
+    }
+
+    fn init(&mut self, ctx: &mut Context<'_>) -> Result<(), MemberError> {
+        ctx.subscribe_to::<Odometry>(RequestType::Local);
+        ctx.subscribe_to::<CameraFrame>(RequestType::Local);
+        ctx.subscribe_to::<MateReport>(RequestType::Remote);
+        Ok(())
+    }
+
+    fn do_your_job(&mut self, ctx: &mut Context<'_>) -> Result<(), MemberError> {
+        let mut frame = None;
+        while let Some(m) = ctx.receive_msg() {
+            if let Ok(o) = m.get::<Odometry>() {
+                self.model.odometry(o);
+            } else if let Ok(f) = m.get::<CameraFrame>() {
+                frame = Some(f.clone());
+            } else {
+                let r = m.get::<MateReport>()?;
+                self.mates.insert(r.id, *r);
+            }
+        }
+        let Some(frame) = frame else { return Ok(()) };
+        let mut w = self.model.camera(&frame);
+        let id = u32::try_from(self.robot).unwrap_or(u32::MAX);
+        let report = MateReport::of(id, self.keeper, &w);
+        // Teammates and their ball as the bus told them, not as the simulator knows them.
+        merge_team(&mut w, self.mates.values());
+        ctx.publish(report);
+        self.body.perceive(&mut w);
+        ctx.publish(w);
+        Ok(())
+    }
+}
+
+/// Guidance of one robot: the behaviors' command, adapted to the body, through the Guidance
+/// µAgent with the latest world state and sonar scan.
+struct Guide {
+    robot: usize,
+    body: Commander,
+    guidance: Guidance,
+    world: WorldSnapshot,
+    scan: SonarScan,
+}
+
+impl Member for Guide {
+    fn name(&self) -> String {
+        format!("guide-{}", self.robot)
+    }
+
+    fn init(&mut self, ctx: &mut Context<'_>) -> Result<(), MemberError> {
+        ctx.subscribe_to::<RobotCommand>(RequestType::Local);
+        ctx.subscribe_to::<WorldSnapshot>(RequestType::Local);
+        ctx.subscribe_to::<SonarScan>(RequestType::Local);
+        Ok(())
+    }
+
+    fn do_your_job(&mut self, ctx: &mut Context<'_>) -> Result<(), MemberError> {
+        let mut last = None;
+        while let Some(m) = ctx.receive_msg() {
+            if let Ok(c) = m.get::<RobotCommand>() {
+                last = Some(c.clone());
+            } else if let Ok(w) = m.get::<WorldSnapshot>() {
+                self.world.clone_from(w);
+            } else {
+                self.scan.clone_from(m.get::<SonarScan>()?);
+            }
+        }
+        if let Some(mut cmd) = last {
+            self.body.act(&mut cmd);
+            ctx.publish(MotorCommand(guide(&self.guidance, &cmd, &self.world, &self.scan.sonars)));
+        }
+        Ok(())
+    }
+}
+
+/// The motor and kicker driver of one robot: commands become duty cycles for its motor
+/// driver (the processing side of the AIRBoard), kick requests fire the kicker.
+struct Motor {
+    devices: SharedDevices,
+    robot: usize,
+    base: Base,
+}
+
+impl Member for Motor {
+    fn name(&self) -> String {
+        format!("motor-{}", self.robot)
+    }
+
+    fn init(&mut self, ctx: &mut Context<'_>) -> Result<(), MemberError> {
+        ctx.subscribe_to::<MotorCommand>(RequestType::Local);
+        Ok(())
+    }
+
+    fn do_your_job(&mut self, ctx: &mut Context<'_>) -> Result<(), MemberError> {
+        let mut last = None;
+        while let Some(m) = ctx.receive_msg() {
+            last = Some(m.get::<MotorCommand>()?.0.clone());
+        }
+        if let Some(cmd) = last {
+            let mut devices = lock(&self.devices)?;
+            devices.set_duty(&self.base.duties(&cmd))?;
+            if cmd.kick.is_some() {
+                devices.kick()?;
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Books a robot's script errors (its behavior Member's `BehaviorStatus`) against the robot,
+/// as a referee's assistant would note a robot that stopped.
+struct FaultBook {
+    devices: SharedDevices,
+    robot: usize,
+}
+
+impl Member for FaultBook {
+    fn name(&self) -> String {
+        format!("faults-{}", self.robot)
+    }
+
+    fn init(&mut self, ctx: &mut Context<'_>) -> Result<(), MemberError> {
+        ctx.subscribe_to::<BehaviorStatus>(RequestType::Local);
+        Ok(())
+    }
+
+    fn do_your_job(&mut self, ctx: &mut Context<'_>) -> Result<(), MemberError> {
+        while let Some(m) = ctx.receive_msg() {
+            if let Some(e) = m.get::<BehaviorStatus>()?.errors.first() {
+                lock(&self.devices)?.fault(e)?;
+            }
+        }
+        Ok(())
+    }
+}
+
+/// One robot of a match: which robot it is (0 .. 2 × team size: home, then away), whether it
+/// keeps goal and which behavior stack drives it. Its Agora's id is `robot + 1`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct RobotSpec {
+    /// The robot.
+    pub robot: usize,
+    /// Keeps goal (robot 0 of each team).
+    pub keeper: bool,
+    /// What drives it.
+    pub stack: Stack,
+}
+
+impl RobotSpec {
+    /// Robot `robot` of a match with `team_size` robots a side, the home team playing `home`
+    /// and the away team `away`.
+    pub fn of(robot: usize, team_size: usize, (home, away): (Stack, Stack)) -> RobotSpec {
+        let n = team_size.max(1);
+        RobotSpec { robot, keeper: robot % n == 0, stack: if robot < n { home } else { away } }
+    }
+
+    /// The id of the robot's Agora.
+    pub fn agora_id(&self) -> Result<u32, String> {
+        u32::try_from(self.robot + 1).map_err(|e| e.to_string())
+    }
+}
+
+/// Puts one robot's Members into `agora`, activated: the drivers of its `devices`, its world
+/// state, its behaviors (the TeamChaos files of `behaviors` for the Chaos stack), guidance,
+/// motor and fault book (module doc). The same robot code runs on a pitch in this process
+/// (`mrt_sim::bus::BusMatch`), on a simulator in another one ([`crate::remote::RemoteRobot`])
+/// and on a real robot's devices.
+pub fn add_robot(
+    agora: &mut Agora,
+    cfg: &RobotConfig,
+    spec: &RobotSpec,
+    behaviors: &Path,
+    devices: SharedDevices,
+) -> Result<(), String> {
+    let RobotSpec { robot, keeper, stack } = *spec;
+    let every = Activation::Periodic(cfg.period());
+    let body = if stack == Stack::Chaos { Commander::chaos(cfg) } else { Commander::PLAIN };
+    let model = cfg.world_model();
+    let base = cfg.base;
+    let dev = || devices.clone();
+    let odometry: Driver<Odometry> =
+        Driver { kind: "odometry", robot, devices: dev(), read: |d| d.odometry() };
+    let camera: Driver<CameraFrame> =
+        Driver { kind: "camera", robot, devices: dev(), read: |d| d.camera() };
+    let sonars: Driver<SonarScan> = Driver {
+        kind: "sonars",
+        robot,
+        devices: dev(),
+        read: |d| d.sonars().map(|sonars| SonarScan { sonars }),
+    };
+    let mut ids = vec![
+        agora.add_member(odometry, every),
+        agora.add_member(camera, every),
+        agora.add_member(WorldState { robot, keeper, body, model, mates: BTreeMap::new() }, every),
+        agora.add_member(sonars, every),
+    ];
+    ids.push(match stack {
+        Stack::Chaos if keeper => {
+            agora.add_member(BehaviorMember::hbm(behaviors, CHAOS_KEEPER), every)
+        }
+        Stack::Chaos => {
+            agora.add_member(BehaviorMember::hfsm(behaviors, behaviors.join(CHAOS_PLAYER)), every)
+        }
+        other => agora.add_member(BrainMember::new(send_brain(other, keeper, cfg)?), every),
+    });
+    let guidance = cfg.guidance;
+    let scan = SonarScan::default();
+    let guide = Guide { robot, body, guidance, world: WorldSnapshot::default(), scan };
+    ids.push(agora.add_member(guide, Activation::OnMessage));
+    ids.push(agora.add_member(Motor { devices: dev(), robot, base }, Activation::OnMessage));
+    ids.push(agora.add_member(FaultBook { devices, robot }, Activation::OnMessage));
+    for m in ids {
+        agora.activate_member(m).map_err(|e| e.to_string())?;
+    }
+    Ok(())
+}
+
+/// The TeamChaos files robots of `stacks` run: `behaviors`, or the compiled-in ones when the
+/// Chaos stack plays (nothing otherwise).
+/// Keep the handle while the robots may read them: compiled-in files are removed with it.
+pub fn behaviors_dir(stacks: &[Stack], behaviors: Option<&Path>) -> Result<FilesDir, String> {
+    match behaviors {
+        Some(d) => Ok(FilesDir::user(d)),
+        None if stacks.contains(&Stack::Chaos) => embedded_teamchaos(),
+        None => Ok(FilesDir::user(PathBuf::new())),
+    }
+}
+
+/// The faulty Members of one Agora's report: failed starts, jobs and panics, and mailboxes
+/// that lost messages (their bus bounds dropped or refused some: a Member that fell thousands
+/// of messages behind).
+pub fn member_faults(report: &RunReport) -> Vec<MemberFault> {
+    report
+        .members
+        .iter()
+        .flat_map(|m| {
+            let failed = m.last_error.clone().map(|error| MemberFault {
+                name: m.name.clone(),
+                count: m.errors + m.panics + m.restarts.max(1),
+                never_ran: m.cycles == 0,
+                error,
+            });
+            let lost =
+                m.mailboxes.iter().filter(|b| b.dropped + b.refused > 0).map(|b| MemberFault {
+                    name: m.name.clone(),
+                    count: b.dropped + b.refused,
+                    never_ran: false,
+                    error: format!(
+                        "its mailbox for {} dropped {} and refused {} messages (capacity {})",
+                        b.msg_type, b.dropped, b.refused, b.capacity
+                    ),
+                });
+            failed.into_iter().chain(lost)
+        })
+        .collect()
+}
+
+/// Guidance for one robot's cycle: the behaviors' command `cmd`, the world state the robot
+/// believes (its pose, the ball where it is known) and its sonar ring.
+pub fn guide(
+    g: &Guidance,
+    cmd: &RobotCommand,
+    w: &WorldSnapshot,
+    sonars: &[Sonar],
+) -> RobotCommand {
+    let ball = w.global_ball;
+    let ball = (ball.quality >= 0.1).then(|| Point2::new(ball.pose.x, ball.pose.y));
+    g.guide(cmd, &w.my_pos.pose, ball, sonars).command
+}
