@@ -5,8 +5,8 @@ use indicatif::{ProgressBar, ProgressStyle};
 use mrt_robot::stacks::Stack;
 use mrt_sim::config::SimConfig;
 use mrt_sim::game::MatchReport;
+use mrt_sim::play;
 use mrt_sim::referee::{Call, Team};
-use mrt_sim::{play, Wiring};
 use std::path::PathBuf;
 
 /// What `mrt sim` was asked (its command-line options).
@@ -42,14 +42,10 @@ pub struct SimArgs {
     /// Run the TeamChaos behaviors of this directory instead of the built-in ones.
     #[arg(long)]
     pub behaviors: Option<PathBuf>,
-    /// Call the robots' brains directly instead of running each robot as an Agora with
-    /// its Members on the bus (faster; the default shows the real MRT wiring).
-    #[arg(long)]
-    pub direct: bool,
     /// Run each robot's Agora in a process of its own, talking to the simulator and its
     /// teammates over zenoh on loopback (the same match as in one process; see
     /// docs/network.md).
-    #[arg(long, conflicts_with = "direct")]
+    #[arg(long)]
     pub distributed: bool,
     /// With --distributed: kill this robot's process mid-match and start it again at once
     /// (a crash and a supervisor's restart); the report says when it answered again.
@@ -126,8 +122,7 @@ fn play_one(
              (cargo run --release -p mrt-cli -- sim --distributed)"
         );
     }
-    let wiring = if args.direct { Wiring::Direct } else { Wiring::Bus };
-    let report = play(cfg, seed, stacks, wiring, args.behaviors.as_deref(), record, progress)
+    let report = play(cfg, seed, stacks, args.behaviors.as_deref(), record, progress)
         .map_err(|e| anyhow!("{e}"))?;
     Ok((report, Vec::new()))
 }
@@ -136,8 +131,6 @@ fn play_one(
 fn wiring_name(args: &SimArgs) -> &'static str {
     if args.distributed {
         "each robot an Agora in its own process, over zenoh"
-    } else if args.direct {
-        "brains called directly"
     } else {
         "each robot an Agora on the bus"
     }

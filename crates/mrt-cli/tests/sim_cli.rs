@@ -28,8 +28,8 @@ fn a_short_match_reports_score_stats_and_reproduces_from_its_seed() {
     assert!(out.starts_with("milan (home) ") && out.contains("chaos (away)   seed 5"), "{out}");
     assert!(out.contains("possession") && out.contains("40 s of play"), "{out}");
     assert!(out.contains("each robot an Agora on the bus"), "{out}");
-    let (_, direct, _) = run(&["--half", "20", "--seed", "5", "--direct"]);
-    assert!(direct.contains("brains called directly"), "{direct}");
+    let (ok, _, err) = run(&["--half", "20", "--seed", "5", "--direct"]);
+    assert!(!ok && err.contains("--direct"), "the direct wiring is gone: {err}");
     let (_, again, _) = run(&["--half", "20", "--seed", "5"]);
     assert_eq!(hash_of(&out), hash_of(&again), "same seed, same match");
     let (_, other, _) = run(&["--half", "20", "--seed", "6"]);
@@ -176,7 +176,6 @@ fn match_counts_and_seeds_are_range_checked() {
         "chaser",
         "--away",
         "chaser",
-        "--direct",
     ]);
     assert!(ok, "{err}");
     assert!(out.contains("seeds 18446744073709551613..=18446744073709551615"), "{out}");

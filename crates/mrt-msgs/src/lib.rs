@@ -14,6 +14,7 @@
 //! | [`SonarScan`] of [`Sonar`]s | sonar driver → guidance | ISocRob `003` §2, §3.2.3 |
 //! | [`GameInfo`] | game controller → world model | TeamChaos `001` §3.3 (`getCurrentState`) |
 //! | [`MateReport`] | world model → teammates' world models | ISocRob `003` §3.1 |
+//! | [`Localization`] (pose, uncertainty, [`FilterCounts`]) | world model → monitors, recorders | TeamChaos `001` §4.1 |
 //! | [`WorldSnapshot`] | world model → behaviors, guidance | TeamChaos `001` §3.3 (LPS, GS) |
 //! | [`RobotCommand`] | behaviors → guidance | TeamChaos `001` §3.3 |
 //! | [`MotorCommand`] | guidance → motor and kicker driver | ISocRob `003` §3.2.3 |
@@ -39,6 +40,7 @@ mod acting;
 mod behavior;
 mod device;
 pub mod ids;
+mod localization;
 pub mod robot;
 mod sensing;
 mod team;
@@ -46,6 +48,7 @@ mod team;
 pub use acting::MotorCommand;
 pub use behavior::{BehaviorStatus, ReloadRequest};
 pub use device::{DeviceAct, DeviceFrame, FinalWhistle, MemberFault, RobotEnd};
+pub use localization::{FilterCounts, Localization};
 pub use mrt_core::{Message, MsgType};
 pub use robot::{lps, Estimate, Field, GameState, Lpo, Mate, RobotCommand, Target, WorldSnapshot};
 pub use sensing::{
@@ -84,6 +87,7 @@ messages! {
     FinalWhistle => FINAL_WHISTLE,
     RobotEnd => ROBOT_END,
     GameInfo => GAME_INFO,
+    Localization => LOCALIZATION,
 }
 
 #[cfg(test)]

@@ -3,7 +3,7 @@
 //! puts any `Send` brain on the bus.
 
 use mrt_dcdt::{Context, Member, MemberError, RequestType};
-use mrt_msgs::{RobotCommand, WorldSnapshot};
+use mrt_msgs::{BehaviorStatus, RobotCommand, WorldSnapshot};
 
 /// What drives one robot: a behavior stack (Lua HFSM and HBM, Mr. BRIAN, ...).
 pub trait Brain {
@@ -41,7 +41,8 @@ impl Brain for Stopped {
     }
 }
 
-/// Runs any `Send` [`Brain`] as a behavior Member: world snapshot in, command out.
+/// Runs any `Send` [`Brain`] as a behavior Member: world snapshot in, command out, and the
+/// brain's faults as a [`BehaviorStatus`] for the robot's fault book.
 pub struct BrainMember {
     brain: Box<dyn Brain + Send>,
     world: Option<WorldSnapshot>,
@@ -66,6 +67,12 @@ impl Member for BrainMember {
         }
         if let Some(w) = &self.world {
             ctx.publish(self.brain.cycle(w));
+        }
+        // What went wrong, for the fault book (one fault per faulty cycle, named by its first
+        // error, as a behavior Member reports).
+        let errors = self.brain.take_faults();
+        if !errors.is_empty() {
+            ctx.publish(BehaviorStatus { errors, ..BehaviorStatus::default() });
         }
         Ok(())
     }

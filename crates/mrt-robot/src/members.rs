@@ -9,7 +9,8 @@
 //!    ([`CameraFrame`]), `sonars-<n>` the sonar ring ([`SonarScan`]);
 //! 2. **`WorldState`** (periodic): fuses odometry and camera into the robot's own pose and LPS
 //!    ([`WorldModel`]), takes its teammates' poses from their reports received over the bus,
-//!    and publishes the [`WorldSnapshot`]; it also publishes a [`MateReport`] (its pose and its
+//!    and publishes the [`WorldSnapshot`] and, for monitors, its [`Localization`](mrt_msgs::Localization);
+//!    it also publishes a [`MateReport`] (its pose and its
 //!    ball estimate) that the teammates' Agoras receive through their team's link — a
 //!    `RequestType::Remote` subscription, so a robot never hears itself;
 //! 3. **the behaviors**: a [`BehaviorMember`] running the TeamChaos HFSM or goalkeeper for the
@@ -117,6 +118,7 @@ impl Member for WorldState {
         // Teammates and their ball as the bus told them, not as the simulator knows them.
         merge_team(&mut w, self.mates.values());
         ctx.publish(report);
+        ctx.publish(self.model.localization());
         self.body.perceive(&mut w);
         ctx.publish(w);
         Ok(())
@@ -252,10 +254,10 @@ impl RobotSpec {
 }
 
 /// Puts one robot's Members into `agora`, activated: the drivers of its `devices`, its world
-/// state, its behaviors (the TeamChaos files of `behaviors` for the Chaos stack), guidance,
-/// motor and fault book (module doc). The same robot code runs on a pitch in this process
-/// (`mrt_sim::bus::BusMatch`), on a simulator in another one ([`crate::remote::RemoteRobot`])
-/// and on a real robot's devices.
+/// state, its behaviors (the stack of `spec`: the TeamChaos files of `behaviors` for the Chaos
+/// stack), guidance, motor and fault book (module doc). The same robot code runs on a pitch
+/// in this process (`mrt_sim::bus::BusMatch`), on a simulator in another one
+/// ([`crate::remote::RemoteRobot`]) and on a real robot's devices.
 pub fn add_robot(
     agora: &mut Agora,
     cfg: &RobotConfig,
@@ -264,10 +266,45 @@ pub fn add_robot(
     devices: SharedDevices,
 ) -> Result<(), String> {
     let RobotSpec { robot, keeper, stack } = *spec;
+    let (behavior, commander): (Box<dyn Member>, _) = match stack {
+        Stack::Chaos if keeper => {
+            (Box::new(BehaviorMember::hbm(behaviors, CHAOS_KEEPER)), Commander::chaos(cfg))
+        }
+        Stack::Chaos => (
+            Box::new(BehaviorMember::hfsm(behaviors, behaviors.join(CHAOS_PLAYER))),
+            Commander::chaos(cfg),
+        ),
+        other => (Box::new(BrainMember::new(send_brain(other, keeper, cfg)?)), Commander::PLAIN),
+    };
+    add_cycle(agora, cfg, (robot, keeper), behavior, commander, devices)
+}
+
+/// [`add_robot`] with any `Send` [`Brain`](crate::brain::Brain) as the behaviors (a team's
+/// own Rust behaviors, a test's scripted player): the brain adapts itself to the body (its
+/// Commander is [`Commander::PLAIN`]); its faults are booked by the fault book.
+pub fn add_robot_with_brain(
+    agora: &mut Agora,
+    cfg: &RobotConfig,
+    (robot, keeper): (usize, bool),
+    brain: Box<dyn crate::brain::Brain + Send>,
+    devices: SharedDevices,
+) -> Result<(), String> {
+    let behavior = Box::new(BrainMember::new(brain));
+    add_cycle(agora, cfg, (robot, keeper), behavior, Commander::PLAIN, devices)
+}
+
+/// **The robot cycle**, defined once: the Members of robot `robot` in their order, each with
+/// its activation (module doc). Every wiring runs it: the simulator's in-process match, its
+/// distributed match and `mrt robot` on a real robot's devices.
+fn add_cycle(
+    agora: &mut Agora,
+    cfg: &RobotConfig,
+    (robot, keeper): (usize, bool),
+    behavior: Box<dyn Member>,
+    commander: Commander,
+    devices: SharedDevices,
+) -> Result<(), String> {
     let every = Activation::Periodic(cfg.period());
-    let body = if stack == Stack::Chaos { Commander::chaos(cfg) } else { Commander::PLAIN };
-    let model = cfg.world_model();
-    let base = cfg.base;
     let dev = || devices.clone();
     let odometry: Driver<Odometry> =
         Driver { kind: "odometry", robot, devices: dev(), read: |d| d.odometry() };
@@ -279,27 +316,30 @@ pub fn add_robot(
         devices: dev(),
         read: |d| d.sonars().map(|sonars| SonarScan { sonars }),
     };
-    let mut ids = vec![
+    let world = WorldState {
+        robot,
+        keeper,
+        body: commander,
+        model: cfg.world_model(),
+        mates: BTreeMap::new(),
+    };
+    let guide = Guide {
+        robot,
+        body: commander,
+        guidance: cfg.guidance,
+        world: WorldSnapshot::default(),
+        scan: SonarScan::default(),
+    };
+    let ids = [
         agora.add_member(odometry, every),
         agora.add_member(camera, every),
-        agora.add_member(WorldState { robot, keeper, body, model, mates: BTreeMap::new() }, every),
+        agora.add_member(world, every),
         agora.add_member(sonars, every),
+        agora.add_boxed_member(behavior, every),
+        agora.add_member(guide, Activation::OnMessage),
+        agora.add_member(Motor { devices: dev(), robot, base: cfg.base }, Activation::OnMessage),
+        agora.add_member(FaultBook { devices, robot }, Activation::OnMessage),
     ];
-    ids.push(match stack {
-        Stack::Chaos if keeper => {
-            agora.add_member(BehaviorMember::hbm(behaviors, CHAOS_KEEPER), every)
-        }
-        Stack::Chaos => {
-            agora.add_member(BehaviorMember::hfsm(behaviors, behaviors.join(CHAOS_PLAYER)), every)
-        }
-        other => agora.add_member(BrainMember::new(send_brain(other, keeper, cfg)?), every),
-    });
-    let guidance = cfg.guidance;
-    let scan = SonarScan::default();
-    let guide = Guide { robot, body, guidance, world: WorldSnapshot::default(), scan };
-    ids.push(agora.add_member(guide, Activation::OnMessage));
-    ids.push(agora.add_member(Motor { devices: dev(), robot, base }, Activation::OnMessage));
-    ids.push(agora.add_member(FaultBook { devices, robot }, Activation::OnMessage));
     for m in ids {
         agora.activate_member(m).map_err(|e| e.to_string())?;
     }

@@ -301,10 +301,10 @@ pub fn team(
     stack: Stack,
     cfg: &RobotConfig,
     behaviors: Option<&Path>,
-) -> Result<Vec<Box<dyn Brain>>, String> {
+) -> Result<Vec<Box<dyn Brain + Send>>, String> {
     let size = cfg.team_size;
     if stack != Stack::Chaos {
-        return (0..size).map(|i| Ok(send_brain(stack, i == 0, cfg)? as Box<dyn Brain>)).collect();
+        return (0..size).map(|i| send_brain(stack, i == 0, cfg)).collect();
     }
     let dir = match behaviors {
         Some(d) => FilesDir::user(d),
@@ -313,7 +313,7 @@ pub fn team(
     // A robot whose behaviors do not load stands still and is reported; the match goes on.
     Ok((0..size)
         .map(|i| match ChaosBrain::new(&dir, i == 0, cfg) {
-            Ok(b) => Box::new(b) as Box<dyn Brain>,
+            Ok(b) => Box::new(b) as Box<dyn Brain + Send>,
             Err(e) => Box::new(Stopped::new(e)),
         })
         .collect())

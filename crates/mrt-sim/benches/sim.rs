@@ -1,17 +1,16 @@
 //! The simulator's hot paths: one physics step with eight robots, one control cycle of a match
-//! (eight object-sensor looks, eight brains, ten physics steps), and whole short matches: the
-//! full-stack default (Milan on Mr. BRIAN against Chaos on Lua, each robot an Agora on the bus)
-//! and the direct wiring. Speed as times real time = 60 s / the match's time.
+//! (eight robot programs on the bus, ten physics steps), and whole short matches: the
+//! full-stack default (Milan on Mr. BRIAN against Chaos on Lua), each robot an Agora running the
+//! robot program on the bus. Speed as times real time = 60 s / the match's time.
 //!
 //! Run: `cargo bench -p mrt-sim`. Results go to `docs/performance.md`.
 #![allow(missing_docs, clippy::unwrap_used)]
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use mrt_robot::stacks::{team, Stack};
+use mrt_sim::bus::BusMatch;
 use mrt_sim::config::SimConfig;
-use mrt_sim::game::Match;
 use mrt_sim::world::{Drive, World};
-use mrt_sim::Wiring;
 use std::time::Duration;
 
 fn bench(c: &mut Criterion) {
@@ -32,14 +31,8 @@ fn bench(c: &mut Criterion) {
         ("milan_vs_chaos", Stack::Milan, Stack::Chaos),
     ];
     for (name, home, away) in stacks {
-        let mut m = Match::new(
-            &cfg,
-            1,
-            team(home, &cfg.robot().unwrap(), None).unwrap(),
-            team(away, &cfg.robot().unwrap(), None).unwrap(),
-        )
-        .unwrap();
-        c.bench_function(&format!("control_cycle_{name}"), |b| b.iter(|| m.cycle()));
+        let mut m = BusMatch::new(&cfg, 1, home, Some(away), None).unwrap();
+        c.bench_function(&format!("control_cycle_{name}"), |b| b.iter(|| m.cycle().unwrap()));
     }
 
     let mut short = SimConfig::default();
@@ -48,26 +41,22 @@ fn bench(c: &mut Criterion) {
     g.sample_size(10);
     g.bench_function("chaos_vs_chaser", |b| {
         b.iter(|| {
-            let m = Match::new(
-                &short,
-                1,
-                team(Stack::Chaos, &short.robot().unwrap(), None).unwrap(),
-                team(Stack::Chaser, &short.robot().unwrap(), None).unwrap(),
-            )
-            .unwrap();
-            m.play(f64::MAX, |_| {})
+            let stacks = (Stack::Chaos, Stack::Chaser);
+            mrt_sim::play(&short, 1, stacks, None, false, |_| {}).unwrap()
         })
     });
-    g.bench_function("milan_vs_chaos_direct", |b| {
+    g.bench_function("chaos_vs_chaser_brains", |b| {
         b.iter(|| {
-            let stacks = (Stack::Milan, Stack::Chaos);
-            mrt_sim::play(&short, 1, stacks, Wiring::Direct, None, false, |_| {}).unwrap()
+            let robot = short.robot().unwrap();
+            let home = team(Stack::Chaos, &robot, None).unwrap();
+            let away = team(Stack::Chaser, &robot, None).unwrap();
+            BusMatch::with_brains(&short, 1, home, away).unwrap().play(|_| {}).unwrap()
         })
     });
     g.bench_function("milan_vs_chaos_bus", |b| {
         b.iter(|| {
             let stacks = (Stack::Milan, Stack::Chaos);
-            mrt_sim::play(&short, 1, stacks, Wiring::Bus, None, false, |_| {}).unwrap()
+            mrt_sim::play(&short, 1, stacks, None, false, |_| {}).unwrap()
         })
     });
     g.finish();

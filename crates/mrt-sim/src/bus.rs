@@ -7,14 +7,20 @@
 //! [`InnerLinkManager`]. Members that failed to start, failed or panicked are restarted by the
 //! executor and booked against their robot when the match ends ([`MatchReport::faults`]).
 
+use crate::config::SimConfig;
 use crate::devices::PitchDevices;
 use crate::game::{MatchReport, Pitch};
 use crate::referee::Call;
 use mrt_core::SimClock;
 use mrt_dcdt::{InnerLinkManager, SteppedExecutor};
 use mrt_msgs::MemberFault;
+use mrt_robot::brain::Brain;
+use mrt_robot::config::RobotConfig;
+use mrt_robot::devices::SharedDevices;
 use mrt_robot::files::FilesDir;
-use mrt_robot::members::{add_robot, behaviors_dir, member_faults, RobotSpec};
+use mrt_robot::members::{
+    add_robot, add_robot_with_brain, behaviors_dir, member_faults, RobotSpec,
+};
 use mrt_robot::stacks::Stack;
 use std::path::Path;
 use std::sync::{Arc, Mutex, MutexGuard};
@@ -52,38 +58,83 @@ impl BusMatch {
     /// A match between two stacks, `team_size` robots each (robot 0 keeps goal), or home alone
     /// when `away` is `None`. `behaviors` overrides the compiled-in TeamChaos files.
     pub fn new(
-        cfg: &crate::config::SimConfig,
+        cfg: &SimConfig,
         seed: u64,
         home: Stack,
         away: Option<Stack>,
         behaviors: Option<&Path>,
     ) -> Result<BusMatch, String> {
         let n = cfg.rules.team_size;
-        let robot_cfg = cfg.robot()?;
-        let pitch = Pitch::new(cfg, seed, n, if away.is_some() { n } else { 0 })?;
-        let pitch = Arc::new(Mutex::new(pitch));
-        let period = Duration::from_secs_f64(cfg.rules.control_period);
-        let mut exec = SteppedExecutor::new(SimClock::new(), period);
         let stacks: Vec<Stack> = [Some(home), away].into_iter().flatten().collect();
         let dir = behaviors_dir(&stacks, behaviors)?;
+        let files = dir.clone();
+        let teams = (n, if away.is_some() { n } else { 0 });
+        BusMatch::build(cfg, seed, teams, files, |agora, robot_cfg, robot, devices| {
+            let spec = RobotSpec::of(robot, n, (home, away.unwrap_or(home)));
+            add_robot(agora, robot_cfg, &spec, &dir, devices)
+        })
+    }
+
+    /// A match whose robots run the given brains (home's, then away's; robot 0 of each team
+    /// keeps goal; an empty `away` leaves home alone on the field) in the same robot cycle as
+    /// the stacks: a team's own Rust behaviors, or a test's scripted players.
+    pub fn with_brains(
+        cfg: &SimConfig,
+        seed: u64,
+        home: Vec<Box<dyn Brain + Send>>,
+        away: Vec<Box<dyn Brain + Send>>,
+    ) -> Result<BusMatch, String> {
+        let teams = (home.len(), away.len());
+        let n = cfg.rules.team_size.max(1);
+        let mut brains = home.into_iter().chain(away);
+        let files = FilesDir::user(std::path::PathBuf::new());
+        BusMatch::build(cfg, seed, teams, files, |agora, robot_cfg, robot, devices| {
+            let brain = brains.next().ok_or("more robots than brains")?;
+            add_robot_with_brain(agora, robot_cfg, (robot, robot % n == 0), brain, devices)
+        })
+    }
+
+    /// The pitch with `home` and `away` robots, each an Agora of the robot program that `add`
+    /// puts in (robot number, its devices); each team on its own link.
+    fn build(
+        cfg: &SimConfig,
+        seed: u64,
+        (home, away): (usize, usize),
+        files: FilesDir,
+        mut add: impl FnMut(
+            &mut mrt_dcdt::Agora,
+            &RobotConfig,
+            usize,
+            SharedDevices,
+        ) -> Result<(), String>,
+    ) -> Result<BusMatch, String> {
+        let robot_cfg = cfg.robot()?;
+        let pitch = Arc::new(Mutex::new(Pitch::new(cfg, seed, home, away)?));
+        let period = robot_cfg.period();
+        let mut exec = SteppedExecutor::new(SimClock::new(), period);
         let mut links = Vec::new();
-        for _ in &stacks {
+        for size in [home, away].into_iter().filter(|&n| n > 0) {
             let team_link = InnerLinkManager::new();
             links.push(team_link.clone());
-            for _ in 0..n {
+            for _ in 0..size {
                 let robot = exec.agoras().count();
-                let spec = RobotSpec::of(robot, n, (home, away.unwrap_or(home)));
+                let id = u32::try_from(robot + 1).map_err(|e| e.to_string())?;
                 let mut agora = exec
-                    .agora_builder(spec.agora_id()?)
+                    .agora_builder(id)
                     .inner_link(&team_link)
                     .build()
                     .map_err(|e| e.to_string())?;
                 let devices = Arc::new(Mutex::new(PitchDevices::new(pitch.clone(), robot)?));
-                add_robot(&mut agora, &robot_cfg, &spec, &dir, devices)?;
+                add(&mut agora, &robot_cfg, robot, devices)?;
                 exec.add_agora(agora).map_err(|e| e.to_string())?;
             }
         }
-        Ok(BusMatch { pitch, exec, period, links, _files: dir })
+        Ok(BusMatch { pitch, exec, period, links, _files: files })
+    }
+
+    /// The pitch (the world, the referee, the book), between cycles.
+    pub fn pitch(&self) -> Result<MutexGuard<'_, Pitch>, String> {
+        lock_pitch(&self.pitch)
     }
 
     /// A team's community of Agoras (0 home, 1 away), to attach monitors to.
@@ -112,8 +163,25 @@ impl BusMatch {
     }
 
     /// Plays until the end, calling `progress` with the simulated time after each cycle.
-    pub fn play(mut self, mut progress: impl FnMut(f64)) -> Result<MatchReport, String> {
-        while !lock_pitch(&self.pitch)?.finished() {
+    pub fn play(self, progress: impl FnMut(f64)) -> Result<MatchReport, String> {
+        self.play_until(f64::INFINITY, progress)
+    }
+
+    /// Plays until the end or until `max_seconds` of simulated time, calling `progress` with
+    /// the simulated time after each cycle.
+    pub fn play_until(
+        mut self,
+        max_seconds: f64,
+        mut progress: impl FnMut(f64),
+    ) -> Result<MatchReport, String> {
+        loop {
+            let (over, time) = {
+                let p = lock_pitch(&self.pitch)?;
+                (p.finished(), p.world().time())
+            };
+            if over || time >= max_seconds {
+                break;
+            }
             self.cycle()?;
             progress(lock_pitch(&self.pitch)?.world().time());
         }
@@ -194,25 +262,30 @@ mod tests {
         assert!(faults[0].error.contains("dropped 3 and refused 1"), "{}", faults[0].error);
     }
 
-    /// The same robot code gives the same match whether the brains run as Members on the bus
-    /// or are called directly (teammates' reports included: the direct wiring hands them over
-    /// with the bus's timing).
+    /// A stack gives the same match whether it runs as its own Members (the TeamChaos
+    /// behavior Member) or as a brain in a `BrainMember` (`ChaosBrain`): the robot cycle
+    /// around it is the same.
     #[test]
-    fn the_bus_and_the_direct_wiring_play_the_same_match() {
+    fn a_stack_plays_the_same_match_as_members_and_as_brains() {
         let cfg = short(15.0, 2);
-        let bus = BusMatch::new(&cfg, 9, Stack::Chaos, Some(Stack::Chaser), None)
+        let members = BusMatch::new(&cfg, 9, Stack::Chaos, Some(Stack::Chaser), None)
             .unwrap()
             .play(|_| {})
             .unwrap();
-        let home = mrt_robot::stacks::team(Stack::Chaos, &cfg.robot().unwrap(), None).unwrap();
-        let away = mrt_robot::stacks::team(Stack::Chaser, &cfg.robot().unwrap(), None).unwrap();
-        let direct = crate::game::Match::new(&cfg, 9, home, away).unwrap().play(f64::MAX, |_| {});
-        assert_eq!((bus.score, bus.trajectory_hash), (direct.score, direct.trajectory_hash));
+        let robot = cfg.robot().unwrap();
+        let home = mrt_robot::stacks::team(Stack::Chaos, &robot, None).unwrap();
+        let away = mrt_robot::stacks::team(Stack::Chaser, &robot, None).unwrap();
+        let brains = BusMatch::with_brains(&cfg, 9, home, away).unwrap().play(|_| {}).unwrap();
+        assert_eq!(
+            (members.score, members.trajectory_hash),
+            (brains.score, brains.trajectory_hash)
+        );
     }
 
     /// Bad behavior files never stop a match: a file that does not compile stops the robots
     /// that load it (they stand still), a behavior that runs away is cut off by its budget;
-    /// both are reported with the file and line, on the bus and in the direct wiring.
+    /// both are reported with the file and line, whether the stack runs as its Members or as
+    /// brains.
     #[test]
     fn broken_or_runaway_behaviors_stop_their_robot_and_are_reported() {
         let tmp = std::env::temp_dir().join(format!("mrt-sim-broken-{}", std::process::id()));
@@ -237,11 +310,11 @@ mod tests {
             .unwrap()
             .play(|_| {})
             .unwrap();
-        let home =
-            mrt_robot::stacks::team(Stack::Chaos, &cfg.robot().unwrap(), Some(&broken)).unwrap();
-        let away = mrt_robot::stacks::team(Stack::Chaser, &cfg.robot().unwrap(), None).unwrap();
-        let direct = crate::game::Match::new(&cfg, 1, home, away).unwrap().play(f64::MAX, |_| {});
-        for r in [&bus, &direct] {
+        let robot = cfg.robot().unwrap();
+        let home = mrt_robot::stacks::team(Stack::Chaos, &robot, Some(&broken)).unwrap();
+        let away = mrt_robot::stacks::team(Stack::Chaser, &robot, None).unwrap();
+        let brains = BusMatch::with_brains(&cfg, 1, home, away).unwrap().play(|_| {}).unwrap();
+        for r in [&bus, &brains] {
             assert!((r.duration - 10.0).abs() < 0.011, "the match went on: {}", r.duration);
             let robots: Vec<usize> = r.faults.iter().map(|f| f.robot).collect();
             assert_eq!(robots, [0, 1], "{:?}", r.faults);

@@ -1,23 +1,19 @@
-//! A match: the world, the referee, and one [`Brain`] per robot, stepped in lockstep on
-//! simulated time so that the same seed gives the same match.
+//! The physical side of a match ([`Pitch`]): the world, the referee, the robots' sensors with
+//! their random streams, and the book (statistics, trajectory hash, calls, frames, faults),
+//! stepped in lockstep on simulated time so that the same seed gives the same match.
 //!
-//! Every control period (100 ms by default) each robot looks through its object sensor, its
-//! brain turns the [`WorldSnapshot`] into a [`RobotCommand`], and the command drives the robot
-//! (mm/s and deg/s in the command, as the behaviors write them); then the physics runs until the
-//! next control period, with the referee watching every step.
+//! Every control period (100 ms by default) each robot's program runs on its devices (see
+//! [`crate::bus`]); then the physics runs until the next control period, with the referee
+//! watching every step.
 
 use crate::config::SimConfig;
 use crate::referee::{Call, Referee, Team};
 use crate::sensor::{self, sonar_ring, Odometer};
 use crate::world::{Drive, World};
-use mrt_msgs::robot::{GameState, RobotCommand, WorldSnapshot};
+use mrt_msgs::robot::{GameState, RobotCommand};
 use mrt_msgs::Sonar;
-use mrt_msgs::{CameraFrame, MateReport, Odometry};
-use mrt_plan::guide::Guidance;
+use mrt_msgs::{CameraFrame, Odometry};
 use mrt_robot::base::Base;
-use mrt_robot::brain::Brain;
-use mrt_robot::members::guide;
-use mrt_world::{merge_team, WorldModel};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 
@@ -85,14 +81,10 @@ pub struct MatchReport {
 pub struct Pitch {
     cfg: SimConfig,
     base: Base,
-    guidance: Guidance,
     seed: u64,
     world: World,
     referee: Referee,
     odometers: Vec<Odometer>,
-    /// The robots' world models, for the direct wiring (on the bus each robot has its own).
-    minds: Vec<WorldModel>,
-    fresh_mind: WorldModel,
     rngs: Vec<ChaCha8Rng>,
     stats: [TeamStats; 2],
     hash: u64,
@@ -139,17 +131,13 @@ impl Pitch {
             })
             .collect();
         let mice = cfg.odometry.mice()?;
-        let model = cfg.robot()?.world_model();
         Ok(Pitch {
             cfg: cfg.clone(),
             base: Base::parse(&cfg.robot.base)?,
-            guidance: cfg.guidance()?,
             seed,
             world,
             referee,
             odometers: (0..robots).map(|i| Odometer::new(i, mice)).collect(),
-            minds: vec![model.clone(); robots],
-            fresh_mind: model,
             rngs,
             stats: Default::default(),
             hash: FNV_OFFSET,
@@ -194,34 +182,9 @@ impl Pitch {
         sensor::look(&self.world, &self.referee, i, &self.cfg.sensor, &mut self.rngs[i])
     }
 
-    /// A robot's world model as it starts a match: the field map, the mice's geometry and the
-    /// camera's noise from the configuration, the pose unknown until it is put down.
-    pub fn world_model(&self) -> WorldModel {
-        self.fresh_mind.clone()
-    }
-
-    /// Robot `i` reads its odometry and camera into its world model (direct wiring): the
-    /// snapshot its behaviors see.
-    pub fn look(&mut self, i: usize) -> WorldSnapshot {
-        let odometry = self.odometry(i);
-        let frame = self.camera(i);
-        self.minds[i].odometry(&odometry);
-        self.minds[i].camera(&frame)
-    }
-
-    /// Robot `i`'s world model in the direct wiring.
-    pub fn mind(&self, i: usize) -> Option<&WorldModel> {
-        self.minds.get(i)
-    }
-
     /// Robot `i`'s sonar ring listens once (after [`Pitch::camera`] in a cycle).
     pub fn sonar(&mut self, i: usize) -> Vec<Sonar> {
         sonar_ring(&self.world, i, &self.cfg.sonar, &mut self.rngs[i])
-    }
-
-    /// The robots' Guidance µAgent.
-    pub fn guidance(&self) -> Guidance {
-        self.guidance
     }
 
     /// Books a fault of robot `i`'s software now (`count` of them, the first one's `message`).
@@ -239,13 +202,6 @@ impl Pitch {
         tracing::warn!(robot = i, "robot {i}: {message}");
         self.faults.push(RobotFault { robot: i, first_at, count, message: message.to_string() });
         self.faults.sort_by_key(|f| f.robot);
-    }
-
-    /// What robot `i` tells its teammates about its snapshot `w` (robot 0 of each team keeps
-    /// goal).
-    pub fn mate_report(&self, i: usize, w: &WorldSnapshot) -> MateReport {
-        let keeper = i % self.cfg.rules.team_size.max(1) == 0;
-        MateReport::of(u32::try_from(i).unwrap_or(u32::MAX), keeper, w)
     }
 
     /// The robots' base (kinematics and wheel limits).
@@ -359,99 +315,22 @@ impl Pitch {
     }
 }
 
-/// A match whose robots' brains are called directly, in order (the fast mode; see
-/// [`crate::bus`] for robots as Agoras on the bus).
-pub struct Match {
-    pitch: Pitch,
-    brains: Vec<Box<dyn Brain>>,
-    /// Each robot's latest report to its teammates.
-    reports: Vec<Option<MateReport>>,
-}
-
-impl Match {
-    /// A match between `home` and `away` (each `cfg.rules.team_size` brains; the first is
-    /// the goalkeeper; an empty `away` leaves home alone on the field), with all randomness
-    /// drawn from `seed`.
-    pub fn new(
-        cfg: &SimConfig,
-        seed: u64,
-        home: Vec<Box<dyn Brain>>,
-        away: Vec<Box<dyn Brain>>,
-    ) -> Result<Match, String> {
-        let pitch = Pitch::new(cfg, seed, home.len(), away.len())?;
-        let brains: Vec<_> = home.into_iter().chain(away).collect();
-        Ok(Match { pitch, reports: vec![None; brains.len()], brains })
-    }
-
-    /// Keeps one [`Frame`] per control cycle for drawings.
-    pub fn record_frames(&mut self, on: bool) {
-        self.pitch.record_frames(on);
-    }
-
-    /// The world.
-    pub fn world(&self) -> &World {
-        self.pitch.world()
-    }
-
-    /// The referee.
-    pub fn referee(&self) -> &Referee {
-        self.pitch.referee()
-    }
-
-    /// Whether the match is over.
-    pub fn finished(&self) -> bool {
-        self.pitch.finished()
-    }
-
-    /// Runs one control cycle and the physics up to the next one. Returns the referee's calls.
-    ///
-    /// Teammates' reports reach a robot as they would on the bus: those of the robots before
-    /// it in this cycle, those of the robots after it from the previous cycle.
-    pub fn cycle(&mut self) -> Vec<Call> {
-        for i in 0..self.brains.len() {
-            let mut snapshot = self.pitch.look(i);
-            let own = self.pitch.mate_report(i, &snapshot);
-            let referee = self.pitch.referee();
-            let team = referee.team_of(i);
-            let mates = self
-                .reports
-                .iter()
-                .enumerate()
-                .filter(|(j, _)| *j != i && referee.team_of(*j) == team)
-                .filter_map(|(_, r)| r.as_ref());
-            merge_team(&mut snapshot, mates);
-            self.reports[i] = Some(own);
-            let sonars = self.pitch.sonar(i);
-            let cmd = self.brains[i].cycle(&snapshot);
-            for fault in self.brains[i].take_faults() {
-                self.pitch.fault(i, 1, &fault);
-            }
-            let cmd = guide(&self.pitch.guidance(), &cmd, &snapshot, &sonars);
-            self.pitch.apply(i, &cmd);
-        }
-        self.pitch.advance()
-    }
-
-    /// Plays until the end (or until `max_seconds` of simulated time), calling `progress` with
-    /// the simulated time after each control cycle.
-    pub fn play(mut self, max_seconds: f64, mut progress: impl FnMut(f64)) -> MatchReport {
-        while !self.finished() && self.world().time() < max_seconds {
-            self.cycle();
-            progress(self.world().time());
-        }
-        self.pitch.report()
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-
+    use crate::bus::BusMatch;
+    use mrt_dcdt::{Activation, Context, Member, MemberError, RequestType};
+    use mrt_msgs::Localization;
+    use mrt_msgs::WorldSnapshot;
+    use mrt_robot::brain::Brain;
     use mrt_robot::stacks::{team, Chaser, Stack};
+    use std::sync::{Arc, Mutex};
 
-    fn chasers(n: usize) -> Vec<Box<dyn Brain>> {
+    fn chasers(n: usize) -> Vec<Box<dyn Brain + Send>> {
         (0..n)
-            .map(|i| Box::new(Chaser { keeper: i == 0, ..Chaser::default() }) as Box<dyn Brain>)
+            .map(|i| {
+                Box::new(Chaser { keeper: i == 0, ..Chaser::default() }) as Box<dyn Brain + Send>
+            })
             .collect()
     }
 
@@ -462,61 +341,101 @@ mod tests {
         cfg
     }
 
+    /// A brain that always asks for the same command.
+    struct Always(RobotCommand);
+    impl Brain for Always {
+        fn cycle(&mut self, _: &WorldSnapshot) -> RobotCommand {
+            self.0.clone()
+        }
+    }
+
     /// Velocity mode in the simulator: a robot driven straight at the north wall (at y = 7 m,
-    /// the field's 6 m plus the 1 m border) at 0.4 m/s from 1 m away. Through guidance, its
-    /// sonars halt it when the wall is 0.35 m from its centre; braking (0.4² / (2 · 2) = 0.04
-    /// m) and one control period of delay (0.04 m) leave it short of the wall. Without
-    /// guidance it drives into the wall. The sonars hear through the simulator's ray casts and
-    /// noise; READY lets robots move.
+    /// the field's 6 m plus the 1 m border) at 0.4 m/s from 1 m away. Through guidance (the
+    /// robot program's cycle), its sonars halt it when the wall is 0.35 m from its centre;
+    /// braking (0.4² / (2 · 2) = 0.04 m) and one control period of delay (0.04 m) leave it
+    /// short of the wall. Without guidance (the command applied straight to the motors) it
+    /// drives into the wall. The sonars hear through the simulator's ray casts and noise;
+    /// READY lets robots move.
     #[test]
     fn guidance_halts_a_robot_before_the_wall_and_without_it_the_robot_hits() {
         let mut cfg = SimConfig::default();
         cfg.rules.ready_duration = 100.0;
         cfg.rules.team_size = 2;
-        let drive = |guided: bool| {
-            let mut pitch = Pitch::new(&cfg, 1, 2, 2).unwrap();
-            pitch
-                .world
-                .place_robot(1, mrt_core::Pose2::new(3.0, 5.75, std::f64::consts::FRAC_PI_2));
-            let go = RobotCommand { vlin: 400.0, ..RobotCommand::default() };
-            let mut closest = f64::INFINITY;
-            for _ in 0..40 {
-                let w = pitch.look(1);
-                let sonars = pitch.sonar(1);
-                assert_eq!(sonars.len(), 16);
-                let cmd =
-                    if guided { guide(&pitch.guidance(), &go, &w, &sonars) } else { go.clone() };
-                pitch.apply(1, &cmd);
-                pitch.advance();
-                let edge = 7.0 - pitch.world().robot(1).unwrap().y - cfg.robot.radius;
-                closest = closest.min(edge);
-            }
-            closest
-        };
-        let guided = drive(true);
+        let start = mrt_core::Pose2::new(3.0, 5.75, std::f64::consts::FRAC_PI_2);
+        let go = RobotCommand { vlin: 400.0, ..RobotCommand::default() };
+        let edge = |p: &Pitch| 7.0 - p.world().robot(1).unwrap().y - cfg.robot.radius;
+        // Guided: the robot's own cycle, on the bus.
+        let stand = || Box::new(Always(RobotCommand::default())) as Box<dyn Brain + Send>;
+        let home = vec![stand(), Box::new(Always(go.clone())) as Box<dyn Brain + Send>];
+        let mut m = BusMatch::with_brains(&cfg, 1, home, vec![stand(), stand()]).unwrap();
+        m.pitch().unwrap().world.place_robot(1, start);
+        let mut guided = f64::INFINITY;
+        for _ in 0..40 {
+            m.cycle().unwrap();
+            guided = guided.min(edge(&m.pitch().unwrap()));
+        }
+        // Unguided: the same command straight to the motors.
+        let mut pitch = Pitch::new(&cfg, 1, 2, 2).unwrap();
+        pitch.world.place_robot(1, start);
+        let mut unguided = f64::INFINITY;
+        for _ in 0..40 {
+            assert_eq!(pitch.sonar(1).len(), 16);
+            pitch.apply(1, &go);
+            pitch.advance();
+            unguided = unguided.min(edge(&pitch));
+        }
         assert!(guided > 0.01 && guided < 0.1, "stopped short of the wall: {guided} m");
-        assert!(drive(false) < 0.005, "without guidance it reaches the wall");
+        assert!(unguided < 0.005, "without guidance it reaches the wall: {unguided} m");
+    }
+
+    /// Keeps every robot's `Localization` of the current cycle (a monitor on a team's link).
+    struct Monitor(Arc<Mutex<Vec<(u32, Localization)>>>);
+    impl Member for Monitor {
+        fn init(&mut self, ctx: &mut Context<'_>) -> Result<(), MemberError> {
+            ctx.subscribe_to::<Localization>(RequestType::Remote);
+            Ok(())
+        }
+        fn do_your_job(&mut self, ctx: &mut Context<'_>) -> Result<(), MemberError> {
+            while let Some(m) = ctx.receive_msg() {
+                let robot = m.header().agora_id.0 - 1;
+                let l = *m.get::<Localization>()?;
+                self.0.lock().map_err(|_| "poisoned")?.push((robot, l));
+            }
+            Ok(())
+        }
     }
 
     /// Issue 6 item 4: each robot's world state fuses its own odometry and sightings; the
     /// simulator's truth never reaches it. Over a 4 v 4 match of two 1-minute halves (with a
     /// half-time side change, robots put down by hand at the start), every robot's own pose
-    /// estimate is compared with the truth every cycle.
+    /// estimate (its `Localization` on the bus) is compared with the truth every cycle.
     #[test]
     fn robots_know_where_they_are_from_odometry_and_landmarks() {
         let cfg = short(1.0, 4);
-        let mut m = Match::new(&cfg, 3, chasers(4), chasers(4)).unwrap();
+        let mut m = BusMatch::with_brains(&cfg, 3, chasers(4), chasers(4)).unwrap();
+        let heard = Arc::new(Mutex::new(Vec::new()));
+        for (team, id) in [(0, 90), (1, 91)] {
+            let link = m.team_link(team).cloned().unwrap();
+            let mut agora = m.executor().agora_builder(id).inner_link(&link).build().unwrap();
+            let monitor = agora.add_member(Monitor(heard.clone()), Activation::OnMessage);
+            agora.activate_member(monitor).unwrap();
+            m.executor().add_agora(agora).unwrap();
+        }
         let (mut errors, mut headings, mut qualities) = (Vec::new(), Vec::new(), Vec::new());
-        while !m.finished() {
+        let mut last = vec![Localization::default(); 8];
+        while !m.pitch().unwrap().finished() {
             // The estimate is of the pose when the sensors were read: at the cycle's start.
-            let before: Vec<_> = (0..8).map(|i| m.world().robot(i)).collect();
-            m.cycle();
-            for (i, truth) in before.into_iter().enumerate() {
-                let (Some(mind), Some(truth)) = (m.pitch.mind(i), truth) else { continue };
-                let p = mind.pose();
-                errors.push((p.x - truth.x).hypot(p.y - truth.y));
-                headings.push(mrt_core::normalize_angle(p.theta - truth.theta).abs());
-                qualities.push(mind.quality());
+            let before: Vec<_> = (0..8).map(|i| m.pitch().unwrap().world().robot(i)).collect();
+            m.cycle().unwrap();
+            let mut now = std::mem::take(&mut *heard.lock().unwrap());
+            now.sort_by_key(|(robot, _)| *robot);
+            assert_eq!(now.len(), 8, "one estimate per robot and cycle");
+            for ((robot, l), truth) in now.into_iter().zip(before) {
+                let truth = truth.unwrap();
+                errors.push((l.pose.x - truth.x).hypot(l.pose.y - truth.y));
+                headings.push(mrt_core::normalize_angle(l.pose.theta - truth.theta).abs());
+                qualities.push(l.quality);
+                last[robot as usize] = l;
             }
         }
         let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len() as f64;
@@ -531,23 +450,24 @@ mod tests {
         assert!(e < 0.03 && e99 < 0.1, "{says}");
         assert!(h < 0.01 && h99 < 0.05, "{says}");
         assert!(q > 0.8, "{says}");
-        for i in 0..8 {
-            let c = m.pitch.mind(i).unwrap().counts();
+        for (i, l) in last.iter().enumerate() {
+            let c = l.counts;
             // 1200 cycles: the mice nearly always, the §4.2 reduction sometimes, the wheels
             // rarely; about 7.6 landmarks a frame (5 % missed) correct the pose.
             assert_eq!(c.mice + c.reduced + c.wheels, 1200, "robot {i}: {c:?}");
             assert!(c.mice > 1100 && c.wheels < 20, "robot {i}: {c:?}");
             assert!(c.corrections > 8500 && c.rejected < 100, "robot {i}: {c:?}");
         }
-        let reduced: u64 = (0..8).map(|i| m.pitch.mind(i).unwrap().counts().reduced).sum();
+        let reduced: u64 = last.iter().map(|l| l.counts.reduced).sum();
         assert!(reduced > 20, "under-reading mice were repaired: {reduced}");
     }
 
     #[test]
     fn a_match_with_the_same_seed_is_the_same_match() {
         let cfg = short(0.5, 2);
-        let play =
-            |seed| Match::new(&cfg, seed, chasers(2), chasers(2)).unwrap().play(f64::MAX, |_| {});
+        let play = |seed| {
+            BusMatch::with_brains(&cfg, seed, chasers(2), chasers(2)).unwrap().play(|_| {}).unwrap()
+        };
         let (a, b, c) = (play(7), play(7), play(8));
         assert_eq!((a.score, a.trajectory_hash), (b.score, b.trajectory_hash));
         assert_ne!(a.trajectory_hash, c.trajectory_hash, "another seed, another match");
@@ -558,15 +478,14 @@ mod tests {
     #[test]
     fn a_chaser_alone_scores_within_two_minutes() {
         let cfg = short(2.0, 1);
-        let m = Match::new(
+        let m = BusMatch::with_brains(
             &cfg,
             1,
             vec![Box::new(Chaser { keeper: false, ..Chaser::default() })],
             vec![Box::new(Chaser { keeper: true, ..Chaser::default() })],
         )
         .unwrap();
-        // The away keeper stands still as a test dummy only if it cannot see; here it defends.
-        let report = m.play(120.0, |_| {});
+        let report = m.play_until(120.0, |_| {}).unwrap();
         assert!(report.stats[0].shots > 0, "{:?}", report.stats);
         assert!(
             report.score.0 >= 1,
@@ -576,20 +495,16 @@ mod tests {
         );
     }
 
+    /// Each stack scores alone within two minutes, through its brains in the robot cycle.
     #[test]
-    fn the_chaos_team_alone_scores_within_two_minutes() {
+    fn the_chaos_and_milan_teams_alone_score_within_two_minutes() {
         let cfg = short(2.0, 2);
-        let home = team(Stack::Chaos, &cfg.robot().unwrap(), None).unwrap();
-        let report = Match::new(&cfg, 3, home, Vec::new()).unwrap().play(120.0, |_| {});
-        assert!(report.score.0 >= 1, "{:?} {:?} {:?}", report.score, report.stats, report.calls);
-    }
-
-    #[test]
-    fn the_milan_team_alone_scores_within_two_minutes() {
-        let cfg = short(2.0, 2);
-        let home = team(Stack::Milan, &cfg.robot().unwrap(), None).unwrap();
-        let report = Match::new(&cfg, 3, home, Vec::new()).unwrap().play(120.0, |_| {});
-        assert!(report.score.0 >= 1, "{:?} {:?} {:?}", report.score, report.stats, report.calls);
+        for stack in [Stack::Chaos, Stack::Milan] {
+            let home = team(stack, &cfg.robot().unwrap(), None).unwrap();
+            let m = BusMatch::with_brains(&cfg, 3, home, Vec::new()).unwrap();
+            let report = m.play_until(120.0, |_| {}).unwrap();
+            assert!(report.score.0 >= 1, "{stack:?}: {:?} {:?}", report.score, report.calls);
+        }
     }
 
     /// On a smaller field (12 × 8 m, 1.5 m goals) Milan and the baseline aim at the goals that
@@ -604,7 +519,8 @@ mod tests {
         cfg.field.penalty_area_depth = 1.5;
         for stack in [Stack::Milan, Stack::Chaser] {
             let home = team(stack, &cfg.robot().unwrap(), None).unwrap();
-            let report = Match::new(&cfg, 5, home, Vec::new()).unwrap().play(120.0, |_| {});
+            let m = BusMatch::with_brains(&cfg, 5, home, Vec::new()).unwrap();
+            let report = m.play_until(120.0, |_| {}).unwrap();
             assert!(report.score.0 >= 1, "{stack:?}: {:?} {:?}", report.score, report.calls);
         }
     }
@@ -612,6 +528,6 @@ mod tests {
     #[test]
     fn wrong_team_sizes_are_refused() {
         let cfg = short(1.0, 2);
-        assert!(Match::new(&cfg, 1, chasers(1), chasers(2)).is_err());
+        assert!(BusMatch::with_brains(&cfg, 1, chasers(1), chasers(2)).is_err());
     }
 }

@@ -34,43 +34,22 @@ pub mod sensor;
 pub mod soak;
 pub mod world;
 
-use mrt_robot::stacks::{team, Stack};
+use mrt_robot::stacks::Stack;
 use std::path::Path;
 
-/// How the robots' brains are called.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Wiring {
-    /// Each robot an Agora with its Members on the bus ([`bus::BusMatch`]).
-    Bus,
-    /// The brains called directly, in order ([`game::Match`]); faster, same match.
-    Direct,
-}
-
 /// Plays one match between two stacks (`home`, `away`), `cfg.rules.team_size` robots each,
-/// from `seed`; `behaviors` overrides the compiled-in TeamChaos files; `record` keeps the frames
-/// for [`game::MatchReport::to_svg`]; `progress` gets the simulated time after each cycle.
+/// from `seed`, each robot an Agora running the robot program ([`bus::BusMatch`]);
+/// `behaviors` overrides the compiled-in TeamChaos files; `record` keeps the frames for
+/// [`game::MatchReport::to_svg`]; `progress` gets the simulated time after each cycle.
 pub fn play(
     cfg: &config::SimConfig,
     seed: u64,
     (home, away): (Stack, Stack),
-    wiring: Wiring,
     behaviors: Option<&Path>,
     record: bool,
     mut progress: impl FnMut(f64),
 ) -> Result<game::MatchReport, String> {
-    match wiring {
-        Wiring::Bus => {
-            let mut m = bus::BusMatch::new(cfg, seed, home, Some(away), behaviors)?;
-            m.record_frames(record);
-            m.play(&mut progress)
-        }
-        Wiring::Direct => {
-            let robot = cfg.robot()?;
-            let home = team(home, &robot, behaviors).map_err(|e| format!("home team: {e}"))?;
-            let away = team(away, &robot, behaviors).map_err(|e| format!("away team: {e}"))?;
-            let mut m = game::Match::new(cfg, seed, home, away)?;
-            m.record_frames(record);
-            Ok(m.play(f64::MAX, &mut progress))
-        }
-    }
+    let mut m = bus::BusMatch::new(cfg, seed, home, Some(away), behaviors)?;
+    m.record_frames(record);
+    m.play(&mut progress)
 }

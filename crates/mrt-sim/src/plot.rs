@@ -129,7 +129,7 @@ impl MatchReport {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::game::Match;
+    use crate::bus::BusMatch;
     use mrt_robot::stacks::Chaser;
 
     #[test]
@@ -137,7 +137,7 @@ mod tests {
         let mut cfg = SimConfig::default();
         cfg.rules.half_duration = 5.0;
         cfg.rules.team_size = 1;
-        let mut m = Match::new(
+        let mut m = BusMatch::with_brains(
             &cfg,
             2,
             vec![Box::new(Chaser::default())],
@@ -145,7 +145,7 @@ mod tests {
         )
         .unwrap();
         m.record_frames(true);
-        let r = m.play(f64::MAX, |_| {});
+        let r = m.play(|_| {}).unwrap();
         let svg = r.to_svg(&cfg, ("red", "blue"));
         assert!(svg.starts_with("<svg") && svg.trim_end().ends_with("</svg>"));
         // The field outline is 18 m × 12 m at 50 px/m: 900 × 600 px.

@@ -7,7 +7,6 @@
 //! are faults the match reports, not crashes.
 
 use crate::config::SimConfig;
-use crate::Wiring;
 use mrt_robot::stacks::Stack;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -22,27 +21,23 @@ pub struct SoakMatch {
     pub cfg: SimConfig,
     /// Home and away stacks.
     pub stacks: (Stack, Stack),
-    /// How the robots are wired.
-    pub wiring: Wiring,
 }
 
 impl SoakMatch {
     /// The match of a campaign numbered `seed`: a random valid configuration with halves of
-    /// `half` simulated seconds at most, random stacks and wiring.
+    /// `half` simulated seconds at most, random stacks.
     pub fn draw(seed: u64, half: f64) -> SoakMatch {
         let mut rng = ChaCha8Rng::seed_from_u64(seed);
         let cfg = random_config(&mut rng, half);
         let stacks = [Stack::Chaos, Stack::Milan, Stack::Chaser];
         let home = stacks[rng.random_range(0..3)];
         let away = stacks[rng.random_range(0..3)];
-        let wiring = if rng.random_bool(0.5) { Wiring::Bus } else { Wiring::Direct };
-        SoakMatch { seed, cfg, stacks: (home, away), wiring }
+        SoakMatch { seed, cfg, stacks: (home, away) }
     }
 
     /// Plays it; `Err` for a crash (a panic, with its message, or the simulator's error).
     pub fn play(&self) -> Result<crate::game::MatchReport, String> {
-        let run =
-            || crate::play(&self.cfg, self.seed, self.stacks, self.wiring, None, false, |_| {});
+        let run = || crate::play(&self.cfg, self.seed, self.stacks, None, false, |_| {});
         match std::panic::catch_unwind(AssertUnwindSafe(run)) {
             Ok(r) => r,
             Err(payload) => Err(format!("panic: {}", panic_message(payload.as_ref()))),

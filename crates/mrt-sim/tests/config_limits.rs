@@ -13,7 +13,7 @@
 
 use mrt_robot::stacks::Stack;
 use mrt_sim::config::SimConfig;
-use mrt_sim::{play, Wiring};
+use mrt_sim::play;
 use proptest::prelude::*;
 
 fn refused(toml: &str, needle: &str) {
@@ -24,7 +24,7 @@ fn refused(toml: &str, needle: &str) {
 /// Plays a short match (halves of `half` s) between the Milan stack and the Chaser.
 fn plays(cfg: &mut SimConfig, half: f64) {
     cfg.rules.half_duration = half;
-    let r = play(cfg, 7, (Stack::Milan, Stack::Chaser), Wiring::Direct, None, false, |_| {});
+    let r = play(cfg, 7, (Stack::Milan, Stack::Chaser), None, false, |_| {});
     let r = r.unwrap();
     assert!((r.duration - 2.0 * half).abs() < 0.2, "{}", r.duration);
 }
@@ -142,7 +142,7 @@ proptest! {
     #[test]
     fn random_configurations_are_refused_or_play(cfg in any_config()) {
         if cfg.validate().is_ok() {
-            let r = play(&cfg, 3, (Stack::Milan, Stack::Chaser), Wiring::Direct, None, false, |_| {});
+            let r = play(&cfg, 3, (Stack::Milan, Stack::Chaser), None, false, |_| {});
             prop_assert!(r.is_ok(), "{r:?}");
         }
     }

@@ -8,12 +8,12 @@
 use mrt_robot::stacks::Stack;
 use mrt_sim::config::SimConfig;
 use mrt_sim::game::MatchReport;
+use mrt_sim::play;
 use mrt_sim::referee::Call;
-use mrt_sim::{play, Wiring};
 
 fn default_match(seed: u64) -> MatchReport {
     let cfg = SimConfig::default();
-    play(&cfg, seed, (Stack::Milan, Stack::Chaos), Wiring::Bus, None, false, |_| {}).unwrap()
+    play(&cfg, seed, (Stack::Milan, Stack::Chaos), None, false, |_| {}).unwrap()
 }
 
 #[test]

@@ -27,7 +27,7 @@
 use crate::field::FieldMap;
 use mrt_core::{normalize_angle, Pose2, Time, Vec2};
 use mrt_msgs::robot::{lps, Estimate, Lpo, WorldSnapshot};
-use mrt_msgs::{CameraFrame, Odometry, Sighting, FIELD_OBJECTS};
+use mrt_msgs::{CameraFrame, Localization, Odometry, Sighting, FIELD_OBJECTS};
 use mrt_perception::mice::{Displacement, MiceOdometry, MiceReadings};
 use mrt_perception::PerceptionError;
 use nalgebra::{Matrix2, Matrix2x3, Matrix3, Vector2, Vector3};
@@ -68,22 +68,7 @@ struct Memory {
     seen: f64,
 }
 
-/// What the filter used and refused, counted since it started.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct FilterCounts {
-    /// Cycles predicted with consistent mice readings.
-    pub mice: u64,
-    /// Cycles predicted with mice readings repaired by the §4.2 reduction.
-    pub reduced: u64,
-    /// Cycles predicted with the wheels (the mice could not be trusted).
-    pub wheels: u64,
-    /// Landmark sightings that corrected the pose.
-    pub corrections: u64,
-    /// Landmark sightings rejected as outliers.
-    pub rejected: u64,
-    /// Frames after which the filter admitted it was lost.
-    pub lost: u64,
-}
+pub use mrt_msgs::FilterCounts;
 
 /// One robot's world state between cycles.
 #[derive(Clone, Debug)]
@@ -138,6 +123,18 @@ impl WorldModel {
     /// What the filter used and refused so far.
     pub fn counts(&self) -> FilterCounts {
         self.counts
+    }
+
+    /// The estimate for monitors: pose, uncertainty, quality and counts.
+    pub fn localization(&self) -> Localization {
+        let (sigma_xy, sigma_theta) = self.sigma();
+        Localization {
+            pose: self.pose,
+            sigma_xy,
+            sigma_theta,
+            quality: self.quality(),
+            counts: self.counts,
+        }
     }
 
     /// Sets the pose, as when the robot is put down by hand.

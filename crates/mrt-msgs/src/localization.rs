@@ -1,0 +1,39 @@
+//! What the world model says about its own pose, for monitors, recorders and tests (ThinkingCap
+//! seed `001` §4.1: the monitor shows the pose's uncertainty): the estimate in the field frame
+//! with its uncertainty and what the filter used and refused.
+
+use mrt_core::Pose2;
+use serde::{Deserialize, Serialize};
+
+/// What a pose filter used and refused, counted since it started.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub struct FilterCounts {
+    /// Cycles predicted with consistent mice readings.
+    pub mice: u64,
+    /// Cycles predicted with mice readings repaired by the §4.2 reduction.
+    pub reduced: u64,
+    /// Cycles predicted with the wheels (the mice could not be trusted).
+    pub wheels: u64,
+    /// Landmark sightings that corrected the pose.
+    pub corrections: u64,
+    /// Landmark sightings rejected as outliers.
+    pub rejected: u64,
+    /// Frames after which the filter admitted it was lost.
+    pub lost: u64,
+}
+
+/// A robot's own pose estimate after a cycle, in the field frame (m, rad; not the team frame
+/// of the behaviors' snapshot), published by its world state every cycle.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Localization {
+    /// The estimate: field frame, metres from the centre spot, heading in radians.
+    pub pose: Pose2,
+    /// Standard deviation of the position (root mean square of x and y), m.
+    pub sigma_xy: f64,
+    /// Standard deviation of the heading, rad.
+    pub sigma_theta: f64,
+    /// The pose's quality, 0 (unknown) to 1.
+    pub quality: f64,
+    /// What the filter used and refused so far.
+    pub counts: FilterCounts,
+}
