@@ -37,7 +37,10 @@ impl SoakMatch {
 
     /// Plays it; `Err` for a crash (a panic, with its message, or the simulator's error).
     pub fn play(&self) -> Result<crate::game::MatchReport, String> {
-        let run = || crate::play(&self.cfg, self.seed, self.stacks, None, false, |_| {});
+        let (home, away) = self.stacks;
+        let run = || {
+            crate::bus::BusMatch::new(&self.cfg, self.seed, home, Some(away), None)?.play(|_| {})
+        };
         match std::panic::catch_unwind(AssertUnwindSafe(run)) {
             Ok(r) => r,
             Err(payload) => Err(format!("panic: {}", panic_message(payload.as_ref()))),

@@ -3,7 +3,7 @@
 //!
 //! Frame: metres, origin at the centre spot, +x towards the east goal, +y to the north,
 //! headings counter-clockwise from +x. Nothing here knows about teams or rules (see
-//! [`crate::referee`]).
+//! the referee, `referee.rs`).
 
 use crate::config::SimConfig;
 use mrt_core::Pose2;
@@ -231,7 +231,7 @@ impl World {
     /// first sonar straight ahead, then counter-clockwise, evenly spaced, as the SuperScout's
     /// sixteen): each beam of half-width `half_beam` is three rays (centre and edges) that see
     /// walls, goals, robots and the ball; the nearest hit counts, `range` when nothing is hit.
-    /// Noise is the caller's (see [`crate::sensor`]).
+    /// Noise is the caller's (the sensor models, `sensor.rs`).
     pub fn sonar(&self, i: usize, count: usize, half_beam: f64, range: f64) -> Vec<f64> {
         let (Some(pose), Some(robot)) = (self.robot(i), self.robots.get(i)) else {
             return Vec::new();
