@@ -3,7 +3,7 @@
 //! drivers did ([`DeviceAct`]); at the [`FinalWhistle`] it sends its Members' faults
 //! ([`RobotEnd`]). A real robot never sees these: its devices are its own.
 
-use crate::sensing::{CameraFrame, Odometry, Sonar};
+use crate::sensing::{CameraFrame, GameInfo, Odometry, Sonar};
 use serde::{Deserialize, Serialize};
 
 /// What robot `robot`'s devices read at the start of control cycle `cycle`.
@@ -17,6 +17,8 @@ pub struct DeviceFrame {
     pub odometry: Odometry,
     /// The object sensor's frame.
     pub camera: CameraFrame,
+    /// The game controller's news.
+    pub game: GameInfo,
     /// The sonar ring.
     pub sonars: Vec<Sonar>,
     /// Robots the simulator is not waiting for (silent, or known gone): teammates do not wait

@@ -124,7 +124,8 @@ pub struct Sighting {
 
 /// What the game controller tells every robot each cycle (field frame, m): the referee's
 /// state of TeamChaos' `getCurrentState()` (seed `001` §3.3) and the robot's place in the
-/// kickoff formation.
+/// kickoff formation. Its own message, published by the game controller's driver (a radio
+/// listening to the referee box on a real field), not part of any camera frame.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct GameInfo {
     /// The referee's state.
@@ -147,6 +148,4 @@ pub struct CameraFrame {
     /// The ball's velocity in the robot's frame (m/s), when the ball is seen: the stand-in
     /// for a ball tracker.
     pub ball_velocity: Option<(f64, f64)>,
-    /// The game controller's news.
-    pub game: GameInfo,
 }

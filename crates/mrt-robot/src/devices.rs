@@ -12,7 +12,7 @@
 //!   of the cycle's [`DeviceFrame`](mrt_msgs::DeviceFrame) and gathers what the drivers did
 //!   into a [`DeviceAct`](mrt_msgs::DeviceAct) (see [`crate::remote`]).
 
-use mrt_msgs::{CameraFrame, Odometry, Sonar};
+use mrt_msgs::{CameraFrame, GameInfo, Odometry, Sonar};
 use std::sync::{Arc, Mutex};
 
 /// A robot's devices (module doc). Errors are the device's own words; the driver Member
@@ -20,8 +20,11 @@ use std::sync::{Arc, Mutex};
 pub trait Devices: Send {
     /// The mice and the wheels since the last reading (first in a cycle).
     fn odometry(&mut self) -> Result<Odometry, String>;
-    /// What the object sensor sees now, with the game controller's news (after the odometry).
+    /// What the object sensor sees now (after the odometry).
     fn camera(&mut self) -> Result<CameraFrame, String>;
+    /// The game controller's news (the referee's state, which way the team attacks, the
+    /// robot's kickoff pose).
+    fn game(&mut self) -> Result<GameInfo, String>;
     /// The sonar ring (after the camera).
     fn sonars(&mut self) -> Result<Vec<Sonar>, String>;
     /// Drives the motors: one PWM duty cycle per wheel.
@@ -42,6 +45,7 @@ pub type SharedDevices = Arc<Mutex<dyn Devices>>;
 pub struct LinkedDevices {
     odometry: Option<Odometry>,
     camera: Option<CameraFrame>,
+    game: Option<GameInfo>,
     sonars: Option<Vec<Sonar>>,
     duty: Option<Vec<f64>>,
     kick: bool,
@@ -61,9 +65,16 @@ pub struct Actuation {
 
 impl LinkedDevices {
     /// The readings of the next cycle (each is read once).
-    pub fn load(&mut self, odometry: Odometry, camera: CameraFrame, sonars: Vec<Sonar>) {
+    pub fn load(
+        &mut self,
+        odometry: Odometry,
+        camera: CameraFrame,
+        game: GameInfo,
+        sonars: Vec<Sonar>,
+    ) {
         self.odometry = Some(odometry);
         self.camera = Some(camera);
+        self.game = Some(game);
         self.sonars = Some(sonars);
     }
 
@@ -88,6 +99,10 @@ impl Devices for LinkedDevices {
 
     fn camera(&mut self) -> Result<CameraFrame, String> {
         unread(&mut self.camera, "camera")
+    }
+
+    fn game(&mut self) -> Result<GameInfo, String> {
+        unread(&mut self.game, "game controller")
     }
 
     fn sonars(&mut self) -> Result<Vec<Sonar>, String> {
@@ -119,7 +134,8 @@ mod tests {
         let mut d = LinkedDevices::default();
         assert!(d.camera().is_err(), "nothing loaded yet");
         let frame = CameraFrame { time: 1.5, ..CameraFrame::default() };
-        d.load(Odometry::default(), frame.clone(), vec![Sonar::default(); 2]);
+        d.load(Odometry::default(), frame.clone(), GameInfo::default(), vec![Sonar::default(); 2]);
+        assert_eq!(d.game().unwrap(), GameInfo::default());
         assert_eq!(d.camera().unwrap(), frame);
         assert!(d.camera().unwrap_err().contains("no camera reading"), "read once");
         assert_eq!(d.sonars().unwrap().len(), 2);

@@ -5,9 +5,10 @@
 //!
 //! 1. **drivers** (periodic, one generic [`Member`] reading one device each): `odometry-<n>`
 //!    publishes the mice's and the wheels' readings since the last cycle ([`Odometry`]),
-//!    `camera-<n>` what the camera (object sensor) sees with the game controller's news
-//!    ([`CameraFrame`]), `sonars-<n>` the sonar ring ([`SonarScan`]);
-//! 2. **`WorldState`** (periodic): fuses odometry and camera into the robot's own pose and LPS
+//!    `camera-<n>` what the camera (object sensor) sees ([`CameraFrame`]),
+//!    `game-controller-<n>` the referee's news ([`GameInfo`]), `sonars-<n>` the sonar ring
+//!    ([`SonarScan`]);
+//! 2. **`WorldState`** (periodic): fuses odometry, camera and game controller into the robot's own pose and LPS
 //!    ([`WorldModel`]), takes its teammates' poses from their reports received over the bus,
 //!    and publishes the [`WorldSnapshot`] and, for monitors, its [`Localization`](mrt_msgs::Localization);
 //!    it also publishes a [`MateReport`] (its pose and its
@@ -39,8 +40,8 @@ use crate::stacks::{embedded_teamchaos, send_brain, Stack, CHAOS_KEEPER, CHAOS_P
 use mrt_core::Point2;
 use mrt_dcdt::{Activation, Agora, Context, Member, MemberError, Message, RequestType, RunReport};
 use mrt_msgs::{
-    BehaviorStatus, CameraFrame, MateReport, MemberFault, MotorCommand, Odometry, RobotCommand,
-    Sonar, SonarScan, WorldSnapshot,
+    BehaviorStatus, CameraFrame, GameInfo, MateReport, MemberFault, MotorCommand, Odometry,
+    RobotCommand, Sonar, SonarScan, WorldSnapshot,
 };
 use mrt_plan::guide::Guidance;
 use mrt_script::member::BehaviorMember;
@@ -95,6 +96,7 @@ impl Member for WorldState {
     fn init(&mut self, ctx: &mut Context<'_>) -> Result<(), MemberError> {
         ctx.subscribe_to::<Odometry>(RequestType::Local);
         ctx.subscribe_to::<CameraFrame>(RequestType::Local);
+        ctx.subscribe_to::<GameInfo>(RequestType::Local);
         ctx.subscribe_to::<MateReport>(RequestType::Remote);
         Ok(())
     }
@@ -104,15 +106,17 @@ impl Member for WorldState {
         while let Some(m) = ctx.receive_msg() {
             if let Ok(o) = m.get::<Odometry>() {
                 self.model.odometry(o);
-            } else if let Ok(f) = m.get::<CameraFrame>() {
-                frame = Some(f.clone());
+            } else if m.is::<CameraFrame>() {
+                frame = Some(m);
+            } else if let Ok(g) = m.get::<GameInfo>() {
+                self.model.game(*g);
             } else {
                 let r = m.get::<MateReport>()?;
                 self.mates.insert(r.id, *r);
             }
         }
         let Some(frame) = frame else { return Ok(()) };
-        let mut w = self.model.camera(&frame);
+        let mut w = self.model.camera(frame.get::<CameraFrame>()?);
         let id = u32::try_from(self.robot).unwrap_or(u32::MAX);
         let report = MateReport::of(id, self.keeper, &w);
         // Teammates and their ball as the bus told them, not as the simulator knows them.
@@ -310,6 +314,8 @@ fn add_cycle(
         Driver { kind: "odometry", robot, devices: dev(), read: |d| d.odometry() };
     let camera: Driver<CameraFrame> =
         Driver { kind: "camera", robot, devices: dev(), read: |d| d.camera() };
+    let game: Driver<GameInfo> =
+        Driver { kind: "game-controller", robot, devices: dev(), read: |d| d.game() };
     let sonars: Driver<SonarScan> = Driver {
         kind: "sonars",
         robot,
@@ -333,6 +339,7 @@ fn add_cycle(
     let ids = [
         agora.add_member(odometry, every),
         agora.add_member(camera, every),
+        agora.add_member(game, every),
         agora.add_member(world, every),
         agora.add_member(sonars, every),
         agora.add_boxed_member(behavior, every),

@@ -243,7 +243,7 @@ impl RemoteRobot {
                 run.late_mates += 1;
             }
             if let Ok(mut d) = self.devices.lock() {
-                d.load(frame.odometry, frame.camera, frame.sonars);
+                d.load(frame.odometry, frame.camera, frame.game, frame.sonars);
             }
             self.exec.run_for(self.period);
             let act = self.devices.lock().map_err(|_| "the devices lock is poisoned")?.take();

@@ -5,7 +5,7 @@
 
 use crate::drivers::SimulatedAirboard;
 use crate::game::Pitch;
-use mrt_msgs::{CameraFrame, Odometry, Sonar};
+use mrt_msgs::{CameraFrame, GameInfo, Odometry, Sonar};
 use mrt_robot::base::MotorDriver;
 use mrt_robot::devices::Devices;
 use std::sync::{Arc, Mutex};
@@ -38,6 +38,10 @@ impl Devices for PitchDevices {
 
     fn camera(&mut self) -> Result<CameraFrame, String> {
         self.with(|p, i| p.camera(i))
+    }
+
+    fn game(&mut self) -> Result<GameInfo, String> {
+        self.with(|p, i| p.game_info(i))
     }
 
     fn sonars(&mut self) -> Result<Vec<Sonar>, String> {

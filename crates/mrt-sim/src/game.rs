@@ -12,7 +12,7 @@ use crate::sensor::{self, sonar_ring, Odometer};
 use crate::world::{Drive, World};
 use mrt_msgs::robot::{GameState, RobotCommand};
 use mrt_msgs::Sonar;
-use mrt_msgs::{CameraFrame, Odometry};
+use mrt_msgs::{CameraFrame, GameInfo, Odometry};
 use mrt_robot::base::Base;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
@@ -182,9 +182,14 @@ impl Pitch {
         self.odometers[i].read(&self.world, &self.cfg.odometry, period, &mut self.rngs[i])
     }
 
-    /// What robot `i`'s camera (the object sensor) sees now, with the game controller's news.
+    /// What robot `i`'s camera (the object sensor) sees now.
     pub fn camera(&mut self, i: usize) -> CameraFrame {
-        sensor::look(&self.world, &self.referee, i, &self.cfg.sensor, &mut self.rngs[i])
+        sensor::look(&self.world, i, &self.cfg.sensor, &mut self.rngs[i])
+    }
+
+    /// What the game controller tells robot `i` now (no randomness: read it at any time).
+    pub fn game_info(&self, i: usize) -> GameInfo {
+        sensor::game_info(&self.referee, i)
     }
 
     /// Robot `i`'s sonar ring listens once (after [`Pitch::camera`] in a cycle).

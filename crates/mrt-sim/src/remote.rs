@@ -199,6 +199,7 @@ impl PitchServer {
                     cycle: k,
                     odometry: pitch.odometry(i),
                     camera: pitch.camera(i),
+                    game: pitch.game_info(i),
                     sonars: pitch.sonar(i),
                     not_awaited: not_awaited.clone(),
                 };

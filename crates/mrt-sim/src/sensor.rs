@@ -73,32 +73,27 @@ fn blocks(a: (f64, f64), b: (f64, f64), c: (f64, f64), radius: f64) -> bool {
 
 pub use mrt_msgs::{CameraFrame, GameInfo, Sighting, FIELD_OBJECTS};
 
+/// What the game controller tells robot `robot` now: the referee's state, the direction its
+/// team attacks, its place in the kickoff formation.
+pub fn game_info(referee: &Referee, robot: usize) -> GameInfo {
+    GameInfo {
+        state: referee.state(),
+        attack: referee.attack_direction(referee.team_of(robot)),
+        kickoff_pose: referee.kickoff_pose(robot),
+    }
+}
+
 /// What the camera of robot `robot` sees now (the object sensor): every object within its
 /// range and field of view, not hidden behind another robot (the ball) and not missed, as
 /// distance and bearing with range-dependent noise.
-pub fn look(
-    world: &World,
-    referee: &Referee,
-    robot: usize,
-    cfg: &SensorConfig,
-    rng: &mut dyn RngCore,
-) -> CameraFrame {
+pub fn look(world: &World, robot: usize, cfg: &SensorConfig, rng: &mut dyn RngCore) -> CameraFrame {
     let me = world.robot(robot).unwrap_or_default();
-    let team = referee.team_of(robot);
     let r_robot = world.config().robot.radius;
     let robots: Vec<(f64, f64)> = (0..world.robot_count())
         .filter(|&i| i != robot)
         .filter_map(|i| world.robot(i).map(|p| (p.x, p.y)))
         .collect();
-    let mut frame = CameraFrame {
-        time: world.time(),
-        game: GameInfo {
-            state: referee.state(),
-            attack: referee.attack_direction(team),
-            kickoff_pose: referee.kickoff_pose(robot),
-        },
-        ..Default::default()
-    };
+    let mut frame = CameraFrame { time: world.time(), ..Default::default() };
     for (k, target) in targets(world).into_iter().enumerate() {
         let (dx, dy) = (target.0 - me.x, target.1 - me.y);
         let dist = dx.hypot(dy);
@@ -221,7 +216,7 @@ mod tests {
         // the heading (bearing -π/4).
         w.place_robot(1, Pose2::new(-2.0, 0.0, std::f64::consts::FRAC_PI_2));
         w.place_ball(0.0, 2.0);
-        let f = look(&w, &r, 1, &exact(), &mut rng);
+        let f = look(&w, 1, &exact(), &mut rng);
         let ball = f.sightings[lps::BALL].unwrap();
         assert!((ball.distance - 2.828427).abs() < 1e-5, "{ball:?}");
         assert!((ball.bearing + std::f64::consts::FRAC_PI_4).abs() < 1e-6, "{ball:?}"); // f32
@@ -234,12 +229,13 @@ mod tests {
         );
         assert!((f.sightings[EAST_NET].unwrap().distance - 11.0).abs() < 1e-5);
         let short = SensorConfig { landmark_range: 9.0, ..exact() };
-        let f2 = look(&w, &r, 1, &short, &mut rng);
+        let f2 = look(&w, 1, &short, &mut rng);
         assert_eq!(f2.sightings[EAST_NET], None, "11 m: beyond a 9 m landmark range");
         // The game controller's news: home attacks east in the first half, away west.
-        assert_eq!((f.game.attack, f.game.state), (1.0, GameState::Ready));
-        assert_eq!(look(&w, &r, 5, &exact(), &mut rng).game.attack, -1.0);
-        assert_eq!(f.game.kickoff_pose, r.kickoff_pose(1));
+        let g = game_info(&r, 1);
+        assert_eq!((g.attack, g.state), (1.0, GameState::Ready));
+        assert_eq!(game_info(&r, 5).attack, -1.0);
+        assert_eq!(g.kickoff_pose, r.kickoff_pose(1));
         assert_eq!(f.time, w.time());
         // A still ball: zero velocity, reported because the ball is seen.
         assert_eq!(f.ball_velocity, Some((0.0, 0.0)));
@@ -247,25 +243,25 @@ mod tests {
 
     #[test]
     fn a_robot_in_between_hides_the_ball() {
-        let (mut w, r) = setup();
+        let (mut w, _) = setup();
         let mut rng = ChaCha8Rng::seed_from_u64(2);
         w.place_robot(1, Pose2::new(-3.0, 0.0, 0.0));
         w.place_ball(0.0, 0.0);
-        assert!(look(&w, &r, 1, &exact(), &mut rng).sightings[lps::BALL].is_some());
+        assert!(look(&w, 1, &exact(), &mut rng).sightings[lps::BALL].is_some());
         w.place_robot(6, Pose2::new(-1.5, 0.05, 0.0)); // in the line of sight
-        let hidden = look(&w, &r, 1, &exact(), &mut rng);
+        let hidden = look(&w, 1, &exact(), &mut rng);
         assert_eq!((hidden.sightings[lps::BALL], hidden.ball_velocity), (None, None));
         assert!(hidden.sightings[WEST_NET].is_some(), "landmarks stand above the robots");
     }
 
     #[test]
     fn a_narrow_field_of_view_and_range_limit_what_is_seen() {
-        let (mut w, r) = setup();
+        let (mut w, _) = setup();
         let mut rng = ChaCha8Rng::seed_from_u64(3);
         let cfg = SensorConfig { half_fov: 0.5, range: 5.0, landmark_range: 5.0, ..exact() };
         w.place_robot(1, Pose2::new(-5.0, 0.0, std::f64::consts::PI)); // facing west
         w.place_ball(-1.0, 0.0);
-        let f = look(&w, &r, 1, &cfg, &mut rng);
+        let f = look(&w, 1, &cfg, &mut rng);
         assert_eq!(f.sightings[lps::BALL], None, "4 m behind the robot");
         assert!(f.sightings[WEST_NET].is_some(), "west net 4 m ahead");
         assert_eq!(f.sightings[EAST_NET], None, "east net 14 m behind");
@@ -353,7 +349,7 @@ mod tests {
 
     #[test]
     fn noise_is_seeded_and_proportional_to_distance() {
-        let (mut w, r) = setup();
+        let (mut w, _) = setup();
         // Off the kickoff lanes (y = 0, ±3), so nobody stands in the line of sight.
         w.place_robot(1, Pose2::new(-6.0, 1.5, 0.0));
         w.place_ball(0.0, 1.5);
@@ -361,7 +357,7 @@ mod tests {
         let sample = |seed| {
             let mut rng = ChaCha8Rng::seed_from_u64(seed);
             (0..400)
-                .filter_map(|_| look(&w, &r, 1, &cfg, &mut rng).sightings[lps::BALL])
+                .filter_map(|_| look(&w, 1, &cfg, &mut rng).sightings[lps::BALL])
                 .map(|s| s.distance * 1000.0)
                 .collect::<Vec<_>>()
         };

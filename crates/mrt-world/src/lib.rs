@@ -20,14 +20,15 @@
 //! let mut model = WorldModel::new(map, MiceOdometry::new(0.2, 1e-3)?, 0.03, 0.02);
 //! model.place(Pose2::new(0.0, 0.0, 0.0)); // put down on the centre spot, facing east
 //! // The camera sees the east net 9 m straight ahead and the ball 2 m to the front left.
+//! model.game(GameInfo { state: GameState::Playing, attack: 1.0, kickoff_pose: None });
 //! let mut frame = CameraFrame::default();
-//! frame.game = GameInfo { state: GameState::Playing, attack: 1.0, kickoff_pose: None };
 //! frame.sightings[mrt_world::field::EAST_NET] = Some(Sighting { distance: 9.0, bearing: 0.0 });
 //! frame.sightings[lps::BALL] = Some(Sighting { distance: 2.0, bearing: 0.5 });
 //! let w = model.camera(&frame);
 //! assert!((w.lps[lps::BALL].rho - 2000.0).abs() < 1e-6, "LPS distances are in mm");
 //! assert_eq!(w.lps[lps::BALL].reliability, 1.0);
 //! assert!(w.my_pos.quality > 0.8);
+//! assert_eq!(w.game_state, GameState::Playing);
 //! # Ok::<(), mrt_perception::PerceptionError>(())
 //! ```
 #![deny(missing_docs)]

@@ -27,7 +27,7 @@
 use crate::field::FieldMap;
 use mrt_core::{normalize_angle, Pose2, Time, Vec2};
 use mrt_msgs::robot::{lps, Estimate, Lpo, WorldSnapshot};
-use mrt_msgs::{CameraFrame, Localization, Odometry, Sighting, FIELD_OBJECTS};
+use mrt_msgs::{CameraFrame, GameInfo, Localization, Odometry, Sighting, FIELD_OBJECTS};
 use mrt_perception::mice::{Displacement, MiceOdometry, MiceReadings};
 use mrt_perception::PerceptionError;
 use nalgebra::{Matrix2, Matrix2x3, Matrix3, Vector2, Vector3};
@@ -81,6 +81,8 @@ pub struct WorldModel {
     cov: Matrix3<f64>,
     memory: [Option<Memory>; FIELD_OBJECTS],
     counts: FilterCounts,
+    /// The game controller's latest news (which way the team attacks, the state).
+    game: GameInfo,
 }
 
 impl WorldModel {
@@ -97,6 +99,7 @@ impl WorldModel {
             cov: Matrix3::from_diagonal(&Vector3::new(100.0, 100.0, PI * PI)),
             memory: [None; FIELD_OBJECTS],
             counts: FilterCounts::default(),
+            game: GameInfo::default(),
         }
     }
 
@@ -135,6 +138,12 @@ impl WorldModel {
             quality: self.quality(),
             counts: self.counts,
         }
+    }
+
+    /// The game controller's news: the snapshots that follow are in the team's frame of
+    /// `game.attack` and carry its state and kickoff pose.
+    pub fn game(&mut self, game: GameInfo) {
+        self.game = game;
     }
 
     /// Sets the pose, as when the robot is put down by hand.
@@ -302,13 +311,13 @@ impl WorldModel {
     /// The world snapshot in the team frame.
     fn snapshot(&self, frame: &CameraFrame) -> WorldSnapshot {
         let me = self.pose;
-        let west = frame.game.attack < 0.0;
+        let west = self.game.attack < 0.0;
         let dir = if west { -1.0 } else { 1.0 };
         let to_team = |x: f64, y: f64| (dir * x * MM, dir * y * MM);
         let turn = |theta: f64| if west { normalize_angle(theta + PI) } else { theta };
         let mut w = WorldSnapshot {
             time: Time::from_secs_f64(frame.time),
-            game_state: frame.game.state,
+            game_state: self.game.state,
             field: self.map.snapshot(),
             ..Default::default()
         };
@@ -327,7 +336,7 @@ impl WorldModel {
         }
         let (mx, my) = to_team(me.x, me.y);
         w.my_pos = Estimate { pose: Pose2::new(mx, my, turn(me.theta)), quality: self.quality() };
-        w.kickoff_pose = frame.game.kickoff_pose.map(|p| {
+        w.kickoff_pose = self.game.kickoff_pose.map(|p| {
             let (x, y) = to_team(p.x, p.y);
             Pose2::new(x, y, turn(p.theta))
         });
@@ -349,7 +358,6 @@ impl WorldModel {
 mod tests {
     use super::*;
     use mrt_msgs::robot::GameState;
-    use mrt_msgs::GameInfo;
 
     fn model() -> WorldModel {
         // The default field: 18 m × 12 m. Mice 0.2 m apart, 3 mm tolerance.
@@ -357,13 +365,14 @@ mod tests {
         WorldModel::new(FieldMap::default(), mice, 0.03, 0.02)
     }
 
+    /// The game controller's news while playing, attacking east (`attack` 1) or west (−1).
+    fn playing(attack: f64) -> GameInfo {
+        GameInfo { state: GameState::Playing, attack, kickoff_pose: None }
+    }
+
     /// Exact sightings, from `at`, of the field objects at `objects` (field frame, m).
-    fn frame(at: Pose2, time: f64, attack: f64, objects: &[(usize, (f64, f64))]) -> CameraFrame {
-        let mut f = CameraFrame {
-            time,
-            game: GameInfo { state: GameState::Playing, attack, kickoff_pose: None },
-            ..Default::default()
-        };
+    fn frame(at: Pose2, time: f64, objects: &[(usize, (f64, f64))]) -> CameraFrame {
+        let mut f = CameraFrame { time, ..Default::default() };
         for &(k, (x, y)) in objects {
             let (dx, dy) = (x - at.x, y - at.y);
             f.sightings[k] = Some(Sighting {
@@ -415,7 +424,7 @@ mod tests {
         m.cov = Matrix3::from_diagonal(&Vector3::new(0.25, 0.25, 0.04));
         for t in 0..5 {
             m.odometry(&exact_mice(Pose2::default()));
-            m.camera(&frame(truth, f64::from(t) * 0.1, 1.0, &landmarks()));
+            m.camera(&frame(truth, f64::from(t) * 0.1, &landmarks()));
         }
         let p = m.pose();
         assert!((p.x - truth.x).hypot(p.y - truth.y) < 0.01, "{p:?}");
@@ -432,10 +441,10 @@ mod tests {
         m.place(truth);
         for t in 0..3 {
             m.odometry(&exact_mice(Pose2::default()));
-            m.camera(&frame(truth, f64::from(t) * 0.1, 1.0, &landmarks()));
+            m.camera(&frame(truth, f64::from(t) * 0.1, &landmarks()));
         }
         // One net reported 3 m too close: gated out, the pose does not move.
-        let mut bad = frame(truth, 0.3, 1.0, &landmarks());
+        let mut bad = frame(truth, 0.3, &landmarks());
         if let Some(s) = &mut bad.sightings[1] {
             s.distance -= 3.0;
         }
@@ -448,7 +457,7 @@ mod tests {
         let kidnapped = Pose2::new(2.0, 1.0, 0.0);
         for t in 4..14 {
             m.odometry(&exact_mice(Pose2::default()));
-            m.camera(&frame(kidnapped, f64::from(t) * 0.1, 1.0, &landmarks()));
+            m.camera(&frame(kidnapped, f64::from(t) * 0.1, &landmarks()));
         }
         assert!(m.counts().lost >= 1, "{:?}", m.counts());
         let p = m.pose();
@@ -500,7 +509,9 @@ mod tests {
         let mut objects = landmarks();
         objects.push((lps::BALL, (0.0, 2.0)));
         // Attacking east: the team frame is the field frame (mm).
-        let w = m.camera(&frame(at, 1.0, 1.0, &objects));
+        m.game(playing(1.0));
+        let w = m.camera(&frame(at, 1.0, &objects));
+        assert_eq!(w.game_state, GameState::Playing, "the game controller's state");
         let ball = w.lps[lps::BALL];
         assert!((ball.rho - 2828.427).abs() < 0.01 && (ball.theta + PI / 4.0).abs() < 1e-9);
         assert_eq!((ball.reliability, ball.seen_ago), (1.0, 0.0));
@@ -516,7 +527,8 @@ mod tests {
         // the field's south-west corner.
         let mut m2 = model();
         m2.place(at);
-        let w = m2.camera(&frame(at, 1.0, -1.0, &objects));
+        m2.game(playing(-1.0));
+        let w = m2.camera(&frame(at, 1.0, &objects));
         assert!((w.lps[lps::NET1].rho - 7000.0).abs() < 0.01);
         assert!((w.lps[lps::NET1].theta - PI / 2.0).abs() < 1e-9);
         let sw = w.lps[lps::LANDMARK0];
@@ -528,7 +540,7 @@ mod tests {
         // Nothing seen next cycle: memories stay where they were, fading; the robot moves
         // 1 m forward (north) by the mice, so the ball, 2 m north-east, is now 2.236 m away.
         m.odometry(&exact_mice(Pose2::new(1.0, 0.0, 0.0)));
-        let w = m.camera(&frame(at, 1.1, 1.0, &[]));
+        let w = m.camera(&frame(at, 1.1, &[]));
         let ball = w.lps[lps::BALL];
         assert!((ball.reliability - DECAY).abs() < 1e-12);
         assert!((ball.rho - 5f64.sqrt() * 1000.0).abs() < 0.01, "{ball:?}");
