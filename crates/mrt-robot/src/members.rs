@@ -278,7 +278,7 @@ pub fn add_robot(
             Box::new(BehaviorMember::hfsm(behaviors, behaviors.join(CHAOS_PLAYER))),
             Commander::chaos(cfg),
         ),
-        other => (Box::new(BrainMember::new(send_brain(other, keeper, cfg)?)), Commander::PLAIN),
+        other => (Box::new(BrainMember::new(send_brain(other, keeper)?)), Commander::PLAIN),
     };
     add_cycle(agora, cfg, (robot, keeper), behavior, commander, devices)
 }

@@ -17,10 +17,9 @@ use crate::config::RobotConfig;
 use crate::files::FilesDir;
 use mrt_core::{Point2, Pose2};
 use mrt_fuzzy::brian::Brian;
-use mrt_msgs::robot::{lps, GameState, Lpo, RobotCommand, Target, WorldSnapshot};
+use mrt_msgs::robot::{lps, Field, GameState, Lpo, RobotCommand, Target, WorldSnapshot};
 use mrt_plan::guidance::behind_ball;
 use mrt_script::{Sandbox, ThinkingCap, Watchdog, DEFAULT_DEADLINE};
-use mrt_world::FieldMap;
 use std::path::Path;
 
 /// A behavior stack.
@@ -104,7 +103,7 @@ const MILAN: &[(&str, &str)] = &[
     ("want.txt", include_str!("../../../configs/brian/milan/want.txt")),
 ];
 
-/// The field as the teams need it, in the team frame (mm).
+/// The field as the teams need it, in the team frame (mm), from the snapshot's field.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Geometry {
     /// From the centre spot to a goal line.
@@ -113,18 +112,11 @@ pub struct Geometry {
     pub goal_half_width: f64,
 }
 
-impl Default for Geometry {
-    /// The default Middle Size League field.
-    fn default() -> Self {
-        Geometry::of(&FieldMap::default())
-    }
-}
-
 impl Geometry {
-    /// The geometry of a field map.
-    pub fn of(map: &FieldMap) -> Geometry {
-        let m = map.snapshot();
-        Geometry { half_length: m.half_length, goal_half_width: m.goal_half_width }
+    /// The geometry of the field a world snapshot carries (the world model's map: behaviors
+    /// never read a simulator's configuration).
+    pub fn of(field: &Field) -> Geometry {
+        Geometry { half_length: field.half_length, goal_half_width: field.goal_half_width }
     }
 
     /// Where the ball is in the team frame (mm), from the robot's pose and its LPS ball.
@@ -216,7 +208,6 @@ impl Brain for ChaosBrain {
 pub struct MilanBrain {
     brian: Brian,
     keeper: bool,
-    field: Geometry,
 }
 
 /// Degrees in [0, 360) of an angle in radians.
@@ -226,14 +217,15 @@ fn deg360(a: f64) -> f64 {
 
 impl MilanBrain {
     /// The goalkeeper or a field player, on the configuration of `dir`.
-    pub fn new(dir: &Path, keeper: bool, field: Geometry) -> Result<MilanBrain, String> {
-        Ok(MilanBrain { brian: Brian::from_dir(dir).map_err(|e| e.to_string())?, keeper, field })
+    pub fn new(dir: &Path, keeper: bool) -> Result<MilanBrain, String> {
+        Ok(MilanBrain { brian: Brian::from_dir(dir).map_err(|e| e.to_string())?, keeper })
     }
 
     /// The Parser: crisp inputs from the world snapshot (team frame, mm, degrees).
     pub fn inputs(&self, w: &WorldSnapshot) -> Vec<(&'static str, f64, f64)> {
         let me = w.my_pos.pose;
         let q = w.my_pos.quality;
+        let field = Geometry::of(&w.field);
         let mut v = vec![("Keeper", f64::from(u8::from(self.keeper)), 1.0), ("Always", 1.0, 1.0)];
         v.push(("HeadingBearing", deg360(me.theta), q));
         let ball = w.lps[lps::BALL];
@@ -243,13 +235,13 @@ impl MilanBrain {
             v.push(("BallBearing", deg360(ball.theta), r));
             // The ball and the point 400 mm behind it on the line from the opponent's net.
             let (bx, by) = Geometry::ball_at(me, &ball);
-            let spot = self.field.behind_ball((bx, by), 400.0);
+            let spot = field.behind_ball((bx, by), 400.0);
             let (dx, dy) = (spot.x - me.x, spot.y - me.y);
             v.push(("ApproachDistance", dx.hypot(dy), r));
             v.push(("ApproachAngle", deg360(dy.atan2(dx) - me.theta), r));
             let a = me.theta + ball.theta;
             let mis = mrt_core::normalize_angle(a - spot.theta).abs().to_degrees();
-            let gw = self.field.goal_half_width;
+            let gw = field.goal_half_width;
             v.push(("Misalignment", mis, r));
             if self.keeper {
                 // Stand 500 mm out of the goal line, facing the field, level with the ball
@@ -258,7 +250,7 @@ impl MilanBrain {
             }
         }
         if self.keeper {
-            v.push(("KeeperDepth", me.x - (-self.field.half_length + 500.0), q));
+            v.push(("KeeperDepth", me.x - (-field.half_length + 500.0), q));
         }
         let nearest = w
             .mates
@@ -304,7 +296,7 @@ pub fn team(
 ) -> Result<Vec<Box<dyn Brain + Send>>, String> {
     let size = cfg.team_size;
     if stack != Stack::Chaos {
-        return (0..size).map(|i| send_brain(stack, i == 0, cfg)).collect();
+        return (0..size).map(|i| send_brain(stack, i == 0)).collect();
     }
     let dir = match behaviors {
         Some(d) => FilesDir::user(d),
@@ -319,18 +311,12 @@ pub fn team(
         .collect())
 }
 
-/// A brain that may move between threads (a bus Member): Milan or the baseline. The Chaos
-/// stack lives in a Lua state, which may not: it runs as a [`ChaosBrain`] or, on the bus, as a
-/// `BehaviorMember`.
-pub fn send_brain(
-    stack: Stack,
-    keeper: bool,
-    cfg: &RobotConfig,
-) -> Result<Box<dyn Brain + Send>, String> {
-    let field = Geometry::of(&cfg.field);
+/// The brain of a Milan or baseline robot (the goalkeeper when `keeper`). The Chaos stack
+/// needs its behavior files: a [`ChaosBrain`], or on the bus its behavior Member.
+pub fn send_brain(stack: Stack, keeper: bool) -> Result<Box<dyn Brain + Send>, String> {
     match stack {
-        Stack::Milan => Ok(Box::new(MilanBrain::new(&embedded_milan()?, keeper, field)?)),
-        Stack::Chaser => Ok(Box::new(Chaser { keeper, field })),
+        Stack::Milan => Ok(Box::new(MilanBrain::new(&embedded_milan()?, keeper)?)),
+        Stack::Chaser => Ok(Box::new(Chaser { keeper })),
         Stack::Chaos => {
             Err("the Chaos stack runs in a Lua state (ChaosBrain, BehaviorMember)".into())
         }
@@ -344,8 +330,6 @@ pub fn send_brain(
 pub struct Chaser {
     /// Plays as goalkeeper.
     pub keeper: bool,
-    /// The field it plays on.
-    pub field: Geometry,
 }
 
 impl Chaser {
@@ -389,7 +373,8 @@ impl Brain for Chaser {
         }
         let me = w.my_pos.pose;
         // Ball in the team frame (mm); x towards the opponent's net at (half length, 0).
-        let (hl, gw) = (self.field.half_length, self.field.goal_half_width);
+        let field = Geometry::of(&w.field);
+        let (hl, gw) = (field.half_length, field.goal_half_width);
         let a = me.theta + ball.theta;
         let (bx, by) = Geometry::ball_at(me, &ball);
         if self.keeper {
@@ -398,7 +383,7 @@ impl Brain for Chaser {
             let target = (-(hl - 300.0), by.clamp(-lim, lim));
             Chaser::go(me, target, a, &mut c);
         } else {
-            let behind = self.field.behind_ball((bx, by), 500.0);
+            let behind = field.behind_ball((bx, by), 500.0);
             let shot = behind.theta;
             let (ux, uy) = (shot.cos(), shot.sin());
             // Lined up: behind the ball, looking at the net.

@@ -17,9 +17,7 @@ use mrt_robot::stacks::{team, Chaser, Stack};
 use std::sync::{Arc, Mutex};
 
 fn chasers(n: usize) -> Vec<Box<dyn Brain + Send>> {
-    (0..n)
-        .map(|i| Box::new(Chaser { keeper: i == 0, ..Chaser::default() }) as Box<dyn Brain + Send>)
-        .collect()
+    (0..n).map(|i| Box::new(Chaser { keeper: i == 0 }) as Box<dyn Brain + Send>).collect()
 }
 
 fn short(minutes: f64, team: usize) -> SimConfig {
@@ -169,8 +167,8 @@ fn a_chaser_alone_scores_within_two_minutes() {
     let m = BusMatch::with_brains(
         &cfg,
         1,
-        vec![Box::new(Chaser { keeper: false, ..Chaser::default() })],
-        vec![Box::new(Chaser { keeper: true, ..Chaser::default() })],
+        vec![Box::new(Chaser { keeper: false })],
+        vec![Box::new(Chaser { keeper: true })],
     )
     .unwrap();
     let report = m.play_until(120.0, |_| {}).unwrap();
