@@ -1,8 +1,9 @@
 //! `mrt sim --distributed`: the simulator in this process, each robot's Agora in a process of
-//! its own (`mrt sim-robot`), talking over zenoh on loopback (`mrt-net`).
+//! its own (`mrt robot --config FILE`, the real-robot entry point, with a robot file written
+//! for it), talking over zenoh on loopback (`mrt-net`).
 //!
-//! The robots run the same Members as in one process (`mrt_sim::remote`); only configuration
-//! differs. Each team is a network of its own: for team `t` this process writes one
+//! The robots run the same robot program as in one process (`mrt-robot`); only their devices
+//! differ (linked, over the network). Each team is a network of its own: for team `t` this process writes one
 //! MRT-manual §3.3.1 file per robot into a temporary directory, with the team's discovery port
 //! on the network line and static `ip link` lines to the simulator and to the lower-numbered
 //! teammates, so no robot depends on multicast and no robot hears the other team.
@@ -14,7 +15,8 @@ use mrt_dcdt::Message;
 use mrt_msgs::MateReport;
 use mrt_msgs::{DeviceAct, DeviceFrame};
 use mrt_net::{NetConfig, NetLink};
-use mrt_robot::members::{behaviors_dir, RobotSpec};
+use mrt_robot::config::RobotFile;
+use mrt_robot::members::behaviors_dir;
 use mrt_robot::remote::RemoteRobot;
 use mrt_robot::stacks::Stack;
 use mrt_sim::config::SimConfig;
@@ -34,27 +36,13 @@ fn sim_agora(t: usize) -> u32 {
     201 + t as u32
 }
 
-/// What `mrt sim-robot` is given (written by `mrt sim --distributed`).
+/// `mrt robot --config FILE`: one robot's Agora on its configured devices.
 #[derive(clap::Args)]
 pub struct RobotArgs {
-    /// The robot (0 .. 2 × team size: home, then away).
+    /// The robot file (TOML; see configs/robot/linked.toml): which robot, its stack, body,
+    /// sensors, field, guidance and devices.
     #[arg(long)]
-    pub robot: usize,
-    /// The home team's stack.
-    #[arg(long)]
-    pub home: String,
-    /// The away team's stack.
-    #[arg(long)]
-    pub away: String,
-    /// The simulator configuration of the match (TOML).
-    #[arg(long)]
-    pub sim_config: PathBuf,
-    /// The robot's Agora configuration file (MRT manual §3.3.1).
-    #[arg(long)]
-    pub net: PathBuf,
-    /// TeamChaos behaviors to run instead of the built-in ones.
-    #[arg(long)]
-    pub behaviors: Option<PathBuf>,
+    pub config: PathBuf,
 }
 
 fn free_tcp_port() -> Result<u16> {
@@ -152,8 +140,6 @@ pub fn play(
     let dir = std::env::temp_dir().join(format!("mrt-distributed-{}-{seed}", std::process::id()));
     std::fs::create_dir_all(&dir).with_context(|| format!("cannot create {}", dir.display()))?;
     let mut procs = Robots { dir: dir.clone(), children: Vec::new() };
-    let sim_config = dir.join("sim.toml");
-    std::fs::write(&sim_config, cfg.to_toml().map_err(|e| anyhow!("{e}"))?)?;
     let ports = (0..robots).map(|_| free_tcp_port()).collect::<Result<Vec<_>>>()?;
     let sim_ports = [free_tcp_port()?, free_tcp_port()?];
     let exe = std::env::current_exe().context("cannot find the mrt executable")?;
@@ -165,18 +151,21 @@ pub fn play(
         links.push(NetLink::attach(&agora, &NetConfig::loopback(port, &[]))?);
         agoras.push(agora);
     }
-    let mut nets = Vec::new();
+    let mut files = Vec::new();
     for (t, sim_port) in sim_ports.iter().enumerate() {
         let discovery = free_udp_port()?;
+        let stack = if t == 0 { home } else { away };
         for i in t * n..(t + 1) * n {
             let net = dir.join(format!("robot-{i}.cfg"));
             std::fs::write(&net, robot_net_file(i, t * n, discovery, *sim_port, &ports))?;
-            nets.push(net);
+            let file = dir.join(format!("robot-{i}.toml"));
+            std::fs::write(&file, robot_file(cfg, i, stack, behaviors, &net)?)?;
+            files.push(file);
         }
     }
-    let launch = Launch { exe, stacks: (home, away), sim_config, behaviors };
-    for (i, net) in nets.iter().enumerate() {
-        let child = launch.robot(i, net, &procs.log(i))?;
+    let launch = Launch { exe };
+    for (i, file) in files.iter().enumerate() {
+        let child = launch.robot(i, file, &procs.log(i))?;
         procs.children.push((i, child));
     }
     // The simulator subscribes to the robots' answers before any robot is ready.
@@ -234,7 +223,7 @@ pub fn play(
                 let _ = c.wait();
             }
             presence.mark_gone(r.robot);
-            match launch.robot(r.robot, &nets[r.robot], &log) {
+            match launch.robot(r.robot, &files[r.robot], &log) {
                 Ok(child) => {
                     restarted = Some((Instant::now(), log));
                     procs.children.push((r.robot, child));
@@ -273,33 +262,44 @@ pub fn play(
     Ok((report, rejoined))
 }
 
-/// How the robot processes are started (also again, mid-match).
-struct Launch<'a> {
+/// How the robot processes are started (also again, mid-match): `mrt robot --config FILE`,
+/// each with the robot file this match wrote for it.
+struct Launch {
     exe: PathBuf,
-    stacks: (Stack, Stack),
-    sim_config: PathBuf,
-    behaviors: Option<&'a Path>,
 }
 
-impl Launch<'_> {
-    fn robot(&self, i: usize, net: &Path, log: &Path) -> Result<Child> {
+impl Launch {
+    fn robot(&self, i: usize, file: &Path, log: &Path) -> Result<Child> {
         let log = std::fs::File::create(log)?;
-        let mut cmd = Command::new(&self.exe);
-        cmd.arg("sim-robot")
-            .args(["--robot", &i.to_string(), "--home", self.stacks.0.name()])
-            .args(["--away", self.stacks.1.name()])
-            .arg("--sim-config")
-            .arg(&self.sim_config)
-            .arg("--net")
-            .arg(net)
+        Command::new(&self.exe)
+            .arg("robot")
+            .arg("--config")
+            .arg(file)
             .stdin(Stdio::null())
             .stdout(Stdio::null())
-            .stderr(log);
-        if let Some(b) = self.behaviors {
-            cmd.arg("--behaviors").arg(b);
-        }
-        cmd.spawn().with_context(|| format!("cannot start robot {i}"))
+            .stderr(log)
+            .spawn()
+            .with_context(|| format!("cannot start robot {i}"))
     }
+}
+
+/// Robot `i`'s file in this match: the world's robot (`SimConfig::robot_file`), its stack,
+/// the behaviors, its devices linked over `net` to the simulator's Agora of its team.
+fn robot_file(
+    cfg: &SimConfig,
+    i: usize,
+    stack: Stack,
+    behaviors: Option<&Path>,
+    net: &Path,
+) -> Result<String> {
+    let n = cfg.rules.team_size.max(1);
+    let mut file = cfg.robot_file(i, stack.name());
+    // The robot resolves relative paths against its file's directory: give it absolute ones.
+    file.robot.behaviors = behaviors.map(std::path::absolute).transpose()?;
+    file.devices.net = Some(net.to_path_buf());
+    file.devices.agora = sim_agora(i / n);
+    let text = file.to_toml().map_err(|e| anyhow!("{e}"))?;
+    Ok(format!("# Robot {i} of a distributed match (written by mrt sim --distributed).\n{text}"))
 }
 
 /// A robot process to kill and start again during the match.
@@ -329,23 +329,33 @@ const FIRST_ANSWER: &str = "first answer ";
 /// What a robot process writes to its log when it is ready to play.
 const PHASES: &str = "phases: ";
 
-/// `mrt sim-robot`: one robot of a distributed match, until the final whistle.
+/// `mrt robot --config FILE`: one robot's Agora on its configured devices, until the final
+/// whistle (linked devices: the simulator that drives them says when).
 pub fn robot(args: &RobotArgs) -> Result<()> {
     let started = Instant::now();
-    let cfg = SimConfig::from_file(&args.sim_config).map_err(|e| anyhow!("{e}"))?;
-    let net = AgoraConfig::from_file(&args.net).map_err(|e| anyhow!("{e}"))?;
-    let stacks = (
-        Stack::parse(&args.home).map_err(|e| anyhow!("--home: {e}"))?,
-        Stack::parse(&args.away).map_err(|e| anyhow!("--away: {e}"))?,
-    );
-    let n = cfg.rules.team_size.max(1);
-    if args.robot >= 2 * n {
-        bail!("--robot {}: a match has robots 0 to {}", args.robot, 2 * n - 1);
+    let file = RobotFile::from_file(&args.config).map_err(|e| anyhow!("{e}"))?;
+    let robot_cfg = file.config().map_err(|e| anyhow!("{}: {e}", args.config.display()))?;
+    let spec = file.spec().map_err(|e| anyhow!("{}: {e}", args.config.display()))?;
+    if file.devices.kind != "linked" {
+        bail!(
+            "{}: devices.kind = \"{}\": this mrt drives linked devices only (a robot with its \
+             own hardware implements mrt_robot::devices::Devices; see ARCHITECTURE.md)",
+            args.config.display(),
+            file.devices.kind
+        );
     }
-    let spec = RobotSpec::of(args.robot, n, stacks);
-    let dir =
-        behaviors_dir(&[spec.stack], args.behaviors.as_deref()).map_err(|e| anyhow!("{e}"))?;
-    let robot_cfg = cfg.robot().map_err(|e| anyhow!("{e}"))?;
+    // Paths in the file are relative to it.
+    let here = args.config.parent().unwrap_or(Path::new("."));
+    let net = file
+        .devices
+        .net
+        .as_ref()
+        .map(|p| here.join(p))
+        .ok_or_else(|| anyhow!("{}: devices.net is missing", args.config.display()))?;
+    let net = AgoraConfig::from_file(&net).map_err(|e| anyhow!("{e}"))?;
+    let behaviors = file.robot.behaviors.as_ref().map(|p| here.join(p));
+    let dir = behaviors_dir(&[spec.stack], behaviors.as_deref()).map_err(|e| anyhow!("{e}"))?;
+    let id = spec.robot;
     let mut robot =
         RemoteRobot::new(&robot_cfg, spec, &dir, Some(net)).map_err(|e| anyhow!("{e}"))?;
     let agora = robot.agora().ok_or_else(|| anyhow!("the robot has no Agora"))?;
@@ -353,8 +363,8 @@ pub fn robot(args: &RobotArgs) -> Result<()> {
     let online = link.presence();
     robot.set_presence(move |j| online.contains(AgoraId(j + 1)));
     let linked = Instant::now();
-    // Ready when the simulator hears this robot's answers and every teammate its reports.
-    let sim = AgoraId(sim_agora(args.robot / n));
+    // Ready when the devices' side hears this robot's answers and every teammate its reports.
+    let sim = AgoraId(file.devices.agora);
     let mates: Vec<AgoraId> = robot.mate_agoras().into_iter().map(AgoraId).collect();
     let ready = link.wait_until(START, |l| {
         l.subscribers(DeviceAct::TYPE).contains(&sim)
@@ -362,24 +372,21 @@ pub fn robot(args: &RobotArgs) -> Result<()> {
     });
     if !ready {
         bail!(
-            "robot {}: the simulator ({sim}) and teammates {mates:?} not all found after {START:?} \
-             (found: {:?})",
-            args.robot,
+            "robot {id}: the devices' Agora ({sim}) and teammates {mates:?} not all found after \
+             {START:?} (found: {:?})",
             link.agoras()
         );
     }
     eprintln!(
-        "robot {}: {PHASES}behaviors loaded and linked {:.3} s, ready {:.3} s after start",
-        args.robot,
+        "robot {id}: {PHASES}behaviors loaded and linked {:.3} s, ready {:.3} s after start",
         (linked - started).as_secs_f64(),
         started.elapsed().as_secs_f64()
     );
     robot.open();
-    let run = robot.run(SILENCE).map_err(|e| anyhow!("robot {}: {e}", args.robot))?;
+    let run = robot.run(SILENCE).map_err(|e| anyhow!("robot {id}: {e}"))?;
     if let (Some(f), Some(t)) = (run.first_frame, run.first_answer) {
         eprintln!(
-            "robot {}: {FIRST_ANSWER}{:.3} s after start (first frame {:.3} s)",
-            args.robot,
+            "robot {id}: {FIRST_ANSWER}{:.3} s after start (first frame {:.3} s)",
             (t - started).as_secs_f64(),
             (f - started).as_secs_f64()
         );
@@ -387,8 +394,7 @@ pub fn robot(args: &RobotArgs) -> Result<()> {
     // Let the last word leave before the session closes.
     std::thread::sleep(Duration::from_millis(300));
     eprintln!(
-        "robot {}: {} cycles, teammates late in {}; {:?}",
-        args.robot,
+        "robot {id}: {} cycles, teammates late in {}; {:?}",
         run.cycles,
         run.late_mates,
         link.stats()

@@ -43,10 +43,10 @@ struct Cli {
 enum Command {
     /// Play a simulated robot-soccer match on the embedded default world (or a series).
     Sim(sim::SimArgs),
-    /// One robot of `mrt sim --distributed` (started by it).
+    /// Run one robot: its Agora on the devices its robot file names (configs/robot/; `mrt sim
+    /// --distributed` starts each of its robots with this command).
     #[cfg(feature = "net")]
-    #[command(hide = true)]
-    SimRobot(distributed::RobotArgs),
+    Robot(distributed::RobotArgs),
     /// The blackboard: serve one with its relay, or get, set, watch and list variables
     /// through a relay (docs/relay-protocol.md).
     Bb {
@@ -213,7 +213,7 @@ fn run(command: Command) -> Result<()> {
         Command::Sim(args) => sim::run(&args)?,
         Command::Soak { command } => soak::run(&command)?,
         #[cfg(feature = "net")]
-        Command::SimRobot(args) => distributed::robot(&args)?,
+        Command::Robot(args) => distributed::robot(&args)?,
         Command::Bb { command } => bb::run(command)?,
         Command::Behave { file, world, cycles, period_ms } => {
             behave::behave(&file, world.as_deref(), cycles, period_ms)?

@@ -1,12 +1,15 @@
 //! What belongs to one robot, apart from any simulator's world: its base, its body's size and
 //! kicker reach, its sensors (the mice's mounting, the camera's noise), the field it plays on,
-//! its guidance, its control period and its team's size. The simulator builds one from its
-//! world configuration (`mrt_sim::config::SimConfig::robot`); a real robot fills its own.
+//! its guidance, its control period and its team's size. A robot reads it from its robot file
+//! ([`RobotFile`], `mrt robot --config FILE`, `configs/robot/`); the simulator builds the same
+//! file from its world configuration (`mrt_sim::config::SimConfig::robot_file`).
 
 use crate::base::Base;
 use mrt_perception::mice::MiceOdometry;
 use mrt_plan::guide::Guidance;
 use mrt_world::{FieldMap, WorldModel};
+use serde::{Deserialize, Serialize};
+use std::path::{Path, PathBuf};
 
 /// The camera's measurement noise as the world model assumes it: a relative distance error
 /// and a bearing error (rad), one standard deviation each.
@@ -53,5 +56,363 @@ impl RobotConfig {
     /// The control period as a `Duration` (a non-finite or negative period is 0).
     pub fn period(&self) -> std::time::Duration {
         std::time::Duration::try_from_secs_f64(self.control_period).unwrap_or_default()
+    }
+}
+
+/// What went wrong reading a robot file.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum RobotFileError {
+    /// The file could not be read.
+    #[error("{file}: {source}")]
+    Io {
+        /// The file.
+        file: String,
+        /// The OS error.
+        #[source]
+        source: std::io::Error,
+    },
+    /// The TOML is malformed or names an unknown field.
+    #[error("{file}:{line}:{column}: {message}")]
+    Parse {
+        /// The file.
+        file: String,
+        /// Line, from 1.
+        line: usize,
+        /// Column, from 1.
+        column: usize,
+        /// What is wrong.
+        message: String,
+    },
+    /// A value is out of its range, or the sections do not make a robot.
+    #[error("{file}: {message}")]
+    Invalid {
+        /// The file.
+        file: String,
+        /// What is wrong.
+        message: String,
+    },
+}
+
+/// `[robot]`: which robot this is and what drives it.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct RobotSection {
+    /// The robot's number in its match or team (its Agora is `id + 1`; `id % team_size == 0`
+    /// keeps goal).
+    pub id: usize,
+    /// Robots per team.
+    pub team_size: usize,
+    /// The behavior stack: `chaos`, `milan` or `chaser`.
+    pub stack: String,
+    /// TeamChaos behaviors to run instead of the compiled-in ones (relative to the file).
+    pub behaviors: Option<PathBuf>,
+    /// The control period, s.
+    pub control_period: f64,
+}
+
+impl Default for RobotSection {
+    fn default() -> Self {
+        RobotSection {
+            id: 0,
+            team_size: 4,
+            stack: "chaos".into(),
+            behaviors: None,
+            control_period: 0.1,
+        }
+    }
+}
+
+/// `[body]`: the base and the body's size, speed and kicker.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct BodySection {
+    /// `omni` (three omni wheels, the manual's Triskar) or `differential` (IANUS3).
+    pub base: String,
+    /// Radius of the round footprint, m.
+    pub radius: f64,
+    /// How far in front of the robot's edge the kicker reaches, m.
+    pub kick_reach: f64,
+    /// Top linear speed, m/s (guidance's position mode).
+    pub max_speed: f64,
+    /// Top turning rate, rad/s.
+    pub max_turn_rate: f64,
+}
+
+impl Default for BodySection {
+    fn default() -> Self {
+        BodySection {
+            base: "omni".into(),
+            radius: 0.25,
+            kick_reach: 0.12,
+            max_speed: 1.2,
+            max_turn_rate: 4.0,
+        }
+    }
+}
+
+/// `[sensors]`: the mice's mounting and the camera's noise.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct SensorsSection {
+    /// Distance between the two mice (`D` of the manual's §4.1), m.
+    pub mice_distance: f64,
+    /// Tolerance of the `x̄_r = x̄_l` check, m.
+    pub mice_tolerance: f64,
+    /// The camera's relative distance error.
+    pub camera_distance_noise: f64,
+    /// The camera's bearing error, rad.
+    pub camera_bearing_noise: f64,
+    /// Radius of the ball, m.
+    pub ball_radius: f64,
+}
+
+impl Default for SensorsSection {
+    fn default() -> Self {
+        SensorsSection {
+            mice_distance: 0.2,
+            mice_tolerance: 0.003,
+            camera_distance_noise: 0.03,
+            camera_bearing_noise: 0.02,
+            ball_radius: 0.11,
+        }
+    }
+}
+
+/// `[guidance]` (ISocRob seed `003` §3.2.3).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct GuidanceSection {
+    /// Velocity mode halts the translation when a sonar within `half_cone` of the direction
+    /// of motion reads less than this, m from the robot's centre.
+    pub safety_distance: f64,
+    /// See `safety_distance`, rad.
+    pub half_cone: f64,
+}
+
+impl Default for GuidanceSection {
+    fn default() -> Self {
+        GuidanceSection { safety_distance: 0.35, half_cone: std::f64::consts::PI / 6.0 }
+    }
+}
+
+/// `[devices]`: what the robot's drivers talk to.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct DevicesSection {
+    /// `linked`: the devices are reached over the bus ([`crate::devices::LinkedDevices`]: a
+    /// simulator in another process, or a board that speaks DCDT). A team whose robot has its
+    /// own hardware implements [`crate::devices::Devices`] in Rust (ARCHITECTURE.md, "Adding
+    /// a real robot").
+    pub kind: String,
+    /// The robot's Agora configuration file (MRT manual §3.3.1), relative to this file.
+    pub net: Option<PathBuf>,
+    /// The Agora id of the devices' side (the simulator's Agora of this robot's team).
+    pub agora: u32,
+}
+
+impl Default for DevicesSection {
+    fn default() -> Self {
+        DevicesSection { kind: "linked".into(), net: None, agora: 201 }
+    }
+}
+
+/// A robot file (`mrt robot --config FILE`, `configs/robot/`): everything that belongs to one
+/// robot, in SI units. Every section and value has a default (a Triskar base on the Middle Size
+/// League field), so a file only says what differs.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct RobotFile {
+    /// Which robot, which stack.
+    pub robot: RobotSection,
+    /// Its body.
+    pub body: BodySection,
+    /// Its sensors.
+    pub sensors: SensorsSection,
+    /// The field it plays on (metres).
+    pub field: FieldMap,
+    /// Its guidance.
+    pub guidance: GuidanceSection,
+    /// Its devices.
+    pub devices: DevicesSection,
+}
+
+impl RobotFile {
+    /// Parses a robot file; `file` names it in errors (with line and column for TOML errors).
+    pub fn from_toml(text: &str, file: &str) -> Result<RobotFile, RobotFileError> {
+        let parsed: RobotFile = toml::from_str(text).map_err(|e| {
+            let (line, column) = e.span().map_or((1, 1), |s| line_column(text, s.start));
+            RobotFileError::Parse {
+                file: file.to_string(),
+                line,
+                column,
+                message: e.message().trim().to_string(),
+            }
+        })?;
+        let invalid = |message| RobotFileError::Invalid { file: file.to_string(), message };
+        parsed.config().map_err(invalid)?;
+        parsed.spec().map_err(invalid)?;
+        Ok(parsed)
+    }
+
+    /// Reads a robot file.
+    pub fn from_file(path: impl AsRef<Path>) -> Result<RobotFile, RobotFileError> {
+        let path = path.as_ref();
+        let file = path.display().to_string();
+        let text = std::fs::read_to_string(path)
+            .map_err(|source| RobotFileError::Io { file: file.clone(), source })?;
+        RobotFile::from_toml(&text, &file)
+    }
+
+    /// The file as TOML that [`RobotFile::from_toml`] reads back.
+    pub fn to_toml(&self) -> Result<String, String> {
+        toml::to_string(self).map_err(|e| e.to_string())
+    }
+
+    /// Which robot and which stack ([`crate::members::RobotSpec`]).
+    pub fn spec(&self) -> Result<crate::members::RobotSpec, String> {
+        let r = &self.robot;
+        let stack =
+            crate::stacks::Stack::parse(&r.stack).map_err(|e| format!("robot.stack: {e}"))?;
+        let n = r.team_size;
+        if !(1..=11).contains(&n) {
+            return Err(format!("robot.team_size must be 1 to 11, not {n}"));
+        }
+        if r.id >= 2 * n {
+            return Err(format!("robot.id must be below 2 × team_size = {}, not {}", 2 * n, r.id));
+        }
+        Ok(crate::members::RobotSpec { robot: r.id, keeper: r.id % n == 0, stack })
+    }
+
+    /// The robot's configuration, every value checked.
+    pub fn config(&self) -> Result<RobotConfig, String> {
+        use mrt_plan::guidance::{PositionParams, PotentialField, PotentialParams, VelocityGuard};
+        let (r, b, s) = (&self.robot, &self.body, &self.sensors);
+        let positive = |name: &str, v: f64| {
+            if v.is_finite() && v > 0.0 {
+                Ok(v)
+            } else {
+                Err(format!("{name} must be a finite number > 0, not {v}"))
+            }
+        };
+        let control_period = positive("robot.control_period", r.control_period)?;
+        if control_period > 10.0 {
+            return Err(format!("robot.control_period must be at most 10 s, not {control_period}"));
+        }
+        let base = Base::parse(&b.base).map_err(|e| format!("body.{e}"))?;
+        let radius = positive("body.radius", b.radius)?;
+        let f = &self.field;
+        for (name, v) in [
+            ("field.length", f.length),
+            ("field.width", f.width),
+            ("field.goal_width", f.goal_width),
+            ("field.penalty_area_depth", f.penalty_area_depth),
+            ("field.penalty_area_width", f.penalty_area_width),
+            ("field.centre_circle_radius", f.centre_circle_radius),
+            ("sensors.ball_radius", s.ball_radius),
+        ] {
+            positive(name, v)?;
+        }
+        let mice = MiceOdometry::new(s.mice_distance, s.mice_tolerance)
+            .map_err(|e| format!("sensors: {e}"))?;
+        let position = PositionParams {
+            steering: base.steering(),
+            max_speed: positive("body.max_speed", b.max_speed)?,
+            max_omega: positive("body.max_turn_rate", b.max_turn_rate)?,
+            position_tolerance: 0.05,
+            angle_tolerance: 0.05,
+            ..PositionParams::default()
+        };
+        let obstacles = PotentialParams { robot_radius: radius, ..PotentialParams::default() };
+        let g = &self.guidance;
+        let guard = VelocityGuard::new(g.safety_distance, g.half_cone)
+            .map_err(|e| format!("guidance: {e}"))?;
+        let field =
+            PotentialField::new(position, obstacles).map_err(|e| format!("guidance: {e}"))?;
+        let non_negative = |name: &str, v: f64| {
+            if v.is_finite() && v >= 0.0 {
+                Ok(v)
+            } else {
+                Err(format!("{name} must be a finite number >= 0, not {v}"))
+            }
+        };
+        Ok(RobotConfig {
+            control_period,
+            base,
+            radius,
+            kick_reach: non_negative("body.kick_reach", b.kick_reach)?,
+            ball_radius: s.ball_radius,
+            field: self.field,
+            mice,
+            camera: CameraNoise {
+                distance: non_negative("sensors.camera_distance_noise", s.camera_distance_noise)?,
+                bearing: non_negative("sensors.camera_bearing_noise", s.camera_bearing_noise)?,
+            },
+            guidance: Guidance::new(guard, field, s.ball_radius),
+            team_size: r.team_size,
+        })
+    }
+}
+
+/// Line and column (from 1) of byte `offset` in `text`.
+fn line_column(text: &str, offset: usize) -> (usize, usize) {
+    let before = text.get(..offset).unwrap_or(text);
+    let line = before.matches('\n').count() + 1;
+    let column = before.rsplit('\n').next().map_or(0, |l| l.chars().count()) + 1;
+    (line, column)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    #[test]
+    fn an_empty_file_is_the_default_robot() {
+        let f = RobotFile::from_toml("", "robot.toml").unwrap();
+        assert_eq!(f, RobotFile::default());
+        let c = f.config().unwrap();
+        assert_eq!((c.control_period, c.radius, c.team_size), (0.1, 0.25, 4));
+        assert_eq!(c.field, FieldMap::default());
+        let spec = f.spec().unwrap();
+        assert!(spec.keeper, "robot 0 keeps goal");
+        let back = RobotFile::from_toml(&f.to_toml().unwrap(), "again.toml").unwrap();
+        assert_eq!(back, f, "written and read back");
+    }
+
+    #[test]
+    fn errors_name_the_file_line_column_and_value() {
+        let e = RobotFile::from_toml("[robot]\nid = 1\nstak = \"milan\"\n", "r.toml").unwrap_err();
+        assert!(e.to_string().starts_with("r.toml:3:1: unknown field `stak`"), "{e}");
+        let e = RobotFile::from_toml("[body]\nradius = -1\n", "r.toml").unwrap_err();
+        assert_eq!(e.to_string(), "r.toml: body.radius must be a finite number > 0, not -1");
+        let e = RobotFile::from_toml("[robot]\nid = 9\nteam_size = 2\n", "r.toml").unwrap_err();
+        assert!(e.to_string().contains("robot.id must be below 2 × team_size = 4"), "{e}");
+        let e = RobotFile::from_toml("[robot]\nstack = \"lego\"\n", "r.toml").unwrap_err();
+        assert!(e.to_string().contains("unknown team stack 'lego'"), "{e}");
+        let e = RobotFile::from_toml("[sensors]\nmice_distance = 0\n", "r.toml").unwrap_err();
+        assert!(e.to_string().starts_with("r.toml: sensors: "), "{e}");
+    }
+
+    proptest! {
+        /// Random bytes never panic the parser: a robot file or an error.
+        #[test]
+        fn random_text_is_parsed_or_refused(text in "\\PC{0,300}") {
+            let _ = RobotFile::from_toml(&text, "fuzz.toml");
+        }
+
+        /// Random values in every field give a robot or a clear error, never a panic.
+        #[test]
+        fn random_values_are_checked(period in -1e3f64..1e3, radius in -1.0f64..2.0,
+                                     id in 0usize..40, n in 0usize..14, d in -1.0f64..1.0) {
+            let text = format!(
+                "[robot]\nid = {id}\nteam_size = {n}\ncontrol_period = {period:?}\n\
+                 [body]\nradius = {radius:?}\n[sensors]\nmice_distance = {d:?}\n"
+            );
+            if let Ok(f) = RobotFile::from_toml(&text, "p.toml") {
+                let c = f.config().unwrap();
+                prop_assert!(c.control_period > 0.0 && c.radius > 0.0);
+            }
+        }
     }
 }

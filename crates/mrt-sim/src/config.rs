@@ -280,46 +280,48 @@ impl Default for GuidanceConfig {
 }
 
 impl SimConfig {
-    /// The Guidance µAgent for these robots (`[guidance]`, the robot's base, speed and size).
-    pub fn guidance(&self) -> Result<mrt_plan::guide::Guidance, String> {
-        let cfg = self;
-        use mrt_plan::guidance::{PositionParams, PotentialField, PotentialParams, VelocityGuard};
-        let position = PositionParams {
-            steering: mrt_robot::base::Base::parse(&cfg.robot.base)?.steering(),
-            max_speed: cfg.robot.max_speed,
-            max_omega: cfg.robot.max_turn_rate,
-            position_tolerance: 0.05,
-            angle_tolerance: 0.05,
-            ..PositionParams::default()
+    /// Robot `id`'s robot file in this world: its base, size, kicker reach, mice, camera noise,
+    /// guidance and the field it plays on, from this world's sections, with `stack` driving it
+    /// (what `mrt sim --distributed` gives each robot process).
+    pub fn robot_file(&self, id: usize, stack: &str) -> mrt_robot::config::RobotFile {
+        use mrt_robot::config::{
+            BodySection, DevicesSection, GuidanceSection, RobotFile, RobotSection, SensorsSection,
         };
-        let obstacles =
-            PotentialParams { robot_radius: cfg.robot.radius, ..PotentialParams::default() };
-        let guard = VelocityGuard::new(cfg.guidance.safety_distance, cfg.guidance.half_cone)
-            .map_err(|e| format!("guidance: {e}"))?;
-        let field =
-            PotentialField::new(position, obstacles).map_err(|e| format!("guidance: {e}"))?;
-        Ok(mrt_plan::guide::Guidance::new(guard, field, cfg.ball.radius))
+        RobotFile {
+            robot: RobotSection {
+                id,
+                team_size: self.rules.team_size,
+                stack: stack.to_string(),
+                behaviors: None,
+                control_period: self.rules.control_period,
+            },
+            body: BodySection {
+                base: self.robot.base.clone(),
+                radius: self.robot.radius,
+                kick_reach: self.robot.kick_reach,
+                max_speed: self.robot.max_speed,
+                max_turn_rate: self.robot.max_turn_rate,
+            },
+            sensors: SensorsSection {
+                mice_distance: self.odometry.mice_distance,
+                mice_tolerance: self.odometry.mice_tolerance,
+                camera_distance_noise: self.sensor.distance_noise,
+                camera_bearing_noise: self.sensor.bearing_noise,
+                ball_radius: self.ball.radius,
+            },
+            field: self.field.map(),
+            guidance: GuidanceSection {
+                safety_distance: self.guidance.safety_distance,
+                half_cone: self.guidance.half_cone,
+            },
+            devices: DevicesSection::default(),
+        }
     }
 
     /// What each robot of this world is configured with (the robot program's
-    /// [`RobotConfig`](mrt_robot::config::RobotConfig)): its base, size, kicker reach, mice,
-    /// camera noise, guidance and the field it plays on, from this world's sections.
+    /// [`RobotConfig`](mrt_robot::config::RobotConfig)), from [`SimConfig::robot_file`].
     pub fn robot(&self) -> Result<mrt_robot::config::RobotConfig, String> {
-        Ok(mrt_robot::config::RobotConfig {
-            control_period: self.rules.control_period,
-            base: mrt_robot::base::Base::parse(&self.robot.base)?,
-            radius: self.robot.radius,
-            kick_reach: self.robot.kick_reach,
-            ball_radius: self.ball.radius,
-            field: self.field.map(),
-            mice: self.odometry.mice()?,
-            camera: mrt_robot::config::CameraNoise {
-                distance: self.sensor.distance_noise,
-                bearing: self.sensor.bearing_noise,
-            },
-            guidance: self.guidance()?,
-            team_size: self.rules.team_size,
-        })
+        self.robot_file(0, "chaser").config()
     }
 }
 
@@ -516,8 +518,8 @@ impl SimConfig {
             ));
         }
         self.check_derived()?;
-        self.guidance()?;
         self.odometry.mice()?;
+        self.robot()?;
         Ok(())
     }
 

@@ -40,6 +40,7 @@ impl Segment {
 
 /// The field as a map (Middle Size League proportions by default), in metres.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
 pub struct FieldMap {
     /// Length between the goal lines.
     pub length: f64,

@@ -9,6 +9,7 @@ use mrt_blackboard::{BbLimits, Blackboard};
 use mrt_core::SimClock;
 use mrt_dcdt::config::AgoraConfig;
 use mrt_fuzzy::brian::{Brian, BrianSources};
+use mrt_robot::config::RobotFile;
 use mrt_sim::config::SimConfig;
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -116,7 +117,8 @@ impl Harness for SimToml {
         let Ok(cfg) = SimConfig::from_toml(text, "fuzz.toml") else { return false };
         let _ = cfg.field.map();
         let _ = cfg.odometry.mice();
-        let _ = cfg.guidance();
+        let _ = cfg.robot();
+        let _ = cfg.robot_file(0, "chaos").to_toml();
         // Documented: to_toml gives a file from_toml reads back.
         match cfg.to_toml() {
             Ok(again) => {
@@ -125,6 +127,38 @@ impl Harness for SimToml {
                 }
             }
             Err(e) => panic!("a valid configuration does not write as TOML: {e}"),
+        }
+        true
+    }
+}
+
+/// A robot's file (`mrt robot --config`).
+pub(super) const ROBOT_FILE: Target = Target {
+    name: "robot-file",
+    about: "a robot file (mrt robot --config): RobotFile::from_toml (parse + config + spec), and to_toml read back",
+    keywords: &["[robot]", "[body]", "[sensors]", "[field]", "[guidance]", "[devices]", "id", "team_size", "stack", "=", "\"chaos\"", "\"linked\"", "nan", "inf", "-inf", "1e400", "-1"],
+    structured: Some(crate::mutate::mutate_toml),
+    seeds: |root| files_under(&root.join("configs/robot"), |s| s.ends_with(".toml")),
+    harness: |_| Ok(Box::new(RobotToml)),
+};
+
+struct RobotToml;
+
+impl Harness for RobotToml {
+    fn exec(&mut self, _seed: &Seed, input: &[u8]) -> bool {
+        let Ok(text) = std::str::from_utf8(input) else { return false };
+        let Ok(file) = RobotFile::from_toml(text, "fuzz.toml") else { return false };
+        // Documented: a file that reads gives a configuration and a robot.
+        if let Err(e) = file.config().and(file.spec().map(|_| ())) {
+            panic!("a robot file that reads does not make a robot: {e}");
+        }
+        match file.to_toml() {
+            Ok(again) => {
+                if let Err(e) = RobotFile::from_toml(&again, "again.toml") {
+                    panic!("to_toml's output does not read back: {e}\n{again}");
+                }
+            }
+            Err(e) => panic!("a valid robot file does not write as TOML: {e}"),
         }
         true
     }

@@ -68,6 +68,7 @@ pub static TARGETS: &[Target] = &[
     wire::XML,
     files::BRIAN,
     files::SIM_CONFIG,
+    files::ROBOT_FILE,
     files::BB_CONFIG,
     files::RELAY_LINE,
     lua::LUA_SCRIPT,
