@@ -6,6 +6,8 @@
 pub mod fuzzy_controller;
 #[path = "01_hello_agora.rs"]
 pub mod hello_agora;
+#[path = "05_robot_on_its_own_devices.rs"]
+pub mod robot_on_its_own_devices;
 #[path = "04_teamchaos_behaviors.rs"]
 pub mod teamchaos_behaviors;
 #[path = "02_two_agoras.rs"]
@@ -24,6 +26,20 @@ mod tests {
         assert_eq!(names[0], ("Greeter", 5));
         assert_eq!(names[1].0, "Listener");
         assert!(names[1].1 >= 1 && names[1].1 <= 5);
+    }
+
+    /// The robot program runs on a team's own `Devices` with no simulator: the baseline walks
+    /// from 2 m to the ball and kicks it.
+    #[test]
+    fn the_robot_program_runs_on_its_own_devices_and_kicks() {
+        let out = super::robot_on_its_own_devices::run(40, false).unwrap();
+        assert!(out.distances[0] > 1.8, "{:?}", out.distances);
+        // `kicks` counts cycles from 1; `distances[k - 1]` is measured after cycle k.
+        let first = *out.kicks.first().unwrap();
+        assert!(first > 2 && first < 30, "{:?}", out.kicks);
+        let before = out.distances[first - 2];
+        assert!(before < 0.6, "walked up to the ball: {before} m before the kick");
+        assert!(out.distances[first - 1] > 2.0, "and kicked it away: {:?}", out.distances);
     }
 
     #[test]
