@@ -14,7 +14,8 @@
 #![allow(clippy::print_stdout)] // examples talk to the user
 
 use anyhow::{anyhow, Result};
-use mrt_core::{normalize_angle, Pose2, SimClock};
+use mrt_core::frames::{Field, Framed};
+use mrt_core::{Point2, Pose2, SimClock};
 use mrt_dcdt::SteppedExecutor;
 use mrt_msgs::{
     CameraFrame, Displacement, GameInfo, GameState, Odometry, Sighting, Sonar, FIELD_OBJECTS,
@@ -64,9 +65,10 @@ impl Devices for TableRobot {
                 Some(p) => (p.x, p.y),
                 None => self.ball, // object 0 is the ball
             };
-            let (dx, dy) = (at.0 - self.pose.x, at.1 - self.pose.y);
-            let bearing = normalize_angle(dy.atan2(dx) - self.pose.theta);
-            frame.sightings[k] = Some(Sighting { distance: dx.hypot(dy), bearing });
+            // Where it is for the robot (frames are types: a field point, a field pose).
+            let me: Framed<Field, Pose2> = Framed::new(self.pose);
+            let (distance, bearing) = me.range_bearing(Framed::new(Point2::new(at.0, at.1)));
+            frame.sightings[k] = Some(Sighting { distance, bearing });
         }
         Ok(frame)
     }

@@ -8,6 +8,8 @@
 //! - **time**: the [`Clock`] trait with a [`WallClock`] for real robots and a manually advanced
 //!   [`SimClock`] for the simulator. Everything in DCDT reads time only through a `Clock`, so a
 //!   simulated match runs as fast as the CPU allows and is reproducible;
+//! - **frames and units** ([`frames`]): field, team and robot frames as types
+//!   ([`frames::Framed`]), their named conversions, and the one millimetre factor of the edges;
 //! - **2D geometry** on top of `nalgebra`: [`Vec2`], [`Point2`], [`Pose2`] and angle helpers
 //!   ([`normalize_angle`], [`angle_diff`]).
 //!
@@ -36,6 +38,7 @@
 //! | a typed DCDT message (§3.2) | [`Message`] (the standard ones: crate `mrt-msgs`) |
 #![deny(missing_docs)]
 
+pub mod frames;
 mod geometry;
 mod ids;
 mod message;

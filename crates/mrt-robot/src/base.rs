@@ -6,6 +6,7 @@
 //! base (a differential drive cannot move sideways; a command beyond a wheel's top speed is
 //! scaled down as a whole, keeping its direction).
 
+use mrt_core::frames::MM_PER_M;
 use mrt_msgs::RobotCommand;
 use mrt_plan::kinematics::{
     duty_cycle, DiffDrive, Kinematics, Omni3, OmniWheels, Steering, Twist, WheelSpeeds,
@@ -72,9 +73,10 @@ impl Base {
     /// beyond the wheels' top speed is scaled down as a whole (direction kept).
     pub fn duties(&self, cmd: &RobotCommand) -> Vec<f64> {
         let finite = |x: f64| if x.is_finite() { x } else { 0.0 };
+        // The command's edge units (mm/s, deg/s: the behaviors' own) to SI.
         let twist = Twist::new(
-            finite(cmd.vlin) / 1000.0,
-            finite(cmd.vlat) / 1000.0,
+            finite(cmd.vlin) / MM_PER_M,
+            finite(cmd.vlat) / MM_PER_M,
             finite(cmd.vrot).to_radians(),
         );
         match self {

@@ -11,6 +11,7 @@
 use crate::config::{OdometryConfig, SensorConfig, SonarConfig};
 use crate::referee::Referee;
 use crate::world::World;
+use mrt_core::frames::{Field, Framed};
 use mrt_core::{normalize_angle, Pose2};
 use mrt_msgs::robot::lps;
 use mrt_perception::mice::{Displacement, MiceOdometry};
@@ -95,9 +96,9 @@ pub fn look(world: &World, robot: usize, cfg: &SensorConfig, rng: &mut dyn RngCo
         .collect();
     let mut frame = CameraFrame { time: world.time(), ..Default::default() };
     for (k, target) in targets(world).into_iter().enumerate() {
-        let (dx, dy) = (target.0 - me.x, target.1 - me.y);
-        let dist = dx.hypot(dy);
-        let bearing = normalize_angle(dy.atan2(dx) - me.theta);
+        // The truth, in the robot's frame: what a perfect camera would measure.
+        let (dist, bearing) = Framed::<Field, _>::new(me)
+            .range_bearing(Framed::new(mrt_core::Point2::new(target.0, target.1)));
         let occluded =
             k == lps::BALL && robots.iter().any(|&c| blocks((me.x, me.y), target, c, r_robot));
         let range = if k == lps::BALL { cfg.range } else { cfg.landmark_range };

@@ -25,7 +25,8 @@
 //! robot sees the landmarks, falling as it goes without them.
 
 use crate::field::FieldMap;
-use mrt_core::{normalize_angle, Pose2, Time, Vec2};
+use mrt_core::frames::{Attack, Field, Framed, Team, MM_PER_M};
+use mrt_core::{normalize_angle, Point2, Pose2, Time, Vec2};
 use mrt_msgs::robot::{lps, Estimate, Lpo, WorldSnapshot};
 use mrt_msgs::{CameraFrame, GameInfo, Localization, Odometry, Sighting, FIELD_OBJECTS};
 use mrt_perception::mice::{Displacement, MiceOdometry, MiceReadings};
@@ -52,8 +53,6 @@ const FLOOR: (f64, f64) = (0.002, 0.002);
 const PLACED_SIGMA: (f64, f64) = (0.05, 0.05);
 /// Uncertainty added when the filter finds itself lost (m, rad).
 const LOST_SIGMA: (f64, f64) = (1.0, 0.5);
-/// Millimetres per metre: the snapshot's unit (TeamChaos' LPS, seed `001` §3.3).
-const MM: f64 = 1000.0;
 
 /// LPS slot → field object (sensor order) for a team attacking west: its frame is the field
 /// turned half round, so its opponent's net is the west net, its "north-east" corner the
@@ -63,7 +62,7 @@ const ATTACKING_WEST: [usize; FIELD_OBJECTS] = [0, 2, 1, 6, 5, 4, 3, 8, 7];
 /// Where one object was last seen (field frame, m), how reliable that is, and when (s).
 #[derive(Clone, Copy, Debug)]
 struct Memory {
-    at: (f64, f64),
+    at: Framed<Field, Point2>,
     reliability: f64,
     seen: f64,
 }
@@ -273,12 +272,11 @@ impl WorldModel {
             self.cov += Matrix3::from_diagonal(&Vector3::new(xy * xy, xy * xy, theta * theta));
             self.correct_all(frame);
         }
-        let me = self.pose;
+        let me: Framed<Field, Pose2> = Framed::new(self.pose);
         for (k, z) in frame.sightings.iter().enumerate() {
             match z {
                 Some(z) => {
-                    let a = me.theta + z.bearing;
-                    let at = (me.x + z.distance * a.cos(), me.y + z.distance * a.sin());
+                    let at = me.at_range_bearing(z.distance, z.bearing);
                     self.memory[k] = Some(Memory { at, reliability: 1.0, seen: frame.time });
                 }
                 None => {
@@ -310,11 +308,13 @@ impl WorldModel {
 
     /// The world snapshot in the team frame.
     fn snapshot(&self, frame: &CameraFrame) -> WorldSnapshot {
-        let me = self.pose;
-        let west = self.game.attack < 0.0;
-        let dir = if west { -1.0 } else { 1.0 };
-        let to_team = |x: f64, y: f64| (dir * x * MM, dir * y * MM);
-        let turn = |theta: f64| if west { normalize_angle(theta + PI) } else { theta };
+        let me: Framed<Field, Pose2> = Framed::new(self.pose);
+        let attack = Attack::from_direction(self.game.attack);
+        // The snapshot's edge: the team frame in millimetres (TeamChaos' LPS and GS).
+        let mm = |p: Framed<Team, Point2>| (p.inner.x * MM_PER_M, p.inner.y * MM_PER_M);
+        let mm_pose = |p: Framed<Team, Pose2>| {
+            Pose2::new(p.inner.x * MM_PER_M, p.inner.y * MM_PER_M, p.inner.theta)
+        };
         let mut w = WorldSnapshot {
             time: Time::from_secs_f64(frame.time),
             game_state: self.game.state,
@@ -322,32 +322,32 @@ impl WorldModel {
             ..Default::default()
         };
         for (slot, lpo) in w.lps.iter_mut().enumerate() {
-            let object = if west { ATTACKING_WEST[slot] } else { slot };
-            let Some(Memory { at: (x, y), reliability, seen }) = self.memory[object] else {
+            let object = if attack == Attack::West { ATTACKING_WEST[slot] } else { slot };
+            let Some(Memory { at, reliability, seen }) = self.memory[object] else {
                 continue;
             };
-            let (dx, dy) = (x - me.x, y - me.y);
+            let (range, bearing) = me.range_bearing(at);
             *lpo = Lpo {
-                rho: dx.hypot(dy) * MM,
-                theta: normalize_angle(dy.atan2(dx) - me.theta),
+                rho: range * MM_PER_M,
+                theta: bearing,
                 reliability,
                 seen_ago: frame.time - seen,
             };
         }
-        let (mx, my) = to_team(me.x, me.y);
-        w.my_pos = Estimate { pose: Pose2::new(mx, my, turn(me.theta)), quality: self.quality() };
-        w.kickoff_pose = self.game.kickoff_pose.map(|p| {
-            let (x, y) = to_team(p.x, p.y);
-            Pose2::new(x, y, turn(p.theta))
-        });
-        if let Some(Memory { at: (bx, by), reliability, .. }) = self.memory[lps::BALL] {
-            let (x, y) = to_team(bx, by);
+        w.my_pos = Estimate { pose: mm_pose(me.to_team(attack)), quality: self.quality() };
+        w.kickoff_pose =
+            self.game.kickoff_pose.map(|p| mm_pose(Framed::<Field, _>::new(p).to_team(attack)));
+        if let Some(Memory { at, reliability, .. }) = self.memory[lps::BALL] {
+            let (x, y) = mm(at.to_team(attack));
             w.global_ball = Estimate { pose: Pose2::new(x, y, 0.0), quality: reliability };
         }
         if let Some((vx, vy)) = frame.ball_velocity {
-            // Robot frame → field (by the estimated heading) → team.
-            let (s, c) = me.theta.sin_cos();
-            let (fx, fy) = to_team(c * vx - s * vy, s * vx + c * vy);
+            // A velocity in the robot frame, turned by the estimated heading into the field
+            // frame, then into the team's.
+            let (s, c) = self.pose.theta.sin_cos();
+            let v: Framed<Field, Point2> =
+                Framed::new(Point2::new(c * vx - s * vy, s * vx + c * vy));
+            let (fx, fy) = mm(v.to_team(attack));
             w.ball_vel = Vec2::new(fx, fy);
         }
         w
