@@ -38,12 +38,14 @@
 //! | a typed DCDT message (§3.2) | [`Message`] (the standard ones: crate `mrt-msgs`) |
 #![deny(missing_docs)]
 
+mod file_error;
 pub mod frames;
 mod geometry;
 mod ids;
 mod message;
 mod time;
 
+pub use file_error::{line_column, FileError};
 pub use geometry::{
     angle_diff, arc_displacement, arc_velocity, normalize_angle, normalize_angle_positive, sinc,
     Point2, Pose2, Vec2,

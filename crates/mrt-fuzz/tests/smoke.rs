@@ -39,6 +39,7 @@ smoke_tests! {
     xml => "xml",
     brian => "brian",
     sim_config => "sim-config",
+    robot_file => "robot-file",
     bb_config => "bb-config",
     relay_line => "relay-line",
     lua_script => "lua-script",

@@ -59,40 +59,8 @@ impl RobotConfig {
     }
 }
 
-/// What went wrong reading a robot file.
-#[derive(Debug, thiserror::Error)]
-#[non_exhaustive]
-pub enum RobotFileError {
-    /// The file could not be read.
-    #[error("{file}: {source}")]
-    Io {
-        /// The file.
-        file: String,
-        /// The OS error.
-        #[source]
-        source: std::io::Error,
-    },
-    /// The TOML is malformed or names an unknown field.
-    #[error("{file}:{line}:{column}: {message}")]
-    Parse {
-        /// The file.
-        file: String,
-        /// Line, from 1.
-        line: usize,
-        /// Column, from 1.
-        column: usize,
-        /// What is wrong.
-        message: String,
-    },
-    /// A value is out of its range, or the sections do not make a robot.
-    #[error("{file}: {message}")]
-    Invalid {
-        /// The file.
-        file: String,
-        /// What is wrong.
-        message: String,
-    },
-}
+/// What went wrong reading a robot file (the file, and the line and column of a syntax error).
+pub type RobotFileError = mrt_core::FileError;
 
 /// `[robot]`: which robot this is and what drives it.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -241,13 +209,7 @@ impl RobotFile {
     /// Parses a robot file; `file` names it in errors (with line and column for TOML errors).
     pub fn from_toml(text: &str, file: &str) -> Result<RobotFile, RobotFileError> {
         let parsed: RobotFile = toml::from_str(text).map_err(|e| {
-            let (line, column) = e.span().map_or((1, 1), |s| line_column(text, s.start));
-            RobotFileError::Parse {
-                file: file.to_string(),
-                line,
-                column,
-                message: e.message().trim().to_string(),
-            }
+            RobotFileError::parse(file, text, e.span().map(|s| s.start), e.message())
         })?;
         let invalid = |message| RobotFileError::Invalid { file: file.to_string(), message };
         parsed.config().map_err(invalid)?;
@@ -352,14 +314,6 @@ impl RobotFile {
             team_size: r.team_size,
         })
     }
-}
-
-/// Line and column (from 1) of byte `offset` in `text`.
-fn line_column(text: &str, offset: usize) -> (usize, usize) {
-    let before = text.get(..offset).unwrap_or(text);
-    let line = before.matches('\n').count() + 1;
-    let column = before.rsplit('\n').next().map_or(0, |l| l.chars().count()) + 1;
-    (line, column)
 }
 
 #[cfg(test)]

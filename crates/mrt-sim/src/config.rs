@@ -347,53 +347,15 @@ pub struct SimConfig {
     pub odometry: OdometryConfig,
 }
 
-/// A configuration that cannot be used.
-#[derive(Debug, thiserror::Error)]
-#[non_exhaustive]
-pub enum ConfigError {
-    /// The file could not be read.
-    #[error("{file}: {source}")]
-    Io {
-        /// The file.
-        file: String,
-        /// The OS error.
-        #[source]
-        source: std::io::Error,
-    },
-    /// The TOML is malformed or names an unknown field.
-    #[error("{file}:{line}:{column}: {message}")]
-    Parse {
-        /// The file.
-        file: String,
-        /// Line, from 1.
-        line: usize,
-        /// Column, from 1.
-        column: usize,
-        /// What is wrong.
-        message: String,
-    },
-    /// A value is out of its range.
-    #[error("{file}: {message}")]
-    Invalid {
-        /// The file.
-        file: String,
-        /// What is wrong.
-        message: String,
-    },
-}
+/// What went wrong reading a configuration file (the file, and the line and column of a
+/// syntax error).
+pub type ConfigError = mrt_core::FileError;
 
 impl SimConfig {
     /// Parses a configuration; `file` names it in errors.
     pub fn from_toml(text: &str, file: &str) -> Result<SimConfig, ConfigError> {
-        let cfg: SimConfig = toml::from_str(text).map_err(|e| {
-            let (line, column) = e.span().map_or((1, 1), |s| line_column(text, s.start));
-            ConfigError::Parse {
-                file: file.to_string(),
-                line,
-                column,
-                message: e.message().to_string(),
-            }
-        })?;
+        let cfg: SimConfig = toml::from_str(text)
+            .map_err(|e| ConfigError::parse(file, text, e.span().map(|s| s.start), e.message()))?;
         cfg.validate()
             .map_err(|message| ConfigError::Invalid { file: file.to_string(), message })?;
         Ok(cfg)
@@ -619,14 +581,6 @@ pub const MAX_HALF_DURATION: f64 = 86_400.0;
 pub const ENTRY_SPACING: f64 = 1.2;
 /// The narrowest goal, m: the goalkeepers of every stack keep 0.1 m inside the posts.
 pub const MIN_GOAL_WIDTH: f64 = 0.2;
-
-/// Line and column (from 1) of a byte offset.
-fn line_column(text: &str, offset: usize) -> (usize, usize) {
-    let before = &text[..offset.min(text.len())];
-    let line = before.matches('\n').count() + 1;
-    let column = before.rsplit('\n').next().map_or(0, |l| l.chars().count()) + 1;
-    (line, column)
-}
 
 /// The default configuration with halves of `seconds` and `team` robots a side (tests).
 #[cfg(test)]
