@@ -8,11 +8,11 @@
 //!    `camera-<n>` what the camera (object sensor) sees ([`CameraFrame`]),
 //!    `game-controller-<n>` the referee's news ([`GameInfo`]), `sonars-<n>` the sonar ring
 //!    ([`SonarScan`]);
-//! 2. **`WorldState`** (periodic): fuses odometry, camera and game controller into the robot's own pose and LPS
-//!    ([`WorldModel`]), takes its teammates' poses from their reports received over the bus,
-//!    and publishes the [`WorldSnapshot`] and, for monitors, its [`Localization`](mrt_msgs::Localization);
-//!    it also publishes a [`MateReport`] (its pose and its
-//!    ball estimate) that the teammates' Agoras receive through their team's link — a
+//! 2. **`WorldState`** (periodic): fuses odometry, camera and game controller into the robot's
+//!    own pose and LPS ([`WorldModel`]), takes its teammates' poses from their reports
+//!    received over the bus, and publishes the [`WorldSnapshot`] and, for monitors, its
+//!    [`Localization`](mrt_msgs::Localization); it also publishes a [`MateReport`] (its pose
+//!    and its ball estimate) that the teammates' Agoras receive through their team's link — a
 //!    `RequestType::Remote` subscription, so a robot never hears itself;
 //! 3. **the behaviors**: a [`BehaviorMember`] running the TeamChaos HFSM or goalkeeper for the
 //!    Chaos stack, or a [`BrainMember`] around any `Send` [`Brain`](crate::brain::Brain)
@@ -55,8 +55,8 @@ fn lock(d: &SharedDevices) -> Result<MutexGuard<'_, dyn Devices + 'static>, Memb
 }
 
 /// A driver Member (MRT manual §2.1: drivers apart from processing): each cycle it reads one
-/// of the robot's devices and publishes what it read. The odometry, camera and sonar drivers
-/// are this one Member with a different reading.
+/// of the robot's devices and publishes what it read. The odometry, camera, game-controller and
+/// sonar drivers are this one Member with a different reading.
 struct Driver<M> {
     /// `odometry`, `camera`, `sonars`: the Member is named `<kind>-<robot>`.
     kind: &'static str,

@@ -1,10 +1,9 @@
-//! Motors: the robot's base kinematics and the motor-driver interface, in the spirit of the
-//! AIRBoard (MRT manual ch. 5): the processing side turns a velocity command into one PWM duty
-//! cycle per wheel; the driver side applies duty cycles to the motors. In the simulator the
-//! driver is [`SimulatedAirboard`], which turns duty cycles back into wheel speeds and the body
-//! velocity the simulated robot follows — so wheel-speed limits shape the motion exactly as on
-//! a real base (a differential drive cannot move sideways; a command beyond a wheel's top speed
-//! is scaled down as a whole, keeping its direction).
+//! The simulated motors: [`SimulatedAirboard`] is the robot program's
+//! [`MotorDriver`] (AIRBoard-style, MRT manual ch. 5) on the pitch. It takes one PWM duty cycle
+//! per wheel, as a real board does, turns them into the body velocity the base's wheels give
+//! ([`Base::twist_for`]) and drives the simulated robot with it, so wheel-speed limits shape the
+//! motion exactly as on a real base (a differential drive cannot move sideways; a command
+//! beyond a wheel's top speed is scaled down as a whole, keeping its direction).
 
 use crate::world::Drive;
 use mrt_robot::base::{Base, DriverError, MotorDriver};
