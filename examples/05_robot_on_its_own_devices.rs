@@ -48,7 +48,7 @@ impl Devices for TableRobot {
         let twist = self.cfg.base.twist_for(&self.duty).map_err(|e| e.to_string())?;
         self.pose = integrate(self.pose, &twist, self.cfg.control_period);
         let d = self.pose.relative_to(&before);
-        let placed = (!self.placed).then_some(before);
+        let placed = (!self.placed).then_some(Framed::new(before));
         self.placed = true;
         self.cycle += 1;
         Ok(Odometry {

@@ -28,6 +28,7 @@
 //! ```
 
 use crate::geometry::{normalize_angle, Point2, Pose2};
+use serde::{Deserialize, Deserializer, Serialize, Serializer};
 use std::f64::consts::PI;
 use std::marker::PhantomData;
 
@@ -59,6 +60,20 @@ impl<F, T> Framed<F, T> {
     /// `inner`, declared to be in frame `F`.
     pub const fn new(inner: T) -> Self {
         Framed { inner, frame: PhantomData }
+    }
+}
+
+/// On the wire and in files a framed value is its inner value: the frame is the field's type,
+/// documented with the message.
+impl<F, T: Serialize> Serialize for Framed<F, T> {
+    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        self.inner.serialize(s)
+    }
+}
+
+impl<'de, F, T: Deserialize<'de>> Deserialize<'de> for Framed<F, T> {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        T::deserialize(d).map(Framed::new)
     }
 }
 

@@ -102,7 +102,22 @@ mod tests {
             assert_eq!(ids::name_of(*ty), Some(*name), "{ty}");
         }
         use mrt_dcdt::describe::SelfDescribing;
+        assert_eq!(CATALOGUE.len() + 6, ids::TABLE.len(), "SelfDescribing, BbUpdate, 4 probes");
         assert_eq!(SelfDescribing::TYPE, ids::SELF_DESCRIBING);
         assert_eq!(ids::name_of(SelfDescribing::TYPE), Some(SelfDescribing::NAME));
+    }
+
+    /// A framed pose is its pose on the wire: typing the frames changed no byte, and a field
+    /// frame pose reads back as one.
+    #[test]
+    fn framed_fields_are_their_values_on_the_wire() {
+        use mrt_core::frames::{Field, Framed};
+        use mrt_core::Pose2;
+        let pose = Pose2::new(-1.5, 2.0, 0.25);
+        let framed: Framed<Field, Pose2> = Framed::new(pose);
+        assert_eq!(serde_json::to_string(&framed).unwrap(), serde_json::to_string(&pose).unwrap());
+        let g = GameInfo { state: GameState::Ready, attack: -1.0, kickoff_pose: Some(framed) };
+        let back: GameInfo = serde_json::from_str(&serde_json::to_string(&g).unwrap()).unwrap();
+        assert_eq!(back, g);
     }
 }

@@ -2,6 +2,7 @@
 //! seed `001` §4.1: the monitor shows the pose's uncertainty): the estimate in the field frame
 //! with its uncertainty and what the filter used and refused.
 
+use mrt_core::frames::{Field, Framed};
 use mrt_core::Pose2;
 use serde::{Deserialize, Serialize};
 
@@ -27,7 +28,7 @@ pub struct FilterCounts {
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct Localization {
     /// The estimate: field frame, metres from the centre spot, heading in radians.
-    pub pose: Pose2,
+    pub pose: Framed<Field, Pose2>,
     /// Standard deviation of the position (root mean square of x and y), m.
     pub sigma_xy: f64,
     /// Standard deviation of the heading, rad.

@@ -4,6 +4,7 @@
 //! ([`GameInfo`]).
 
 use crate::robot::{lps, GameState};
+use mrt_core::frames::{Field, Framed};
 use mrt_core::Pose2;
 use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
@@ -106,7 +107,7 @@ pub struct Odometry {
     /// The robot was put down by hand at this pose (field frame, m) since the last reading:
     /// the motion above counts from there. The operator tells the robot, as a team does when
     /// it places its robots before a match.
-    pub placed: Option<Pose2>,
+    pub placed: Option<Framed<Field, Pose2>>,
 }
 
 /// How many objects the camera knows: the ball, two nets, six landmarks (as many as LPS slots).
@@ -132,8 +133,8 @@ pub struct GameInfo {
     pub state: GameState,
     /// The direction the robot's team attacks: +1 east, −1 west.
     pub attack: f64,
-    /// The robot's place in the kickoff formation, in READY.
-    pub kickoff_pose: Option<Pose2>,
+    /// The robot's place in the kickoff formation (field frame, m), in READY.
+    pub kickoff_pose: Option<Framed<Field, Pose2>>,
 }
 
 /// One frame of the object sensor, published by the camera driver: distance and bearing of the

@@ -80,7 +80,7 @@ pub fn game_info(referee: &Referee, robot: usize) -> GameInfo {
     GameInfo {
         state: referee.state(),
         attack: referee.attack_direction(referee.team_of(robot)),
-        kickoff_pose: referee.kickoff_pose(robot),
+        kickoff_pose: referee.kickoff_pose(robot).map(Framed::new),
     }
 }
 
@@ -151,7 +151,7 @@ impl Odometer {
         let mut placed = None;
         let from = if count != self.placements {
             self.placements = count;
-            placed = Some(at);
+            placed = Some(Framed::new(at));
             at
         } else {
             self.last.unwrap_or(now)
@@ -236,7 +236,7 @@ mod tests {
         let g = game_info(&r, 1);
         assert_eq!((g.attack, g.state), (1.0, GameState::Ready));
         assert_eq!(game_info(&r, 5).attack, -1.0);
-        assert_eq!(g.kickoff_pose, r.kickoff_pose(1));
+        assert_eq!(g.kickoff_pose.map(|p| p.inner), r.kickoff_pose(1));
         assert_eq!(f.time, w.time());
         // A still ball: zero velocity, reported because the ball is seen.
         assert_eq!(f.ball_velocity, Some((0.0, 0.0)));
@@ -284,7 +284,7 @@ mod tests {
         // The first reading tells where the robot was put down (start of the match).
         let first = odo.read(&w, &exact, 0.1, &mut rng);
         let placed = w.placement(2).1;
-        assert_eq!(first.placed, Some(placed));
+        assert_eq!(first.placed.map(|p| p.inner), Some(placed));
         let d = mice.displacement(&first.mice).unwrap();
         assert!(d.dx.hypot(d.dy) < 1e-6 && d.dtheta.abs() < 1e-6, "f32 physics: {d:?}");
         // Drive forward, sideways and turning for 0.3 s: the mice invert to the body's true
@@ -311,7 +311,7 @@ mod tests {
         let there = Pose2::new(3.0, -1.0, -2.0);
         w.place_robot(2, there);
         let again = odo.read(&w, &exact, 0.1, &mut rng);
-        assert_eq!(again.placed, Some(there));
+        assert_eq!(again.placed.map(|p| p.inner), Some(there));
         assert!(mice.displacement(&again.mice).unwrap().dx.abs() < 1e-6);
     }
 

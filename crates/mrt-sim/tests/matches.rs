@@ -118,8 +118,9 @@ fn robots_know_where_they_are_from_odometry_and_landmarks() {
         assert_eq!(now.len(), 8, "one estimate per robot and cycle");
         for ((robot, l), truth) in now.into_iter().zip(before) {
             let truth = truth.unwrap();
-            errors.push((l.pose.x - truth.x).hypot(l.pose.y - truth.y));
-            headings.push(mrt_core::normalize_angle(l.pose.theta - truth.theta).abs());
+            let p = l.pose.inner;
+            errors.push((p.x - truth.x).hypot(p.y - truth.y));
+            headings.push(mrt_core::normalize_angle(p.theta - truth.theta).abs());
             qualities.push(l.quality);
             last[robot as usize] = l;
         }

@@ -11,6 +11,7 @@
 //! MUREA come here (issue 20).
 //!
 //! ```
+//! use mrt_core::frames::Framed;
 //! use mrt_core::Pose2;
 //! use mrt_msgs::{CameraFrame, GameInfo, GameState, Sighting, lps};
 //! use mrt_perception::mice::MiceOdometry;
@@ -18,7 +19,8 @@
 //!
 //! let map = FieldMap::default();
 //! let mut model = WorldModel::new(map, MiceOdometry::new(0.2, 1e-3)?, 0.03, 0.02);
-//! model.place(Pose2::new(0.0, 0.0, 0.0)); // put down on the centre spot, facing east
+//! // Put down on the centre spot, facing east (a field-frame pose, as its type says).
+//! model.place(Framed::new(Pose2::new(0.0, 0.0, 0.0)));
 //! // The camera sees the east net 9 m straight ahead and the ball 2 m to the front left.
 //! model.game(GameInfo { state: GameState::Playing, attack: 1.0, kickoff_pose: None });
 //! let mut frame = CameraFrame::default();

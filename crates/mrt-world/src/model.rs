@@ -103,8 +103,8 @@ impl WorldModel {
     }
 
     /// The pose estimate (field frame, m).
-    pub fn pose(&self) -> Pose2 {
-        self.pose
+    pub fn pose(&self) -> Framed<Field, Pose2> {
+        Framed::new(self.pose)
     }
 
     /// Standard deviations of the estimate: position (m, root mean square of x and y) and
@@ -131,7 +131,7 @@ impl WorldModel {
     pub fn localization(&self) -> Localization {
         let (sigma_xy, sigma_theta) = self.sigma();
         Localization {
-            pose: self.pose,
+            pose: self.pose(),
             sigma_xy,
             sigma_theta,
             quality: self.quality(),
@@ -146,8 +146,8 @@ impl WorldModel {
     }
 
     /// Sets the pose, as when the robot is put down by hand.
-    pub fn place(&mut self, pose: Pose2) {
-        self.pose = pose;
+    pub fn place(&mut self, pose: Framed<Field, Pose2>) {
+        self.pose = pose.inner;
         let (xy, theta) = PLACED_SIGMA;
         self.cov = Matrix3::from_diagonal(&Vector3::new(xy * xy, xy * xy, theta * theta));
     }
@@ -335,8 +335,7 @@ impl WorldModel {
             };
         }
         w.my_pos = Estimate { pose: mm_pose(me.to_team(attack)), quality: self.quality() };
-        w.kickoff_pose =
-            self.game.kickoff_pose.map(|p| mm_pose(Framed::<Field, _>::new(p).to_team(attack)));
+        w.kickoff_pose = self.game.kickoff_pose.map(|p| mm_pose(p.to_team(attack)));
         if let Some(Memory { at, reliability, .. }) = self.memory[lps::BALL] {
             let (x, y) = mm(at.to_team(attack));
             w.global_ball = Estimate { pose: Pose2::new(x, y, 0.0), quality: reliability };
@@ -397,7 +396,7 @@ mod tests {
     #[test]
     fn the_mice_alone_carry_the_pose_along_the_path() {
         let mut m = model();
-        m.place(Pose2::new(-2.0, 1.0, 0.5));
+        m.place(Framed::new(Pose2::new(-2.0, 1.0, 0.5)));
         let mut truth = Pose2::new(-2.0, 1.0, 0.5);
         // A curve with a sideways component (omni base), 50 cycles.
         let step = Pose2::new(0.08, 0.02, 0.06);
@@ -405,7 +404,7 @@ mod tests {
             m.odometry(&exact_mice(step));
             truth = truth.compose(&step);
         }
-        let p = m.pose();
+        let p = m.pose().inner;
         assert!((p.x - truth.x).abs() < 1e-9 && (p.y - truth.y).abs() < 1e-9, "{p:?} {truth:?}");
         assert!(normalize_angle(p.theta - truth.theta).abs() < 1e-9);
         assert_eq!(m.counts().mice, 50);
@@ -420,13 +419,13 @@ mod tests {
         let mut m = model();
         let truth = Pose2::new(3.0, -2.0, 2.0);
         // The robot believes it is 0.6 m and 0.15 rad off, and knows it is unsure.
-        m.place(Pose2::new(3.4, -2.45, 2.15));
+        m.place(Framed::new(Pose2::new(3.4, -2.45, 2.15)));
         m.cov = Matrix3::from_diagonal(&Vector3::new(0.25, 0.25, 0.04));
         for t in 0..5 {
             m.odometry(&exact_mice(Pose2::default()));
             m.camera(&frame(truth, f64::from(t) * 0.1, &landmarks()));
         }
-        let p = m.pose();
+        let p = m.pose().inner;
         assert!((p.x - truth.x).hypot(p.y - truth.y) < 0.01, "{p:?}");
         assert!(normalize_angle(p.theta - truth.theta).abs() < 0.005, "{p:?}");
         assert_eq!((m.counts().corrections, m.counts().rejected), (40, 0));
@@ -438,7 +437,7 @@ mod tests {
     fn an_outlier_is_rejected_and_a_lost_robot_finds_itself() {
         let mut m = model();
         let truth = Pose2::new(0.0, 0.0, 0.0);
-        m.place(truth);
+        m.place(Framed::new(truth));
         for t in 0..3 {
             m.odometry(&exact_mice(Pose2::default()));
             m.camera(&frame(truth, f64::from(t) * 0.1, &landmarks()));
@@ -451,7 +450,11 @@ mod tests {
         m.odometry(&exact_mice(Pose2::default()));
         m.camera(&bad);
         assert_eq!(m.counts().rejected, 1);
-        assert!(m.pose().x.abs() < 0.01 && m.pose().y.abs() < 0.01, "{:?}", m.pose());
+        assert!(
+            m.pose().inner.x.abs() < 0.01 && m.pose().inner.y.abs() < 0.01,
+            "{:?}",
+            m.pose().inner
+        );
         // Kidnapped: moved 2 m without odometry. Every landmark disagrees → lost, widen, and
         // the following frames bring it back.
         let kidnapped = Pose2::new(2.0, 1.0, 0.0);
@@ -460,14 +463,14 @@ mod tests {
             m.camera(&frame(kidnapped, f64::from(t) * 0.1, &landmarks()));
         }
         assert!(m.counts().lost >= 1, "{:?}", m.counts());
-        let p = m.pose();
+        let p = m.pose().inner;
         assert!((p.x - 2.0).hypot(p.y - 1.0) < 0.05, "{p:?} {:?}", m.counts());
     }
 
     #[test]
     fn an_under_reading_mouse_is_repaired_and_broken_mice_give_way_to_the_wheels() {
         let mut m = model();
-        m.place(Pose2::default());
+        m.place(Framed::new(Pose2::default()));
         // Sideways and forward (omni): x̄ ≠ 0, so a short mouse shows. The left mouse reads
         // 70 % of its motion: §4.2 scales it back exactly.
         let step = Pose2::new(0.1, 0.05, 0.02);
@@ -475,7 +478,7 @@ mod tests {
         o.mice.x_left *= 0.7;
         o.mice.y_left *= 0.7;
         m.odometry(&o);
-        let p = m.pose();
+        let p = m.pose().inner;
         assert!((p.x - 0.1).abs() < 1e-9 && (p.y - 0.05).abs() < 1e-9, "{p:?}");
         assert_eq!(m.counts().reduced, 1);
         // Opposite x̄: no reduction possible → the wheels' motion is used.
@@ -485,7 +488,7 @@ mod tests {
         m.odometry(&o);
         assert_eq!(m.counts().wheels, 1);
         let expected = p.compose(&Pose2::new(0.2, 0.0, 0.0));
-        assert!(m.pose().distance(&expected) < 1e-9, "{:?} {expected:?}", m.pose());
+        assert!(m.pose().inner.distance(&expected) < 1e-9, "{:?} {expected:?}", m.pose().inner);
         // A short mouse whose x̄ is almost 0 would be scaled by > 2: refused, wheels again.
         let mut o = exact_mice(Pose2::new(0.1, 0.001, 0.0));
         o.mice.x_left = 0.0002;
@@ -497,14 +500,14 @@ mod tests {
         o.mice.y_right = f64::NAN;
         m.odometry(&o);
         assert_eq!(m.counts().wheels, 3);
-        assert!(m.pose().x.is_finite());
+        assert!(m.pose().inner.x.is_finite());
     }
 
     #[test]
     fn the_snapshot_is_in_the_team_frame_and_unseen_objects_fade() {
         let mut m = model();
         let at = Pose2::new(-2.0, 0.0, std::f64::consts::FRAC_PI_2);
-        m.place(at);
+        m.place(Framed::new(at));
         m.odometry(&Odometry::default());
         let mut objects = landmarks();
         objects.push((lps::BALL, (0.0, 2.0)));
@@ -526,7 +529,7 @@ mod tests {
         // the west net, 7 m on the left, and "landmark 0" (the opponent's left corner) is
         // the field's south-west corner.
         let mut m2 = model();
-        m2.place(at);
+        m2.place(Framed::new(at));
         m2.game(playing(-1.0));
         let w = m2.camera(&frame(at, 1.0, &objects));
         assert!((w.lps[lps::NET1].rho - 7000.0).abs() < 0.01);
