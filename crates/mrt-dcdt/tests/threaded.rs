@@ -207,3 +207,51 @@ fn wait_msg_returns_only_with_a_message_or_at_its_timeout() {
     assert!(!ep.wait_msg(Duration::from_millis(20)));
     assert!(t.elapsed() >= Duration::from_millis(20), "{:?}", t.elapsed());
 }
+
+/// The waker's handshake (`PMQ` wakes without a fence after its `SeqCst` put): a ping-pong of
+/// 20 000 round trips between an endpoint and an on-message Member, each side parking when it
+/// has nothing to do, never loses a wake-up. A lost one would leave the Member asleep with a
+/// message in its mailbox, and the endpoint's 5 s wait would come back empty.
+#[test]
+fn no_wake_up_is_lost_in_20_000_round_trips() {
+    struct Echo;
+    impl Member for Echo {
+        fn init(&mut self, ctx: &mut Context<'_>) -> Result<(), MemberError> {
+            ctx.subscribe_to::<Count>(RequestType::Local);
+            Ok(())
+        }
+        fn do_your_job(&mut self, ctx: &mut Context<'_>) -> Result<(), MemberError> {
+            while let Some(m) = ctx.receive_msg() {
+                let n = m.get::<Count>()?.0;
+                ctx.publish(Status(n.to_string()));
+            }
+            Ok(())
+        }
+    }
+    let mut agora = mrt_dcdt::Agora::builder(1).policy(PolicyKind::Pmq).build().unwrap();
+    let echo = agora.add_member(Echo, Activation::OnMessage);
+    agora.activate_member(echo).unwrap();
+    let mut endpoint = agora.endpoint();
+    endpoint.subscribe_to::<Status>(RequestType::Local);
+    let stop = agora.shutdown_handle();
+    let run = std::thread::spawn(move || agora.lets_work());
+    while !endpoint.has_subscribers(Count::TYPE) {
+        std::thread::sleep(Duration::from_millis(1));
+    }
+    for n in 0..20_000u32 {
+        endpoint.publish(Count(n));
+        let answer = loop {
+            if let Some(m) = endpoint.receive_msg() {
+                break m;
+            }
+            assert!(
+                endpoint.wait_msg(Duration::from_secs(5)),
+                "round trip {n}: a wake-up was lost"
+            );
+        };
+        assert_eq!(answer.get::<Status>().unwrap().0, n.to_string());
+    }
+    stop.shutdown();
+    let report = run.join().unwrap().unwrap();
+    assert_eq!(report.member(echo).unwrap().errors, 0);
+}

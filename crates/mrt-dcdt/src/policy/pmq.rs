@@ -145,7 +145,8 @@ impl Lane {
             return Pushed::Refused;
         }
         spill.push_back(entry);
-        self.spilled.store(true, Ordering::Release);
+        // `SeqCst`: the put the waker's handshake relies on (`Mailbox::push`).
+        self.spilled.store(true, Ordering::SeqCst);
         Pushed::Spill
     }
 
@@ -176,7 +177,8 @@ impl Lane {
 
     #[inline]
     fn has_pending(&self) -> bool {
-        !self.ring.is_empty() || self.spilled.load(Ordering::Acquire)
+        // `SeqCst` loads (the ring's `is_empty` too): the waker's handshake.
+        !self.ring.is_empty() || self.spilled.load(Ordering::SeqCst)
     }
 
     fn len(&self) -> usize {
@@ -226,7 +228,9 @@ impl Mailbox {
             0
         };
         match lane.push((seq, msg)) {
-            Pushed::Ring | Pushed::Spill => self.waker.wake(),
+            // Every put is a `SeqCst` read-modify-write or store that `has_pending` reads with
+            // `SeqCst` (see `Lane::push`): no fence needed.
+            Pushed::Ring | Pushed::Spill => self.waker.wake_after_seqcst_put(),
             Pushed::Dropped => {}
             Pushed::Refused => return false,
         }
