@@ -4,8 +4,11 @@
 //! processing): readings come in as the standard messages of `mrt-msgs` (from a real robot's
 //! drivers or from the simulator's), and what they mean comes out. Today: the dead-reckoning
 //! sensor made of two optical mice (manual ch. 4), with the manual's formula typos fixed and
-//! its error detection and reduction (§4.2). Colour vision on camera images (ISocRob seed
-//! `003` §3.2.1) comes here next. A plain library: no bus, no simulator.
+//! its error detection and reduction (§4.2), and the camera models colour vision will use
+//! ([`camera`]: a pinhole camera on a pan joint with radial distortion, ISocRob's
+//! omnidirectional mirror, the ball's floor point and apparent size, with the report's typos
+//! fixed). Colour vision on camera images (ISocRob seed `003` §3.2.1) comes here next. A plain
+//! library: no bus, no simulator.
 //!
 //! ```
 //! use mrt_perception::mice::MiceOdometry;
@@ -27,11 +30,15 @@
 //! | eq. (4.1), (4.2) and the mid-point of the mice | [`mice::MiceOdometry::displacement`], [`mice::MiceArcs`] |
 //! | eq. (4.3)–(4.5) | [`mice::update_pose`] |
 //! | `x̄_r = x̄_l` error detection, error reduction (manual §4.2) | [`mice::MiceOdometry::check`], [`mice::MiceOdometry::reduce`] |
+//! | front camera, inverse projection eqs (7)–(9) (ISocRob `003` §3.2.1) | [`camera::Pinhole`] (with a pan joint) |
+//! | "up" camera, mirror (ISocRob `003` §2.2) | [`camera::Omni`] |
+//! | ball correction and expected size, eqs (10)–(11) | [`camera::ball_floor_point`], [`camera::ball_diameter_px`] |
 //!
 //! The manual's mice equations have typos; [`mice`] lists each one with the corrected formula,
 //! and a test pins each fix. Errors: [`PerceptionError`].
 #![deny(missing_docs)]
 
+pub mod camera;
 mod error;
 pub mod mice;
 

@@ -1,0 +1,402 @@
+//! Camera models: where a point of the world appears in the image, and which floor point a
+//! pixel sees (ISocRob seed `003` §2.2 and §3.2.1; the research notes
+//! `shared/research/ISOCROB_VISION.md` §2–3 write the report's equations 7–11 out, with their
+//! typos and approximations fixed).
+//!
+//! Two models behind one trait, [`Camera`]:
+//! - [`Pinhole`]: a perspective camera mounted on the robot at a height, tilted down, on a
+//!   **pan joint** the robot can turn (TeamChaos' head, seed `001` §2.1; ISocRob's front camera
+//!   is the pan-0 case), with intrinsics `(fx, fy, cx, cy)` and optional radial distortion
+//!   `(k1, k2)`;
+//! - [`Omni`]: ISocRob's omnidirectional "up" camera, whose mirror images the floor
+//!   orthographically up to an affine map (seed `003` §2.2): a floor point `(x, y)` of the
+//!   robot frame appears at pixel `A·(x, y) + b`, and any point above it at the same pixel.
+//!
+//! Frames and units: the **robot frame** (m): x forward, y to the left, z up from the floor,
+//! origin on the floor under the robot's centre. **Pixels**: `(col, row)`, the origin at the
+//! top-left corner, rows growing downwards (the usual image convention; the report's `(u, v)`
+//! is `u = cy − row` upwards and `v = cx − col` to the left).
+//!
+//! The report's inverse projection (eq. 8) is exact for the forward distance; its lateral one
+//! (`y = (v/f)·√(h² + x²)`) divides by the slant range instead of the depth along the optical
+//! axis and over-estimates `|y|` by `1/cos δ` off the axis. [`Pinhole`] intersects the pixel's
+//! ray with the floor, which is the exact form; a test checks the research vectors and the
+//! report's error.
+
+use nalgebra::{Matrix2, Point2, Point3, Rotation3, Vector2, Vector3};
+
+/// A pixel position `(col, row)`, sub-pixel, top-left origin, rows downwards.
+pub type Pixel = Point2<f64>;
+
+/// A camera's geometry: forward and inverse projection (module doc).
+pub trait Camera {
+    /// The image size, `(width, height)` in pixels.
+    fn size(&self) -> (u32, u32);
+
+    /// Where the point `p` (robot frame, m) appears, or `None` when the camera cannot see it
+    /// (behind a pinhole camera; for [`Omni`], never). The pixel may lie outside the image:
+    /// [`Camera::in_image`] says.
+    fn project(&self, p: Point3<f64>) -> Option<Pixel>;
+
+    /// The point at height `z` (m above the floor) that pixel `px` sees, robot frame, or `None`
+    /// when its ray never meets that plane (at or above the horizon).
+    fn unproject_at_height(&self, px: Pixel, z: f64) -> Option<Point3<f64>>;
+
+    /// The floor point pixel `px` sees (robot frame, m), or `None` above the horizon.
+    fn unproject(&self, px: Pixel) -> Option<Point2<f64>> {
+        self.unproject_at_height(px, 0.0).map(|p| Point2::new(p.x, p.y))
+    }
+
+    /// Whether a pixel lies within the image.
+    fn in_image(&self, px: Pixel) -> bool {
+        let (w, h) = self.size();
+        px.x >= 0.0 && px.y >= 0.0 && px.x < f64::from(w) && px.y < f64::from(h)
+    }
+}
+
+/// A pinhole camera's intrinsics, in pixels.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Intrinsics {
+    /// Focal length along the columns.
+    pub fx: f64,
+    /// Focal length along the rows.
+    pub fy: f64,
+    /// Principal point's column.
+    pub cx: f64,
+    /// Principal point's row.
+    pub cy: f64,
+    /// Image width.
+    pub width: u32,
+    /// Image height.
+    pub height: u32,
+}
+
+impl Intrinsics {
+    /// A `width × height` image with focal length `f` for both axes and the principal point at
+    /// the image's centre.
+    pub fn centred(width: u32, height: u32, f: f64) -> Intrinsics {
+        Intrinsics {
+            fx: f,
+            fy: f,
+            cx: f64::from(width) / 2.0,
+            cy: f64::from(height) / 2.0,
+            width,
+            height,
+        }
+    }
+}
+
+/// A perspective camera on a pan joint (module doc).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Pinhole {
+    /// Intrinsics.
+    pub intrinsics: Intrinsics,
+    /// Where the pan joint's axis stands (robot frame, m): x forward, y to the left.
+    pub mount: Point2<f64>,
+    /// The optical centre's height above the floor, m.
+    pub height: f64,
+    /// The optical axis below the horizontal, rad (positive: looking down).
+    pub tilt: f64,
+    /// The pan joint's angle, rad, counter-clockwise from straight ahead (positive: looking
+    /// left).
+    pub pan: f64,
+    /// Radial distortion `(k1, k2)`: a normalized point at radius `r` is imaged at radius
+    /// `r·(1 + k1·r² + k2·r⁴)`. `(0, 0)` for an ideal lens.
+    pub distortion: (f64, f64),
+}
+
+impl Pinhole {
+    /// A camera at `height` (m), tilted down by `tilt` (rad), looking straight ahead from the
+    /// robot's centre, without distortion.
+    pub fn new(intrinsics: Intrinsics, height: f64, tilt: f64) -> Pinhole {
+        Pinhole {
+            intrinsics,
+            mount: Point2::origin(),
+            height,
+            tilt,
+            pan: 0.0,
+            distortion: (0.0, 0.0),
+        }
+    }
+
+    /// The same camera with the pan joint at `pan` (rad).
+    pub fn panned(mut self, pan: f64) -> Pinhole {
+        self.pan = pan;
+        self
+    }
+
+    /// The optical centre (robot frame, m).
+    pub fn centre(&self) -> Point3<f64> {
+        Point3::new(self.mount.x, self.mount.y, self.height)
+    }
+
+    /// The rotation from camera axes (x right, y down, z along the optical axis) to the robot
+    /// frame: pan about z, then tilt down about the panned y axis.
+    fn camera_to_robot(&self) -> Rotation3<f64> {
+        // Columns: the camera's right, down and forward axes in the pan-0 level frame.
+        let (s, c) = self.tilt.sin_cos();
+        let axes = nalgebra::Matrix3::new(0.0, -s, c, -1.0, 0.0, 0.0, 0.0, -c, -s);
+        Rotation3::from_axis_angle(&Vector3::z_axis(), self.pan)
+            * Rotation3::from_matrix_unchecked(axes)
+    }
+
+    /// Applies the radial distortion to a normalized point.
+    fn distort(&self, n: Vector2<f64>) -> Vector2<f64> {
+        let (k1, k2) = self.distortion;
+        let r2 = n.norm_squared();
+        n * (1.0 + k1 * r2 + k2 * r2 * r2)
+    }
+
+    /// Removes the radial distortion from a normalized point (fixed-point iteration; exact for
+    /// an ideal lens).
+    fn undistort(&self, d: Vector2<f64>) -> Vector2<f64> {
+        let (k1, k2) = self.distortion;
+        if k1 == 0.0 && k2 == 0.0 {
+            return d;
+        }
+        let mut n = d;
+        for _ in 0..30 {
+            let r2 = n.norm_squared();
+            let scale = 1.0 + k1 * r2 + k2 * r2 * r2;
+            if !(scale.is_finite() && scale > 0.0) {
+                break;
+            }
+            n = d / scale;
+        }
+        n
+    }
+}
+
+impl Camera for Pinhole {
+    fn size(&self) -> (u32, u32) {
+        (self.intrinsics.width, self.intrinsics.height)
+    }
+
+    fn project(&self, p: Point3<f64>) -> Option<Pixel> {
+        let v = self.camera_to_robot().inverse() * (p - self.centre());
+        // On or behind the image plane (a NaN point is not seen either).
+        if v.z.is_nan() || v.z <= 1e-9 {
+            return None;
+        }
+        let d = self.distort(Vector2::new(v.x / v.z, v.y / v.z));
+        let k = &self.intrinsics;
+        Some(Pixel::new(k.cx + k.fx * d.x, k.cy + k.fy * d.y))
+    }
+
+    fn unproject_at_height(&self, px: Pixel, z: f64) -> Option<Point3<f64>> {
+        let k = &self.intrinsics;
+        let n = self.undistort(Vector2::new((px.x - k.cx) / k.fx, (px.y - k.cy) / k.fy));
+        let ray = self.camera_to_robot() * Vector3::new(n.x, n.y, 1.0);
+        let t = (z - self.height) / ray.z;
+        (t.is_finite() && t > 0.0).then(|| self.centre() + ray * t)
+    }
+}
+
+/// ISocRob's omnidirectional "up" camera (module doc): pixel = `A·(x, y) + b` for the floor
+/// point under any point it sees.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Omni {
+    /// The affine map's matrix, pixels per metre.
+    pub a: Matrix2<f64>,
+    /// The pixel of the robot's centre.
+    pub b: Vector2<f64>,
+    /// Image width.
+    pub width: u32,
+    /// Image height.
+    pub height: u32,
+}
+
+impl Omni {
+    /// A mirror whose image has `scale` pixels per metre, the robot's centre at `centre` and
+    /// the robot's forward direction towards the top of the image (x forward → rows up, y left
+    /// → columns left).
+    pub fn upright(width: u32, height: u32, scale: f64, centre: Pixel) -> Omni {
+        Omni { a: Matrix2::new(0.0, -scale, -scale, 0.0), b: centre.coords, width, height }
+    }
+}
+
+impl Camera for Omni {
+    fn size(&self) -> (u32, u32) {
+        (self.width, self.height)
+    }
+
+    fn project(&self, p: Point3<f64>) -> Option<Pixel> {
+        Some(Pixel::from(self.a * Vector2::new(p.x, p.y) + self.b))
+    }
+
+    fn unproject_at_height(&self, px: Pixel, z: f64) -> Option<Point3<f64>> {
+        let inv = self.a.try_inverse()?;
+        let f = inv * (px.coords - self.b);
+        Some(Point3::new(f.x, f.y, z))
+    }
+}
+
+/// The report's ball correction (eqs 10–11, research §3): the centroid of a ball's pixels
+/// images its centre, at height `radius`; where that ray meets the floor is `floor_hit`, at
+/// horizontal run `r` from the camera's foot. The ball's own floor point lies on the same
+/// line at `r·(1 − radius/h)` (`h`: the camera's height). **The report corrects x only; the
+/// same factor applies to y** (research §3, flag): both are scalings of the ray's run.
+pub fn ball_floor_point(
+    camera_foot: Point2<f64>,
+    height: f64,
+    floor_hit: Point2<f64>,
+    radius: f64,
+) -> Point2<f64> {
+    camera_foot + (floor_hit - camera_foot) * (1.0 - radius / height)
+}
+
+/// The apparent diameter (pixels) of a ball of `radius` (m) whose centre is at `range` (m)
+/// from the optical centre, for focal length `f` (pixels): `w = 2·radius·f / range` (research
+/// §3: the report's eq. 11b divides by the range to the *floor* point, which under-estimates
+/// `w` by exactly `1 − D/(2h)`, and names the diameter a radius).
+pub fn ball_diameter_px(radius: f64, f: f64, range: f64) -> f64 {
+    2.0 * radius * f / range
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    /// The research notes' camera (§2): h = 450 mm, the optical axis meets the floor c = 625
+    /// mm ahead, f = 400 px. In metres here.
+    fn isocrob_front() -> Pinhole {
+        let (h, c) = (0.45, 0.625);
+        Pinhole::new(Intrinsics::centred(640, 480, 400.0), h, (h / c).atan())
+    }
+
+    /// The report's (u, v): u upwards from the centre, v to the left.
+    fn report_uv(cam: &Pinhole, px: Pixel) -> (f64, f64) {
+        (cam.intrinsics.cy - px.y, cam.intrinsics.cx - px.x)
+    }
+
+    #[test]
+    fn the_research_vectors_project_and_come_back() {
+        let cam = isocrob_front();
+        // floor (x, y) mm → (u, v) px, from research §2.
+        for ((x, y), (u, v)) in [
+            ((1000.0, 200.0), (81.571, 74.455)),
+            ((625.0, 300.0), (0.0, 155.815)),
+            ((3000.0, 500.0), (205.776, 74.142)),
+        ] {
+            let p = Point3::new(x / 1000.0, y / 1000.0, 0.0);
+            let px = cam.project(p).unwrap();
+            let (pu, pv) = report_uv(&cam, px);
+            assert!((pu - u).abs() < 1e-3 && (pv - v).abs() < 1e-3, "({x}, {y}): {pu} {pv}");
+            let back = cam.unproject(px).unwrap();
+            assert!((back.x - p.x).abs() < 1e-9 && (back.y - p.y).abs() < 1e-9, "{back:?}");
+        }
+    }
+
+    /// The report's lateral inverse (eq. 8's y = (v/f)·√(h² + x²)) is not the pinhole one: at
+    /// (3000, 500) mm it gives 562.283 mm (research §2); the model gives 500.
+    #[test]
+    fn the_reports_lateral_formula_overestimates_off_axis() {
+        let cam = isocrob_front();
+        let px = cam.project(Point3::new(3.0, 0.5, 0.0)).unwrap();
+        let (_, v) = report_uv(&cam, px);
+        let x = cam.unproject(px).unwrap().x;
+        let report_y = v / 400.0 * (0.45f64.powi(2) + x * x).sqrt();
+        assert!((report_y - 0.562283).abs() < 1e-5, "{report_y}");
+        assert!((cam.unproject(px).unwrap().y - 0.5).abs() < 1e-9);
+    }
+
+    #[test]
+    fn above_the_horizon_there_is_no_floor() {
+        let cam = isocrob_front();
+        // The horizon is u = f·h/c = 288 px above the centre: row 240 − 288 < 0, outside this
+        // image; with the camera level, the horizon is the centre row.
+        assert!(cam.unproject(Pixel::new(320.0, 0.0)).is_some());
+        let level = Pinhole::new(Intrinsics::centred(640, 480, 400.0), 0.45, 0.0);
+        assert!(level.unproject(Pixel::new(320.0, 240.0)).is_none(), "the horizon");
+        assert!(level.unproject(Pixel::new(320.0, 100.0)).is_none(), "above it");
+        assert!(level.unproject(Pixel::new(320.0, 300.0)).is_some());
+        // A point behind the camera is not seen.
+        assert!(level.project(Point3::new(-1.0, 0.0, 0.0)).is_none());
+    }
+
+    /// The research vector of §3: camera at h = 0.45 m, ball of diameter 0.22 m centred at
+    /// 1.5 m: its centre's ray meets the floor at 1.985294 m, the correction gives 1.5 back;
+    /// the exact apparent diameter is 57.215 px (the report's formula: 43.229).
+    #[test]
+    fn ball_correction_and_size_by_the_research_vector() {
+        let (h, f, radius) = (0.45, 400.0, 0.11);
+        let cam = Pinhole::new(Intrinsics::centred(640, 480, f), h, 0.0);
+        let centre = Point3::new(1.5, 0.0, radius);
+        let px = cam.project(centre).unwrap();
+        let hit = cam.unproject_at_height(Pixel::new(px.x, px.y + 1e-9), 0.0);
+        // (A level camera's centre ray is horizontal at the ball's height below it.)
+        let hit = hit.map(|p| Point2::new(p.x, p.y)).unwrap();
+        assert!((hit.x - 1.985294).abs() < 1e-5, "{hit:?}");
+        let b = ball_floor_point(Point2::origin(), h, hit, radius);
+        assert!((b.x - 1.5).abs() < 1e-6 && b.y.abs() < 1e-9);
+        let range = (centre - cam.centre()).norm();
+        assert!((ball_diameter_px(radius, f, range) - 57.215).abs() < 1e-3);
+        let report = 2.0 * radius * f / (h * h + hit.x * hit.x).sqrt();
+        assert!((report - 43.229).abs() < 1e-3, "{report}");
+    }
+
+    /// The lateral correction applies to y too (research §3, flag): a ball off to the side.
+    #[test]
+    fn the_ball_correction_scales_y_as_well() {
+        let cam = isocrob_front();
+        let centre = Point3::new(1.2, -0.4, 0.11);
+        let px = cam.project(centre).unwrap();
+        let hit = cam.unproject(px).unwrap();
+        let b = ball_floor_point(Point2::origin(), cam.height, hit, 0.11);
+        assert!((b.x - 1.2).abs() < 1e-9 && (b.y + 0.4).abs() < 1e-9, "{b:?}");
+        // Correcting x only (the report) leaves y wrong by the same factor.
+        assert!((hit.y + 0.4).abs() > 0.05);
+    }
+
+    #[test]
+    fn a_panned_camera_sees_to_its_side() {
+        let cam = isocrob_front().panned(std::f64::consts::FRAC_PI_2);
+        // Looking left: a floor point 0.625 m to the left is at the image centre.
+        let px = cam.project(Point3::new(0.0, 0.625, 0.0)).unwrap();
+        assert!((px.x - 320.0).abs() < 1e-9 && (px.y - 240.0).abs() < 1e-9, "{px:?}");
+        assert!(cam.project(Point3::new(0.0, -1.0, 0.0)).is_none(), "behind it now");
+    }
+
+    #[test]
+    fn the_omni_camera_maps_the_floor_affinely() {
+        let cam = Omni::upright(480, 480, 100.0, Pixel::new(240.0, 240.0));
+        // 1 m ahead: 100 px up; 0.5 m to the left: 50 px left.
+        let px = cam.project(Point3::new(1.0, 0.5, 0.3)).unwrap();
+        assert_eq!((px.x, px.y), (190.0, 140.0));
+        let back = cam.unproject(px).unwrap();
+        assert!((back.x - 1.0).abs() < 1e-12 && (back.y - 0.5).abs() < 1e-12);
+        assert!(cam.in_image(px) && !cam.in_image(Pixel::new(-1.0, 3.0)));
+    }
+
+    proptest! {
+        /// Every floor point in view comes back from its pixel, with any pan, tilt, height and a
+        /// mild lens distortion.
+        #[test]
+        fn pinhole_round_trips(x in 0.3f64..6.0, y in -3.0f64..3.0, h in 0.2f64..1.0,
+                               tilt in 0.1f64..1.2, pan in -1.0f64..1.0,
+                               k1 in -0.1f64..0.1, k2 in -0.02f64..0.02) {
+            let mut cam = Pinhole::new(Intrinsics::centred(640, 480, 500.0), h, tilt).panned(pan);
+            cam.distortion = (k1, k2);
+            let p = Point3::new(x, y, 0.0);
+            // Only where the lens model is meant to hold: within 0.8 (about 39°) of the axis,
+            // where the distortion is one-to-one.
+            let ideal = Pinhole { distortion: (0.0, 0.0), ..cam };
+            let k = cam.intrinsics;
+            let undistorted = ideal.project(p).map(|q| (q.x - k.cx).hypot(q.y - k.cy) / k.fx);
+            prop_assume!(undistorted.is_some_and(|r| r < 0.8));
+            let px = cam.project(p).unwrap();
+            let back = cam.unproject(px).unwrap();
+            let tol = 1e-6 * (1.0 + x * x);
+            prop_assert!((back.x - x).abs() < tol && (back.y - y).abs() < tol,
+                         "{back:?} for ({x}, {y})");
+        }
+
+        #[test]
+        fn omni_round_trips(x in -5.0f64..5.0, y in -5.0f64..5.0, s in 10.0f64..200.0) {
+            let cam = Omni::upright(640, 480, s, Pixel::new(320.0, 240.0));
+            let back = cam.unproject(cam.project(Point3::new(x, y, 0.0)).unwrap()).unwrap();
+            prop_assert!((back.x - x).abs() < 1e-9 && (back.y - y).abs() < 1e-9);
+        }
+    }
+}
