@@ -41,5 +41,6 @@
 pub mod camera;
 mod error;
 pub mod mice;
+pub mod vision;
 
 pub use error::PerceptionError;
