@@ -1,13 +1,14 @@
 //! Colour vision's hot path on the synthetic 640×480 frame: green field, 3 px white
 //! lines and centre circle, a yellow and a blue goal, an orange ball of radius 10 px, five black
 //! robots of radius 22 px, Gaussian noise σ = 8 per channel. Measured: building the lookup table
-//! (once per colour file) and classifying the frame through it.
+//! (once per colour file), classifying the frame through it, and that plus the ball's blob.
 //!
 //! Run: `cargo bench -p mrt-perception --bench vision`. Results go to `docs/performance.md`.
 #![allow(missing_docs, clippy::unwrap_used)]
 
 use criterion::{black_box, criterion_group, criterion_main, Criterion, Throughput};
-use mrt_perception::vision::colors::{ColorTable, Lut};
+use mrt_perception::vision::blobs::blobs;
+use mrt_perception::vision::colors::{ColorClass, ColorTable, Lut};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
@@ -71,6 +72,12 @@ fn bench(c: &mut Criterion) {
     let mut g = c.benchmark_group("frame_640x480");
     g.throughput(Throughput::Elements((W * H) as u64));
     g.bench_function("lut_classify", |b| b.iter(|| lut.classify(black_box(&img), &mut out)));
+    g.bench_function("lut_classify_and_ball_blob", |b| {
+        b.iter(|| {
+            lut.classify(black_box(&img), &mut out);
+            blobs(&out, W as u32, H as u32, ColorClass::Ball, 3)
+        })
+    });
     g.finish();
 }
 

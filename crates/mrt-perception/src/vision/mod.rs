@@ -2,4 +2,5 @@
 //! lookup table built from HSV thresholds ([`colors`]). Blobs, the ball, goals, lines and open
 //! space build on it (issue 19).
 
+pub mod blobs;
 pub mod colors;

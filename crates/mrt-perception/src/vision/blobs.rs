@@ -1,0 +1,290 @@
+//! Blobs of one colour class and the ball percept (ISocRob seed `003` §3.2.1: the windowed
+//! centre of mass of the ball's pixels, its distance-dependent size test and its centre
+//! correction, eqs 10–11 as fixed in the research notes §3).
+//!
+//! Connected components are `imageproc`'s (8-connected); this module only gathers each
+//! component's pixel count, centre of mass and bounding box, and turns the best ball blob into
+//! a floor position through the camera model.
+
+use super::colors::ColorClass;
+use crate::camera::{ball_diameter_px, ball_floor_point, Camera, Pinhole, Pixel};
+use image::{GrayImage, Luma};
+use imageproc::region_labelling::{connected_components, Connectivity};
+use nalgebra::{Point2, Point3};
+
+/// The largest image side the vision accepts (larger frames are refused, not processed).
+pub const MAX_SIDE: u32 = 16_384;
+
+/// One connected region of a class.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Blob {
+    /// Its pixels.
+    pub pixels: u32,
+    /// Its centre of mass `(col, row)`.
+    pub centroid: Pixel,
+    /// Its bounding box: first and last column, first and last row.
+    pub bbox: BoundingBox,
+}
+
+/// First and last column, first and last row.
+pub type BoundingBox = (u32, u32, u32, u32);
+
+/// Side of the coarse cells in which [`blobs`] first looks for a class (pixels).
+const CELL: u32 = 8;
+
+/// The blobs of `class` in a class map (`classes`: one `ColorClass as u8` a pixel, row after
+/// row, `width × height`), largest first; blobs under `min_pixels` are left out. An empty list
+/// when the sizes do not fit the map or exceed [`MAX_SIDE`].
+///
+/// Windowed, for speed (the seed's "windowed centre of mass"): the map is first reduced to
+/// 8 × 8 cells that hold any pixel of the class; `imageproc` labels the cells' connected
+/// regions, then the full-resolution pixels inside each region's cells. An 8-connected blob
+/// only touches 8-connected cells, so every blob lies within one region: the result is the
+/// same as labelling the whole map, at a fraction of the cost when the class is rare.
+pub fn blobs(
+    classes: &[u8],
+    width: u32,
+    height: u32,
+    class: ColorClass,
+    min_pixels: u32,
+) -> Vec<Blob> {
+    let n = (width as usize).saturating_mul(height as usize);
+    if width == 0 || height == 0 || width > MAX_SIDE || height > MAX_SIDE || classes.len() < n {
+        return Vec::new();
+    }
+    let want = class as u8;
+    let (cw, ch) = (width.div_ceil(CELL), height.div_ceil(CELL));
+    let mut cells = vec![0u8; (cw * ch) as usize];
+    for (y, row) in classes[..n].chunks_exact(width as usize).enumerate() {
+        let cy = y / CELL as usize;
+        for (cx, chunk) in row.chunks(CELL as usize).enumerate() {
+            if chunk.contains(&want) {
+                cells[cy * cw as usize + cx] = 255;
+            }
+        }
+    }
+    let Some(cells) = GrayImage::from_raw(cw, ch, cells) else { return Vec::new() };
+    let regions = connected_components(&cells, Connectivity::Eight, Luma([0u8]));
+    // Each region's bounding box, in cells.
+    let mut boxes: Vec<BoundingBox> = Vec::new();
+    for (x, y, l) in regions.enumerate_pixels() {
+        let l = l.0[0] as usize;
+        if l == 0 {
+            continue;
+        }
+        if boxes.len() < l {
+            boxes.resize(l, (u32::MAX, 0, u32::MAX, 0));
+        }
+        let b = &mut boxes[l - 1];
+        *b = (b.0.min(x), b.1.max(x), b.2.min(y), b.3.max(y));
+    }
+    let mut out = Vec::new();
+    for (i, &(x0, x1, y0, y1)) in boxes.iter().enumerate() {
+        let label = i as u32 + 1;
+        // The region's window in pixels; only the pixels of its own cells take part.
+        let (px0, py0) = (x0 * CELL, y0 * CELL);
+        let (px1, py1) = (((x1 + 1) * CELL).min(width), ((y1 + 1) * CELL).min(height));
+        let (ww, wh) = (px1 - px0, py1 - py0);
+        let mut mask = vec![0u8; (ww * wh) as usize];
+        for y in 0..wh {
+            let row = ((py0 + y) * width + px0) as usize;
+            for x in 0..ww {
+                let (gx, gy) = (px0 + x, py0 + y);
+                if classes[row + x as usize] == want
+                    && regions.get_pixel(gx / CELL, gy / CELL).0[0] == label
+                {
+                    mask[(y * ww + x) as usize] = 255;
+                }
+            }
+        }
+        let Some(mask) = GrayImage::from_raw(ww, wh, mask) else { continue };
+        out.extend(label_blobs(&mask, (px0, py0), min_pixels));
+    }
+    out.sort_by(|a, b| b.pixels.cmp(&a.pixels).then(a.bbox.cmp(&b.bbox)));
+    out
+}
+
+/// The blobs of a mask (255: the class), offset by the window's origin.
+fn label_blobs(mask: &GrayImage, (ox, oy): (u32, u32), min_pixels: u32) -> Vec<Blob> {
+    let labels = connected_components(mask, Connectivity::Eight, Luma([0u8]));
+    // Per label: count, sums of columns and rows, bounding box.
+    let mut stats: Vec<(u32, f64, f64, BoundingBox)> = Vec::new();
+    for (x, y, l) in labels.enumerate_pixels() {
+        let l = l.0[0] as usize;
+        if l == 0 {
+            continue;
+        }
+        if stats.len() < l {
+            stats.resize(l, (0, 0.0, 0.0, (u32::MAX, 0, u32::MAX, 0)));
+        }
+        let (x, y) = (x + ox, y + oy);
+        let s = &mut stats[l - 1];
+        s.0 += 1;
+        s.1 += f64::from(x);
+        s.2 += f64::from(y);
+        s.3 = (s.3 .0.min(x), s.3 .1.max(x), s.3 .2.min(y), s.3 .3.max(y));
+    }
+    stats
+        .into_iter()
+        .filter(|s| s.0 >= min_pixels.max(1))
+        .map(|(count, sx, sy, bbox)| Blob {
+            pixels: count,
+            // Pixel centres: a pixel (x, y) covers [x, x + 1).
+            centroid: Pixel::new(sx / f64::from(count) + 0.5, sy / f64::from(count) + 0.5),
+            bbox,
+        })
+        .collect()
+}
+
+/// The ball as the camera saw it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BallPercept {
+    /// Its blob's centre of mass.
+    pub pixel: Pixel,
+    /// Its apparent radius, pixels (from the blob's area).
+    pub radius_px: f64,
+    /// The ball's floor point (robot frame, m): under its centre.
+    pub at: Point2<f64>,
+    /// Distance on the floor from the point under the camera to the ball's floor point, m.
+    pub distance: f64,
+    /// Bearing from the robot's heading (pan included), rad, counter-clockwise.
+    pub bearing: f64,
+    /// Its pixels.
+    pub pixels: u32,
+}
+
+/// The size test's bounds on a blob's area against the expected one, π(w/2)² (research §3,
+/// a design choice: partial segmentation and occlusion on the low side, merged noise on the
+/// high side).
+pub const BALL_AREA_RANGE: (f64, f64) = (0.3, 3.0);
+
+/// The ball in a class map seen by `camera`: the largest ball blob whose area fits the size a
+/// ball of `radius` (m) would have where its centre's ray says it is, corrected from the floor
+/// point of that ray to the point under the ball (both coordinates).
+pub fn find_ball(classes: &[u8], camera: &Pinhole, radius: f64) -> Option<BallPercept> {
+    let (w, h) = camera.size();
+    for blob in blobs(classes, w, h, ColorClass::Ball, 3) {
+        let Some(hit) = camera.unproject(blob.centroid) else { continue };
+        let foot = camera.mount;
+        let at = ball_floor_point(foot, camera.height, hit, radius);
+        let centre = Point3::new(at.x, at.y, radius);
+        let range = (centre - camera.centre()).norm();
+        let expected = ball_diameter_px(radius, camera.intrinsics.fx, range) / 2.0;
+        let area = std::f64::consts::PI * expected * expected;
+        let (lo, hi) = BALL_AREA_RANGE;
+        let n = f64::from(blob.pixels);
+        if n < lo * area || n > hi * area {
+            continue;
+        }
+        let d = at - foot;
+        return Some(BallPercept {
+            pixel: blob.centroid,
+            radius_px: (n / std::f64::consts::PI).sqrt(),
+            at,
+            distance: d.norm(),
+            bearing: at.y.atan2(at.x),
+            pixels: blob.pixels,
+        });
+    }
+    None
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::camera::Intrinsics;
+
+    /// A class map with discs of `class` painted at `(col, row, radius)`.
+    fn map(w: u32, h: u32, discs: &[(ColorClass, f64, f64, f64)]) -> Vec<u8> {
+        let mut m = vec![ColorClass::Field as u8; (w * h) as usize];
+        for &(class, cx, cy, r) in discs {
+            for y in 0..h {
+                for x in 0..w {
+                    let (dx, dy) = (f64::from(x) + 0.5 - cx, f64::from(y) + 0.5 - cy);
+                    if dx * dx + dy * dy <= r * r {
+                        m[(y * w + x) as usize] = class as u8;
+                    }
+                }
+            }
+        }
+        m
+    }
+
+    #[test]
+    fn blobs_are_counted_centred_and_sorted() {
+        let m = map(
+            80,
+            60,
+            &[(ColorClass::Ball, 20.0, 20.0, 5.0), (ColorClass::Ball, 60.0, 40.0, 3.0)],
+        );
+        let b = blobs(&m, 80, 60, ColorClass::Ball, 1);
+        assert_eq!(b.len(), 2);
+        assert!(b[0].pixels > b[1].pixels);
+        assert!((b[0].centroid.x - 20.0).abs() < 0.05 && (b[0].centroid.y - 20.0).abs() < 0.05);
+        assert_eq!(b[0].bbox, (15, 24, 15, 24));
+        assert!(blobs(&m, 80, 60, ColorClass::GoalBlue, 1).is_empty());
+        // Sizes that do not fit the map: nothing, no panic.
+        assert!(blobs(&m, 81, 60, ColorClass::Ball, 1).is_empty());
+        assert!(blobs(&m, MAX_SIDE + 1, 1, ColorClass::Ball, 1).is_empty());
+    }
+
+    /// The windowed labelling gives what labelling the whole map gives, on random maps.
+    #[test]
+    fn windowed_blobs_equal_whole_map_blobs() {
+        use rand::{Rng, SeedableRng};
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(3);
+        for _ in 0..20 {
+            let (w, h) = (rng.random_range(1..90u32), rng.random_range(1..70u32));
+            let density = rng.random_range(0.0..0.6);
+            let m: Vec<u8> = (0..w * h)
+                .map(|_| if rng.random_bool(density) { ColorClass::Ball as u8 } else { 0 })
+                .collect();
+            let mut fast = blobs(&m, w, h, ColorClass::Ball, 1);
+            let full = GrayImage::from_raw(
+                w,
+                h,
+                m.iter().map(|&c| if c == 1 { 255 } else { 0 }).collect(),
+            )
+            .unwrap();
+            let mut slow = label_blobs(&full, (0, 0), 1);
+            for v in [&mut fast, &mut slow] {
+                v.sort_by(|a, b| a.bbox.cmp(&b.bbox).then(a.pixels.cmp(&b.pixels)));
+            }
+            assert_eq!(fast.len(), slow.len(), "{w}×{h}");
+            for (a, b) in fast.iter().zip(&slow) {
+                assert_eq!((a.pixels, a.bbox), (b.pixels, b.bbox));
+                assert!((a.centroid - b.centroid).norm() < 1e-9);
+            }
+        }
+    }
+
+    /// The ball across the field: painted where the camera would see it, with the apparent
+    /// size of a sphere, found at the right distance and bearing (issue 19: error ≤ 5 % of the
+    /// distance and ≤ 1.5°).
+    #[test]
+    fn the_ball_is_found_at_its_distance_and_bearing_across_the_field() {
+        let cam = Pinhole::new(Intrinsics::centred(320, 240, 260.0), 0.45, 0.35);
+        let radius = 0.11;
+        for (x, y) in [(0.8, 0.0), (1.2, 0.3), (2.0, -0.5), (3.0, 0.8), (4.5, -1.0), (6.0, 0.0)] {
+            let centre = Point3::new(x, y, radius);
+            let px = cam.project(centre).unwrap();
+            let range = (centre - cam.centre()).norm();
+            let r_px = ball_diameter_px(radius, 260.0, range) / 2.0;
+            let m = map(320, 240, &[(ColorClass::Ball, px.x, px.y, r_px)]);
+            let ball = find_ball(&m, &cam, radius).unwrap_or_else(|| panic!("({x}, {y})"));
+            let (d, b) = (x.hypot(y), y.atan2(x));
+            assert!((ball.distance - d).abs() <= 0.05 * d, "({x}, {y}): {ball:?}");
+            assert!((ball.bearing - b).abs() <= 1.5f64.to_radians(), "({x}, {y}): {ball:?}");
+        }
+    }
+
+    #[test]
+    fn no_ball_when_there_is_none_or_the_blob_has_the_wrong_size() {
+        let cam = Pinhole::new(Intrinsics::centred(320, 240, 260.0), 0.45, 0.35);
+        assert!(find_ball(&map(320, 240, &[]), &cam, 0.11).is_none());
+        // An orange disc 3× too big for where it is: not a ball.
+        let px = cam.project(Point3::new(2.0, 0.0, 0.11)).unwrap();
+        let m = map(320, 240, &[(ColorClass::Ball, px.x, px.y, 3.0 * 16.0)]);
+        assert!(find_ball(&m, &cam, 0.11).is_none());
+    }
+}
