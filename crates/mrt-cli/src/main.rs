@@ -26,6 +26,7 @@ mod brian;
 mod distributed;
 mod sim;
 mod soak;
+mod vision;
 
 use anyhow::{Context as _, Result};
 use clap::{Parser, Subcommand, ValueEnum};
@@ -40,6 +41,13 @@ struct Cli {
 }
 
 #[derive(Subcommand)]
+enum VisionCommand {
+    /// Classify images with a colour file and find the ball through a camera file: one JSON
+    /// line per image.
+    Detect(vision::DetectArgs),
+}
+
+#[derive(Subcommand)]
 enum Command {
     /// Play a simulated robot-soccer match on the embedded default world (or a series).
     Sim(sim::SimArgs),
@@ -47,6 +55,11 @@ enum Command {
     /// --distributed` starts each of its robots with this command).
     #[cfg(feature = "net")]
     Robot(distributed::RobotArgs),
+    /// Vision tools: find the ball in camera images (`detect`).
+    Vision {
+        #[command(subcommand)]
+        command: VisionCommand,
+    },
     /// The blackboard: serve one with its relay, or get, set, watch and list variables
     /// through a relay (docs/relay-protocol.md).
     Bb {
@@ -215,6 +228,7 @@ fn run(command: Command) -> Result<()> {
         #[cfg(feature = "net")]
         Command::Robot(args) => distributed::robot(&args)?,
         Command::Bb { command } => bb::run(command)?,
+        Command::Vision { command: VisionCommand::Detect(args) } => vision::detect(&args)?,
         Command::Behave { file, world, cycles, period_ms } => {
             behave::behave(&file, world.as_deref(), cycles, period_ms)?
         }

@@ -253,6 +253,120 @@ pub fn ball_diameter_px(radius: f64, f: f64, range: f64) -> f64 {
     2.0 * radius * f / range
 }
 
+/// A camera file (CAMERA.toml, `mrt vision --camera`): `model = "pinhole"`, `width`, `height`,
+/// `fx`, `fy`, `cx`, `cy` (pixels, rows downwards), `height_m` (the optical centre above the
+/// floor), `tilt_deg` (the optical axis below the horizontal), and optionally `pan_deg` (0 =
+/// straight ahead, positive to the left), `k1`, `k2` (radial distortion), `mount_x_m`,
+/// `mount_y_m` (the pan axis in the robot frame). Degrees here because people measure them;
+/// radians inside.
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CameraFile {
+    /// `pinhole` (the only model a file describes today).
+    pub model: String,
+    /// Image width, pixels.
+    pub width: u32,
+    /// Image height, pixels.
+    pub height: u32,
+    /// Focal length along the columns, pixels.
+    pub fx: f64,
+    /// Focal length along the rows, pixels.
+    pub fy: f64,
+    /// Principal point's column.
+    pub cx: f64,
+    /// Principal point's row.
+    pub cy: f64,
+    /// The optical centre above the floor, m.
+    pub height_m: f64,
+    /// The optical axis below the horizontal, degrees.
+    pub tilt_deg: f64,
+    /// The pan joint, degrees (positive: looking left).
+    #[serde(default)]
+    pub pan_deg: f64,
+    /// Radial distortion k1.
+    #[serde(default)]
+    pub k1: f64,
+    /// Radial distortion k2.
+    #[serde(default)]
+    pub k2: f64,
+    /// The pan axis, forward of the robot's centre, m.
+    #[serde(default)]
+    pub mount_x_m: f64,
+    /// The pan axis, left of the robot's centre, m.
+    #[serde(default)]
+    pub mount_y_m: f64,
+}
+
+impl CameraFile {
+    /// Parses a camera file; `file` names it in errors (line and column for syntax).
+    pub fn from_toml(text: &str, file: &str) -> Result<CameraFile, mrt_core::FileError> {
+        let parsed: CameraFile = toml::from_str(text).map_err(|e| {
+            mrt_core::FileError::parse(file, text, e.span().map(|s| s.start), e.message())
+        })?;
+        parsed
+            .camera()
+            .map_err(|message| mrt_core::FileError::Invalid { file: file.to_string(), message })?;
+        Ok(parsed)
+    }
+
+    /// Reads a camera file.
+    pub fn from_file(path: impl AsRef<std::path::Path>) -> Result<CameraFile, mrt_core::FileError> {
+        let path = path.as_ref();
+        let file = path.display().to_string();
+        let text = std::fs::read_to_string(path)
+            .map_err(|source| mrt_core::FileError::Io { file: file.clone(), source })?;
+        CameraFile::from_toml(&text, &file)
+    }
+
+    /// The camera it describes, every value checked.
+    pub fn camera(&self) -> Result<Pinhole, String> {
+        if self.model != "pinhole" {
+            return Err(format!("model = \"{}\": the models are \"pinhole\"", self.model));
+        }
+        let max = crate::vision::blobs::MAX_SIDE;
+        if !(1..=max).contains(&self.width) || !(1..=max).contains(&self.height) {
+            return Err(format!("width and height must be 1 to {max} pixels"));
+        }
+        let finite = [
+            ("cx", self.cx),
+            ("cy", self.cy),
+            ("k1", self.k1),
+            ("k2", self.k2),
+            ("mount_x_m", self.mount_x_m),
+            ("mount_y_m", self.mount_y_m),
+        ];
+        for (name, v) in finite {
+            if !v.is_finite() {
+                return Err(format!("{name} must be a finite number, not {v}"));
+            }
+        }
+        for (name, v) in [("fx", self.fx), ("fy", self.fy), ("height_m", self.height_m)] {
+            if !(v.is_finite() && v > 0.0) {
+                return Err(format!("{name} must be a finite number > 0, not {v}"));
+            }
+        }
+        if !(-90.0..=90.0).contains(&self.tilt_deg) || !(-180.0..=180.0).contains(&self.pan_deg) {
+            return Err(format!(
+                "tilt_deg must be -90 to 90 and pan_deg -180 to 180 (got {} and {})",
+                self.tilt_deg, self.pan_deg
+            ));
+        }
+        let intrinsics = Intrinsics {
+            fx: self.fx,
+            fy: self.fy,
+            cx: self.cx,
+            cy: self.cy,
+            width: self.width,
+            height: self.height,
+        };
+        let mut cam = Pinhole::new(intrinsics, self.height_m, self.tilt_deg.to_radians())
+            .panned(self.pan_deg.to_radians());
+        cam.mount = Point2::new(self.mount_x_m, self.mount_y_m);
+        cam.distortion = (self.k1, self.k2);
+        Ok(cam)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -369,7 +483,29 @@ mod tests {
         assert!(cam.in_image(px) && !cam.in_image(Pixel::new(-1.0, 3.0)));
     }
 
+    #[test]
+    fn camera_files_read_and_say_where_they_are_wrong() {
+        let text = "model = \"pinhole\"\nwidth = 320\nheight = 240\nfx = 260.0\nfy = 260.0\n\
+                    cx = 160.0\ncy = 120.0\nheight_m = 0.45\ntilt_deg = 20.0\n";
+        let cam = CameraFile::from_toml(text, "cam.toml").unwrap().camera().unwrap();
+        assert!((cam.tilt - 20f64.to_radians()).abs() < 1e-12 && cam.pan == 0.0);
+        let shipped = concat!(env!("CARGO_MANIFEST_DIR"), "/../../configs/vision/camera.toml");
+        assert!(CameraFile::from_file(shipped).is_ok());
+        let e = CameraFile::from_toml(&text.replace("fx = 260.0", "fx = -1.0"), "c.toml");
+        assert_eq!(e.unwrap_err().to_string(), "c.toml: fx must be a finite number > 0, not -1");
+        let e = CameraFile::from_toml(&format!("{text}roll_deg = 3\n"), "c.toml").unwrap_err();
+        assert!(e.to_string().starts_with("c.toml:10:1: unknown field `roll_deg`"), "{e}");
+        let e = CameraFile::from_toml(&text.replace("pinhole", "fisheye"), "c.toml").unwrap_err();
+        assert!(e.to_string().contains("the models are \"pinhole\""), "{e}");
+    }
+
     proptest! {
+        /// Random text never panics the camera file's parser.
+        #[test]
+        fn random_camera_files_are_parsed_or_refused(text in "\\PC{0,300}") {
+            let _ = CameraFile::from_toml(&text, "fuzz.toml");
+        }
+
         /// Every floor point in view comes back from its pixel, with any pan, tilt, height and a
         /// mild lens distortion.
         #[test]

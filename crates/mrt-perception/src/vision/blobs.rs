@@ -147,7 +147,8 @@ pub struct BallPercept {
     pub at: Point2<f64>,
     /// Distance on the floor from the point under the camera to the ball's floor point, m.
     pub distance: f64,
-    /// Bearing from the robot's heading (pan included), rad, counter-clockwise.
+    /// Bearing from the robot's heading (pan included), rad, counter-clockwise, seen from the
+    /// point under the camera.
     pub bearing: f64,
     /// Its pixels.
     pub pixels: u32,
@@ -182,7 +183,7 @@ pub fn find_ball(classes: &[u8], camera: &Pinhole, radius: f64) -> Option<BallPe
             radius_px: (n / std::f64::consts::PI).sqrt(),
             at,
             distance: d.norm(),
-            bearing: at.y.atan2(at.x),
+            bearing: d.y.atan2(d.x),
             pixels: blob.pixels,
         });
     }

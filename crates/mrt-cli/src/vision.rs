@@ -1,0 +1,121 @@
+//! `mrt vision`: the vision µAgent's tools for a competition (issue 19). `detect` classifies
+//! images with a colour file and finds the ball through a camera file, one JSON line per
+//! image; `--png OUT` draws what it found.
+
+use anyhow::{anyhow, bail, Context as _, Result};
+use image::{Rgb, RgbImage};
+use mrt_perception::camera::{Camera, CameraFile, Pinhole};
+use mrt_perception::vision::blobs::find_ball;
+use mrt_perception::vision::colors::{ColorClass, ColorTable, Lut};
+use std::io::Write as _;
+use std::path::{Path, PathBuf};
+
+/// `mrt vision detect`.
+#[derive(clap::Args)]
+pub struct DetectArgs {
+    /// The camera file (TOML; see configs/vision/camera.toml).
+    #[arg(long)]
+    pub camera: PathBuf,
+    /// The colour file (TOML; see configs/vision/colors.toml).
+    #[arg(long)]
+    pub colors: PathBuf,
+    /// The ball's radius, m.
+    #[arg(long, default_value_t = 0.11)]
+    pub ball_radius: f64,
+    /// Draw the classified image with the detections to this PNG file (one image only).
+    #[arg(long)]
+    pub png: Option<PathBuf>,
+    /// The images (PNG or JPEG), each the camera's size.
+    #[arg(required = true)]
+    pub images: Vec<PathBuf>,
+}
+
+/// The colour a class is drawn with.
+fn paint(c: ColorClass) -> Rgb<u8> {
+    Rgb(match c {
+        ColorClass::Unknown => [128, 128, 128],
+        ColorClass::Ball => [255, 120, 0],
+        ColorClass::GoalYellow => [240, 220, 0],
+        ColorClass::GoalBlue => [0, 80, 255],
+        ColorClass::Robot => [0, 0, 0],
+        ColorClass::Line => [255, 255, 255],
+        ColorClass::Field => [0, 130, 0],
+    })
+}
+
+/// Runs `mrt vision detect`.
+pub fn detect(args: &DetectArgs) -> Result<()> {
+    if !(args.ball_radius.is_finite() && args.ball_radius > 0.0 && args.ball_radius < 1.0) {
+        bail!("--ball-radius must be between 0 and 1 m, not {}", args.ball_radius);
+    }
+    if args.png.is_some() && args.images.len() != 1 {
+        bail!("--png draws one image: give one image with it");
+    }
+    let camera = CameraFile::from_file(&args.camera).and_then(|f| {
+        f.camera().map_err(|message| mrt_core::FileError::Invalid {
+            file: args.camera.display().to_string(),
+            message,
+        })
+    });
+    let camera = camera.map_err(|e| anyhow!("{e}"))?;
+    let colors = ColorTable::from_file(&args.colors).map_err(|e| anyhow!("{e}"))?;
+    let lut = Lut::new(&colors);
+    let stdout = std::io::stdout();
+    let mut out = stdout.lock();
+    for path in &args.images {
+        let line = detect_one(path, &camera, &lut, args.ball_radius, args.png.as_deref())?;
+        if writeln!(out, "{line}").is_err() {
+            return Ok(()); // the reader went away
+        }
+    }
+    Ok(())
+}
+
+fn detect_one(
+    path: &Path,
+    camera: &Pinhole,
+    lut: &Lut,
+    ball_radius: f64,
+    png: Option<&Path>,
+) -> Result<serde_json::Value> {
+    let img = image::open(path).with_context(|| format!("{}", path.display()))?.to_rgb8();
+    let (w, h) = img.dimensions();
+    if (w, h) != camera.size() {
+        bail!(
+            "{}: the image is {w}×{h}, the camera file says {}×{}",
+            path.display(),
+            camera.size().0,
+            camera.size().1
+        );
+    }
+    let mut classes = vec![0u8; (w * h) as usize];
+    lut.classify(img.as_raw(), &mut classes);
+    let ball = find_ball(&classes, camera, ball_radius);
+    let mut objects = Vec::new();
+    if let Some(b) = ball {
+        objects.push(serde_json::json!({
+            "class": "ball",
+            "pixel": [round3(b.pixel.x), round3(b.pixel.y)],
+            "radius_px": round3(b.radius_px),
+            "distance_m": round3(b.distance),
+            "bearing_deg": round3(b.bearing.to_degrees()),
+        }));
+    }
+    if let Some(out) = png {
+        let mut drawn = RgbImage::from_fn(w, h, |x, y| {
+            paint(ColorClass::from_u8(classes[(y * w + x) as usize]))
+        });
+        if let Some(b) = ball {
+            let c = (b.pixel.x as i32, b.pixel.y as i32);
+            let r = b.radius_px.round().max(1.0) as i32;
+            imageproc::drawing::draw_hollow_circle_mut(&mut drawn, c, r + 2, Rgb([255, 0, 255]));
+            imageproc::drawing::draw_cross_mut(&mut drawn, Rgb([255, 0, 255]), c.0, c.1);
+        }
+        drawn.save(out).with_context(|| format!("cannot write {}", out.display()))?;
+    }
+    Ok(serde_json::json!({ "image": path.display().to_string(), "objects": objects }))
+}
+
+fn round3(x: f64) -> f64 {
+    (x * 1000.0).round() / 1000.0
+}

@@ -1,0 +1,106 @@
+//! `mrt vision detect` on images it has never seen: frames drawn here through the shipped
+//! camera file (green carpet, noise, an orange ball where the camera sees it, with the size a
+//! sphere has), read back as PNG and JPEG.
+#![allow(clippy::unwrap_used)]
+
+use image::{Rgb, RgbImage};
+use mrt_perception::camera::{ball_diameter_px, Camera, CameraFile};
+use nalgebra::Point3;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+fn config(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../configs/vision").join(name)
+}
+
+/// A 320×240 frame of the shipped camera with the ball centred at `(x, y)` on the floor (m),
+/// or none.
+fn frame(ball: Option<(f64, f64)>, seed: u32) -> RgbImage {
+    let cam = CameraFile::from_file(config("camera.toml")).unwrap().camera().unwrap();
+    let (w, h) = cam.size();
+    let disc = ball.map(|(x, y)| {
+        let centre = Point3::new(x, y, 0.11);
+        let px = cam.project(centre).unwrap();
+        let r = ball_diameter_px(0.11, cam.intrinsics.fx, (centre - cam.centre()).norm()) / 2.0;
+        (px, r)
+    });
+    // A cheap deterministic noise, ±6 per channel.
+    let mut state = seed.wrapping_mul(2_654_435_761).max(1);
+    let mut noise = move || {
+        state ^= state << 13;
+        state ^= state >> 17;
+        state ^= state << 5;
+        (state % 13) as i32 - 6
+    };
+    RgbImage::from_fn(w, h, |x, y| {
+        let mut c = [30, 140, 40];
+        if let Some((px, r)) = disc {
+            if (f64::from(x) + 0.5 - px.x).hypot(f64::from(y) + 0.5 - px.y) <= r {
+                c = [255, 120, 0];
+            }
+        }
+        Rgb(c.map(|v: i32| (v + noise()).clamp(0, 255) as u8))
+    })
+}
+
+fn detect(images: &[&Path], extra: &[&str]) -> (bool, String, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_mrt"))
+        .args(["vision", "detect", "--camera"])
+        .arg(config("camera.toml"))
+        .arg("--colors")
+        .arg(config("colors.toml"))
+        .args(extra)
+        .args(images)
+        .output()
+        .unwrap();
+    let text = |b: &[u8]| String::from_utf8_lossy(b).into_owned();
+    (out.status.success(), text(&out.stdout), text(&out.stderr))
+}
+
+#[test]
+fn the_ball_is_found_in_images_at_its_distance_and_bearing() {
+    let dir = std::env::temp_dir().join(format!("mrt-vision-cli-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let spots = [(1.0, 0.0), (1.5, 0.4), (2.5, -0.6), (3.5, 0.5)];
+    let mut files = Vec::new();
+    for (i, &(x, y)) in spots.iter().enumerate() {
+        let ext = if i % 2 == 0 { "png" } else { "jpg" };
+        let path = dir.join(format!("ball-{i}.{ext}"));
+        frame(Some((x, y)), i as u32 + 1).save(&path).unwrap();
+        files.push(path);
+    }
+    let empty = dir.join("empty.png");
+    frame(None, 9).save(&empty).unwrap();
+    files.push(empty.clone());
+    let paths: Vec<&Path> = files.iter().map(|p| p.as_path()).collect();
+    let (ok, out, err) = detect(&paths, &[]);
+    assert!(ok, "{err}");
+    let lines: Vec<serde_json::Value> =
+        out.lines().map(|l| serde_json::from_str(l).unwrap()).collect();
+    assert_eq!(lines.len(), files.len());
+    for (line, &(x, y)) in lines.iter().zip(&spots) {
+        let ball = &line["objects"][0];
+        assert_eq!(ball["class"], "ball", "{line}");
+        let d = ball["distance_m"].as_f64().unwrap();
+        let b = ball["bearing_deg"].as_f64().unwrap();
+        let (td, tb) = (x.hypot(y), y.atan2(x).to_degrees());
+        assert!((d - td).abs() <= 0.05 * td, "({x}, {y}): {line}");
+        assert!((b - tb).abs() <= 1.5, "({x}, {y}): {line}");
+    }
+    assert_eq!(lines[4]["objects"].as_array().unwrap().len(), 0, "no ball: {}", lines[4]);
+    // The drawing.
+    let drawn = dir.join("drawn.png");
+    let (ok, _, err) = detect(&[&files[0]], &["--png", drawn.to_str().unwrap()]);
+    assert!(ok && image::open(&drawn).unwrap().width() == 320, "{err}");
+    // An image of another size than the camera's is refused, with both sizes.
+    let small = dir.join("small.png");
+    RgbImage::new(32, 24).save(&small).unwrap();
+    let (ok, _, err) = detect(&[&small], &[]);
+    assert!(!ok && err.contains("32×24") && err.contains("320×240"), "{err}");
+    // Not an image.
+    let text = dir.join("not-an-image.png");
+    std::fs::write(&text, "hello").unwrap();
+    let (ok, _, err) = detect(&[&text], &[]);
+    assert!(!ok && err.contains("not-an-image.png") && !err.contains("panicked"), "{err}");
+    std::fs::remove_dir_all(&dir).unwrap();
+}
