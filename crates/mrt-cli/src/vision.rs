@@ -1,12 +1,14 @@
 //! `mrt vision`: the vision µAgent's tools for a competition (issue 19). `detect` classifies
-//! images with a colour file and finds the ball through a camera file, one JSON line per
-//! image; `--png OUT` draws what it found.
+//! images with a colour file and finds the ball and the goals (their nearest point and the open
+//! space for a shot) through a camera file, one JSON line per image; `--png OUT` draws what it
+//! found.
 
 use anyhow::{anyhow, bail, Context as _, Result};
 use image::{Rgb, RgbImage};
 use mrt_perception::camera::{Camera, CameraFile, Pinhole};
 use mrt_perception::vision::blobs::find_ball;
 use mrt_perception::vision::colors::{ColorClass, ColorTable, Lut};
+use mrt_perception::vision::goals::find_goal;
 use std::io::Write as _;
 use std::path::{Path, PathBuf};
 
@@ -100,6 +102,17 @@ fn detect_one(
             "distance_m": round3(b.distance),
             "bearing_deg": round3(b.bearing.to_degrees()),
         }));
+    }
+    for class in [ColorClass::GoalYellow, ColorClass::GoalBlue] {
+        if let Some(g) = find_goal(&classes, camera, class, 20, 0) {
+            objects.push(serde_json::json!({
+                "class": class.name(),
+                "pixel": [round3(g.nearest.x), round3(g.nearest.y)],
+                "distance_m": round3(g.distance),
+                "bearing_deg": round3(g.bearing.to_degrees()),
+                "open_bearing_deg": round3(g.open_bearing.to_degrees()),
+            }));
+        }
     }
     if let Some(out) = png {
         let mut drawn = RgbImage::from_fn(w, h, |x, y| {

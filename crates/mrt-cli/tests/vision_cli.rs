@@ -88,6 +88,26 @@ fn the_ball_is_found_in_images_at_its_distance_and_bearing() {
         assert!((b - tb).abs() <= 1.5, "({x}, {y}): {line}");
     }
     assert_eq!(lines[4]["objects"].as_array().unwrap().len(), 0, "no ball: {}", lines[4]);
+    // A blue goal 3 m ahead, 1 m wide: its nearest point at 3 m, straight ahead.
+    let goal = dir.join("goal.png");
+    let mut img = frame(None, 5);
+    let cam = CameraFile::from_file(config("camera.toml")).unwrap().camera().unwrap();
+    let l = cam.project(Point3::new(3.0, 0.5, 0.0)).unwrap();
+    let r = cam.project(Point3::new(3.0, -0.5, 0.0)).unwrap();
+    let t = cam.project(Point3::new(3.0, 0.0, 0.8)).unwrap();
+    for y in t.y as u32..l.y as u32 {
+        for x in l.x as u32..r.x as u32 {
+            img.put_pixel(x, y, Rgb([20, 60, 220]));
+        }
+    }
+    img.save(&goal).unwrap();
+    let (ok, out, err) = detect(&[&goal], &[]);
+    assert!(ok, "{err}");
+    let line: serde_json::Value = serde_json::from_str(out.trim()).unwrap();
+    let g = &line["objects"][0];
+    assert_eq!(g["class"], "goal_blue", "{line}");
+    assert!((g["distance_m"].as_f64().unwrap() - 3.0).abs() < 0.15, "{line}");
+    assert!(g["bearing_deg"].as_f64().unwrap().abs() < 1.5, "{line}");
     // The drawing.
     let drawn = dir.join("drawn.png");
     let (ok, _, err) = detect(&[&files[0]], &["--png", drawn.to_str().unwrap()]);

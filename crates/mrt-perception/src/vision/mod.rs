@@ -4,3 +4,4 @@
 
 pub mod blobs;
 pub mod colors;
+pub mod goals;
