@@ -38,6 +38,16 @@ pub enum FileError {
 }
 
 impl FileError {
+    /// Reads a text file for a parser: its text and its name for error messages, or the
+    /// [`FileError::Io`] that names it.
+    pub fn read(path: &std::path::Path) -> Result<(String, String), FileError> {
+        let file = path.display().to_string();
+        match std::fs::read_to_string(path) {
+            Ok(text) => Ok((text, file)),
+            Err(source) => Err(FileError::Io { file, source }),
+        }
+    }
+
     /// A syntax error at byte `offset` of `text` (the start of the file when unknown).
     pub fn parse(file: &str, text: &str, offset: Option<usize>, message: &str) -> FileError {
         let (line, column) = line_column(text, offset.unwrap_or(0));
@@ -74,5 +84,10 @@ mod tests {
         assert_eq!(e.to_string(), "a.toml:2:5: bad value");
         // Inside a multi-byte character: no panic, the end of the text.
         assert_eq!(line_column("é", 1), (1, 2));
+        let missing = std::path::Path::new("/nonexistent/mrt/x.toml");
+        assert!(FileError::read(missing)
+            .unwrap_err()
+            .to_string()
+            .starts_with("/nonexistent/mrt/x.toml: "));
     }
 }

@@ -311,10 +311,7 @@ impl CameraFile {
 
     /// Reads a camera file.
     pub fn from_file(path: impl AsRef<std::path::Path>) -> Result<CameraFile, mrt_core::FileError> {
-        let path = path.as_ref();
-        let file = path.display().to_string();
-        let text = std::fs::read_to_string(path)
-            .map_err(|source| mrt_core::FileError::Io { file: file.clone(), source })?;
+        let (text, file) = mrt_core::FileError::read(path.as_ref())?;
         CameraFile::from_toml(&text, &file)
     }
 

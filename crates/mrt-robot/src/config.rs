@@ -219,10 +219,7 @@ impl RobotFile {
 
     /// Reads a robot file.
     pub fn from_file(path: impl AsRef<Path>) -> Result<RobotFile, RobotFileError> {
-        let path = path.as_ref();
-        let file = path.display().to_string();
-        let text = std::fs::read_to_string(path)
-            .map_err(|source| RobotFileError::Io { file: file.clone(), source })?;
+        let (text, file) = mrt_core::FileError::read(path.as_ref())?;
         RobotFile::from_toml(&text, &file)
     }
 

@@ -363,10 +363,7 @@ impl SimConfig {
 
     /// Reads a configuration file.
     pub fn from_file(path: impl AsRef<Path>) -> Result<SimConfig, ConfigError> {
-        let path = path.as_ref();
-        let file = path.display().to_string();
-        let text = std::fs::read_to_string(path)
-            .map_err(|source| ConfigError::Io { file: file.clone(), source })?;
+        let (text, file) = mrt_core::FileError::read(path.as_ref())?;
         SimConfig::from_toml(&text, &file)
     }
 

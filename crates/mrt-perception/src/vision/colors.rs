@@ -164,10 +164,7 @@ impl ColorTable {
 
     /// Reads a COLORS.toml file.
     pub fn from_file(path: impl AsRef<std::path::Path>) -> Result<ColorTable, FileError> {
-        let path = path.as_ref();
-        let file = path.display().to_string();
-        let text = std::fs::read_to_string(path)
-            .map_err(|source| FileError::Io { file: file.clone(), source })?;
+        let (text, file) = mrt_core::FileError::read(path.as_ref())?;
         ColorTable::from_toml(&text, &file)
     }
 
