@@ -1,7 +1,8 @@
 //! Colour vision (ISocRob seed `003` §3.2.1, the vision µAgent): pixels classified by a colour
-//! lookup table built from HSV thresholds ([`colors`]). Blobs, the ball, goals, lines and open
-//! space build on it (issue 19).
+//! lookup table built from HSV thresholds ([`colors`]); blobs and the ball ([`blobs`]), goals with
+//! their nearest point and open space ([`goals`]), field-line points ([`lines`]) build on it.
 
 pub mod blobs;
 pub mod colors;
 pub mod goals;
+pub mod lines;
