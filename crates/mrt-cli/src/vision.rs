@@ -53,13 +53,11 @@ pub fn detect(args: &DetectArgs) -> Result<()> {
     if args.png.is_some() && args.images.len() != 1 {
         bail!("--png draws one image: give one image with it");
     }
-    let camera = CameraFile::from_file(&args.camera).and_then(|f| {
-        f.camera().map_err(|message| mrt_core::FileError::Invalid {
-            file: args.camera.display().to_string(),
-            message,
-        })
-    });
-    let camera = camera.map_err(|e| anyhow!("{e}"))?;
+    // `from_file` has checked the camera already: `camera()` cannot fail on what it read.
+    let camera = CameraFile::from_file(&args.camera)
+        .map_err(|e| anyhow!("{e}"))?
+        .camera()
+        .map_err(|e| anyhow!("{}: {e}", args.camera.display()))?;
     let colors = ColorTable::from_file(&args.colors).map_err(|e| anyhow!("{e}"))?;
     let lut = Lut::new(&colors);
     let stdout = std::io::stdout();

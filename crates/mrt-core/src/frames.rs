@@ -139,10 +139,7 @@ impl Framed<Field, Pose2> {
 
     /// A point the robot at this pose measured in its own frame, in the field frame.
     pub fn to_field(self, p: Framed<Robot, Point2>) -> Framed<Field, Point2> {
-        let me = self.inner;
-        let (s, c) = me.theta.sin_cos();
-        let (x, y) = (p.inner.x, p.inner.y);
-        Framed::new(Point2::new(me.x + c * x - s * y, me.y + s * x + c * y))
+        Framed::new(self.inner.transform_point(p.inner))
     }
 
     /// Where a field point is for the robot at this pose: distance (m) and bearing (rad,

@@ -55,7 +55,15 @@ impl ColorClass {
 
     /// The class of a table entry (`Unknown` for anything else).
     pub fn from_u8(v: u8) -> ColorClass {
-        ColorClass::ALL.into_iter().find(|c| *c as u8 == v).unwrap_or(ColorClass::Unknown)
+        match v {
+            1 => ColorClass::Ball,
+            2 => ColorClass::GoalYellow,
+            3 => ColorClass::GoalBlue,
+            4 => ColorClass::Robot,
+            5 => ColorClass::Line,
+            6 => ColorClass::Field,
+            _ => ColorClass::Unknown,
+        }
     }
 
     /// The name used in COLORS.toml and in `mrt vision`'s output.
@@ -326,6 +334,15 @@ mod tests {
         // 102 with the shipped colours: ratios such as s = 1/5 or h = 40° that the two formulas
         // round to either side of a threshold set exactly there.
         assert!(on_a_threshold < 256, "{on_a_threshold} disagreements on thresholds");
+    }
+
+    #[test]
+    fn class_bytes_round_trip() {
+        for c in ColorClass::ALL {
+            assert_eq!(ColorClass::from_u8(c as u8), c);
+        }
+        assert_eq!(ColorClass::from_u8(0), ColorClass::Unknown);
+        assert_eq!(ColorClass::from_u8(200), ColorClass::Unknown);
     }
 
     #[test]
