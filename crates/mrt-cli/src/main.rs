@@ -45,6 +45,9 @@ enum VisionCommand {
     /// Classify images with a colour file and find the ball through a camera file: one JSON
     /// line per image.
     Detect(vision::DetectArgs),
+    /// Save what a simulated camera sees: a robot placed on the simulator's field, the ball
+    /// and other robots where you say.
+    Render(vision::RenderArgs),
 }
 
 #[derive(Subcommand)]
@@ -229,6 +232,7 @@ fn run(command: Command) -> Result<()> {
         Command::Robot(args) => distributed::robot(&args)?,
         Command::Bb { command } => bb::run(command)?,
         Command::Vision { command: VisionCommand::Detect(args) } => vision::detect(&args)?,
+        Command::Vision { command: VisionCommand::Render(args) } => vision::render(&args)?,
         Command::Behave { file, world, cycles, period_ms } => {
             behave::behave(&file, world.as_deref(), cycles, period_ms)?
         }

@@ -1,7 +1,8 @@
 //! `mrt vision`: the vision µAgent's tools for a competition (issue 19). `detect` classifies
 //! images with a colour file and finds the ball and the goals (their nearest point and the open
 //! space for a shot) through a camera file, one JSON line per image; `--png OUT` draws what it
-//! found.
+//! found. `render` saves what a simulated camera sees (the simulator's renderer,
+//! `mrt_sim::render`).
 
 use anyhow::{anyhow, bail, Context as _, Result};
 use image::{Rgb, RgbImage};
@@ -129,4 +130,106 @@ fn detect_one(
 
 fn round3(x: f64) -> f64 {
     (x * 1000.0).round() / 1000.0
+}
+
+/// `mrt vision render`.
+#[derive(clap::Args)]
+pub struct RenderArgs {
+    /// The world: a simulator configuration (TOML; see configs/sim/default.toml), for the
+    /// field, its camera (`[camera]`) and what is drawn (`[render]`). Default: the built-in
+    /// world.
+    #[arg(long)]
+    pub world: Option<PathBuf>,
+    /// A camera file instead of the world's `[camera]` (see configs/vision/camera.toml).
+    #[arg(long)]
+    pub camera: Option<PathBuf>,
+    /// Where the viewing robot stands: `X,Y,HEADING_DEG` (field frame: m from the centre spot,
+    /// x towards the east (yellow) goal, heading counter-clockwise from east).
+    #[arg(long, value_parser = parse_pose, allow_hyphen_values = true)]
+    pub at: (f64, f64, f64),
+    /// The pan joint, degrees (positive: to the left).
+    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
+    pub pan: f64,
+    /// The ball: `X,Y` (m). No ball when not given.
+    #[arg(long, value_parser = parse_point, allow_hyphen_values = true)]
+    pub ball: Option<(f64, f64)>,
+    /// Another robot: `X,Y,home` or `X,Y,away` (repeat for more).
+    #[arg(long = "robot", value_parser = parse_robot, allow_hyphen_values = true)]
+    pub robots: Vec<(f64, f64, bool)>,
+    /// Seed of the image noise (when the world's `[render]` turns noise on).
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// The PNG file to write.
+    #[arg(long)]
+    pub out: PathBuf,
+}
+
+fn numbers(text: &str, n: usize, what: &str) -> Result<Vec<f64>, String> {
+    let parts: Vec<&str> = text.split(',').map(str::trim).collect();
+    if parts.len() != n {
+        return Err(format!("expected {what}, got {text:?}"));
+    }
+    parts
+        .iter()
+        .map(|p| match p.parse::<f64>() {
+            Ok(v) if v.is_finite() && v.abs() <= 1000.0 => Ok(v),
+            _ => Err(format!("{p:?} in {text:?} is not a number from -1000 to 1000 ({what})")),
+        })
+        .collect()
+}
+
+fn parse_point(text: &str) -> Result<(f64, f64), String> {
+    let v = numbers(text, 2, "X,Y")?;
+    Ok((v[0], v[1]))
+}
+
+fn parse_pose(text: &str) -> Result<(f64, f64, f64), String> {
+    let v = numbers(text, 3, "X,Y,HEADING_DEG")?;
+    Ok((v[0], v[1], v[2]))
+}
+
+fn parse_robot(text: &str) -> Result<(f64, f64, bool), String> {
+    let Some((xy, team)) = text.rsplit_once(',') else {
+        return Err(format!("expected X,Y,home or X,Y,away, got {text:?}"));
+    };
+    let home = match team.trim() {
+        "home" => true,
+        "away" => false,
+        other => return Err(format!("the team is home or away, not {other:?}")),
+    };
+    let (x, y) = parse_point(xy)?;
+    Ok((x, y, home))
+}
+
+/// Runs `mrt vision render`.
+pub fn render(args: &RenderArgs) -> Result<()> {
+    use mrt_core::Pose2;
+    use mrt_sim::render::{CameraState, Renderer, Scene};
+    let mut cfg = match &args.world {
+        Some(path) => mrt_sim::config::SimConfig::from_file(path).map_err(|e| anyhow!("{e}"))?,
+        None => mrt_sim::config::SimConfig::default(),
+    };
+    if let Some(path) = &args.camera {
+        cfg.camera = CameraFile::from_file(path).map_err(|e| anyhow!("{e}"))?;
+    }
+    if !(args.pan.is_finite() && args.pan.abs() <= 180.0) {
+        bail!("--pan must be -180 to 180 degrees, not {}", args.pan);
+    }
+    let renderer = Renderer::new(&cfg).map_err(|e| anyhow!("camera: {e}"))?;
+    let (x, y, heading) = args.at;
+    let scene = Scene {
+        ball: args.ball,
+        robots: args.robots.iter().map(|&(x, y, home)| (Pose2::new(x, y, 0.0), home)).collect(),
+    };
+    let frame = renderer.render(
+        &scene,
+        Pose2::new(x, y, heading.to_radians()),
+        args.pan.to_radians(),
+        None,
+        &mut CameraState::new(args.seed),
+    );
+    let image = RgbImage::from_raw(frame.width, frame.height, frame.rgb)
+        .ok_or_else(|| anyhow!("the renderer made an image of the wrong size"))?;
+    image.save(&args.out).with_context(|| format!("cannot write {}", args.out.display()))?;
+    Ok(())
 }

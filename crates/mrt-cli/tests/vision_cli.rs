@@ -124,3 +124,60 @@ fn the_ball_is_found_in_images_at_its_distance_and_bearing() {
     assert!(!ok && err.contains("not-an-image.png") && !err.contains("panicked"), "{err}");
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+fn render(args: &[&str]) -> (bool, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_mrt"))
+        .args(["vision", "render"])
+        .args(args)
+        .output()
+        .unwrap();
+    (out.status.success(), String::from_utf8_lossy(&out.stderr).into_owned())
+}
+
+/// `mrt vision render` draws what the simulator's camera sees; `mrt vision detect` finds the
+/// ball in it where it was put: 2 m ahead-left of a robot at (-3, 1) facing 30°.
+#[test]
+fn detect_finds_the_ball_in_a_rendered_frame() {
+    let dir = std::env::temp_dir().join(format!("mrt-vision-render-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let png = dir.join("frame.png");
+    // The ball 2 m away, 10° left of the heading: 40° in the field frame.
+    let (bx, by) = (-3.0 + 2.0 * 40f64.to_radians().cos(), 1.0 + 2.0 * 40f64.to_radians().sin());
+    let ball = format!("{bx},{by}");
+    let (ok, err) = render(&[
+        "--at",
+        "-3,1,30",
+        "--ball",
+        &ball,
+        "--robot",
+        "0,2,away",
+        "--robot",
+        "1,0.5,home",
+        "--out",
+        png.to_str().unwrap(),
+    ]);
+    assert!(ok, "{err}");
+    let (ok, out, err) = detect(&[&png], &[]);
+    assert!(ok, "{err}");
+    let line: serde_json::Value = serde_json::from_str(out.trim()).unwrap();
+    let ball = &line["objects"][0];
+    assert_eq!(ball["class"], "ball", "{line}");
+    let d = ball["distance_m"].as_f64().unwrap();
+    let b = ball["bearing_deg"].as_f64().unwrap();
+    assert!((d - 2.0).abs() < 0.1 && (b - 10.0).abs() < 1.5, "{line}");
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn render_says_what_is_wrong_with_its_arguments() {
+    let out = std::env::temp_dir().join("mrt-never-written.png");
+    let out = out.to_str().unwrap();
+    let (ok, err) = render(&["--at", "1,2", "--out", out]);
+    assert!(!ok && err.contains("expected X,Y,HEADING_DEG"), "{err}");
+    let (ok, err) = render(&["--at", "0,0,0", "--robot", "1,1,referee", "--out", out]);
+    assert!(!ok && err.contains("home or away"), "{err}");
+    let (ok, err) = render(&["--at", "0,0,0", "--ball", "1,nan", "--out", out]);
+    assert!(!ok && err.contains("is not a number"), "{err}");
+    let (ok, err) = render(&["--at", "0,0,0", "--world", "/nonexistent/world.toml", "--out", out]);
+    assert!(!ok && err.contains("/nonexistent/world.toml"), "{err}");
+}

@@ -52,7 +52,7 @@ pub use localization::{FilterCounts, Localization};
 pub use mrt_core::{Message, MsgType};
 pub use robot::{lps, Estimate, Field, GameState, Lpo, Mate, RobotCommand, Target, WorldSnapshot};
 pub use sensing::{
-    CameraFrame, Displacement, GameInfo, MiceReadings, Odometry, Sighting, Sonar, SonarScan,
+    CameraFrame, Displacement, GameInfo, Image, MiceReadings, Odometry, Sighting, Sonar, SonarScan,
     FIELD_OBJECTS,
 };
 pub use team::MateReport;

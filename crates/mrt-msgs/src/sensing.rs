@@ -149,4 +149,52 @@ pub struct CameraFrame {
     /// The ball's velocity in the robot's frame (m/s), when the ball is seen: the stand-in
     /// for a ball tracker.
     pub ball_velocity: Option<(f64, f64)>,
+    /// The camera's image, when the camera renders or grabs one (the vision µAgent's input,
+    /// ISocRob seed `003` §3.2.1); `None` from the object sensor alone.
+    #[serde(default)]
+    pub image: Option<Image>,
+}
+
+/// An RGB image, 8 bits per channel, row by row from the top-left corner (`3·width` bytes a
+/// row): what a camera driver grabs or the simulator renders (ISocRob seed `003` §3.2.1).
+#[derive(Clone, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Image {
+    /// Columns.
+    pub width: u32,
+    /// Rows.
+    pub height: u32,
+    /// `width × height × 3` bytes: red, green, blue of each pixel.
+    pub rgb: Vec<u8>,
+}
+
+impl Image {
+    /// A black `width × height` image.
+    pub fn new(width: u32, height: u32) -> Image {
+        Image { width, height, rgb: vec![0; width as usize * height as usize * 3] }
+    }
+
+    /// Whether the buffer holds exactly `width × height` pixels (a message from the network
+    /// may not).
+    pub fn is_consistent(&self) -> bool {
+        (self.width as usize)
+            .checked_mul(self.height as usize)
+            .and_then(|n| n.checked_mul(3))
+            .is_some_and(|n| n == self.rgb.len())
+    }
+
+    /// The pixel at column `col`, row `row`, or `None` outside the image.
+    pub fn pixel(&self, col: u32, row: u32) -> Option<[u8; 3]> {
+        if col >= self.width || row >= self.height {
+            return None;
+        }
+        let i = (row as usize * self.width as usize + col as usize) * 3;
+        self.rgb.get(i..i + 3).map(|p| [p[0], p[1], p[2]])
+    }
+}
+
+impl std::fmt::Debug for Image {
+    /// Size only: a frame's bytes would fill a log.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "Image({}×{}, {} bytes)", self.width, self.height, self.rgb.len())
+    }
 }

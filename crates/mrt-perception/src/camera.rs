@@ -140,6 +140,14 @@ impl Pinhole {
             * Rotation3::from_matrix_unchecked(axes)
     }
 
+    /// The direction of the ray that pixel `px` sees, from the optical centre (robot frame, not
+    /// normalized: its component along the optical axis is 1).
+    pub fn ray(&self, px: Pixel) -> Vector3<f64> {
+        let k = &self.intrinsics;
+        let n = self.undistort(Vector2::new((px.x - k.cx) / k.fx, (px.y - k.cy) / k.fy));
+        self.camera_to_robot() * Vector3::new(n.x, n.y, 1.0)
+    }
+
     /// Applies the radial distortion to a normalized point.
     fn distort(&self, n: Vector2<f64>) -> Vector2<f64> {
         let (k1, k2) = self.distortion;
@@ -184,9 +192,7 @@ impl Camera for Pinhole {
     }
 
     fn unproject_at_height(&self, px: Pixel, z: f64) -> Option<Point3<f64>> {
-        let k = &self.intrinsics;
-        let n = self.undistort(Vector2::new((px.x - k.cx) / k.fx, (px.y - k.cy) / k.fy));
-        let ray = self.camera_to_robot() * Vector3::new(n.x, n.y, 1.0);
+        let ray = self.ray(px);
         let t = (z - self.height) / ray.z;
         (t.is_finite() && t > 0.0).then(|| self.centre() + ray * t)
     }
@@ -295,6 +301,29 @@ pub struct CameraFile {
     /// The pan axis, left of the robot's centre, m.
     #[serde(default)]
     pub mount_y_m: f64,
+}
+
+impl Default for CameraFile {
+    /// The shipped `configs/vision/camera.toml`: a 320×240 pinhole camera 0.45 m above the
+    /// floor, tilted 20° down, straight ahead from the robot's centre.
+    fn default() -> Self {
+        CameraFile {
+            model: "pinhole".to_string(),
+            width: 320,
+            height: 240,
+            fx: 260.0,
+            fy: 260.0,
+            cx: 160.0,
+            cy: 120.0,
+            height_m: 0.45,
+            tilt_deg: 20.0,
+            pan_deg: 0.0,
+            k1: 0.0,
+            k2: 0.0,
+            mount_x_m: 0.0,
+            mount_y_m: 0.0,
+        }
+    }
 }
 
 impl CameraFile {
@@ -487,7 +516,7 @@ mod tests {
         let cam = CameraFile::from_toml(text, "cam.toml").unwrap().camera().unwrap();
         assert!((cam.tilt - 20f64.to_radians()).abs() < 1e-12 && cam.pan == 0.0);
         let shipped = concat!(env!("CARGO_MANIFEST_DIR"), "/../../configs/vision/camera.toml");
-        assert!(CameraFile::from_file(shipped).is_ok());
+        assert_eq!(CameraFile::from_file(shipped).unwrap(), CameraFile::default());
         let e = CameraFile::from_toml(&text.replace("fx = 260.0", "fx = -1.0"), "c.toml");
         assert_eq!(e.unwrap_err().to_string(), "c.toml: fx must be a finite number > 0, not -1");
         let e = CameraFile::from_toml(&format!("{text}roll_deg = 3\n"), "c.toml").unwrap_err();

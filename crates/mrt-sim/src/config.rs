@@ -195,6 +195,76 @@ impl Default for SensorConfig {
     }
 }
 
+/// What the simulated cameras draw (the `render` module): the heights of the things that the
+/// 2-D physics has no use for, and the image effects, all off by default.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct RenderConfig {
+    /// Width of the white field lines, m.
+    pub line_width: f64,
+    /// Height of the goals' coloured walls and crossbar, m.
+    pub goal_height: f64,
+    /// Height of the walls around the field, m.
+    pub wall_height: f64,
+    /// Height of a robot's dark cylinder, m (its team marker is a band near the top).
+    pub robot_height: f64,
+    /// Radius of a landmark post (the corners, the ends of the half-way line), m.
+    pub post_radius: f64,
+    /// Height of a landmark post, m.
+    pub post_height: f64,
+    /// Image noise: standard deviation per channel, in levels of 0–255.
+    pub noise: f64,
+    /// Lighting variation: each frame's brightness is scaled by a factor drawn uniformly
+    /// within `1 ± lighting`.
+    pub lighting: f64,
+    /// Motion blur: the fraction of the previous frame that stays in the next, 0 (off) to 0.9.
+    pub motion_blur: f64,
+}
+
+impl Default for RenderConfig {
+    fn default() -> Self {
+        Self {
+            line_width: 0.1,
+            goal_height: 1.0,
+            wall_height: 0.5,
+            robot_height: 0.6,
+            post_radius: 0.1,
+            post_height: 0.8,
+            noise: 0.0,
+            lighting: 0.0,
+            motion_blur: 0.0,
+        }
+    }
+}
+
+impl RenderConfig {
+    fn validate(&self) -> Result<(), String> {
+        let positive = [
+            ("render.line_width", self.line_width),
+            ("render.goal_height", self.goal_height),
+            ("render.wall_height", self.wall_height),
+            ("render.robot_height", self.robot_height),
+            ("render.post_radius", self.post_radius),
+            ("render.post_height", self.post_height),
+        ];
+        for (name, v) in positive {
+            if !(v.is_finite() && v > 0.0 && v <= 10.0) {
+                return Err(format!("{name} must be more than 0 and at most 10 m, not {v}"));
+            }
+        }
+        if !(0.0..=100.0).contains(&self.noise) {
+            return Err(format!("render.noise must be 0 to 100 levels, not {}", self.noise));
+        }
+        if !(0.0..=0.9).contains(&self.lighting) || !(0.0..=0.9).contains(&self.motion_blur) {
+            return Err(format!(
+                "render.lighting and render.motion_blur must be 0 to 0.9 (got {} and {})",
+                self.lighting, self.motion_blur
+            ));
+        }
+        Ok(())
+    }
+}
+
 /// How near its kickoff position a robot must be for READY to end early, and not to be
 /// placed when it ends (m).
 pub const READY_TOLERANCE: f64 = 0.3;
@@ -345,6 +415,11 @@ pub struct SimConfig {
     pub guidance: GuidanceConfig,
     /// The odometry sensors.
     pub odometry: OdometryConfig,
+    /// Every robot's camera: a camera file's keys (`mrt_perception::camera::CameraFile`;
+    /// all of them when the table is given, the shipped `configs/vision/camera.toml` when not).
+    pub camera: mrt_perception::camera::CameraFile,
+    /// What the cameras draw.
+    pub render: RenderConfig,
 }
 
 /// What went wrong reading a configuration file (the file, and the line and column of a
@@ -476,6 +551,8 @@ impl SimConfig {
                 self.sonar.count
             ));
         }
+        self.render.validate()?;
+        self.camera.camera().map_err(|e| format!("camera: {e}"))?;
         self.check_derived()?;
         self.odometry.mice()?;
         self.robot()?;

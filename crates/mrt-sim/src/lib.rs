@@ -30,6 +30,7 @@ pub mod game;
 pub mod plot;
 pub mod referee;
 pub mod remote;
+pub mod render;
 pub mod sensor;
 pub mod soak;
 pub mod world;
