@@ -59,6 +59,20 @@ pub struct SimArgs {
     /// core, headless, and report how many times faster than real time they ran.
     #[arg(long)]
     pub bench: bool,
+    /// Where the robots' percepts come from: oracle (the object sensor: fast, for long
+    /// series) or vision (every camera renders images, the robots' vision µAgent finds the
+    /// ball and the goals in them). Default: the configuration's `[sensor] percepts`.
+    #[arg(long, value_enum)]
+    pub percepts: Option<Percepts>,
+}
+
+/// `--percepts`.
+#[derive(Clone, Copy, Debug, clap::ValueEnum)]
+pub enum Percepts {
+    /// The object sensor.
+    Oracle,
+    /// Rendered images through the vision µAgent.
+    Vision,
 }
 
 fn config(args: &SimArgs) -> Result<SimConfig> {
@@ -68,6 +82,12 @@ fn config(args: &SimArgs) -> Result<SimConfig> {
     };
     if let Some(h) = args.half {
         cfg.rules.half_duration = h;
+    }
+    if let Some(p) = args.percepts {
+        cfg.sensor.percepts = match p {
+            Percepts::Oracle => mrt_sim::config::PerceptSource::Oracle,
+            Percepts::Vision => mrt_sim::config::PerceptSource::Vision,
+        };
     }
     cfg.validate().map_err(|e| anyhow!("{e}"))?;
     Ok(cfg)

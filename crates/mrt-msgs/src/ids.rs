@@ -44,6 +44,8 @@ pub const ROBOT_END: MsgType = reserved(0x48);
 pub const GAME_INFO: MsgType = reserved(0x49);
 /// [`crate::Localization`]: the world model's own pose estimate, for monitors.
 pub const LOCALIZATION: MsgType = reserved(0x4A);
+/// [`crate::Percepts`]: what the vision µAgent found in a camera image.
+pub const PERCEPTS: MsgType = reserved(0x4B);
 /// The blackboard's `BbUpdate` (ISocRob seed `003` §3.1; `mrt_blackboard::proxy`).
 pub const BB_UPDATE: MsgType = reserved(0x50);
 /// `mrt-net`'s probe: a ping (for `mrt-net-node` and the network tests).
@@ -73,6 +75,7 @@ pub const TABLE: &[(MsgType, &str)] = &[
     (ROBOT_END, "RobotEnd"),
     (GAME_INFO, "GameInfo"),
     (LOCALIZATION, "Localization"),
+    (PERCEPTS, "Percepts"),
     (BB_UPDATE, "BbUpdate"),
     (NET_PING, "Ping"),
     (NET_PROBE, "Probe"),
@@ -119,6 +122,7 @@ mod tests {
             (0xFFFF_0048, "RobotEnd"),
             (0xFFFF_0049, "GameInfo"),
             (0xFFFF_004A, "Localization"),
+            (0xFFFF_004B, "Percepts"),
             (0xFFFF_0050, "BbUpdate"),
             (0x4E45_5401, "Ping"),
             (0x4E45_5402, "Probe"),

@@ -52,8 +52,8 @@ pub use localization::{FilterCounts, Localization};
 pub use mrt_core::{Message, MsgType};
 pub use robot::{lps, Estimate, Field, GameState, Lpo, Mate, RobotCommand, Target, WorldSnapshot};
 pub use sensing::{
-    CameraFrame, Displacement, GameInfo, Image, MiceReadings, Odometry, Sighting, Sonar, SonarScan,
-    FIELD_OBJECTS,
+    CameraFrame, Displacement, GameInfo, Image, MiceReadings, Odometry, Percepts, Sighting, Sonar,
+    SonarScan, FIELD_OBJECTS,
 };
 pub use team::MateReport;
 
@@ -88,6 +88,7 @@ messages! {
     RobotEnd => ROBOT_END,
     GameInfo => GAME_INFO,
     Localization => LOCALIZATION,
+    Percepts => PERCEPTS,
 }
 
 #[cfg(test)]

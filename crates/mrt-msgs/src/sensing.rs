@@ -155,6 +155,26 @@ pub struct CameraFrame {
     pub image: Option<Image>,
 }
 
+/// What the vision µAgent found in one camera image (ISocRob seed `003` §3.2.1), robot frame:
+/// the objects in the object sensor's form (so the world model reads both alike), their
+/// uncertainty and pixel evidence, the field-line points and the obstacles.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Percepts {
+    /// Time of the image, s.
+    pub time: f64,
+    /// Ball, nets and landmarks in [`FIELD_OBJECTS`] order, from the robot's centre.
+    pub sightings: [Option<Sighting>; FIELD_OBJECTS],
+    /// Standard deviations of each sighting, `(distance m, bearing rad)`: what one pixel of
+    /// error at that place in the image amounts to.
+    pub sigmas: [Option<(f64, f64)>; FIELD_OBJECTS],
+    /// How many pixels each sighting rests on.
+    pub pixels: [u32; FIELD_OBJECTS],
+    /// Points of the white field lines on the floor (robot frame, m).
+    pub line_points: Vec<(f64, f64)>,
+    /// Other robots: the nearest point of each, from the robot's centre.
+    pub obstacles: Vec<Sighting>,
+}
+
 /// An RGB image, 8 bits per channel, row by row from the top-left corner (`3·width` bytes a
 /// row): what a camera driver grabs or the simulator renders (ISocRob seed `003` §3.2.1).
 #[derive(Clone, Default, PartialEq, Eq, Serialize, Deserialize)]

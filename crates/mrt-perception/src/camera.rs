@@ -148,6 +148,12 @@ impl Pinhole {
         self.camera_to_robot() * Vector3::new(n.x, n.y, 1.0)
     }
 
+    /// How far in front of the optical centre the point `p` (robot frame, m) lies, along the
+    /// optical axis (negative: behind the camera).
+    pub fn depth(&self, p: Point3<f64>) -> f64 {
+        (self.camera_to_robot().inverse() * (p - self.centre())).z
+    }
+
     /// Applies the radial distortion to a normalized point.
     fn distort(&self, n: Vector2<f64>) -> Vector2<f64> {
         let (k1, k2) = self.distortion;

@@ -5,7 +5,9 @@
 //! file from its world configuration (`mrt_sim::config::SimConfig::robot_file`).
 
 use crate::base::Base;
+use mrt_perception::camera::{CameraFile, Pinhole};
 use mrt_perception::mice::MiceOdometry;
+use mrt_perception::vision::colors::ColorTable;
 use mrt_plan::guide::Guidance;
 use mrt_world::{FieldMap, WorldModel};
 use serde::{Deserialize, Serialize};
@@ -44,6 +46,19 @@ pub struct RobotConfig {
     pub guidance: Guidance,
     /// Robots per team (robot 0 of each keeps goal).
     pub team_size: usize,
+    /// The vision µAgent's camera and colour classes, when it runs on the camera's images
+    /// (`None`: the camera driver's frames carry percepts already, as the simulator's object
+    /// sensor does).
+    pub vision: Option<VisionSetup>,
+}
+
+/// What the vision µAgent needs (ISocRob seed `003` §3.2.1).
+#[derive(Clone, Debug, PartialEq)]
+pub struct VisionSetup {
+    /// The camera's geometry, pan joint at rest.
+    pub camera: Pinhole,
+    /// The colour classes.
+    pub colors: ColorTable,
 }
 
 impl RobotConfig {
@@ -164,6 +179,31 @@ impl Default for GuidanceSection {
     }
 }
 
+/// `[vision]`: whether the vision µAgent turns the camera's images into percepts, with the
+/// camera's geometry (`[vision.camera]`, a camera file's keys) and the colour classes
+/// (`[vision.colors.ball]`, ... a colour file's tables; the shipped `configs/vision/colors.toml`
+/// when left out).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct VisionSection {
+    /// Run the vision µAgent.
+    pub enabled: bool,
+    /// The camera.
+    pub camera: CameraFile,
+    /// The colour classes.
+    pub colors: ColorTable,
+}
+
+impl Default for VisionSection {
+    fn default() -> Self {
+        VisionSection {
+            enabled: false,
+            camera: CameraFile::default(),
+            colors: ColorTable::shipped(),
+        }
+    }
+}
+
 /// `[devices]`: what the robot's drivers talk to.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
@@ -203,6 +243,8 @@ pub struct RobotFile {
     pub guidance: GuidanceSection,
     /// Its devices.
     pub devices: DevicesSection,
+    /// Its vision.
+    pub vision: VisionSection,
 }
 
 impl RobotFile {
@@ -309,6 +351,12 @@ impl RobotFile {
             },
             guidance: Guidance::new(guard, field, s.ball_radius),
             team_size: r.team_size,
+            vision: {
+                let v = &self.vision;
+                let camera = v.camera.camera().map_err(|e| format!("vision.camera: {e}"))?;
+                v.colors.check().map_err(|e| format!("vision.colors: {e}"))?;
+                v.enabled.then(|| VisionSetup { camera, colors: v.colors.clone() })
+            },
         })
     }
 }

@@ -5,10 +5,13 @@
 //!
 //! 1. **drivers** (periodic, one generic [`Member`] reading one device each): `odometry-<n>`
 //!    publishes the mice's and the wheels' readings since the last cycle ([`Odometry`]),
-//!    `camera-<n>` what the camera (object sensor) sees ([`CameraFrame`]),
-//!    `game-controller-<n>` the referee's news ([`GameInfo`]), `sonars-<n>` the sonar ring
-//!    ([`SonarScan`]);
-//! 2. **`WorldState`** (periodic): fuses odometry, camera and game controller into the robot's
+//!    `camera-<n>` what the camera sees ([`CameraFrame`]: an image, or the simulator's object
+//!    sensor's percepts), `game-controller-<n>` the referee's news ([`GameInfo`]),
+//!    `sonars-<n>` the sonar ring ([`SonarScan`]);
+//! 1. **`vision-<n>`** (periodic, when the robot's configuration has
+//!    [`vision`](RobotConfig::vision)): the vision µAgent (ISocRob seed `003` §3.2.1) turns
+//!    the camera's latest image into [`Percepts`];
+//! 2. **`WorldState`** (periodic): fuses odometry, camera percepts and game controller into the robot's
 //!    own pose and LPS ([`WorldModel`]), takes its teammates' poses from their reports
 //!    received over the bus, and publishes the [`WorldSnapshot`] and, for monitors, its
 //!    [`Localization`](mrt_msgs::Localization); it also publishes a [`MateReport`] (its pose
@@ -41,8 +44,9 @@ use mrt_core::Point2;
 use mrt_dcdt::{Activation, Agora, Context, Member, MemberError, Message, RequestType, RunReport};
 use mrt_msgs::{
     BehaviorStatus, CameraFrame, GameInfo, MateReport, MemberFault, MotorCommand, Odometry,
-    RobotCommand, Sonar, SonarScan, WorldSnapshot,
+    Percepts, RobotCommand, Sonar, SonarScan, WorldSnapshot,
 };
+use mrt_perception::vision::agent::VisionAgent;
 use mrt_plan::guide::Guidance;
 use mrt_script::member::BehaviorMember;
 use mrt_world::{merge_team, WorldModel};
@@ -96,6 +100,7 @@ impl Member for WorldState {
     fn init(&mut self, ctx: &mut Context<'_>) -> Result<(), MemberError> {
         ctx.subscribe_to::<Odometry>(RequestType::Local);
         ctx.subscribe_to::<CameraFrame>(RequestType::Local);
+        ctx.subscribe_to::<Percepts>(RequestType::Local);
         ctx.subscribe_to::<GameInfo>(RequestType::Local);
         ctx.subscribe_to::<MateReport>(RequestType::Remote);
         Ok(())
@@ -106,7 +111,12 @@ impl Member for WorldState {
         while let Some(m) = ctx.receive_msg() {
             if let Ok(o) = m.get::<Odometry>() {
                 self.model.odometry(o);
-            } else if m.is::<CameraFrame>() {
+            } else if let Ok(f) = m.get::<CameraFrame>() {
+                // A frame with an image is the vision µAgent's to read; its percepts follow.
+                if f.image.is_none() {
+                    frame = Some(m);
+                }
+            } else if m.is::<Percepts>() {
                 frame = Some(m);
             } else if let Ok(g) = m.get::<GameInfo>() {
                 self.model.game(*g);
@@ -116,7 +126,10 @@ impl Member for WorldState {
             }
         }
         let Some(frame) = frame else { return Ok(()) };
-        let mut w = self.model.camera(frame.get::<CameraFrame>()?);
+        let mut w = match frame.get::<Percepts>() {
+            Ok(p) => self.model.percepts(p),
+            Err(_) => self.model.camera(frame.get::<CameraFrame>()?),
+        };
         let id = u32::try_from(self.robot).unwrap_or(u32::MAX);
         let report = MateReport::of(id, self.keeper, &w);
         // Teammates and their ball as the bus told them, not as the simulator knows them.
@@ -125,6 +138,50 @@ impl Member for WorldState {
         ctx.publish(self.model.localization());
         self.body.perceive(&mut w);
         ctx.publish(w);
+        Ok(())
+    }
+}
+
+/// The vision µAgent of one robot (ISocRob seed `003` §3.2.1): the camera's latest image into
+/// [`Percepts`]. An image the camera's geometry does not fit is counted, logged once, and
+/// dropped.
+struct Vision {
+    robot: usize,
+    agent: VisionAgent,
+    refused: u64,
+}
+
+impl Member for Vision {
+    fn name(&self) -> String {
+        format!("vision-{}", self.robot)
+    }
+
+    fn init(&mut self, ctx: &mut Context<'_>) -> Result<(), MemberError> {
+        ctx.subscribe_to::<CameraFrame>(RequestType::Local);
+        Ok(())
+    }
+
+    fn do_your_job(&mut self, ctx: &mut Context<'_>) -> Result<(), MemberError> {
+        let mut latest = None;
+        while let Some(m) = ctx.receive_msg() {
+            if m.get::<CameraFrame>().is_ok_and(|f| f.image.is_some()) {
+                latest = Some(m);
+            }
+        }
+        let Some(m) = latest else { return Ok(()) };
+        let frame = m.get::<CameraFrame>()?;
+        let Some(image) = &frame.image else { return Ok(()) };
+        match self.agent.see(image, frame.time, self.agent.camera().pan) {
+            Ok(p) => {
+                ctx.publish(p);
+            }
+            Err(e) => {
+                self.refused += 1;
+                if self.refused == 1 {
+                    tracing::warn!(robot = self.robot, "vision: {e} (further ones are counted)");
+                }
+            }
+        }
         Ok(())
     }
 }
@@ -336,9 +393,12 @@ fn add_cycle(
         world: WorldSnapshot::default(),
         scan: SonarScan::default(),
     };
-    let ids = [
-        agora.add_member(odometry, every),
-        agora.add_member(camera, every),
+    let mut ids = vec![agora.add_member(odometry, every), agora.add_member(camera, every)];
+    if let Some(v) = &cfg.vision {
+        let agent = VisionAgent::new(v.camera, &v.colors, cfg.ball_radius);
+        ids.push(agora.add_member(Vision { robot, agent, refused: 0 }, every));
+    }
+    ids.extend([
         agora.add_member(game, every),
         agora.add_member(world, every),
         agora.add_member(sonars, every),
@@ -346,7 +406,7 @@ fn add_cycle(
         agora.add_member(guide, Activation::OnMessage),
         agora.add_member(Motor { devices: dev(), robot, base: cfg.base }, Activation::OnMessage),
         agora.add_member(FaultBook { devices, robot }, Activation::OnMessage),
-    ];
+    ]);
     for m in ids {
         agora.activate_member(m).map_err(|e| e.to_string())?;
     }

@@ -180,6 +180,21 @@ pub struct SensorConfig {
     pub bearing_noise: f64,
     /// Probability of missing a visible object in one frame.
     pub miss_probability: f64,
+    /// Where the robots' percepts come from.
+    pub percepts: PerceptSource,
+}
+
+/// Where the robots' percepts come from (`[sensor] percepts`, `mrt sim --percepts`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum PerceptSource {
+    /// The object sensor: distance and bearing computed from the world with noise, field of
+    /// view, occlusion and misses (fast: for long series of matches).
+    #[default]
+    Oracle,
+    /// Every robot's camera renders an image (the `render` module) and the robot's vision
+    /// µAgent finds the ball and the goals in it.
+    Vision,
 }
 
 impl Default for SensorConfig {
@@ -191,6 +206,7 @@ impl Default for SensorConfig {
             distance_noise: 0.03,
             bearing_noise: 0.02,
             miss_probability: 0.05,
+            percepts: PerceptSource::Oracle,
         }
     }
 }
@@ -356,6 +372,7 @@ impl SimConfig {
     pub fn robot_file(&self, id: usize, stack: &str) -> mrt_robot::config::RobotFile {
         use mrt_robot::config::{
             BodySection, DevicesSection, GuidanceSection, RobotFile, RobotSection, SensorsSection,
+            VisionSection,
         };
         RobotFile {
             robot: RobotSection {
@@ -385,6 +402,11 @@ impl SimConfig {
                 half_cone: self.guidance.half_cone,
             },
             devices: DevicesSection::default(),
+            vision: VisionSection {
+                enabled: self.sensor.percepts == PerceptSource::Vision,
+                camera: self.camera.clone(),
+                colors: mrt_perception::vision::colors::ColorTable::shipped(),
+            },
         }
     }
 

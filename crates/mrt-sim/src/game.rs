@@ -6,8 +6,9 @@
 //! wirings `bus` and `remote` build on this); then the physics runs until the next control period, with the referee
 //! watching every step.
 
-use crate::config::SimConfig;
+use crate::config::{PerceptSource, SimConfig};
 use crate::referee::{Call, Referee, Team};
+use crate::render::{CameraState, Renderer, Scene};
 use crate::sensor::{self, sonar_ring, Odometer};
 use crate::world::{Drive, World};
 use mrt_msgs::robot::{GameState, RobotCommand};
@@ -95,6 +96,8 @@ pub struct Pitch {
     faults: Vec<RobotFault>,
     /// Kicks asked this cycle, fired when the physics runs.
     kicks: Vec<usize>,
+    /// The cameras' renderer and each robot's camera state, when percepts come from vision.
+    eyes: Option<(Renderer, Vec<CameraState>)>,
 }
 
 const FNV_OFFSET: u64 = 0xcbf2_9ce4_8422_2325;
@@ -147,6 +150,15 @@ impl Pitch {
             record: false,
             faults: Vec::new(),
             kicks: Vec::new(),
+            eyes: match cfg.sensor.percepts {
+                PerceptSource::Oracle => None,
+                PerceptSource::Vision => Some((
+                    Renderer::new(cfg)?,
+                    (0..robots as u64)
+                        .map(|i| CameraState::new(seed.wrapping_mul(0x2545_F491_4F6C_DD1D) ^ i))
+                        .collect(),
+                )),
+            },
         })
     }
 
@@ -182,9 +194,27 @@ impl Pitch {
         self.odometers[i].read(&self.world, &self.cfg.odometry, period, &mut self.rngs[i])
     }
 
-    /// What robot `i`'s camera (the object sensor) sees now.
+    /// What robot `i`'s camera sees now: its image (vision percepts), or the object sensor's
+    /// sightings (oracle percepts).
     pub fn camera(&mut self, i: usize) -> CameraFrame {
-        sensor::look(&self.world, i, &self.cfg.sensor, &mut self.rngs[i])
+        let Some((renderer, states)) = &mut self.eyes else {
+            return sensor::look(&self.world, i, &self.cfg.sensor, &mut self.rngs[i]);
+        };
+        let scene = Scene {
+            ball: Some(self.world.ball()),
+            robots: (0..self.world.robot_count())
+                .filter_map(|k| {
+                    let home = self.referee.team_of(k) == Team::Home;
+                    Some((self.world.robot(k)?, home))
+                })
+                .collect(),
+        };
+        let viewer = self.world.robot(i).unwrap_or_default();
+        let image = match states.get_mut(i) {
+            Some(state) => renderer.render(&scene, viewer, 0.0, Some(i), state),
+            None => return CameraFrame { time: self.world.time(), ..Default::default() },
+        };
+        CameraFrame { time: self.world.time(), image: Some(image), ..Default::default() }
     }
 
     /// What the game controller tells robot `i` now (no randomness: read it at any time).

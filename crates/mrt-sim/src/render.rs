@@ -510,44 +510,56 @@ impl Renderer {
     }
 
     /// The pixels `(col0, row0, col1, row1)` (end exclusive) that may show `shape`, from its
-    /// bounding box's corners; `None` when it is wholly behind the camera or off the image.
+    /// bounding box clipped to the space in front of the camera; `None` when nothing of it is
+    /// in front or its projection misses the image.
     fn image_box(
         &self,
         shape: Shape,
         viewer: Pose2,
         pan: f64,
     ) -> Option<(usize, usize, usize, usize)> {
+        /// Points nearer to the image plane than this (m) are clipped.
+        const NEAR: f64 = 0.01;
         let (min, max) = shape.bounds();
         let cam = self.camera.panned(pan);
         let (s, c) = viewer.theta.sin_cos();
-        let (w, h) = cam.size();
-        let (mut lo, mut hi) =
-            ((f64::INFINITY, f64::INFINITY), (f64::NEG_INFINITY, f64::NEG_INFINITY));
-        let mut behind = 0;
-        for k in 0..8 {
+        let corners: [Point3<f64>; 8] = std::array::from_fn(|k| {
             let p = [
                 if k & 1 == 0 { min[0] } else { max[0] },
                 if k & 2 == 0 { min[1] } else { max[1] },
                 if k & 4 == 0 { min[2] } else { max[2] },
             ];
             let (dx, dy) = (p[0] - viewer.x, p[1] - viewer.y);
-            let robot = Point3::new(c * dx + s * dy, -s * dx + c * dy, p[2]);
-            match cam.project(robot) {
-                Some(px) if px.x.is_finite() && px.y.is_finite() => {
-                    lo = (lo.0.min(px.x), lo.1.min(px.y));
-                    hi = (hi.0.max(px.x), hi.1.max(px.y));
+            Point3::new(c * dx + s * dy, -s * dx + c * dy, p[2])
+        });
+        let depth = corners.map(|p| cam.depth(p));
+        let mut lo = (f64::INFINITY, f64::INFINITY);
+        let mut hi = (f64::NEG_INFINITY, f64::NEG_INFINITY);
+        let mut take = |p: Point3<f64>| {
+            if let Some(px) = cam.project(p).filter(|px| px.x.is_finite() && px.y.is_finite()) {
+                lo = (lo.0.min(px.x), lo.1.min(px.y));
+                hi = (hi.0.max(px.x), hi.1.max(px.y));
+            }
+        };
+        for k in 0..8 {
+            if depth[k] >= NEAR {
+                take(corners[k]);
+            }
+            // The box's edges from this corner (to the corners differing in one coordinate)
+            // that cross the near plane: their crossing point bounds the visible part.
+            for bit in [1, 2, 4] {
+                let l = k | bit;
+                if l != k && (depth[k] >= NEAR) != (depth[l] >= NEAR) {
+                    let t = (NEAR - depth[k]) / (depth[l] - depth[k]);
+                    take(corners[k] + (corners[l] - corners[k]) * t);
                 }
-                _ => behind += 1,
             }
         }
-        if behind == 8 {
+        if !(lo.0.is_finite() && hi.0.is_finite()) {
             return None;
         }
+        let (w, h) = cam.size();
         let (wf, hf) = (f64::from(w), f64::from(h));
-        if behind > 0 {
-            // Partly behind the camera: its projection is unbounded; test every pixel.
-            return Some((0, 0, w as usize, h as usize));
-        }
         // Two pixels of margin: the corners bound the solid's projection up to lens distortion.
         let clamp = |v: f64, max: f64| v.clamp(0.0, max) as usize;
         let (c0, r0) = (clamp(lo.0 - 2.0, wf), clamp(lo.1 - 2.0, hf));

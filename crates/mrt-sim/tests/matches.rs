@@ -217,3 +217,53 @@ fn wrong_team_sizes_are_refused() {
     let cfg = short(1.0, 2);
     assert!(BusMatch::with_brains(&cfg, 1, chasers(1), chasers(2)).is_err());
 }
+
+/// Through vision (`percepts = "vision"`): each robot's camera renders images, its vision µAgent
+/// finds the ball and the goals in them, and nothing else tells it where they are. A chaser
+/// against a keeper finds the ball and shoots at the goal, and its own pose estimate, with only
+/// the two nets to correct it (the striped posts are not recognised yet), stays within a metre.
+/// Measured (seed 1, 2 minutes): 12-15 shots, all wide of the goal (the nets' distances rest on
+/// pixel rows half a metre of floor deep at 8 m); pose error median 0.51-0.59 m. Scoring through
+/// vision is issue 19's next step, not this test's claim.
+#[test]
+fn a_chaser_plays_through_vision_and_roughly_knows_where_it_is() {
+    let mut cfg = short(2.0, 1);
+    cfg.sensor.percepts = mrt_sim::config::PerceptSource::Vision;
+    let mut m = BusMatch::with_brains(
+        &cfg,
+        1,
+        vec![Box::new(Chaser { keeper: false })],
+        vec![Box::new(Chaser { keeper: true })],
+    )
+    .unwrap();
+    let heard = Arc::new(Mutex::new(Vec::new()));
+    let link = m.team_link(0).cloned().unwrap();
+    let mut agora = m.executor().agora_builder(90).inner_link(&link).build().unwrap();
+    let monitor = agora.add_member(Monitor(heard.clone()), Activation::OnMessage);
+    agora.activate_member(monitor).unwrap();
+    m.executor().add_agora(agora).unwrap();
+    let mut errors = Vec::new();
+    while !m.pitch().unwrap().finished() && m.pitch().unwrap().world().time() < 120.0 {
+        let before = m.pitch().unwrap().world().robot(0).unwrap();
+        m.cycle().unwrap();
+        for (robot, l) in std::mem::take(&mut *heard.lock().unwrap()) {
+            if robot == 0 {
+                errors.push((l.pose.inner.x - before.x).hypot(l.pose.inner.y - before.y));
+            }
+        }
+    }
+    errors.sort_by(f64::total_cmp);
+    let median = errors[errors.len() / 2];
+    eprintln!("vision: pose error median {median:.3} m over {} cycles", errors.len());
+    let report = m.play_until(120.0, |_| {}).unwrap();
+    assert!(report.faults.is_empty(), "{:?}", report.faults);
+    assert!(report.stats[0].shots >= 5, "the chaser reached the ball: {:?}", report.stats);
+    let towards_goal =
+        report.calls.iter().filter(|(_, c)| matches!(c, Call::Out { at } if at.0 > 8.5)).count();
+    assert!(
+        towards_goal + report.score.0 as usize >= 3,
+        "its shots went to the east goal line: {:?}",
+        report.calls
+    );
+    assert!(median < 1.0, "pose error median {median:.3} m");
+}

@@ -259,3 +259,62 @@ fn noise_lighting_and_blur_are_off_by_default_and_deterministic_when_on() {
         trail.rgb.chunks_exact(3).zip(sharp.rgb.chunks_exact(3)).filter(|(a, b)| a != b).count();
     assert!(differ > 100, "{differ} pixels show the trail");
 }
+
+/// The vision µAgent on a rendered frame: the ball, both nets and the robots where they are
+/// (from the robot's centre; the nets are the centres of the goal lines).
+#[test]
+fn the_vision_agent_finds_ball_nets_and_robots_in_a_rendered_frame() {
+    use mrt_perception::vision::agent::VisionAgent;
+    let cfg = SimConfig::default();
+    let renderer = Renderer::new(&cfg).unwrap();
+    let mut agent = VisionAgent::new(
+        *renderer.camera(),
+        &mrt_perception::vision::colors::ColorTable::shipped(),
+        cfg.ball.radius,
+    );
+    let truth = |from: Pose2, x: f64, y: f64| {
+        let (dx, dy) = (x - from.x, y - from.y);
+        let (s, c) = from.theta.sin_cos();
+        let (fx, fy) = (c * dx + s * dy, -s * dx + c * dy);
+        (fx.hypot(fy), fy.atan2(fx))
+    };
+    // Facing the yellow (east) goal from 4 m, the ball and an opponent in between.
+    let me = Pose2::new(5.0, 0.4, 0.05);
+    let scene = Scene { ball: Some((6.5, 0.0)), robots: vec![(Pose2::new(7.0, 1.2, 0.0), false)] };
+    let image = renderer.render(&scene, me, 0.0, None, &mut CameraState::default());
+    let p = agent.see(&image, 3.0, 0.0).unwrap();
+    assert_eq!(p.time, 3.0);
+    let ball = p.sightings[0].expect("the ball");
+    let (d, b) = truth(me, 6.5, 0.0);
+    assert!((ball.distance - d).abs() < 0.05 * d && (ball.bearing - b).abs() < 0.026, "{ball:?}");
+    let net = p.sightings[1].expect("the east net");
+    let (d, b) = truth(me, 9.0, 0.0);
+    // The posts' feet, or the back corners seen past them: within the goal's depth (0.6 m).
+    assert!((net.distance - d).abs() < 0.6 && (net.bearing - b).abs() < 0.1, "{net:?} vs {d} {b}");
+    assert!(p.sightings[2].is_none(), "the west net is behind");
+    assert!(p.sigmas[0].is_some_and(|(sd, sb)| sd > 0.0 && sd < 0.1 && sb > 0.0));
+    assert!(p.pixels[0] > 50);
+    // The opponent: its nearest point is its radius short of its centre.
+    let (d, b) = truth(me, 7.0, 1.2);
+    assert!(
+        p.obstacles
+            .iter()
+            .any(|o| (o.distance - (d - 0.25)).abs() < 0.2 && (o.bearing - b).abs() < 0.1),
+        "{:?} vs {d} {b}",
+        p.obstacles
+    );
+    assert!(!p.line_points.is_empty(), "the penalty area's lines");
+    // The west net, turning round.
+    let back = Pose2::new(-5.0, -0.5, std::f64::consts::PI);
+    let image = renderer.render(&Scene::default(), back, 0.0, None, &mut CameraState::default());
+    let p = agent.see(&image, 3.1, 0.0).unwrap();
+    let net = p.sightings[2].expect("the west net");
+    let (d, b) = truth(back, -9.0, 0.0);
+    assert!((net.distance - d).abs() < 0.6 && (net.bearing - b).abs() < 0.1, "{net:?} vs {d} {b}");
+    assert!(p.sightings[0].is_none() && p.sightings[1].is_none());
+    // An image of the wrong size is refused, not read.
+    let small = mrt_msgs::Image::new(10, 10);
+    assert!(agent.see(&small, 0.0, 0.0).is_err());
+    let broken = mrt_msgs::Image { width: 320, height: 240, rgb: vec![0; 7] };
+    assert!(agent.see(&broken, 0.0, 0.0).is_err());
+}

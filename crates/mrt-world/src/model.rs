@@ -28,7 +28,7 @@ use crate::field::FieldMap;
 use mrt_core::frames::{Attack, Field, Framed, Team, MM_PER_M};
 use mrt_core::{normalize_angle, Point2, Pose2, Time, Vec2};
 use mrt_msgs::robot::{lps, Estimate, Lpo, WorldSnapshot};
-use mrt_msgs::{CameraFrame, GameInfo, Localization, Odometry, Sighting, FIELD_OBJECTS};
+use mrt_msgs::{CameraFrame, GameInfo, Localization, Odometry, Percepts, Sighting, FIELD_OBJECTS};
 use mrt_perception::mice::{Displacement, MiceOdometry, MiceReadings};
 use mrt_perception::PerceptionError;
 use nalgebra::{Matrix2, Matrix2x3, Matrix3, Vector2, Vector3};
@@ -82,7 +82,23 @@ pub struct WorldModel {
     counts: FilterCounts,
     /// The game controller's latest news (which way the team attacks, the state).
     game: GameInfo,
+    /// The ball's last place and velocity estimated from the vision's percepts.
+    ball_track: Option<BallTrack>,
 }
+
+/// The ball's velocity from successive vision percepts (an α filter on the field-frame
+/// differences; the simulator's object sensor reports a velocity of its own).
+#[derive(Clone, Copy, Debug)]
+struct BallTrack {
+    at: Point2,
+    time: f64,
+    velocity: (f64, f64),
+}
+
+/// Weight of a new difference in the ball's velocity estimate.
+const BALL_VELOCITY_GAIN: f64 = 0.4;
+/// Longest gap between two sightings of the ball that still gives a velocity, s.
+const BALL_TRACK_GAP: f64 = 0.5;
 
 impl WorldModel {
     /// A robot on the field `map` with two mice `mice`, whose camera has the relative
@@ -99,6 +115,7 @@ impl WorldModel {
             memory: [None; FIELD_OBJECTS],
             counts: FilterCounts::default(),
             game: GameInfo::default(),
+            ball_track: None,
         }
     }
 
@@ -227,7 +244,7 @@ impl WorldModel {
 
     /// The EKF correction by one sighting of a landmark at `at`. Returns whether it was
     /// accepted (not gated out).
-    fn correct(&mut self, at: (f64, f64), z: &Sighting) -> bool {
+    fn correct(&mut self, at: (f64, f64), z: &Sighting, sigma: Option<(f64, f64)>) -> bool {
         let (dx, dy) = (at.0 - self.pose.x, at.1 - self.pose.y);
         let q = dx * dx + dy * dy;
         let rho = q.sqrt();
@@ -239,8 +256,13 @@ impl WorldModel {
             z.distance - rho,
             normalize_angle(z.bearing - (dy.atan2(dx) - self.pose.theta)),
         );
-        let sd = self.distance_noise * z.distance + 0.01;
-        let sb = self.bearing_noise + 0.005;
+        let (mut sd, mut sb) =
+            (self.distance_noise * z.distance + 0.01, self.bearing_noise + 0.005);
+        // The vision µAgent's own estimate, where larger: a far net's distance rests on a
+        // pixel row that spans half a metre of floor.
+        if let Some((d, b)) = sigma {
+            (sd, sb) = (sd.max(d), sb.max(b));
+        }
         let r = Matrix2::new(sd * sd, 0.0, 0.0, sb * sb);
         let s = h * self.cov * h.transpose() + r;
         let Some(s_inv) = s.try_inverse() else { return false };
@@ -263,14 +285,23 @@ impl WorldModel {
     /// One camera frame: the nets and landmarks correct the pose, every sighting refreshes the
     /// LPS memory, and the snapshot is built. Call after this cycle's [`WorldModel::odometry`].
     pub fn camera(&mut self, frame: &CameraFrame) -> WorldSnapshot {
-        let (seen, rejected) = self.correct_all(frame);
+        self.observe(frame, &[None; FIELD_OBJECTS])
+    }
+
+    /// [`WorldModel::camera`] with each sighting's own standard deviations, where known.
+    fn observe(
+        &mut self,
+        frame: &CameraFrame,
+        sigmas: &[Option<(f64, f64)>; FIELD_OBJECTS],
+    ) -> WorldSnapshot {
+        let (seen, rejected) = self.correct_all(frame, sigmas);
         if seen >= 3 && 2 * rejected > seen {
             // Most landmarks disagree: the estimate is wrong, not the camera. Widen the
             // uncertainty and listen to the same sightings again.
             self.counts.lost += 1;
             let (xy, theta) = LOST_SIGMA;
             self.cov += Matrix3::from_diagonal(&Vector3::new(xy * xy, xy * xy, theta * theta));
-            self.correct_all(frame);
+            self.correct_all(frame, sigmas);
         }
         let me: Framed<Field, Pose2> = Framed::new(self.pose);
         for (k, z) in frame.sightings.iter().enumerate() {
@@ -289,14 +320,43 @@ impl WorldModel {
         self.snapshot(frame)
     }
 
+    /// What the vision µAgent found in one image (a [`Percepts`]): read like a camera frame
+    /// whose ball velocity is estimated here from the ball's successive places on the field.
+    /// Call after this cycle's [`WorldModel::odometry`].
+    pub fn percepts(&mut self, p: &Percepts) -> WorldSnapshot {
+        let mut frame = CameraFrame { time: p.time, sightings: p.sightings, ..Default::default() };
+        if let Some(z) = p.sightings[lps::BALL] {
+            let at = Framed::<Field, _>::new(self.pose).at_range_bearing(z.distance, z.bearing);
+            let velocity = match self.ball_track {
+                Some(t) if p.time > t.time && p.time - t.time <= BALL_TRACK_GAP => {
+                    let dt = p.time - t.time;
+                    let (vx, vy) = ((at.inner.x - t.at.x) / dt, (at.inner.y - t.at.y) / dt);
+                    let k = BALL_VELOCITY_GAIN;
+                    (t.velocity.0 + k * (vx - t.velocity.0), t.velocity.1 + k * (vy - t.velocity.1))
+                }
+                _ => (0.0, 0.0),
+            };
+            self.ball_track = Some(BallTrack { at: at.inner, time: p.time, velocity });
+            // In the robot's frame, as a camera frame carries it.
+            let (s, c) = self.pose.theta.sin_cos();
+            let (vx, vy) = velocity;
+            frame.ball_velocity = Some((c * vx + s * vy, -s * vx + c * vy));
+        }
+        self.observe(&frame, &p.sigmas)
+    }
+
     /// Corrects the pose with every net and landmark of `frame`. Returns how many were seen
     /// and how many of them were rejected.
-    fn correct_all(&mut self, frame: &CameraFrame) -> (u64, u64) {
+    fn correct_all(
+        &mut self,
+        frame: &CameraFrame,
+        sigmas: &[Option<(f64, f64)>; FIELD_OBJECTS],
+    ) -> (u64, u64) {
         let (mut seen, mut rejected) = (0, 0);
         for (k, z) in frame.sightings.iter().enumerate() {
             let (Some(z), Some(at)) = (z, self.landmark(k)) else { continue };
             seen += 1;
-            if self.correct(at, z) {
+            if self.correct(at, z, sigmas[k]) {
                 self.counts.corrections += 1;
             } else {
                 rejected += 1;

@@ -161,13 +161,27 @@ impl ColorTable {
     pub fn from_toml(text: &str, file: &str) -> Result<ColorTable, FileError> {
         let t: ColorTable = toml::from_str(text)
             .map_err(|e| FileError::parse(file, text, e.span().map(|s| s.start), e.message()))?;
+        t.check().map_err(|message| FileError::Invalid { file: file.to_string(), message })?;
+        Ok(t)
+    }
+
+    /// Checks every class's thresholds (a table embedded in another file, such as a robot
+    /// file's `[vision.colors]`, is read without [`ColorTable::from_toml`]).
+    pub fn check(&self) -> Result<(), String> {
         for class in ColorClass::ALL {
-            if let Some(th) = t.get(class) {
-                th.check(class.name())
-                    .map_err(|message| FileError::Invalid { file: file.to_string(), message })?;
+            if let Some(th) = self.get(class) {
+                th.check(class.name())?;
             }
         }
-        Ok(t)
+        Ok(())
+    }
+
+    /// The shipped `configs/vision/colors.toml`, tuned for the simulator's images (built into
+    /// the program).
+    pub fn shipped() -> ColorTable {
+        const SHIPPED: &str = include_str!("../../../../configs/vision/colors.toml");
+        // The file is checked by a test: it parses.
+        ColorTable::from_toml(SHIPPED, "configs/vision/colors.toml").unwrap_or_default()
     }
 
     /// Reads a COLORS.toml file.
@@ -287,7 +301,10 @@ mod tests {
 
     fn shipped() -> ColorTable {
         let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../../configs/vision/colors.toml");
-        ColorTable::from_file(path).unwrap()
+        let table = ColorTable::from_file(path).unwrap();
+        assert_eq!(ColorTable::shipped(), table, "the built-in table is the file's");
+        assert!(ColorClass::ALL.iter().all(|&c| table.get(c).is_some()));
+        table
     }
 
     /// An independent HSV: the textbook formula on channels scaled to [0, 1], in degrees.

@@ -1,7 +1,9 @@
 //! Colour vision (ISocRob seed `003` §3.2.1, the vision µAgent): pixels classified by a colour
 //! lookup table built from HSV thresholds ([`colors`]); blobs and the ball ([`blobs`]), goals with
-//! their nearest point and open space ([`goals`]), field-line points ([`lines`]) build on it.
+//! their nearest point and open space ([`goals`]), field-line points ([`lines`]) build on it;
+//! [`agent`] puts them together into the µAgent: one image in, the percepts out.
 
+pub mod agent;
 pub mod blobs;
 pub mod colors;
 pub mod goals;

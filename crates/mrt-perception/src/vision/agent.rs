@@ -1,0 +1,238 @@
+//! The vision µAgent (ISocRob seed `003` §3.2.1): one camera image in, [`Percepts`] out. The
+//! pieces of this module put together: the colour lookup table, the ball (size test and centre
+//! correction), the goals, the field-line points, other robots as obstacles.
+//!
+//! The nets of the world model's sightings ([`mrt_msgs::CameraFrame::sightings`]) are the
+//! centres of the goal lines. A goal's blob gives its two outermost columns; the lowest goal
+//! pixel of each is the foot of a post (or of a back corner, seen obliquely), and the net is
+//! the middle of the two floor points. Which colour is the east goal is the field's, not the
+//! camera's: [`VisionAgent::east_goal`] (yellow by default, as the simulator paints it).
+
+use super::blobs::find_ball;
+use super::colors::{ColorClass, ColorTable, Lut};
+use super::lines::line_points;
+use crate::camera::{Camera, Pinhole, Pixel};
+use mrt_msgs::{Image, Percepts, Sighting};
+use nalgebra::{Point2, Vector2};
+
+/// Sighting index of the ball, the east and the west net (the world model's order).
+const BALL: usize = 0;
+const EAST_NET: usize = 1;
+const WEST_NET: usize = 2;
+
+/// Pixels a goal must show to count.
+pub const MIN_GOAL_PIXELS: u32 = 30;
+/// Obstacle scan lines: every this many columns.
+pub const OBSTACLE_STEP: usize = 4;
+/// Robot pixels in a row, up a column, that make a robot's foot.
+pub const OBSTACLE_MIN_RUN: usize = 3;
+/// Field-line scan lines: every this many columns.
+pub const LINE_STEP: usize = 8;
+/// The longest white run that is a line, pixels.
+pub const LINE_MAX_RUN: usize = 24;
+
+/// Why an image was not processed.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum VisionError {
+    /// The image is not the camera's size, or its buffer does not hold its pixels.
+    #[error("the image is {width}×{height} with {bytes} bytes; the camera takes {cam_w}×{cam_h}")]
+    WrongSize {
+        /// Its width.
+        width: u32,
+        /// Its height.
+        height: u32,
+        /// Its buffer's length.
+        bytes: usize,
+        /// The camera's width.
+        cam_w: u32,
+        /// The camera's height.
+        cam_h: u32,
+    },
+}
+
+/// The vision µAgent of one camera (module doc).
+#[derive(Debug)]
+pub struct VisionAgent {
+    camera: Pinhole,
+    lut: Lut,
+    ball_radius: f64,
+    east_goal: ColorClass,
+    classes: Vec<u8>,
+}
+
+impl VisionAgent {
+    /// The µAgent of `camera` with the colour classes of `colors`, for a ball of `ball_radius`
+    /// (m).
+    pub fn new(camera: Pinhole, colors: &ColorTable, ball_radius: f64) -> VisionAgent {
+        VisionAgent {
+            camera,
+            lut: Lut::new(colors),
+            ball_radius,
+            east_goal: ColorClass::GoalYellow,
+            classes: Vec::new(),
+        }
+    }
+
+    /// The colour of the east goal (the other goal colour is the west's).
+    pub fn east_goal(mut self, colour: ColorClass) -> VisionAgent {
+        self.east_goal = colour;
+        self
+    }
+
+    /// The camera, with its pan joint where the last image was taken.
+    pub fn camera(&self) -> &Pinhole {
+        &self.camera
+    }
+
+    /// The class of every pixel of the last image (`ColorClass as u8`, row after row).
+    pub fn classes(&self) -> &[u8] {
+        &self.classes
+    }
+
+    /// What `image`, taken at `time` (s) with the pan joint at `pan` (rad), shows.
+    pub fn see(&mut self, image: &Image, time: f64, pan: f64) -> Result<Percepts, VisionError> {
+        let (w, h) = self.camera.size();
+        if (image.width, image.height) != (w, h) || !image.is_consistent() {
+            return Err(VisionError::WrongSize {
+                width: image.width,
+                height: image.height,
+                bytes: image.rgb.len(),
+                cam_w: w,
+                cam_h: h,
+            });
+        }
+        self.camera.pan = pan;
+        self.classes.resize(w as usize * h as usize, 0);
+        self.lut.classify(&image.rgb, &mut self.classes);
+        let mut p = Percepts { time, ..Default::default() };
+        if let Some(ball) = find_ball(&self.classes, &self.camera, self.ball_radius) {
+            p.sightings[BALL] = Some(sighting(ball.at));
+            p.sigmas[BALL] = self.sigma(ball.pixel, 1.0 - self.ball_radius / self.camera.height);
+            p.pixels[BALL] = ball.pixels;
+        }
+        let west = if self.east_goal == ColorClass::GoalYellow {
+            ColorClass::GoalBlue
+        } else {
+            ColorClass::GoalYellow
+        };
+        for (k, class) in [(EAST_NET, self.east_goal), (WEST_NET, west)] {
+            if let Some((at, foot, pixels)) = self.net(class) {
+                p.sightings[k] = Some(sighting(at));
+                p.sigmas[k] = self.sigma(foot, 1.0);
+                p.pixels[k] = pixels;
+            }
+        }
+        p.line_points = line_points(&self.classes, &self.camera, LINE_STEP, LINE_MAX_RUN)
+            .into_iter()
+            .map(|l| (l.at.x, l.at.y))
+            .collect();
+        p.obstacles = self.obstacles();
+        Ok(p)
+    }
+
+    /// The net of the goal of `class`: the middle of its outermost columns' floor points, one
+    /// of those feet's pixels, and the goal's pixel count.
+    fn net(&self, class: ColorClass) -> Option<(Point2<f64>, Pixel, u32)> {
+        let (w, h) = self.camera.size();
+        let (w, h) = (w as usize, h as usize);
+        let want = class as u8;
+        let mut count = vec![0u32; w];
+        for row in self.classes.chunks_exact(w) {
+            for (c, &v) in count.iter_mut().zip(row) {
+                *c += u32::from(v == want);
+            }
+        }
+        let pixels: u32 = count.iter().sum();
+        if pixels < MIN_GOAL_PIXELS {
+            return None;
+        }
+        // The outermost columns where the goal stands on the carpet: its lowest pixel there
+        // has carpet (or a line) right below it. (Under a tilted camera the goal's sides
+        // slant outwards upwards; the columns of those slants end on the wall or the hall,
+        // and a robot in front hides the foot.)
+        let (field, line) = (ColorClass::Field as u8, ColorClass::Line as u8);
+        let foot = |col: usize| {
+            if count[col] < 2 {
+                return None;
+            }
+            let row = (0..h).rev().find(|&r| self.classes[r * w + col] == want)?;
+            let below = *self.classes.get((row + 1) * w + col)?;
+            if below != field && below != line {
+                return None;
+            }
+            let px = Pixel::new(col as f64 + 0.5, row as f64 + 1.0);
+            Some((px, self.camera.unproject(px)?))
+        };
+        let (pl, l) = (0..w).find_map(foot)?;
+        let (_, r) = (0..w).rev().find_map(foot)?;
+        Some((Point2::from((l.coords + r.coords) / 2.0), pl, pixels))
+    }
+
+    /// Other robots: scanning every [`OBSTACLE_STEP`]-th column from the bottom up over the
+    /// carpet, the first run of robot pixels is a robot's foot; neighbouring columns whose
+    /// feet are within a few rows of each other are one robot, seen at its lowest foot.
+    /// (Cheaper than labelling the dark blobs, which are large, and it gives the foot.)
+    fn obstacles(&self) -> Vec<Sighting> {
+        let (w, h) = self.camera.size();
+        let (w, h) = (w as usize, h as usize);
+        let (robot, field, line) =
+            (ColorClass::Robot as u8, ColorClass::Field as u8, ColorClass::Line as u8);
+        // The foot row of each scanned column, if it meets a robot over the floor.
+        let feet = (0..w).step_by(OBSTACLE_STEP).map(|col| {
+            let mut run = 0;
+            for row in (0..h).rev() {
+                match self.classes[row * w + col] {
+                    c if c == robot => {
+                        run += 1;
+                        if run == OBSTACLE_MIN_RUN {
+                            return (col, Some(row + OBSTACLE_MIN_RUN - 1));
+                        }
+                    }
+                    c if c == field || c == line => run = 0,
+                    // Anything else (a goal, the ball, the wall) ends the floor.
+                    _ => return (col, None),
+                }
+            }
+            (col, None)
+        });
+        let mut out = Vec::new();
+        let mut group: Option<(usize, usize, usize)> = None; // first column, last column, lowest row
+        let flush = |g: (usize, usize, usize), out: &mut Vec<Sighting>| {
+            let px = Pixel::new((g.0 + g.1) as f64 / 2.0 + 0.5, g.2 as f64 + 1.0);
+            if let Some(at) = self.camera.unproject(px) {
+                out.push(sighting(at));
+            }
+        };
+        for (col, foot) in feet {
+            group = match (group, foot) {
+                (Some((a, b, r)), Some(f)) if col - b <= OBSTACLE_STEP && r.abs_diff(f) <= 8 => {
+                    Some((a, col, r.max(f)))
+                }
+                (g, foot) => {
+                    if let Some(g) = g {
+                        flush(g, &mut out);
+                    }
+                    foot.map(|f| (col, col, f))
+                }
+            };
+        }
+        if let Some(g) = group {
+            flush(g, &mut out);
+        }
+        out
+    }
+
+    /// One pixel's worth of error at `px`, whose floor point is `scale` times as far as the
+    /// floor point its ray meets (the ball's centre correction; 1 for a point on the floor):
+    /// `(σ distance, σ bearing)`.
+    fn sigma(&self, px: Pixel, scale: f64) -> Option<(f64, f64)> {
+        let here = self.camera.unproject(px)?;
+        let below = self.camera.unproject(px + Vector2::new(0.0, 1.0))?;
+        let d = (here.coords.norm() - below.coords.norm()).abs() * scale;
+        Some((d.max(0.005), (1.0 / self.camera.intrinsics.fx).atan()))
+    }
+}
+
+fn sighting(at: Point2<f64>) -> Sighting {
+    Sighting { distance: at.coords.norm(), bearing: at.y.atan2(at.x) }
+}
