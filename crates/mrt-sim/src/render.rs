@@ -684,11 +684,6 @@ fn noise_table(sigma: f64) -> Vec<i8> {
     }
     let mut rng = ChaCha8Rng::seed_from_u64(0x4d52_545f_6e6f_6973);
     (0..NOISE_SAMPLES)
-        .map(|_| {
-            let u1: f64 = rng.random_range(f64::EPSILON..1.0);
-            let u2: f64 = rng.random_range(0.0..1.0);
-            let g = (-2.0 * u1.ln()).sqrt() * (2.0 * std::f64::consts::PI * u2).cos();
-            (g * sigma).round().clamp(-127.0, 127.0) as i8
-        })
+        .map(|_| (crate::sensor::gauss(&mut rng) * sigma).round().clamp(-127.0, 127.0) as i8)
         .collect()
 }

@@ -39,7 +39,7 @@ pub fn sonar_ring(world: &World, i: usize, cfg: &SonarConfig, rng: &mut dyn RngC
 }
 
 /// Standard normal sample (Box–Muller), from any RNG.
-fn gauss(rng: &mut dyn RngCore) -> f64 {
+pub(crate) fn gauss(rng: &mut dyn RngCore) -> f64 {
     let u1: f64 = rng.random_range(f64::EPSILON..1.0);
     let u2: f64 = rng.random_range(0.0..1.0);
     (-2.0 * u1.ln()).sqrt() * (2.0 * std::f64::consts::PI * u2).cos()

@@ -10,6 +10,7 @@
 
 use super::blobs::find_ball;
 use super::colors::{ColorClass, ColorTable, Lut};
+use super::goals::projections;
 use super::lines::line_points;
 use crate::camera::{Camera, Pinhole, Pixel};
 use mrt_msgs::{Image, Percepts, Sighting};
@@ -136,12 +137,7 @@ impl VisionAgent {
         let (w, h) = self.camera.size();
         let (w, h) = (w as usize, h as usize);
         let want = class as u8;
-        let mut count = vec![0u32; w];
-        for row in self.classes.chunks_exact(w) {
-            for (c, &v) in count.iter_mut().zip(row) {
-                *c += u32::from(v == want);
-            }
-        }
+        let (count, _) = projections(&self.classes, w as u32, h as u32, class);
         let pixels: u32 = count.iter().sum();
         if pixels < MIN_GOAL_PIXELS {
             return None;
@@ -152,7 +148,7 @@ impl VisionAgent {
         // and a robot in front hides the foot.)
         let (field, line) = (ColorClass::Field as u8, ColorClass::Line as u8);
         let foot = |col: usize| {
-            if count[col] < 2 {
+            if count.get(col).is_none_or(|&c| c < 2) {
                 return None;
             }
             let row = (0..h).rev().find(|&r| self.classes[r * w + col] == want)?;
@@ -235,4 +231,41 @@ impl VisionAgent {
 
 fn sighting(at: Point2<f64>) -> Sighting {
     Sighting { distance: at.coords.norm(), bearing: at.y.atan2(at.x) }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::camera::Intrinsics;
+    use proptest::prelude::*;
+
+    fn agent() -> VisionAgent {
+        let cam = Pinhole::new(Intrinsics::centred(32, 24, 26.0), 0.45, 0.35);
+        VisionAgent::new(cam, &ColorTable::shipped(), 0.11)
+    }
+
+    proptest! {
+        /// Images of any size and content (a frame from the network) never panic the µAgent:
+        /// the camera's size is processed, anything else refused.
+        #[test]
+        fn any_image_is_processed_or_refused(
+            width in 0u32..64,
+            height in 0u32..48,
+            bytes in proptest::collection::vec(any::<u8>(), 0..8000),
+        ) {
+            let image = Image { width, height, rgb: bytes };
+            let fits = (width, height) == (32, 24) && image.rgb.len() == 32 * 24 * 3;
+            prop_assert_eq!(agent().see(&image, 0.0, 0.0).is_ok(), fits);
+        }
+
+        /// Random pixels of the right size: every percept is finite.
+        #[test]
+        fn random_frames_give_finite_percepts(bytes in proptest::collection::vec(any::<u8>(), 2304)) {
+            let image = Image { width: 32, height: 24, rgb: bytes };
+            let p = agent().see(&image, 1.0, 0.2).unwrap();
+            for s in p.sightings.iter().flatten().chain(&p.obstacles) {
+                prop_assert!(s.distance.is_finite() && s.bearing.is_finite());
+            }
+        }
+    }
 }
