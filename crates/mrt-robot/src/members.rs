@@ -171,7 +171,10 @@ impl Member for Vision {
         let Some(m) = latest else { return Ok(()) };
         let frame = m.get::<CameraFrame>()?;
         let Some(image) = &frame.image else { return Ok(()) };
-        match self.agent.see(image, frame.time, self.agent.camera().pan) {
+        // The pan joint stays where the camera file puts it: nothing turns it yet (gaze,
+        // issue 19 item 7), and a frame does not say where it was.
+        let pan = self.agent.camera().pan;
+        match self.agent.see(image, frame.time, pan) {
             Ok(p) => {
                 ctx.publish(p);
             }

@@ -318,3 +318,27 @@ fn the_vision_agent_finds_ball_nets_and_robots_in_a_rendered_frame() {
     let broken = mrt_msgs::Image { width: 320, height: 240, rgb: vec![0; 7] };
     assert!(agent.see(&broken, 0.0, 0.0).is_err());
 }
+
+/// A lens with radial distortion takes the per-pixel floor table instead of the per-row
+/// stepping: the same scene looks the same at the image's centre, and the ball is still found
+/// where it is (the µAgent undistorts through the same camera).
+#[test]
+fn a_distorting_lens_renders_through_its_per_pixel_floor_table() {
+    let mut cfg = SimConfig::default();
+    let ideal = Renderer::new(&cfg).unwrap();
+    cfg.camera.k1 = -0.15;
+    let barrel = Renderer::new(&cfg).unwrap();
+    let scene = Scene { ball: Some((2.0, 0.4)), robots: vec![] };
+    let at = Pose2::new(-4.0, 1.0, 0.0);
+    let (a, b) = (
+        ideal.render(&scene, at, 0.0, None, &mut CameraState::default()),
+        barrel.render(&scene, at, 0.0, None, &mut CameraState::default()),
+    );
+    assert_eq!(a.pixel(160, 200), b.pixel(160, 200), "no distortion on the axis");
+    assert_ne!(a, b, "but off it");
+    let lut = lut();
+    let found = find_ball(&classes(&lut, &b), barrel.camera(), cfg.ball.radius).unwrap();
+    let (d, bearing) = ((6.0f64).hypot(-0.6), (-0.6f64).atan2(6.0));
+    assert!((found.distance - d).abs() < 0.05 * d, "{found:?}");
+    assert!((found.bearing - bearing).abs() < 1.5f64.to_radians(), "{found:?}");
+}

@@ -3,9 +3,9 @@
 //! correction), the goals, the field-line points, other robots as obstacles.
 //!
 //! The nets of the world model's sightings ([`mrt_msgs::CameraFrame::sightings`]) are the
-//! centres of the goal lines. A goal's blob gives its two outermost columns; the lowest goal
-//! pixel of each is the foot of a post (or of a back corner, seen obliquely), and the net is
-//! the middle of the two floor points. Which colour is the east goal is the field's, not the
+//! centres of the goal lines. The goal's outermost columns whose lowest goal pixel has carpet
+//! right below it are the feet of its posts (or of a back corner, seen obliquely); the net is
+//! the middle of those two floor points. Which colour is the east goal is the field's, not the
 //! camera's: [`VisionAgent::east_goal`] (yellow by default, as the simulator paints it).
 
 use super::blobs::find_ball;
