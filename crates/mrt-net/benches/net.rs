@@ -7,7 +7,10 @@
 //!
 //! - `round_trip`: one probe, wait for its echo (latency).
 //! - `stream`: 1000 messages one way, then the receiver's single acknowledgement
-//!   (throughput: how many messages a second one Agora delivers to another).
+//!   (throughput: how many messages a second one Agora delivers to another). The raw side
+//!   counts in zenoh's receive callback.
+//! - `stream_thread`: the same stream against zenoh's default subscriber, its FIFO channel
+//!   received on a thread of the application's own, as a Member's thread receives its mailbox.
 //! - `echo_window`: 100 probes in flight, then their 100 echoes (request/response throughput;
 //!   here every message crosses a Member's thread on the far side, while the raw echo answers
 //!   in zenoh's receive callback).
@@ -117,6 +120,17 @@ fn bench(c: &mut Criterion) {
         }
         rx.recv_timeout(Duration::from_secs(5)).expect("no acknowledgement");
     };
+    let raw_fifo = session
+        .declare_publisher("raw/flood_fifo")
+        .congestion_control(zenoh::qos::CongestionControl::Block)
+        .wait()
+        .unwrap();
+    let raw_fifo_stream = |payload: &[u8]| {
+        for _ in 0..STREAM {
+            raw_fifo.put(payload.to_vec()).wait().unwrap();
+        }
+        rx.recv_timeout(Duration::from_secs(5)).expect("no acknowledgement");
+    };
     for size in [64usize, 1024] {
         let payload = vec![7u8; size];
         let flood = flood_payload(STREAM, size);
@@ -136,6 +150,14 @@ fn bench(c: &mut Criterion) {
             STREAM.into(),
             &mut || mrt_stream(&mut ep.borrow_mut(), &flood),
             &mut || raw_stream(&flood),
+        );
+        compare(
+            c,
+            &format!("stream_thread_{size}B"),
+            size,
+            STREAM.into(),
+            &mut || mrt_stream(&mut ep.borrow_mut(), &flood),
+            &mut || raw_fifo_stream(&flood),
         );
         compare(
             c,

@@ -88,7 +88,8 @@ impl Member for Echoer {
 
 /// The far side of the benchmark: an Agora echoing Probes and acknowledging batches of Floods
 /// (threaded executor: a Member wakes as a message arrives), and plain zenoh subscribers doing
-/// the same on `raw/ping` and `raw/flood` (answers on `raw/pong`) on the same session.
+/// the same on `raw/ping` and `raw/flood` in zenoh's receive callback and on `raw/flood_fifo` on
+/// a thread of their own (answers on `raw/pong`), on the same session.
 fn echo(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
     use zenoh::Wait;
     let mut agora = mrt_dcdt::Agora::builder(args.id).build()?;
@@ -113,15 +114,27 @@ fn echo(args: &Args) -> Result<(), Box<dyn std::error::Error>> {
         .wait()
         .map_err(z)?;
     let flood = FloodCounter::default();
+    let ack = publisher.clone();
     let _raw_flood = session
         .declare_subscriber("raw/flood")
         .callback(move |s| {
             if flood.count(&s.payload().to_bytes()) {
-                let _ = publisher.put(Vec::new()).wait();
+                let _ = ack.put(Vec::new()).wait();
             }
         })
         .wait()
         .map_err(z)?;
+    // zenoh's default subscriber: its FIFO channel, received on a thread of the application's
+    // own (what a Member's thread does with its mailbox).
+    let fifo = session.declare_subscriber("raw/flood_fifo").wait().map_err(z)?;
+    std::thread::spawn(move || {
+        let flood = FloodCounter::default();
+        while let Ok(s) = fifo.recv() {
+            if flood.count(&s.payload().to_bytes()) {
+                let _ = publisher.put(Vec::new()).wait();
+            }
+        }
+    });
     println!("echo ready");
     let stop = agora.shutdown_handle();
     let duration = args.duration;
