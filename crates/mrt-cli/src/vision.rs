@@ -1,12 +1,13 @@
 //! `mrt vision`: the vision µAgent's tools for a competition (issue 19). `detect` classifies
 //! images with a colour file and finds the ball and the goals (their nearest point and the open
-//! space for a shot) through a camera file, one JSON line per image; `--png OUT` draws what it
-//! found. `render` saves what a simulated camera sees (the simulator's renderer,
+//! space for a shot) through a camera file, one JSON line per image (or per image of a
+//! directory, `mrt_perception::source::ImageSequence`); `--png OUT` draws what it found. `render` saves what a simulated camera sees (the simulator's renderer,
 //! `mrt_sim::render`).
 
 use anyhow::{anyhow, bail, Context as _, Result};
 use image::{Rgb, RgbImage};
 use mrt_perception::camera::{Camera, CameraFile, Pinhole};
+use mrt_perception::source::{load_image, ImageSequence};
 use mrt_perception::vision::blobs::find_ball;
 use mrt_perception::vision::colors::{ColorClass, ColorTable, Lut};
 use mrt_perception::vision::goals::find_goal;
@@ -28,7 +29,8 @@ pub struct DetectArgs {
     /// Draw the classified image with the detections to this PNG file (one image only).
     #[arg(long)]
     pub png: Option<PathBuf>,
-    /// The images (PNG or JPEG), each the camera's size.
+    /// The images (PNG or JPEG), each the camera's size; a directory stands for its image
+    /// files in name order (a recorded sequence).
     #[arg(required = true)]
     pub images: Vec<PathBuf>,
 }
@@ -51,7 +53,11 @@ pub fn detect(args: &DetectArgs) -> Result<()> {
     if !(args.ball_radius.is_finite() && args.ball_radius > 0.0 && args.ball_radius < 1.0) {
         bail!("--ball-radius must be between 0 and 1 m, not {}", args.ball_radius);
     }
-    if args.png.is_some() && args.images.len() != 1 {
+    let mut images = Vec::new();
+    for path in &args.images {
+        images.extend_from_slice(ImageSequence::open(path)?.files());
+    }
+    if args.png.is_some() && images.len() != 1 {
         bail!("--png draws one image: give one image with it");
     }
     // `from_file` has checked the camera already: `camera()` cannot fail on what it read.
@@ -63,7 +69,7 @@ pub fn detect(args: &DetectArgs) -> Result<()> {
     let lut = Lut::new(&colors);
     let stdout = std::io::stdout();
     let mut out = stdout.lock();
-    for path in &args.images {
+    for path in &images {
         let line = detect_one(path, &camera, &lut, args.ball_radius, args.png.as_deref())?;
         if writeln!(out, "{line}").is_err() {
             return Ok(()); // the reader went away
@@ -79,8 +85,8 @@ fn detect_one(
     ball_radius: f64,
     png: Option<&Path>,
 ) -> Result<serde_json::Value> {
-    let img = image::open(path).with_context(|| format!("{}", path.display()))?.to_rgb8();
-    let (w, h) = img.dimensions();
+    let img = load_image(path)?;
+    let (w, h) = (img.width, img.height);
     if (w, h) != camera.size() {
         bail!(
             "{}: the image is {w}×{h}, the camera file says {}×{}",
@@ -90,7 +96,7 @@ fn detect_one(
         );
     }
     let mut classes = vec![0u8; (w * h) as usize];
-    lut.classify(img.as_raw(), &mut classes);
+    lut.classify(&img.rgb, &mut classes);
     let ball = find_ball(&classes, camera, ball_radius);
     let mut objects = Vec::new();
     if let Some(b) = ball {

@@ -181,3 +181,31 @@ fn render_says_what_is_wrong_with_its_arguments() {
     let (ok, err) = render(&["--at", "0,0,0", "--world", "/nonexistent/world.toml", "--out", out]);
     assert!(!ok && err.contains("/nonexistent/world.toml"), "{err}");
 }
+
+/// A directory is a recorded sequence: its images in name order, other files skipped.
+#[test]
+fn detect_reads_a_directory_of_frames_in_name_order() {
+    let dir = std::env::temp_dir().join(format!("mrt-vision-seq-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    frame(Some((2.0, 0.0)), 1).save(dir.join("002.png")).unwrap();
+    frame(Some((1.0, 0.0)), 2).save(dir.join("001.png")).unwrap();
+    frame(None, 3).save(dir.join("003.png")).unwrap();
+    std::fs::write(dir.join("README.txt"), "the frames of one run").unwrap();
+    let (ok, out, err) = detect(&[&dir], &[]);
+    assert!(ok, "{err}");
+    let lines: Vec<serde_json::Value> =
+        out.lines().map(|l| serde_json::from_str(l).unwrap()).collect();
+    assert_eq!(lines.len(), 3, "{out}");
+    let distance = |l: &serde_json::Value| l["objects"][0]["distance_m"].as_f64();
+    assert!(lines[0]["image"].as_str().unwrap().ends_with("001.png"));
+    assert!((distance(&lines[0]).unwrap() - 1.0).abs() < 0.05, "{}", lines[0]);
+    assert!((distance(&lines[1]).unwrap() - 2.0).abs() < 0.1, "{}", lines[1]);
+    assert_eq!(lines[2]["objects"].as_array().map(Vec::len), Some(0), "{}", lines[2]);
+    // A directory without images says so.
+    let empty = dir.join("empty");
+    std::fs::create_dir_all(&empty).unwrap();
+    let (ok, _, err) = detect(&[&empty], &[]);
+    assert!(!ok && err.contains("no .png, .jpg or .jpeg files"), "{err}");
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -7,8 +7,10 @@
 //! its error detection and reduction (§4.2), and the camera models colour vision will use
 //! ([`camera`]: a pinhole camera on a pan joint with radial distortion, ISocRob's
 //! omnidirectional mirror, the ball's floor point and apparent size, with the report's typos
-//! fixed). Colour vision on camera images (ISocRob seed `003` §3.2.1) comes here next. A plain
-//! library: no bus, no simulator.
+//! fixed), colour vision on camera images ([`vision`]: ISocRob seed `003` §3.2.1's lookup table,
+//! ball, goals, lines and obstacles, and the vision µAgent that turns an image into percepts),
+//! and where images come from ([`source`]: the camera driver trait and a player of image
+//! files). A plain library: no bus, no simulator.
 //!
 //! ```
 //! use mrt_perception::mice::MiceOdometry;
@@ -33,6 +35,8 @@
 //! | front camera, inverse projection eqs (7)–(9) (ISocRob `003` §3.2.1) | [`camera::Pinhole`] (with a pan joint) |
 //! | "up" camera, mirror (ISocRob `003` §2.2) | [`camera::Omni`] |
 //! | ball correction and expected size, eqs (10)–(11) | [`camera::ball_floor_point`], [`camera::ball_diameter_px`] |
+//! | the vision µAgent (ISocRob `003` §3.2.1) | [`vision::agent::VisionAgent`] |
+//! | a camera driver (manual ch. 12, ISocRob §2.2) | [`source::ImageSource`], [`source::ImageSequence`] |
 //!
 //! The manual's mice equations have typos; [`mice`] lists each one with the corrected formula,
 //! and a test pins each fix. Errors: [`PerceptionError`].
@@ -41,6 +45,7 @@
 pub mod camera;
 mod error;
 pub mod mice;
+pub mod source;
 pub mod vision;
 
 pub use error::PerceptionError;
