@@ -48,6 +48,10 @@ enum VisionCommand {
     /// Save what a simulated camera sees: a robot placed on the simulator's field, the ball
     /// and other robots where you say.
     Render(vision::RenderArgs),
+    /// Help tune a colour file: per class, histograms of the hue, saturation and value of the
+    /// pixels it takes (JSON), and with --out an SVG of them and an image of what each class
+    /// covers.
+    Calibrate(vision::CalibrateArgs),
 }
 
 #[derive(Subcommand)]
@@ -58,7 +62,8 @@ enum Command {
     /// --distributed` starts each of its robots with this command).
     #[cfg(feature = "net")]
     Robot(distributed::RobotArgs),
-    /// Vision tools: find the ball in camera images (`detect`).
+    /// Vision tools: find the ball in camera images (`detect`), tune colours (`calibrate`),
+    /// save what a simulated camera sees (`render`).
     Vision {
         #[command(subcommand)]
         command: VisionCommand,
@@ -233,6 +238,7 @@ fn run(command: Command) -> Result<()> {
         Command::Bb { command } => bb::run(command)?,
         Command::Vision { command: VisionCommand::Detect(args) } => vision::detect(&args)?,
         Command::Vision { command: VisionCommand::Render(args) } => vision::render(&args)?,
+        Command::Vision { command: VisionCommand::Calibrate(args) } => vision::calibrate(&args)?,
         Command::Behave { file, world, cycles, period_ms } => {
             behave::behave(&file, world.as_deref(), cycles, period_ms)?
         }

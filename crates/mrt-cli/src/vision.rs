@@ -1,8 +1,9 @@
 //! `mrt vision`: the vision µAgent's tools for a competition (issue 19). `detect` classifies
 //! images with a colour file and finds the ball and the goals (their nearest point and the open
 //! space for a shot) through a camera file, one JSON line per image (or per image of a
-//! directory, `mrt_perception::source::ImageSequence`); `--png OUT` draws what it found. `render` saves what a simulated camera sees (the simulator's renderer,
-//! `mrt_sim::render`).
+//! directory, `mrt_perception::source::ImageSequence`); `--png OUT` draws what it found.
+//! `calibrate` shows per class what the thresholds take (histograms, coverage images). `render`
+//! saves what a simulated camera sees (the simulator's renderer, `mrt_sim::render`).
 
 use anyhow::{anyhow, bail, Context as _, Result};
 use image::{Rgb, RgbImage};
@@ -238,4 +239,217 @@ pub fn render(args: &RenderArgs) -> Result<()> {
         .ok_or_else(|| anyhow!("the renderer made an image of the wrong size"))?;
     image.save(&args.out).with_context(|| format!("cannot write {}", args.out.display()))?;
     Ok(())
+}
+
+/// `mrt vision calibrate`.
+#[derive(clap::Args)]
+pub struct CalibrateArgs {
+    /// The colour file to tune (TOML; see configs/vision/colors.toml).
+    #[arg(long)]
+    pub colors: PathBuf,
+    /// A directory to write `histograms.svg` and, per image and class, `<image>-<class>.png`
+    /// (the class's pixels in their colours, the rest dimmed).
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    /// The images (PNG or JPEG; a directory stands for its image files).
+    #[arg(required = true)]
+    pub images: Vec<PathBuf>,
+}
+
+/// The classes in the report: the colour file's, then the pixels none of them takes.
+fn report_classes() -> impl Iterator<Item = ColorClass> {
+    ColorClass::ALL.into_iter().chain(std::iter::once(ColorClass::Unknown))
+}
+
+/// Runs `mrt vision calibrate`.
+pub fn calibrate(args: &CalibrateArgs) -> Result<()> {
+    use mrt_perception::vision::calibrate::{ClassHistogram, Histograms};
+    let colors = ColorTable::from_file(&args.colors).map_err(|e| anyhow!("{e}"))?;
+    let lut = Lut::new(&colors);
+    let mut images = Vec::new();
+    for path in &args.images {
+        images.extend_from_slice(ImageSequence::open(path)?.files());
+    }
+    if let Some(dir) = &args.out {
+        std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
+    }
+    let mut hist = Histograms::default();
+    for path in &images {
+        let img = load_image(path)?;
+        hist.add(&lut, &img.rgb);
+        if let Some(dir) = &args.out {
+            coverage(&img, &lut, path, dir)?;
+        }
+    }
+    let total = hist.pixels().max(1) as f64;
+    let range = |bins: &[u64], width: f64| {
+        ClassHistogram::central_range(bins, width, 0.02).map(|(a, b)| [round3(a), round3(b)])
+    };
+    let classes: Vec<serde_json::Value> = report_classes()
+        .map(|class| {
+            let h = hist.class(class);
+            serde_json::json!({
+                "class": class.name(),
+                "pixels": h.pixels,
+                "share": round3(h.pixels as f64 / total),
+                "thresholds": colors.get(class),
+                "hue_range_deg": range(&h.hue, 10.0),
+                "sat_range": range(&h.sat, 0.05),
+                "val_range": range(&h.val, 0.05),
+                "hue": h.hue.to_vec(),
+                "sat": h.sat.to_vec(),
+                "val": h.val.to_vec(),
+            })
+        })
+        .collect();
+    let report =
+        serde_json::json!({ "images": images.len(), "pixels": hist.pixels(), "classes": classes });
+    println!("{report}");
+    if let Some(dir) = &args.out {
+        let svg = dir.join("histograms.svg");
+        std::fs::write(&svg, histogram_svg(&hist, &colors))
+            .with_context(|| format!("cannot write {}", svg.display()))?;
+    }
+    Ok(())
+}
+
+/// Writes one image per class of `img`: the class's pixels as they are, the rest dimmed to a
+/// quarter, so that a person sees what the class takes.
+fn coverage(img: &mrt_msgs::Image, lut: &Lut, path: &Path, dir: &Path) -> Result<()> {
+    let stem = path.file_stem().and_then(|s| s.to_str()).unwrap_or("image");
+    let mut classes = vec![0u8; img.rgb.len() / 3];
+    lut.classify(&img.rgb, &mut classes);
+    for class in report_classes() {
+        let mut rgb = img.rgb.clone();
+        for (px, &c) in rgb.chunks_exact_mut(3).zip(&classes) {
+            if c != class as u8 {
+                px.iter_mut().for_each(|v| *v /= 4);
+            }
+        }
+        let out = dir.join(format!("{stem}-{}.png", class.name()));
+        RgbImage::from_raw(img.width, img.height, rgb)
+            .ok_or_else(|| anyhow!("{}: inconsistent image buffer", path.display()))?
+            .save(&out)
+            .with_context(|| format!("cannot write {}", out.display()))?;
+    }
+    Ok(())
+}
+
+/// One row per class, three bar charts (hue, saturation, value), each bar in the colour of its
+/// bin, the class's thresholds as red lines and the shaded band between them.
+fn histogram_svg(
+    hist: &mrt_perception::vision::calibrate::Histograms,
+    colors: &ColorTable,
+) -> String {
+    use std::fmt::Write as _;
+    const W: f64 = 216.0; // chart width, px
+    const H: f64 = 60.0; // chart height, px
+    const ROW: f64 = 95.0;
+    const LEFT: f64 = 110.0;
+    let rows = report_classes().count() as f64;
+    let mut s = String::new();
+    let _ = write!(
+        s,
+        r#"<svg xmlns="http://www.w3.org/2000/svg" width="{}" height="{}" font-family="sans-serif" font-size="11">"#,
+        LEFT + 3.0 * (W + 30.0),
+        40.0 + rows * ROW
+    );
+    let _ = write!(s, r##"<rect width="100%" height="100%" fill="#fff"/>"##);
+    for (j, title) in ["hue (°)", "saturation", "value"].iter().enumerate() {
+        let x = LEFT + j as f64 * (W + 30.0);
+        let _ = write!(s, r#"<text x="{x}" y="20" font-weight="bold">{title}</text>"#);
+    }
+    for (i, class) in report_classes().enumerate() {
+        let h = hist.class(class);
+        let y0 = 40.0 + i as f64 * ROW;
+        let _ = write!(
+            s,
+            r#"<text x="8" y="{}" font-weight="bold">{}</text><text x="8" y="{}">{} px</text>"#,
+            y0 + H / 2.0,
+            class.name(),
+            y0 + H / 2.0 + 14.0,
+            h.pixels
+        );
+        let t = colors.get(class);
+        type Chart<'a> = (&'a [u64], f64, Option<(f64, f64)>);
+        let charts: [Chart<'_>; 3] = [
+            (&h.hue, 360.0, t.map(|t| (t.hue_min, t.hue_max))),
+            (&h.sat, 1.0, t.map(|t| (t.sat_min, t.sat_max))),
+            (&h.val, 1.0, t.map(|t| (t.val_min, t.val_max))),
+        ];
+        for (j, (bins, span, limits)) in charts.into_iter().enumerate() {
+            let x0 = LEFT + j as f64 * (W + 30.0);
+            let sx = |v: f64| x0 + v / span * W;
+            // The accepted band (hue may wrap through 0°).
+            if let Some((lo, hi)) = limits {
+                let bands = if lo <= hi { vec![(lo, hi)] } else { vec![(lo, span), (0.0, hi)] };
+                for (a, b) in bands {
+                    let _ = write!(
+                        s,
+                        r##"<rect x="{:.1}" y="{y0}" width="{:.1}" height="{H}" fill="#fdd"/>"##,
+                        sx(a),
+                        sx(b) - sx(a)
+                    );
+                }
+            }
+            let max = bins.iter().copied().max().unwrap_or(0).max(1) as f64;
+            let bw = W / bins.len() as f64;
+            for (k, &n) in bins.iter().enumerate() {
+                let bh = (n as f64 / max).sqrt() * H; // square root: small counts stay visible
+                let fill = match j {
+                    0 => hue_colour(k as f64 * 360.0 / bins.len() as f64 + 5.0),
+                    _ => {
+                        let g = (k as f64 / bins.len() as f64 * 255.0) as u8;
+                        format!("rgb({g},{g},{g})")
+                    }
+                };
+                let _ = write!(
+                    s,
+                    r##"<rect x="{:.1}" y="{:.1}" width="{:.1}" height="{bh:.1}" fill="{fill}" stroke="#444" stroke-width="0.3"/>"##,
+                    x0 + k as f64 * bw,
+                    y0 + H - bh,
+                    bw
+                );
+            }
+            let _ = write!(
+                s,
+                r##"<line x1="{x0}" y1="{0}" x2="{1}" y2="{0}" stroke="#000"/>"##,
+                y0 + H,
+                x0 + W
+            );
+            if let Some((lo, hi)) = limits {
+                for v in [lo, hi] {
+                    let _ = write!(
+                        s,
+                        r##"<line x1="{0:.1}" y1="{y0}" x2="{0:.1}" y2="{1}" stroke="#d00" stroke-width="1.5"/>"##,
+                        sx(v),
+                        y0 + H
+                    );
+                }
+            }
+            let _ = write!(
+                s,
+                r##"<text x="{x0}" y="{0}" fill="#555">0</text><text x="{1}" y="{0}" fill="#555" text-anchor="end">{2}</text>"##,
+                y0 + H + 12.0,
+                x0 + W,
+                span
+            );
+        }
+    }
+    s.push_str("</svg>\n");
+    s
+}
+
+/// The fully saturated colour of a hue (degrees), as an SVG colour.
+fn hue_colour(h: f64) -> String {
+    let x = 1.0 - ((h / 60.0) % 2.0 - 1.0).abs();
+    let (r, g, b) = match (h / 60.0) as u32 {
+        0 => (1.0, x, 0.0),
+        1 => (x, 1.0, 0.0),
+        2 => (0.0, 1.0, x),
+        3 => (0.0, x, 1.0),
+        4 => (x, 0.0, 1.0),
+        _ => (1.0, 0.0, x),
+    };
+    format!("rgb({},{},{})", (r * 255.0) as u8, (g * 255.0) as u8, (b * 255.0) as u8)
 }

@@ -209,3 +209,61 @@ fn detect_reads_a_directory_of_frames_in_name_order() {
     assert!(!ok && err.contains("no .png, .jpg or .jpeg files"), "{err}");
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// `mrt vision calibrate` on a rendered frame: every pixel counted once, each class's pixels
+/// within its thresholds, an SVG of the histograms and one coverage image per class.
+#[test]
+fn calibrate_reports_what_each_class_takes() {
+    let dir = std::env::temp_dir().join(format!("mrt-vision-calib-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let png = dir.join("frame.png");
+    let (ok, err) =
+        render(&["--at", "-3,0,0", "--ball", "-1.5,0.3", "--out", png.to_str().unwrap()]);
+    assert!(ok, "{err}");
+    let out_dir = dir.join("out");
+    let out = Command::new(env!("CARGO_BIN_EXE_mrt"))
+        .args(["vision", "calibrate", "--colors"])
+        .arg(config("colors.toml"))
+        .arg("--out")
+        .arg(&out_dir)
+        .arg(&png)
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(report["images"], 1);
+    assert_eq!(report["pixels"], 320 * 240);
+    let classes = report["classes"].as_array().unwrap();
+    let sum: u64 = classes.iter().map(|c| c["pixels"].as_u64().unwrap()).sum();
+    assert_eq!(sum, 320 * 240, "every pixel under exactly one class");
+    let class = |name: &str| classes.iter().find(|c| c["class"] == name).unwrap();
+    let ball = class("ball");
+    assert!(ball["pixels"].as_u64().unwrap() > 50, "{ball}");
+    // The rendered ball is orange: its hues between 10° and 40°, its saturation high.
+    let hue = ball["hue_range_deg"].as_array().unwrap();
+    assert!(hue[0].as_f64().unwrap() >= 10.0 && hue[1].as_f64().unwrap() <= 40.0, "{ball}");
+    assert!(
+        ball["sat_range"][0].as_f64().unwrap()
+            >= ball["thresholds"]["sat_min"].as_f64().unwrap() - 0.05
+    );
+    assert!(class("field")["share"].as_f64().unwrap() > 0.5);
+    assert!(class("unknown")["thresholds"].is_null());
+    let svg = std::fs::read_to_string(out_dir.join("histograms.svg")).unwrap();
+    assert!(svg.starts_with("<svg") && svg.trim_end().ends_with("</svg>"));
+    for c in classes {
+        let name = c["class"].as_str().unwrap();
+        assert!(svg.contains(&format!(">{name}<")), "{name} missing from the SVG");
+        let cover = image::open(out_dir.join(format!("frame-{name}.png"))).unwrap();
+        assert_eq!((cover.width(), cover.height()), (320, 240));
+    }
+    // A colour file that does not exist is named in the error.
+    let out = Command::new(env!("CARGO_BIN_EXE_mrt"))
+        .args(["vision", "calibrate", "--colors", "/nonexistent/colors.toml"])
+        .arg(&png)
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("/nonexistent/colors.toml"));
+    std::fs::remove_dir_all(&dir).ok();
+}
