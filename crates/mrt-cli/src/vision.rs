@@ -36,6 +36,16 @@ pub struct DetectArgs {
     pub images: Vec<PathBuf>,
 }
 
+/// The image files the arguments name: files as given, directories as their image files in
+/// name order.
+fn image_files(args: &[PathBuf]) -> Result<Vec<PathBuf>> {
+    let mut images = Vec::new();
+    for path in args {
+        images.extend_from_slice(ImageSequence::open(path)?.files());
+    }
+    Ok(images)
+}
+
 /// The colour a class is drawn with.
 fn paint(c: ColorClass) -> Rgb<u8> {
     Rgb(match c {
@@ -54,10 +64,7 @@ pub fn detect(args: &DetectArgs) -> Result<()> {
     if !(args.ball_radius.is_finite() && args.ball_radius > 0.0 && args.ball_radius < 1.0) {
         bail!("--ball-radius must be between 0 and 1 m, not {}", args.ball_radius);
     }
-    let mut images = Vec::new();
-    for path in &args.images {
-        images.extend_from_slice(ImageSequence::open(path)?.files());
-    }
+    let images = image_files(&args.images)?;
     if args.png.is_some() && images.len() != 1 {
         bail!("--png draws one image: give one image with it");
     }
@@ -266,10 +273,7 @@ pub fn calibrate(args: &CalibrateArgs) -> Result<()> {
     use mrt_perception::vision::calibrate::{ClassHistogram, Histograms};
     let colors = ColorTable::from_file(&args.colors).map_err(|e| anyhow!("{e}"))?;
     let lut = Lut::new(&colors);
-    let mut images = Vec::new();
-    for path in &args.images {
-        images.extend_from_slice(ImageSequence::open(path)?.files());
-    }
+    let images = image_files(&args.images)?;
     if let Some(dir) = &args.out {
         std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
     }
