@@ -109,25 +109,19 @@ fn bench(c: &mut Criterion) {
             assert!(ep.wait_msg(Duration::from_secs(5)), "no acknowledgement, {:?}", stats());
         }
     };
-    let raw_flood = session
-        .declare_publisher("raw/flood")
-        .congestion_control(zenoh::qos::CongestionControl::Block)
-        .wait()
-        .unwrap();
-    let raw_stream = |payload: &[u8]| {
-        for _ in 0..STREAM {
-            raw_flood.put(payload.to_vec()).wait().unwrap();
-        }
-        rx.recv_timeout(Duration::from_secs(5)).expect("no acknowledgement");
+    // A raw stream on `key`: counted in the far side's receive callback (`raw/flood`) or on a
+    // thread of its own behind zenoh's FIFO channel (`raw/flood_fifo`).
+    let raw_publisher = |key: &'static str| {
+        session
+            .declare_publisher(key)
+            .congestion_control(zenoh::qos::CongestionControl::Block)
+            .wait()
+            .unwrap()
     };
-    let raw_fifo = session
-        .declare_publisher("raw/flood_fifo")
-        .congestion_control(zenoh::qos::CongestionControl::Block)
-        .wait()
-        .unwrap();
-    let raw_fifo_stream = |payload: &[u8]| {
+    let (raw_flood, raw_fifo) = (raw_publisher("raw/flood"), raw_publisher("raw/flood_fifo"));
+    let raw_stream = |publisher: &zenoh::pubsub::Publisher<'_>, payload: &[u8]| {
         for _ in 0..STREAM {
-            raw_fifo.put(payload.to_vec()).wait().unwrap();
+            publisher.put(payload.to_vec()).wait().unwrap();
         }
         rx.recv_timeout(Duration::from_secs(5)).expect("no acknowledgement");
     };
@@ -149,7 +143,7 @@ fn bench(c: &mut Criterion) {
             size,
             STREAM.into(),
             &mut || mrt_stream(&mut ep.borrow_mut(), &flood),
-            &mut || raw_stream(&flood),
+            &mut || raw_stream(&raw_flood, &flood),
         );
         compare(
             c,
@@ -157,7 +151,7 @@ fn bench(c: &mut Criterion) {
             size,
             STREAM.into(),
             &mut || mrt_stream(&mut ep.borrow_mut(), &flood),
-            &mut || raw_fifo_stream(&flood),
+            &mut || raw_stream(&raw_fifo, &flood),
         );
         compare(
             c,
