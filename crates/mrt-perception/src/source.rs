@@ -18,12 +18,9 @@
 //! # Ok::<(), mrt_perception::source::SourceError>(())
 //! ```
 
+use crate::vision::blobs::MAX_SIDE;
 use mrt_msgs::Image;
 use std::path::{Path, PathBuf};
-
-/// The largest image side accepted, pixels (a camera image is far smaller; a file claiming
-/// more is refused before its pixels are allocated).
-pub const MAX_SIDE: u32 = 8192;
 
 /// What can go wrong when reading images.
 #[derive(Debug, thiserror::Error)]
@@ -82,7 +79,8 @@ pub trait ImageSource: Send {
 }
 
 /// Decodes one PNG or JPEG file (the format is read from the content, not the name) into an
-/// RGB image, with at most [`MAX_SIDE`] pixels a side.
+/// RGB image, with at most [`MAX_SIDE`] pixels a side (the largest image a camera file and the
+/// vision accept; a file claiming more is refused before its pixels are allocated).
 pub fn load_image(path: &Path) -> Result<Image, SourceError> {
     let io = |e: std::io::Error| SourceError::Io { path: path.to_owned(), reason: e.to_string() };
     let decode =
