@@ -52,6 +52,9 @@ enum VisionCommand {
     /// pixels it takes (JSON), and with --out an SVG of them and an image of what each class
     /// covers.
     Calibrate(vision::CalibrateArgs),
+    /// Measure the vision against the simulator's truth: random scenes rendered and seen, the
+    /// detection rate and the errors of the ball, the nets, the posts and the other robots.
+    Survey(vision::SurveyArgs),
 }
 
 #[derive(Subcommand)]
@@ -63,7 +66,7 @@ enum Command {
     #[cfg(feature = "net")]
     Robot(distributed::RobotArgs),
     /// Vision tools: find the ball in camera images (`detect`), tune colours (`calibrate`),
-    /// save what a simulated camera sees (`render`).
+    /// save what a simulated camera sees (`render`), measure the vision on it (`survey`).
     Vision {
         #[command(subcommand)]
         command: VisionCommand,
@@ -239,6 +242,7 @@ fn run(command: Command) -> Result<()> {
         Command::Vision { command: VisionCommand::Detect(args) } => vision::detect(&args)?,
         Command::Vision { command: VisionCommand::Render(args) } => vision::render(&args)?,
         Command::Vision { command: VisionCommand::Calibrate(args) } => vision::calibrate(&args)?,
+        Command::Vision { command: VisionCommand::Survey(args) } => vision::survey(&args)?,
         Command::Behave { file, world, cycles, period_ms } => {
             behave::behave(&file, world.as_deref(), cycles, period_ms)?
         }

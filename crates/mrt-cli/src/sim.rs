@@ -233,6 +233,16 @@ pub fn run(args: &SimArgs) -> Result<()> {
             outln!("  goal {who:<8} at {:>3}:{:02}", (*t as u64) / 60, (*t as u64) % 60);
         }
     }
+    let l = &report.localization;
+    if let (Some((pm, hm)), Some((p9, h9))) = (l.quantile(0.5), l.quantile(0.9)) {
+        outln!(
+            "  localization error (the robots' own estimates against the truth): position {:.2} m median, {:.2} m p90; heading {:.1}° median, {:.1}° p90",
+            pm,
+            p9,
+            hm.to_degrees(),
+            h9.to_degrees()
+        );
+    }
     let n = cfg.rules.team_size;
     for f in &report.faults {
         let (team, k) = if f.robot < n { (h, f.robot) } else { (a, f.robot - n) };

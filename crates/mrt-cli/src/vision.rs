@@ -3,7 +3,8 @@
 //! space for a shot) through a camera file, one JSON line per image (or per image of a
 //! directory, `mrt_perception::source::ImageSequence`); `--png OUT` draws what it found.
 //! `calibrate` shows per class what the thresholds take (histograms, coverage images). `render`
-//! saves what a simulated camera sees (the simulator's renderer, `mrt_sim::render`).
+//! saves what a simulated camera sees (the simulator's renderer, `mrt_sim::render`). `survey`
+//! measures the vision on random rendered scenes against the truth (`mrt_sim::survey`).
 
 use anyhow::{anyhow, bail, Context as _, Result};
 use image::{Rgb, RgbImage};
@@ -12,6 +13,7 @@ use mrt_perception::source::{load_image, ImageSequence};
 use mrt_perception::vision::blobs::find_ball;
 use mrt_perception::vision::colors::{ColorClass, ColorTable, Lut};
 use mrt_perception::vision::goals::find_goal;
+use mrt_perception::vision::posts::{find_posts, PostShape};
 use std::io::Write as _;
 use std::path::{Path, PathBuf};
 
@@ -127,6 +129,16 @@ fn detect_one(
             }));
         }
     }
+    let posts = find_posts(&classes, camera, PostShape::default());
+    for p in &posts {
+        objects.push(serde_json::json!({
+            "class": "post",
+            "outer": p.outer.name(),
+            "pixel": [round3(p.pixel.x), round3(p.pixel.y)],
+            "distance_m": round3(p.at.coords.norm()),
+            "bearing_deg": round3(p.at.y.atan2(p.at.x).to_degrees()),
+        }));
+    }
     if let Some(out) = png {
         let mut drawn = RgbImage::from_fn(w, h, |x, y| {
             paint(ColorClass::from_u8(classes[(y * w + x) as usize]))
@@ -136,6 +148,13 @@ fn detect_one(
             let r = b.radius_px.round().max(1.0) as i32;
             imageproc::drawing::draw_hollow_circle_mut(&mut drawn, c, r + 2, Rgb([255, 0, 255]));
             imageproc::drawing::draw_cross_mut(&mut drawn, Rgb([255, 0, 255]), c.0, c.1);
+        }
+        for p in &posts {
+            let (x0, x1) = (p.columns.0 as i32 - 2, p.columns.1 as i32 + 2);
+            let y = p.pixel.y as i32;
+            let rect = imageproc::rect::Rect::at(x0, (y - 4 * (x1 - x0)).max(0))
+                .of_size((x1 - x0 + 1) as u32, (4 * (x1 - x0)).min(y).max(1) as u32);
+            imageproc::drawing::draw_hollow_rect_mut(&mut drawn, rect, Rgb([255, 0, 255]));
         }
         drawn.save(out).with_context(|| format!("cannot write {}", out.display()))?;
     }
@@ -456,4 +475,39 @@ fn hue_colour(h: f64) -> String {
         _ => (1.0, 0.0, x),
     };
     format!("rgb({},{},{})", (r * 255.0) as u8, (g * 255.0) as u8, (b * 255.0) as u8)
+}
+
+/// `mrt vision survey`.
+#[derive(clap::Args)]
+pub struct SurveyArgs {
+    /// The world: a simulator configuration (TOML; see configs/sim/default.toml), for the
+    /// field, the camera and what is drawn. Default: the built-in world.
+    #[arg(long)]
+    pub world: Option<PathBuf>,
+    /// Random scenes to render and see (1 to 1 000 000).
+    #[arg(long, default_value_t = 1000, value_parser = clap::value_parser!(u32).range(1..=1_000_000))]
+    pub scenes: u32,
+    /// The seed of the scenes.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Print JSON instead of a table.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// Runs `mrt vision survey`.
+pub fn survey(args: &SurveyArgs) -> Result<()> {
+    let cfg = match &args.world {
+        Some(path) => mrt_sim::config::SimConfig::from_file(path).map_err(|e| anyhow!("{e}"))?,
+        None => mrt_sim::config::SimConfig::default(),
+    };
+    let report = mrt_sim::survey::survey(&cfg, args.seed, args.scenes as usize)
+        .map_err(|e| anyhow!("survey: {e}"))?;
+    let mut out = std::io::stdout().lock();
+    if args.json {
+        writeln!(out, "{}", serde_json::to_string(&report)?)?;
+    } else {
+        write!(out, "{}", report.table())?;
+    }
+    Ok(())
 }

@@ -52,8 +52,8 @@ pub use localization::{FilterCounts, Localization};
 pub use mrt_core::{Message, MsgType};
 pub use robot::{lps, Estimate, Field, GameState, Lpo, Mate, RobotCommand, Target, WorldSnapshot};
 pub use sensing::{
-    CameraFrame, Displacement, GameInfo, Image, MiceReadings, Odometry, Percepts, Sighting, Sonar,
-    SonarScan, FIELD_OBJECTS,
+    CameraFrame, Displacement, GameInfo, Image, MiceReadings, Odometry, Percepts, PostSighting,
+    Sighting, Sonar, SonarScan, FIELD_OBJECTS,
 };
 pub use team::MateReport;
 

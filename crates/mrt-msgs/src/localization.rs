@@ -21,6 +21,10 @@ pub struct FilterCounts {
     pub rejected: u64,
     /// Frames after which the filter admitted it was lost.
     pub lost: u64,
+    /// Landmark posts of the vision named (told which post they are) by where the robot
+    /// believed it was.
+    #[serde(default)]
+    pub posts_named: u64,
 }
 
 /// A robot's own pose estimate after a cycle, in the field frame (m, rad; not the team frame

@@ -173,6 +173,26 @@ pub struct Percepts {
     pub line_points: Vec<(f64, f64)>,
     /// Other robots: the nearest point of each, from the robot's centre.
     pub obstacles: Vec<Sighting>,
+    /// The landmark posts seen, each with the half of the field it stands on but not which
+    /// post of that half it is (the world model tells them apart).
+    #[serde(default)]
+    pub posts: Vec<PostSighting>,
+}
+
+/// A landmark post in a camera image (ISocRob seed `003` §3.2.1: landmarks told apart by
+/// colour): its outer bands wear the colour of the goal of its half, so the image tells the
+/// half, not which of the half's posts it is.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct PostSighting {
+    /// Distance and bearing of its axis from the robot's centre.
+    pub sighting: Sighting,
+    /// Standard deviations `(distance m, bearing rad)`.
+    pub sigma: (f64, f64),
+    /// It wears the east goal's colour outside (the posts of the east half; see
+    /// `mrt_world::field::FieldMap::east_pattern`).
+    pub east: bool,
+    /// How many pixels it rests on.
+    pub pixels: u32,
 }
 
 /// An RGB image, 8 bits per channel, row by row from the top-left corner (`3·width` bytes a

@@ -8,6 +8,7 @@ use crate::base::Base;
 use mrt_perception::camera::{CameraFile, Pinhole};
 use mrt_perception::mice::MiceOdometry;
 use mrt_perception::vision::colors::ColorTable;
+use mrt_perception::vision::posts::PostShape;
 use mrt_plan::guide::Guidance;
 use mrt_world::{FieldMap, WorldModel};
 use serde::{Deserialize, Serialize};
@@ -59,6 +60,8 @@ pub struct VisionSetup {
     pub camera: Pinhole,
     /// The colour classes.
     pub colors: ColorTable,
+    /// The landmark posts' shape.
+    pub posts: PostShape,
 }
 
 impl RobotConfig {
@@ -192,14 +195,21 @@ pub struct VisionSection {
     pub camera: CameraFile,
     /// The colour classes.
     pub colors: ColorTable,
+    /// The landmark posts' radius, m.
+    pub post_radius: f64,
+    /// The landmark posts' height, m (three bands of equal height).
+    pub post_height: f64,
 }
 
 impl Default for VisionSection {
     fn default() -> Self {
+        let posts = PostShape::default();
         VisionSection {
             enabled: false,
             camera: CameraFile::default(),
             colors: ColorTable::shipped(),
+            post_radius: posts.radius,
+            post_height: posts.height,
         }
     }
 }
@@ -355,7 +365,11 @@ impl RobotFile {
                 let v = &self.vision;
                 let camera = v.camera.camera().map_err(|e| format!("vision.camera: {e}"))?;
                 v.colors.check().map_err(|e| format!("vision.colors: {e}"))?;
-                v.enabled.then(|| VisionSetup { camera, colors: v.colors.clone() })
+                let posts = PostShape {
+                    radius: positive("vision.post_radius", v.post_radius)?,
+                    height: positive("vision.post_height", v.post_height)?,
+                };
+                v.enabled.then(|| VisionSetup { camera, colors: v.colors.clone(), posts })
             },
         })
     }

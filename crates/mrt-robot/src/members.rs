@@ -398,7 +398,9 @@ fn add_cycle(
     };
     let mut ids = vec![agora.add_member(odometry, every), agora.add_member(camera, every)];
     if let Some(v) = &cfg.vision {
-        let agent = VisionAgent::new(v.camera, &v.colors, cfg.ball_radius);
+        let agent = VisionAgent::new(v.camera, &v.colors, cfg.ball_radius)
+            .post_shape(v.posts)
+            .goal_width(cfg.field.goal_width);
         ids.push(agora.add_member(Vision { robot, agent, refused: 0 }, every));
     }
     ids.extend([

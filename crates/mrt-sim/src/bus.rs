@@ -13,7 +13,7 @@ use crate::game::{MatchReport, Pitch};
 use crate::referee::Call;
 use mrt_core::SimClock;
 use mrt_dcdt::{InnerLinkManager, SteppedExecutor};
-use mrt_msgs::MemberFault;
+use mrt_msgs::{Localization, MemberFault};
 use mrt_robot::brain::Brain;
 use mrt_robot::config::RobotConfig;
 use mrt_robot::devices::SharedDevices;
@@ -41,6 +41,32 @@ pub fn book_fault(fault: &MemberFault, pitch: &mut Pitch, robot: usize) {
         fault.count,
         &format!("member {}: {}", fault.name, fault.error),
     );
+}
+
+/// The simulator's observer in each robot's Agora: it books every pose estimate the robot
+/// publishes ([`Localization`]) against where the robot really is
+/// ([`MatchReport::localization`]). It only reads the robot's messages; nothing goes back.
+struct EstimateWatch {
+    pitch: Shared,
+    robot: usize,
+}
+
+impl mrt_dcdt::Member for EstimateWatch {
+    fn init(&mut self, ctx: &mut mrt_dcdt::Context<'_>) -> Result<(), mrt_dcdt::MemberError> {
+        ctx.subscribe_to::<Localization>(mrt_dcdt::RequestType::Local);
+        Ok(())
+    }
+
+    fn do_your_job(
+        &mut self,
+        ctx: &mut mrt_dcdt::Context<'_>,
+    ) -> Result<(), mrt_dcdt::MemberError> {
+        while let Some(m) = ctx.receive_msg() {
+            let estimate = m.get::<Localization>()?.pose.inner;
+            lock_pitch(&self.pitch)?.book_estimate(self.robot, estimate);
+        }
+        Ok(())
+    }
 }
 
 /// A match whose robots are Agoras on the bus.
@@ -126,6 +152,9 @@ impl BusMatch {
                     .map_err(|e| e.to_string())?;
                 let devices = Arc::new(Mutex::new(PitchDevices::new(pitch.clone(), robot)?));
                 add(&mut agora, &robot_cfg, robot, devices)?;
+                let watch = EstimateWatch { pitch: pitch.clone(), robot };
+                let watch = agora.add_member(watch, mrt_dcdt::Activation::OnMessage);
+                agora.activate_member(watch).map_err(|e| e.to_string())?;
                 exec.add_agora(agora).map_err(|e| e.to_string())?;
             }
         }

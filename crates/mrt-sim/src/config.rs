@@ -406,6 +406,8 @@ impl SimConfig {
                 enabled: self.sensor.percepts == PerceptSource::Vision,
                 camera: self.camera.clone(),
                 colors: mrt_perception::vision::colors::ColorTable::shipped(),
+                post_radius: self.render.post_radius,
+                post_height: self.render.post_height,
             },
         }
     }

@@ -11,6 +11,7 @@ use crate::referee::{Call, Referee, Team};
 use crate::render::{CameraState, Renderer, Scene};
 use crate::sensor::{self, sonar_ring, Odometer};
 use crate::world::{Drive, World};
+use mrt_core::{normalize_angle, Pose2};
 use mrt_msgs::robot::{GameState, RobotCommand};
 use mrt_msgs::Sonar;
 use mrt_msgs::{CameraFrame, GameInfo, Odometry};
@@ -75,6 +76,33 @@ pub struct MatchReport {
     pub frames: Vec<Frame>,
     /// Robots whose software failed during the match, by robot.
     pub faults: Vec<RobotFault>,
+    /// How far each robot's own pose estimate was from the truth (every robot's
+    /// `Localization` against where it was; empty when nobody watched).
+    pub localization: LocalizationErrors,
+}
+
+/// The robots' pose estimates against the truth over a match: every robot's position error
+/// (m) and heading error (rad), one sample per published estimate.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct LocalizationErrors {
+    /// Position errors, m.
+    pub position: Vec<f64>,
+    /// Heading errors (absolute), rad.
+    pub heading: Vec<f64>,
+}
+
+impl LocalizationErrors {
+    /// The `q` quantile (nearest rank) of the position errors (m) and of the heading errors
+    /// (rad); `None` without samples.
+    pub fn quantile(&self, q: f64) -> Option<(f64, f64)> {
+        let pick = |v: &[f64]| {
+            let mut v = v.to_vec();
+            v.sort_by(f64::total_cmp);
+            let i = ((v.len().checked_sub(1)?) as f64 * q.clamp(0.0, 1.0)).round() as usize;
+            v.get(i).copied()
+        };
+        Some((pick(&self.position)?, pick(&self.heading)?))
+    }
 }
 
 /// The physical side of a match, whatever drives the robots: the world, the referee, the
@@ -94,6 +122,7 @@ pub struct Pitch {
     frames: Vec<Frame>,
     record: bool,
     faults: Vec<RobotFault>,
+    localization: LocalizationErrors,
     /// Kicks asked this cycle, fired when the physics runs.
     kicks: Vec<usize>,
     /// The cameras' renderer and each robot's camera state, when percepts come from vision.
@@ -149,6 +178,7 @@ impl Pitch {
             frames: Vec::new(),
             record: false,
             faults: Vec::new(),
+            localization: LocalizationErrors::default(),
             kicks: Vec::new(),
             eyes: match cfg.sensor.percepts {
                 PerceptSource::Oracle => None,
@@ -242,6 +272,15 @@ impl Pitch {
         tracing::warn!(robot = i, "robot {i}: {message}");
         self.faults.push(RobotFault { robot: i, first_at, count, message: message.to_string() });
         self.faults.sort_by_key(|f| f.robot);
+    }
+
+    /// Books robot `i`'s own pose estimate against where it is now.
+    pub fn book_estimate(&mut self, i: usize, estimate: Pose2) {
+        if let Some(truth) = self.world.robot(i) {
+            let l = &mut self.localization;
+            l.position.push((estimate.x - truth.x).hypot(estimate.y - truth.y));
+            l.heading.push(normalize_angle(estimate.theta - truth.theta).abs());
+        }
     }
 
     /// The robots' base (kinematics and wheel limits).
@@ -351,6 +390,7 @@ impl Pitch {
             shots: self.shots,
             frames: self.frames,
             faults: self.faults,
+            localization: self.localization,
         }
     }
 }

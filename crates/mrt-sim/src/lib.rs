@@ -33,6 +33,7 @@ pub mod remote;
 pub mod render;
 pub mod sensor;
 pub mod soak;
+pub mod survey;
 pub mod world;
 
 use mrt_robot::stacks::Stack;

@@ -660,7 +660,7 @@ fn fixed_things(map: &FieldMap, cfg: &SimConfig) -> Vec<Thing> {
     let (r, top) = (cfg.render.post_radius, cfg.render.post_height);
     for k in 3..mrt_msgs::FIELD_OBJECTS {
         let Some(p) = map.object(k) else { continue };
-        let (outer, inner) = if p.x >= 0.0 {
+        let (outer, inner) = if map.east_pattern(k) == Some(true) {
             (palette::YELLOW, palette::BLUE)
         } else {
             (palette::BLUE, palette::YELLOW)

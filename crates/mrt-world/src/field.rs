@@ -100,6 +100,19 @@ impl FieldMap {
         Some(Point2::new(at.0, at.1))
     }
 
+    /// Whether landmark post `k` wears the east goal's colour in its outer bands and the west
+    /// goal's in the middle one (ISocRob seed `003` §3.2.1: the landmarks are told apart by
+    /// colour). The posts of the east half do, and, a choice of this map, those at the ends
+    /// of the half-way line; the west half's wear the colours the other way round. A camera
+    /// tells the pattern, not which post of its pattern it sees. `None` for the ball, the
+    /// nets and past the last object.
+    pub fn east_pattern(&self, k: usize) -> Option<bool> {
+        if k <= WEST_NET {
+            return None;
+        }
+        self.object(k).map(|p| p.x >= 0.0)
+    }
+
     /// The field lines: the boundary (two touch lines, two goal lines), the half-way line and
     /// the three lines of each penalty area. The centre circle is [`FieldMap::centre_circle_radius`]
     /// around the origin.
@@ -140,6 +153,15 @@ pub const MAP_OBJECTS: usize = FIELD_OBJECTS - 1;
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_posts_wear_the_pattern_of_their_half() {
+        let map = FieldMap::default();
+        let east: Vec<Option<bool>> = (0..=FIELD_OBJECTS).map(|k| map.east_pattern(k)).collect();
+        let (y, n) = (Some(true), Some(false));
+        // ball, nets; NE, SE, NW, SW, the half-way line's N and S ends; past the end.
+        assert_eq!(east, [None, None, None, y, y, n, n, y, y, None]);
+    }
 
     #[test]
     fn the_landmarks_of_the_default_field() {

@@ -28,11 +28,26 @@ use crate::field::FieldMap;
 use mrt_core::frames::{Attack, Field, Framed, Team, MM_PER_M};
 use mrt_core::{normalize_angle, Point2, Pose2, Time, Vec2};
 use mrt_msgs::robot::{lps, Estimate, Lpo, WorldSnapshot};
-use mrt_msgs::{CameraFrame, GameInfo, Localization, Odometry, Percepts, Sighting, FIELD_OBJECTS};
+use mrt_msgs::{
+    CameraFrame, GameInfo, Localization, Odometry, Percepts, PostSighting, Sighting, FIELD_OBJECTS,
+};
 use mrt_perception::mice::{Displacement, MiceOdometry, MiceReadings};
 use mrt_perception::PerceptionError;
 use nalgebra::{Matrix2, Matrix2x3, Matrix3, Vector2, Vector3};
 use std::f64::consts::PI;
+
+/// A post is named only when the next best landmark of its pattern fits this many times
+/// worse (squared Mahalanobis distances).
+pub const AMBIGUITY: f64 = 9.0;
+
+/// The EKF's view of one sighting ([`WorldModel::innovation`]).
+struct Innovation {
+    h: Matrix2x3<f64>,
+    nu: Vector2<f64>,
+    s_inv: Matrix2<f64>,
+    r: Matrix2<f64>,
+    d2: f64,
+}
 
 /// Reliability kept per control cycle by an object that was not seen again.
 pub const DECAY: f64 = 0.85;
@@ -242,17 +257,24 @@ impl WorldModel {
         self.map.object(k).map(|p| (p.x, p.y))
     }
 
-    /// The EKF correction by one sighting of a landmark at `at`. Returns whether it was
-    /// accepted (not gated out).
-    fn correct(&mut self, at: (f64, f64), z: &Sighting, sigma: Option<(f64, f64)>) -> bool {
+    /// The EKF's view of one sighting `z` of a landmark at `at` with the sensor's own
+    /// standard deviations `sigma` (where known): the measurement Jacobian, the innovation, its
+    /// covariance's inverse, the measurement noise and the squared Mahalanobis distance.
+    /// `None` when the landmark is too close to linearise or the numbers are not finite.
+    fn innovation(
+        &self,
+        at: (f64, f64),
+        z: &Sighting,
+        sigma: Option<(f64, f64)>,
+    ) -> Option<Innovation> {
         let (dx, dy) = (at.0 - self.pose.x, at.1 - self.pose.y);
         let q = dx * dx + dy * dy;
         let rho = q.sqrt();
         if rho < 0.3 || !(z.distance.is_finite() && z.bearing.is_finite()) {
-            return true; // too close to linearise; nothing learnt, nothing wrong
+            return None;
         }
         let h = Matrix2x3::new(-dx / rho, -dy / rho, 0.0, dy / q, -dx / q, -1.0);
-        let innovation = Vector2::new(
+        let nu = Vector2::new(
             z.distance - rho,
             normalize_angle(z.bearing - (dy.atan2(dx) - self.pose.theta)),
         );
@@ -264,13 +286,22 @@ impl WorldModel {
             (sd, sb) = (sd.max(d), sb.max(b));
         }
         let r = Matrix2::new(sd * sd, 0.0, 0.0, sb * sb);
-        let s = h * self.cov * h.transpose() + r;
-        let Some(s_inv) = s.try_inverse() else { return false };
-        if (innovation.transpose() * s_inv * innovation)[(0, 0)] > GATE {
+        let s_inv = (h * self.cov * h.transpose() + r).try_inverse()?;
+        let d2 = (nu.transpose() * s_inv * nu)[(0, 0)];
+        d2.is_finite().then_some(Innovation { h, nu, s_inv, r, d2 })
+    }
+
+    /// The EKF correction by one sighting of a landmark at `at`. Returns whether it was
+    /// accepted (not gated out).
+    fn correct(&mut self, at: (f64, f64), z: &Sighting, sigma: Option<(f64, f64)>) -> bool {
+        let Some(Innovation { h, nu, s_inv, r, d2 }) = self.innovation(at, z, sigma) else {
+            return true; // too close to linearise; nothing learnt, nothing wrong
+        };
+        if d2 > GATE {
             return false;
         }
         let k = self.cov * h.transpose() * s_inv;
-        let step = k * innovation;
+        let step = k * nu;
         self.pose = Pose2::new(
             self.pose.x + step[0],
             self.pose.y + step[1],
@@ -280,6 +311,25 @@ impl WorldModel {
         let i_kh = Matrix3::identity() - k * h;
         self.cov = i_kh * self.cov * i_kh.transpose() + k * r * k.transpose();
         true
+    }
+
+    /// Which landmark a post of the vision is (data association): of the posts wearing its
+    /// pattern ([`FieldMap::east_pattern`]), the one its sighting fits best by the squared
+    /// Mahalanobis distance, when that fit passes the [`GATE`] and the second best fits
+    /// [`AMBIGUITY`] times worse or fails the gate. A robot unsure where it is leaves its
+    /// posts unnamed (the nets, unique, put it right first).
+    fn associate(&self, post: &PostSighting) -> Option<usize> {
+        let mut fits: Vec<(usize, f64)> = (lps::LANDMARK0..FIELD_OBJECTS)
+            .filter(|&k| self.map.east_pattern(k) == Some(post.east))
+            .filter_map(|k| {
+                let at = self.landmark(k)?;
+                Some((k, self.innovation(at, &post.sighting, Some(post.sigma))?.d2))
+            })
+            .collect();
+        fits.sort_by(|a, b| a.1.total_cmp(&b.1));
+        let (best, d2) = *fits.first()?;
+        let clear = fits.get(1).is_none_or(|&(_, next)| next > GATE || next > AMBIGUITY * d2);
+        (d2 <= GATE && clear).then_some(best)
     }
 
     /// One camera frame: the nets and landmarks correct the pose, every sighting refreshes the
@@ -325,6 +375,19 @@ impl WorldModel {
     /// Call after this cycle's [`WorldModel::odometry`].
     pub fn percepts(&mut self, p: &Percepts) -> WorldSnapshot {
         let mut frame = CameraFrame { time: p.time, sightings: p.sightings, ..Default::default() };
+        let mut sigmas = p.sigmas;
+        // The posts, named by where the robot believes it is; a landmark claimed by two posts
+        // is left out (one of them is wrong).
+        let mut named = [0u8; FIELD_OBJECTS];
+        let names: Vec<Option<usize>> = p.posts.iter().map(|post| self.associate(post)).collect();
+        names.iter().flatten().for_each(|&k| named[k] += 1);
+        for (post, k) in p.posts.iter().zip(names) {
+            if let Some(k) = k.filter(|&k| named[k] == 1 && frame.sightings[k].is_none()) {
+                frame.sightings[k] = Some(post.sighting);
+                sigmas[k] = Some(post.sigma);
+                self.counts.posts_named += 1;
+            }
+        }
         if let Some(z) = p.sightings[lps::BALL] {
             let at = Framed::<Field, _>::new(self.pose).at_range_bearing(z.distance, z.bearing);
             let velocity = match self.ball_track {
@@ -342,7 +405,7 @@ impl WorldModel {
             let (vx, vy) = velocity;
             frame.ball_velocity = Some((c * vx + s * vy, -s * vx + c * vy));
         }
-        self.observe(&frame, &p.sigmas)
+        self.observe(&frame, &sigmas)
     }
 
     /// Corrects the pose with every net and landmark of `frame`. Returns how many were seen
@@ -608,5 +671,47 @@ mod tests {
         assert!((ball.reliability - DECAY).abs() < 1e-12);
         assert!((ball.rho - 5f64.sqrt() * 1000.0).abs() < 0.01, "{ball:?}");
         assert!((ball.seen_ago - 0.1).abs() < 1e-9);
+    }
+
+    /// The vision's posts carry their half's pattern only: a robot that knows where it is
+    /// names each by the nearest landmark of that pattern and corrects its pose with it; a
+    /// robot that does not know where it is names none.
+    #[test]
+    fn posts_are_named_by_where_the_robot_believes_it_is() {
+        let map = FieldMap::default();
+        let truth = Pose2::new(6.0, 3.0, 0.6);
+        // Looking north-east: the NE corner post (3) and the half-way line's north end (7)
+        // wear the east pattern; the robot believes it is 0.2 m and 0.03 rad off.
+        let post = |k: usize, east: bool| {
+            let at = map.object(k).unwrap();
+            let f = frame(truth, 1.0, &[(k, (at.x, at.y))]);
+            PostSighting {
+                sighting: f.sightings[k].unwrap(),
+                sigma: (0.05, 0.01),
+                east,
+                pixels: 40,
+            }
+        };
+        let mut m = model();
+        m.place(Framed::new(Pose2::new(6.2, 2.9, 0.63)));
+        let p =
+            Percepts { time: 1.0, posts: vec![post(3, true), post(7, true)], ..Default::default() };
+        m.percepts(&p);
+        assert_eq!(m.counts().posts_named, 2);
+        assert_eq!(m.counts().corrections, 2);
+        // Closer than the 0.22 m it was put down off.
+        let e = m.pose().inner;
+        assert!((e.x - truth.x).hypot(e.y - truth.y) < 0.2, "{e:?}");
+        // The same sighting with the west pattern fits no west post: not named.
+        let mut m = model();
+        m.place(Framed::new(Pose2::new(6.2, 2.9, 0.63)));
+        let p = Percepts { time: 1.0, posts: vec![post(3, false)], ..Default::default() };
+        m.percepts(&p);
+        assert_eq!(m.counts().posts_named, 0);
+        // A robot that was never put down (10 m of uncertainty): every east post fits.
+        let mut m = model();
+        let p = Percepts { time: 1.0, posts: vec![post(3, true)], ..Default::default() };
+        m.percepts(&p);
+        assert_eq!((m.counts().posts_named, m.counts().corrections), (0, 0));
     }
 }

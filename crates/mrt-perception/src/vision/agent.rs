@@ -5,15 +5,19 @@
 //! The nets of the world model's sightings ([`mrt_msgs::CameraFrame::sightings`]) are the
 //! centres of the goal lines. The goal's outermost columns whose lowest goal pixel has carpet
 //! right below it are the feet of its posts (or of a back corner, seen obliquely); the net is
-//! the middle of those two floor points. Which colour is the east goal is the field's, not the
-//! camera's: [`VisionAgent::east_goal`] (yellow by default, as the simulator paints it).
+//! the middle of those two floor points, when they are about a goal's width apart. Which colour is the east goal is the field's, not the
+//! camera's: [`VisionAgent::east_goal`] (yellow by default, as the simulator paints it). A goal
+//! that touches the image's side is not reported (where its far end stands is unknown), and
+//! the columns of the landmark posts ([`super::posts`]), whose bands wear the goal colours,
+//! do not count as goal.
 
 use super::blobs::find_ball;
 use super::colors::{ColorClass, ColorTable, Lut};
 use super::goals::projections;
 use super::lines::line_points;
+use super::posts::{find_posts, PostPercept, PostShape};
 use crate::camera::{Camera, Pinhole, Pixel};
-use mrt_msgs::{Image, Percepts, Sighting};
+use mrt_msgs::{Image, Percepts, PostSighting, Sighting};
 use nalgebra::{Point2, Vector2};
 
 /// Sighting index of the ball, the east and the west net (the world model's order).
@@ -27,6 +31,8 @@ pub const MIN_GOAL_PIXELS: u32 = 30;
 pub const OBSTACLE_STEP: usize = 4;
 /// Robot pixels in a row, up a column, that make a robot's foot.
 pub const OBSTACLE_MIN_RUN: usize = 3;
+/// Neighbouring obstacle feet closer than this on the floor are one robot, m.
+pub const SAME_ROBOT: f64 = 0.4;
 /// Field-line scan lines: every this many columns.
 pub const LINE_STEP: usize = 8;
 /// The longest white run that is a line, pixels.
@@ -58,6 +64,8 @@ pub struct VisionAgent {
     lut: Lut,
     ball_radius: f64,
     east_goal: ColorClass,
+    posts: PostShape,
+    goal_width: f64,
     classes: Vec<u8>,
 }
 
@@ -70,6 +78,8 @@ impl VisionAgent {
             lut: Lut::new(colors),
             ball_radius,
             east_goal: ColorClass::GoalYellow,
+            posts: PostShape::default(),
+            goal_width: 2.0,
             classes: Vec::new(),
         }
     }
@@ -77,6 +87,18 @@ impl VisionAgent {
     /// The colour of the east goal (the other goal colour is the west's).
     pub fn east_goal(mut self, colour: ColorClass) -> VisionAgent {
         self.east_goal = colour;
+        self
+    }
+
+    /// The landmark posts' shape (0.1 m radius, 0.8 m high by default).
+    pub fn post_shape(mut self, shape: PostShape) -> VisionAgent {
+        self.posts = shape;
+        self
+    }
+
+    /// The goals' inner width, m (2 m by default, the Middle Size League's of the seeds' time).
+    pub fn goal_width(mut self, width: f64) -> VisionAgent {
+        self.goal_width = width;
         self
     }
 
@@ -116,8 +138,9 @@ impl VisionAgent {
         } else {
             ColorClass::GoalYellow
         };
+        let posts = find_posts(&self.classes, &self.camera, self.posts);
         for (k, class) in [(EAST_NET, self.east_goal), (WEST_NET, west)] {
-            if let Some((at, foot, pixels)) = self.net(class) {
+            if let Some((at, foot, pixels)) = self.net(class, &posts) {
                 p.sightings[k] = Some(sighting(at));
                 p.sigmas[k] = self.sigma(foot, 1.0);
                 p.pixels[k] = pixels;
@@ -128,18 +151,46 @@ impl VisionAgent {
             .map(|l| (l.at.x, l.at.y))
             .collect();
         p.obstacles = self.obstacles();
+        p.posts = posts
+            .iter()
+            .filter_map(|post| {
+                Some(PostSighting {
+                    sighting: sighting(post.at),
+                    sigma: self
+                        .sigma(post.pixel, if post.foot { 1.0 } else { self.boundary_scale() })?,
+                    east: post.outer == self.east_goal,
+                    pixels: post.pixels,
+                })
+            })
+            .collect();
         Ok(p)
     }
 
+    /// A distance measured at the posts' lower band boundary is this many times as uncertain
+    /// as one measured on the floor at the same pixel (the boundary's plane is nearer the
+    /// camera's height).
+    fn boundary_scale(&self) -> f64 {
+        let h = self.camera.height;
+        h / (h - self.posts.height / 3.0).abs().max(0.05)
+    }
+
     /// The net of the goal of `class`: the middle of its outermost columns' floor points, one
-    /// of those feet's pixels, and the goal's pixel count.
-    fn net(&self, class: ColorClass) -> Option<(Point2<f64>, Pixel, u32)> {
+    /// of those feet's pixels, and the goal's pixel count; `posts`' columns do not count.
+    fn net(&self, class: ColorClass, posts: &[PostPercept]) -> Option<(Point2<f64>, Pixel, u32)> {
         let (w, h) = self.camera.size();
         let (w, h) = (w as usize, h as usize);
         let want = class as u8;
-        let (count, _) = projections(&self.classes, w as u32, h as u32, class);
+        let (mut count, _) = projections(&self.classes, w as u32, h as u32, class);
+        for post in posts {
+            // The cylinder's shaded edges may not pass as a post's columns: a margin.
+            let margin = 2 + (post.columns.1 - post.columns.0) / 4;
+            let (a, b) =
+                (post.columns.0.saturating_sub(margin), (post.columns.1 + margin).min(w - 1));
+            count[a..=b].iter_mut().for_each(|c| *c = 0);
+        }
         let pixels: u32 = count.iter().sum();
-        if pixels < MIN_GOAL_PIXELS {
+        // Too little of it, or cut by the image's side: where its far end is is unknown.
+        if pixels < MIN_GOAL_PIXELS || count[0] > 0 || count[w - 1] > 0 {
             return None;
         }
         // The outermost columns where the goal stands on the carpet: its lowest pixel there
@@ -161,12 +212,19 @@ impl VisionAgent {
         };
         let (pl, l) = (0..w).find_map(foot)?;
         let (_, r) = (0..w).rev().find_map(foot)?;
+        // The two feet are the goal's posts (or a post and a back corner): as far apart as
+        // the goal is wide, give or take its depth. Anything else is not the whole goal.
+        let apart = (l - r).norm();
+        if !(0.5 * self.goal_width..=1.5 * self.goal_width).contains(&apart) {
+            return None;
+        }
         Some((Point2::from((l.coords + r.coords) / 2.0), pl, pixels))
     }
 
     /// Other robots: scanning every [`OBSTACLE_STEP`]-th column from the bottom up over the
     /// carpet, the first run of robot pixels is a robot's foot; neighbouring columns whose
-    /// feet are within a few rows of each other are one robot, seen at its lowest foot.
+    /// feet are within [`SAME_ROBOT`] of each other on the floor are one robot, seen at its
+    /// lowest foot.
     /// (Cheaper than labelling the dark blobs, which are large, and it gives the foot.)
     fn obstacles(&self) -> Vec<Sighting> {
         let (w, h) = self.camera.size();
@@ -191,29 +249,46 @@ impl VisionAgent {
             }
             (col, None)
         });
+        // Groups of neighbouring feet: first column, last column, lowest foot row, and the
+        // floor point of the last foot.
+        let mut groups: Vec<(usize, usize, usize, Point2<f64>)> = Vec::new();
+        for (col, foot) in feet {
+            let Some(f) = foot else { continue };
+            let Some(at) = self.camera.unproject(Pixel::new(col as f64 + 0.5, f as f64 + 1.0))
+            else {
+                continue;
+            };
+            match groups.last_mut() {
+                // Neighbouring feet on the floor within a robot's size of each other: one
+                // robot (the bottom of a near robot's body curves over many rows).
+                Some(g) if col - g.1 <= OBSTACLE_STEP && (at - g.3).norm() <= SAME_ROBOT => {
+                    *g = (g.0, col, g.2.max(f), at);
+                }
+                _ => groups.push((col, col, f, at)),
+            }
+        }
+        // A narrow group right beside a nearer one is the nearer robot's slanted side (a
+        // tilted camera leans vertical edges outwards), its "foot" high up on the body.
+        let beside_nearer = |i: usize| {
+            let (a, b, r, _) = groups[i];
+            let near = |j: Option<usize>| {
+                j.and_then(|j| groups.get(j)).is_some_and(
+                    |n: &(usize, usize, usize, Point2<f64>)| {
+                        (n.1 + OBSTACLE_STEP == a || b + OBSTACLE_STEP == n.0) && n.2 > r
+                    },
+                )
+            };
+            b - a <= OBSTACLE_STEP && (near(i.checked_sub(1)) || near(Some(i + 1)))
+        };
         let mut out = Vec::new();
-        let mut group: Option<(usize, usize, usize)> = None; // first column, last column, lowest row
-        let flush = |g: (usize, usize, usize), out: &mut Vec<Sighting>| {
+        for (i, g) in groups.iter().enumerate() {
+            if beside_nearer(i) {
+                continue;
+            }
             let px = Pixel::new((g.0 + g.1) as f64 / 2.0 + 0.5, g.2 as f64 + 1.0);
             if let Some(at) = self.camera.unproject(px) {
                 out.push(sighting(at));
             }
-        };
-        for (col, foot) in feet {
-            group = match (group, foot) {
-                (Some((a, b, r)), Some(f)) if col - b <= OBSTACLE_STEP && r.abs_diff(f) <= 8 => {
-                    Some((a, col, r.max(f)))
-                }
-                (g, foot) => {
-                    if let Some(g) = g {
-                        flush(g, &mut out);
-                    }
-                    foot.map(|f| (col, col, f))
-                }
-            };
-        }
-        if let Some(g) = group {
-            flush(g, &mut out);
         }
         out
     }

@@ -1,6 +1,7 @@
 //! Colour vision (ISocRob seed `003` §3.2.1, the vision µAgent): pixels classified by a colour
 //! lookup table built from HSV thresholds ([`colors`]); blobs and the ball ([`blobs`]), goals with
-//! their nearest point and open space ([`goals`]), field-line points ([`lines`]) build on it;
+//! their nearest point and open space ([`goals`]), field-line points ([`lines`]) and the landmark posts ([`posts`])
+//! build on it;
 //! [`agent`] puts them together into the µAgent: one image in, the percepts out; [`calibrate`]
 //! helps a person tune the thresholds.
 
@@ -10,3 +11,4 @@ pub mod calibrate;
 pub mod colors;
 pub mod goals;
 pub mod lines;
+pub mod posts;
