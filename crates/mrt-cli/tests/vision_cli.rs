@@ -267,3 +267,36 @@ fn calibrate_reports_what_each_class_takes() {
     assert!(String::from_utf8_lossy(&out.stderr).contains("/nonexistent/colors.toml"));
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// `mrt vision survey`: the table of the vision against the truth, and its JSON, whose counts
+/// agree with each other; a count of 0 scenes is refused.
+#[test]
+fn survey_prints_the_vision_against_the_truth() {
+    let run = |args: &[&str]| {
+        let out = Command::new(env!("CARGO_BIN_EXE_mrt"))
+            .args(["vision", "survey"])
+            .args(args)
+            .output()
+            .unwrap();
+        (
+            out.status.success(),
+            String::from_utf8_lossy(&out.stdout).to_string(),
+            String::from_utf8_lossy(&out.stderr).to_string(),
+        )
+    };
+    let (ok, table, err) = run(&["--scenes", "40", "--seed", "5"]);
+    assert!(ok, "{err}");
+    assert!(table.starts_with("40 scenes, seed 5"), "{table}");
+    for kind in ["| ball |", "| net |", "| post |", "| obstacle |"] {
+        assert!(table.contains(kind), "{kind} in {table}");
+    }
+    let (ok, json, err) = run(&["--scenes", "40", "--seed", "5", "--json"]);
+    assert!(ok, "{err}");
+    let v: serde_json::Value = serde_json::from_str(&json).unwrap();
+    let ball = &v["kinds"][0];
+    assert_eq!(ball["kind"], "ball");
+    assert!(ball["found"].as_u64().unwrap() <= ball["in_view"].as_u64().unwrap());
+    assert!(ball["in_view"].as_u64().unwrap() > 5, "{json}");
+    let (ok, _, err) = run(&["--scenes", "0"]);
+    assert!(!ok && err.contains("--scenes"), "{err}");
+}

@@ -13,7 +13,7 @@
 
 use super::blobs::find_ball;
 use super::colors::{ColorClass, ColorTable, Lut};
-use super::goals::projections;
+use super::goals::goal_columns;
 use super::lines::line_points;
 use super::posts::{find_posts, PostPercept, PostShape};
 use crate::camera::{Camera, Pinhole, Pixel};
@@ -139,8 +139,13 @@ impl VisionAgent {
             ColorClass::GoalYellow
         };
         let posts = find_posts(&self.classes, &self.camera, self.posts);
-        for (k, class) in [(EAST_NET, self.east_goal), (WEST_NET, west)] {
-            if let Some((at, foot, pixels)) = self.net(class, &posts) {
+        let [yellow, blue] = goal_columns(&self.classes, w, h);
+        let (east_count, west_count) =
+            if self.east_goal == ColorClass::GoalYellow { (yellow, blue) } else { (blue, yellow) };
+        for (k, class, count) in
+            [(EAST_NET, self.east_goal, east_count), (WEST_NET, west, west_count)]
+        {
+            if let Some((at, foot, pixels)) = self.net(class, count, &posts) {
                 p.sightings[k] = Some(sighting(at));
                 p.sigmas[k] = self.sigma(foot, 1.0);
                 p.pixels[k] = pixels;
@@ -176,11 +181,16 @@ impl VisionAgent {
 
     /// The net of the goal of `class`: the middle of its outermost columns' floor points, one
     /// of those feet's pixels, and the goal's pixel count; `posts`' columns do not count.
-    fn net(&self, class: ColorClass, posts: &[PostPercept]) -> Option<(Point2<f64>, Pixel, u32)> {
+    /// `count` holds the goal's column counts (eq. 16).
+    fn net(
+        &self,
+        class: ColorClass,
+        mut count: Vec<u32>,
+        posts: &[PostPercept],
+    ) -> Option<(Point2<f64>, Pixel, u32)> {
         let (w, h) = self.camera.size();
         let (w, h) = (w as usize, h as usize);
         let want = class as u8;
-        let (mut count, _) = projections(&self.classes, w as u32, h as u32, class);
         for post in posts {
             // The cylinder's shaded edges may not pass as a post's columns: a margin.
             let margin = 2 + (post.columns.1 - post.columns.0) / 4;

@@ -41,6 +41,24 @@ pub fn projections(
     (cols, rows)
 }
 
+/// The column counts (eq. 16) of both goal colours, yellow then blue, in one pass over a
+/// `width × height` class map; empty when the sizes do not fit the map.
+pub fn goal_columns(classes: &[u8], width: u32, height: u32) -> [Vec<u32>; 2] {
+    let (w, h) = (width as usize, height as usize);
+    if w == 0 || h == 0 || classes.len() < w.saturating_mul(h) {
+        return [Vec::new(), Vec::new()];
+    }
+    let (yellow, blue) = (ColorClass::GoalYellow as u8, ColorClass::GoalBlue as u8);
+    let (mut ys, mut bs) = (vec![0u32; w], vec![0u32; w]);
+    for row in classes.chunks_exact(w).take(h) {
+        for ((y, b), &c) in ys.iter_mut().zip(bs.iter_mut()).zip(row) {
+            *y += u32::from(c == yellow);
+            *b += u32::from(c == blue);
+        }
+    }
+    [ys, bs]
+}
+
 /// The nearest point's row: the last row (bottom-most in the image) whose count exceeds `t_p`.
 pub fn nearest_row(rows: &[u32], t_p: u32) -> Option<usize> {
     rows.iter().rposition(|&n| n > t_p)
@@ -137,6 +155,17 @@ mod tests {
 
     /// The research notes' vector (§5): p_h = [0,0,3,5,5,0,0,4,6,6,6,2], T_o = 1: windowed sums
     /// [0,3,8,13,10,5,4,10,16,18,14,8], x_o = 9.
+    #[test]
+    fn both_goal_colours_are_counted_in_one_pass_as_each_alone() {
+        let (w, h) = (7u32, 5u32);
+        let map: Vec<u8> = (0..w * h).map(|i| (i * 7 % 5) as u8).collect();
+        let [y, b] = goal_columns(&map, w, h);
+        assert_eq!(y, projections(&map, w, h, ColorClass::GoalYellow).0);
+        assert_eq!(b, projections(&map, w, h, ColorClass::GoalBlue).0);
+        assert!(y.iter().sum::<u32>() > 0 && b.iter().sum::<u32>() > 0);
+        assert!(goal_columns(&map, w, h + 1).iter().all(Vec::is_empty));
+    }
+
     #[test]
     fn open_space_by_the_research_vector() {
         let p_h = [0, 0, 3, 5, 5, 0, 0, 4, 6, 6, 6, 2];

@@ -146,11 +146,20 @@ pub fn find_posts(classes: &[u8], camera: &Pinhole, shape: PostShape) -> Vec<Pos
     if w == 0 || h == 0 || classes.len() < w.saturating_mul(h) {
         return Vec::new();
     }
+    // Only columns holding both goal colours can cross a post: found in one pass along the
+    // rows (the column scans below read across cache lines).
+    let (yellow, blue) = (ColorClass::GoalYellow as u8, ColorClass::GoalBlue as u8);
+    let mut colours = vec![0u8; w];
+    for row in classes.chunks_exact(w).take(h) {
+        for (seen, &c) in colours.iter_mut().zip(row) {
+            *seen |= u8::from(c == yellow) | (u8::from(c == blue) << 1);
+        }
+    }
     let mut buf = Vec::new();
     let mut out = Vec::new();
     let mut group: Vec<Cut> = Vec::new();
     for col in 0..=w {
-        let c = if col < w {
+        let c = if colours.get(col) == Some(&3) {
             runs(classes, w, h, col, &mut buf);
             cut(classes, w, h, col, &buf)
         } else {
