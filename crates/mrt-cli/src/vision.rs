@@ -108,6 +108,18 @@ fn detect_one(
     let mut classes = vec![0u8; (w * h) as usize];
     lut.classify(&img.rgb, &mut classes);
     let ball = find_ball(&classes, camera, ball_radius);
+    let posts = find_posts(&classes, camera, PostShape::default());
+    // The posts' bands wear the goal colours: the goals are looked for without them.
+    let mut goal_classes = classes.clone();
+    for p in &posts {
+        for row in goal_classes.chunks_exact_mut(w as usize) {
+            for c in &mut row[p.masked_columns(w as usize)] {
+                if *c == ColorClass::GoalYellow as u8 || *c == ColorClass::GoalBlue as u8 {
+                    *c = ColorClass::Unknown as u8;
+                }
+            }
+        }
+    }
     let mut objects = Vec::new();
     if let Some(b) = ball {
         objects.push(serde_json::json!({
@@ -119,7 +131,7 @@ fn detect_one(
         }));
     }
     for class in [ColorClass::GoalYellow, ColorClass::GoalBlue] {
-        if let Some(g) = find_goal(&classes, camera, class, 20, 0) {
+        if let Some(g) = find_goal(&goal_classes, camera, class, 20, 0) {
             objects.push(serde_json::json!({
                 "class": class.name(),
                 "pixel": [round3(g.nearest.x), round3(g.nearest.y)],
@@ -129,7 +141,6 @@ fn detect_one(
             }));
         }
     }
-    let posts = find_posts(&classes, camera, PostShape::default());
     for p in &posts {
         objects.push(serde_json::json!({
             "class": "post",

@@ -192,11 +192,7 @@ impl VisionAgent {
         let (w, h) = (w as usize, h as usize);
         let want = class as u8;
         for post in posts {
-            // The cylinder's shaded edges may not pass as a post's columns: a margin.
-            let margin = 2 + (post.columns.1 - post.columns.0) / 4;
-            let (a, b) =
-                (post.columns.0.saturating_sub(margin), (post.columns.1 + margin).min(w - 1));
-            count[a..=b].iter_mut().for_each(|c| *c = 0);
+            count[post.masked_columns(w)].iter_mut().for_each(|c| *c = 0);
         }
         let pixels: u32 = count.iter().sum();
         // Too little of it, or cut by the image's side: where its far end is is unknown.

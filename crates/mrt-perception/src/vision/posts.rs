@@ -60,6 +60,17 @@ pub struct PostPercept {
     pub pixels: u32,
 }
 
+impl PostPercept {
+    /// The image columns whose goal colours belong to this post: its own and a margin for
+    /// the cylinder's shaded, slanted edges, which may not pass as a post's columns. Goal
+    /// finding leaves them out. `width`: the image's.
+    pub fn masked_columns(&self, width: usize) -> std::ops::RangeInclusive<usize> {
+        let margin = 2 + (self.columns.1 - self.columns.0) / 4;
+        self.columns.0.saturating_sub(margin)
+            ..=(self.columns.1 + margin).min(width.saturating_sub(1))
+    }
+}
+
 /// What one column shows of a post.
 #[derive(Clone, Copy, Debug)]
 struct Cut {
