@@ -5,17 +5,17 @@
 //! The nets of the world model's sightings ([`mrt_msgs::CameraFrame::sightings`]) are the
 //! centres of the goal lines. The goal's outermost columns whose lowest goal pixel has carpet
 //! right below it are the feet of its posts (or of a back corner, seen obliquely); the net is
-//! the middle of those two floor points, when they are about a goal's width apart. Which colour is the east goal is the field's, not the
-//! camera's: [`VisionAgent::east_goal`] (yellow by default, as the simulator paints it). A goal
-//! that touches the image's side is not reported (where its far end stands is unknown), and
-//! the columns of the landmark posts ([`super::posts`]), whose bands wear the goal colours,
-//! do not count as goal.
+//! the middle of those two floor points, when they are about a goal's width apart. Which colour
+//! is the east goal is the field's, not the camera's: [`VisionAgent::east_goal`] (yellow by
+//! default, as the simulator paints it). A goal that touches the image's side is not reported
+//! (where its far end stands is unknown), and the columns of the landmark posts
+//! ([`super::posts`]), whose bands wear the goal colours, do not count as goal.
 
 use super::blobs::find_ball;
 use super::colors::{ColorClass, ColorTable, Lut};
 use super::goals::goal_columns;
 use super::lines::line_points;
-use super::posts::{find_posts, PostPercept, PostShape};
+use super::posts::{find_posts_in, PostPercept, PostShape};
 use crate::camera::{Camera, Pinhole, Pixel};
 use mrt_msgs::{Image, Percepts, PostSighting, Sighting};
 use nalgebra::{Point2, Vector2};
@@ -138,8 +138,9 @@ impl VisionAgent {
         } else {
             ColorClass::GoalYellow
         };
-        let posts = find_posts(&self.classes, &self.camera, self.posts);
-        let [yellow, blue] = goal_columns(&self.classes, w, h);
+        let columns = goal_columns(&self.classes, w, h);
+        let posts = find_posts_in(&self.classes, &self.camera, self.posts, &columns);
+        let [yellow, blue] = columns;
         let (east_count, west_count) =
             if self.east_goal == ColorClass::GoalYellow { (yellow, blue) } else { (blue, yellow) };
         for (k, class, count) in

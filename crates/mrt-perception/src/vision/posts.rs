@@ -17,6 +17,7 @@
 //! believes it is).
 
 use super::colors::ColorClass;
+use super::goals::goal_columns;
 use crate::camera::{Camera, Pinhole, Pixel};
 use nalgebra::Point2;
 
@@ -153,24 +154,31 @@ fn cut(classes: &[u8], w: usize, h: usize, col: usize, runs: &[Run]) -> Option<C
 /// The landmark posts in a class map seen by `camera` (module doc).
 pub fn find_posts(classes: &[u8], camera: &Pinhole, shape: PostShape) -> Vec<PostPercept> {
     let (w, h) = camera.size();
+    find_posts_in(classes, camera, shape, &goal_columns(classes, w, h))
+}
+
+/// [`find_posts`] with the class map's goal column counts ([`goal_columns`]) already taken,
+/// as the vision µAgent has them for the goals: only columns holding both goal colours can
+/// cross a post, and only those are scanned (a column scan reads across cache lines).
+pub fn find_posts_in(
+    classes: &[u8],
+    camera: &Pinhole,
+    shape: PostShape,
+    [yellow, blue]: &[Vec<u32>; 2],
+) -> Vec<PostPercept> {
+    let (w, h) = camera.size();
     let (w, h) = (w as usize, h as usize);
     if w == 0 || h == 0 || classes.len() < w.saturating_mul(h) {
         return Vec::new();
     }
-    // Only columns holding both goal colours can cross a post: found in one pass along the
-    // rows (the column scans below read across cache lines).
-    let (yellow, blue) = (ColorClass::GoalYellow as u8, ColorClass::GoalBlue as u8);
-    let mut colours = vec![0u8; w];
-    for row in classes.chunks_exact(w).take(h) {
-        for (seen, &c) in colours.iter_mut().zip(row) {
-            *seen |= u8::from(c == yellow) | (u8::from(c == blue) << 1);
-        }
-    }
+    let both = |col: usize| {
+        yellow.get(col).is_some_and(|&n| n > 0) && blue.get(col).is_some_and(|&n| n > 0)
+    };
     let mut buf = Vec::new();
     let mut out = Vec::new();
     let mut group: Vec<Cut> = Vec::new();
     for col in 0..=w {
-        let c = if colours.get(col) == Some(&3) {
+        let c = if both(col) {
             runs(classes, w, h, col, &mut buf);
             cut(classes, w, h, col, &buf)
         } else {
