@@ -7,9 +7,10 @@
 //! the robot's pose predicted by the two-mice odometry and corrected by the landmarks the
 //! camera saw, with the local perceptual space (LPS) of anchors whose reliability decays when
 //! they go unseen; the PAM's camera control, [`gaze::Gaze`], which turns the camera's pan joint
-//! to the object the behaviors need most (seed `001` §2.1); and the team side, [`team::merge_team`]. It reads the standard messages of
-//! `mrt-msgs` only (never a simulator), so the same world model runs on a real robot. MAP and
-//! MUREA come here (issue 20).
+//! to the object the behaviors need most (seed `001` §2.1); and the team side,
+//! [`team::merge_team`]. It reads the standard messages of `mrt-msgs` only (never a
+//! simulator), so the same world model runs on a real robot. MAP and MUREA come here
+//! (issue 20).
 //!
 //! ```
 //! use mrt_core::frames::Framed;
