@@ -37,6 +37,9 @@ pub struct DeviceAct {
     pub duty: Option<Vec<f64>>,
     /// Whether the kicker fired.
     pub kick: bool,
+    /// The camera's pan joint set-point, rad, if the gaze control turned it.
+    #[serde(default)]
+    pub pan: Option<f64>,
     /// Faults of the robot's software noted this cycle.
     pub faults: Vec<String>,
 }

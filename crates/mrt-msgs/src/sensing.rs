@@ -153,6 +153,10 @@ pub struct CameraFrame {
     /// ISocRob seed `003` §3.2.1); `None` from the object sensor alone.
     #[serde(default)]
     pub image: Option<Image>,
+    /// The camera's pan joint when the frame was taken, rad (`None`: the camera has no joint
+    /// and stands where its camera file puts it).
+    #[serde(default)]
+    pub pan: Option<f64>,
 }
 
 /// What the vision µAgent found in one camera image (ISocRob seed `003` §3.2.1), robot frame:

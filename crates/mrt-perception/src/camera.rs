@@ -125,6 +125,14 @@ impl Pinhole {
         self
     }
 
+    /// Half the horizontal field of view, rad: the angle from the optical axis to the nearer
+    /// side of the image, on the principal row (what a gaze control may count as in view).
+    pub fn half_fov(&self) -> f64 {
+        let k = &self.intrinsics;
+        let side = k.cx.min(f64::from(k.width) - k.cx).max(0.0);
+        (side / k.fx).atan()
+    }
+
     /// The optical centre (robot frame, m).
     pub fn centre(&self) -> Point3<f64> {
         Point3::new(self.mount.x, self.mount.y, self.height)

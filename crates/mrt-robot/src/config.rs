@@ -10,6 +10,7 @@ use mrt_perception::mice::MiceOdometry;
 use mrt_perception::vision::colors::ColorTable;
 use mrt_perception::vision::posts::PostShape;
 use mrt_plan::guide::Guidance;
+use mrt_world::gaze::{GazeConfig, PanJoint};
 use mrt_world::{FieldMap, WorldModel};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
@@ -51,6 +52,9 @@ pub struct RobotConfig {
     /// (`None`: the camera driver's frames carry percepts already, as the simulator's object
     /// sensor does).
     pub vision: Option<VisionSetup>,
+    /// The PAM's gaze control of the camera's pan joint (TeamChaos seed `001` §2.1), when the
+    /// camera has one (`None`: the camera stays where its file puts it).
+    pub gaze: Option<GazeConfig>,
 }
 
 /// What the vision µAgent needs (ISocRob seed `003` §3.2.1).
@@ -214,6 +218,69 @@ impl Default for VisionSection {
     }
 }
 
+/// `[gaze]`: the camera's pan joint and the PAM's gaze control that turns it to the object the
+/// behaviors need most (TeamChaos seed `001` §2.1, [`mrt_world::gaze`]).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct GazeSection {
+    /// Run the gaze control (the camera has a pan joint).
+    pub enabled: bool,
+    /// The rightmost pan, rad.
+    pub pan_min: f64,
+    /// The leftmost pan, rad.
+    pub pan_max: f64,
+    /// The joint's top speed, rad/s.
+    pub pan_speed: f64,
+    /// How long a fixation is held once its object is in view, s.
+    pub dwell: f64,
+    /// Half the camera's horizontal field of view, rad (default: from `[vision.camera]` when
+    /// the vision µAgent runs; required otherwise).
+    pub half_fov: Option<f64>,
+}
+
+impl Default for GazeSection {
+    fn default() -> Self {
+        GazeSection {
+            enabled: false,
+            pan_min: -std::f64::consts::FRAC_PI_2,
+            pan_max: std::f64::consts::FRAC_PI_2,
+            pan_speed: 3.0,
+            dwell: 0.3,
+            half_fov: None,
+        }
+    }
+}
+
+impl GazeSection {
+    /// The gaze control, checked, when enabled (`camera`: the vision µAgent's, if it runs).
+    fn config(&self, camera: Option<&Pinhole>) -> Result<Option<GazeConfig>, String> {
+        if !self.enabled {
+            return Ok(None);
+        }
+        let joint = PanJoint { min: self.pan_min, max: self.pan_max, max_speed: self.pan_speed };
+        if !joint.is_valid() {
+            return Err(format!(
+                "gaze: pan_min {} ≤ pan_max {} and pan_speed {} > 0 must be finite numbers",
+                self.pan_min, self.pan_max, self.pan_speed
+            ));
+        }
+        if !(self.dwell.is_finite() && self.dwell >= 0.0) {
+            return Err(format!("gaze.dwell must be a finite number >= 0, not {}", self.dwell));
+        }
+        let half_fov = match (self.half_fov, camera) {
+            (Some(h), _) => h,
+            (None, Some(c)) => c.half_fov(),
+            (None, None) => {
+                return Err("gaze.half_fov is needed when the vision µAgent does not run".into())
+            }
+        };
+        if !(half_fov.is_finite() && half_fov > 0.0) {
+            return Err(format!("gaze.half_fov must be a finite number > 0, not {half_fov}"));
+        }
+        Ok(Some(GazeConfig { joint, half_fov, dwell: self.dwell }))
+    }
+}
+
 /// `[devices]`: what the robot's drivers talk to.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
@@ -255,6 +322,8 @@ pub struct RobotFile {
     pub devices: DevicesSection,
     /// Its vision.
     pub vision: VisionSection,
+    /// Its camera's pan joint and gaze control.
+    pub gaze: GazeSection,
 }
 
 impl RobotFile {
@@ -347,6 +416,16 @@ impl RobotFile {
                 Err(format!("{name} must be a finite number >= 0, not {v}"))
             }
         };
+        let vision = {
+            let v = &self.vision;
+            let camera = v.camera.camera().map_err(|e| format!("vision.camera: {e}"))?;
+            v.colors.check().map_err(|e| format!("vision.colors: {e}"))?;
+            let posts = PostShape {
+                radius: positive("vision.post_radius", v.post_radius)?,
+                height: positive("vision.post_height", v.post_height)?,
+            };
+            v.enabled.then(|| VisionSetup { camera, colors: v.colors.clone(), posts })
+        };
         Ok(RobotConfig {
             control_period,
             base,
@@ -361,16 +440,8 @@ impl RobotFile {
             },
             guidance: Guidance::new(guard, field, s.ball_radius),
             team_size: r.team_size,
-            vision: {
-                let v = &self.vision;
-                let camera = v.camera.camera().map_err(|e| format!("vision.camera: {e}"))?;
-                v.colors.check().map_err(|e| format!("vision.colors: {e}"))?;
-                let posts = PostShape {
-                    radius: positive("vision.post_radius", v.post_radius)?,
-                    height: positive("vision.post_height", v.post_height)?,
-                };
-                v.enabled.then(|| VisionSetup { camera, colors: v.colors.clone(), posts })
-            },
+            gaze: self.gaze.config(vision.as_ref().map(|v| &v.camera))?,
+            vision,
         })
     }
 }

@@ -31,6 +31,12 @@ pub trait Devices: Send {
     fn set_duty(&mut self, duty: &[f64]) -> Result<(), String>;
     /// Fires the kicker.
     fn kick(&mut self) -> Result<(), String>;
+    /// Turns the camera's pan joint to `pan` (rad, counter-clockwise from straight ahead),
+    /// asked by the gaze control (`[gaze]` of the robot file) once per cycle within the
+    /// joint's range and speed. A robot without a pan joint keeps this default, an error.
+    fn set_pan(&mut self, pan: f64) -> Result<(), String> {
+        Err(format!("this robot's camera has no pan joint (asked for {pan} rad)"))
+    }
     /// Books a fault of the robot's software now (a script error with its file and line).
     fn fault(&mut self, message: &str) -> Result<(), String>;
 }
@@ -49,6 +55,7 @@ pub struct LinkedDevices {
     sonars: Option<Vec<Sonar>>,
     duty: Option<Vec<f64>>,
     kick: bool,
+    pan: Option<f64>,
     faults: Vec<String>,
 }
 
@@ -59,6 +66,8 @@ pub struct Actuation {
     pub duty: Option<Vec<f64>>,
     /// Whether the kicker fired.
     pub kick: bool,
+    /// The pan joint's last set-point, if any (the joint stays where it is otherwise).
+    pub pan: Option<f64>,
     /// Faults booked, in order.
     pub faults: Vec<String>,
 }
@@ -83,6 +92,7 @@ impl LinkedDevices {
         Actuation {
             duty: self.duty.take(),
             kick: std::mem::take(&mut self.kick),
+            pan: self.pan.take(),
             faults: std::mem::take(&mut self.faults),
         }
     }
@@ -119,6 +129,11 @@ impl Devices for LinkedDevices {
         Ok(())
     }
 
+    fn set_pan(&mut self, pan: f64) -> Result<(), String> {
+        self.pan = Some(pan);
+        Ok(())
+    }
+
     fn fault(&mut self, message: &str) -> Result<(), String> {
         self.faults.push(message.to_string());
         Ok(())
@@ -142,10 +157,12 @@ mod tests {
         d.set_duty(&[0.1, -0.2]).unwrap();
         d.set_duty(&[0.3, 0.4]).unwrap();
         d.kick().unwrap();
+        d.set_pan(0.4).unwrap();
         d.fault("go2ball.lua:3: boom").unwrap();
         let act = d.take();
         assert_eq!(act.duty, Some(vec![0.3, 0.4]), "the last set-point counts");
         assert!(act.kick);
+        assert_eq!(act.pan, Some(0.4));
         assert_eq!(act.faults, ["go2ball.lua:3: boom"]);
         assert_eq!(d.take(), Actuation::default(), "taken once");
     }

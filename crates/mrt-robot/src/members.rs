@@ -20,6 +20,9 @@
 //! 3. **the behaviors**: a [`BehaviorMember`] running the TeamChaos HFSM or goalkeeper for the
 //!    Chaos stack, or a [`BrainMember`] around any `Send` [`Brain`](crate::brain::Brain)
 //!    (Milan, the baseline);
+//! 4. **`gaze-<n>`** (periodic, when the robot's configuration has
+//!    [`gaze`](RobotConfig::gaze)): the PAM's camera control (seed `001` §2.1) turns the
+//!    camera's pan joint to the object the behaviors need most ([`Devices::set_pan`]);
 //! 4. **`Guide`** (guidance, ISocRob §3.2.3, on message): turns the behaviors'
 //!    [`RobotCommand`] into a [`MotorCommand`] with [`mrt_plan::guide::Guidance`]: velocity
 //!    mode halted by the sonars, or position and potential-field modes to a target posture;
@@ -42,6 +45,7 @@ use crate::files::FilesDir;
 use crate::stacks::{embedded_teamchaos, send_brain, Stack, CHAOS_KEEPER, CHAOS_PLAYER};
 use mrt_core::Point2;
 use mrt_dcdt::{Activation, Agora, Context, Member, MemberError, Message, RequestType, RunReport};
+use mrt_msgs::robot::Lpo;
 use mrt_msgs::{
     BehaviorStatus, CameraFrame, GameInfo, MateReport, MemberFault, MotorCommand, Odometry,
     Percepts, RobotCommand, Sonar, SonarScan, WorldSnapshot,
@@ -49,6 +53,7 @@ use mrt_msgs::{
 use mrt_perception::vision::agent::VisionAgent;
 use mrt_plan::guide::Guidance;
 use mrt_script::member::BehaviorMember;
+use mrt_world::gaze::Gaze;
 use mrt_world::{merge_team, WorldModel};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -171,9 +176,9 @@ impl Member for Vision {
         let Some(m) = latest else { return Ok(()) };
         let frame = m.get::<CameraFrame>()?;
         let Some(image) = &frame.image else { return Ok(()) };
-        // The pan joint stays where the camera file puts it: nothing turns it yet (gaze,
-        // issue 19 item 7), and a frame does not say where it was.
-        let pan = self.agent.camera().pan;
+        // Where the pan joint was when the frame was taken (the gaze control turns it), or,
+        // for a camera without a joint, where its camera file puts it.
+        let pan = frame.pan.unwrap_or(self.agent.camera().pan);
         match self.agent.see(image, frame.time, pan) {
             Ok(p) => {
                 ctx.publish(p);
@@ -183,6 +188,50 @@ impl Member for Vision {
                 if self.refused == 1 {
                     tracing::warn!(robot = self.robot, "vision: {e} (further ones are counted)");
                 }
+            }
+        }
+        Ok(())
+    }
+}
+
+/// The PAM's gaze control of one robot (TeamChaos seed `001` §2.1, [`mrt_world::gaze`]): each
+/// cycle, the behaviors' latest perceptual needs and the latest LPS choose the object to look
+/// at, and the camera's pan joint is turned towards it. A joint that refuses is counted and
+/// logged once; the robot plays on with its camera where it is.
+struct GazeControl {
+    robot: usize,
+    devices: SharedDevices,
+    gaze: Gaze,
+    period: f64,
+    needs: Vec<(usize, f64)>,
+    lps: Vec<Lpo>,
+    refused: u64,
+}
+
+impl Member for GazeControl {
+    fn name(&self) -> String {
+        format!("gaze-{}", self.robot)
+    }
+
+    fn init(&mut self, ctx: &mut Context<'_>) -> Result<(), MemberError> {
+        ctx.subscribe_to::<RobotCommand>(RequestType::Local);
+        ctx.subscribe_to::<WorldSnapshot>(RequestType::Local);
+        Ok(())
+    }
+
+    fn do_your_job(&mut self, ctx: &mut Context<'_>) -> Result<(), MemberError> {
+        while let Some(m) = ctx.receive_msg() {
+            if let Ok(c) = m.get::<RobotCommand>() {
+                self.needs.clone_from(&c.needs);
+            } else {
+                self.lps.clone_from(&m.get::<WorldSnapshot>()?.lps);
+            }
+        }
+        let aim = self.gaze.step(&self.needs, &self.lps, self.period);
+        if let Err(e) = lock(&self.devices)?.set_pan(aim.pan) {
+            self.refused += 1;
+            if self.refused == 1 {
+                tracing::warn!(robot = self.robot, "gaze: {e} (further ones are counted)");
             }
         }
         Ok(())
@@ -408,6 +457,20 @@ fn add_cycle(
         agora.add_member(world, every),
         agora.add_member(sonars, every),
         agora.add_boxed_member(behavior, every),
+    ]);
+    if let Some(g) = cfg.gaze {
+        let gaze = GazeControl {
+            robot,
+            devices: dev(),
+            gaze: Gaze::new(g),
+            period: cfg.control_period,
+            needs: Vec::new(),
+            lps: Vec::new(),
+            refused: 0,
+        };
+        ids.push(agora.add_member(gaze, every));
+    }
+    ids.extend([
         agora.add_member(guide, Activation::OnMessage),
         agora.add_member(Motor { devices: dev(), robot, base: cfg.base }, Activation::OnMessage),
         agora.add_member(FaultBook { devices, robot }, Activation::OnMessage),

@@ -252,6 +252,7 @@ impl RemoteRobot {
                 cycle: frame.cycle,
                 duty: act.duty,
                 kick: act.kick,
+                pan: act.pan,
                 faults: act.faults,
             };
             self.outbox.publish_with(answer, DeliveryWarranty::Reliable, 128);

@@ -371,8 +371,8 @@ impl SimConfig {
     /// (what `mrt sim --distributed` gives each robot process).
     pub fn robot_file(&self, id: usize, stack: &str) -> mrt_robot::config::RobotFile {
         use mrt_robot::config::{
-            BodySection, DevicesSection, GuidanceSection, RobotFile, RobotSection, SensorsSection,
-            VisionSection,
+            BodySection, DevicesSection, GazeSection, GuidanceSection, RobotFile, RobotSection,
+            SensorsSection, VisionSection,
         };
         RobotFile {
             robot: RobotSection {
@@ -409,6 +409,13 @@ impl SimConfig {
                 post_radius: self.render.post_radius,
                 post_height: self.render.post_height,
             },
+            gaze: GazeSection {
+                half_fov: self.gaze.half_fov.or(match self.sensor.percepts {
+                    PerceptSource::Oracle => Some(self.sensor.half_fov),
+                    PerceptSource::Vision => None,
+                }),
+                ..self.gaze.clone()
+            },
         }
     }
 
@@ -444,6 +451,10 @@ pub struct SimConfig {
     pub camera: mrt_perception::camera::CameraFile,
     /// What the cameras draw.
     pub render: RenderConfig,
+    /// Every robot's camera pan joint and gaze control (a robot file's `[gaze]`; off by
+    /// default: the cameras look straight ahead). Without `half_fov`, the robots take the
+    /// object sensor's `[sensor] half_fov` (oracle percepts) or their camera's (vision).
+    pub gaze: mrt_robot::config::GazeSection,
 }
 
 /// What went wrong reading a configuration file (the file, and the line and column of a

@@ -56,6 +56,10 @@ impl Devices for PitchDevices {
         self.with(|p, i| p.kick(i))
     }
 
+    fn set_pan(&mut self, pan: f64) -> Result<(), String> {
+        self.with(|p, i| p.set_pan(i, pan))?
+    }
+
     fn fault(&mut self, message: &str) -> Result<(), String> {
         self.with(|p, i| p.fault(i, 1, message))
     }

@@ -127,6 +127,8 @@ pub struct Pitch {
     kicks: Vec<usize>,
     /// The cameras' renderer and each robot's camera state, when percepts come from vision.
     eyes: Option<(Renderer, Vec<CameraState>)>,
+    /// Each robot's camera pan joint, rad (the camera file's pan until a robot turns it).
+    pans: Vec<f64>,
 }
 
 const FNV_OFFSET: u64 = 0xcbf2_9ce4_8422_2325;
@@ -189,6 +191,7 @@ impl Pitch {
                         .collect(),
                 )),
             },
+            pans: vec![cfg.camera.camera().map_or(0.0, |c| c.pan); robots],
         })
     }
 
@@ -227,8 +230,10 @@ impl Pitch {
     /// What robot `i`'s camera sees now: its image (vision percepts), or the object sensor's
     /// sightings (oracle percepts).
     pub fn camera(&mut self, i: usize) -> CameraFrame {
+        let pan = self.pans.get(i).copied().unwrap_or(0.0);
         let Some((renderer, states)) = &mut self.eyes else {
-            return sensor::look(&self.world, i, &self.cfg.sensor, &mut self.rngs[i]);
+            let frame = sensor::look(&self.world, i, pan, &self.cfg.sensor, &mut self.rngs[i]);
+            return CameraFrame { pan: Some(pan), ..frame };
         };
         let scene = Scene {
             ball: Some(self.world.ball()),
@@ -241,10 +246,28 @@ impl Pitch {
         };
         let viewer = self.world.robot(i).unwrap_or_default();
         let image = match states.get_mut(i) {
-            Some(state) => renderer.render(&scene, viewer, 0.0, Some(i), state),
+            Some(state) => renderer.render(&scene, viewer, pan, Some(i), state),
             None => return CameraFrame { time: self.world.time(), ..Default::default() },
         };
-        CameraFrame { time: self.world.time(), image: Some(image), ..Default::default() }
+        let time = self.world.time();
+        CameraFrame { time, image: Some(image), pan: Some(pan), ..Default::default() }
+    }
+
+    /// Robot `i`'s camera pan joint now, rad.
+    pub fn pan(&self, i: usize) -> Option<f64> {
+        self.pans.get(i).copied()
+    }
+
+    /// Turns robot `i`'s camera pan joint to `pan` (rad from straight ahead, counter-clockwise;
+    /// the joint turns within one cycle: its range and speed are the robot's gaze control's
+    /// to keep). A pan that is not a finite number is refused.
+    pub fn set_pan(&mut self, i: usize, pan: f64) -> Result<(), String> {
+        if !pan.is_finite() {
+            return Err(format!("camera pan joint: {pan} rad is not an angle"));
+        }
+        let slot = self.pans.get_mut(i).ok_or_else(|| format!("no robot {i}"))?;
+        *slot = mrt_core::normalize_angle(pan);
+        Ok(())
     }
 
     /// What the game controller tells robot `i` now (no randomness: read it at any time).

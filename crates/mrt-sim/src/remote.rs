@@ -229,6 +229,11 @@ impl PitchServer {
             if act.kick {
                 pitch.kick(i);
             }
+            if let Some(pan) = act.pan {
+                if let Err(e) = pitch.set_pan(i, pan) {
+                    pitch.fault(i, 1, &e);
+                }
+            }
             for f in &act.faults {
                 pitch.fault(i, 1, f);
             }

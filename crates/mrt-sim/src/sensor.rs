@@ -84,10 +84,17 @@ pub fn game_info(referee: &Referee, robot: usize) -> GameInfo {
     }
 }
 
-/// What the camera of robot `robot` sees now (the object sensor): every object within its
-/// range and field of view, not hidden behind another robot (the ball) and not missed, as
-/// distance and bearing with range-dependent noise.
-pub fn look(world: &World, robot: usize, cfg: &SensorConfig, rng: &mut dyn RngCore) -> CameraFrame {
+/// What the camera of robot `robot`, its pan joint at `pan` (rad), sees now (the object
+/// sensor): every object within its range and field of view, not hidden behind another robot
+/// (the ball) and not missed, as distance and bearing (robot frame) with range-dependent
+/// noise.
+pub fn look(
+    world: &World,
+    robot: usize,
+    pan: f64,
+    cfg: &SensorConfig,
+    rng: &mut dyn RngCore,
+) -> CameraFrame {
     let me = world.robot(robot).unwrap_or_default();
     let r_robot = world.config().robot.radius;
     let robots: Vec<(f64, f64)> = (0..world.robot_count())
@@ -102,7 +109,8 @@ pub fn look(world: &World, robot: usize, cfg: &SensorConfig, rng: &mut dyn RngCo
         let occluded =
             k == lps::BALL && robots.iter().any(|&c| blocks((me.x, me.y), target, c, r_robot));
         let range = if k == lps::BALL { cfg.range } else { cfg.landmark_range };
-        let visible = dist <= range && bearing.abs() <= cfg.half_fov && !occluded;
+        let in_view = normalize_angle(bearing - pan).abs() <= cfg.half_fov;
+        let visible = dist <= range && in_view && !occluded;
         let missed = rng.random_bool(cfg.miss_probability.clamp(0.0, 1.0));
         if visible && !missed {
             let distance = (dist * (1.0 + cfg.distance_noise * gauss(rng))).max(0.0);
@@ -217,7 +225,7 @@ mod tests {
         // the heading (bearing -π/4).
         w.place_robot(1, Pose2::new(-2.0, 0.0, std::f64::consts::FRAC_PI_2));
         w.place_ball(0.0, 2.0);
-        let f = look(&w, 1, &exact(), &mut rng);
+        let f = look(&w, 1, 0.0, &exact(), &mut rng);
         let ball = f.sightings[lps::BALL].unwrap();
         assert!((ball.distance - 2.828427).abs() < 1e-5, "{ball:?}");
         assert!((ball.bearing + std::f64::consts::FRAC_PI_4).abs() < 1e-6, "{ball:?}"); // f32
@@ -230,7 +238,7 @@ mod tests {
         );
         assert!((f.sightings[EAST_NET].unwrap().distance - 11.0).abs() < 1e-5);
         let short = SensorConfig { landmark_range: 9.0, ..exact() };
-        let f2 = look(&w, 1, &short, &mut rng);
+        let f2 = look(&w, 1, 0.0, &short, &mut rng);
         assert_eq!(f2.sightings[EAST_NET], None, "11 m: beyond a 9 m landmark range");
         // The game controller's news: home attacks east in the first half, away west.
         let g = game_info(&r, 1);
@@ -248,9 +256,9 @@ mod tests {
         let mut rng = ChaCha8Rng::seed_from_u64(2);
         w.place_robot(1, Pose2::new(-3.0, 0.0, 0.0));
         w.place_ball(0.0, 0.0);
-        assert!(look(&w, 1, &exact(), &mut rng).sightings[lps::BALL].is_some());
+        assert!(look(&w, 1, 0.0, &exact(), &mut rng).sightings[lps::BALL].is_some());
         w.place_robot(6, Pose2::new(-1.5, 0.05, 0.0)); // in the line of sight
-        let hidden = look(&w, 1, &exact(), &mut rng);
+        let hidden = look(&w, 1, 0.0, &exact(), &mut rng);
         assert_eq!((hidden.sightings[lps::BALL], hidden.ball_velocity), (None, None));
         assert!(hidden.sightings[WEST_NET].is_some(), "landmarks stand above the robots");
     }
@@ -262,11 +270,17 @@ mod tests {
         let cfg = SensorConfig { half_fov: 0.5, range: 5.0, landmark_range: 5.0, ..exact() };
         w.place_robot(1, Pose2::new(-5.0, 0.0, std::f64::consts::PI)); // facing west
         w.place_ball(-1.0, 0.0);
-        let f = look(&w, 1, &cfg, &mut rng);
+        let f = look(&w, 1, 0.0, &cfg, &mut rng);
         assert_eq!(f.sightings[lps::BALL], None, "4 m behind the robot");
         assert!(f.sightings[WEST_NET].is_some(), "west net 4 m ahead");
         assert_eq!(f.sightings[EAST_NET], None, "east net 14 m behind");
         assert_eq!(f.sightings[NW_CORNER], None, "corner (-9, 6): 7.2 m, out of range");
+        // The pan joint turned half round: the camera looks east, at the ball, and the
+        // bearing stays in the robot's frame.
+        let turned = look(&w, 1, std::f64::consts::PI, &cfg, &mut rng);
+        let ball = turned.sightings[lps::BALL].expect("the ball is in view");
+        assert!((ball.bearing.abs() - std::f64::consts::PI).abs() < 1e-6, "{ball:?}");
+        assert_eq!(turned.sightings[WEST_NET], None, "now behind the camera");
     }
 
     #[test]
@@ -358,7 +372,7 @@ mod tests {
         let sample = |seed| {
             let mut rng = ChaCha8Rng::seed_from_u64(seed);
             (0..400)
-                .filter_map(|_| look(&w, 1, &cfg, &mut rng).sightings[lps::BALL])
+                .filter_map(|_| look(&w, 1, 0.0, &cfg, &mut rng).sightings[lps::BALL])
                 .map(|s| s.distance * 1000.0)
                 .collect::<Vec<_>>()
         };

@@ -215,12 +215,12 @@ fn age(l: &Lpo) -> f64 {
 /// index (so that the choice is deterministic).
 fn choose(needs: &[(usize, f64)], lps: &[Lpo]) -> Option<usize> {
     let mut best: Option<(usize, f64, f64)> = None;
-    for o in 0..lps.len() {
+    for (o, anchor) in lps.iter().enumerate() {
         let need = need_of(needs, o);
         if need <= 0.0 {
             continue;
         }
-        let a = age(&lps[o]);
+        let a = age(anchor);
         let better = match best {
             None => true,
             Some((_, n, b)) => need > n || (need == n && a > b),
