@@ -242,8 +242,8 @@ impl Default for GazeSection {
     fn default() -> Self {
         GazeSection {
             enabled: false,
-            pan_min: -std::f64::consts::FRAC_PI_2,
-            pan_max: std::f64::consts::FRAC_PI_2,
+            pan_min: -1.5,
+            pan_max: 1.5,
             pan_speed: 3.0,
             dwell: 0.3,
             half_fov: None,
@@ -476,6 +476,25 @@ mod tests {
         assert!(e.to_string().contains("unknown team stack 'lego'"), "{e}");
         let e = RobotFile::from_toml("[sensors]\nmice_distance = 0\n", "r.toml").unwrap_err();
         assert!(e.to_string().starts_with("r.toml: sensors: "), "{e}");
+    }
+
+    #[test]
+    fn gaze_is_checked_and_takes_its_field_of_view_from_the_camera() {
+        let read = |t: &str| RobotFile::from_toml(t, "r.toml").map(|f| f.config().unwrap().gaze);
+        assert_eq!(read("").unwrap(), None, "off by default");
+        let e = read("[gaze]\nenabled = true\n").unwrap_err();
+        assert!(e.to_string().contains("gaze.half_fov is needed"), "{e}");
+        let g = read("[gaze]\nenabled = true\nhalf_fov = 0.4\n").unwrap().unwrap();
+        assert_eq!((g.half_fov, g.dwell, g.joint.max_speed), (0.4, 0.3, 3.0));
+        // The shipped camera: 160 px from the principal point to the side at fx = 260 px.
+        let g = read("[gaze]\nenabled = true\n[vision]\nenabled = true\n").unwrap().unwrap();
+        assert!((g.half_fov - (160.0f64 / 260.0).atan()).abs() < 1e-12, "{}", g.half_fov);
+        for bad in ["pan_min = 2.0", "pan_speed = 0.0", "dwell = -1.0", "half_fov = nan"] {
+            let fov = if bad.starts_with("half_fov") { "" } else { "half_fov = 0.4\n" };
+            let e = read(&format!("[gaze]\nenabled = true\n{fov}{bad}\n")).unwrap_err();
+            let e = e.to_string();
+            assert!(e.starts_with("r.toml: gaze"), "{bad}: {e}");
+        }
     }
 
     proptest! {
