@@ -45,7 +45,7 @@ use crate::files::FilesDir;
 use crate::stacks::{embedded_teamchaos, send_brain, Stack, CHAOS_KEEPER, CHAOS_PLAYER};
 use mrt_core::Point2;
 use mrt_dcdt::{Activation, Agora, Context, Member, MemberError, Message, RequestType, RunReport};
-use mrt_msgs::robot::Lpo;
+use mrt_msgs::robot::{lps, Lpo};
 use mrt_msgs::{
     BehaviorStatus, CameraFrame, GameInfo, MateReport, MemberFault, MotorCommand, Odometry,
     Percepts, RobotCommand, Sonar, SonarScan, WorldSnapshot,
@@ -195,8 +195,9 @@ impl Member for Vision {
 }
 
 /// The PAM's gaze control of one robot (TeamChaos seed `001` §2.1, [`mrt_world::gaze`]): each
-/// cycle, the behaviors' latest perceptual needs and the latest LPS choose the object to look
-/// at, and the camera's pan joint is turned towards it. A joint that refuses is counted and
+/// cycle, the behaviors' latest perceptual needs (with `trackLandMarks`, the least recently seen
+/// landmark or net) and the latest LPS choose the object to look at, and the camera's pan joint
+/// is turned towards it. A joint that refuses is counted and
 /// logged once; the robot plays on with its camera where it is.
 struct GazeControl {
     robot: usize,
@@ -204,6 +205,7 @@ struct GazeControl {
     gaze: Gaze,
     period: f64,
     needs: Vec<(usize, f64)>,
+    track_landmarks: bool,
     lps: Vec<Lpo>,
     refused: u64,
 }
@@ -223,9 +225,18 @@ impl Member for GazeControl {
         while let Some(m) = ctx.receive_msg() {
             if let Ok(c) = m.get::<RobotCommand>() {
                 self.needs.clone_from(&c.needs);
+                self.track_landmarks = c.track_landmarks;
             } else {
                 self.lps.clone_from(&m.get::<WorldSnapshot>()?.lps);
             }
+        }
+        if self.track_landmarks {
+            // One landmark, the least recently seen, as needed as what the behaviors need most.
+            let need = self.needs.iter().map(|n| n.1).fold(0.0, f64::max);
+            let need = if need > 0.0 { need } else { 1.0 };
+            let slots: Vec<usize> = (lps::NET1..lps::COUNT).collect();
+            let group = self.gaze.landmark_need(&slots, need, &self.lps);
+            self.needs.extend(group);
         }
         let aim = self.gaze.step(&self.needs, &self.lps, self.period);
         if let Err(e) = lock(&self.devices)?.set_pan(aim.pan) {
@@ -465,6 +476,7 @@ fn add_cycle(
             gaze: Gaze::new(g),
             period: cfg.control_period,
             needs: Vec::new(),
+            track_landmarks: false,
             lps: Vec::new(),
             refused: 0,
         };

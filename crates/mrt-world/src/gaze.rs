@@ -164,6 +164,28 @@ impl Gaze {
         Aim { object: Some(object), pan: self.pan, searching }
     }
 
+    /// `trackLandMarks` (seed `001` §3 and §4: "sets necessities for the most relevant
+    /// landmarks or nets"; `gktracklms` "selects the least recently seen landmark"): the need
+    /// `(slot, need)` for the landmark of `slots` to look at next. That is the fixated one
+    /// while it is held, else the least recently seen whose anchor is within the camera's
+    /// reach (a landmark behind the robot cannot be seen), else, none being known, the first
+    /// (never seen: searched). Push it onto the needs given to [`Gaze::step`].
+    pub fn landmark_need(&self, slots: &[usize], need: f64, lps: &[Lpo]) -> Option<(usize, f64)> {
+        let (j, h) = (self.cfg.joint, self.cfg.half_fov);
+        let reachable = |&o: &usize| {
+            lps.get(o).is_some_and(|l| {
+                l.reliability > 0.0 && l.theta >= j.min - h && l.theta <= j.max + h
+            })
+        };
+        let held = self.fixation.filter(|o| slots.contains(o) && reachable(o) && self.held > 0.0);
+        let oldest = || {
+            let by_age = |a: &usize, b: &usize| age(&lps[*a]).total_cmp(&age(&lps[*b]));
+            slots.iter().copied().filter(reachable).max_by(by_age)
+        };
+        let slot = held.or_else(oldest).or_else(|| slots.first().copied())?;
+        Some((slot, need))
+    }
+
     /// Whether object `o` was seen this cycle where the camera points now.
     fn in_view(&self, lps: &[Lpo], o: usize) -> bool {
         lps.get(o).is_some_and(|l| seen_now(l) && (l.theta - self.pan).abs() <= self.cfg.half_fov)
@@ -332,6 +354,38 @@ mod tests {
         assert_eq!(choose(&[(0, 1.0), (1, 1.0), (2, 1.0)], &lps_now), Some(2), "never seen");
         assert_eq!(choose(&[(0, 1.0), (1, 0.5), (9, 1.0)], &lps_now), Some(0), "out of LPS");
         assert_eq!(choose(&[], &lps_now), None);
+    }
+
+    #[test]
+    fn tracked_landmarks_are_looked_at_least_recently_seen_first_and_the_ball_in_its_turn() {
+        // The ball ahead-left, three landmarks to the right, one behind the robot.
+        let objects = [(lps::BALL, 0.9), (3, -0.8), (4, -1.1), (5, -1.4), (6, 3.0)];
+        let (g, mut s) = (&mut gaze(), Stand::new(&objects));
+        // All were seen before, long ago (a gaze only aims at anchors it has).
+        for (o, b) in objects.into_iter().skip(1) {
+            s.lps[o] = Lpo { rho: 5000.0, theta: b, reliability: 0.1, seen_ago: 9.0 };
+        }
+        let mut looks = std::collections::BTreeMap::new();
+        let mut oldest = [0.0_f64; 4];
+        for k in 0..500 {
+            s.look(g.pan(), g.cfg.half_fov);
+            let mut needs = vec![(lps::BALL, 1.0)];
+            needs.extend(g.landmark_need(&[3, 4, 5, 6], 1.0, &s.lps));
+            let aim = g.step(&needs, &s.lps, DT);
+            *looks.entry(aim.object).or_insert(0) += 1;
+            for (slot, o) in oldest.iter_mut().zip([lps::BALL, 3, 4, 5]) {
+                if k > 100 {
+                    *slot = slot.max(s.lps[o].seen_ago);
+                }
+            }
+        }
+        // The camera turns to the farthest landmark (5) and sees the two others on its way:
+        // each anchor is refreshed every couple of seconds, the ball's too.
+        assert!(looks[&Some(lps::BALL)] > 100 && looks[&Some(5)] > 100, "{looks:?}");
+        assert!(oldest.iter().all(|&a| a < 2.0), "oldest ages: {oldest:?}");
+        assert_eq!(looks.get(&Some(6)), None, "the landmark behind is out of reach");
+        assert_eq!(g.landmark_need(&[], 1.0, &s.lps), None);
+        assert_eq!(g.landmark_need(&[7, 8], 0.5, &s.lps), Some((7, 0.5)), "none known: searched");
     }
 
     #[test]
