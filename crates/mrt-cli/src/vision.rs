@@ -8,8 +8,9 @@
 
 use anyhow::{anyhow, bail, Context as _, Result};
 use image::{Rgb, RgbImage};
+use mrt_msgs::Image;
 use mrt_perception::camera::{Camera, CameraFile, Pinhole};
-use mrt_perception::source::{load_image, ImageSequence};
+use mrt_perception::source::{load_image, ImageSequence, ImageSource};
 use mrt_perception::vision::blobs::find_ball;
 use mrt_perception::vision::colors::{ColorClass, ColorTable, Lut};
 use mrt_perception::vision::goals::find_goal;
@@ -34,8 +35,15 @@ pub struct DetectArgs {
     pub png: Option<PathBuf>,
     /// The images (PNG or JPEG), each the camera's size; a directory stands for its image
     /// files in name order (a recorded sequence).
-    #[arg(required = true)]
+    #[arg(required_unless_present = "device", conflicts_with = "device")]
     pub images: Vec<PathBuf>,
+    /// Grab the images from a USB camera instead (Video4Linux2, e.g. /dev/video0), at the
+    /// camera file's size.
+    #[arg(long)]
+    pub device: Option<PathBuf>,
+    /// How many frames to grab from --device (1 to 1000000; default 1).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=1_000_000))]
+    pub frames: Option<u32>,
 }
 
 /// The image files the arguments name: files as given, directories as their image files in
@@ -66,9 +74,16 @@ pub fn detect(args: &DetectArgs) -> Result<()> {
     if !(args.ball_radius.is_finite() && args.ball_radius > 0.0 && args.ball_radius < 1.0) {
         bail!("--ball-radius must be between 0 and 1 m, not {}", args.ball_radius);
     }
+    if args.frames.is_some() && args.device.is_none() {
+        bail!("--frames counts the frames grabbed from --device: give a device with it");
+    }
     let images = image_files(&args.images)?;
-    if args.png.is_some() && images.len() != 1 {
-        bail!("--png draws one image: give one image with it");
+    let count = match args.device {
+        Some(_) => args.frames.unwrap_or(1) as usize,
+        None => images.len(),
+    };
+    if args.png.is_some() && count != 1 {
+        bail!("--png draws one image: give one image (or one frame) with it");
     }
     // `from_file` has checked the camera already: `camera()` cannot fail on what it read.
     let camera = CameraFile::from_file(&args.camera)
@@ -79,8 +94,20 @@ pub fn detect(args: &DetectArgs) -> Result<()> {
     let lut = Lut::new(&colors);
     let stdout = std::io::stdout();
     let mut out = stdout.lock();
-    for path in &images {
-        let line = detect_one(path, &camera, &lut, args.ball_radius, args.png.as_deref())?;
+    let mut source = match &args.device {
+        Some(device) => Some(open_device(device, camera.size())?),
+        None => None,
+    };
+    for k in 0..count {
+        let (name, img) = match (&mut source, images.get(k)) {
+            (Some(usb), _) => {
+                let img = usb.grab()?.ok_or_else(|| anyhow!("{}: ended", usb.describe()))?;
+                (format!("{}#{k}", usb.describe()), img)
+            }
+            (None, Some(path)) => (path.display().to_string(), load_image(path)?),
+            (None, None) => break,
+        };
+        let line = detect_one(&name, &img, &camera, &lut, args.ball_radius, args.png.as_deref())?;
         if writeln!(out, "{line}").is_err() {
             return Ok(()); // the reader went away
         }
@@ -88,19 +115,30 @@ pub fn detect(args: &DetectArgs) -> Result<()> {
     Ok(())
 }
 
+/// A USB camera streaming frames of `(width, height)`.
+#[cfg(target_os = "linux")]
+fn open_device(device: &Path, (width, height): (u32, u32)) -> Result<Box<dyn ImageSource>> {
+    Ok(Box::new(mrt_perception::v4l2::V4l2Camera::open(device, width, height)?))
+}
+
+/// USB cameras are read through Video4Linux2, on Linux only.
+#[cfg(not(target_os = "linux"))]
+fn open_device(device: &Path, _: (u32, u32)) -> Result<Box<dyn ImageSource>> {
+    bail!("{}: USB cameras are read through Video4Linux2, on Linux only", device.display())
+}
+
 fn detect_one(
-    path: &Path,
+    name: &str,
+    img: &Image,
     camera: &Pinhole,
     lut: &Lut,
     ball_radius: f64,
     png: Option<&Path>,
 ) -> Result<serde_json::Value> {
-    let img = load_image(path)?;
     let (w, h) = (img.width, img.height);
     if (w, h) != camera.size() {
         bail!(
-            "{}: the image is {w}×{h}, the camera file says {}×{}",
-            path.display(),
+            "{name}: the image is {w}×{h}, the camera file says {}×{}",
             camera.size().0,
             camera.size().1
         );
@@ -169,7 +207,7 @@ fn detect_one(
         }
         drawn.save(out).with_context(|| format!("cannot write {}", out.display()))?;
     }
-    Ok(serde_json::json!({ "image": path.display().to_string(), "objects": objects }))
+    Ok(serde_json::json!({ "image": name, "objects": objects }))
 }
 
 fn round3(x: f64) -> f64 {

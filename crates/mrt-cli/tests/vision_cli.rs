@@ -300,3 +300,20 @@ fn survey_prints_the_vision_against_the_truth() {
     let (ok, _, err) = run(&["--scenes", "0"]);
     assert!(!ok && err.contains("--scenes"), "{err}");
 }
+
+/// Issue 19 item 5: the USB camera path is built in and says clearly when there is no camera.
+#[test]
+fn detect_from_a_missing_camera_says_so() {
+    let (ok, out, err) = detect(&[], &["--device", "/dev/video-mrt-none", "--frames", "2"]);
+    assert!(!ok && out.is_empty());
+    assert!(
+        err.contains("/dev/video-mrt-none: no such device: is the camera plugged in?"),
+        "{err}"
+    );
+    let (ok, _, err) = detect(&[], &["--device", "/dev/null"]);
+    assert!(!ok && err.contains("/dev/null: cannot open it as a V4L2 device"), "{err}");
+    let (ok, _, err) = detect(&["x.png".as_ref()], &["--frames", "2"]);
+    assert!(!ok && err.contains("--frames counts the frames grabbed from --device"), "{err}");
+    let (ok, _, err) = detect(&[], &["--device", "/dev/video0", "--frames", "0"]);
+    assert!(!ok && err.contains("--frames"), "{err}");
+}

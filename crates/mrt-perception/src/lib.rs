@@ -46,6 +46,8 @@ pub mod camera;
 mod error;
 pub mod mice;
 pub mod source;
+#[cfg(all(feature = "v4l2", target_os = "linux"))]
+pub mod v4l2;
 pub mod vision;
 
 pub use error::PerceptionError;
