@@ -40,6 +40,7 @@
 pub mod field;
 pub mod gaze;
 pub mod model;
+pub mod murea;
 pub mod team;
 
 pub use field::FieldMap;
