@@ -162,7 +162,15 @@ impl Map {
     fn meets(&self, kind: Kind, (x0, x1): (f64, f64), (y0, y1): (f64, f64)) -> bool {
         let inside = |p: &Point2| p.x >= x0 && p.x <= x1 && p.y >= y0 && p.y <= y1;
         self.points.iter().any(|(k, p)| *k == kind && inside(p))
-            || self.segments.iter().any(|(k, s)| *k == kind && clips(s, (x0, x1), (y0, y1)))
+            || self.segments.iter().any(|(k, s)| {
+                // The segment's own box first: most segments are far from the region.
+                *k == kind
+                    && s.a.x.max(s.b.x) >= x0
+                    && s.a.x.min(s.b.x) <= x1
+                    && s.a.y.max(s.b.y) >= y0
+                    && s.a.y.min(s.b.y) <= y1
+                    && clips(s, (x0, x1), (y0, y1))
+            })
     }
 }
 

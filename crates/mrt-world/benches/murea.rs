@@ -1,0 +1,96 @@
+//! MUREA's cost (issue 20 item 7: ≤ 10 ms per global localization of one frame on one core):
+//! one frame of a robot on the MSL field that sees 6 landmarks and 16 field-line points, with
+//! noise of a third of the tolerances, localized globally (the whole field, every heading) and
+//! in tracking mode (±0.5 m, ±0.3 rad round a prediction), under several cell budgets. The
+//! position error of each setting is printed once before it is timed.
+//!
+//! Run: `cargo bench -p mrt-world --bench murea`.
+#![allow(missing_docs, clippy::unwrap_used, clippy::print_stdout)]
+
+use criterion::{black_box, criterion_group, criterion_main, Criterion};
+use mrt_core::{normalize_angle, Pose2};
+use mrt_world::field::FieldMap;
+use mrt_world::murea::{Kind, Map, Murea, Perception};
+
+/// What a robot at `pose` sees: the goals and posts within 9 m and points of the lines
+/// within 5 m, each off by a third of its tolerances in turn.
+fn frame(field: &FieldMap, pose: Pose2) -> Vec<Perception> {
+    let mut out = Vec::new();
+    let mut see = |kind: Kind, x: f64, y: f64| {
+        let (dx, dy) = (x - pose.x, y - pose.y);
+        let range = dx.hypot(dy);
+        let bearing = normalize_angle(dy.atan2(dx) - pose.theta);
+        let wobble = [0.33, -0.33, 0.2, -0.1][out.len() % 4];
+        let p = Perception::point(kind, range, bearing);
+        out.push(Perception {
+            range: Some(range + wobble * p.range_tolerance),
+            bearing: Some(bearing - wobble * p.bearing_tolerance),
+            ..p
+        });
+    };
+    for k in 1..mrt_msgs::FIELD_OBJECTS {
+        let at = field.object(k).unwrap();
+        let kind = match (k, field.east_pattern(k)) {
+            (1, _) => Kind::EAST_GOAL,
+            (2, _) => Kind::WEST_GOAL,
+            (_, Some(true)) => Kind::EAST_POST,
+            _ => Kind::WEST_POST,
+        };
+        if (at.x - pose.x).hypot(at.y - pose.y) < 9.0 {
+            see(kind, at.x, at.y);
+        }
+    }
+    let mut lines = 0;
+    for s in field.lines() {
+        for k in 0..20 {
+            let p = s.a + (s.b - s.a) * (f64::from(k) + 0.5) / 20.0;
+            if (p.x - pose.x).hypot(p.y - pose.y) < 5.0 && lines < 16 {
+                see(Kind::LINE, p.x, p.y);
+                lines += 1;
+            }
+        }
+    }
+    out
+}
+
+fn bench(c: &mut Criterion) {
+    let field = FieldMap::default();
+    let truth = Pose2::new(-3.1, 1.7, 0.6);
+    let seen = frame(&field, truth);
+    let mut g = c.benchmark_group("murea");
+    for cells in [5_000, 20_000, 200_000] {
+        let mut murea = Murea::new(Map::field(&field, true));
+        murea.budget.cells = cells;
+        let fix = murea.localize(&seen, murea.whole_field());
+        let err = (fix.pose.x - truth.x).hypot(fix.pose.y - truth.y);
+        let turn = normalize_angle(fix.pose.theta - truth.theta).abs().to_degrees();
+        println!(
+            "global, budget {cells} cells: {} perceptions, error {err:.3} m {turn:.2}°, {} cells, \
+             timed out {}",
+            seen.len(),
+            fix.cells,
+            fix.timed_out
+        );
+        g.bench_function(format!("global_{cells}_cells"), |b| {
+            b.iter(|| murea.localize(black_box(&seen), murea.whole_field()))
+        });
+    }
+    let mut murea = Murea::new(Map::field(&field, true));
+    murea.ambiguity = 1.0;
+    let fix = murea.localize(&seen, murea.whole_field());
+    let err = (fix.pose.x - truth.x).hypot(fix.pose.y - truth.y);
+    println!("global, no alternatives: error {err:.3} m, {} cells", fix.cells);
+    g.bench_function("global_no_alternatives", |b| {
+        b.iter(|| murea.localize(black_box(&seen), murea.whole_field()))
+    });
+    let murea = Murea::new(Map::field(&field, true));
+    let area = Murea::around(Pose2::new(-3.3, 1.5, 0.7), 0.5, 0.3);
+    let fix = murea.localize(&seen, area);
+    let err = (fix.pose.x - truth.x).hypot(fix.pose.y - truth.y);
+    println!("tracking: error {err:.3} m, {} cells", fix.cells);
+    g.bench_function("tracking", |b| b.iter(|| murea.localize(black_box(&seen), area)));
+    g.finish();
+}
+
+criterion_group!(benches, bench);
+criterion_main!(benches);
