@@ -230,15 +230,16 @@ impl Member for GazeControl {
                 self.lps.clone_from(&m.get::<WorldSnapshot>()?.lps);
             }
         }
+        // The behaviors' needs stand until their next command; `trackLandMarks` adds one
+        // landmark, the least recently seen, as needed as what they need most (this cycle).
+        let mut needs = self.needs.clone();
         if self.track_landmarks {
-            // One landmark, the least recently seen, as needed as what the behaviors need most.
-            let need = self.needs.iter().map(|n| n.1).fold(0.0, f64::max);
+            let need = needs.iter().map(|n| n.1).fold(0.0, f64::max);
             let need = if need > 0.0 { need } else { 1.0 };
             let slots: Vec<usize> = (lps::NET1..lps::COUNT).collect();
-            let group = self.gaze.landmark_need(&slots, need, &self.lps);
-            self.needs.extend(group);
+            needs.extend(self.gaze.landmark_need(&slots, need, &self.lps));
         }
-        let aim = self.gaze.step(&self.needs, &self.lps, self.period);
+        let aim = self.gaze.step(&needs, &self.lps, self.period);
         if let Err(e) = lock(&self.devices)?.set_pan(aim.pan) {
             self.refused += 1;
             if self.refused == 1 {
