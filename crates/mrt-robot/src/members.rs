@@ -236,7 +236,7 @@ impl Member for GazeControl {
         if self.track_landmarks {
             let need = needs.iter().map(|n| n.1).fold(0.0, f64::max);
             let need = if need > 0.0 { need } else { 1.0 };
-            let slots: Vec<usize> = (lps::NET1..lps::COUNT).collect();
+            let slots: [usize; lps::COUNT - lps::NET1] = std::array::from_fn(|i| lps::NET1 + i);
             needs.extend(self.gaze.landmark_need(&slots, need, &self.lps));
         }
         let aim = self.gaze.step(&needs, &self.lps, self.period);

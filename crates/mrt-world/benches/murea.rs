@@ -30,14 +30,8 @@ fn frame(field: &FieldMap, pose: Pose2) -> Vec<Perception> {
     };
     for k in 1..mrt_msgs::FIELD_OBJECTS {
         let at = field.object(k).unwrap();
-        let kind = match (k, field.east_pattern(k)) {
-            (1, _) => Kind::EAST_GOAL,
-            (2, _) => Kind::WEST_GOAL,
-            (_, Some(true)) => Kind::EAST_POST,
-            _ => Kind::WEST_POST,
-        };
         if (at.x - pose.x).hypot(at.y - pose.y) < 9.0 {
-            see(kind, at.x, at.y);
+            see(Kind::of_object(field, k, true).unwrap(), at.x, at.y);
         }
     }
     let mut lines = 0;

@@ -78,6 +78,21 @@ impl Kind {
     pub const GOAL: Kind = Kind(5);
     /// A landmark post whose pattern is not known.
     pub const POST: Kind = Kind(6);
+
+    /// The kind of field object `k` (camera sighting order, [`FieldMap::object`]): its goal
+    /// colour or post pattern when `coloured`, else just goal or post; `None` for the ball and
+    /// past the last landmark.
+    pub fn of_object(field: &FieldMap, k: usize, coloured: bool) -> Option<Kind> {
+        field.object(k)?;
+        Some(match (k, coloured, field.east_pattern(k)) {
+            (EAST_NET, true, _) => Kind::EAST_GOAL,
+            (WEST_NET, true, _) => Kind::WEST_GOAL,
+            (EAST_NET | WEST_NET, false, _) => Kind::GOAL,
+            (_, true, Some(true)) => Kind::EAST_POST,
+            (_, true, _) => Kind::WEST_POST,
+            (_, false, _) => Kind::POST,
+        })
+    }
 }
 
 /// The map MUREA localizes on: typed points (goals, posts) and segments (lines), field frame.
@@ -112,16 +127,9 @@ impl Map {
     pub fn field(field: &FieldMap, coloured: bool) -> Map {
         let mut map = Map::new();
         for k in 1..FIELD_OBJECTS {
-            let Some(at) = field.object(k) else { continue };
-            let kind = match (k, coloured, field.east_pattern(k)) {
-                (EAST_NET, true, _) => Kind::EAST_GOAL,
-                (WEST_NET, true, _) => Kind::WEST_GOAL,
-                (EAST_NET | WEST_NET, false, _) => Kind::GOAL,
-                (_, true, Some(true)) => Kind::EAST_POST,
-                (_, true, _) => Kind::WEST_POST,
-                (_, false, _) => Kind::POST,
-            };
-            map = map.point(kind, at);
+            if let (Some(at), Some(kind)) = (field.object(k), Kind::of_object(field, k, coloured)) {
+                map = map.point(kind, at);
+            }
         }
         for s in field.lines() {
             map = map.segment(Kind::LINE, s);
@@ -372,7 +380,8 @@ impl Ord for Entry {
 }
 
 impl Murea {
-    /// MUREA on `map`, to 5 cm and 1° within 200 000 cells (about 10 ms), no timeout.
+    /// MUREA on `map`, to 5 cm and 1° within 200 000 cells, no timeout (docs/performance.md:
+    /// about 9 ms for a global search of one frame, 35 ms with the ambiguity search).
     pub fn new(map: Map) -> Murea {
         let (lo, hi) = map.bounds();
         let reach = if lo.x.is_finite() { (hi - lo).norm().max(1.0) } else { 1.0 };
@@ -462,7 +471,7 @@ impl Murea {
 
     /// The root cells tiling `area`: each dimension in cells of the accuracy times a power of
     /// two (about 1 m and 64°), so that splitting them ends on the grid of the accuracy.
-    fn roots(&self, area: &Cell) -> Vec<(Cell, u32)> {
+    fn roots(&self, area: &Cell) -> Vec<Cell> {
         let (axy, ath) = self.accuracy;
         let levels = |acc: f64, target: f64| (target / acc).log2().ceil().max(0.0) as u32;
         let (kxy, kth) = (levels(axy, 1.0), levels(ath, 1.1));
@@ -475,7 +484,7 @@ impl Murea {
         for x in tiles(area.x, sxy) {
             for y in tiles(area.y, sxy) {
                 for theta in tiles(area.theta, sth) {
-                    roots.push((Cell { x, y, theta }, kxy.max(kth)));
+                    roots.push(Cell { x, y, theta });
                 }
             }
         }
@@ -562,7 +571,7 @@ impl Murea {
         let mut heap = BinaryHeap::new();
         let mut order = 0u64;
         let mut cells = 0usize;
-        for (cell, _) in self.roots(&area) {
+        for cell in self.roots(&area) {
             let (evidence, support) = self.evidence(&cell, perceptions, &valid);
             cells += 1;
             heap.push(Entry { evidence, depth: 0, order, cell, support, scored: false });
@@ -704,7 +713,7 @@ mod tests {
         let fix = murea.localize(&seen, area);
         // Brute force: every cell of the finest grid that the roots split into.
         let all: Vec<u16> = (0..seen.len() as u16).collect();
-        let mut leaves: Vec<Cell> = murea.roots(&area).into_iter().map(|r| r.0).collect();
+        let mut leaves: Vec<Cell> = murea.roots(&area);
         while leaves.iter().any(|c| !murea.is_leaf(c)) {
             leaves = leaves.iter().flat_map(|c| murea.split(c)).collect();
         }
