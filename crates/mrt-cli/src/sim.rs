@@ -64,6 +64,11 @@ pub struct SimArgs {
     /// ball and the goals in them). Default: the configuration's `[sensor] percepts`.
     #[arg(long, value_enum)]
     pub percepts: Option<Percepts>,
+    /// Which estimator keeps each robot's pose: murea (the EKF tracks, MUREA finds the robot
+    /// again when it is lost) or ekf (the EKF alone). Default: the configuration's
+    /// `[localization] localizer`.
+    #[arg(long)]
+    pub localizer: Option<mrt_robot::config::Localizer>,
 }
 
 /// `--percepts`.
@@ -88,6 +93,9 @@ fn config(args: &SimArgs) -> Result<SimConfig> {
             Percepts::Oracle => mrt_sim::config::PerceptSource::Oracle,
             Percepts::Vision => mrt_sim::config::PerceptSource::Vision,
         };
+    }
+    if let Some(l) = args.localizer {
+        cfg.localization.localizer = l;
     }
     cfg.validate().map_err(|e| anyhow!("{e}"))?;
     Ok(cfg)

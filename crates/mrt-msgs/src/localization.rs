@@ -25,6 +25,12 @@ pub struct FilterCounts {
     /// believed it was.
     #[serde(default)]
     pub posts_named: u64,
+    /// Global searches run by the relocalizer (MUREA, `mrt_world::relocalize`).
+    #[serde(default)]
+    pub searches: u64,
+    /// Times the relocalizer's fix replaced the filter's pose.
+    #[serde(default)]
+    pub relocalized: u64,
 }
 
 /// A robot's own pose estimate after a cycle, in the field frame (m, rad; not the team frame

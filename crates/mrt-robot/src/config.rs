@@ -11,6 +11,7 @@ use mrt_perception::vision::colors::ColorTable;
 use mrt_perception::vision::posts::PostShape;
 use mrt_plan::guide::Guidance;
 use mrt_world::gaze::{GazeConfig, PanJoint};
+pub use mrt_world::relocalize::Localizer;
 use mrt_world::{FieldMap, WorldModel};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
@@ -55,6 +56,8 @@ pub struct RobotConfig {
     /// The PAM's gaze control of the camera's pan joint (TeamChaos seed `001` §2.1), when the
     /// camera has one (`None`: the camera stays where its file puts it).
     pub gaze: Option<GazeConfig>,
+    /// Which estimator keeps the robot's pose ([`mrt_world::relocalize`]).
+    pub localizer: Localizer,
 }
 
 /// What the vision µAgent needs (ISocRob seed `003` §3.2.1).
@@ -73,6 +76,7 @@ impl RobotConfig {
     /// pose unknown until it is put down.
     pub fn world_model(&self) -> WorldModel {
         WorldModel::new(self.field, self.mice, self.camera.distance, self.camera.bearing)
+            .with_localizer(self.localizer)
     }
 
     /// The control period as a `Duration` (a non-finite or negative period is 0).
@@ -281,6 +285,16 @@ impl GazeSection {
     }
 }
 
+/// `[localization]`: how the robot knows where it is (MRT manual ch. 7,
+/// [`mrt_world::relocalize`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct LocalizationSection {
+    /// `murea` (the default: the EKF tracks, MUREA finds the robot again when it is lost or
+    /// was carried) or `ekf` (the EKF alone).
+    pub localizer: Localizer,
+}
+
 /// `[devices]`: what the robot's drivers talk to.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
@@ -324,6 +338,8 @@ pub struct RobotFile {
     pub vision: VisionSection,
     /// Its camera's pan joint and gaze control.
     pub gaze: GazeSection,
+    /// How it knows where it is.
+    pub localization: LocalizationSection,
 }
 
 impl RobotFile {
@@ -442,6 +458,7 @@ impl RobotFile {
             team_size: r.team_size,
             gaze: self.gaze.config(vision.as_ref().map(|v| &v.camera))?,
             vision,
+            localizer: self.localization.localizer,
         })
     }
 }

@@ -416,6 +416,7 @@ impl SimConfig {
                 }),
                 ..self.gaze.clone()
             },
+            localization: self.localization,
         }
     }
 
@@ -455,6 +456,8 @@ pub struct SimConfig {
     /// default: the cameras look straight ahead). Without `half_fov`, the robots take the
     /// object sensor's `[sensor] half_fov` (oracle percepts) or their camera's (vision).
     pub gaze: mrt_robot::config::GazeSection,
+    /// How every robot knows where it is (a robot file's `[localization]`).
+    pub localization: mrt_robot::config::LocalizationSection,
 }
 
 /// What went wrong reading a configuration file (the file, and the line and column of a

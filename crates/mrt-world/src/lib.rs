@@ -41,6 +41,7 @@ pub mod field;
 pub mod gaze;
 pub mod model;
 pub mod murea;
+pub mod relocalize;
 pub mod team;
 
 pub use field::FieldMap;

@@ -25,6 +25,8 @@
 //! robot sees the landmarks, falling as it goes without them.
 
 use crate::field::FieldMap;
+use crate::murea::{Fix, Perception};
+use crate::relocalize::{self, CameraNoise, Localizer, Relocalizer};
 use mrt_core::frames::{Attack, Field, Framed, Team, MM_PER_M};
 use mrt_core::{normalize_angle, Point2, Pose2, Time, Vec2};
 use mrt_msgs::robot::{lps, Estimate, Lpo, WorldSnapshot};
@@ -66,6 +68,8 @@ const WHEEL_SIGMA: (f64, f64) = (0.15, 0.3);
 const FLOOR: (f64, f64) = (0.002, 0.002);
 /// Uncertainty after being put down by hand (m, rad).
 const PLACED_SIGMA: (f64, f64) = (0.05, 0.05);
+/// Uncertainty after a relocalization (m, rad): MUREA's tolerances, about.
+const RELOCATED_SIGMA: (f64, f64) = (0.15, 0.08);
 /// Uncertainty added when the filter finds itself lost (m, rad).
 const LOST_SIGMA: (f64, f64) = (1.0, 0.5);
 
@@ -99,6 +103,8 @@ pub struct WorldModel {
     game: GameInfo,
     /// The ball's last place and velocity estimated from the vision's percepts.
     ball_track: Option<BallTrack>,
+    /// MUREA watching the filter, with [`Localizer::Murea`].
+    relocalizer: Option<Box<Relocalizer>>,
 }
 
 /// The ball's velocity from successive vision percepts (an α filter on the field-frame
@@ -131,6 +137,30 @@ impl WorldModel {
             counts: FilterCounts::default(),
             game: GameInfo::default(),
             ball_track: None,
+            relocalizer: None,
+        }
+    }
+
+    /// The same model keeping its pose with `localizer` (the EKF alone unless told).
+    pub fn with_localizer(mut self, localizer: Localizer) -> Self {
+        self.relocalizer = match localizer {
+            Localizer::Ekf => None,
+            Localizer::Murea => Some(Box::new(Relocalizer::new(&self.map))),
+        };
+        self
+    }
+
+    /// The camera's errors as this model assumes them.
+    fn noise(&self) -> CameraNoise {
+        CameraNoise { distance: self.distance_noise, bearing: self.bearing_noise }
+    }
+
+    /// Which localizer keeps the pose.
+    pub fn localizer(&self) -> Localizer {
+        if self.relocalizer.is_some() {
+            Localizer::Murea
+        } else {
+            Localizer::Ekf
         }
     }
 
@@ -182,6 +212,19 @@ impl WorldModel {
         self.pose = pose.inner;
         let (xy, theta) = PLACED_SIGMA;
         self.cov = Matrix3::from_diagonal(&Vector3::new(xy * xy, xy * xy, theta * theta));
+        if let Some(r) = &mut self.relocalizer {
+            r.forget();
+        }
+    }
+
+    /// Puts the filter where the relocalizer's `fix` says, as sure as MUREA's accuracy and
+    /// the perceptions' tolerances allow.
+    fn relocate(&mut self, fix: &Fix) {
+        self.pose = fix.pose;
+        let (xy, theta) = RELOCATED_SIGMA;
+        let (xy, theta) = (xy.max(fix.cell.0), theta.max(fix.cell.2));
+        self.cov = Matrix3::from_diagonal(&Vector3::new(xy * xy, xy * xy, theta * theta));
+        self.counts.relocalized += 1;
     }
 
     /// One cycle's odometry: a placement resets the pose, then the motion moves it.
@@ -249,6 +292,9 @@ impl WorldModel {
         self.cov = f * self.cov * f.transpose() + rot * q * rot.transpose();
         let p = self.pose.compose(&d.as_pose());
         self.pose = Pose2::new(p.x, p.y, normalize_angle(p.theta));
+        if let Some(r) = &mut self.relocalizer {
+            r.moved(d.as_pose());
+        }
     }
 
     /// Field position (m) of field object `k` (1..: nets and landmarks, sensor order).
@@ -278,13 +324,9 @@ impl WorldModel {
             z.distance - rho,
             normalize_angle(z.bearing - (dy.atan2(dx) - self.pose.theta)),
         );
-        let (mut sd, mut sb) =
-            (self.distance_noise * z.distance + 0.01, self.bearing_noise + 0.005);
         // The vision µAgent's own estimate, where larger: a far net's distance rests on a
         // pixel row that spans half a metre of floor.
-        if let Some((d, b)) = sigma {
-            (sd, sb) = (sd.max(d), sb.max(b));
-        }
+        let (sd, sb) = self.noise().sigma(z.distance, sigma);
         let r = Matrix2::new(sd * sd, 0.0, 0.0, sb * sb);
         let s_inv = (h * self.cov * h.transpose() + r).try_inverse()?;
         let d2 = (nu.transpose() * s_inv * nu)[(0, 0)];
@@ -335,15 +377,30 @@ impl WorldModel {
     /// One camera frame: the nets and landmarks correct the pose, every sighting refreshes the
     /// LPS memory, and the snapshot is built. Call after this cycle's [`WorldModel::odometry`].
     pub fn camera(&mut self, frame: &CameraFrame) -> WorldSnapshot {
-        self.observe(frame, &[None; FIELD_OBJECTS])
+        let none = [None; FIELD_OBJECTS];
+        let perceived = self.relocalizer.as_ref().map(|_| {
+            relocalize::perceptions(&self.map, self.noise(), &frame.sightings, &none, &[], &[])
+        });
+        self.observe(frame, &none, perceived)
     }
 
-    /// [`WorldModel::camera`] with each sighting's own standard deviations, where known.
+    /// [`WorldModel::camera`] with each sighting's own standard deviations, where known, and
+    /// the frame's perceptions for the relocalizer.
     fn observe(
         &mut self,
         frame: &CameraFrame,
         sigmas: &[Option<(f64, f64)>; FIELD_OBJECTS],
+        perceived: Option<Vec<Perception>>,
     ) -> WorldSnapshot {
+        // MUREA first checks the odometry's prediction against what the robot sees.
+        if let (Some(r), Some(perceived)) = (&mut self.relocalizer, perceived) {
+            let searches = r.counts().searches;
+            let fix = r.frame(frame.time, perceived, self.pose);
+            self.counts.searches += r.counts().searches - searches;
+            if let Some(fix) = fix {
+                self.relocate(&fix);
+            }
+        }
         let (seen, rejected) = self.correct_all(frame, sigmas);
         if seen >= 3 && 2 * rejected > seen {
             // Most landmarks disagree: the estimate is wrong, not the camera. Widen the
@@ -374,6 +431,18 @@ impl WorldModel {
     /// whose ball velocity is estimated here from the ball's successive places on the field.
     /// Call after this cycle's [`WorldModel::odometry`].
     pub fn percepts(&mut self, p: &Percepts) -> WorldSnapshot {
+        // The relocalizer takes the posts by their pattern: naming them rests on the pose.
+        let perceived = self.relocalizer.as_ref().map(|_| {
+            let noise = self.noise();
+            relocalize::perceptions(
+                &self.map,
+                noise,
+                &p.sightings,
+                &p.sigmas,
+                &p.posts,
+                &p.line_points,
+            )
+        });
         let mut frame = CameraFrame { time: p.time, sightings: p.sightings, ..Default::default() };
         let mut sigmas = p.sigmas;
         // The posts, named by where the robot believes it is; a landmark claimed by two posts
@@ -405,7 +474,7 @@ impl WorldModel {
             let (vx, vy) = velocity;
             frame.ball_velocity = Some((c * vx + s * vy, -s * vx + c * vy));
         }
-        self.observe(&frame, &sigmas)
+        self.observe(&frame, &sigmas, perceived)
     }
 
     /// Corrects the pose with every net and landmark of `frame`. Returns how many were seen
@@ -588,6 +657,82 @@ mod tests {
         assert!(m.counts().lost >= 1, "{:?}", m.counts());
         let p = m.pose().inner;
         assert!((p.x - 2.0).hypot(p.y - 1.0) < 0.05, "{p:?} {:?}", m.counts());
+    }
+
+    /// What a camera with a 60° field of view at `at` sees of the landmarks within 9 m.
+    fn narrow_frame(at: Pose2, time: f64) -> CameraFrame {
+        let near: Vec<_> = landmarks()
+            .into_iter()
+            .filter(|&(_, (x, y))| {
+                let (dx, dy) = (x - at.x, y - at.y);
+                dx.hypot(dy) < 9.0 && normalize_angle(dy.atan2(dx) - at.theta).abs() < 0.52
+            })
+            .collect();
+        frame(at, time, &near)
+    }
+
+    /// A robot carried across the field facing the other way sees only what it did not
+    /// expect: the EKF alone gates it all out (or widens onto the wrong landmarks), MUREA finds
+    /// the robot again within a few frames.
+    #[test]
+    fn a_kidnapped_robot_is_found_again_by_murea_but_not_by_the_ekf_alone() {
+        let before = Pose2::new(-4.0, -1.0, std::f64::consts::PI);
+        let after = Pose2::new(4.5, 0.0, 0.45); // the east net and its north corner in view
+        assert!(narrow_frame(after, 0.0).sightings.iter().flatten().count() >= 2);
+        let run = |localizer: Localizer| {
+            let mut m = model().with_localizer(localizer);
+            m.place(Framed::new(before));
+            let mut t = 0.0;
+            for _ in 0..10 {
+                m.odometry(&exact_mice(Pose2::default()));
+                m.camera(&narrow_frame(before, t));
+                t += 0.1;
+            }
+            let mut found = None;
+            for k in 0..30 {
+                m.odometry(&exact_mice(Pose2::default()));
+                m.camera(&narrow_frame(after, t));
+                let p = m.pose().inner;
+                let off = (p.x - after.x).hypot(p.y - after.y);
+                if found.is_none()
+                    && off < 0.1
+                    && normalize_angle(p.theta - after.theta).abs() < 0.05
+                {
+                    found = Some(k);
+                }
+                t += 0.1;
+            }
+            (found, m.counts())
+        };
+        let (ekf, counts) = run(Localizer::Ekf);
+        assert_eq!(ekf, None, "the EKF alone should stay lost here: {counts:?}");
+        assert_eq!(counts.searches, 0);
+        let (murea, counts) = run(Localizer::Murea);
+        let k = murea.unwrap_or_else(|| panic!("MUREA never found it: {counts:?}"));
+        assert!(k <= 3, "found after {k} frames");
+        assert_eq!(counts.relocalized, 1, "{counts:?}");
+    }
+
+    /// Nobody said where it starts: from a handful of frames it knows, wherever it stands.
+    #[test]
+    fn a_robot_never_placed_localizes_globally() {
+        // Each with two landmarks in view: the west net and its north corner, the east net
+        // and its south corner, the west net and its south corner.
+        for truth in
+            [Pose2::new(-4.0, 0.5, 2.8), Pose2::new(4.0, -0.5, -0.35), Pose2::new(-5.0, 1.0, -2.6)]
+        {
+            let mut m = model().with_localizer(Localizer::Murea);
+            assert_eq!(m.localizer(), Localizer::Murea);
+            let n = narrow_frame(truth, 0.0).sightings.iter().flatten().count();
+            assert!(n >= 2, "{truth:?} sees {n}");
+            for t in 0..5 {
+                m.odometry(&exact_mice(Pose2::default()));
+                m.camera(&narrow_frame(truth, f64::from(t) * 0.1));
+            }
+            let p = m.pose().inner;
+            assert!((p.x - truth.x).hypot(p.y - truth.y) < 0.1, "{p:?} {:?}", m.counts());
+            assert!(normalize_angle(p.theta - truth.theta).abs() < 0.05, "{p:?}");
+        }
     }
 
     #[test]

@@ -1,0 +1,480 @@
+//! Global relocalization: MUREA (MRT manual ch. 7) watching the pose tracker and putting it
+//! right when it is lost.
+//!
+//! The manual runs MUREA in two modes: tracking, around the odometry's prediction, and global,
+//! "when the quality of the localization drops or on demand". Here the [`WorldModel`]'s EKF
+//! tracks (it costs microseconds a frame) and a [`Relocalizer`] decides when the global mode
+//! must run:
+//!
+//! 1. Every frame's percepts become MUREA [`Perception`]s ([`perceptions`]): the coloured nets,
+//!    the landmark posts by their colour pattern, a sample of the field-line points. They go
+//!    into a short **window** (the last [`Relocalizer::window`] seconds), each glimpse
+//!    kept in the field frame of the tracker's pose when it was seen and carried to the
+//!    robot's frame now by the tracker's motion since, so that a robot whose camera sees one
+//!    thing at a time (a pan joint sweeping, seed `001` §2.1) still gathers enough to
+//!    localize. (The tracker's motion, not the odometry's alone: a mouse that under-reads
+//!    turns the dead reckoning by tenths of a radian, which the tracker's corrections undo.)
+//!    Older glimpses weigh less (halved every [`HALF_LIFE`] s) and their tolerances grow
+//!    with the distance driven and the angle turned since. When [`DISAGREE`] glimpses in a
+//!    row do not fit the tracker's pose after some that did, the older ones are dropped: the
+//!    odometry cannot feel a robot lifted and carried, so what it saw before says nothing of
+//!    where it is.
+//! 2. Every frame, the window is scored at the tracker's pose ([`Murea::quality_at`], a few
+//!    microseconds). While it explains at least [`SUSPECT`] of the window, nothing else runs.
+//! 3. Otherwise, when the window holds at least two goals' or posts' worth of weight, at most
+//!    every [`RETRY`] s, MUREA searches the whole field on the goals and posts, coarsely
+//!    (25 cm, 4°: line points fit some line from almost anywhere and would keep every cell's
+//!    bound high), then around that pose on everything (10 cm, 2°). The fix replaces the
+//!    tracker's pose when it explains at least [`ACCEPT`] of the window, [`MARGIN`] more
+//!    than the tracker's pose, lies apart from it, the search finished within its budget, and
+//!    the coarse search found no other pose far from it that explains nearly as much (on a
+//!    symmetric field, the mirrored pose).
+//!
+//! A robot carried elsewhere (the kidnapped robot of every RoboCup match) or one whose
+//! tracker locked onto the wrong landmark is found again this way; a robot started anywhere
+//! needs no placement.
+//!
+//! [`WorldModel`]: crate::model::WorldModel
+
+use crate::field::FieldMap;
+use crate::murea::{Fix, Kind, Map, Murea, Perception};
+use mrt_core::{normalize_angle, Point2, Pose2};
+use mrt_msgs::{PostSighting, Sighting, FIELD_OBJECTS};
+use serde::{Deserialize, Serialize};
+use std::collections::VecDeque;
+use std::fmt;
+use std::str::FromStr;
+
+/// Which estimator keeps a robot's pose (`[localization] localizer` in a robot or simulator
+/// file, `mrt sim --localizer`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Localizer {
+    /// The EKF alone: it must be told where it starts, and when lost it only widens its
+    /// uncertainty and listens again.
+    Ekf,
+    /// The EKF tracking, MUREA relocalizing globally when the EKF's pose stops explaining
+    /// what the robot sees (module doc).
+    #[default]
+    Murea,
+}
+
+impl Localizer {
+    /// Every localizer's name, as the files and the command line spell them.
+    pub const NAMES: [&'static str; 2] = ["ekf", "murea"];
+}
+
+impl fmt::Display for Localizer {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            Localizer::Ekf => "ekf",
+            Localizer::Murea => "murea",
+        })
+    }
+}
+
+impl FromStr for Localizer {
+    type Err = String;
+
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        match s {
+            "ekf" => Ok(Localizer::Ekf),
+            "murea" => Ok(Localizer::Murea),
+            _ => Err(format!(
+                "unknown localizer `{s}` (expected one of: {})",
+                Self::NAMES.join(", ")
+            )),
+        }
+    }
+}
+
+/// Below this fraction of the window explained by the tracker's pose, MUREA searches.
+pub const SUSPECT: f64 = 0.5;
+/// A fix must explain at least this fraction of the window...
+pub const ACCEPT: f64 = 0.65;
+/// ... and this much more than the tracker's pose.
+pub const MARGIN: f64 = 0.2;
+/// Shortest time between two global searches, s.
+pub const RETRY: f64 = 0.5;
+/// An older glimpse's weight halves every this many seconds.
+pub const HALF_LIFE: f64 = 0.5;
+/// After this many glimpses in a row that the tracker's pose does not explain, the glimpses
+/// before them are forgotten.
+pub const DISAGREE: usize = 2;
+/// A search takes the newest glimpses' perceptions until it has this many (its time grows
+/// with them: docs/performance.md).
+pub const WINDOW_PERCEPTIONS: usize = 24;
+/// Two sightings of a goal or a post of one kind this close (m, in the field frame of the
+/// tracker) are one object seen twice.
+pub const SAME_OBJECT: f64 = 0.5;
+/// At most this many line points of one frame become perceptions (evenly picked).
+pub const LINE_POINTS: usize = 12;
+/// Weight of one line point (a line point says less than a goal: it fits any point of any
+/// line).
+const LINE_WEIGHT: f64 = 0.3;
+/// Tolerance growth per metre driven since a glimpse (odometry drift), m/m.
+const DRIFT: f64 = 0.05;
+
+/// The camera's errors as the world model assumes them: a standard deviation of the distance
+/// proportional to it (`distance`, a fraction) and one of the bearing (`bearing`, rad).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CameraNoise {
+    /// Relative distance error.
+    pub distance: f64,
+    /// Bearing error, rad.
+    pub bearing: f64,
+}
+
+impl CameraNoise {
+    /// The standard deviations `(m, rad)` of a sighting at `distance`: the camera's, plus
+    /// 1 cm and 0.3° of modelling error, or the sighting's own `sigma` where larger.
+    pub fn sigma(&self, distance: f64, sigma: Option<(f64, f64)>) -> (f64, f64) {
+        let (sd, sb) = (self.distance * distance + 0.01, self.bearing + 0.005);
+        sigma.map_or((sd, sb), |(d, b)| (sd.max(d), sb.max(b)))
+    }
+}
+
+/// The MUREA perceptions of one frame: nets and named landmarks of `sightings` (field-object
+/// order, with their standard deviations `sigmas` where known), the landmark `posts` by their
+/// colour pattern, and up to [`LINE_POINTS`] of the `line_points` (robot frame, m).
+/// Tolerances are three standard deviations ([`CameraNoise::sigma`]), at least 5 cm and 1°.
+pub fn perceptions(
+    field: &FieldMap,
+    noise: CameraNoise,
+    sightings: &[Option<Sighting>; FIELD_OBJECTS],
+    sigmas: &[Option<(f64, f64)>; FIELD_OBJECTS],
+    posts: &[PostSighting],
+    line_points: &[(f64, f64)],
+) -> Vec<Perception> {
+    let point = |kind: Kind, z: &Sighting, sigma: Option<(f64, f64)>| {
+        let (sd, sb) = noise.sigma(z.distance, sigma);
+        Perception::point(kind, z.distance, z.bearing)
+            .tolerances((3.0 * sd).max(0.05), (3.0 * sb).max(1f64.to_radians()))
+    };
+    let mut out = Vec::new();
+    for (k, z) in sightings.iter().enumerate() {
+        if let (Some(z), Some(kind)) = (z, Kind::of_object(field, k, true)) {
+            out.push(point(kind, z, sigmas[k]));
+        }
+    }
+    for post in posts {
+        let kind = if post.east { Kind::EAST_POST } else { Kind::WEST_POST };
+        out.push(point(kind, &post.sighting, Some(post.sigma)));
+    }
+    let step = line_points.len().div_ceil(LINE_POINTS).max(1);
+    for &(x, y) in line_points.iter().step_by(step) {
+        let z = Sighting { distance: x.hypot(y), bearing: y.atan2(x) };
+        out.push(point(Kind::LINE, &z, None).weighted(LINE_WEIGHT));
+    }
+    out.retain(|p| p.range.is_some_and(f64::is_finite) && p.bearing.is_some_and(f64::is_finite));
+    out
+}
+
+/// What one frame showed, kept in the field frame of the tracker's pose then.
+#[derive(Clone, Debug)]
+struct Glimpse {
+    time: f64,
+    /// How far the robot had driven by then, m, and turned, rad.
+    driven: (f64, f64),
+    /// Each perception's point in the field frame, with the perception.
+    seen: Vec<(Point2, Perception)>,
+    /// Whether the tracker's pose explained it when it came (`None`: it weighs too little to
+    /// say).
+    fits: Option<bool>,
+}
+
+/// What the relocalizer did, counted since it started.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct RelocalizerCounts {
+    /// Global searches run.
+    pub searches: u64,
+    /// Fixes that replaced the tracker's pose.
+    pub accepted: u64,
+    /// Fixes refused as ambiguous.
+    pub ambiguous: u64,
+}
+
+/// MUREA in the global mode, watching a pose tracker (module doc).
+#[derive(Clone, Debug)]
+pub struct Relocalizer {
+    /// The global search: coarse (25 cm, 4°), on the goals and posts.
+    coarse: Murea,
+    /// The refinement around the coarse fix (10 cm, 2°), on everything.
+    murea: Murea,
+    /// Glimpses older than this are forgotten, s.
+    pub window: f64,
+    glimpses: VecDeque<Glimpse>,
+    /// How far the robot drove (m) and turned (rad) since it started, as the odometry says.
+    driven: (f64, f64),
+    last_search: Option<f64>,
+    counts: RelocalizerCounts,
+}
+
+impl Relocalizer {
+    /// A relocalizer on `field`, whose goals and posts are told apart by colour, each MUREA
+    /// search within 20 000 cells, and a window of 1.5 s.
+    pub fn new(field: &FieldMap) -> Relocalizer {
+        let mut murea = Murea::new(Map::field(field, true));
+        // The tracker refines the fix from the next sightings: 10 cm and 2° are enough.
+        murea.accuracy = (0.1, 2f64.to_radians());
+        murea.budget.cells = 20_000;
+        let mut coarse = murea.clone();
+        coarse.accuracy = (0.25, 4f64.to_radians());
+        Relocalizer {
+            coarse,
+            murea,
+            window: 1.5,
+            glimpses: VecDeque::new(),
+            driven: (0.0, 0.0),
+            last_search: None,
+            counts: RelocalizerCounts::default(),
+        }
+    }
+
+    /// What it did so far.
+    pub fn counts(&self) -> RelocalizerCounts {
+        self.counts
+    }
+
+    /// The robot moved by `d` (robot frame) as the odometry says.
+    pub fn moved(&mut self, d: Pose2) {
+        if d.x.is_finite() && d.y.is_finite() && d.theta.is_finite() {
+            self.driven.0 += d.x.hypot(d.y);
+            self.driven.1 += d.theta.abs();
+        }
+    }
+
+    /// The robot was put down somewhere by hand: what it saw before says nothing about where
+    /// it is now.
+    pub fn forget(&mut self) {
+        self.glimpses.clear();
+    }
+
+    /// The perceptions of the window, in the robot's frame now, weighed by age and with
+    /// tolerances grown by the drive since: the newest glimpses first, until
+    /// [`WINDOW_PERCEPTIONS`] are taken, a goal or post seen again (of its kind, within
+    /// [`SAME_OBJECT`] of an earlier sighting) only once. `pose`: the tracker's pose now.
+    pub fn window_now(&self, now: f64, pose: Pose2) -> Vec<Perception> {
+        let mut out = Vec::new();
+        let mut taken: Vec<(Kind, Point2)> = Vec::new();
+        for g in self.glimpses.iter().rev() {
+            if out.len() >= WINDOW_PERCEPTIONS {
+                break;
+            }
+            let fade = 0.5f64.powf((now - g.time).max(0.0) / HALF_LIFE);
+            let drift = DRIFT * (self.driven.0 - g.driven.0);
+            let turned = self.driven.1 - g.driven.1;
+            for (at, p) in &g.seen {
+                if p.kind != Kind::LINE
+                    && taken.iter().any(|(k, t)| *k == p.kind && (t - at).norm() < SAME_OBJECT)
+                {
+                    continue; // seen again since: the newer sighting speaks for it
+                }
+                taken.push((p.kind, *at));
+                let q = pose.inverse_transform_point(*at);
+                let range = q.coords.norm();
+                let bearing = q.y.atan2(q.x);
+                out.push(
+                    Perception::point(p.kind, range, bearing)
+                        .tolerances(
+                            p.range_tolerance + drift,
+                            p.bearing_tolerance + DRIFT * turned + drift / range.max(0.5),
+                        )
+                        .weighted((p.weight * fade).max(1e-3)),
+                );
+            }
+        }
+        out
+    }
+
+    /// One frame's `perceptions` at `now` (s), with the tracker's `pose`. Returns MUREA's fix
+    /// when it should replace the tracker's pose (module doc), `None` otherwise.
+    pub fn frame(&mut self, now: f64, perceptions: Vec<Perception>, pose: Pose2) -> Option<Fix> {
+        while self.glimpses.front().is_some_and(|g| now - g.time > self.window) {
+            self.glimpses.pop_front();
+        }
+        if perceptions.is_empty() {
+            return None;
+        }
+        // Whether the tracker's pose explains this frame: `None` when it weighs too little to
+        // say (a few line points).
+        let weight: f64 = perceptions.iter().map(|p| p.weight).sum();
+        let fits = (weight >= 1.0).then(|| self.murea.quality_at(pose, &perceptions) >= SUSPECT);
+        let seen = perceptions
+            .into_iter()
+            .filter_map(|p| {
+                let (r, b) = (p.range?, p.bearing?);
+                let at = Point2::new(r * b.cos(), r * b.sin());
+                Some((pose.transform_point(at), p))
+            })
+            .collect();
+        self.glimpses.push_back(Glimpse { time: now, driven: self.driven, seen, fits });
+        // A run of glimpses that the tracker cannot explain after some that it could: the
+        // robot was carried, or the tracker went wrong. What came before the run no longer
+        // tells where the robot is now.
+        let run = self.glimpses.iter().rev().take_while(|g| g.fits == Some(false)).count();
+        if run >= DISAGREE && run < self.glimpses.len() {
+            self.glimpses.drain(..self.glimpses.len() - run);
+        }
+        if self.glimpses.len() > 1 && (fits == Some(true) || (run > 0 && run < DISAGREE)) {
+            // What it sees now agrees with the tracker, or disagrees for the first time (a
+            // false sighting, or the first after a carry: the next frame tells).
+            return None;
+        }
+        let window = self.window_now(now, pose);
+        // Two goals' or posts' worth at least: line points fit some line from almost
+        // anywhere, so they alone never pin a pose down.
+        let marks: Vec<Perception> =
+            window.iter().filter(|p| p.kind != Kind::LINE).copied().collect();
+        if marks.iter().map(|p| p.weight).sum::<f64>() < 2.0 {
+            return None;
+        }
+        let tracked = self.murea.quality_at(pose, &window);
+        if tracked >= SUSPECT || self.last_search.is_some_and(|t| now - t < RETRY) {
+            return None;
+        }
+        self.last_search = Some(now);
+        self.counts.searches += 1;
+        // Globally on the goals and posts (the lines would keep every cell's bound high), then
+        // around that pose with everything.
+        let global = self.coarse.localize(&marks, self.coarse.whole_field());
+        if global.timed_out || global.quality < ACCEPT {
+            return None;
+        }
+        if !global.alternatives.is_empty() {
+            self.counts.ambiguous += 1;
+            return None;
+        }
+        let fix = self.murea.localize(&window, Murea::around(global.pose, 0.4, 0.15));
+        let apart = (fix.pose.x - pose.x).hypot(fix.pose.y - pose.y) > 0.3
+            || normalize_angle(fix.pose.theta - pose.theta).abs() > 0.2;
+        if fix.timed_out || fix.quality < ACCEPT || fix.quality < tracked + MARGIN || !apart {
+            return None;
+        }
+        self.counts.accepted += 1;
+        Some(fix)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::field::{EAST_NET, WEST_NET};
+
+    const NOISE: CameraNoise = CameraNoise { distance: 0.03, bearing: 0.02 };
+
+    fn field() -> FieldMap {
+        FieldMap::default()
+    }
+
+    /// What a robot at `pose` sees exactly of every net and landmark within 8 m.
+    fn seen_from(pose: Pose2) -> [Option<Sighting>; FIELD_OBJECTS] {
+        let f = field();
+        std::array::from_fn(|k| {
+            let at = f.object(k)?;
+            let (dx, dy) = (at.x - pose.x, at.y - pose.y);
+            (dx.hypot(dy) < 8.0).then(|| Sighting {
+                distance: dx.hypot(dy),
+                bearing: normalize_angle(dy.atan2(dx) - pose.theta),
+            })
+        })
+    }
+
+    #[test]
+    fn localizer_names_round_trip_and_bad_names_say_what_is_expected() {
+        for name in Localizer::NAMES {
+            let l: Localizer = name.parse().unwrap_or_else(|e| panic!("{e}"));
+            assert_eq!(l.to_string(), name);
+        }
+        let err = "amcl".parse::<Localizer>().err().unwrap_or_default();
+        assert!(err.contains("ekf, murea"), "{err}");
+    }
+
+    #[test]
+    fn the_frame_becomes_perceptions_by_kind_with_line_points_thinned() {
+        let f = field();
+        let mut sightings = [None; FIELD_OBJECTS];
+        sightings[EAST_NET] = Some(Sighting { distance: 4.0, bearing: 0.1 });
+        sightings[0] = Some(Sighting { distance: 1.0, bearing: 0.0 }); // the ball: not a landmark
+        let posts = [PostSighting {
+            sighting: Sighting { distance: 3.0, bearing: -0.2 },
+            sigma: (0.2, 0.01),
+            east: false,
+            pixels: 40,
+        }];
+        let lines: Vec<(f64, f64)> = (0..40).map(|i| (1.0 + 0.1 * f64::from(i), 0.5)).collect();
+        let p = perceptions(&f, NOISE, &sightings, &[None; FIELD_OBJECTS], &posts, &lines);
+        assert_eq!(p[0].kind, Kind::EAST_GOAL);
+        assert!((p[0].range_tolerance - 0.39).abs() < 1e-12, "3 × (3 % of 4 m + 1 cm)");
+        assert_eq!(p[1].kind, Kind::WEST_POST);
+        assert!((p[1].range_tolerance - 0.6).abs() < 1e-12, "3 × its σ of 0.2 m");
+        assert!((p[1].bearing_tolerance - 0.075).abs() < 1e-12, "3 × (0.02 + 0.005) rad");
+        let lines = p.iter().filter(|q| q.kind == Kind::LINE).count();
+        assert!((LINE_POINTS - 2..=LINE_POINTS).contains(&lines), "{lines}");
+        assert!(p.iter().filter(|q| q.kind == Kind::LINE).all(|q| q.weight == LINE_WEIGHT));
+    }
+
+    #[test]
+    fn a_tracker_that_agrees_with_the_window_is_left_alone() {
+        let f = field();
+        let mut r = Relocalizer::new(&f);
+        let truth = Pose2::new(2.0, 1.0, 0.3);
+        for k in 0..10 {
+            let seen = seen_from(truth);
+            let p = perceptions(&f, NOISE, &seen, &[None; FIELD_OBJECTS], &[], &[]);
+            assert!(r.frame(0.1 * f64::from(k), p, truth).is_none());
+        }
+        assert_eq!(r.counts().searches, 0, "the window fits the tracked pose");
+    }
+
+    #[test]
+    fn a_kidnapped_robot_is_found_from_what_it_sees_after_the_carry() {
+        let f = field();
+        let mut r = Relocalizer::new(&f);
+        let before = Pose2::new(-3.0, 2.0, 0.0);
+        let mut t = 0.0;
+        for _ in 0..10 {
+            let p = perceptions(&f, NOISE, &seen_from(before), &[None; FIELD_OBJECTS], &[], &[]);
+            assert!(r.frame(t, p, before).is_none());
+            t += 0.1;
+        }
+        // Carried to (3, −2) facing west; the odometry felt nothing, the tracker stays put.
+        let after = Pose2::new(3.0, -2.0, 3.0);
+        let mut fixed = None;
+        for _ in 0..20 {
+            let p = perceptions(&f, NOISE, &seen_from(after), &[None; FIELD_OBJECTS], &[], &[]);
+            if let Some(fix) = r.frame(t, p, before) {
+                fixed = Some((t, fix));
+                break;
+            }
+            t += 0.1;
+        }
+        let (when, fix) = fixed.unwrap_or_else(|| panic!("never relocalized: {:?}", r.counts()));
+        assert!((fix.pose.x - 3.0).abs() < 0.1 && (fix.pose.y + 2.0).abs() < 0.1, "{fix:?}");
+        assert!(normalize_angle(fix.pose.theta - 3.0).abs() < 0.05, "{fix:?}");
+        assert!(when - 1.0 < 0.25, "found {:.1} s after the carry", when - 1.0);
+    }
+
+    #[test]
+    fn glimpses_are_carried_into_the_robot_frame_by_the_tracker_s_motion() {
+        let f = field();
+        let mut r = Relocalizer::new(&f);
+        // It sees the east net 4 m straight ahead, then turns 90° left and drives 1 m: the
+        // tracker says it is at (0, 1) facing north.
+        let mut sightings = [None; FIELD_OBJECTS];
+        sightings[EAST_NET] = Some(Sighting { distance: 4.0, bearing: 0.0 });
+        let p = perceptions(&f, NOISE, &sightings, &[None; FIELD_OBJECTS], &[], &[]);
+        r.frame(0.0, p, Pose2::default());
+        r.moved(Pose2::new(0.0, 0.0, std::f64::consts::FRAC_PI_2));
+        r.moved(Pose2::new(1.0, 0.0, 0.0));
+        let w = r.window_now(0.5, Pose2::new(0.0, 1.0, std::f64::consts::FRAC_PI_2));
+        // Now at (0, 1) facing north: the net is at (4, 0), i.e. 4.12 m at −104°.
+        assert_eq!(w.len(), 1);
+        assert!((w[0].range.unwrap_or(0.0) - 17f64.sqrt()).abs() < 1e-9);
+        let expected = (-1f64).atan2(4.0) - std::f64::consts::FRAC_PI_2;
+        assert!((w[0].bearing.unwrap_or(0.0) - expected).abs() < 1e-9);
+        assert!((w[0].weight - 0.5).abs() < 1e-9, "half its weight after one half-life");
+        assert!(w[0].range_tolerance > 0.43, "grown by the drive: {}", w[0].range_tolerance);
+        assert_eq!(WEST_NET, 2);
+    }
+}
