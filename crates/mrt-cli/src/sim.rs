@@ -5,6 +5,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 use mrt_robot::stacks::Stack;
 use mrt_sim::config::SimConfig;
 use mrt_sim::game::MatchReport;
+use mrt_sim::metrics::MetricsBook;
 use mrt_sim::play;
 use mrt_sim::referee::{Call, Team};
 use std::path::PathBuf;
@@ -69,6 +70,15 @@ pub struct SimArgs {
     /// `[localization] localizer`.
     #[arg(long)]
     pub localizer: Option<mrt_robot::config::Localizer>,
+    /// Carry each robot this many times per half (0 to 100), at random moments of play, to a
+    /// random free spot without telling it (the kidnapped robot); the report says how soon
+    /// each found itself again. Default: the configuration's `[rules] kidnaps`.
+    #[arg(long)]
+    pub kidnap: Option<u32>,
+    /// Write what the robots believed against the truth (localization, ball, kidnaps; keys in
+    /// docs/localization.md) to this JSON file, over the match or the whole series.
+    #[arg(long)]
+    pub metrics: Option<PathBuf>,
 }
 
 /// `--percepts`.
@@ -96,6 +106,9 @@ fn config(args: &SimArgs) -> Result<SimConfig> {
     }
     if let Some(l) = args.localizer {
         cfg.localization.localizer = l;
+    }
+    if let Some(k) = args.kidnap {
+        cfg.rules.kidnaps = k;
     }
     cfg.validate().map_err(|e| anyhow!("{e}"))?;
     Ok(cfg)
@@ -251,6 +264,27 @@ pub fn run(args: &SimArgs) -> Result<()> {
             h9.to_degrees()
         );
     }
+    let mut book = MetricsBook::default();
+    book.add(&report);
+    let m = book.metrics();
+    if let (Some(mean), Some(p95)) = (m.ball.mean_m, m.ball.p95_m) {
+        let velocity = m
+            .ball
+            .velocity_mean_mps
+            .map_or(String::new(), |v| format!("; velocity {v:.2} m/s mean"));
+        outln!("  ball error while seen: {mean:.2} m mean, {p95:.2} m p95{velocity}");
+    }
+    if m.kidnap.count > 0 {
+        outln!(
+            "  kidnapped {} times, found again {} times{}",
+            m.kidnap.count,
+            m.kidnap.recovered,
+            m.kidnap
+                .median_recovery_s
+                .map_or(String::new(), |t| format!(" (median {t:.1} s after the carry)"))
+        );
+    }
+    write_metrics(args, &book)?;
     let n = cfg.rules.team_size;
     for f in &report.faults {
         let (team, k) = if f.robot < n { (h, f.robot) } else { (a, f.robot - n) };
@@ -279,6 +313,16 @@ pub fn run(args: &SimArgs) -> Result<()> {
             .with_context(|| format!("cannot write {}", p.display()))?;
         outln!("  drawing: {}", p.display());
     }
+    Ok(())
+}
+
+/// `--metrics FILE`: the book as JSON.
+fn write_metrics(args: &SimArgs, book: &MetricsBook) -> Result<()> {
+    let Some(path) = &args.metrics else { return Ok(()) };
+    let json = serde_json::to_string_pretty(&book.metrics())?;
+    std::fs::write(path, json + "\n")
+        .with_context(|| format!("cannot write {}", path.display()))?;
+    outln!("  metrics: {}", path.display());
     Ok(())
 }
 
@@ -346,12 +390,16 @@ fn series(args: &SimArgs, cfg: &SimConfig, stacks: (Stack, Stack)) -> Result<()>
     // check_counts: seed + matches − 1 does not overflow.
     let seeds: Vec<u64> = (0..args.matches).map(|k| args.seed.saturating_add(k)).collect();
     let results = std::sync::Mutex::new(Vec::new());
+    let book = std::sync::Mutex::new(MetricsBook::default());
     std::thread::scope(|s| {
         for chunk in seeds.chunks(seeds.len().div_ceil(threads)) {
-            let (bar, results) = (&bar, &results);
+            let (bar, results, book) = (&bar, &results, &book);
             s.spawn(move || {
                 for &seed in chunk {
                     let r = play_one(cfg, seed, stacks, args, false, |_| {}).map(|(r, _)| r);
+                    if let (Ok(r), Ok(mut book)) = (&r, book.lock()) {
+                        book.add(r);
+                    }
                     if let Ok(mut v) = results.lock() {
                         v.push(r.map(|r| (seed, r.score)));
                     }
@@ -392,7 +440,8 @@ fn series(args: &SimArgs, cfg: &SimConfig, stacks: (Stack, Stack)) -> Result<()>
         goals.0 as f64 / n as f64,
         goals.1 as f64 / n as f64
     );
-    Ok(())
+    let book = book.into_inner().map_err(|_| anyhow!("a match thread failed"))?;
+    write_metrics(args, &book)
 }
 
 #[cfg(test)]

@@ -48,7 +48,7 @@ mod team;
 pub use acting::MotorCommand;
 pub use behavior::{BehaviorStatus, ReloadRequest};
 pub use device::{DeviceAct, DeviceFrame, FinalWhistle, MemberFault, RobotEnd};
-pub use localization::{FilterCounts, Localization};
+pub use localization::{BallBelief, FilterCounts, Localization};
 pub use mrt_core::{Message, MsgType};
 pub use robot::{lps, Estimate, Field, GameState, Lpo, Mate, RobotCommand, Target, WorldSnapshot};
 pub use sensing::{

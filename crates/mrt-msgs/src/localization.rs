@@ -1,6 +1,6 @@
 //! What the world model says about its own pose, for monitors, recorders and tests (ThinkingCap
 //! seed `001` §4.1: the monitor shows the pose's uncertainty): the estimate in the field frame
-//! with its uncertainty and what the filter used and refused.
+//! with its uncertainty and what the filter used and refused, and its belief about the ball.
 
 use mrt_core::frames::{Field, Framed};
 use mrt_core::Pose2;
@@ -47,4 +47,19 @@ pub struct Localization {
     pub quality: f64,
     /// What the filter used and refused so far.
     pub counts: FilterCounts,
+    /// Where the robot believes the ball is, when it has seen it.
+    #[serde(default)]
+    pub ball: Option<BallBelief>,
+}
+
+/// A robot's own belief about the ball, in the field frame (m, m/s): what its monitors and the
+/// simulator's scoring compare with the truth.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct BallBelief {
+    /// Where it is.
+    pub at: (f64, f64),
+    /// How fast it moves (`None`: the sensor gives no velocity).
+    pub velocity: Option<(f64, f64)>,
+    /// How long ago it was last seen, s (0: in this frame).
+    pub seen_ago: f64,
 }

@@ -62,7 +62,7 @@ impl mrt_dcdt::Member for EstimateWatch {
         ctx: &mut mrt_dcdt::Context<'_>,
     ) -> Result<(), mrt_dcdt::MemberError> {
         while let Some(m) = ctx.receive_msg() {
-            let estimate = m.get::<Localization>()?.pose.inner;
+            let estimate = m.get::<Localization>()?;
             lock_pitch(&self.pitch)?.book_estimate(self.robot, estimate);
         }
         Ok(())

@@ -146,6 +146,9 @@ pub struct MatchConfig {
     pub stuck_time: f64,
     /// See `stuck_time`.
     pub stuck_distance: f64,
+    /// Times per half that each robot is lifted and carried to a random free spot at a
+    /// random moment of play without being told (the kidnapped robot; `mrt sim --kidnap`).
+    pub kidnaps: u32,
 }
 
 impl Default for MatchConfig {
@@ -159,6 +162,7 @@ impl Default for MatchConfig {
             set_duration: 1.0,
             stuck_time: 10.0,
             stuck_distance: 0.2,
+            kidnaps: 0,
         }
     }
 }
@@ -528,6 +532,9 @@ impl SimConfig {
             if !(v.is_finite() && v >= min) {
                 return Err(format!("{name} must be at least {min}, not {v}"));
             }
+        }
+        if self.rules.kidnaps > 100 {
+            return Err(format!("rules.kidnaps must be at most 100, not {}", self.rules.kidnaps));
         }
         if self.sensor.half_fov > std::f64::consts::PI
             || self.robot.kick_half_angle > std::f64::consts::PI

@@ -14,7 +14,7 @@ use crate::world::{Drive, World};
 use mrt_core::{normalize_angle, Pose2};
 use mrt_msgs::robot::{GameState, RobotCommand};
 use mrt_msgs::Sonar;
-use mrt_msgs::{CameraFrame, GameInfo, Odometry};
+use mrt_msgs::{CameraFrame, GameInfo, Localization, Odometry};
 use mrt_robot::base::Base;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
@@ -79,17 +79,42 @@ pub struct MatchReport {
     /// How far each robot's own pose estimate was from the truth (every robot's
     /// `Localization` against where it was; empty when nobody watched).
     pub localization: LocalizationErrors,
+    /// Every kidnap of the match ([`crate::config::MatchConfig::kidnaps`]), in time order.
+    pub kidnaps: Vec<Kidnap>,
 }
 
-/// The robots' pose estimates against the truth over a match: every robot's position error
-/// (m) and heading error (rad), one sample per published estimate.
+/// The robots' beliefs against the truth over a match: every robot's position error (m) and
+/// heading error (rad), one sample per published estimate; the ball's position error (m) in
+/// every estimate made while the robot saw it, and its velocity error (m/s) where the robot
+/// estimated one.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct LocalizationErrors {
     /// Position errors, m.
     pub position: Vec<f64>,
     /// Heading errors (absolute), rad.
     pub heading: Vec<f64>,
+    /// Ball position errors while seen, m.
+    pub ball: Vec<f64>,
+    /// Ball velocity errors while seen, m/s.
+    pub ball_velocity: Vec<f64>,
 }
+
+/// A robot carried elsewhere without being told, and whether its own estimate found it again.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Kidnap {
+    /// The robot.
+    pub robot: usize,
+    /// Simulated time of the carry, s.
+    pub at: f64,
+    /// Where it was put down.
+    pub to: Pose2,
+    /// How long after the carry its estimate first came back within [`RECOVERED`] of the
+    /// truth, s (`None`: not before the next carry or the end of the match).
+    pub recovered_after: Option<f64>,
+}
+
+/// A kidnapped robot is recovered when its position estimate is this close to the truth (m).
+pub const RECOVERED: f64 = 0.3;
 
 impl LocalizationErrors {
     /// The `q` quantile (nearest rank) of the position errors (m) and of the heading errors
@@ -129,6 +154,11 @@ pub struct Pitch {
     eyes: Option<(Renderer, Vec<CameraState>)>,
     /// Each robot's camera pan joint, rad (the camera file's pan until a robot turns it).
     pans: Vec<f64>,
+    /// Kidnaps still to come: `(simulated time, robot)`, latest first; and their random
+    /// stream.
+    kidnap_plan: Vec<(f64, usize)>,
+    kidnap_rng: ChaCha8Rng,
+    kidnaps: Vec<Kidnap>,
 }
 
 const FNV_OFFSET: u64 = 0xcbf2_9ce4_8422_2325;
@@ -165,6 +195,8 @@ impl Pitch {
             })
             .collect();
         let mice = cfg.odometry.mice()?;
+        let mut kidnap_rng = ChaCha8Rng::seed_from_u64(seed ^ 0x6B69_646E_6170_0001);
+        let kidnap_plan = Self::plan_kidnaps(cfg, robots, &mut kidnap_rng);
         Ok(Pitch {
             cfg: cfg.clone(),
             base: Base::parse(&cfg.robot.base)?,
@@ -192,7 +224,61 @@ impl Pitch {
                 )),
             },
             pans: vec![cfg.camera.camera().map_or(0.0, |c| c.pan); robots],
+            kidnap_plan,
+            kidnap_rng,
+            kidnaps: Vec::new(),
         })
+    }
+
+    /// When each robot is kidnapped: `[rules] kidnaps` times in each half, uniformly in the
+    /// half's clock (which runs in READY and SET too) after its READY and SET and before its
+    /// last 5 s; latest first. A kidnap due outside play waits for play.
+    fn plan_kidnaps(cfg: &SimConfig, robots: usize, rng: &mut ChaCha8Rng) -> Vec<(f64, usize)> {
+        use rand::Rng;
+        let half = cfg.rules.half_duration;
+        let mut plan = Vec::new();
+        for robot in 0..robots {
+            for h in 0..2 {
+                for _ in 0..cfg.rules.kidnaps {
+                    let start = cfg.rules.ready_duration + cfg.rules.set_duration + 1.0;
+                    let (a, b) = (f64::from(h) * half + start, f64::from(h + 1) * half - 5.0);
+                    let at = if b > a { rng.random_range(a..b) } else { f64::from(h) * half };
+                    plan.push((at, robot));
+                }
+            }
+        }
+        plan.sort_by(|a, b| b.0.total_cmp(&a.0).then(b.1.cmp(&a.1)));
+        plan
+    }
+
+    /// Carries the robots whose kidnap is due to random free spots: inside the field 1 m from
+    /// its lines, 1 m from every other robot and the ball, 2 m from where it was.
+    fn kidnap_due(&mut self) {
+        use rand::Rng;
+        let now = self.world.time();
+        while self.kidnap_plan.last().is_some_and(|&(at, _)| at <= now) {
+            let Some((_, robot)) = self.kidnap_plan.pop() else { break };
+            let Some(from) = self.world.robot(robot) else { continue };
+            let (hl, hw) = (self.cfg.field.length / 2.0 - 1.0, self.cfg.field.width / 2.0 - 1.0);
+            let ball = self.world.ball();
+            let others: Vec<Pose2> = (0..self.world.robot_count())
+                .filter(|&j| j != robot)
+                .filter_map(|j| self.world.robot(j))
+                .collect();
+            let rng = &mut self.kidnap_rng;
+            let spot = (0..100).find_map(|_| {
+                let (x, y) = (rng.random_range(-hl..=hl), rng.random_range(-hw..=hw));
+                let theta = rng.random_range(-std::f64::consts::PI..std::f64::consts::PI);
+                let free = others.iter().all(|o| (o.x - x).hypot(o.y - y) >= 1.0)
+                    && (ball.0 - x).hypot(ball.1 - y) >= 1.0
+                    && (from.x - x).hypot(from.y - y) >= 2.0;
+                free.then(|| Pose2::new(x, y, theta))
+            });
+            if let Some(to) = spot {
+                self.world.carry_robot(robot, to);
+                self.kidnaps.push(Kidnap { robot, at: now, to, recovered_after: None });
+            }
+        }
     }
 
     /// The configuration.
@@ -297,12 +383,28 @@ impl Pitch {
         self.faults.sort_by_key(|f| f.robot);
     }
 
-    /// Books robot `i`'s own pose estimate against where it is now.
-    pub fn book_estimate(&mut self, i: usize, estimate: Pose2) {
-        if let Some(truth) = self.world.robot(i) {
-            let l = &mut self.localization;
-            l.position.push((estimate.x - truth.x).hypot(estimate.y - truth.y));
-            l.heading.push(normalize_angle(estimate.theta - truth.theta).abs());
+    /// Books robot `i`'s own estimates (its pose, and the ball's when it sees it) against the
+    /// truth now, and notes when a kidnapped robot is found again.
+    pub fn book_estimate(&mut self, i: usize, estimate: &Localization) {
+        let Some(truth) = self.world.robot(i) else { return };
+        let p = estimate.pose.inner;
+        let l = &mut self.localization;
+        let off = (p.x - truth.x).hypot(p.y - truth.y);
+        l.position.push(off);
+        l.heading.push(normalize_angle(p.theta - truth.theta).abs());
+        if let Some(ball) = estimate.ball.filter(|b| b.seen_ago <= 0.0) {
+            let (bx, by) = self.world.ball();
+            l.ball.push((ball.at.0 - bx).hypot(ball.at.1 - by));
+            if let Some((vx, vy)) = ball.velocity {
+                let (tx, ty) = self.world.ball_velocity();
+                l.ball_velocity.push((vx - tx).hypot(vy - ty));
+            }
+        }
+        let now = self.world.time();
+        if let Some(k) = self.kidnaps.iter_mut().rev().find(|k| k.robot == i) {
+            if k.recovered_after.is_none() && now > k.at && off < RECOVERED {
+                k.recovered_after = Some(now - k.at);
+            }
         }
     }
 
@@ -352,6 +454,9 @@ impl Pitch {
     /// Books this control cycle, then runs the physics (with the referee) up to the next one.
     /// Returns the referee's calls.
     pub fn advance(&mut self) -> Vec<Call> {
+        if self.referee.state() == GameState::Playing {
+            self.kidnap_due();
+        }
         self.account();
         self.fire_kicks();
         let steps =
@@ -414,6 +519,7 @@ impl Pitch {
             frames: self.frames,
             faults: self.faults,
             localization: self.localization,
+            kidnaps: self.kidnaps,
         }
     }
 }

@@ -135,12 +135,13 @@ pub struct Odometer {
     mice: MiceOdometry,
     last: Option<Pose2>,
     placements: u32,
+    carries: u32,
 }
 
 impl Odometer {
     /// The driver of robot `robot`'s mice (`mice`: their geometry) and wheels.
     pub fn new(robot: usize, mice: MiceOdometry) -> Odometer {
-        Odometer { robot, mice, last: None, placements: 0 }
+        Odometer { robot, mice, last: None, placements: 0, carries: 0 }
     }
 
     /// Reads the sensors: the mice see the body's true motion since the last reading (as the
@@ -157,10 +158,15 @@ impl Odometer {
         let now = world.robot(self.robot).unwrap_or_default();
         let (count, at) = world.placement(self.robot);
         let mut placed = None;
+        let carries = world.carried(self.robot);
         let from = if count != self.placements {
             self.placements = count;
             placed = Some(Framed::new(at));
             at
+        } else if carries != self.carries {
+            // Lifted and carried: the mice, off the floor, felt nothing.
+            self.carries = carries;
+            now
         } else {
             self.last.unwrap_or(now)
         };

@@ -34,6 +34,8 @@ struct Robot {
     kick_ready_at: f64,
     /// How often the robot was put down by hand, and where last.
     placed: (u32, Pose2),
+    /// How often it was carried elsewhere without being told ([`World::carry_robot`]).
+    carried: u32,
 }
 
 /// The physical world.
@@ -116,6 +118,7 @@ impl World {
                     drive: Drive::default(),
                     kick_ready_at: 0.0,
                     placed: (0, Pose2::default()),
+                    carried: 0,
                 }
             })
             .collect();
@@ -173,6 +176,24 @@ impl World {
         body.set_position(Pose::new(v(pose.x, pose.y), pose.theta as f32), true);
         body.set_linvel(Vector::ZERO, true);
         body.set_angvel(0.0, true);
+    }
+
+    /// Lifts robot `i` and puts it down at `pose`, at rest, without telling it: the kidnapped
+    /// robot of localization tests (its mice, off the floor, feel nothing of the carry).
+    pub fn carry_robot(&mut self, i: usize, pose: Pose2) {
+        let Some(r) = self.robots.get_mut(i) else { return };
+        r.drive = Drive::default();
+        r.carried = r.carried.wrapping_add(1);
+        let body = &mut self.physics.bodies[r.body];
+        body.set_position(Pose::new(v(pose.x, pose.y), pose.theta as f32), true);
+        body.set_linvel(Vector::ZERO, true);
+        body.set_angvel(0.0, true);
+    }
+
+    /// How many times robot `i` was carried with [`World::carry_robot`] (0 for an unknown
+    /// index).
+    pub fn carried(&self, i: usize) -> u32 {
+        self.robots.get(i).map_or(0, |r| r.carried)
     }
 
     /// How many times robot `i` was put down with [`World::place_robot`], and where last

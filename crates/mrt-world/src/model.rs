@@ -31,7 +31,8 @@ use mrt_core::frames::{Attack, Field, Framed, Team, MM_PER_M};
 use mrt_core::{normalize_angle, Point2, Pose2, Time, Vec2};
 use mrt_msgs::robot::{lps, Estimate, Lpo, WorldSnapshot};
 use mrt_msgs::{
-    CameraFrame, GameInfo, Localization, Odometry, Percepts, PostSighting, Sighting, FIELD_OBJECTS,
+    BallBelief, CameraFrame, GameInfo, Localization, Odometry, Percepts, PostSighting, Sighting,
+    FIELD_OBJECTS,
 };
 use mrt_perception::mice::{Displacement, MiceOdometry, MiceReadings};
 use mrt_perception::PerceptionError;
@@ -105,6 +106,10 @@ pub struct WorldModel {
     ball_track: Option<BallTrack>,
     /// MUREA watching the filter, with [`Localizer::Murea`].
     relocalizer: Option<Box<Relocalizer>>,
+    /// The last frame's time, s.
+    now: f64,
+    /// The ball's velocity in the field frame (m/s) when the last frame gave one.
+    ball_velocity: Option<(f64, f64)>,
 }
 
 /// The ball's velocity from successive vision percepts (an α filter on the field-frame
@@ -138,6 +143,8 @@ impl WorldModel {
             game: GameInfo::default(),
             ball_track: None,
             relocalizer: None,
+            now: 0.0,
+            ball_velocity: None,
         }
     }
 
@@ -189,15 +196,21 @@ impl WorldModel {
         self.counts
     }
 
-    /// The estimate for monitors: pose, uncertainty, quality and counts.
+    /// The estimate for monitors: pose, uncertainty, quality, counts and the ball's belief.
     pub fn localization(&self) -> Localization {
         let (sigma_xy, sigma_theta) = self.sigma();
+        let ball = self.memory[lps::BALL].map(|m| BallBelief {
+            at: (m.at.inner.x, m.at.inner.y),
+            velocity: self.ball_velocity.filter(|_| m.seen == self.now),
+            seen_ago: self.now - m.seen,
+        });
         Localization {
             pose: self.pose(),
             sigma_xy,
             sigma_theta,
             quality: self.quality(),
             counts: self.counts,
+            ball,
         }
     }
 
@@ -411,6 +424,11 @@ impl WorldModel {
             self.correct_all(frame, sigmas);
         }
         let me: Framed<Field, Pose2> = Framed::new(self.pose);
+        self.now = frame.time;
+        self.ball_velocity = frame.ball_velocity.map(|(vx, vy)| {
+            let (s, c) = self.pose.theta.sin_cos();
+            (c * vx - s * vy, s * vx + c * vy)
+        });
         for (k, z) in frame.sightings.iter().enumerate() {
             match z {
                 Some(z) => {
@@ -532,12 +550,10 @@ impl WorldModel {
             let (x, y) = mm(at.to_team(attack));
             w.global_ball = Estimate { pose: Pose2::new(x, y, 0.0), quality: reliability };
         }
-        if let Some((vx, vy)) = frame.ball_velocity {
-            // A velocity in the robot frame, turned by the estimated heading into the field
-            // frame, then into the team's.
-            let (s, c) = self.pose.theta.sin_cos();
-            let v: Framed<Field, Point2> =
-                Framed::new(Point2::new(c * vx - s * vy, s * vx + c * vy));
+        if let Some((vx, vy)) = self.ball_velocity {
+            // The velocity turned by the estimated heading into the field frame (`observe`),
+            // then into the team's.
+            let v: Framed<Field, Point2> = Framed::new(Point2::new(vx, vy));
             let (fx, fy) = mm(v.to_team(attack));
             w.ball_vel = Vec2::new(fx, fy);
         }

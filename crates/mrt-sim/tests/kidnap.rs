@@ -1,0 +1,55 @@
+//! The kidnapped robot (issue 20): robots carried elsewhere without being told find themselves
+//! again from what they see; the carry is booked, never told to the robot.
+#![allow(missing_docs, clippy::unwrap_used, clippy::expect_used)]
+
+use mrt_robot::config::Localizer;
+use mrt_robot::stacks::Stack;
+use mrt_sim::config::SimConfig;
+use mrt_sim::game::{Pitch, RECOVERED};
+use mrt_sim::metrics::MetricsBook;
+
+fn config(kidnaps: u32, localizer: Localizer) -> SimConfig {
+    let mut cfg = SimConfig::default();
+    cfg.rules.half_duration = 40.0;
+    cfg.rules.kidnaps = kidnaps;
+    cfg.localization.localizer = localizer;
+    cfg
+}
+
+/// Every robot is carried twice a match (once a half); with MUREA each is found again within
+/// a few seconds, and the pooled metrics say so.
+#[test]
+fn kidnapped_robots_find_themselves_again() {
+    let cfg = config(1, Localizer::Murea);
+    let r = mrt_sim::play(&cfg, 3, (Stack::Milan, Stack::Chaos), None, false, |_| {}).unwrap();
+    let robots = 2 * cfg.rules.team_size;
+    assert!(r.kidnaps.len() >= robots * 2 - 1, "{} kidnaps", r.kidnaps.len());
+    for k in &r.kidnaps {
+        let after = k.recovered_after.unwrap_or_else(|| panic!("never found again: {k:?}"));
+        assert!(after < 5.0, "{k:?}");
+    }
+    let mut book = MetricsBook::default();
+    book.add(&r);
+    let m = book.metrics();
+    assert_eq!(m.kidnap.count as usize, r.kidnaps.len());
+    assert_eq!(m.kidnap.recovered, m.kidnap.count);
+    assert!(m.kidnap.median_recovery_s.is_some_and(|t| t < 2.0), "{m:?}");
+    assert!(RECOVERED <= 0.3);
+}
+
+/// The carry moves the robot and nothing else: its odometry reports no placement and no motion
+/// for it; without kidnaps the plan is empty and the match is the same as before.
+#[test]
+fn a_carry_is_not_told_to_the_robot() {
+    let cfg = config(0, Localizer::Murea);
+    let mut pitch = Pitch::new(&cfg, 1, 4, 4).unwrap();
+    pitch.odometry(2);
+    let there = mrt_core::Pose2::new(3.0, 2.0, 1.0);
+    pitch.world_mut().carry_robot(2, there);
+    let o = pitch.odometry(2);
+    assert_eq!(o.placed, None, "a carry is not a placement");
+    let moved = o.mice.x_left.hypot(o.mice.y_left) + o.mice.x_right.hypot(o.mice.y_right);
+    assert!(moved < 1e-9, "the mice felt the carry: {o:?}");
+    assert_eq!(pitch.world().robot(2).map(|p| (p.x, p.y)), Some((3.0, 2.0)));
+    assert_eq!(pitch.world().carried(2), 1);
+}
