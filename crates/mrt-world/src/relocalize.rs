@@ -220,6 +220,7 @@ impl Relocalizer {
         murea.budget.cells = 20_000;
         let mut coarse = murea.clone();
         coarse.accuracy = (0.25, 4f64.to_radians());
+        coarse.budget.cells = 60_000;
         Relocalizer {
             coarse,
             murea,
