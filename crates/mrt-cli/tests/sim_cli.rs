@@ -84,12 +84,12 @@ fn a_closed_standard_output_ends_the_program_quietly() {
 }
 
 /// Everything but the line that says how long it took and how the robots were wired, and the
-/// localization error (the in-process match's observer books it; robots in other processes
-/// are not watched).
+/// localization and ball errors (the in-process match's observer books them; robots in other
+/// processes are not watched).
 fn result_lines(stdout: &str) -> Vec<String> {
     stdout
         .lines()
-        .filter(|l| !l.starts_with("  localization error"))
+        .filter(|l| !l.starts_with("  localization error") && !l.starts_with("  ball error"))
         .map(|l| l.split(" simulated in ").next().unwrap_or(l).to_string())
         .collect()
 }

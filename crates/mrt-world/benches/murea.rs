@@ -1,7 +1,8 @@
 //! MUREA's cost (issue 20 item 7: ≤ 10 ms per global localization of one frame on one core):
 //! one frame of a robot on the MSL field that sees 6 landmarks and 16 field-line points, with
 //! noise of a third of the tolerances, localized globally (the whole field, every heading) and
-//! in tracking mode (±0.5 m, ±0.3 rad round a prediction), under several cell budgets. The
+//! in tracking mode (±0.5 m, ±0.3 rad round a prediction), under several cell budgets, and
+//! the world model's relocalizer finding the robot from that frame alone. The
 //! position error of each setting is printed once before it is timed.
 //!
 //! Run: `cargo bench -p mrt-world --bench murea`.
@@ -11,6 +12,7 @@ use criterion::{black_box, criterion_group, criterion_main, Criterion};
 use mrt_core::{normalize_angle, Pose2};
 use mrt_world::field::FieldMap;
 use mrt_world::murea::{Kind, Map, Murea, Perception};
+use mrt_world::relocalize::Relocalizer;
 
 /// What a robot at `pose` sees: the goals and posts within 9 m and points of the lines
 /// within 5 m, each off by a third of its tolerances in turn.
@@ -83,6 +85,22 @@ fn bench(c: &mut Criterion) {
     let err = (fix.pose.x - truth.x).hypot(fix.pose.y - truth.y);
     println!("tracking: error {err:.3} m, {} cells", fix.cells);
     g.bench_function("tracking", |b| b.iter(|| murea.localize(black_box(&seen), area)));
+    // The world model's relocalizer on the same frame with its tracker 6 m off: the coarse
+    // global search on the goals and posts, then the fine one round it with the lines.
+    let wrong = Pose2::new(3.0, -2.0, 2.0);
+    let fresh = Relocalizer::new(&field);
+    let mut r = fresh.clone();
+    let fix = r.frame(0.0, seen.clone(), wrong).unwrap();
+    let err = (fix.pose.x - truth.x).hypot(fix.pose.y - truth.y);
+    let turn = normalize_angle(fix.pose.theta - truth.theta).abs().to_degrees();
+    println!("relocalizer: error {err:.3} m {turn:.2}°, fine search {} cells", fix.cells);
+    g.bench_function("relocalizer_kidnapped", |b| {
+        b.iter_batched(
+            || (fresh.clone(), seen.clone()),
+            |(mut r, seen)| r.frame(0.0, seen, wrong),
+            criterion::BatchSize::SmallInput,
+        )
+    });
     g.finish();
 }
 

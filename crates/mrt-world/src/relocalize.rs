@@ -19,10 +19,13 @@
 //!    row do not fit the tracker's pose after some that did, the older ones are dropped: the
 //!    odometry cannot feel a robot lifted and carried, so what it saw before says nothing of
 //!    where it is.
-//! 2. Every frame, the window is scored at the tracker's pose ([`Murea::quality_at`], a few
-//!    microseconds). While it explains at least [`SUSPECT`] of the window, nothing else runs.
-//! 3. Otherwise, when the window holds at least two goals' or posts' worth of weight, at most
-//!    every [`RETRY`] s, MUREA searches the whole field on the goals and posts, coarsely
+//! 2. Every frame is scored at the tracker's pose ([`Murea::quality_at`], a few
+//!    microseconds). While the pose explains at least [`SUSPECT`] of it, nothing else runs;
+//!    nor on the first frame that it does not explain (a false sighting, or the first after a
+//!    carry: the next frame tells).
+//! 3. Otherwise, the whole window is scored at the tracker's pose. When that too falls below
+//!    [`SUSPECT`] and the window holds at least two goals' or posts' worth of weight, at
+//!    most every [`RETRY`] s, MUREA searches the whole field on the goals and posts, coarsely
 //!    (25 cm, 4°: line points fit some line from almost anywhere and would keep every cell's
 //!    bound high), then around that pose on everything (10 cm, 2°). The fix replaces the
 //!    tracker's pose when it explains at least [`ACCEPT`] of the window, [`MARGIN`] more
@@ -211,8 +214,8 @@ pub struct Relocalizer {
 }
 
 impl Relocalizer {
-    /// A relocalizer on `field`, whose goals and posts are told apart by colour, each MUREA
-    /// search within 20 000 cells, and a window of 1.5 s.
+    /// A relocalizer on `field`, whose goals and posts are told apart by colour, the coarse
+    /// search within 60 000 cells and the fine one within 20 000, and a window of 1.5 s.
     pub fn new(field: &FieldMap) -> Relocalizer {
         let mut murea = Murea::new(Map::field(field, true));
         // The tracker refines the fix from the next sightings: 10 cm and 2° are enough.
