@@ -16,15 +16,9 @@ use mrt_world::{FieldMap, WorldModel};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
-/// The camera's measurement noise as the world model assumes it: a relative distance error
-/// and a bearing error (rad), one standard deviation each.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct CameraNoise {
-    /// Distance error, as a fraction of the distance.
-    pub distance: f64,
-    /// Bearing error, rad.
-    pub bearing: f64,
-}
+/// The camera's measurement noise as the world model assumes it (one definition, the world
+/// model's).
+pub use mrt_world::relocalize::CameraNoise;
 
 /// One robot's configuration (module doc). SI units: metres, seconds, radians.
 #[derive(Clone, Debug, PartialEq)]

@@ -94,8 +94,8 @@ pub use mrt_msgs::FilterCounts;
 pub struct WorldModel {
     map: FieldMap,
     mice: MiceOdometry,
-    distance_noise: f64,
-    bearing_noise: f64,
+    /// The camera's errors as this model assumes them.
+    noise: CameraNoise,
     pose: Pose2,
     cov: Matrix3<f64>,
     memory: [Option<Memory>; FIELD_OBJECTS],
@@ -134,8 +134,7 @@ impl WorldModel {
         WorldModel {
             map,
             mice,
-            distance_noise,
-            bearing_noise,
+            noise: CameraNoise { distance: distance_noise, bearing: bearing_noise },
             pose: Pose2::default(),
             cov: Matrix3::from_diagonal(&Vector3::new(100.0, 100.0, PI * PI)),
             memory: [None; FIELD_OBJECTS],
@@ -155,11 +154,6 @@ impl WorldModel {
             Localizer::Murea => Some(Box::new(Relocalizer::new(&self.map))),
         };
         self
-    }
-
-    /// The camera's errors as this model assumes them.
-    fn noise(&self) -> CameraNoise {
-        CameraNoise { distance: self.distance_noise, bearing: self.bearing_noise }
     }
 
     /// Which localizer keeps the pose.
@@ -339,7 +333,7 @@ impl WorldModel {
         );
         // The vision µAgent's own estimate, where larger: a far net's distance rests on a
         // pixel row that spans half a metre of floor.
-        let (sd, sb) = self.noise().sigma(z.distance, sigma);
+        let (sd, sb) = self.noise.sigma(z.distance, sigma);
         let r = Matrix2::new(sd * sd, 0.0, 0.0, sb * sb);
         let s_inv = (h * self.cov * h.transpose() + r).try_inverse()?;
         let d2 = (nu.transpose() * s_inv * nu)[(0, 0)];
@@ -392,7 +386,7 @@ impl WorldModel {
     pub fn camera(&mut self, frame: &CameraFrame) -> WorldSnapshot {
         let none = [None; FIELD_OBJECTS];
         let perceived = self.relocalizer.as_ref().map(|_| {
-            relocalize::perceptions(&self.map, self.noise(), &frame.sightings, &none, &[], &[])
+            relocalize::perceptions(&self.map, self.noise, &frame.sightings, &none, &[], &[])
         });
         self.observe(frame, &none, perceived)
     }
@@ -451,7 +445,7 @@ impl WorldModel {
     pub fn percepts(&mut self, p: &Percepts) -> WorldSnapshot {
         // The relocalizer takes the posts by their pattern: naming them rests on the pose.
         let perceived = self.relocalizer.as_ref().map(|_| {
-            let noise = self.noise();
+            let noise = self.noise;
             relocalize::perceptions(
                 &self.map,
                 noise,

@@ -118,8 +118,9 @@ const LINE_WEIGHT: f64 = 0.3;
 /// Tolerance growth per metre driven since a glimpse (odometry drift), m/m.
 const DRIFT: f64 = 0.05;
 
-/// The camera's errors as the world model assumes them: a standard deviation of the distance
-/// proportional to it (`distance`, a fraction) and one of the bearing (`bearing`, rad).
+/// The camera's measurement noise as the world model assumes it: a standard deviation of the
+/// distance proportional to it (`distance`, a fraction) and one of the bearing (`bearing`,
+/// rad). Robot files set it (`mrt_robot::config::RobotConfig::camera`).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct CameraNoise {
     /// Relative distance error.
