@@ -45,12 +45,61 @@ pub struct RobotArgs {
     pub config: PathBuf,
 }
 
-fn free_tcp_port() -> Result<u16> {
-    Ok(std::net::TcpListener::bind("127.0.0.1:0")?.local_addr()?.port())
+/// Picks the loopback ports of one match: free now, distinct, and outside the system's
+/// ephemeral range. A port the system handed out for `:0` could be handed out again, to an
+/// outgoing connection of another robot or another match, before the robot it was meant for
+/// has started listening on it (the likely cause of a robot that once ended before a CI match,
+/// its log lost in a backtrace); ports below the ephemeral range are taken only by name.
+struct PortPicker {
+    next: u32,
+    low: u32,
+    span: u32,
+    taken: Vec<u16>,
 }
 
-fn free_udp_port() -> Result<u16> {
-    Ok(std::net::UdpSocket::bind("127.0.0.1:0")?.local_addr()?.port())
+impl PortPicker {
+    /// Starts at a place that differs between processes, so two matches at once rarely
+    /// probe the same ports.
+    fn new() -> Self {
+        let (low, high) = below_ephemeral();
+        let span = high - low;
+        let nanos = std::time::SystemTime::now()
+            .duration_since(std::time::UNIX_EPOCH)
+            .map_or(0, |d| d.subsec_nanos());
+        let next = (std::process::id().wrapping_mul(2_654_435_761) ^ nanos) % span;
+        Self { next, low, span, taken: Vec::new() }
+    }
+
+    /// The next port that both TCP and UDP can bind on loopback.
+    fn port(&mut self) -> Result<u16> {
+        for _ in 0..self.span {
+            let port = (self.low + self.next % self.span) as u16;
+            self.next = self.next.wrapping_add(1);
+            let free = std::net::TcpListener::bind(("127.0.0.1", port)).is_ok()
+                && std::net::UdpSocket::bind(("127.0.0.1", port)).is_ok();
+            if free && !self.taken.contains(&port) {
+                self.taken.push(port);
+                return Ok(port);
+            }
+        }
+        bail!("no free loopback port in {}..{}", self.low, self.low + self.span)
+    }
+}
+
+/// Ports from 20000 up to the start of the ephemeral range (Linux's from
+/// `/proc/sys/net/ipv4/ip_local_port_range`, 32768 by default; other systems start theirs at
+/// 49152).
+fn below_ephemeral() -> (u32, u32) {
+    let first = std::fs::read_to_string("/proc/sys/net/ipv4/ip_local_port_range")
+        .ok()
+        .and_then(|s| s.split_whitespace().next()?.parse::<u32>().ok())
+        .unwrap_or(32768);
+    if first >= 21_000 {
+        (20_000, first)
+    } else {
+        // An unusual range reaching below 21000: above it is what is left.
+        (50_000, 60_000)
+    }
 }
 
 /// The robot processes and their directory; killed and removed on drop.
@@ -64,11 +113,16 @@ impl Robots {
         self.dir.join(format!("robot-{robot}.log"))
     }
 
-    /// The end of a robot's log, for error messages.
+    /// A robot's log for error messages: from its `Error:` line if it has one (robots run
+    /// without backtraces, but an error's causes follow it), else its last lines.
     fn tail(&self, robot: usize) -> String {
         let text = std::fs::read_to_string(self.log(robot)).unwrap_or_default();
         let lines: Vec<&str> = text.lines().collect();
-        lines[lines.len().saturating_sub(8)..].join("\n")
+        let from = lines
+            .iter()
+            .rposition(|l| l.starts_with("Error:"))
+            .unwrap_or(lines.len().saturating_sub(8));
+        lines[from..lines.len().min(from + 12)].join("\n")
     }
 
     /// A robot process that ended already, with its status.
@@ -140,8 +194,9 @@ pub fn play(
     let dir = std::env::temp_dir().join(format!("mrt-distributed-{}-{seed}", std::process::id()));
     std::fs::create_dir_all(&dir).with_context(|| format!("cannot create {}", dir.display()))?;
     let mut procs = Robots { dir: dir.clone(), children: Vec::new() };
-    let ports = (0..robots).map(|_| free_tcp_port()).collect::<Result<Vec<_>>>()?;
-    let sim_ports = [free_tcp_port()?, free_tcp_port()?];
+    let mut picker = PortPicker::new();
+    let ports = (0..robots).map(|_| picker.port()).collect::<Result<Vec<_>>>()?;
+    let sim_ports = [picker.port()?, picker.port()?];
     let exe = std::env::current_exe().context("cannot find the mrt executable")?;
     // The simulator's side of each team's network, listening for the robots.
     let mut agoras = Vec::new();
@@ -153,7 +208,7 @@ pub fn play(
     }
     let mut files = Vec::new();
     for (t, sim_port) in sim_ports.iter().enumerate() {
-        let discovery = free_udp_port()?;
+        let discovery = picker.port()?;
         let stack = if t == 0 { home } else { away };
         for i in t * n..(t + 1) * n {
             let net = dir.join(format!("robot-{i}.cfg"));
@@ -278,6 +333,9 @@ impl Launch {
             .stdin(Stdio::null())
             .stdout(Stdio::null())
             .stderr(log)
+            // The log is for people: the error and its causes, not a backtrace.
+            .env("RUST_BACKTRACE", "0")
+            .env("RUST_LIB_BACKTRACE", "0")
             .spawn()
             .with_context(|| format!("cannot start robot {i}"))
     }
