@@ -30,9 +30,6 @@ fn config(gaze: bool) -> SimConfig {
     cfg.sensor.half_fov = 0.35; // a narrow camera: 40° wide
     cfg.sensor.miss_probability = 0.0;
     cfg.gaze.enabled = gaze;
-    // The gaze on the EKF alone: with MUREA relocalizing, this robot's look alternates only
-    // 4 times in 30 s. A defect not yet found (issue 20, stop 30's note).
-    cfg.localization.localizer = mrt_robot::config::Localizer::Ekf;
     cfg
 }
 

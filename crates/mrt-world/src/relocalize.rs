@@ -108,7 +108,7 @@ pub const DISAGREE: usize = 2;
 /// with them: docs/performance.md).
 pub const WINDOW_PERCEPTIONS: usize = 24;
 /// Two sightings of a goal or a post of one kind this close (m, in the field frame of the
-/// tracker) are one object seen twice.
+/// tracker), or within their range tolerances combined, are one object seen twice.
 pub const SAME_OBJECT: f64 = 0.5;
 /// At most this many line points of one frame become perceptions (evenly picked).
 pub const LINE_POINTS: usize = 12;
@@ -257,39 +257,57 @@ impl Relocalizer {
 
     /// The perceptions of the window, in the robot's frame now, weighed by age and with
     /// tolerances grown by the drive since: the newest glimpses first, until
-    /// [`WINDOW_PERCEPTIONS`] are taken, a goal or post seen again (of its kind, within
-    /// [`SAME_OBJECT`] of an earlier sighting) only once. `pose`: the tracker's pose now.
+    /// [`WINDOW_PERCEPTIONS`] are taken. A goal or post seen again (of its kind, within
+    /// [`SAME_OBJECT`] or the two sightings' range tolerances of it) is one perception at the
+    /// weighted mean of its sightings: a far post seen twice 1 m apart (a camera's range
+    /// error at 10 m) is one post, not two that no single pose explains. `pose`: the
+    /// tracker's pose now.
     pub fn window_now(&self, now: f64, pose: Pose2) -> Vec<Perception> {
-        let mut out = Vec::new();
-        let mut taken: Vec<(Kind, Point2)> = Vec::new();
+        // (field-frame point, the newest sighting's perception with grown tolerances,
+        // the sum of the sightings' weights and of their weighted points)
+        let mut seen: Vec<(Point2, Perception, f64, nalgebra::Vector2<f64>)> = Vec::new();
         for g in self.glimpses.iter().rev() {
-            if out.len() >= WINDOW_PERCEPTIONS {
+            if seen.len() >= WINDOW_PERCEPTIONS {
                 break;
             }
             let fade = 0.5f64.powf((now - g.time).max(0.0) / HALF_LIFE);
             let drift = DRIFT * (self.driven.0 - g.driven.0);
             let turned = self.driven.1 - g.driven.1;
             for (at, p) in &g.seen {
-                if p.kind != Kind::LINE
-                    && taken.iter().any(|(k, t)| *k == p.kind && (t - at).norm() < SAME_OBJECT)
-                {
-                    continue; // seen again since: the newer sighting speaks for it
+                let weight = (p.weight * fade).max(1e-3);
+                let again = (p.kind != Kind::LINE)
+                    .then(|| {
+                        seen.iter_mut().find(|(first, q, ..)| {
+                            q.kind == p.kind
+                                && (first - at).norm()
+                                    < SAME_OBJECT.max(q.range_tolerance.hypot(p.range_tolerance))
+                        })
+                    })
+                    .flatten();
+                if let Some((_, _, sum, mean)) = again {
+                    *sum += weight;
+                    *mean += at.coords * weight;
+                    continue;
                 }
-                taken.push((p.kind, *at));
                 let q = pose.inverse_transform_point(*at);
                 let range = q.coords.norm();
-                let bearing = q.y.atan2(q.x);
-                out.push(
-                    Perception::point(p.kind, range, bearing)
-                        .tolerances(
-                            p.range_tolerance + drift,
-                            p.bearing_tolerance + DRIFT * turned + drift / range.max(0.5),
-                        )
-                        .weighted((p.weight * fade).max(1e-3)),
-                );
+                let grown = Perception::point(p.kind, range, q.y.atan2(q.x))
+                    .tolerances(
+                        p.range_tolerance + drift,
+                        p.bearing_tolerance + DRIFT * turned + drift / range.max(0.5),
+                    )
+                    .weighted(weight);
+                seen.push((*at, grown, weight, at.coords * weight));
             }
         }
-        out
+        seen.into_iter()
+            .map(|(_, mut p, sum, mean)| {
+                let q = pose.inverse_transform_point(Point2::from(mean / sum));
+                p.range = Some(q.coords.norm());
+                p.bearing = Some(q.y.atan2(q.x));
+                p
+            })
+            .collect()
     }
 
     /// One frame's `perceptions` at `now` (s), with the tracker's `pose`. Returns MUREA's fix
@@ -481,5 +499,36 @@ mod tests {
         assert!((w[0].weight - 0.5).abs() < 1e-9, "half its weight after one half-life");
         assert!(w[0].range_tolerance > 0.43, "grown by the drive: {}", w[0].range_tolerance);
         assert_eq!(WEST_NET, 2);
+    }
+
+    /// The gaze test's robot (stop 30's defect): a far post seen twice, 11.5 m and 10.3 m
+    /// away (3σ each is about 1 m), was two posts that no pose explained together, and a
+    /// search put the robot 1.7 m from where it stood.
+    #[test]
+    fn a_far_post_seen_twice_is_one_post_at_the_mean_of_its_sightings() {
+        let f = field();
+        let mut r = Relocalizer::new(&f);
+        let post = |distance: f64| PostSighting {
+            sighting: Sighting { distance, bearing: -0.58 },
+            sigma: (0.0, 0.0),
+            east: true,
+            pixels: 10,
+        };
+        let none = [None; FIELD_OBJECTS];
+        for (t, d) in [(0.0, 11.5), (0.1, 10.3)] {
+            let p = perceptions(&f, NOISE, &none, &[None; FIELD_OBJECTS], &[post(d)], &[]);
+            r.frame(t, p, Pose2::default());
+        }
+        let w = r.window_now(0.1, Pose2::default());
+        assert_eq!(w.len(), 1, "{w:?}");
+        let weights = [0.5f64.powf(0.1 / HALF_LIFE), 1.0];
+        let mean = (11.5 * weights[0] + 10.3 * weights[1]) / (weights[0] + weights[1]);
+        assert!((w[0].range.unwrap_or(0.0) - mean).abs() < 1e-9, "{w:?}");
+        assert!((w[0].bearing.unwrap_or(0.0) + 0.58).abs() < 1e-9);
+        // Two posts of one pattern 3 m apart stay two.
+        let mut r = Relocalizer::new(&f);
+        let p = perceptions(&f, NOISE, &none, &[None; FIELD_OBJECTS], &[post(4.0), post(7.0)], &[]);
+        r.frame(0.0, p, Pose2::default());
+        assert_eq!(r.window_now(0.0, Pose2::default()).len(), 2);
     }
 }
