@@ -274,6 +274,13 @@ pub fn run(args: &SimArgs) -> Result<()> {
             .map_or(String::new(), |v| format!("; velocity {v:.2} m/s mean"));
         outln!("  ball error while seen: {mean:.2} m mean, {p95:.2} m p95{velocity}");
     }
+    if m.localization.relocalized > 0 {
+        outln!(
+            "  relocalized {} times, {} of them falsely (> 1 m from the truth)",
+            m.localization.relocalized,
+            m.localization.falsely_relocalized
+        );
+    }
     if m.kidnap.count > 0 {
         outln!(
             "  kidnapped {} times, found again {} times{}",

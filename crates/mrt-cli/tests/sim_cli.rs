@@ -89,7 +89,11 @@ fn a_closed_standard_output_ends_the_program_quietly() {
 fn result_lines(stdout: &str) -> Vec<String> {
     stdout
         .lines()
-        .filter(|l| !l.starts_with("  localization error") && !l.starts_with("  ball error"))
+        .filter(|l| {
+            !l.starts_with("  localization error")
+                && !l.starts_with("  ball error")
+                && !l.starts_with("  relocalized")
+        })
         .map(|l| l.split(" simulated in ").next().unwrap_or(l).to_string())
         .collect()
 }

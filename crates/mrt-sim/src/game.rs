@@ -97,7 +97,17 @@ pub struct LocalizationErrors {
     pub ball: Vec<f64>,
     /// Ball velocity errors while seen, m/s.
     pub ball_velocity: Vec<f64>,
+    /// Global relocalizations (a robot's estimate put elsewhere by its relocalizer, MUREA's
+    /// fix replacing the tracker's pose).
+    pub relocalized: u64,
+    /// Those of them that left the estimate more than [`FALSELY_RELOCALIZED`] from the truth.
+    pub falsely_relocalized: u64,
+    /// Each robot's count of relocalizations at its last estimate.
+    seen_relocalized: Vec<u64>,
 }
+
+/// A relocalization that leaves the estimate this far from the truth (m) was false.
+pub const FALSELY_RELOCALIZED: f64 = 1.0;
 
 /// A robot carried elsewhere without being told, and whether its own estimate found it again.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -399,6 +409,15 @@ impl Pitch {
                 let (tx, ty) = self.world.ball_velocity();
                 l.ball_velocity.push((vx - tx).hypot(vy - ty));
             }
+        }
+        if l.seen_relocalized.len() <= i {
+            l.seen_relocalized.resize(i + 1, 0);
+        }
+        let fixes = estimate.counts.relocalized.saturating_sub(l.seen_relocalized[i]);
+        l.seen_relocalized[i] = estimate.counts.relocalized;
+        l.relocalized += fixes;
+        if off > FALSELY_RELOCALIZED {
+            l.falsely_relocalized += fixes;
         }
         let now = self.world.time();
         if let Some(k) = self.kidnaps.iter_mut().rev().find(|k| k.robot == i) {

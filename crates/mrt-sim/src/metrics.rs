@@ -66,6 +66,8 @@ pub struct MetricsBook {
     ball_velocity: Histogram,
     kidnaps: u64,
     recoveries: Vec<f64>,
+    relocalized: u64,
+    falsely_relocalized: u64,
 }
 
 impl Default for MetricsBook {
@@ -78,6 +80,8 @@ impl Default for MetricsBook {
             ball_velocity: Histogram::new(0.001, 30.0),
             kidnaps: 0,
             recoveries: Vec::new(),
+            relocalized: 0,
+            falsely_relocalized: 0,
         }
     }
 }
@@ -93,6 +97,8 @@ impl MetricsBook {
         l.ball_velocity.iter().for_each(|&v| self.ball_velocity.add(v));
         self.kidnaps += r.kidnaps.len() as u64;
         self.recoveries.extend(r.kidnaps.iter().filter_map(|k| k.recovered_after));
+        self.relocalized += l.relocalized;
+        self.falsely_relocalized += l.falsely_relocalized;
     }
 
     /// The metrics so far.
@@ -110,6 +116,8 @@ impl MetricsBook {
                 heading_median_deg: deg(self.heading.quantile(0.5)),
                 heading_p95_deg: deg(self.heading.quantile(0.95)),
                 samples: self.position.n,
+                relocalized: self.relocalized,
+                falsely_relocalized: self.falsely_relocalized,
             },
             ball: BallMetrics {
                 mean_m: self.ball.mean(),
@@ -161,6 +169,11 @@ pub struct LocalizationMetrics {
     pub heading_p95_deg: Option<f64>,
     /// Estimates compared.
     pub samples: u64,
+    /// Global relocalizations: a robot's relocalizer moved its estimate (MUREA).
+    pub relocalized: u64,
+    /// Those that left the estimate more than 1 m from the truth
+    /// ([`crate::game::FALSELY_RELOCALIZED`]).
+    pub falsely_relocalized: u64,
 }
 
 /// The ball's position error in every estimate made while the robot saw it, and its velocity
@@ -204,6 +217,11 @@ mod tests {
     use mrt_core::Pose2;
 
     fn report(position: Vec<f64>, kidnaps: Vec<Kidnap>) -> MatchReport {
+        let mut localization = LocalizationErrors::default();
+        localization.heading = vec![0.0; position.len()];
+        localization.position = position;
+        localization.ball = vec![0.1, 0.3];
+        (localization.relocalized, localization.falsely_relocalized) = (3, 1);
         MatchReport {
             seed: 1,
             score: (0, 0),
@@ -214,12 +232,7 @@ mod tests {
             shots: Vec::new(),
             frames: Vec::new(),
             faults: Vec::new(),
-            localization: LocalizationErrors {
-                heading: vec![0.0; position.len()],
-                position,
-                ball: vec![0.1, 0.3],
-                ball_velocity: Vec::new(),
-            },
+            localization,
             kidnaps,
         }
     }
@@ -248,6 +261,7 @@ mod tests {
         assert_eq!((m.kidnap.median_recovery_s, m.kidnap.max_recovery_s), (Some(0.6), Some(1.2)));
         let json = serde_json::to_value(&m).unwrap_or_default();
         assert_eq!(json["kidnap"]["recovered"], 3);
+        assert_eq!((m.localization.relocalized, m.localization.falsely_relocalized), (6, 2));
         assert!(json["ball"]["velocity_mean_mps"].is_null());
     }
 

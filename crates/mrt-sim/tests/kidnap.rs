@@ -34,6 +34,9 @@ fn kidnapped_robots_find_themselves_again() {
     assert_eq!(m.kidnap.count as usize, r.kidnaps.len());
     assert_eq!(m.kidnap.recovered, m.kidnap.count);
     assert!(m.kidnap.median_recovery_s.is_some_and(|t| t < 2.0), "{m:?}");
+    // MUREA found some of them (the EKF, matching named landmarks, the others), never wrongly.
+    let l = &m.localization;
+    assert!(l.relocalized > 0 && l.falsely_relocalized == 0, "{l:?}");
 }
 
 /// The carry moves the robot and nothing else: its odometry reports no placement and no motion

@@ -320,8 +320,9 @@ pub struct Fix {
     /// The size `(x, y, θ)` of its cell: the accuracy asked for, or coarser when the budget ran
     /// out.
     pub cell: (f64, f64, f64),
-    /// Other poses that explain nearly as much, far from `pose` (the mirrored pose on a
-    /// symmetric field), with their evidence, best first.
+    /// Other poses that explain nearly as much, far from `pose` and with poses between that
+    /// explain much less (the mirrored pose on a symmetric field), with their evidence, best
+    /// first.
     pub alternatives: Vec<(Pose2, f64)>,
     /// Whether the budget ran out: before the accuracy was reached (then `cell` is coarser), or
     /// before all the poses of the best evidence were compared (then `pose` may not fit best).
@@ -340,6 +341,12 @@ fn usable(perceptions: &[Perception]) -> (Vec<u16>, f64) {
     let total = valid.iter().map(|&k| perceptions[usize::from(k)].weight).sum();
     (valid, total)
 }
+
+/// Two poses that both fit are two answers (an ambiguity) only when some pose between them
+/// explains less than this fraction of the best's evidence...
+const VALLEY: f64 = 0.5;
+/// ... among this many less one evenly spaced between them.
+const VALLEY_SAMPLES: u32 = 8;
 
 /// The MUREA localizer: a map, the accuracy required, a budget (module doc).
 #[derive(Clone, Debug)]
@@ -661,9 +668,23 @@ impl Murea {
             (a.x - b.x).hypot(a.y - b.y) >= self.apart.0
                 || normalize_angle(a.theta - b.theta).abs() >= self.apart.1
         };
+        // A pose on the same ridge of evidence as the best is not another answer, only the
+        // fix's imprecision (two far goals with metres of range tolerance fit a long strip
+        // of poses): another answer lies beyond a valley.
+        let valley = |q: Pose2| {
+            (1..VALLEY_SAMPLES).any(|k| {
+                let t = f64::from(k) / f64::from(VALLEY_SAMPLES);
+                let between = Pose2::new(
+                    pose.x + t * (q.x - pose.x),
+                    pose.y + t * (q.y - pose.y),
+                    pose.theta + t * normalize_angle(q.theta - pose.theta),
+                );
+                self.score(between, perceptions, &valid) < VALLEY * evidence
+            })
+        };
         let mut alternatives: Vec<(Pose2, f64)> = Vec::new();
         for &(q, e) in &found[1..] {
-            if far(q, pose) && alternatives.iter().all(|a| far(q, a.0)) {
+            if far(q, pose) && alternatives.iter().all(|a| far(q, a.0)) && valley(q) {
                 alternatives.push((q, e));
             }
         }
@@ -793,6 +814,44 @@ mod tests {
             let ambiguous = fix.alternatives.iter().any(|a| near(a.0, other));
             assert_eq!(ambiguous, !coloured, "coloured {coloured}: {:?}", fix.alternatives);
         }
+    }
+
+    /// Two far objects with a metre of range tolerance fit a strip of poses metres long: its
+    /// ends are not two answers (stop 31: the relocalizer refused nearly every search of a
+    /// goalkeeper looking up the field as "ambiguous").
+    #[test]
+    fn a_long_ridge_of_poses_that_fit_is_one_answer_not_an_ambiguity() {
+        let mut murea = Murea::new(Map::field(&FieldMap::default(), true));
+        murea.accuracy = (0.25, 4f64.to_radians());
+        let truth = Pose2::new(-7.5, 0.5, 0.2);
+        let far: Vec<Perception> = seen_from(&murea.map, truth)
+            .into_iter()
+            .filter(|p| {
+                (p.kind == Kind::EAST_GOAL || p.kind == Kind::EAST_POST)
+                    && p.range.unwrap_or(0.0) > 12.0
+            })
+            .map(|p| p.tolerances(0.1 * p.range.unwrap_or(0.0), 4f64.to_radians()))
+            .collect();
+        assert!(far.len() >= 2 && far.iter().all(|p| p.range_tolerance > 1.0), "{far:?}");
+        let fix = murea.localize(&far, murea.whole_field());
+        assert!((fix.pose.x - truth.x).hypot(fix.pose.y - truth.y) < 1.5, "{fix:?}");
+        assert!(fix.alternatives.is_empty(), "{:?}", fix.alternatives);
+        // The ridge is real: some pose a metre or more from the fix explains at least 90 % as
+        // much (what was reported as another answer before).
+        let q = fix.quality;
+        let ridge = (-20..=20).flat_map(|i| (-20..=20).map(move |j| (i, j))).any(|(i, j)| {
+            let (dx, dy) = (0.1 * f64::from(i), 0.1 * f64::from(j));
+            dx.hypot(dy) >= 1.0
+                && (-2..=2).any(|k| {
+                    let at = Pose2::new(
+                        fix.pose.x + dx,
+                        fix.pose.y + dy,
+                        fix.pose.theta + 0.02 * f64::from(k),
+                    );
+                    murea.quality_at(at, &far) >= murea.ambiguity * q
+                })
+        });
+        assert!(ridge, "{fix:?}");
     }
 
     #[test]

@@ -24,7 +24,7 @@
 //!    nor on the first frame that it does not explain (a false sighting, or the first after a
 //!    carry: the next frame tells).
 //! 3. Otherwise, the whole window is scored at the tracker's pose. When that too falls below
-//!    [`SUSPECT`] and the window holds at least two goals' or posts' worth of weight, at
+//!    [`SUSPECT`] and the window holds two goals or posts worth [`MARKS`] together, at
 //!    most every [`RETRY`] s, MUREA searches the whole field on the goals and posts, coarsely
 //!    (25 cm, 4°: line points fit some line from almost anywhere and would keep every cell's
 //!    bound high), then around that pose on everything (10 cm, 2°). The fix replaces the
@@ -110,6 +110,8 @@ pub const WINDOW_PERCEPTIONS: usize = 24;
 /// Two sightings of a goal or a post of one kind this close (m, in the field frame of the
 /// tracker), or within their range tolerances combined, are one object seen twice.
 pub const SAME_OBJECT: f64 = 0.5;
+/// The goals and posts of the window must weigh this much together for a search.
+pub const MARKS: f64 = 1.5;
 /// At most this many line points of one frame become perceptions (evenly picked).
 pub const LINE_POINTS: usize = 12;
 /// Weight of one line point (a line point says less than a goal: it fits any point of any
@@ -305,6 +307,8 @@ impl Relocalizer {
                 let q = pose.inverse_transform_point(Point2::from(mean / sum));
                 p.range = Some(q.coords.norm());
                 p.bearing = Some(q.y.atan2(q.x));
+                // An object seen again and again is as sure as one seen now.
+                p.weight = sum.min(1.0);
                 p
             })
             .collect()
@@ -345,11 +349,11 @@ impl Relocalizer {
             return None;
         }
         let window = self.window_now(now, pose);
-        // Two goals' or posts' worth at least: line points fit some line from almost
-        // anywhere, so they alone never pin a pose down.
+        // Two goals or posts at least, worth [`MARKS`]: line points fit some line from
+        // almost anywhere, and one object puts the robot anywhere on a circle round it.
         let marks: Vec<Perception> =
             window.iter().filter(|p| p.kind != Kind::LINE).copied().collect();
-        if marks.iter().map(|p| p.weight).sum::<f64>() < 2.0 {
+        if marks.len() < 2 || marks.iter().map(|p| p.weight).sum::<f64>() < MARKS {
             return None;
         }
         let tracked = self.murea.quality_at(pose, &window);
