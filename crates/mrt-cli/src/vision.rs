@@ -9,12 +9,10 @@
 use anyhow::{anyhow, bail, Context as _, Result};
 use image::{Rgb, RgbImage};
 use mrt_msgs::Image;
-use mrt_perception::camera::{Camera, CameraFile, Pinhole};
+use mrt_perception::camera::{Camera, CameraFile};
 use mrt_perception::source::{load_image, ImageSequence, ImageSource};
-use mrt_perception::vision::blobs::find_ball;
+use mrt_perception::vision::agent::VisionAgent;
 use mrt_perception::vision::colors::{ColorClass, ColorTable, Lut};
-use mrt_perception::vision::goals::find_goal;
-use mrt_perception::vision::posts::{find_posts, PostShape};
 use std::io::Write as _;
 use std::path::{Path, PathBuf};
 
@@ -91,7 +89,7 @@ pub fn detect(args: &DetectArgs) -> Result<()> {
         .camera()
         .map_err(|e| anyhow!("{}: {e}", args.camera.display()))?;
     let colors = ColorTable::from_file(&args.colors).map_err(|e| anyhow!("{e}"))?;
-    let lut = Lut::new(&colors);
+    let mut agent = VisionAgent::new(camera, &colors, args.ball_radius);
     let stdout = std::io::stdout();
     let mut out = stdout.lock();
     let mut source = match &args.device {
@@ -107,7 +105,7 @@ pub fn detect(args: &DetectArgs) -> Result<()> {
             (None, Some(path)) => (path.display().to_string(), load_image(path)?),
             (None, None) => break,
         };
-        let line = detect_one(&name, &img, &camera, &lut, args.ball_radius, args.png.as_deref())?;
+        let line = detect_one(&name, &img, &mut agent, args.png.as_deref())?;
         if writeln!(out, "{line}").is_err() {
             return Ok(()); // the reader went away
         }
@@ -130,34 +128,17 @@ fn open_device(device: &Path, _: (u32, u32)) -> Result<Box<dyn ImageSource>> {
 fn detect_one(
     name: &str,
     img: &Image,
-    camera: &Pinhole,
-    lut: &Lut,
-    ball_radius: f64,
+    agent: &mut VisionAgent,
     png: Option<&Path>,
 ) -> Result<serde_json::Value> {
     let (w, h) = (img.width, img.height);
-    if (w, h) != camera.size() {
-        bail!(
-            "{name}: the image is {w}×{h}, the camera file says {}×{}",
-            camera.size().0,
-            camera.size().1
-        );
+    let camera = agent.camera().size();
+    if (w, h) != camera {
+        bail!("{name}: the image is {w}×{h}, the camera file says {}×{}", camera.0, camera.1);
     }
-    let mut classes = vec![0u8; (w * h) as usize];
-    lut.classify(&img.rgb, &mut classes);
-    let ball = find_ball(&classes, camera, ball_radius);
-    let posts = find_posts(&classes, camera, PostShape::default());
-    // The posts' bands wear the goal colours: the goals are looked for without them.
-    let mut goal_classes = classes.clone();
-    for p in &posts {
-        for row in goal_classes.chunks_exact_mut(w as usize) {
-            for c in &mut row[p.masked_columns(w as usize)] {
-                if *c == ColorClass::GoalYellow as u8 || *c == ColorClass::GoalBlue as u8 {
-                    *c = ColorClass::Unknown as u8;
-                }
-            }
-        }
-    }
+    let pan = agent.camera().pan;
+    let sight = agent.look(img, 0.0, pan).map_err(|e| anyhow!("{name}: {e}"))?;
+    let (ball, posts) = (sight.ball, &sight.posts);
     let mut objects = Vec::new();
     if let Some(b) = ball {
         objects.push(serde_json::json!({
@@ -168,18 +149,16 @@ fn detect_one(
             "bearing_deg": round3(b.bearing.to_degrees()),
         }));
     }
-    for class in [ColorClass::GoalYellow, ColorClass::GoalBlue] {
-        if let Some(g) = find_goal(&goal_classes, camera, class, 20, 0) {
-            objects.push(serde_json::json!({
-                "class": class.name(),
-                "pixel": [round3(g.nearest.x), round3(g.nearest.y)],
-                "distance_m": round3(g.distance),
-                "bearing_deg": round3(g.bearing.to_degrees()),
-                "open_bearing_deg": round3(g.open_bearing.to_degrees()),
-            }));
-        }
+    for g in &sight.goals {
+        objects.push(serde_json::json!({
+            "class": g.class.name(),
+            "pixel": [round3(g.nearest.x), round3(g.nearest.y)],
+            "distance_m": round3(g.distance),
+            "bearing_deg": round3(g.bearing.to_degrees()),
+            "open_bearing_deg": round3(g.open_bearing.to_degrees()),
+        }));
     }
-    for p in &posts {
+    for p in posts {
         objects.push(serde_json::json!({
             "class": "post",
             "outer": p.outer.name(),
@@ -189,6 +168,7 @@ fn detect_one(
         }));
     }
     if let Some(out) = png {
+        let classes = agent.classes();
         let mut drawn = RgbImage::from_fn(w, h, |x, y| {
             paint(ColorClass::from_u8(classes[(y * w + x) as usize]))
         });
@@ -198,7 +178,7 @@ fn detect_one(
             imageproc::drawing::draw_hollow_circle_mut(&mut drawn, c, r + 2, Rgb([255, 0, 255]));
             imageproc::drawing::draw_cross_mut(&mut drawn, Rgb([255, 0, 255]), c.0, c.1);
         }
-        for p in &posts {
+        for p in posts {
             let (x0, x1) = (p.columns.0 as i32 - 2, p.columns.1 as i32 + 2);
             let y = p.pixel.y as i32;
             let rect = imageproc::rect::Rect::at(x0, (y - 4 * (x1 - x0)).max(0))

@@ -181,6 +181,11 @@ pub struct Percepts {
     /// post of that half it is (the world model tells them apart).
     #[serde(default)]
     pub posts: Vec<PostSighting>,
+    /// Where to shoot into each goal: the bearing (rad, robot frame) of its open space, the
+    /// widest stretch of its mouth that no keeper hides (ISocRob seed `003` eq. 18), for the
+    /// east and the west goal, when the whole goal is in view.
+    #[serde(default)]
+    pub open_space: [Option<f64>; 2],
 }
 
 /// A landmark post in a camera image (ISocRob seed `003` §3.2.1: landmarks told apart by

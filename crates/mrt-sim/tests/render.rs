@@ -319,6 +319,34 @@ fn the_vision_agent_finds_ball_nets_and_robots_in_a_rendered_frame() {
     assert!(agent.see(&broken, 0.0, 0.0).is_err());
 }
 
+/// The open space (seed `003` eq. 18) on a rendered frame: an empty goal's is in its mouth;
+/// with a keeper on its left half, it lies right of the keeper. `look` reports the
+/// same goals by their nearest points.
+#[test]
+fn the_open_space_of_a_goal_with_a_keeper_is_beside_the_keeper() {
+    use mrt_perception::vision::agent::VisionAgent;
+    let cfg = SimConfig::default();
+    let renderer = Renderer::new(&cfg).unwrap();
+    let colors = mrt_perception::vision::colors::ColorTable::shipped();
+    let mut agent = VisionAgent::new(*renderer.camera(), &colors, cfg.ball.radius);
+    let me = Pose2::new(5.0, 0.0, 0.0);
+    let empty = renderer.render(&Scene::default(), me, 0.0, None, &mut CameraState::default());
+    let p = agent.see(&empty, 0.0, 0.0).unwrap();
+    let open = p.open_space[0].expect("the east goal's open space");
+    // Within the mouth (±0.245 rad from here): the goal's inner side panels, seen obliquely,
+    // give its outer columns the most pixels, and a tie goes to the leftmost column.
+    assert!(open.abs() < 0.245, "an empty goal's open space is in its mouth: {open}");
+    assert!(p.open_space[1].is_none(), "the west goal is behind");
+    let keeper = Scene { ball: None, robots: vec![(Pose2::new(8.7, 0.5, 0.0), false)] };
+    let image = renderer.render(&keeper, me, 0.0, None, &mut CameraState::default());
+    let sight = agent.look(&image, 0.0, 0.0).unwrap();
+    let open = sight.percepts.open_space[0].expect("the east goal's open space");
+    // The keeper covers bearings from about 0.07 to 0.17 rad: the open space is the right half.
+    assert!((-0.245..-0.05).contains(&open), "right of the keeper: {open}");
+    let goal = sight.goals.iter().find(|g| g.class.name() == "goal_yellow").expect("the goal");
+    assert!(goal.open_bearing < 0.0 && (goal.open_bearing - open).abs() < 0.1, "{goal:?}");
+}
+
 /// A lens with radial distortion takes the per-pixel floor table instead of the per-row
 /// stepping: the same scene looks the same at the image's centre, and the ball is still found
 /// where it is (the µAgent undistorts through the same camera).

@@ -11,9 +11,9 @@
 //! (where its far end stands is unknown), and the columns of the landmark posts
 //! ([`super::posts`]), whose bands wear the goal colours, do not count as goal.
 
-use super::blobs::find_ball;
+use super::blobs::{find_ball, BallPercept};
 use super::colors::{ColorClass, ColorTable, Lut};
-use super::goals::goal_columns;
+use super::goals::{find_goal, goal_columns, open_space, GoalPercept};
 use super::lines::line_points;
 use super::posts::{find_posts_in, PostPercept, PostShape};
 use crate::camera::{Camera, Pinhole, Pixel};
@@ -55,6 +55,34 @@ pub enum VisionError {
         /// The camera's height.
         cam_h: u32,
     },
+}
+
+/// A goal seen whole (see [`VisionAgent::net`]).
+struct Net {
+    /// The middle of its outermost columns' floor points (robot frame, m).
+    at: Point2<f64>,
+    /// One of those feet's pixels.
+    foot: Pixel,
+    /// The goal's pixel count.
+    pixels: u32,
+    /// The bearing of its open space (eq. 18), rad.
+    open_bearing: Option<f64>,
+}
+
+/// Everything the µAgent found in one image ([`VisionAgent::look`]): the percepts, and the
+/// objects in the image's own terms (pixels, radii, columns) for tools that draw or print
+/// them.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Sight {
+    /// What the robot's world model gets.
+    pub percepts: Percepts,
+    /// The ball.
+    pub ball: Option<BallPercept>,
+    /// The landmark posts.
+    pub posts: Vec<PostPercept>,
+    /// The goals by their nearest point and open space (eqs 16–18; [`find_goal`]), the
+    /// posts' columns left out, even when part of the goal is out of view.
+    pub goals: Vec<GoalPercept>,
 }
 
 /// The vision µAgent of one camera (module doc).
@@ -114,6 +142,40 @@ impl VisionAgent {
 
     /// What `image`, taken at `time` (s) with the pan joint at `pan` (rad), shows.
     pub fn see(&mut self, image: &Image, time: f64, pan: f64) -> Result<Percepts, VisionError> {
+        self.percepts(image, time, pan).map(|(p, ..)| p)
+    }
+
+    /// What [`VisionAgent::see`] finds, with the objects in the image's terms and the goals'
+    /// nearest points too (the `mrt vision detect` tool's view; the goals cost a pass over
+    /// the image more than `see`).
+    pub fn look(&mut self, image: &Image, time: f64, pan: f64) -> Result<Sight, VisionError> {
+        let (percepts, ball, posts) = self.percepts(image, time, pan)?;
+        let w = self.camera.size().0 as usize;
+        // The posts' bands wear the goal colours: the goals are looked for without them.
+        let mut goal_classes = self.classes.clone();
+        for p in &posts {
+            for row in goal_classes.chunks_exact_mut(w) {
+                for c in &mut row[p.masked_columns(w)] {
+                    if *c == ColorClass::GoalYellow as u8 || *c == ColorClass::GoalBlue as u8 {
+                        *c = ColorClass::Unknown as u8;
+                    }
+                }
+            }
+        }
+        let goals = [ColorClass::GoalYellow, ColorClass::GoalBlue]
+            .into_iter()
+            .filter_map(|class| find_goal(&goal_classes, &self.camera, class, MIN_GOAL_PIXELS, 0))
+            .collect();
+        Ok(Sight { percepts, ball, posts, goals })
+    }
+
+    /// The percepts of `image`, with the ball and the posts as found in it.
+    fn percepts(
+        &mut self,
+        image: &Image,
+        time: f64,
+        pan: f64,
+    ) -> Result<(Percepts, Option<BallPercept>, Vec<PostPercept>), VisionError> {
         let (w, h) = self.camera.size();
         if (image.width, image.height) != (w, h) || !image.is_consistent() {
             return Err(VisionError::WrongSize {
@@ -128,7 +190,8 @@ impl VisionAgent {
         self.classes.resize(w as usize * h as usize, 0);
         self.lut.classify(&image.rgb, &mut self.classes);
         let mut p = Percepts { time, ..Default::default() };
-        if let Some(ball) = find_ball(&self.classes, &self.camera, self.ball_radius) {
+        let ball = find_ball(&self.classes, &self.camera, self.ball_radius);
+        if let Some(ball) = ball {
             p.sightings[BALL] = Some(sighting(ball.at));
             p.sigmas[BALL] = self.sigma(ball.pixel, 1.0 - self.ball_radius / self.camera.height);
             p.pixels[BALL] = ball.pixels;
@@ -143,13 +206,16 @@ impl VisionAgent {
         let [yellow, blue] = columns;
         let (east_count, west_count) =
             if self.east_goal == ColorClass::GoalYellow { (yellow, blue) } else { (blue, yellow) };
-        for (k, class, count) in
+        for (side, (k, class, count)) in
             [(EAST_NET, self.east_goal, east_count), (WEST_NET, west, west_count)]
+                .into_iter()
+                .enumerate()
         {
-            if let Some((at, foot, pixels)) = self.net(class, count, &posts) {
-                p.sightings[k] = Some(sighting(at));
-                p.sigmas[k] = self.sigma(foot, 1.0);
-                p.pixels[k] = pixels;
+            if let Some(net) = self.net(class, count, &posts) {
+                p.sightings[k] = Some(sighting(net.at));
+                p.sigmas[k] = self.sigma(net.foot, 1.0);
+                p.pixels[k] = net.pixels;
+                p.open_space[side] = net.open_bearing;
             }
         }
         p.line_points = line_points(&self.classes, &self.camera, LINE_STEP, LINE_MAX_RUN)
@@ -169,7 +235,7 @@ impl VisionAgent {
                 })
             })
             .collect();
-        Ok(p)
+        Ok((p, ball, posts))
     }
 
     /// A distance measured at the posts' lower band boundary is this many times as uncertain
@@ -180,15 +246,9 @@ impl VisionAgent {
         h / (h - self.posts.height / 3.0).abs().max(0.05)
     }
 
-    /// The net of the goal of `class`: the middle of its outermost columns' floor points, one
-    /// of those feet's pixels, and the goal's pixel count; `posts`' columns do not count.
-    /// `count` holds the goal's column counts (eq. 16).
-    fn net(
-        &self,
-        class: ColorClass,
-        mut count: Vec<u32>,
-        posts: &[PostPercept],
-    ) -> Option<(Point2<f64>, Pixel, u32)> {
+    /// The net of the goal of `class` ([`Net`]); `posts`' columns do not count. `count` holds
+    /// the goal's column counts (eq. 16).
+    fn net(&self, class: ColorClass, mut count: Vec<u32>, posts: &[PostPercept]) -> Option<Net> {
         let (w, h) = self.camera.size();
         let (w, h) = (w as usize, h as usize);
         let want = class as u8;
@@ -218,14 +278,22 @@ impl VisionAgent {
             Some((px, self.camera.unproject(px)?))
         };
         let (pl, l) = (0..w).find_map(foot)?;
-        let (_, r) = (0..w).rev().find_map(foot)?;
+        let (pr, r) = (0..w).rev().find_map(foot)?;
         // The two feet are the goal's posts (or a post and a back corner): as far apart as
         // the goal is wide, give or take its depth. Anything else is not the whole goal.
         let apart = (l - r).norm();
         if !(0.5 * self.goal_width..=1.5 * self.goal_width).contains(&apart) {
             return None;
         }
-        Some((Point2::from((l.coords + r.coords) / 2.0), pl, pixels))
+        // Eq. 18 on the goal's columns between its feet, with a half window of an eighth of
+        // them (as `find_goal`'s default); its bearing on the floor between the feet.
+        let (c0, c1) = (pl.x as usize, (pr.x as usize + 1).min(w));
+        let open_bearing = open_space(&count[c0..c1], ((c1 - c0) / 8).max(1)).and_then(|c| {
+            let px = Pixel::new((c0 + c) as f64 + 0.5, 0.5 * (pl.y + pr.y));
+            let at = self.camera.unproject(px)?;
+            Some(at.y.atan2(at.x))
+        });
+        Some(Net { at: Point2::from((l.coords + r.coords) / 2.0), foot: pl, pixels, open_bearing })
     }
 
     /// Other robots: scanning every [`OBSTACLE_STEP`]-th column from the bottom up over the
