@@ -43,6 +43,7 @@ pub mod model;
 pub mod murea;
 pub mod relocalize;
 pub mod team;
+pub mod track;
 
 pub use field::FieldMap;
 pub use model::WorldModel;
