@@ -254,19 +254,17 @@ pub fn run(args: &SimArgs) -> Result<()> {
             outln!("  goal {who:<8} at {:>3}:{:02}", (*t as u64) / 60, (*t as u64) % 60);
         }
     }
-    let l = &report.localization;
-    if let (Some((pm, hm)), Some((p9, h9))) = (l.quantile(0.5), l.quantile(0.9)) {
-        outln!(
-            "  localization error (the robots' own estimates against the truth): position {:.2} m median, {:.2} m p90; heading {:.1}° median, {:.1}° p90",
-            pm,
-            p9,
-            hm.to_degrees(),
-            h9.to_degrees()
-        );
-    }
     let mut book = MetricsBook::default();
     book.add(&report);
     let m = book.metrics();
+    let l = &m.localization;
+    if let (Some(pm), Some(p95), Some(hm), Some(h95)) =
+        (l.median_m, l.p95_m, l.heading_median_deg, l.heading_p95_deg)
+    {
+        outln!(
+            "  localization error (the robots' own estimates against the truth): position {pm:.2} m median, {p95:.2} m p95; heading {hm:.1}° median, {h95:.1}° p95"
+        );
+    }
     if let (Some(mean), Some(p95)) = (m.ball.mean_m, m.ball.p95_m) {
         let velocity = m
             .ball

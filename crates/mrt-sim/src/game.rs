@@ -126,20 +126,6 @@ pub struct Kidnap {
 /// A kidnapped robot is recovered when its position estimate is this close to the truth (m).
 pub const RECOVERED: f64 = 0.3;
 
-impl LocalizationErrors {
-    /// The `q` quantile (nearest rank) of the position errors (m) and of the heading errors
-    /// (rad); `None` without samples.
-    pub fn quantile(&self, q: f64) -> Option<(f64, f64)> {
-        let pick = |v: &[f64]| {
-            let mut v = v.to_vec();
-            v.sort_by(f64::total_cmp);
-            let i = ((v.len().checked_sub(1)?) as f64 * q.clamp(0.0, 1.0)).round() as usize;
-            v.get(i).copied()
-        };
-        Some((pick(&self.position)?, pick(&self.heading)?))
-    }
-}
-
 /// The physical side of a match, whatever drives the robots: the world, the referee, the
 /// robots' eyes with their random streams, and the book (statistics, hash, calls, frames).
 pub struct Pitch {

@@ -224,6 +224,8 @@ impl WorldModel {
         if let Some(r) = &mut self.relocalizer {
             r.forget();
         }
+        // The ball's track lies in the field frame of the pose that was.
+        self.ball_track.reset();
     }
 
     /// Puts the filter where the relocalizer's `fix` says, as sure as MUREA's accuracy and
@@ -234,6 +236,7 @@ impl WorldModel {
         let (xy, theta) = (xy.max(fix.cell.0), theta.max(fix.cell.2));
         self.cov = Matrix3::from_diagonal(&Vector3::new(xy * xy, xy * xy, theta * theta));
         self.counts.relocalized += 1;
+        self.ball_track.reset();
     }
 
     /// One cycle's odometry: a placement resets the pose, then the motion moves it.
@@ -912,5 +915,10 @@ mod tests {
             m.percepts(&Percepts { time: t, sightings: f.sightings, ..Default::default() });
         }
         assert_eq!(m.ball_track_counts().restarts, 2, "{:?}", m.ball_track_counts());
+        // Put down by hand: the track, in the old pose's frame, starts again at once.
+        m.place(Framed::new(me));
+        let f = frame(me, 1.4, &[(lps::BALL, (x0 - 1.4, y0))]);
+        m.percepts(&Percepts { time: 1.4, sightings: f.sightings, ..Default::default() });
+        assert_eq!(m.ball_track_counts().restarts, 3, "{:?}", m.ball_track_counts());
     }
 }

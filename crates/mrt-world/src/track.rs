@@ -107,12 +107,7 @@ impl Track {
         self.state.map_or((0.0, 0.0), |s| (s.x[2], s.x[3]))
     }
 
-    /// The covariance of its place, m².
-    pub fn position_covariance(&self) -> Matrix2<f64> {
-        self.state.map_or(Matrix2::zeros(), |s| s.p.fixed_view::<2, 2>(0, 0).into_owned())
-    }
-
-    /// Forgets the object.
+    /// Forgets the object (the robot's pose jumped: the track lies in the frame it had).
     pub fn reset(&mut self) {
         self.state = None;
         self.gated = 0;
