@@ -159,7 +159,31 @@ impl Pinhole {
     /// How far in front of the optical centre the point `p` (robot frame, m) lies, along the
     /// optical axis (negative: behind the camera).
     pub fn depth(&self, p: Point3<f64>) -> f64 {
-        (self.camera_to_robot().inverse() * (p - self.centre())).z
+        self.to_camera(p).z
+    }
+
+    /// The point `p` (robot frame, m) in camera axes (x right, y down, z along the optical
+    /// axis; origin at the optical centre).
+    pub fn to_camera(&self, p: Point3<f64>) -> Vector3<f64> {
+        self.robot_to_camera() * (p - self.centre())
+    }
+
+    /// The rotation from the robot frame to camera axes, for [`Pinhole::to_camera`] on many
+    /// points: `rotation * (p - centre)`.
+    pub fn robot_to_camera(&self) -> Rotation3<f64> {
+        self.camera_to_robot().inverse()
+    }
+
+    /// The pixel at which a point given in camera axes ([`Pinhole::to_camera`]) is imaged, or
+    /// `None` when it lies on or behind the image plane.
+    pub fn project_camera(&self, v: Vector3<f64>) -> Option<Pixel> {
+        // On or behind the image plane (a NaN point is not seen either).
+        if v.z.is_nan() || v.z <= 1e-9 {
+            return None;
+        }
+        let d = self.distort(Vector2::new(v.x / v.z, v.y / v.z));
+        let k = &self.intrinsics;
+        Some(Pixel::new(k.cx + k.fx * d.x, k.cy + k.fy * d.y))
     }
 
     /// Applies the radial distortion to a normalized point.
@@ -195,14 +219,7 @@ impl Camera for Pinhole {
     }
 
     fn project(&self, p: Point3<f64>) -> Option<Pixel> {
-        let v = self.camera_to_robot().inverse() * (p - self.centre());
-        // On or behind the image plane (a NaN point is not seen either).
-        if v.z.is_nan() || v.z <= 1e-9 {
-            return None;
-        }
-        let d = self.distort(Vector2::new(v.x / v.z, v.y / v.z));
-        let k = &self.intrinsics;
-        Some(Pixel::new(k.cx + k.fx * d.x, k.cy + k.fy * d.y))
+        self.project_camera(self.to_camera(p))
     }
 
     fn unproject_at_height(&self, px: Pixel, z: f64) -> Option<Point3<f64>> {

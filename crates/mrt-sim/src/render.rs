@@ -3,8 +3,8 @@
 //!
 //! The world is "3-D enough": the physics is 2-D, and the renderer gives every thing a height
 //! ([`RenderConfig`]). It draws, for a [`Pinhole`] camera on a robot:
-//! - the **floor**: the green carpet up to the walls with the white field lines and centre
-//!   circle, read from a texture of the field made once (2 cm texels);
+//! - the **floor**: the green carpet up to the walls with the white field lines (strips of
+//!   the line width) and the centre circle (a ring);
 //! - the **walls** around the field and, above them, the hall;
 //! - the **goals**: coloured back, sides and crossbar (the east goal yellow, the west goal
 //!   blue), with height;
@@ -13,10 +13,16 @@
 //! - the **ball**, an orange sphere, and the **robots**, dark cylinders with a band of their
 //!   team's colour (magenta home, cyan away).
 //!
-//! It is not a general ray tracer: the floor is one texture lookup per pixel, from floor points
-//! that depend only on the camera and are computed once; each object is tested only on the
-//! pixels of its projected bounding box, with a depth test against the other objects. Optional
-//! effects: Gaussian noise, lighting variation, motion blur ([`RenderConfig`]).
+//! It is not a general ray tracer. An ideal lens without roll sees a straight line of the
+//! floor along each row of pixels, evenly stepped, so the floor, the walls and the hall are
+//! drawn a row at a time as spans of one colour, cut analytically where the row's floor line
+//! crosses a field line, the ring or the walls (a lens with distortion falls back to a lookup
+//! a pixel in a 2 cm texture of the same paint). Each object is tested only on the pixels of
+//! its projected bounding box, and within a row only on the columns whose rays point at its
+//! footprint, with a depth test against the other objects; robots and posts (cylinders, most
+//! of what a camera sees) are traced a row at a time in `f32` in a loop the compiler
+//! vectorizes. Optional effects: Gaussian noise, lighting variation, motion blur
+//! ([`RenderConfig`]).
 //!
 //! ```
 //! use mrt_sim::config::SimConfig;
@@ -39,9 +45,10 @@ use mrt_core::Pose2;
 use mrt_msgs::Image;
 use mrt_perception::camera::{Camera, Pinhole, Pixel};
 use mrt_world::FieldMap;
-use nalgebra::Point3;
+use nalgebra::{Point3, Vector3};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
+use std::ops::Range;
 
 /// The colours of the simulated world (RGB), each one classified as its class by the shipped
 /// `configs/vision/colors.toml` (a test checks it).
@@ -71,9 +78,6 @@ pub mod palette {
 /// Noise samples in the table (a power of two).
 const NOISE_SAMPLES: usize = 1 << 16;
 
-/// One texel in the floor pass's fixed-point coordinates.
-const FIXED_ONE: f64 = (1u64 << 32) as f64;
-
 /// Side of a floor texel, m.
 const TEXEL: f64 = 0.02;
 
@@ -91,8 +95,32 @@ pub struct Scene {
 pub struct CameraState {
     rng: ChaCha8Rng,
     previous: Option<Image>,
+    scratch: Scratch,
+}
+
+/// Buffers a frame's objects pass reuses from frame to frame.
+#[derive(Clone, Debug, Default)]
+struct Scratch {
     /// The objects' depth per pixel (valid within this frame's objects' boxes only).
-    depth: Vec<f64>,
+    depth: Vec<f32>,
+    /// One object's hits on a run of pixels of a row ([`Hits`]).
+    ts: Vec<f32>,
+    zs: Vec<f32>,
+    shades: Vec<f32>,
+}
+
+/// One object's hits on a run of pixels of a row, one element a pixel: the distance along
+/// the ray (infinite: a miss), the height hit and the shading factor.
+struct Hits<'a> {
+    ts: &'a mut [f32],
+    zs: &'a mut [f32],
+    shades: &'a mut [f32],
+}
+
+impl Hits<'_> {
+    fn of(hit: Option<Hit>) -> (f32, f32, f32) {
+        hit.map_or((f32::INFINITY, 0.0, 1.0), |(t, z, shade)| (t as f32, z as f32, shade as f32))
+    }
 }
 
 impl Default for CameraState {
@@ -104,8 +132,20 @@ impl Default for CameraState {
 impl CameraState {
     /// A camera whose noise is drawn from `seed` (the simulator seeds one per robot).
     pub fn new(seed: u64) -> CameraState {
-        CameraState { rng: ChaCha8Rng::seed_from_u64(seed), previous: None, depth: Vec::new() }
+        CameraState {
+            rng: ChaCha8Rng::seed_from_u64(seed),
+            previous: None,
+            scratch: Scratch::default(),
+        }
     }
+}
+
+/// The flat colours of one frame, under its lighting.
+struct Colours {
+    carpet: [u8; 3],
+    line: [u8; 3],
+    wall: [u8; 3],
+    hall: [u8; 3],
 }
 
 /// How a thing is painted: bands from the floor up, each to its top height (m).
@@ -119,10 +159,38 @@ impl Bands {
     fn flat(colour: [u8; 3]) -> Bands {
         Bands { tops: [f64::INFINITY; 3], colours: [colour; 3] }
     }
+}
 
-    fn at(&self, z: f64) -> [u8; 3] {
-        let k = self.tops.iter().position(|&t| z <= t).unwrap_or(2);
-        self.colours[k]
+/// A thing's bands under one frame's lighting, ready for its pixels.
+struct Lit {
+    /// The tops of the lower two bands.
+    tops: [f32; 2],
+    /// Each band's colour under the frame's brightness.
+    rgb: [[u32; 3]; 3],
+}
+
+impl Lit {
+    fn new(bands: &Bands, brightness: f64) -> Lit {
+        let lit = |v: u8| (f64::from(v) * brightness).clamp(0.0, 255.0) as u32;
+        Lit {
+            tops: [bands.tops[0] as f32, bands.tops[1] as f32],
+            rgb: bands.colours.map(|c| c.map(lit)),
+        }
+    }
+
+    /// The colour at height `z` with the shading factor `shade`.
+    #[inline(always)]
+    fn colour(&self, z: f32, shade: f32) -> [u8; 3] {
+        let band = if z <= self.tops[0] {
+            &self.rgb[0]
+        } else if z <= self.tops[1] {
+            &self.rgb[1]
+        } else {
+            &self.rgb[2]
+        };
+        // In 1/256ths: integer arithmetic a channel.
+        let k = (shade * 256.0) as u32;
+        band.map(|v| ((v * k) >> 8).min(255) as u8)
     }
 }
 
@@ -162,8 +230,131 @@ impl Shape {
         }
     }
 
-    /// Where the ray `o + t·d` (t > 0) first meets the solid.
-    fn hit(&self, o: [f64; 3], d: [f64; 3]) -> Option<Hit> {
+    /// The solid seen from the optical centre `eye` (field frame) with the camera's axes,
+    /// turned by `(sin, cos)` of its heading from the field's: spheres and cylinders are moved
+    /// and turned; a cuboid keeps the field's axes, moved only ([`Shape::hit`] turns the ray).
+    fn relative(&self, eye: [f64; 3], (s, c): (f64, f64)) -> Shape {
+        let turn = |x: f64, y: f64| {
+            let (dx, dy) = (x - eye[0], y - eye[1]);
+            (c * dx + s * dy, -s * dx + c * dy)
+        };
+        match *self {
+            Shape::Sphere { c: centre, r } => {
+                let (x, y) = turn(centre[0], centre[1]);
+                Shape::Sphere { c: [x, y, centre[2]], r }
+            }
+            Shape::Cylinder { x, y, r, top } => {
+                let (x, y) = turn(x, y);
+                Shape::Cylinder { x, y, r, top }
+            }
+            Shape::Cuboid { min, max } => Shape::Cuboid {
+                min: [min[0] - eye[0], min[1] - eye[1], min[2]],
+                max: [max[0] - eye[0], max[1] - eye[1], max[2]],
+            },
+        }
+    }
+
+    /// The directions (camera axes, seen from above) of the right and left edges of the
+    /// wedge of rays from the eye that may meet the solid (placed by [`Shape::relative`]):
+    /// the tangents to a disc, or the outermost corners of a rectangle; `None` when the eye
+    /// stands over its footprint. `(sin, cos)` turns the camera's axes into the field's (a
+    /// cuboid's).
+    fn wedge(&self, (s, c): (f64, f64)) -> Option<([f64; 2], [f64; 2])> {
+        Some(match *self {
+            Shape::Sphere { c: [x, y, _], r } | Shape::Cylinder { x, y, r, .. } => {
+                let l2 = x * x + y * y;
+                if l2 <= r * r {
+                    return None;
+                }
+                let l = l2.sqrt();
+                let (sb, cb) = (r / l, (1.0 - r * r / l2).sqrt());
+                let (ux, uy) = (x / l, y / l);
+                // The tangents: the direction to the axis turned by ∓asin(r / l).
+                ([cb * ux + sb * uy, -sb * ux + cb * uy], [cb * ux - sb * uy, sb * ux + cb * uy])
+            }
+            Shape::Cuboid { min, max } => {
+                if min[0] <= 0.0 && max[0] >= 0.0 && min[1] <= 0.0 && max[1] >= 0.0 {
+                    return None;
+                }
+                // The footprint's corners in the camera's axes, and their angles from the
+                // direction to its centre (the eye is outside it: they span less than π).
+                let turn = |x: f64, y: f64| [c * x + s * y, -s * x + c * y];
+                let u = turn((min[0] + max[0]) / 2.0, (min[1] + max[1]) / 2.0);
+                let corners = [
+                    turn(min[0], min[1]),
+                    turn(max[0], min[1]),
+                    turn(min[0], max[1]),
+                    turn(max[0], max[1]),
+                ];
+                let angle =
+                    corners.map(|p| (u[0] * p[1] - u[1] * p[0]).atan2(u[0] * p[0] + u[1] * p[1]));
+                let by_angle = |a: &usize, b: &usize| angle[*a].total_cmp(&angle[*b]);
+                (corners[(0..4).min_by(by_angle)?], corners[(0..4).max_by(by_angle)?])
+            }
+        })
+    }
+
+    /// The hits of the rays `start + k·step` of the columns `k0, k0 + 1, ...` of a row, one a
+    /// pixel (see [`Hits`]). Cylinders, most of what a camera sees of other robots, are traced
+    /// in a loop without branches that the compiler vectorizes; the other solids go through
+    /// [`Shape::hit`].
+    fn trace_row(
+        &self,
+        o: [f64; 3],
+        (start, step): ([f64; 3], [f64; 3]),
+        k0: usize,
+        (s, c): (f64, f64),
+        hits: Hits,
+    ) {
+        let k0 = k0 as f64;
+        let Hits { ts, zs, shades } = hits;
+        let Shape::Cylinder { x, y, r, top } = *self else {
+            for (j, ((t, z), shade)) in ts.iter_mut().zip(zs).zip(shades).enumerate() {
+                let k = k0 + j as f64;
+                let d = [start[0] + k * step[0], start[1] + k * step[1], start[2]];
+                (*t, *z, *shade) = Hits::of(self.hit(o, d, (s, c)));
+            }
+            return;
+        };
+        // Relative to the column k0, in f32 (image-level accuracy).
+        let (ox, oy, ez) = ((o[0] - x) as f32, (o[1] - y) as f32, o[2] as f32);
+        let (sx, sy) = ((start[0] + k0 * step[0]) as f32, (start[1] + k0 * step[1]) as f32);
+        let (tx, ty, dz) = (step[0] as f32, step[1] as f32, start[2] as f32);
+        let (r, top) = (r as f32, top as f32);
+        let cc = ox * ox + oy * oy - r * r;
+        // The top is met, if at all, at one distance along every ray of the row.
+        let t_top = (top - ez) / dz;
+        let top_seen = dz < 0.0 && t_top > 0.0;
+        // The light from the field's north-east, in the camera's axes.
+        let light = std::f32::consts::FRAC_1_SQRT_2 / r;
+        let (lx, ly) = (((c + s) as f32) * light, ((c - s) as f32) * light);
+        for (j, ((t_out, z_out), shade_out)) in ts.iter_mut().zip(zs).zip(shades).enumerate() {
+            let k = j as f32;
+            let (dx, dy) = (sx + k * tx, sy + k * ty);
+            let a = dx * dx + dy * dy;
+            let b = ox * dx + oy * dy;
+            let disc = b * b - a * cc;
+            let t = (-b - disc.max(0.0).sqrt()) / a;
+            let z = ez + t * dz;
+            let side = disc >= 0.0 && t > 0.0 && z >= 0.0 && z <= top;
+            let (px, py) = (ox + t_top * dx, oy + t_top * dy);
+            let cap = top_seen && px * px + py * py <= r * r;
+            let shade = 0.9 + 0.1 * ((ox + t * dx) * lx + (oy + t * dy) * ly);
+            *t_out = if side {
+                t
+            } else if cap {
+                t_top
+            } else {
+                f32::INFINITY
+            };
+            *z_out = if side { z } else { top };
+            *shade_out = if side { shade } else { 1.0 };
+        }
+    }
+
+    /// Where the ray `o + t·d` (t > 0) first meets the solid; `(sin, cos)` turns the camera's
+    /// axes into the field's (a cuboid's, and the light's).
+    fn hit(&self, o: [f64; 3], d: [f64; 3], (s, c): (f64, f64)) -> Option<Hit> {
         match *self {
             Shape::Sphere { c, r } => {
                 let oc = [o[0] - c[0], o[1] - c[1], o[2] - c[2]];
@@ -189,8 +380,9 @@ impl Shape {
                     let t = (-b - disc.sqrt()) / a;
                     let z = o[2] + t * d[2];
                     if t > 0.0 && (0.0..=top).contains(&z) {
-                        // Lit from the north-east, a little.
+                        // Lit from the north-east of the field, a little.
                         let (nx, ny) = ((ox + t * d[0]) / r, (oy + t * d[1]) / r);
+                        let (nx, ny) = (c * nx - s * ny, s * nx + c * ny);
                         return Some((
                             t,
                             z,
@@ -209,6 +401,7 @@ impl Shape {
                 None
             }
             Shape::Cuboid { min, max } => {
+                let d = [c * d[0] - s * d[1], s * d[0] + c * d[1], d[2]];
                 let (mut t0, mut t1) = (0.0f64, f64::INFINITY);
                 for k in 0..3 {
                     if d[k] == 0.0 {
@@ -233,35 +426,302 @@ struct Thing {
     paint: Bands,
 }
 
-/// Where each pixel's ray meets the floor, relative to the point under the camera (robot axes,
-/// pan 0, m).
-#[derive(Clone, Debug)]
-enum FloorMap {
-    /// An ideal lens: per row, the first pixel's floor point and the step from one pixel to the
-    /// next (`None`: the row is at or above the horizon).
-    Rows(Vec<Option<([f32; 2], [f32; 2])>>),
-    /// A distorting lens: per pixel (NaN: at or above the horizon).
-    Pixels(Vec<[f32; 2]>),
+/// A closed interval of a row's column parameter `k` (pixel centres at integer `k`); empty
+/// when its start exceeds its end.
+type Span = (f64, f64);
+
+/// Every column.
+const ALL: Span = (f64::NEG_INFINITY, f64::INFINITY);
+
+/// No column.
+const EMPTY: Span = (f64::INFINITY, f64::NEG_INFINITY);
+
+/// The columns `k` where `a + b·k` lies in `[lo, hi]`.
+fn slab(a: f64, b: f64, lo: f64, hi: f64) -> Span {
+    if b == 0.0 {
+        return if (lo..=hi).contains(&a) { ALL } else { EMPTY };
+    }
+    let (k1, k2) = ((lo - a) / b, (hi - a) / b);
+    (k1.min(k2), k1.max(k2))
 }
 
-/// Draws camera images of the simulated world. Made once per world: the floor texture and the
-/// camera's rays are computed here.
+/// The columns `k` where `a + b·k ≥ 0`.
+fn half_line(a: f64, b: f64) -> Span {
+    if b == 0.0 {
+        return if a >= 0.0 { ALL } else { EMPTY };
+    }
+    let k = -a / b;
+    if b > 0.0 {
+        (k, f64::INFINITY)
+    } else {
+        (f64::NEG_INFINITY, k)
+    }
+}
+
+/// The columns of a row of rays `start + k·step` (horizontal parts) that point into the
+/// wedge between the directions `right` and `left` ([`Shape::wedge`]): counter-clockwise of
+/// the right edge and clockwise of the left one, which for a wedge of less than π is the wedge
+/// alone (not its opposite too).
+fn within((right, left): ([f64; 2], [f64; 2]), start: [f64; 2], step: [f64; 2]) -> Span {
+    let cross = |a: [f64; 2], v: [f64; 2]| a[0] * v[1] - a[1] * v[0];
+    meet(
+        half_line(cross(right, start), cross(right, step)),
+        half_line(-cross(left, start), -cross(left, step)),
+    )
+}
+
+/// Both spans.
+fn meet(a: Span, b: Span) -> Span {
+    (a.0.max(b.0), a.1.min(b.1))
+}
+
+/// The columns `k` where `|p + k·d|² ≤ r2`.
+fn disc(p: [f64; 2], d: [f64; 2], r2: f64) -> Span {
+    let a = d[0] * d[0] + d[1] * d[1];
+    let b = p[0] * d[0] + p[1] * d[1];
+    let c = p[0] * p[0] + p[1] * p[1] - r2;
+    if a == 0.0 {
+        return if c <= 0.0 { ALL } else { EMPTY };
+    }
+    let e = b * b - a * c;
+    if e < 0.0 {
+        return EMPTY;
+    }
+    let e = e.sqrt();
+    ((-b - e) / a, (-b + e) / a)
+}
+
+/// The pixels of a row of `n` whose centres lie in `span`.
+fn pixels(span: Span, n: usize) -> Range<usize> {
+    // Empty for NaN too.
+    if span.0.partial_cmp(&span.1).is_none_or(|o| o == std::cmp::Ordering::Greater) {
+        return 0..0;
+    }
+    // Clamped first (infinite ends are common), then rounded by conversion: no libm call on a
+    // path taken per row, and no integer overflow.
+    let limit = |v: f64| v.clamp(-1.0, n as f64 + 1.0);
+    let (lo, hi) = (limit(span.0), limit(span.1));
+    let ceil = |v: f64| {
+        let i = v as i64;
+        i + i64::from((i as f64) < v)
+    };
+    let floor = |v: f64| {
+        let i = v as i64;
+        i - i64::from((i as f64) > v)
+    };
+    let (lo, hi) = (ceil(lo).max(0), (floor(hi) + 1).min(n as i64));
+    if lo < hi {
+        lo as usize..hi as usize
+    } else {
+        0..0
+    }
+}
+
+/// Sets the pixels `cols` of a row of RGB bytes to `colour`.
+fn fill(row: &mut [u8], cols: Range<usize>, colour: [u8; 3]) {
+    let Some(part) = row.get_mut(3 * cols.start..3 * cols.end) else { return };
+    // Sixteen pixels at a time: whole-word stores instead of a byte at a time.
+    let mut pattern = [0u8; 48];
+    for px in pattern.chunks_exact_mut(3) {
+        px.copy_from_slice(&colour);
+    }
+    let mut chunks = part.chunks_exact_mut(48);
+    for chunk in &mut chunks {
+        chunk.copy_from_slice(&pattern);
+    }
+    let rest = chunks.into_remainder();
+    rest.copy_from_slice(&pattern[..rest.len()]);
+}
+
+/// A painted field line: a segment widened to the line width, with square ends (where two
+/// lines meet, the corner is filled), field frame.
+#[derive(Clone, Copy, Debug)]
+struct Strip {
+    mid: [f64; 2],
+    /// Unit vector along the segment.
+    along: [f64; 2],
+    half_length: f64,
+    half_width: f64,
+}
+
+/// What is painted on the floor (module doc): the field lines and the centre circle, with
+/// the walls around them; one geometry for a row of pixels at a time and for single points.
+#[derive(Clone, Debug)]
+struct FloorPaint {
+    strips: Vec<Strip>,
+    /// The centre circle's ring, squared inner and outer radii.
+    ring: Option<(f64, f64)>,
+    /// The walls: |x| ≤ wall.0, |y| ≤ wall.1.
+    wall: (f64, f64),
+}
+
+impl FloorPaint {
+    fn new(map: &FieldMap, wall: (f64, f64), line_width: f64) -> FloorPaint {
+        let half_width = line_width / 2.0;
+        let strips = map
+            .lines()
+            .into_iter()
+            .filter_map(|seg| {
+                let ab = seg.b - seg.a;
+                let len = ab.norm();
+                (len > 0.0).then(|| Strip {
+                    mid: [(seg.a.x + seg.b.x) / 2.0, (seg.a.y + seg.b.y) / 2.0],
+                    along: [ab.x / len, ab.y / len],
+                    half_length: len / 2.0 + half_width,
+                    half_width,
+                })
+            })
+            .collect();
+        let r = map.centre_circle_radius;
+        let ring = (r > 0.0).then(|| {
+            let inner = (r - half_width).max(0.0);
+            (inner * inner, (r + half_width) * (r + half_width))
+        });
+        FloorPaint { strips, ring, wall }
+    }
+
+    /// The columns of the floor line `p + k·d` (field frame) within the walls.
+    fn within_walls(&self, p: [f64; 2], d: [f64; 2]) -> Span {
+        meet(
+            slab(p[0], d[0], -self.wall.0, self.wall.0),
+            slab(p[1], d[1], -self.wall.1, self.wall.1),
+        )
+    }
+
+    /// Calls `paint` with the columns of the floor line `p + k·d` (field frame) that fall on a
+    /// painted line (spans may overlap).
+    fn lines(&self, p: [f64; 2], d: [f64; 2], mut paint: impl FnMut(Span)) {
+        for s in &self.strips {
+            let (qx, qy) = (p[0] - s.mid[0], p[1] - s.mid[1]);
+            let (ux, uy) = (s.along[0], s.along[1]);
+            let along =
+                slab(qx * ux + qy * uy, d[0] * ux + d[1] * uy, -s.half_length, s.half_length);
+            let across =
+                slab(ux * qy - uy * qx, ux * d[1] - uy * d[0], -s.half_width, s.half_width);
+            paint(meet(along, across));
+        }
+        if let Some((inner, outer)) = self.ring {
+            let out = disc(p, d, outer);
+            let hole = disc(p, d, inner);
+            if hole.0 > hole.1 {
+                paint(out);
+            } else {
+                paint((out.0, out.1.min(hole.0)));
+                paint((out.0.max(hole.1), out.1));
+            }
+        }
+    }
+
+    /// Whether the floor point `p` (field frame) shows a line.
+    fn is_line(&self, p: [f64; 2]) -> bool {
+        let mut line = false;
+        self.lines(p, [0.0, 0.0], |s| line |= !pixels(s, 1).is_empty());
+        line
+    }
+
+    /// For a row of rays `r + k·dr` from the optical centre `eye` (field frame; the rays'
+    /// height component `rz` is the same along a row of an ideal lens): the columns whose
+    /// rays, where they leave the walls, meet a wall below its top of `height` (`true`) or
+    /// pass over it into the hall (`false`) are the span returned and the rest, in the order
+    /// `(span, colour of the span is the wall)`.
+    fn walls(
+        &self,
+        eye: [f64; 3],
+        r: [f64; 2],
+        dr: [f64; 2],
+        rz: f64,
+        height: f64,
+    ) -> (Span, bool) {
+        if rz == 0.0 {
+            return (ALL, eye[2] <= height);
+        }
+        // Where the ray is at the wall's top height; it sees the wall when it leaves the
+        // walls above that point (rising ray) or below it (falling ray).
+        let t = (height - eye[2]) / rz;
+        if t <= 0.0 {
+            // A rising ray that starts above the walls, or a falling one that starts below.
+            return (ALL, rz < 0.0);
+        }
+        let inside =
+            self.within_walls([eye[0] + t * r[0], eye[1] + t * r[1]], [t * dr[0], t * dr[1]]);
+        (inside, rz < 0.0)
+    }
+}
+
+/// The rays of one row of pixels of an ideal lens: `start + k·step` for the pixel in column
+/// `k` (robot frame at pan 0, not normalized). A pinhole camera without roll images each row
+/// as a straight line of directions, evenly stepped, at one height component.
+#[derive(Clone, Copy, Debug)]
+struct RowRays {
+    start: [f64; 3],
+    step: [f64; 3],
+}
+
+/// The pixels' rays.
+#[derive(Clone, Debug)]
+enum Rays {
+    /// An ideal lens: a row at a time.
+    Rows(Vec<RowRays>),
+    /// A distorting lens: per pixel, its ray and where the ray meets the floor, relative to
+    /// the point under the camera (robot frame, pan 0; NaN at or above the horizon), and the
+    /// floor as a texture.
+    Pixels { rays: Vec<[f32; 3]>, floor: Vec<[f32; 2]>, texture: Texture },
+}
+
+/// The floor's lines as a bitmap (a distorting lens's floor pass): one bit a 2 cm texel, row
+/// major from the south-west corner between the walls (90 KB for the default field, which
+/// stays in the cache).
+#[derive(Clone, Debug)]
+struct Texture {
+    bits: Vec<u64>,
+    size: (usize, usize),
+}
+
+impl Texture {
+    fn new(paint: &FloorPaint) -> Texture {
+        let wall = paint.wall;
+        let size = ((2.0 * wall.0 / TEXEL).ceil() as usize, (2.0 * wall.1 / TEXEL).ceil() as usize);
+        let mut bits = vec![0u64; (size.0 * size.1).div_ceil(64)];
+        for j in 0..size.1 {
+            for i in 0..size.0 {
+                let centre =
+                    [-wall.0 + (i as f64 + 0.5) * TEXEL, -wall.1 + (j as f64 + 0.5) * TEXEL];
+                if paint.is_line(centre) {
+                    let k = j * size.0 + i;
+                    bits[k >> 6] |= 1 << (k & 63);
+                }
+            }
+        }
+        Texture { bits, size }
+    }
+
+    /// Whether the floor point `p` (field frame) shows a line; `None` beyond the walls (and
+    /// for NaN: no floor).
+    #[inline]
+    fn texel(&self, p: [f64; 2], wall: (f64, f64)) -> Option<bool> {
+        let (tx, ty) = ((p[0] + wall.0) / TEXEL, (p[1] + wall.1) / TEXEL);
+        if !(tx >= 0.0 && ty >= 0.0) {
+            return None;
+        }
+        let (i, j) = (tx as usize, ty as usize);
+        if i >= self.size.0 || j >= self.size.1 {
+            return None;
+        }
+        let k = j * self.size.0 + i;
+        Some(self.bits.get(k >> 6).is_some_and(|word| word >> (k & 63) & 1 != 0))
+    }
+}
+
+/// Draws camera images of the simulated world. Made once per world: the floor's paint and
+/// the camera's rays are computed here.
 #[derive(Clone, Debug)]
 pub struct Renderer {
     camera: Pinhole,
     cfg: RenderConfig,
     robot_radius: f64,
     ball_radius: f64,
-    /// The walls: |x| ≤ wall_x, |y| ≤ wall_y.
-    wall: (f64, f64),
-    /// Floor texture, row-major from (−wall_x, −wall_y), one bit a texel: 1 where a line is
-    /// painted (bits: 90 KB for the default field, which stay in the cache).
-    texture: Vec<u64>,
-    texture_size: (usize, usize),
-    /// Per pixel, the ray's direction (robot frame, pan 0).
-    rays: Vec<[f32; 3]>,
-    /// Where the pixels' rays meet the floor.
-    floor: FloorMap,
+    floor: FloorPaint,
+    rays: Rays,
     /// Goals and posts.
     fixed: Vec<Thing>,
     /// Gaussian noise samples, σ = [`RenderConfig::noise`].
@@ -274,49 +734,43 @@ impl Renderer {
         let camera = cfg.camera.camera()?.panned(0.0);
         let map = cfg.field.map();
         let wall = (map.half_length() + cfg.field.border, map.half_width() + cfg.field.border);
-        let (texture, texture_size) = floor_texture(&map, wall, cfg.render.line_width);
+        let floor = FloorPaint::new(&map, wall, cfg.render.line_width);
         let (w, h) = camera.size();
-        let ray =
-            |col: u32, row: u32| camera.ray(Pixel::new(f64::from(col) + 0.5, f64::from(row) + 0.5));
-        let on_floor = |col: u32, row: u32| {
-            let d = ray(col, row);
-            let t = -camera.height / d.z;
-            (d.z < 0.0 && t.is_finite()).then(|| [(t * d.x) as f32, (t * d.y) as f32])
-        };
-        let rays: Vec<[f32; 3]> = (0..h)
-            .flat_map(|row| (0..w).map(move |col| (col, row)))
-            .map(|(col, row)| ray(col, row).map(|v| v as f32).into())
-            .collect();
-        let floor = if camera.distortion == (0.0, 0.0) {
-            FloorMap::Rows(
+        let ray = |col: f64, row: u32| camera.ray(Pixel::new(col + 0.5, f64::from(row) + 0.5));
+        let rays = if camera.distortion == (0.0, 0.0) {
+            Rays::Rows(
                 (0..h)
                     .map(|row| {
-                        let (a, b) = (on_floor(0, row)?, on_floor(1, row)?);
-                        Some((a, [b[0] - a[0], b[1] - a[1]]))
+                        let (a, b) = (ray(0.0, row), ray(1.0, row));
+                        RowRays { start: a.into(), step: (b - a).into() }
                     })
                     .collect(),
             )
         } else {
-            FloorMap::Pixels(
-                (0..h)
-                    .flat_map(|row| (0..w).map(move |col| (col, row)))
-                    .map(|(col, row)| on_floor(col, row).unwrap_or([f32::NAN; 2]))
-                    .collect(),
-            )
+            let pixels = || (0..h).flat_map(|row| (0..w).map(move |col| (f64::from(col), row)));
+            let on_floor = |d: nalgebra::Vector3<f64>| {
+                let t = -camera.height / d.z;
+                if d.z < 0.0 && t.is_finite() {
+                    [(t * d.x) as f32, (t * d.y) as f32]
+                } else {
+                    [f32::NAN; 2]
+                }
+            };
+            Rays::Pixels {
+                rays: pixels().map(|(col, row)| ray(col, row).map(|v| v as f32).into()).collect(),
+                floor: pixels().map(|(col, row)| on_floor(ray(col, row))).collect(),
+                texture: Texture::new(&floor),
+            }
         };
-        let noise = noise_table(cfg.render.noise);
         Ok(Renderer {
             camera,
             cfg: cfg.render.clone(),
             robot_radius: cfg.robot.radius,
             ball_radius: cfg.ball.radius,
-            wall,
-            texture,
-            texture_size,
-            rays,
             floor,
+            rays,
             fixed: fixed_things(&map, cfg),
-            noise,
+            noise: noise_table(cfg.render.noise),
         })
     }
 
@@ -343,76 +797,22 @@ impl Renderer {
             1.0
         };
         let light = |c: [u8; 3], k: f64| c.map(|v| (f64::from(v) * k).min(255.0) as u8);
-        let (carpet, line) = (light(palette::CARPET, brightness), light(palette::LINE, brightness));
-        let (wall, hall) = (light(palette::WALL, brightness), light(palette::HALL, brightness));
-        // The optical centre and the ray rotation, field frame.
+        let colours = Colours {
+            carpet: light(palette::CARPET, brightness),
+            line: light(palette::LINE, brightness),
+            wall: light(palette::WALL, brightness),
+            hall: light(palette::HALL, brightness),
+        };
+        // The optical centre, field frame, and the rotation of the camera's pan-0 robot axes
+        // into the field's.
         let (s, c) = viewer.theta.sin_cos();
         let m = self.camera.mount;
         let eye = [viewer.x + c * m.x - s * m.y, viewer.y + s * m.x + c * m.y, self.camera.height];
-        let (sp, cp) = (viewer.theta + pan).sin_cos();
-        let (sp32, cp32) = (sp as f32, cp as f32);
-        let inv = (1.0 / TEXEL) as f32;
-        // Field-frame texel coordinates of a floor point given relative to the camera's foot,
-        // robot axes at pan 0.
-        let (ox, oy) = ((eye[0] + self.wall.0) as f32 * inv, (eye[1] + self.wall.1) as f32 * inv);
-        let to_texels = |f: [f32; 2]| (cp32 * f[0] - sp32 * f[1], sp32 * f[0] + cp32 * f[1]);
+        let rot = (viewer.theta + pan).sin_cos();
         let w = w as usize;
-        for (row, pixels) in image.rgb.chunks_exact_mut(3 * w).enumerate() {
-            let background = |col: usize| {
-                if self.wall_hit(eye, self.rays[row * w + col], cp, sp) {
-                    wall
-                } else {
-                    hall
-                }
-            };
-            match &self.floor {
-                // Without lens distortion a row of pixels sees a straight line of the floor,
-                // evenly spaced: two additions a pixel.
-                FloorMap::Rows(rows) => {
-                    let Some((start, step)) = rows[row] else {
-                        for (col, px) in pixels.chunks_exact_mut(3).enumerate() {
-                            px.copy_from_slice(&background(col));
-                        }
-                        continue;
-                    };
-                    let (sx, sy) = to_texels(start);
-                    let (dx, dy) = to_texels(step);
-                    // Texel coordinates in 32.32 fixed point: an integer addition a pixel.
-                    let fixed = |v: f32| (f64::from(v) * FIXED_ONE).clamp(-1e18, 1e18) as i64;
-                    let (mut x, mut y) = (fixed(ox + sx * inv), fixed(oy + sy * inv));
-                    let (dx, dy) = (fixed(dx * inv), fixed(dy * inv));
-                    let (tw, th) = (self.texture_size.0 as u64, self.texture_size.1 as u64);
-                    for (col, px) in pixels.chunks_exact_mut(3).enumerate() {
-                        let (i, j) = ((x >> 32) as u64, (y >> 32) as u64);
-                        let colour = if i < tw && j < th {
-                            let k = (j * tw + i) as usize;
-                            match self.texture.get(k >> 6) {
-                                Some(word) if word >> (k & 63) & 1 != 0 => line,
-                                _ => carpet,
-                            }
-                        } else {
-                            background(col)
-                        };
-                        px.copy_from_slice(&colour);
-                        x = x.wrapping_add(dx);
-                        y = y.wrapping_add(dy);
-                    }
-                }
-                FloorMap::Pixels(floor) => {
-                    let floor = &floor[row * w..(row + 1) * w];
-                    for (col, (px, f)) in pixels.chunks_exact_mut(3).zip(floor).enumerate() {
-                        let (fx, fy) = to_texels(*f);
-                        let colour = match self.texel(ox + fx * inv, oy + fy * inv) {
-                            Some(true) => line,
-                            Some(false) => carpet,
-                            None => background(col),
-                        };
-                        px.copy_from_slice(&colour);
-                    }
-                }
-            }
-        }
-        // The objects, each on its projected bounding box, nearest wins.
+        self.draw_floor(&mut image, eye, rot, &colours);
+        // The objects, each on its projected bounding box, nearest wins. They are placed
+        // relative to the optical centre with the camera's axes, so that a ray needs no turn.
         let mut things = Vec::with_capacity(self.fixed.len() + scene.robots.len() + 1);
         things.extend_from_slice(&self.fixed);
         if let Some((bx, by)) = scene.ball {
@@ -438,39 +838,72 @@ impl Renderer {
         }
         let boxes: Vec<_> = things
             .iter()
-            .filter_map(|t| Some((t, self.image_box(t.shape, viewer, pan)?)))
+            .filter_map(|t| {
+                let b = self.image_box(t.shape, viewer, pan)?;
+                Some((t.shape.relative(eye, rot), t.paint, b))
+            })
             .collect();
         // The depth buffer only where an object may be: cleared on those boxes alone.
-        state.depth.resize(self.rays.len(), f64::INFINITY);
-        for (_, (c0, r0, c1, r1)) in &boxes {
+        let depth = &mut state.scratch.depth;
+        depth.resize(w * h as usize, f32::INFINITY);
+        for buffer in [&mut state.scratch.ts, &mut state.scratch.zs, &mut state.scratch.shades] {
+            buffer.resize(w, 0.0);
+        }
+        for (_, _, (c0, r0, c1, r1)) in &boxes {
             for row in *r0..*r1 {
-                state.depth[row * w + c0..row * w + c1].fill(f64::INFINITY);
+                depth[row * w + c0..row * w + c1].fill(f32::INFINITY);
             }
         }
-        for (thing, (c0, r0, c1, r1)) in boxes {
+        let o = [0.0, 0.0, eye[2]];
+        let Scratch { depth, ts, zs, shades } = &mut state.scratch;
+        for (shape, paint, (c0, r0, c1, r1)) in boxes {
+            let lit = Lit::new(&paint, brightness);
+            let wedge = shape.wedge(rot);
             for row in r0..r1 {
-                // A convex solid covers one run of pixels in a row: past its end, the row is done.
-                let mut hit_in_row = false;
-                for col in c0..c1 {
-                    let i = row * w + col;
-                    let d0 = self.rays[i];
-                    let (dx, dy) = (f64::from(d0[0]), f64::from(d0[1]));
-                    let d = [cp * dx - sp * dy, sp * dx + cp * dy, f64::from(d0[2])];
-                    let Some((t, z, shade)) = thing.shape.hit(eye, d) else {
-                        if hit_in_row {
-                            break;
-                        }
-                        continue;
-                    };
-                    if state.depth[i] <= t {
-                        continue;
+                let cols = match &self.rays {
+                    Rays::Rows(rows) => {
+                        let RowRays { start, step } = rows[row];
+                        let wedge = wedge
+                            .map_or(ALL, |w| within(w, [start[0], start[1]], [step[0], step[1]]));
+                        // A pixel of margin for rounding: the test below is exact.
+                        let cols = pixels((wedge.0 - 1.0, wedge.1 + 1.0), c1);
+                        cols.start.max(c0)..cols.end
                     }
-                    state.depth[i] = t;
-                    let k = (brightness * shade * 256.0).clamp(0.0, 1024.0) as u32;
-                    let colour =
-                        thing.paint.at(z).map(|v| ((u32::from(v) * k) >> 8).min(255) as u8);
-                    image.rgb[i * 3..i * 3 + 3].copy_from_slice(&colour);
-                    hit_in_row = true;
+                    Rays::Pixels { .. } => c0..c1,
+                };
+                let n = cols.len();
+                if n == 0 {
+                    continue;
+                }
+                let (ts, zs, shades) = (&mut ts[..n], &mut zs[..n], &mut shades[..n]);
+                match &self.rays {
+                    Rays::Rows(rows) => {
+                        let RowRays { start, step } = rows[row];
+                        let hits = Hits { ts, zs, shades };
+                        shape.trace_row(o, (start, step), cols.start, rot, hits);
+                    }
+                    Rays::Pixels { rays, .. } => {
+                        let rays = &rays[row * w + cols.start..row * w + cols.end];
+                        for (((t, z), shade), d) in
+                            ts.iter_mut().zip(zs.iter_mut()).zip(shades.iter_mut()).zip(rays)
+                        {
+                            (*t, *z, *shade) = Hits::of(shape.hit(o, d.map(f64::from), rot));
+                        }
+                    }
+                }
+                let pixels = row * w + cols.start..row * w + cols.end;
+                let depth = &mut depth[pixels.clone()];
+                let image = &mut image.rgb[3 * pixels.start..3 * pixels.end];
+                for (((t, z), shade), (d, px)) in ts
+                    .iter()
+                    .zip(zs.iter())
+                    .zip(shades.iter())
+                    .zip(depth.iter_mut().zip(image.chunks_exact_mut(3)))
+                {
+                    if *t < *d {
+                        *d = *t;
+                        px.copy_from_slice(&lit.colour(*z, *shade));
+                    }
                 }
             }
         }
@@ -478,35 +911,71 @@ impl Renderer {
         image
     }
 
-    /// Whether the floor texel at `(tx, ty)` (texel units from the south-west corner between the
-    /// walls) shows a line; `None` beyond the walls (and for NaN: no floor).
-    #[inline]
-    fn texel(&self, tx: f32, ty: f32) -> Option<bool> {
-        let (tw, th) = self.texture_size;
-        if !(tx >= 0.0 && ty >= 0.0) {
-            return None;
+    /// The floor, the walls and the hall: a row at a time as spans of one colour (an ideal
+    /// lens), or a pixel at a time through the floor's texture (a distorting lens).
+    fn draw_floor(&self, image: &mut Image, eye: [f64; 3], (s, c): (f64, f64), colours: &Colours) {
+        let w = image.width as usize;
+        let turn = |v: [f64; 3]| [c * v[0] - s * v[1], s * v[0] + c * v[1]];
+        let wall_height = self.cfg.wall_height;
+        // Paints the pixels `cols` of a row whose rays `r + k·dr` miss the floor inside the
+        // walls.
+        let background = |px: &mut [u8], cols: Range<usize>, r: [f64; 2], dr: [f64; 2], rz| {
+            let (span, wall) = self.floor.walls(eye, r, dr, rz, wall_height);
+            let (inner, outer) =
+                if wall { (colours.wall, colours.hall) } else { (colours.hall, colours.wall) };
+            let within = pixels(span, px.len() / 3);
+            let mid =
+                within.start.clamp(cols.start, cols.end)..within.end.clamp(cols.start, cols.end);
+            fill(px, cols.start..mid.start, outer);
+            fill(px, mid.clone(), inner);
+            fill(px, mid.end..cols.end, outer);
+        };
+        match &self.rays {
+            Rays::Rows(rows) => {
+                for (px, ray) in image.rgb.chunks_exact_mut(3 * w).zip(rows) {
+                    let (r, dr, rz) = (turn(ray.start), turn(ray.step), ray.start[2]);
+                    let floor = if rz < 0.0 {
+                        // The floor line that the row sees: the ray scaled to the floor.
+                        let t = -eye[2] / rz;
+                        let p = [eye[0] + t * r[0], eye[1] + t * r[1]];
+                        let d = [t * dr[0], t * dr[1]];
+                        let floor = pixels(self.floor.within_walls(p, d), w);
+                        fill(px, floor.clone(), colours.carpet);
+                        self.floor.lines(p, d, |span| {
+                            let cols = pixels(span, w);
+                            fill(
+                                px,
+                                cols.start.max(floor.start)..cols.end.min(floor.end),
+                                colours.line,
+                            );
+                        });
+                        floor
+                    } else {
+                        0..0
+                    };
+                    background(px, 0..floor.start, r, dr, rz);
+                    background(px, floor.end.max(floor.start)..w, r, dr, rz);
+                }
+            }
+            Rays::Pixels { rays, floor, texture } => {
+                for (k, px) in image.rgb.chunks_exact_mut(3).enumerate() {
+                    let f = floor[k].map(f64::from);
+                    let f = turn([f[0], f[1], 0.0]);
+                    let p = [eye[0] + f[0], eye[1] + f[1]];
+                    let colour = match texture.texel(p, self.floor.wall) {
+                        Some(true) => colours.line,
+                        Some(false) => colours.carpet,
+                        None => {
+                            let d = rays[k].map(f64::from);
+                            let mut one = [0u8; 3];
+                            background(&mut one, 0..1, turn(d), [0.0, 0.0], d[2]);
+                            one
+                        }
+                    };
+                    px.copy_from_slice(&colour);
+                }
+            }
         }
-        let (i, j) = (tx as usize, ty as usize);
-        if i >= tw || j >= th {
-            return None;
-        }
-        let k = j * tw + i;
-        Some(self.texture.get(k >> 6).is_some_and(|word| word >> (k & 63) & 1 != 0))
-    }
-
-    /// Whether a ray that leaves the floor texture meets a wall below its top.
-    fn wall_hit(&self, eye: [f64; 3], d: [f32; 3], c: f64, s: f64) -> bool {
-        let (dx0, dy0) = (f64::from(d[0]), f64::from(d[1]));
-        let (dx, dy) = (c * dx0 - s * dy0, s * dx0 + c * dy0);
-        let mut t = f64::INFINITY;
-        if dx != 0.0 {
-            t = t.min((dx.signum() * self.wall.0 - eye[0]) / dx);
-        }
-        if dy != 0.0 {
-            t = t.min((dy.signum() * self.wall.1 - eye[1]) / dy);
-        }
-        let z = eye[2] + t * f64::from(d[2]);
-        t.is_finite() && z <= self.cfg.wall_height
     }
 
     /// The pixels `(col0, row0, col1, row1)` (end exclusive) that may show `shape`, from its
@@ -523,34 +992,38 @@ impl Renderer {
         let (min, max) = shape.bounds();
         let cam = self.camera.panned(pan);
         let (s, c) = viewer.theta.sin_cos();
-        let corners: [Point3<f64>; 8] = std::array::from_fn(|k| {
+        // The box's corners in camera axes; their z is the depth along the optical axis.
+        let (rotation, centre) = (cam.robot_to_camera(), cam.centre());
+        let corners: [Vector3<f64>; 8] = std::array::from_fn(|k| {
             let p = [
                 if k & 1 == 0 { min[0] } else { max[0] },
                 if k & 2 == 0 { min[1] } else { max[1] },
                 if k & 4 == 0 { min[2] } else { max[2] },
             ];
             let (dx, dy) = (p[0] - viewer.x, p[1] - viewer.y);
-            Point3::new(c * dx + s * dy, -s * dx + c * dy, p[2])
+            rotation * (Point3::new(c * dx + s * dy, -s * dx + c * dy, p[2]) - centre)
         });
-        let depth = corners.map(|p| cam.depth(p));
         let mut lo = (f64::INFINITY, f64::INFINITY);
         let mut hi = (f64::NEG_INFINITY, f64::NEG_INFINITY);
-        let mut take = |p: Point3<f64>| {
-            if let Some(px) = cam.project(p).filter(|px| px.x.is_finite() && px.y.is_finite()) {
+        let mut take = |v: Vector3<f64>| {
+            if let Some(px) =
+                cam.project_camera(v).filter(|px| px.x.is_finite() && px.y.is_finite())
+            {
                 lo = (lo.0.min(px.x), lo.1.min(px.y));
                 hi = (hi.0.max(px.x), hi.1.max(px.y));
             }
         };
         for k in 0..8 {
-            if depth[k] >= NEAR {
+            let near = |k: usize| corners[k].z >= NEAR;
+            if near(k) {
                 take(corners[k]);
             }
             // The box's edges from this corner (to the corners differing in one coordinate)
             // that cross the near plane: their crossing point bounds the visible part.
             for bit in [1, 2, 4] {
                 let l = k | bit;
-                if l != k && (depth[k] >= NEAR) != (depth[l] >= NEAR) {
-                    let t = (NEAR - depth[k]) / (depth[l] - depth[k]);
+                if l != k && near(k) != near(l) {
+                    let t = (NEAR - corners[k].z) / (corners[l].z - corners[k].z);
                     take(corners[k] + (corners[l] - corners[k]) * t);
                 }
             }
@@ -594,49 +1067,6 @@ impl Renderer {
             state.previous = Some(image.clone());
         }
     }
-}
-
-/// The floor texture between the walls: 1 on the field lines and the centre circle.
-fn floor_texture(map: &FieldMap, wall: (f64, f64), line_width: f64) -> (Vec<u64>, (usize, usize)) {
-    let (tw, th) = ((2.0 * wall.0 / TEXEL).ceil() as usize, (2.0 * wall.1 / TEXEL).ceil() as usize);
-    let mut texture = vec![0u64; (tw * th).div_ceil(64)];
-    let mut paint = |k: usize| texture[k >> 6] |= 1 << (k & 63);
-    let half = line_width / 2.0;
-    let centre = |i: usize, j: usize| {
-        (-wall.0 + (i as f64 + 0.5) * TEXEL, -wall.1 + (j as f64 + 0.5) * TEXEL)
-    };
-    let cells = |lo: f64, hi: f64, origin: f64, n: usize| {
-        let a = (((lo + origin) / TEXEL).floor().max(0.0) as usize).min(n);
-        let b = (((hi + origin) / TEXEL).ceil().max(0.0) as usize).min(n);
-        a..b
-    };
-    for seg in map.lines() {
-        let (a, b) = (seg.a, seg.b);
-        let ab = b - a;
-        let len2 = ab.norm_squared().max(1e-12);
-        for j in cells(a.y.min(b.y) - half, a.y.max(b.y) + half, wall.1, th) {
-            for i in cells(a.x.min(b.x) - half, a.x.max(b.x) + half, wall.0, tw) {
-                let (x, y) = centre(i, j);
-                let t = (((x - a.x) * ab.x + (y - a.y) * ab.y) / len2).clamp(0.0, 1.0);
-                let (dx, dy) = (x - (a.x + t * ab.x), y - (a.y + t * ab.y));
-                if dx * dx + dy * dy <= half * half {
-                    paint(j * tw + i);
-                }
-            }
-        }
-    }
-    let r = map.centre_circle_radius;
-    if r > 0.0 {
-        for j in cells(-r - half, r + half, wall.1, th) {
-            for i in cells(-r - half, r + half, wall.0, tw) {
-                let (x, y) = centre(i, j);
-                if ((x * x + y * y).sqrt() - r).abs() <= half {
-                    paint(j * tw + i);
-                }
-            }
-        }
-    }
-    (texture, (tw, th))
 }
 
 /// The goals (east yellow, west blue) and the landmark posts.
@@ -686,4 +1116,47 @@ fn noise_table(sigma: f64) -> Vec<i8> {
     (0..NOISE_SAMPLES)
         .map(|_| (crate::sensor::gauss(&mut rng) * sigma).round().clamp(-127.0, 127.0) as i8)
         .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_span_covers_the_pixels_whose_centres_it_holds() {
+        assert_eq!(pixels((0.5, 2.5), 5), 1..3);
+        assert_eq!(pixels((0.0, 2.0), 5), 0..3, "closed at both ends");
+        assert_eq!(pixels(ALL, 5), 0..5);
+        assert_eq!(pixels((-3.5, 1e300), 5), 0..5);
+        assert!(pixels((4.5, 9.0), 5).is_empty(), "beyond the row");
+        assert!(pixels((5.5, 7.0), 5).is_empty());
+        for empty in [EMPTY, (f64::INFINITY, f64::INFINITY), (f64::NEG_INFINITY, -1.0), (3.2, 3.8)]
+        {
+            assert!(pixels(empty, 5).is_empty(), "{empty:?}");
+        }
+        assert!(pixels((f64::NAN, 3.0), 5).is_empty());
+        assert!(pixels((0.0, f64::NAN), 5).is_empty());
+    }
+
+    #[test]
+    fn the_floor_paint_of_a_point_is_the_paint_of_a_row_through_it() {
+        let map = FieldMap::default();
+        let paint = FloorPaint::new(&map, (9.5, 6.5), 0.1);
+        // On the ring, in its hole, on a side line, on the carpet.
+        assert!(paint.is_line([2.0, 0.0]));
+        assert!(!paint.is_line([0.5, 0.5]));
+        assert!(paint.is_line([3.0, 6.0 + 0.04]));
+        assert!(!paint.is_line([3.0, 5.0]));
+        // A row along y = 0 from x = -5.005 in 1 cm steps (no pixel centre on an edge): the
+        // ring's two crossings and the half-way line, each 10 pixels as wide as the line.
+        let mut spans = vec![];
+        paint.lines([-5.005, 0.0], [0.01, 0.0], |s| {
+            let p = pixels(s, 1000);
+            if !p.is_empty() {
+                spans.push(p);
+            }
+        });
+        spans.sort_by_key(|p| p.start);
+        assert_eq!(spans, vec![296..306, 496..506, 696..706], "{spans:?}");
+    }
 }
