@@ -308,47 +308,87 @@ impl Shape {
     ) {
         let k0 = k0 as f64;
         let Hits { ts, zs, shades } = hits;
-        let Shape::Cylinder { x, y, r, top } = *self else {
-            for (j, ((t, z), shade)) in ts.iter_mut().zip(zs).zip(shades).enumerate() {
-                let k = k0 + j as f64;
-                let d = [start[0] + k * step[0], start[1] + k * step[1], start[2]];
-                (*t, *z, *shade) = Hits::of(self.hit(o, d, (s, c)));
-            }
-            return;
-        };
-        // Relative to the column k0, in f32 (image-level accuracy).
-        let (ox, oy, ez) = ((o[0] - x) as f32, (o[1] - y) as f32, o[2] as f32);
+        // Relative to the column k0, in f32 (image-level accuracy): the ray of the j-th pixel
+        // is (sx + j·tx, sy + j·ty, dz) from (0, 0, ez).
         let (sx, sy) = ((start[0] + k0 * step[0]) as f32, (start[1] + k0 * step[1]) as f32);
         let (tx, ty, dz) = (step[0] as f32, step[1] as f32, start[2] as f32);
-        let (r, top) = (r as f32, top as f32);
-        let cc = ox * ox + oy * oy - r * r;
-        // The top is met, if at all, at one distance along every ray of the row.
-        let t_top = (top - ez) / dz;
-        let top_seen = dz < 0.0 && t_top > 0.0;
-        // The light from the field's north-east, in the camera's axes.
-        let light = std::f32::consts::FRAC_1_SQRT_2 / r;
-        let (lx, ly) = (((c + s) as f32) * light, ((c - s) as f32) * light);
-        for (j, ((t_out, z_out), shade_out)) in ts.iter_mut().zip(zs).zip(shades).enumerate() {
-            let k = j as f32;
-            let (dx, dy) = (sx + k * tx, sy + k * ty);
-            let a = dx * dx + dy * dy;
-            let b = ox * dx + oy * dy;
-            let disc = b * b - a * cc;
-            let t = (-b - disc.max(0.0).sqrt()) / a;
-            let z = ez + t * dz;
-            let side = disc >= 0.0 && t > 0.0 && z >= 0.0 && z <= top;
-            let (px, py) = (ox + t_top * dx, oy + t_top * dy);
-            let cap = top_seen && px * px + py * py <= r * r;
-            let shade = 0.9 + 0.1 * ((ox + t * dx) * lx + (oy + t * dy) * ly);
-            *t_out = if side {
-                t
-            } else if cap {
-                t_top
-            } else {
-                f32::INFINITY
-            };
-            *z_out = if side { z } else { top };
-            *shade_out = if side { shade } else { 1.0 };
+        let ez = o[2] as f32;
+        let pixels = ts.iter_mut().zip(zs).zip(shades).enumerate();
+        match *self {
+            Shape::Cylinder { x, y, r, top } => {
+                let (ox, oy) = ((o[0] - x) as f32, (o[1] - y) as f32);
+                let (r, top) = (r as f32, top as f32);
+                let cc = ox * ox + oy * oy - r * r;
+                // The top is met, if at all, at one distance along every ray of the row.
+                let t_top = (top - ez) / dz;
+                let top_seen = dz < 0.0 && t_top > 0.0;
+                // The light from the field's north-east, in the camera's axes.
+                let light = std::f32::consts::FRAC_1_SQRT_2 / r;
+                let (lx, ly) = (((c + s) as f32) * light, ((c - s) as f32) * light);
+                for (j, ((t_out, z_out), shade_out)) in pixels {
+                    let k = j as f32;
+                    let (dx, dy) = (sx + k * tx, sy + k * ty);
+                    let a = dx * dx + dy * dy;
+                    let b = ox * dx + oy * dy;
+                    let disc = b * b - a * cc;
+                    let t = (-b - disc.max(0.0).sqrt()) / a;
+                    let z = ez + t * dz;
+                    let side = disc >= 0.0 && t > 0.0 && z >= 0.0 && z <= top;
+                    let (px, py) = (ox + t_top * dx, oy + t_top * dy);
+                    let cap = top_seen && px * px + py * py <= r * r;
+                    let shade = 0.9 + 0.1 * ((ox + t * dx) * lx + (oy + t * dy) * ly);
+                    *t_out = if side {
+                        t
+                    } else if cap {
+                        t_top
+                    } else {
+                        f32::INFINITY
+                    };
+                    *z_out = if side { z } else { top };
+                    *shade_out = if side { shade } else { 1.0 };
+                }
+            }
+            Shape::Sphere { c: centre, r } => {
+                let oc =
+                    [(o[0] - centre[0]) as f32, (o[1] - centre[1]) as f32, ez - centre[2] as f32];
+                let r = r as f32;
+                let cc = oc[0] * oc[0] + oc[1] * oc[1] + oc[2] * oc[2] - r * r;
+                let (bz, cz) = (oc[2] * dz, centre[2] as f32);
+                for (j, ((t_out, z_out), shade_out)) in pixels {
+                    let k = j as f32;
+                    let (dx, dy) = (sx + k * tx, sy + k * ty);
+                    let a = dx * dx + dy * dy + dz * dz;
+                    let b = oc[0] * dx + oc[1] * dy + bz;
+                    let disc = b * b - a * cc;
+                    let t = (-b - disc.max(0.0).sqrt()) / a;
+                    let z = ez + t * dz;
+                    *t_out = if disc >= 0.0 && t > 0.0 { t } else { f32::INFINITY };
+                    *z_out = z;
+                    // Lit from above: the top bright, the underside darker.
+                    *shade_out = 0.8 + 0.2 * (z - cz) / r;
+                }
+            }
+            Shape::Cuboid { min, max } => {
+                // The slabs in the field's axes: the ray turned, and its inverse per axis (an
+                // axis the ray runs along gives ±∞, or NaN on a face, which `min`/`max` skip).
+                let (sc, ss) = (c as f32, s as f32);
+                let (min, max) = (min.map(|v| v as f32), max.map(|v| v as f32));
+                let (lo_z, hi_z) = ((min[2] - ez) / dz, (max[2] - ez) / dz);
+                let (tz0, tz1) = (lo_z.min(hi_z), lo_z.max(hi_z));
+                for (j, ((t_out, z_out), shade_out)) in pixels {
+                    let k = j as f32;
+                    let (dx, dy) = (sx + k * tx, sy + k * ty);
+                    let (fx, fy) = (sc * dx - ss * dy, ss * dx + sc * dy);
+                    let (ax, bx) = (min[0] / fx, max[0] / fx);
+                    let (ay, by) = (min[1] / fy, max[1] / fy);
+                    let t0 = ax.min(bx).max(ay.min(by)).max(tz0).max(0.0);
+                    let t1 = ax.max(bx).min(ay.max(by)).min(tz1);
+                    let hit = t0 <= t1 && t0 > 0.0;
+                    *t_out = if hit { t0 } else { f32::INFINITY };
+                    *z_out = ez + t0 * dz;
+                    *shade_out = 1.0;
+                }
+            }
         }
     }
 
@@ -542,6 +582,8 @@ struct Strip {
     along: [f64; 2],
     half_length: f64,
     half_width: f64,
+    /// Its bounding box (min, max corners).
+    bounds: ([f64; 2], [f64; 2]),
 }
 
 /// What is painted on the floor (module doc): the field lines and the centre circle, with
@@ -564,11 +606,14 @@ impl FloorPaint {
             .filter_map(|seg| {
                 let ab = seg.b - seg.a;
                 let len = ab.norm();
-                (len > 0.0).then(|| Strip {
-                    mid: [(seg.a.x + seg.b.x) / 2.0, (seg.a.y + seg.b.y) / 2.0],
-                    along: [ab.x / len, ab.y / len],
-                    half_length: len / 2.0 + half_width,
-                    half_width,
+                (len > 0.0).then(|| {
+                    let mid = [(seg.a.x + seg.b.x) / 2.0, (seg.a.y + seg.b.y) / 2.0];
+                    let (along, half_length) = ([ab.x / len, ab.y / len], len / 2.0 + half_width);
+                    // Half the box: each half-extent projected on the axes.
+                    let ex = along[0].abs() * half_length + along[1].abs() * half_width;
+                    let ey = along[1].abs() * half_length + along[0].abs() * half_width;
+                    let bounds = ([mid[0] - ex, mid[1] - ey], [mid[0] + ex, mid[1] + ey]);
+                    Strip { mid, along, half_length, half_width, bounds }
                 })
             })
             .collect();
@@ -588,10 +633,19 @@ impl FloorPaint {
         )
     }
 
-    /// Calls `paint` with the columns of the floor line `p + k·d` (field frame) that fall on a
-    /// painted line (spans may overlap).
-    fn lines(&self, p: [f64; 2], d: [f64; 2], mut paint: impl FnMut(Span)) {
+    /// Calls `paint` with the columns `k` in `0..n` of the floor line `p + k·d` (field frame)
+    /// that fall on a painted line (spans may overlap, and reach beyond `0..n`). A strip whose
+    /// bounding box the line's stretch misses costs four comparisons.
+    fn lines(&self, p: [f64; 2], d: [f64; 2], n: usize, mut paint: impl FnMut(Span)) {
+        let end = [p[0] + n as f64 * d[0], p[1] + n as f64 * d[1]];
+        let (lo, hi) = ([p[0].min(end[0]), p[1].min(end[1])], [p[0].max(end[0]), p[1].max(end[1])]);
+        let misses = |(bmin, bmax): ([f64; 2], [f64; 2])| {
+            hi[0] < bmin[0] || lo[0] > bmax[0] || hi[1] < bmin[1] || lo[1] > bmax[1]
+        };
         for s in &self.strips {
+            if misses(s.bounds) {
+                continue;
+            }
             let (qx, qy) = (p[0] - s.mid[0], p[1] - s.mid[1]);
             let (ux, uy) = (s.along[0], s.along[1]);
             let along =
@@ -601,6 +655,10 @@ impl FloorPaint {
             paint(meet(along, across));
         }
         if let Some((inner, outer)) = self.ring {
+            let r = outer.sqrt();
+            if misses(([-r, -r], [r, r])) {
+                return;
+            }
             let out = disc(p, d, outer);
             let hole = disc(p, d, inner);
             if hole.0 > hole.1 {
@@ -615,7 +673,7 @@ impl FloorPaint {
     /// Whether the floor point `p` (field frame) shows a line.
     fn is_line(&self, p: [f64; 2]) -> bool {
         let mut line = false;
-        self.lines(p, [0.0, 0.0], |s| line |= !pixels(s, 1).is_empty());
+        self.lines(p, [0.0, 0.0], 1, |s| line |= !pixels(s, 1).is_empty());
         line
     }
 
@@ -941,7 +999,7 @@ impl Renderer {
                         let d = [t * dr[0], t * dr[1]];
                         let floor = pixels(self.floor.within_walls(p, d), w);
                         fill(px, floor.clone(), colours.carpet);
-                        self.floor.lines(p, d, |span| {
+                        self.floor.lines(p, d, w, |span| {
                             let cols = pixels(span, w);
                             fill(
                                 px,
@@ -1150,7 +1208,7 @@ mod tests {
         // A row along y = 0 from x = -5.005 in 1 cm steps (no pixel centre on an edge): the
         // ring's two crossings and the half-way line, each 10 pixels as wide as the line.
         let mut spans = vec![];
-        paint.lines([-5.005, 0.0], [0.01, 0.0], |s| {
+        paint.lines([-5.005, 0.0], [0.01, 0.0], 1000, |s| {
             let p = pixels(s, 1000);
             if !p.is_empty() {
                 spans.push(p);

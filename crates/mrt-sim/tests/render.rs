@@ -394,7 +394,8 @@ fn the_vision_sees_what_is_there_and_invents_almost_nothing() {
 /// cut at the painted lines, robots traced in `f32`), a lens with any distortion a pixel at a
 /// time (the floor through its 2 cm texture, every solid through the exact `f64` test). With
 /// a distortion far below a pixel, the two images differ only where a pixel centre lies
-/// within a texel of a line's edge or within rounding of an object's outline.
+/// within a texel of a line's edge or within rounding of an object's outline (under 0.5 %;
+/// 0.14 % when written).
 #[test]
 fn the_row_renderer_and_the_pixel_renderer_draw_the_same_image() {
     let mut cfg = SimConfig::default();
@@ -425,6 +426,6 @@ fn the_row_renderer_and_the_pixel_renderer_draw_the_same_image() {
             .filter(|(p, q)| p.iter().zip(q.iter()).any(|(x, y)| x.abs_diff(*y) > 2))
             .count();
     }
-    assert!(differ * 100 < total, "{differ} of {total} pixels differ");
+    assert!(differ * 200 < total, "{differ} of {total} pixels differ");
     assert!(differ > 0, "the texture's 2 cm steps show somewhere");
 }
