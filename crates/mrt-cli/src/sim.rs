@@ -303,8 +303,12 @@ pub fn run(args: &SimArgs) -> Result<()> {
             f.message
         );
     }
+    let seeing = match cfg.sensor.percepts {
+        mrt_sim::config::PerceptSource::Vision => "seeing through its camera images",
+        mrt_sim::config::PerceptSource::Oracle => "seeing through the object sensor",
+    };
     outln!(
-        "  {:.0} s of play simulated in {:.1} s ({}); trajectory hash {:016x}",
+        "  {:.0} s of play simulated in {:.1} s ({}, {seeing}); trajectory hash {:016x}",
         report.duration,
         started.elapsed().as_secs_f64(),
         wiring_name(args),

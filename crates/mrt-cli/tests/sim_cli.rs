@@ -36,6 +36,18 @@ fn a_short_match_reports_score_stats_and_reproduces_from_its_seed() {
     assert_ne!(hash_of(&out), hash_of(&other));
 }
 
+/// Issue 19: `mrt sim` plays through rendered camera images and the robots' vision by
+/// default; `--percepts oracle` is the object sensor's fast mode.
+#[test]
+fn the_default_match_is_seen_through_camera_images() {
+    let (ok, out, err) = run(&["--half", "3"]);
+    assert!(ok, "{err}");
+    assert!(out.contains("seeing through its camera images"), "{out}");
+    let (ok, out, err) = run(&["--half", "3", "--percepts", "oracle"]);
+    assert!(ok, "{err}");
+    assert!(out.contains("seeing through the object sensor"), "{out}");
+}
+
 #[test]
 fn the_match_is_drawn_as_svg() {
     let svg = std::env::temp_dir().join(format!("mrt-sim-cli-{}.svg", std::process::id()));

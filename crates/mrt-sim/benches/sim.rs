@@ -14,7 +14,9 @@ use mrt_sim::world::{Drive, World};
 use std::time::Duration;
 
 fn bench(c: &mut Criterion) {
-    let cfg = SimConfig::default();
+    // The object sensor's percepts (`--percepts oracle`): the cycle without rendering, as
+    // measured before vision became the default; `vision_control_cycle` below with it.
+    let cfg = SimConfig::oracle();
     let mut world = World::new(&cfg, 8);
     for i in 0..8 {
         world.place_robot(
@@ -35,7 +37,7 @@ fn bench(c: &mut Criterion) {
         c.bench_function(&format!("control_cycle_{name}"), |b| b.iter(|| m.cycle().unwrap()));
     }
 
-    let mut short = SimConfig::default();
+    let mut short = SimConfig::oracle();
     short.rules.half_duration = 30.0;
     let mut g = c.benchmark_group("match_2x30s");
     g.sample_size(10);

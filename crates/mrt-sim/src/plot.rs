@@ -134,7 +134,7 @@ mod tests {
 
     #[test]
     fn the_drawing_shows_the_field_the_paths_and_the_score() {
-        let mut cfg = SimConfig::default();
+        let mut cfg = SimConfig::oracle();
         cfg.rules.half_duration = 5.0;
         cfg.rules.team_size = 1;
         let mut m = BusMatch::with_brains(

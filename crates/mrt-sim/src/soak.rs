@@ -89,6 +89,12 @@ pub fn random_config(rng: &mut impl Rng, half: f64) -> SimConfig {
         m.half_duration = rng.random_range(1.0..=half.max(1.0));
         m.ready_duration = rng.random_range(0.0..5.0);
         m.set_duration = rng.random_range(0.0..1.5);
+        // Both ways of seeing: rendered images and vision (the default), the object sensor.
+        c.sensor.percepts = if rng.random_bool(0.5) {
+            crate::config::PerceptSource::Vision
+        } else {
+            crate::config::PerceptSource::Oracle
+        };
         if c.validate().is_ok() {
             return c;
         }

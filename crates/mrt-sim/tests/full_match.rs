@@ -1,7 +1,10 @@
-//! A full default match (2 × 5 min, four robots a side, Milan on Mr. BRIAN at home against
-//! Chaos on Lua, each robot an Agora on the bus: what `mrt sim` plays) finishes, both teams
-//! score, and the same seed reproduces it exactly: the same score and the same trajectory hash.
-//! Before every kickoff the robots walk to the formation in READY themselves.
+//! A full match (2 × 5 min, four robots a side, Milan on Mr. BRIAN at home against Chaos on
+//! Lua, each robot an Agora on the bus) finishes, both teams score, and the same seed
+//! reproduces it exactly: the same score and the same trajectory hash. Before every kickoff
+//! the robots walk to the formation in READY themselves. These matches see through the object
+//! sensor (`mrt sim --percepts oracle`, seven times faster); `mrt sim` plays through rendered
+//! images and vision by default (`tests/matches.rs` plays that, and `docs/performance.md`
+//! holds its 20-match series).
 
 #![allow(clippy::unwrap_used)]
 
@@ -12,7 +15,7 @@ use mrt_sim::play;
 use mrt_sim::referee::Call;
 
 fn default_match(seed: u64) -> MatchReport {
-    let cfg = SimConfig::default();
+    let cfg = SimConfig::oracle();
     play(&cfg, seed, (Stack::Milan, Stack::Chaos), None, false, |_| {}).unwrap()
 }
 

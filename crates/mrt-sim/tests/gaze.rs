@@ -24,7 +24,7 @@ impl Brain for Needs {
 const SE_CORNER: usize = lps::LANDMARK0 + 1;
 
 fn config(gaze: bool) -> SimConfig {
-    let mut cfg = SimConfig::default();
+    let mut cfg = SimConfig::oracle();
     cfg.rules.team_size = 1;
     cfg.rules.ready_duration = 100.0; // nobody moves the robot for the whole test
     cfg.sensor.half_fov = 0.35; // a narrow camera: 40° wide

@@ -9,7 +9,7 @@ use mrt_sim::game::Pitch;
 use mrt_sim::metrics::MetricsBook;
 
 fn config(kidnaps: u32, localizer: Localizer) -> SimConfig {
-    let mut cfg = SimConfig::default();
+    let mut cfg = SimConfig::oracle();
     cfg.rules.half_duration = 40.0;
     cfg.rules.kidnaps = kidnaps;
     cfg.localization.localizer = localizer;

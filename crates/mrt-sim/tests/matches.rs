@@ -21,7 +21,7 @@ fn chasers(n: usize) -> Vec<Box<dyn Brain + Send>> {
 }
 
 fn short(minutes: f64, team: usize) -> SimConfig {
-    let mut cfg = SimConfig::default();
+    let mut cfg = SimConfig::oracle();
     cfg.rules.half_duration = minutes * 60.0;
     cfg.rules.team_size = team;
     cfg
@@ -44,7 +44,7 @@ impl Brain for Always {
 /// READY lets robots move.
 #[test]
 fn guidance_halts_a_robot_before_the_wall_and_without_it_the_robot_hits() {
-    let mut cfg = SimConfig::default();
+    let mut cfg = SimConfig::oracle();
     cfg.rules.ready_duration = 100.0;
     cfg.rules.team_size = 2;
     let start = mrt_core::Pose2::new(3.0, 5.75, std::f64::consts::FRAC_PI_2);
