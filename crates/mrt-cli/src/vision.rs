@@ -9,10 +9,12 @@
 use anyhow::{anyhow, bail, Context as _, Result};
 use image::{Rgb, RgbImage};
 use mrt_msgs::Image;
-use mrt_perception::camera::{Camera, CameraFile};
+use mrt_perception::camera::{Camera, CameraFile, CameraModel, Omni};
 use mrt_perception::source::{load_image, ImageSequence, ImageSource};
 use mrt_perception::vision::agent::VisionAgent;
+use mrt_perception::vision::blobs::BallPercept;
 use mrt_perception::vision::colors::{ColorClass, ColorTable, Lut};
+use mrt_perception::vision::up::find_ball_up;
 use std::io::Write as _;
 use std::path::{Path, PathBuf};
 
@@ -83,13 +85,14 @@ pub fn detect(args: &DetectArgs) -> Result<()> {
     if args.png.is_some() && count != 1 {
         bail!("--png draws one image: give one image (or one frame) with it");
     }
-    // `from_file` has checked the camera already: `camera()` cannot fail on what it read.
-    let camera = CameraFile::from_file(&args.camera)
-        .map_err(|e| anyhow!("{e}"))?
-        .camera()
-        .map_err(|e| anyhow!("{}: {e}", args.camera.display()))?;
+    let camera = CameraModel::from_file(&args.camera).map_err(|e| anyhow!("{e}"))?;
     let colors = ColorTable::from_file(&args.colors).map_err(|e| anyhow!("{e}"))?;
-    let mut agent = VisionAgent::new(camera, &colors, args.ball_radius);
+    let mut detector = match camera {
+        CameraModel::Pinhole(c) => Detector::Front(VisionAgent::new(c, &colors, args.ball_radius)),
+        CameraModel::Omni(omni) => {
+            Detector::Up { omni, lut: Lut::new(&colors), radius: args.ball_radius, classes: vec![] }
+        }
+    };
     let stdout = std::io::stdout();
     let mut out = stdout.lock();
     let mut source = match &args.device {
@@ -105,7 +108,7 @@ pub fn detect(args: &DetectArgs) -> Result<()> {
             (None, Some(path)) => (path.display().to_string(), load_image(path)?),
             (None, None) => break,
         };
-        let line = detect_one(&name, &img, &mut agent, args.png.as_deref())?;
+        let line = detect_one(&name, &img, &mut detector, args.png.as_deref())?;
         if writeln!(out, "{line}").is_err() {
             return Ok(()); // the reader went away
         }
@@ -125,50 +128,71 @@ fn open_device(device: &Path, _: (u32, u32)) -> Result<Box<dyn ImageSource>> {
     bail!("{}: USB cameras are read through Video4Linux2, on Linux only", device.display())
 }
 
+/// What `detect` runs on each image: the vision µAgent of a pinhole camera (front mode), or
+/// the up mode's ball finder on an omnidirectional camera's image (seed `003` §3.2.1).
+enum Detector {
+    Front(VisionAgent),
+    Up { omni: Omni, lut: Lut, radius: f64, classes: Vec<u8> },
+}
+
 fn detect_one(
     name: &str,
     img: &Image,
-    agent: &mut VisionAgent,
+    detector: &mut Detector,
     png: Option<&Path>,
 ) -> Result<serde_json::Value> {
     let (w, h) = (img.width, img.height);
-    let camera = agent.camera().size();
+    let camera = match detector {
+        Detector::Front(agent) => agent.camera().size(),
+        Detector::Up { omni, .. } => omni.size(),
+    };
     if (w, h) != camera {
         bail!("{name}: the image is {w}×{h}, the camera file says {}×{}", camera.0, camera.1);
     }
-    let pan = agent.camera().pan;
-    let sight = agent.look(img, 0.0, pan).map_err(|e| anyhow!("{name}: {e}"))?;
-    let (ball, posts) = (sight.ball, &sight.posts);
     let mut objects = Vec::new();
-    if let Some(b) = ball {
-        objects.push(serde_json::json!({
+    let ball_json = |b: &BallPercept| {
+        serde_json::json!({
             "class": "ball",
             "pixel": [round3(b.pixel.x), round3(b.pixel.y)],
             "radius_px": round3(b.radius_px),
             "distance_m": round3(b.distance),
             "bearing_deg": round3(b.bearing.to_degrees()),
-        }));
-    }
-    for g in &sight.goals {
-        objects.push(serde_json::json!({
-            "class": g.class.name(),
-            "pixel": [round3(g.nearest.x), round3(g.nearest.y)],
-            "distance_m": round3(g.distance),
-            "bearing_deg": round3(g.bearing.to_degrees()),
-            "open_bearing_deg": round3(g.open_bearing.to_degrees()),
-        }));
-    }
-    for p in posts {
-        objects.push(serde_json::json!({
-            "class": "post",
-            "outer": p.outer.name(),
-            "pixel": [round3(p.pixel.x), round3(p.pixel.y)],
-            "distance_m": round3(p.at.coords.norm()),
-            "bearing_deg": round3(p.at.y.atan2(p.at.x).to_degrees()),
-        }));
-    }
+        })
+    };
+    let (ball, posts, classes) = match detector {
+        Detector::Front(agent) => {
+            let pan = agent.camera().pan;
+            let sight = agent.look(img, 0.0, pan).map_err(|e| anyhow!("{name}: {e}"))?;
+            objects.extend(sight.ball.as_ref().map(ball_json));
+            for g in &sight.goals {
+                objects.push(serde_json::json!({
+                    "class": g.class.name(),
+                    "pixel": [round3(g.nearest.x), round3(g.nearest.y)],
+                    "distance_m": round3(g.distance),
+                    "bearing_deg": round3(g.bearing.to_degrees()),
+                    "open_bearing_deg": round3(g.open_bearing.to_degrees()),
+                }));
+            }
+            for p in &sight.posts {
+                objects.push(serde_json::json!({
+                    "class": "post",
+                    "outer": p.outer.name(),
+                    "pixel": [round3(p.pixel.x), round3(p.pixel.y)],
+                    "distance_m": round3(p.at.coords.norm()),
+                    "bearing_deg": round3(p.at.y.atan2(p.at.x).to_degrees()),
+                }));
+            }
+            (sight.ball, sight.posts, agent.classes())
+        }
+        Detector::Up { omni, lut, radius, classes } => {
+            classes.resize((w * h) as usize, 0);
+            lut.classify(&img.rgb, classes);
+            let ball = find_ball_up(classes, omni, *radius);
+            objects.extend(ball.as_ref().map(ball_json));
+            (ball, Vec::new(), &classes[..])
+        }
+    };
     if let Some(out) = png {
-        let classes = agent.classes();
         let mut drawn = RgbImage::from_fn(w, h, |x, y| {
             paint(ColorClass::from_u8(classes[(y * w + x) as usize]))
         });
@@ -178,7 +202,7 @@ fn detect_one(
             imageproc::drawing::draw_hollow_circle_mut(&mut drawn, c, r + 2, Rgb([255, 0, 255]));
             imageproc::drawing::draw_cross_mut(&mut drawn, Rgb([255, 0, 255]), c.0, c.1);
         }
-        for p in posts {
+        for p in &posts {
             let (x0, x1) = (p.columns.0 as i32 - 2, p.columns.1 as i32 + 2);
             let y = p.pixel.y as i32;
             let rect = imageproc::rect::Rect::at(x0, (y - 4 * (x1 - x0)).max(0))
@@ -271,13 +295,18 @@ pub fn render(args: &RenderArgs) -> Result<()> {
         Some(path) => mrt_sim::config::SimConfig::from_file(path).map_err(|e| anyhow!("{e}"))?,
         None => mrt_sim::config::SimConfig::default(),
     };
-    if let Some(path) = &args.camera {
+    let camera = match &args.camera {
+        Some(path) => CameraModel::from_file(path).map_err(|e| anyhow!("{e}"))?,
+        None => CameraModel::Pinhole(cfg.camera.camera().map_err(|e| anyhow!("camera: {e}"))?),
+    };
+    if let (Some(path), CameraModel::Pinhole(_)) = (&args.camera, camera) {
+        // The world's robots carry this camera (its file keeps the pan and the mount).
         cfg.camera = CameraFile::from_file(path).map_err(|e| anyhow!("{e}"))?;
     }
     if !(args.pan.is_finite() && args.pan.abs() <= 180.0) {
         bail!("--pan must be -180 to 180 degrees, not {}", args.pan);
     }
-    let renderer = Renderer::new(&cfg).map_err(|e| anyhow!("camera: {e}"))?;
+    let renderer = Renderer::with_camera(&cfg, camera).map_err(|e| anyhow!("camera: {e}"))?;
     let (x, y, heading) = args.at;
     let scene = Scene {
         ball: args.ball,

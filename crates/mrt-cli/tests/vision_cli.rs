@@ -317,3 +317,46 @@ fn detect_from_a_missing_camera_says_so() {
     let (ok, _, err) = detect(&[], &["--device", "/dev/video0", "--frames", "0"]);
     assert!(!ok && err.contains("--frames"), "{err}");
 }
+
+/// The up camera (`configs/vision/omni.toml`): `render` draws what its mirror images and
+/// `detect` finds the ball in it through the same file, 2.12 m away at 5° (a robot at
+/// (-2, 1) facing 40°, the ball at (-0.5, 2.5)); `--png` draws it.
+#[test]
+fn the_up_camera_renders_and_detects_through_its_camera_file() {
+    let dir = std::env::temp_dir().join(format!("mrt-vision-omni-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let (png, found) = (dir.join("up.png"), dir.join("found.png"));
+    let omni = config("omni.toml");
+    let (ok, err) = render(&[
+        "--camera",
+        omni.to_str().unwrap(),
+        "--at",
+        "-2,1,40",
+        "--ball",
+        "-0.5,2.5",
+        "--robot",
+        "0,0,away",
+        "--out",
+        png.to_str().unwrap(),
+    ]);
+    assert!(ok, "{err}");
+    let out = Command::new(env!("CARGO_BIN_EXE_mrt"))
+        .args(["vision", "detect", "--camera"])
+        .arg(&omni)
+        .arg("--colors")
+        .arg(config("colors.toml"))
+        .arg("--png")
+        .arg(&found)
+        .arg(&png)
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let line: serde_json::Value = serde_json::from_str(stdout.trim()).unwrap();
+    let ball = &line["objects"][0];
+    assert_eq!(ball["class"], "ball", "{line}");
+    let (d, b) = (ball["distance_m"].as_f64().unwrap(), ball["bearing_deg"].as_f64().unwrap());
+    assert!((d - 1.5f64.hypot(1.5)).abs() < 0.05 * d && (b - 5.0).abs() < 1.5, "{line}");
+    assert_eq!(image::open(&found).unwrap().to_rgb8().dimensions(), (480, 480));
+    std::fs::remove_dir_all(&dir).unwrap();
+}

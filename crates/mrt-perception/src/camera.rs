@@ -10,7 +10,11 @@
 //!   `(k1, k2)`;
 //! - [`Omni`]: ISocRob's omnidirectional "up" camera, whose mirror images the floor
 //!   orthographically up to an affine map (seed `003` §2.2): a floor point `(x, y)` of the
-//!   robot frame appears at pixel `A·(x, y) + b`, and any point above it at the same pixel.
+//!   robot frame appears at pixel `A·(x, y) + b`; a point above the floor appears where the
+//!   line from the mirror's viewpoint through it meets the floor.
+//!
+//! A camera file names its model ([`CameraModel::from_file`]): [`CameraFile`] for a pinhole
+//! camera, [`OmniFile`] for the mirror.
 //!
 //! Frames and units: the **robot frame** (m): x forward, y to the left, z up from the floor,
 //! origin on the floor under the robot's centre. **Pixels**: `(col, row)`, the origin at the
@@ -34,8 +38,8 @@ pub trait Camera {
     fn size(&self) -> (u32, u32);
 
     /// Where the point `p` (robot frame, m) appears, or `None` when the camera cannot see it
-    /// (behind a pinhole camera; for [`Omni`], never). The pixel may lie outside the image:
-    /// [`Camera::in_image`] says.
+    /// (behind a pinhole camera; for [`Omni`], at or above its viewpoint). The pixel may lie
+    /// outside the image: [`Camera::in_image`] says.
     fn project(&self, p: Point3<f64>) -> Option<Pixel>;
 
     /// The point at height `z` (m above the floor) that pixel `px` sees, robot frame, or `None`
@@ -229,8 +233,14 @@ impl Camera for Pinhole {
     }
 }
 
-/// ISocRob's omnidirectional "up" camera (module doc): pixel = `A·(x, y) + b` for the floor
-/// point under any point it sees.
+/// ISocRob's omnidirectional "up" camera (module doc): a floor point `(x, y)` appears at pixel
+/// `A·(x, y) + b`. The mirror sees the world from a viewpoint `viewpoint` metres above the
+/// robot's centre (a camera under a mirror on the robot's top): a point at height `z` appears
+/// where its line from the viewpoint meets the floor, `viewpoint / (viewpoint − z)` times
+/// farther out than the point itself (with `viewpoint = ∞`, every point above a floor point
+/// appears at that floor point). The robot's own body hides the floor within `blind` of its
+/// centre, and the mirror's rim everything beyond `range` (ISocRob: about 4.5 m, seed `003`
+/// §3.2.1 "up").
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Omni {
     /// The affine map's matrix, pixels per metre.
@@ -241,14 +251,66 @@ pub struct Omni {
     pub width: u32,
     /// Image height.
     pub height: u32,
+    /// The mirror's viewpoint above the floor, m (`f64::INFINITY`: orthographic).
+    pub viewpoint: f64,
+    /// The floor hidden by the robot's body: within this distance of its centre, m.
+    pub blind: f64,
+    /// The mirror's reach: floor points farther than this from the robot's centre are not
+    /// imaged, m.
+    pub range: f64,
 }
 
 impl Omni {
     /// A mirror whose image has `scale` pixels per metre, the robot's centre at `centre` and
     /// the robot's forward direction towards the top of the image (x forward → rows up, y left
-    /// → columns left).
+    /// → columns left); orthographic, seeing every floor point.
     pub fn upright(width: u32, height: u32, scale: f64, centre: Pixel) -> Omni {
-        Omni { a: Matrix2::new(0.0, -scale, -scale, 0.0), b: centre.coords, width, height }
+        Omni {
+            a: Matrix2::new(0.0, -scale, -scale, 0.0),
+            b: centre.coords,
+            width,
+            height,
+            viewpoint: f64::INFINITY,
+            blind: 0.0,
+            range: f64::INFINITY,
+        }
+    }
+
+    /// The same mirror seen from `viewpoint` (m above the floor), imaging the floor between
+    /// `blind` and `range` (m from the robot's centre).
+    pub fn with_mirror(mut self, viewpoint: f64, blind: f64, range: f64) -> Omni {
+        self.viewpoint = viewpoint;
+        self.blind = blind;
+        self.range = range;
+        self
+    }
+
+    /// The floor point at which the point `p` (robot frame) appears: `p`'s own floor point
+    /// pushed out by `viewpoint / (viewpoint − z)`; `None` at or above the viewpoint.
+    pub fn floor_image(&self, p: Point3<f64>) -> Option<Point2<f64>> {
+        let k = if self.viewpoint.is_finite() {
+            let below = self.viewpoint - p.z;
+            if below.is_nan() || below <= 0.0 {
+                return None;
+            }
+            self.viewpoint / below
+        } else {
+            1.0
+        };
+        Some(Point2::new(p.x * k, p.y * k))
+    }
+
+    /// The floor point a pixel images (robot frame), or `None` for a degenerate map.
+    pub fn floor_of(&self, px: Pixel) -> Option<Point2<f64>> {
+        let f = self.a.try_inverse()? * (px.coords - self.b);
+        Some(Point2::new(f.x, f.y))
+    }
+
+    /// Whether the mirror images the floor point `f` (robot frame): between `blind` and
+    /// `range` of the robot's centre.
+    pub fn images(&self, f: Point2<f64>) -> bool {
+        let d = f.coords.norm();
+        d >= self.blind && d <= self.range
     }
 }
 
@@ -258,13 +320,16 @@ impl Camera for Omni {
     }
 
     fn project(&self, p: Point3<f64>) -> Option<Pixel> {
-        Some(Pixel::from(self.a * Vector2::new(p.x, p.y) + self.b))
+        let f = self.floor_image(p)?;
+        Some(Pixel::from(self.a * f.coords + self.b))
     }
 
     fn unproject_at_height(&self, px: Pixel, z: f64) -> Option<Point3<f64>> {
-        let inv = self.a.try_inverse()?;
-        let f = inv * (px.coords - self.b);
-        Some(Point3::new(f.x, f.y, z))
+        let f = self.floor_of(px)?;
+        // Back along the viewpoint's line from the floor point to height z.
+        let k =
+            if self.viewpoint.is_finite() { (self.viewpoint - z) / self.viewpoint } else { 1.0 };
+        (k > 0.0).then(|| Point3::new(f.x * k, f.y * k, z))
     }
 }
 
@@ -424,6 +489,174 @@ impl CameraFile {
     }
 }
 
+/// An omnidirectional camera file (`model = "omni"`, `mrt vision --camera`): `width`, `height`
+/// (pixels), `cx`, `cy` (the pixel under the robot's centre), `scale_px_per_m` (pixels per
+/// metre of floor), and optionally `rotation_deg` (the robot's forward direction, counter-
+/// clockwise from the top of the image; 0 by default), `mirrored` (a mirror's image is
+/// reflected left-right; false by default), `viewpoint_m` (the mirror's viewpoint above the
+/// floor, 0.8 by default), `blind_m` (the floor the robot's body hides around its centre, 1.0
+/// by default: ISocRob's "about 1 m") and `range_m` (the mirror's reach, 4.5 by default).
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct OmniFile {
+    /// `omni`.
+    pub model: String,
+    /// Image width, pixels.
+    pub width: u32,
+    /// Image height, pixels.
+    pub height: u32,
+    /// The column of the robot's centre.
+    pub cx: f64,
+    /// The row of the robot's centre.
+    pub cy: f64,
+    /// Pixels per metre of floor.
+    pub scale_px_per_m: f64,
+    /// The robot's forward direction in the image, degrees counter-clockwise from up.
+    #[serde(default)]
+    pub rotation_deg: f64,
+    /// Whether the image is reflected left-right.
+    #[serde(default)]
+    pub mirrored: bool,
+    /// The mirror's viewpoint above the floor, m.
+    #[serde(default = "OmniFile::default_viewpoint")]
+    pub viewpoint_m: f64,
+    /// The floor hidden around the robot's centre, m.
+    #[serde(default = "OmniFile::default_blind")]
+    pub blind_m: f64,
+    /// The mirror's reach on the floor, m.
+    #[serde(default = "OmniFile::default_range")]
+    pub range_m: f64,
+}
+
+impl Default for OmniFile {
+    /// The shipped `configs/vision/omni.toml`: a 480×480 image, 50 px a metre, the robot's
+    /// centre in the middle and its forward direction up.
+    fn default() -> Self {
+        OmniFile {
+            model: "omni".to_string(),
+            width: 480,
+            height: 480,
+            cx: 240.0,
+            cy: 240.0,
+            scale_px_per_m: 50.0,
+            rotation_deg: 0.0,
+            mirrored: false,
+            viewpoint_m: OmniFile::default_viewpoint(),
+            blind_m: OmniFile::default_blind(),
+            range_m: OmniFile::default_range(),
+        }
+    }
+}
+
+impl OmniFile {
+    fn default_viewpoint() -> f64 {
+        0.8
+    }
+
+    fn default_blind() -> f64 {
+        1.0
+    }
+
+    fn default_range() -> f64 {
+        4.5
+    }
+
+    /// The camera it describes, every value checked.
+    pub fn camera(&self) -> Result<Omni, String> {
+        if self.model != "omni" {
+            return Err(format!(
+                "model = \"{}\": an omnidirectional camera file says \"omni\"",
+                self.model
+            ));
+        }
+        let max = crate::vision::blobs::MAX_SIDE;
+        if !(1..=max).contains(&self.width) || !(1..=max).contains(&self.height) {
+            return Err(format!("width and height must be 1 to {max} pixels"));
+        }
+        for (name, v) in [("cx", self.cx), ("cy", self.cy), ("rotation_deg", self.rotation_deg)] {
+            if !v.is_finite() {
+                return Err(format!("{name} must be a finite number, not {v}"));
+            }
+        }
+        for (name, v) in
+            [("scale_px_per_m", self.scale_px_per_m), ("viewpoint_m", self.viewpoint_m)]
+        {
+            if !(v.is_finite() && v > 0.0) {
+                return Err(format!("{name} must be a finite number > 0, not {v}"));
+            }
+        }
+        if !(self.blind_m.is_finite() && self.blind_m >= 0.0 && self.range_m.is_finite())
+            || self.range_m <= self.blind_m
+        {
+            return Err(format!(
+                "blind_m must be ≥ 0 and less than range_m (got {} and {})",
+                self.blind_m, self.range_m
+            ));
+        }
+        let centre = Pixel::new(self.cx, self.cy);
+        let mut cam = Omni::upright(self.width, self.height, self.scale_px_per_m, centre);
+        // Turn the image by the rotation (counter-clockwise on the screen, whose rows grow
+        // downwards), after an optional left-right reflection.
+        let (s, c) = self.rotation_deg.to_radians().sin_cos();
+        let turn = Matrix2::new(c, s, -s, c);
+        let flip = Matrix2::new(if self.mirrored { -1.0 } else { 1.0 }, 0.0, 0.0, 1.0);
+        cam.a = turn * flip * cam.a;
+        Ok(cam.with_mirror(self.viewpoint_m, self.blind_m, self.range_m))
+    }
+}
+
+/// A camera of either model, from a camera file whose `model` names it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum CameraModel {
+    /// `model = "pinhole"` ([`CameraFile`]).
+    Pinhole(Pinhole),
+    /// `model = "omni"` ([`OmniFile`]).
+    Omni(Omni),
+}
+
+impl CameraModel {
+    /// Parses a camera file of either model; `file` names it in errors (line and column for
+    /// syntax).
+    pub fn from_toml(text: &str, file: &str) -> Result<CameraModel, mrt_core::FileError> {
+        let parse = |e: toml::de::Error| {
+            mrt_core::FileError::parse(file, text, e.span().map(|s| s.start), e.message())
+        };
+        let table: toml::Table = toml::from_str(text).map_err(parse)?;
+        let invalid =
+            |message: String| mrt_core::FileError::Invalid { file: file.to_string(), message };
+        match table.get("model").and_then(|m| m.as_str()) {
+            Some("omni") => {
+                let f: OmniFile = toml::from_str(text).map_err(parse)?;
+                f.camera().map(CameraModel::Omni).map_err(invalid)
+            }
+            Some("pinhole") => {
+                let f: CameraFile = toml::from_str(text).map_err(parse)?;
+                f.camera().map(CameraModel::Pinhole).map_err(invalid)
+            }
+            Some(other) => Err(invalid(format!(
+                "model = \"{other}\": the models are \"pinhole\" and \"omni\""
+            ))),
+            None => Err(invalid("no model: say model = \"pinhole\" or \"omni\"".to_string())),
+        }
+    }
+
+    /// Reads a camera file of either model.
+    pub fn from_file(
+        path: impl AsRef<std::path::Path>,
+    ) -> Result<CameraModel, mrt_core::FileError> {
+        let (text, file) = mrt_core::FileError::read(path.as_ref())?;
+        CameraModel::from_toml(&text, &file)
+    }
+
+    /// The image size, `(width, height)` in pixels.
+    pub fn size(&self) -> (u32, u32) {
+        match self {
+            CameraModel::Pinhole(c) => c.size(),
+            CameraModel::Omni(c) => c.size(),
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -540,6 +773,52 @@ mod tests {
         assert!(cam.in_image(px) && !cam.in_image(Pixel::new(-1.0, 3.0)));
     }
 
+    /// Seen from a viewpoint 0.8 m up, a point 0.4 m high appears twice as far out as its
+    /// own floor point (0.8 / (0.8 − 0.4)); unprojected at its height it comes back.
+    #[test]
+    fn the_mirror_pushes_raised_points_out_along_its_viewpoints_lines() {
+        let cam =
+            Omni::upright(480, 480, 100.0, Pixel::new(240.0, 240.0)).with_mirror(0.8, 0.5, 4.5);
+        let px = cam.project(Point3::new(1.0, 0.5, 0.4)).unwrap();
+        assert!((px.x - 140.0).abs() < 1e-9 && (px.y - 40.0).abs() < 1e-9, "{px:?}");
+        let back = cam.unproject_at_height(px, 0.4).unwrap();
+        assert!((back - Point3::new(1.0, 0.5, 0.4)).norm() < 1e-12, "{back:?}");
+        assert!(cam.project(Point3::new(1.0, 0.0, 0.8)).is_none(), "at the viewpoint's height");
+        assert!(cam.images(Point2::new(0.0, 1.0)) && !cam.images(Point2::new(0.3, 0.0)));
+        assert!(!cam.images(Point2::new(4.0, 3.0)), "5 m: beyond the mirror's reach");
+    }
+
+    #[test]
+    fn omni_files_read_turn_and_reflect_and_say_where_they_are_wrong() {
+        let shipped = concat!(env!("CARGO_MANIFEST_DIR"), "/../../configs/vision/omni.toml");
+        let CameraModel::Omni(cam) = CameraModel::from_file(shipped).unwrap() else {
+            panic!("the shipped omni file is an omni camera")
+        };
+        assert_eq!(cam, OmniFile::default().camera().unwrap());
+        // 1 m ahead: 50 px up from the centre.
+        let px = cam.project(Point3::new(1.0, 0.0, 0.0)).unwrap();
+        assert!((px.x - 240.0).abs() < 1e-9 && (px.y - 190.0).abs() < 1e-9, "{px:?}");
+        // Forward turned 90° counter-clockwise on the screen: ahead is to the left.
+        let turned = OmniFile { rotation_deg: 90.0, ..OmniFile::default() }.camera().unwrap();
+        let px = turned.project(Point3::new(1.0, 0.0, 0.0)).unwrap();
+        assert!((px.x - 190.0).abs() < 1e-9 && (px.y - 240.0).abs() < 1e-9, "{px:?}");
+        // Reflected: the left appears on the right.
+        let mirrored = OmniFile { mirrored: true, ..OmniFile::default() }.camera().unwrap();
+        let px = mirrored.project(Point3::new(0.0, 1.0, 0.0)).unwrap();
+        assert!((px.x - 290.0).abs() < 1e-9 && (px.y - 240.0).abs() < 1e-9, "{px:?}");
+        let text = "model = \"omni\"\nwidth = 480\nheight = 480\ncx = 240.0\ncy = 240.0\n\
+                    scale_px_per_m = 50.0\n";
+        assert!(matches!(CameraModel::from_toml(text, "o.toml"), Ok(CameraModel::Omni(_))));
+        let e = CameraModel::from_toml(&format!("{text}range_m = 0.5\n"), "o.toml").unwrap_err();
+        assert!(e.to_string().contains("blind_m must be ≥ 0 and less than range_m"), "{e}");
+        let e = CameraModel::from_toml(&format!("{text}fx = 3.0\n"), "o.toml").unwrap_err();
+        assert!(e.to_string().contains("o.toml:7:"), "{e}");
+        let e = CameraModel::from_toml(&text.replace("omni", "fisheye"), "o.toml").unwrap_err();
+        assert!(e.to_string().contains("the models are \"pinhole\" and \"omni\""), "{e}");
+        let e = CameraModel::from_toml("width = 3\n", "o.toml").unwrap_err();
+        assert!(e.to_string().contains("no model"), "{e}");
+    }
+
     #[test]
     fn camera_files_read_and_say_where_they_are_wrong() {
         let text = "model = \"pinhole\"\nwidth = 320\nheight = 240\nfx = 260.0\nfy = 260.0\n\
@@ -586,10 +865,22 @@ mod tests {
         }
 
         #[test]
-        fn omni_round_trips(x in -5.0f64..5.0, y in -5.0f64..5.0, s in 10.0f64..200.0) {
-            let cam = Omni::upright(640, 480, s, Pixel::new(320.0, 240.0));
-            let back = cam.unproject(cam.project(Point3::new(x, y, 0.0)).unwrap()).unwrap();
+        fn omni_round_trips(
+            x in -5.0f64..5.0, y in -5.0f64..5.0, z in 0.0f64..0.7, s in 10.0f64..200.0,
+            rotation in -180.0f64..180.0, mirrored: bool,
+        ) {
+            let file = OmniFile { scale_px_per_m: s, rotation_deg: rotation, mirrored, ..OmniFile::default() };
+            let cam = file.camera().unwrap();
+            let back = cam.unproject_at_height(cam.project(Point3::new(x, y, z)).unwrap(), z).unwrap();
             prop_assert!((back.x - x).abs() < 1e-9 && (back.y - y).abs() < 1e-9);
+        }
+
+        /// Random bytes as a camera file: an error or a camera, never a panic.
+        #[test]
+        fn camera_model_files_never_panic(text in ".{0,200}") {
+            let _ = CameraModel::from_toml(&text, "random.toml");
+            let with_model = format!("model = \"omni\"\n{text}");
+            let _ = CameraModel::from_toml(&with_model, "random.toml");
         }
     }
 }

@@ -33,7 +33,8 @@
 //! | eq. (4.3)–(4.5) | [`mice::update_pose`] |
 //! | `x̄_r = x̄_l` error detection, error reduction (manual §4.2) | [`mice::MiceOdometry::check`], [`mice::MiceOdometry::reduce`] |
 //! | front camera, inverse projection eqs (7)–(9) (ISocRob `003` §3.2.1) | [`camera::Pinhole`] (with a pan joint) |
-//! | "up" camera, mirror (ISocRob `003` §2.2) | [`camera::Omni`] |
+//! | "up" camera, mirror (ISocRob `003` §2.2) | [`camera::Omni`], its file [`camera::OmniFile`]; either model's file [`camera::CameraModel`] |
+//! | the µAgent's "up" mode: the ball all around (ISocRob `003` §3.2.1) | [`vision::up::find_ball_up`] |
 //! | ball correction and expected size, eqs (10)–(11) | [`camera::ball_floor_point`], [`camera::ball_diameter_px`] |
 //! | the vision µAgent (ISocRob `003` §3.2.1) | [`vision::agent::VisionAgent`] |
 //! | a camera driver (manual ch. 12, ISocRob §2.2) | [`source::ImageSource`], [`source::ImageSequence`] |

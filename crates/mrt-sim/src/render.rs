@@ -43,7 +43,7 @@
 use crate::config::{RenderConfig, SimConfig};
 use mrt_core::Pose2;
 use mrt_msgs::Image;
-use mrt_perception::camera::{Camera, Pinhole, Pixel};
+use mrt_perception::camera::{Camera, CameraModel, Omni, Pinhole, Pixel};
 use mrt_world::FieldMap;
 use nalgebra::{Point3, Vector3};
 use rand::{Rng, SeedableRng};
@@ -73,6 +73,8 @@ pub mod palette {
     pub const WALL: [u8; 3] = [140, 140, 140];
     /// The hall above the walls.
     pub const HALL: [u8; 3] = [90, 82, 74];
+    /// What an omnidirectional camera's mirror does not image (its rim, the robot's body).
+    pub const UNSEEN: [u8; 3] = [0, 0, 0];
 }
 
 /// Noise samples in the table (a power of two).
@@ -774,7 +776,7 @@ impl Texture {
 /// the camera's rays are computed here.
 #[derive(Clone, Debug)]
 pub struct Renderer {
-    camera: Pinhole,
+    camera: CameraModel,
     cfg: RenderConfig,
     robot_radius: f64,
     ball_radius: f64,
@@ -789,36 +791,22 @@ pub struct Renderer {
 impl Renderer {
     /// The renderer of `cfg`'s world, with its camera (`[camera]`) and settings (`[render]`).
     pub fn new(cfg: &SimConfig) -> Result<Renderer, String> {
-        let camera = cfg.camera.camera()?.panned(0.0);
+        Renderer::with_camera(cfg, CameraModel::Pinhole(cfg.camera.camera()?))
+    }
+
+    /// The renderer of `cfg`'s world for `camera`: a pinhole camera (drawn at pan 0 and turned
+    /// by [`Renderer::render`]'s `pan`), or an omnidirectional one (its mirror needs a finite
+    /// viewpoint).
+    pub fn with_camera(cfg: &SimConfig, camera: CameraModel) -> Result<Renderer, String> {
         let map = cfg.field.map();
         let wall = (map.half_length() + cfg.field.border, map.half_width() + cfg.field.border);
         let floor = FloorPaint::new(&map, wall, cfg.render.line_width);
-        let (w, h) = camera.size();
-        let ray = |col: f64, row: u32| camera.ray(Pixel::new(col + 0.5, f64::from(row) + 0.5));
-        let rays = if camera.distortion == (0.0, 0.0) {
-            Rays::Rows(
-                (0..h)
-                    .map(|row| {
-                        let (a, b) = (ray(0.0, row), ray(1.0, row));
-                        RowRays { start: a.into(), step: (b - a).into() }
-                    })
-                    .collect(),
-            )
-        } else {
-            let pixels = || (0..h).flat_map(|row| (0..w).map(move |col| (f64::from(col), row)));
-            let on_floor = |d: nalgebra::Vector3<f64>| {
-                let t = -camera.height / d.z;
-                if d.z < 0.0 && t.is_finite() {
-                    [(t * d.x) as f32, (t * d.y) as f32]
-                } else {
-                    [f32::NAN; 2]
-                }
-            };
-            Rays::Pixels {
-                rays: pixels().map(|(col, row)| ray(col, row).map(|v| v as f32).into()).collect(),
-                floor: pixels().map(|(col, row)| on_floor(ray(col, row))).collect(),
-                texture: Texture::new(&floor),
+        let (camera, rays) = match camera {
+            CameraModel::Pinhole(camera) => {
+                let camera = camera.panned(0.0);
+                (CameraModel::Pinhole(camera), pinhole_rays(&camera, &floor))
             }
+            CameraModel::Omni(omni) => (CameraModel::Omni(omni), Rays::Rows(omni_rays(&omni)?)),
         };
         Ok(Renderer {
             camera,
@@ -832,9 +820,17 @@ impl Renderer {
         })
     }
 
-    /// The camera at pan 0.
-    pub fn camera(&self) -> &Pinhole {
+    /// The camera it draws for (a pinhole camera at pan 0).
+    pub fn camera(&self) -> &CameraModel {
         &self.camera
+    }
+
+    /// The pinhole camera it draws for, at pan 0; `None` for an omnidirectional one.
+    pub fn pinhole(&self) -> Option<&Pinhole> {
+        match &self.camera {
+            CameraModel::Pinhole(c) => Some(c),
+            CameraModel::Omni(_) => None,
+        }
     }
 
     /// What the camera of a robot at `viewer` (field frame), its pan joint at `pan` (rad), sees
@@ -861,12 +857,17 @@ impl Renderer {
             wall: light(palette::WALL, brightness),
             hall: light(palette::HALL, brightness),
         };
-        // The optical centre, field frame, and the rotation of the camera's pan-0 robot axes
-        // into the field's.
+        // The optical centre (a mirror's viewpoint), field frame, and the rotation of the
+        // camera's pan-0 robot axes into the field's (a mirror does not pan).
         let (s, c) = viewer.theta.sin_cos();
-        let m = self.camera.mount;
-        let eye = [viewer.x + c * m.x - s * m.y, viewer.y + s * m.x + c * m.y, self.camera.height];
-        let rot = (viewer.theta + pan).sin_cos();
+        let (eye, rot) = match &self.camera {
+            CameraModel::Pinhole(cam) => {
+                let m = cam.mount;
+                let eye = [viewer.x + c * m.x - s * m.y, viewer.y + s * m.x + c * m.y, cam.height];
+                (eye, (viewer.theta + pan).sin_cos())
+            }
+            CameraModel::Omni(omni) => ([viewer.x, viewer.y, omni.viewpoint], (s, c)),
+        };
         let w = w as usize;
         self.draw_floor(&mut image, eye, rot, &colours);
         // The objects, each on its projected bounding box, nearest wins. They are placed
@@ -965,6 +966,9 @@ impl Renderer {
                 }
             }
         }
+        if let (CameraModel::Omni(omni), Rays::Rows(rows)) = (&self.camera, &self.rays) {
+            blind_and_rim(&mut image, omni, rows);
+        }
         self.effects(&mut image, state);
         image
     }
@@ -1048,33 +1052,54 @@ impl Renderer {
         /// Points nearer to the image plane than this (m) are clipped.
         const NEAR: f64 = 0.01;
         let (min, max) = shape.bounds();
-        let cam = self.camera.panned(pan);
         let (s, c) = viewer.theta.sin_cos();
-        // The box's corners in camera axes; their z is the depth along the optical axis.
-        let (rotation, centre) = (cam.robot_to_camera(), cam.centre());
-        let corners: [Vector3<f64>; 8] = std::array::from_fn(|k| {
+        // The box's corners in the robot frame.
+        let corners: [Point3<f64>; 8] = std::array::from_fn(|k| {
             let p = [
                 if k & 1 == 0 { min[0] } else { max[0] },
                 if k & 2 == 0 { min[1] } else { max[1] },
                 if k & 4 == 0 { min[2] } else { max[2] },
             ];
             let (dx, dy) = (p[0] - viewer.x, p[1] - viewer.y);
-            rotation * (Point3::new(c * dx + s * dy, -s * dx + c * dy, p[2]) - centre)
+            Point3::new(c * dx + s * dy, -s * dx + c * dy, p[2])
         });
         let mut lo = (f64::INFINITY, f64::INFINITY);
         let mut hi = (f64::NEG_INFINITY, f64::NEG_INFINITY);
-        let mut take = |v: Vector3<f64>| {
-            if let Some(px) =
-                cam.project_camera(v).filter(|px| px.x.is_finite() && px.y.is_finite())
-            {
+        let mut take = |px: Pixel| {
+            if px.x.is_finite() && px.y.is_finite() {
                 lo = (lo.0.min(px.x), lo.1.min(px.y));
                 hi = (hi.0.max(px.x), hi.1.max(px.y));
             }
         };
+        let cam = match &self.camera {
+            CameraModel::Pinhole(cam) => cam.panned(pan),
+            CameraModel::Omni(omni) => {
+                // Straight lines from the viewpoint: the corners bound the image, unless one
+                // is at or above the viewpoint (then the solid may cover any of it).
+                for p in corners {
+                    match omni.project(p) {
+                        Some(px) => take(px),
+                        None => {
+                            take(Pixel::new(-1e9, -1e9));
+                            take(Pixel::new(1e9, 1e9));
+                        }
+                    }
+                }
+                return self.clip_box(lo, hi);
+            }
+        };
+        // The corners in camera axes; their z is the depth along the optical axis.
+        let (rotation, centre) = (cam.robot_to_camera(), cam.centre());
+        let corners = corners.map(|p| rotation * (p - centre));
         for k in 0..8 {
             let near = |k: usize| corners[k].z >= NEAR;
+            let mut project = |v: Vector3<f64>| {
+                if let Some(px) = cam.project_camera(v) {
+                    take(px);
+                }
+            };
             if near(k) {
-                take(corners[k]);
+                project(corners[k]);
             }
             // The box's edges from this corner (to the corners differing in one coordinate)
             // that cross the near plane: their crossing point bounds the visible part.
@@ -1082,14 +1107,20 @@ impl Renderer {
                 let l = k | bit;
                 if l != k && near(k) != near(l) {
                     let t = (NEAR - corners[k].z) / (corners[l].z - corners[k].z);
-                    take(corners[k] + (corners[l] - corners[k]) * t);
+                    project(corners[k] + (corners[l] - corners[k]) * t);
                 }
             }
         }
+        self.clip_box(lo, hi)
+    }
+
+    /// The pixels `(col0, row0, col1, row1)` (end exclusive) of the image within the bounds
+    /// `lo`, `hi` of a solid's projection, with a margin; `None` when it misses the image.
+    fn clip_box(&self, lo: (f64, f64), hi: (f64, f64)) -> Option<(usize, usize, usize, usize)> {
         if !(lo.0.is_finite() && hi.0.is_finite()) {
             return None;
         }
-        let (w, h) = cam.size();
+        let (w, h) = self.camera.size();
         let (wf, hf) = (f64::from(w), f64::from(h));
         // Two pixels of margin: the corners bound the solid's projection up to lens distortion.
         let clamp = |v: f64, max: f64| v.clamp(0.0, max) as usize;
@@ -1124,6 +1155,73 @@ impl Renderer {
             }
             state.previous = Some(image.clone());
         }
+    }
+}
+
+/// The rays of a pinhole camera at pan 0: a row at a time for an ideal lens, a pixel at a
+/// time (with the floor's texture) for a distorting one.
+fn pinhole_rays(camera: &Pinhole, floor: &FloorPaint) -> Rays {
+    let (w, h) = camera.size();
+    let ray = |col: f64, row: u32| camera.ray(Pixel::new(col + 0.5, f64::from(row) + 0.5));
+    if camera.distortion == (0.0, 0.0) {
+        return Rays::Rows(
+            (0..h)
+                .map(|row| {
+                    let (a, b) = (ray(0.0, row), ray(1.0, row));
+                    RowRays { start: a.into(), step: (b - a).into() }
+                })
+                .collect(),
+        );
+    }
+    let pixels = || (0..h).flat_map(|row| (0..w).map(move |col| (f64::from(col), row)));
+    let on_floor = |d: nalgebra::Vector3<f64>| {
+        let t = -camera.height / d.z;
+        if d.z < 0.0 && t.is_finite() {
+            [(t * d.x) as f32, (t * d.y) as f32]
+        } else {
+            [f32::NAN; 2]
+        }
+    };
+    Rays::Pixels {
+        rays: pixels().map(|(col, row)| ray(col, row).map(|v| v as f32).into()).collect(),
+        floor: pixels().map(|(col, row)| on_floor(ray(col, row))).collect(),
+        texture: Texture::new(floor),
+    }
+}
+
+/// The rays of an omnidirectional camera: from the mirror's viewpoint to the floor point each
+/// pixel images (an affine map: a row of pixels is an evenly stepped line of the floor).
+fn omni_rays(omni: &Omni) -> Result<Vec<RowRays>, String> {
+    if !(omni.viewpoint.is_finite() && omni.viewpoint > 0.0) {
+        return Err(format!(
+            "the mirror's viewpoint must be finite and > 0, not {}",
+            omni.viewpoint
+        ));
+    }
+    let (_, h) = omni.size();
+    let floor = |col: f64, row: u32| omni.floor_of(Pixel::new(col + 0.5, f64::from(row) + 0.5));
+    (0..h)
+        .map(|row| {
+            let (Some(a), Some(b)) = (floor(0.0, row), floor(1.0, row)) else {
+                return Err("the camera's affine map has no inverse".to_string());
+            };
+            Ok(RowRays { start: [a.x, a.y, -omni.viewpoint], step: [b.x - a.x, b.y - a.y, 0.0] })
+        })
+        .collect()
+}
+
+/// What a mirror does not image: the floor its robot's body hides and the floor beyond its
+/// reach, black (the image around a real mirror's rim). Each row of an omnidirectional image
+/// sees an evenly stepped line of the floor (`rows`' rays, from the viewpoint to the floor).
+fn blind_and_rim(image: &mut Image, omni: &Omni, rows: &[RowRays]) {
+    let w = image.width as usize;
+    for (px, ray) in image.rgb.chunks_exact_mut(3 * w).zip(rows) {
+        let (p, d) = ([ray.start[0], ray.start[1]], [ray.step[0], ray.step[1]]);
+        let seen = pixels(disc(p, d, omni.range * omni.range), w);
+        let hidden = pixels(disc(p, d, omni.blind * omni.blind), w);
+        fill(px, 0..seen.start, palette::UNSEEN);
+        fill(px, seen.end..w, palette::UNSEEN);
+        fill(px, hidden, palette::UNSEEN);
     }
 }
 

@@ -220,7 +220,7 @@ fn range(kind: &str) -> f64 {
 pub fn survey(cfg: &SimConfig, seed: u64, scenes: usize) -> Result<SurveyReport, String> {
     let renderer = Renderer::new(cfg)?;
     let map = cfg.field.map();
-    let camera = *renderer.camera();
+    let camera = cfg.camera.camera()?.panned(0.0);
     let shape = PostShape { radius: cfg.render.post_radius, height: cfg.render.post_height };
     let mut agent = VisionAgent::new(camera, &ColorTable::shipped(), cfg.ball.radius)
         .post_shape(shape)

@@ -23,7 +23,7 @@ fn classes(lut: &Lut, image: &Image) -> Vec<u8> {
 
 fn ball(renderer: &Renderer, lut: &Lut, scene: &Scene, viewer: Pose2) -> Option<BallPercept> {
     let image = renderer.render(scene, viewer, 0.0, None, &mut CameraState::default());
-    find_ball(&classes(lut, &image), renderer.camera(), SimConfig::default().ball.radius)
+    find_ball(&classes(lut, &image), renderer.pinhole().unwrap(), SimConfig::default().ball.radius)
 }
 
 #[test]
@@ -268,7 +268,7 @@ fn the_vision_agent_finds_ball_nets_and_robots_in_a_rendered_frame() {
     let cfg = SimConfig::default();
     let renderer = Renderer::new(&cfg).unwrap();
     let mut agent = VisionAgent::new(
-        *renderer.camera(),
+        *renderer.pinhole().unwrap(),
         &mrt_perception::vision::colors::ColorTable::shipped(),
         cfg.ball.radius,
     );
@@ -328,7 +328,7 @@ fn the_open_space_of_a_goal_with_a_keeper_is_beside_the_keeper() {
     let cfg = SimConfig::default();
     let renderer = Renderer::new(&cfg).unwrap();
     let colors = mrt_perception::vision::colors::ColorTable::shipped();
-    let mut agent = VisionAgent::new(*renderer.camera(), &colors, cfg.ball.radius);
+    let mut agent = VisionAgent::new(*renderer.pinhole().unwrap(), &colors, cfg.ball.radius);
     let me = Pose2::new(5.0, 0.0, 0.0);
     let empty = renderer.render(&Scene::default(), me, 0.0, None, &mut CameraState::default());
     let p = agent.see(&empty, 0.0, 0.0).unwrap();
@@ -365,7 +365,7 @@ fn a_distorting_lens_renders_through_its_per_pixel_floor_table() {
     assert_eq!(a.pixel(160, 200), b.pixel(160, 200), "no distortion on the axis");
     assert_ne!(a, b, "but off it");
     let lut = lut();
-    let found = find_ball(&classes(&lut, &b), barrel.camera(), cfg.ball.radius).unwrap();
+    let found = find_ball(&classes(&lut, &b), barrel.pinhole().unwrap(), cfg.ball.radius).unwrap();
     let (d, bearing) = ((6.0f64).hypot(-0.6), (-0.6f64).atan2(6.0));
     assert!((found.distance - d).abs() < 0.05 * d, "{found:?}");
     assert!((found.bearing - bearing).abs() < 1.5f64.to_radians(), "{found:?}");
@@ -428,4 +428,49 @@ fn the_row_renderer_and_the_pixel_renderer_draw_the_same_image() {
     }
     assert!(differ * 200 < total, "{differ} of {total} pixels differ");
     assert!(differ > 0, "the texture's 2 cm steps show somewhere");
+}
+
+/// ISocRob's "up" camera (`configs/vision/omni.toml`): the renderer draws what its mirror
+/// images (the floor around the robot, raised things pushed outwards along the viewpoint's
+/// lines, black within the robot's blind disc and beyond the mirror's reach), and the vision's
+/// up mode finds the ball in it all around the robot: within 5 % of the distance and 1.5° of
+/// the bearing, also beside other robots.
+#[test]
+fn the_up_camera_sees_the_ball_all_around() {
+    use mrt_perception::camera::{CameraModel, OmniFile};
+    use mrt_perception::vision::up::find_ball_up;
+    let cfg = SimConfig::default();
+    let omni = OmniFile::default().camera().unwrap();
+    let renderer = Renderer::with_camera(&cfg, CameraModel::Omni(omni)).unwrap();
+    let lut = lut();
+    let viewer = Pose2::new(-2.0, 1.0, 0.7);
+    let robots = vec![
+        (viewer, true),
+        (Pose2::new(-0.5, 2.5, 0.0), false),
+        (Pose2::new(-3.5, -0.5, 1.0), true),
+    ];
+    for (d, bearing) in [(1.4f64, 0.0f64), (2.0, 1.2), (2.6, -2.0), (3.2, 2.8), (3.6, -0.9)] {
+        let (s, c) = (viewer.theta + bearing).sin_cos();
+        let ball = (viewer.x + d * c, viewer.y + d * s);
+        let scene = Scene { ball: Some(ball), robots: robots.clone() };
+        let image = renderer.render(&scene, viewer, 0.0, Some(0), &mut CameraState::default());
+        assert_eq!((image.width, image.height), (480, 480));
+        let found = find_ball_up(&classes(&lut, &image), &omni, cfg.ball.radius)
+            .unwrap_or_else(|| panic!("the ball at {d} m, {bearing} rad"));
+        assert!((found.distance - d).abs() < 0.05 * d, "{d} m: {found:?}");
+        let off = (found.bearing - bearing + std::f64::consts::PI)
+            .rem_euclid(std::f64::consts::TAU)
+            - std::f64::consts::PI;
+        assert!(off.abs() < 1.5f64.to_radians(), "{d} m, {bearing} rad: {found:?}");
+    }
+    // Within the blind disc, and beyond the reach: black, no ball.
+    let near = Scene { ball: Some((viewer.x + 0.5, viewer.y)), robots: robots.clone() };
+    let image = renderer.render(&near, viewer, 0.0, Some(0), &mut CameraState::default());
+    assert_eq!(image.pixel(240, 240), Some(palette::UNSEEN));
+    assert_eq!(image.pixel(2, 2), Some(palette::UNSEEN), "a corner: beyond the rim");
+    assert!(find_ball_up(&classes(&lut, &image), &omni, cfg.ball.radius).is_none());
+    // The floor in between: carpet (or a line) 2 m to the left (ahead and behind stand the
+    // other robots, stretched outwards).
+    let floor = image.pixel(140, 240).unwrap();
+    assert!(floor == palette::CARPET || floor == palette::LINE, "{floor:?}");
 }

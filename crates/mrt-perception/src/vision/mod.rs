@@ -2,7 +2,8 @@
 //! lookup table built from HSV thresholds ([`colors`]); blobs and the ball ([`blobs`]), goals
 //! with their nearest point and open space ([`goals`]), field-line points ([`lines`]) and the
 //! landmark posts ([`posts`]) build on it; [`agent`] puts them together into the µAgent: one
-//! image in, the percepts out; [`calibrate`] helps a person tune the thresholds.
+//! image in, the percepts out; [`up`] is the µAgent's up mode, the ball in an omnidirectional
+//! camera's image; [`calibrate`] helps a person tune the thresholds.
 
 pub mod agent;
 pub mod blobs;
@@ -11,3 +12,4 @@ pub mod colors;
 pub mod goals;
 pub mod lines;
 pub mod posts;
+pub mod up;
