@@ -40,6 +40,7 @@ smoke_tests! {
     brian => "brian",
     sim_config => "sim-config",
     robot_file => "robot-file",
+    vision_files => "vision-files",
     bb_config => "bb-config",
     relay_line => "relay-line",
     lua_script => "lua-script",

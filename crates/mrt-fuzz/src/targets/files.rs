@@ -132,6 +132,48 @@ impl Harness for SimToml {
     }
 }
 
+/// The vision's files (`mrt vision --camera`, `--colors`): camera files of either model, and
+/// colour files.
+pub(super) const VISION_FILES: Target = Target {
+    name: "vision-files",
+    about: "a camera file (CameraModel::from_toml, pinhole or omni; a camera that reads must project and unproject) or a colour file (ColorTable::from_toml and its lookup table)",
+    keywords: &["model", "\"pinhole\"", "\"omni\"", "[ball]", "[goal_yellow]", "[goal_blue]", "[robot]", "[line]", "[field]", "hue_min", "hue_max", "sat_min", "val_min", "=", "true", "false", "nan", "inf", "-inf", "1e400", "-1", "0"],
+    structured: Some(crate::mutate::mutate_toml),
+    seeds: |root| files_under(&root.join("configs/vision"), |s| s.ends_with(".toml")),
+    harness: |_| Ok(Box::new(VisionToml)),
+};
+
+struct VisionToml;
+
+impl Harness for VisionToml {
+    fn exec(&mut self, seed: &Seed, input: &[u8]) -> bool {
+        use mrt_perception::camera::{Camera, CameraModel, Pixel};
+        use mrt_perception::vision::colors::{ColorTable, Lut};
+        let Ok(text) = std::str::from_utf8(input) else { return false };
+        if seed.slot.contains("colors") {
+            let Ok(table) = ColorTable::from_toml(text, "fuzz.toml") else { return false };
+            let lut = Lut::new(&table);
+            let _ = lut.class(255, 120, 0);
+            return true;
+        }
+        let Ok(camera) = CameraModel::from_toml(text, "fuzz.toml") else { return false };
+        let (w, h) = camera.size();
+        let centre = Pixel::new(f64::from(w) / 2.0, f64::from(h) / 2.0);
+        let p = nalgebra::Point3::new(2.0, 0.5, 0.1);
+        match camera {
+            CameraModel::Pinhole(c) => {
+                let _ = c.project(p).map(|px| c.unproject(px));
+                let _ = c.unproject(centre);
+            }
+            CameraModel::Omni(c) => {
+                let _ = c.project(p).map(|px| c.unproject_at_height(px, 0.1));
+                let _ = c.unproject(centre);
+            }
+        }
+        true
+    }
+}
+
 /// A robot's file (`mrt robot --config`).
 pub(super) const ROBOT_FILE: Target = Target {
     name: "robot-file",

@@ -69,6 +69,7 @@ pub static TARGETS: &[Target] = &[
     files::BRIAN,
     files::SIM_CONFIG,
     files::ROBOT_FILE,
+    files::VISION_FILES,
     files::BB_CONFIG,
     files::RELAY_LINE,
     lua::LUA_SCRIPT,
