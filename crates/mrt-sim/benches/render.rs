@@ -1,6 +1,6 @@
 //! Rendering benchmark (issue 19 item 8: one 320×240 frame ≤ 0.2 ms): a robot's camera in a
 //! busy scene (the ball, nine other robots, a goal in view), with and without the image
-//! effects.
+//! effects; the same scene through the omnidirectional up camera, and its up mode.
 //!
 //! Run: `cargo bench -p mrt-sim --bench render`. Results go to `docs/performance.md`.
 #![allow(missing_docs, clippy::unwrap_used)]
@@ -44,6 +44,29 @@ fn render(c: &mut Criterion) {
     });
     g.finish();
     c.bench_function("renderer_new", |b| b.iter(|| Renderer::new(black_box(&cfg)).unwrap()));
+
+    // ISocRob's up camera (configs/vision/omni.toml, 480×480) in the same scene, and its up
+    // mode: the lookup table and the ball all around.
+    use mrt_perception::camera::{CameraModel, OmniFile};
+    use mrt_perception::vision::colors::{ColorTable, Lut};
+    use mrt_perception::vision::up::find_ball_up;
+    let plain = SimConfig::default();
+    let omni = OmniFile::default().camera().unwrap();
+    let up = Renderer::with_camera(&plain, CameraModel::Omni(omni)).unwrap();
+    let mut g = c.benchmark_group("omni_480x480");
+    g.bench_function("busy_scene", |b| {
+        b.iter(|| up.render(black_box(&scene), black_box(viewer), 0.0, None, &mut state))
+    });
+    let image = up.render(&scene, viewer, 0.0, None, &mut state);
+    let lut = Lut::new(&ColorTable::shipped());
+    let mut classes = vec![0u8; image.rgb.len() / 3];
+    g.bench_function("classify_and_find_ball_up", |b| {
+        b.iter(|| {
+            lut.classify(black_box(&image.rgb), &mut classes);
+            find_ball_up(&classes, &omni, plain.ball.radius)
+        })
+    });
+    g.finish();
 }
 
 criterion_group!(benches, render);
