@@ -102,6 +102,32 @@ fn bench(c: &mut Criterion) {
         )
     });
     g.finish();
+
+    // ISocRob's self mode (mrt_world::hough): the field-line points within 4 m of a robot near
+    // the west penalty area, every 10 cm, through the Hough transform and the matching.
+    use mrt_world::hough::{hough_lines, self_localize, HoughParams};
+    let at = Pose2::new(-6.0, 1.5, 2.6);
+    let (sin, cos) = at.theta.sin_cos();
+    let mut points = Vec::new();
+    for seg in field.lines() {
+        let n = (seg.length() / 0.1) as usize;
+        for k in 0..=n {
+            let p = seg.a + (seg.b - seg.a) * (k as f64 / n as f64);
+            let (dx, dy) = (p.x - at.x, p.y - at.y);
+            if dx.hypot(dy) <= 4.0 {
+                points.push(mrt_core::Point2::new(cos * dx + sin * dy, -sin * dx + cos * dy));
+            }
+        }
+    }
+    let params = HoughParams::default();
+    let mut g = c.benchmark_group("hough");
+    g.bench_function("hough_lines", |b| b.iter(|| hough_lines(black_box(&points), &params)));
+    let lines = hough_lines(&points, &params);
+    println!("hough: {} points, {} lines", points.len(), lines.len());
+    g.bench_function("hough_self_localize", |b| {
+        b.iter(|| self_localize(&field, black_box(&points), &lines, &params))
+    });
+    g.finish();
 }
 
 criterion_group!(benches, bench);

@@ -36,6 +36,13 @@ impl Segment {
     pub fn length(&self) -> f64 {
         (self.b - self.a).norm()
     }
+
+    /// How far the point `p` lies from it, m.
+    pub fn distance(&self, p: Point2) -> f64 {
+        let d = self.b - self.a;
+        let t = ((p - self.a).dot(&d) / d.norm_squared().max(1e-12)).clamp(0.0, 1.0);
+        (p - (self.a + d * t)).norm()
+    }
 }
 
 /// The field as a map (Middle Size League proportions by default), in metres.

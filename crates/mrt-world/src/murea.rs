@@ -565,9 +565,7 @@ impl Murea {
                 // The largest disc round the seen point within its tolerance sector.
                 let tol = tol_r.min(r * tol_b.min(0.5 * PI).sin()).max(1e-6);
                 for (_, seg) in self.map.segments.iter().filter(|(kind, _)| *kind == p.kind) {
-                    let d = seg.b - seg.a;
-                    let t = ((seen - seg.a).dot(&d) / d.norm_squared().max(1e-12)).clamp(0.0, 1.0);
-                    let off = (seen - (seg.a + d * t)).norm() / tol;
+                    let off = seg.distance(seen) / tol;
                     best = best.min(off * off);
                 }
             }

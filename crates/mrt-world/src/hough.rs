@@ -1,0 +1,386 @@
+//! ISocRob's self-localization from the field lines (seed `003` §3.2.1, the vision µAgent's
+//! "self" mode; the research notes `MODULES.md` §7 write the steps out): the white points a
+//! camera found on the floor (robot frame) vote in a **Hough** transform for straight lines,
+//! `ρ = x·cos φ + y·sin φ`; the strongest lines are matched **combinatorially** to the field
+//! model, whose lines all run along the field's axes: a detected line's direction gives the
+//! heading up to a quarter turn, and its distance, put against each model line of its family,
+//! one coordinate of the robot. Every combination is scored by how many of the points fall on
+//! the field's lines (the centre circle included) from that pose.
+//!
+//! The field is symmetric under a half turn about the centre spot: a pose and its twin
+//! (`(−x, −y, θ + π)`) explain the same lines, and both are returned with the same score.
+//! The goal colour breaks the tie ([`HoughPose::facing`]: which goal the robot sees where),
+//! or the pose the robot believed ([`nearest`]).
+//!
+//! Design choices (the research notes' [DES] tags): 1° × 5 cm cells; after a line is taken,
+//! its points leave the vote, so a second line is not the first one's neighbour cell; a line
+//! needs [`HoughParams::min_votes`] points; a point is on a line within
+//! [`HoughParams::tolerance`].
+//!
+//! ```
+//! use mrt_core::{Point2, Pose2};
+//! use mrt_world::field::FieldMap;
+//! use mrt_world::hough::{hough_lines, self_localize, HoughParams};
+//!
+//! // A robot at (-6, 1.5) facing west-north-west sees the west goal line, the
+//! // front of the west penalty area and its north side: points every 10 cm within 4 m, in
+//! // its own frame.
+//! let (truth, map) = (Pose2::new(-6.0, 1.5, 2.6), FieldMap::default());
+//! let mut seen = Vec::new();
+//! for seg in map.lines() {
+//!     let n = (seg.length() / 0.1) as usize;
+//!     for k in 0..=n {
+//!         let field = seg.a + (seg.b - seg.a) * (k as f64 / n as f64);
+//!         let (dx, dy) = (field.x - truth.x, field.y - truth.y);
+//!         let (sin, cos) = truth.theta.sin_cos();
+//!         if dx.hypot(dy) <= 4.0 {
+//!             seen.push(Point2::new(cos * dx + sin * dy, -sin * dx + cos * dy));
+//!         }
+//!     }
+//! }
+//! let params = HoughParams::default();
+//! let lines = hough_lines(&seen, &params);
+//! assert!(lines.len() >= 3, "{lines:?}");
+//! let poses = self_localize(&map, &seen, &lines, &params);
+//! // The truth and its half-turn twin explain every point.
+//! let best = poses[0].pose;
+//! let twin = Pose2::new(-best.x, -best.y, best.theta + std::f64::consts::PI);
+//! assert!(poses.iter().take(2).any(|p| (p.pose.x - truth.x).hypot(p.pose.y - truth.y) < 0.05));
+//! assert!(poses.iter().take(2).any(|p| (p.pose.x - twin.x).hypot(p.pose.y - twin.y) < 0.05));
+//! ```
+
+use crate::field::{FieldMap, Segment};
+use mrt_core::{Point2, Pose2};
+use std::f64::consts::{FRAC_PI_2, PI, TAU};
+
+/// The Hough transform's and the matching's settings (module doc).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct HoughParams {
+    /// Angle of a cell, rad.
+    pub angle_step: f64,
+    /// Distance of a cell, m.
+    pub rho_step: f64,
+    /// Points a line needs.
+    pub min_votes: usize,
+    /// Lines taken at most.
+    pub max_lines: usize,
+    /// How far a point may lie from a line (detected or of the field) and be on it, m.
+    pub tolerance: f64,
+}
+
+impl Default for HoughParams {
+    fn default() -> Self {
+        HoughParams {
+            angle_step: 1f64.to_radians(),
+            rho_step: 0.05,
+            min_votes: 6,
+            max_lines: 6,
+            tolerance: 0.08,
+        }
+    }
+}
+
+/// A straight line of points: `x·cos φ + y·sin φ = ρ` (robot frame), `φ` in `[0, π)`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct HoughLine {
+    /// The direction of its normal, rad.
+    pub phi: f64,
+    /// Its signed distance from the robot along the normal, m.
+    pub rho: f64,
+    /// The points on it.
+    pub votes: usize,
+}
+
+/// The strongest lines through `points` (robot frame, m), strongest first: the Hough cell
+/// with the most votes, refined to its points' mean distance; its points then leave the vote
+/// and the next line is sought, until a line would have fewer than `min_votes` points.
+pub fn hough_lines(points: &[Point2], params: &HoughParams) -> Vec<HoughLine> {
+    let finite: Vec<Point2> =
+        points.iter().copied().filter(|p| p.x.is_finite() && p.y.is_finite()).collect();
+    if finite.is_empty()
+        || !(params.angle_step > 0.0 && params.rho_step > 0.0 && params.tolerance > 0.0)
+    {
+        return Vec::new();
+    }
+    let reach = finite.iter().map(|p| p.coords.norm()).fold(0.0, f64::max) + params.rho_step;
+    let angles = ((PI / params.angle_step).ceil() as usize).clamp(1, 3600);
+    let rhos = ((2.0 * reach / params.rho_step).ceil() as usize + 1).min(100_000);
+    let trig: Vec<(f64, f64)> =
+        (0..angles).map(|k| (k as f64 * PI / angles as f64).sin_cos()).collect();
+    let mut left = finite;
+    let mut lines = Vec::new();
+    let mut votes = vec![0u32; angles * rhos];
+    while lines.len() < params.max_lines && left.len() >= params.min_votes {
+        votes.iter_mut().for_each(|v| *v = 0);
+        for p in &left {
+            for (k, (s, c)) in trig.iter().enumerate() {
+                let rho = p.x * c + p.y * s;
+                let bin = ((rho + reach) / params.rho_step).round() as usize;
+                if let Some(v) = votes.get_mut(k * rhos + bin.min(rhos - 1)) {
+                    *v += 1;
+                }
+            }
+        }
+        let Some((best, _)) = votes.iter().enumerate().max_by_key(|(i, v)| (**v, usize::MAX - i))
+        else {
+            break;
+        };
+        let (k, bin) = (best / rhos, best % rhos);
+        let (s, c) = trig[k];
+        let rho0 = bin as f64 * params.rho_step - reach;
+        let on = |p: &Point2| (p.x * c + p.y * s - rho0).abs() <= params.tolerance;
+        let inliers: Vec<Point2> = left.iter().copied().filter(on).collect();
+        if inliers.len() < params.min_votes {
+            break;
+        }
+        let rho = inliers.iter().map(|p| p.x * c + p.y * s).sum::<f64>() / inliers.len() as f64;
+        lines.push(HoughLine { phi: k as f64 * PI / angles as f64, rho, votes: inliers.len() });
+        left.retain(|p| !on(p));
+    }
+    lines
+}
+
+/// A pose found by [`self_localize`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct HoughPose {
+    /// The robot's pose, field frame.
+    pub pose: Pose2,
+    /// How many of the points lie on a field line from there.
+    pub explained: usize,
+}
+
+impl HoughPose {
+    /// How well the pose agrees with seeing the east (yellow) goal's centre at `bearing`
+    /// (robot frame, rad): the cosine of the angle between where it is seen and where that
+    /// pose would see it, 1 at best. Of a pose and its half-turn twin, the one facing the
+    /// goal seen is the right one (seed `003` §3.2.1: goal colour breaks the symmetry).
+    pub fn facing(&self, map: &FieldMap, bearing: f64) -> f64 {
+        let p = self.pose;
+        let expected = (0.0 - p.y).atan2(map.half_length() - p.x) - p.theta;
+        (expected - bearing).cos()
+    }
+}
+
+/// The candidate nearest to `belief` (field frame): of twins that explain the lines equally
+/// well, the one the robot's own estimate points at.
+pub fn nearest(poses: &[HoughPose], belief: Pose2) -> Option<HoughPose> {
+    let best = poses.first()?.explained;
+    let heading = |a: f64, b: f64| (a - b + PI).rem_euclid(TAU) - PI;
+    poses.iter().filter(|p| p.explained == best).copied().min_by(|a, b| {
+        let d = |p: &HoughPose| {
+            (p.pose.x - belief.x).hypot(p.pose.y - belief.y)
+                + heading(p.pose.theta, belief.theta).abs()
+        };
+        d(a).total_cmp(&d(b))
+    })
+}
+
+/// The poses (field frame) from which the `lines` found in `points` (robot frame) are the
+/// field's lines, best first (module doc); a pose and its half-turn twin come with the same
+/// score. Empty when the lines do not fix both coordinates: lines of both directions are
+/// needed (one direction fixes one coordinate and the heading).
+pub fn self_localize(
+    map: &FieldMap,
+    points: &[Point2],
+    lines: &[HoughLine],
+    params: &HoughParams,
+) -> Vec<HoughPose> {
+    let Some(first) = lines.first() else { return Vec::new() };
+    let (hl, hw) = (map.half_length(), map.half_width());
+    let front = hl - map.penalty_area_depth;
+    let pw = map.penalty_area_width / 2.0;
+    // Model lines: x = c (the goal lines, the penalty areas' fronts, the half-way line) and
+    // y = c (the side lines, the penalty areas' sides).
+    let across = [-hl, -front, 0.0, front, hl];
+    let along = [-hw, -pw, pw, hw];
+    let segments = map.lines();
+    let ring = map.centre_circle_radius;
+    let mut found: Vec<HoughPose> = Vec::new();
+    for quarter in 0..4 {
+        // The strongest line is one of the field's: its normal, turned into the field, lies
+        // along an axis. The other lines that agree (modulo a quarter turn) refine it.
+        let theta = quarter as f64 * FRAC_PI_2 - first.phi;
+        let mut xs = Vec::new();
+        let mut ys = Vec::new();
+        for l in lines {
+            let normal = l.phi + theta;
+            let off = (normal / FRAC_PI_2).round();
+            if (normal - off * FRAC_PI_2).abs() > 3.0 * params.angle_step {
+                continue;
+            }
+            // The line's field normal is s·x̂ (off even) or s·ŷ (off odd): points p on it
+            // have s·p = ρ + s·t, so a model line at c puts the robot at t = c − s·ρ.
+            let s = if (off as i64).rem_euclid(4) < 2 { 1.0 } else { -1.0 };
+            if (off as i64).rem_euclid(2) == 0 {
+                xs.extend(across.iter().map(|c| c - s * l.rho));
+            } else {
+                ys.extend(along.iter().map(|c| c - s * l.rho));
+            }
+        }
+        for &x in &xs {
+            for &y in &ys {
+                let pose = Pose2::new(x, y, theta.rem_euclid(TAU));
+                let explained = explained(points, pose, &segments, ring, params.tolerance);
+                found.push(HoughPose { pose, explained });
+            }
+        }
+    }
+    found.sort_by(|a, b| {
+        b.explained
+            .cmp(&a.explained)
+            .then(a.pose.x.total_cmp(&b.pose.x))
+            .then(a.pose.y.total_cmp(&b.pose.y))
+    });
+    // One of each place: candidates within the tolerance of a better one are the same.
+    let mut unique: Vec<HoughPose> = Vec::new();
+    for p in found {
+        let same = |q: &HoughPose| {
+            (q.pose.x - p.pose.x).hypot(q.pose.y - p.pose.y) < 2.0 * params.tolerance
+                && ((q.pose.theta - p.pose.theta + PI).rem_euclid(TAU) - PI).abs() < 0.1
+        };
+        if p.explained > 0 && !unique.iter().any(same) {
+            unique.push(p);
+        }
+    }
+    unique
+}
+
+/// How many of `points` (robot frame) lie within `tolerance` of a field line or the centre
+/// circle when the robot stands at `pose`.
+fn explained(
+    points: &[Point2],
+    pose: Pose2,
+    segments: &[Segment],
+    ring: f64,
+    tolerance: f64,
+) -> usize {
+    let (s, c) = pose.theta.sin_cos();
+    points
+        .iter()
+        .filter(|q| {
+            let p = Point2::new(pose.x + c * q.x - s * q.y, pose.y + s * q.x + c * q.y);
+            (ring > 0.0 && (p.coords.norm() - ring).abs() <= tolerance)
+                || segments.iter().any(|seg| seg.distance(p) <= tolerance)
+        })
+        .count()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::{Rng, SeedableRng};
+
+    /// The field's line points within `reach` of `pose`, every 10 cm, in the robot frame,
+    /// with Gaussian-ish noise of `noise` m, and `outliers` random points besides.
+    fn seen(pose: Pose2, reach: f64, noise: f64, outliers: usize, seed: u64) -> Vec<Point2> {
+        let map = FieldMap::default();
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+        let mut field = Vec::new();
+        for seg in map.lines() {
+            let n = (seg.length() / 0.1).ceil() as usize;
+            for k in 0..=n {
+                field.push(seg.a + (seg.b - seg.a) * (k as f64 / n as f64));
+            }
+        }
+        for k in 0..126 {
+            let a = TAU * k as f64 / 126.0;
+            field.push(Point2::new(2.0 * a.cos(), 2.0 * a.sin()));
+        }
+        let (s, c) = pose.theta.sin_cos();
+        let mut out: Vec<Point2> = field
+            .into_iter()
+            .filter(|p| (p.x - pose.x).hypot(p.y - pose.y) <= reach)
+            .map(|p| {
+                let (dx, dy) = (p.x - pose.x, p.y - pose.y);
+                let jitter = |rng: &mut rand_chacha::ChaCha8Rng| {
+                    (rng.random::<f64>() + rng.random::<f64>() + rng.random::<f64>() - 1.5)
+                        * noise
+                        * 2.0
+                };
+                Point2::new(c * dx + s * dy + jitter(&mut rng), -s * dx + c * dy + jitter(&mut rng))
+            })
+            .collect();
+        for _ in 0..outliers {
+            out.push(Point2::new(rng.random_range(-reach..reach), rng.random_range(-reach..reach)));
+        }
+        out
+    }
+
+    fn close(a: Pose2, b: Pose2) -> bool {
+        (a.x - b.x).hypot(a.y - b.y) < 0.1
+            && ((a.theta - b.theta + PI).rem_euclid(TAU) - PI).abs() < 0.03
+    }
+
+    fn twin(p: Pose2) -> Pose2 {
+        Pose2::new(-p.x, -p.y, (p.theta + PI).rem_euclid(TAU))
+    }
+
+    /// Research §7's test: field-line points from known poses, with noise and 30 % outliers,
+    /// give the pose up to the half-turn symmetry (the truth and its twin, both best), and
+    /// the goal seen (or the pose believed) picks the truth.
+    #[test]
+    fn the_pose_is_found_up_to_the_symmetry_and_the_goal_picks_it() {
+        let map = FieldMap::default();
+        let params = HoughParams::default();
+        let truths = [
+            Pose2::new(-5.0, 2.0, 0.5),
+            Pose2::new(6.5, -4.0, 2.0),
+            Pose2::new(-7.5, -5.0, -1.2),
+            Pose2::new(3.0, 5.0, 3.0),
+        ];
+        for (i, truth) in truths.into_iter().enumerate() {
+            let mut points = seen(truth, 4.0, 0.02, 0, i as u64);
+            let real = points.len();
+            points.extend(
+                seen(truth, 4.0, 0.0, real * 3 / 10, 100 + i as u64).into_iter().skip(real),
+            );
+            let lines = hough_lines(&points, &params);
+            assert!(lines.len() >= 2, "{truth:?}: {lines:?}");
+            let poses = self_localize(&map, &points, &lines, &params);
+            assert!(poses.len() >= 2, "{truth:?}");
+            let (a, b) = (poses[0], poses[1]);
+            assert_eq!(a.explained, b.explained, "twins explain the same points");
+            assert!(
+                (close(a.pose, truth) && close(b.pose, twin(truth)))
+                    || (close(b.pose, truth) && close(a.pose, twin(truth))),
+                "{truth:?}: {a:?} {b:?}"
+            );
+            assert!(a.explained * 10 >= real * 8, "{truth:?}: {} of {real}", a.explained);
+            // The east goal's centre, where the truth sees it.
+            let bearing = (0.0 - truth.y).atan2(9.0 - truth.x) - truth.theta;
+            let picked = if a.facing(&map, bearing) > b.facing(&map, bearing) { a } else { b };
+            assert!(close(picked.pose, truth), "{truth:?}: {picked:?}");
+            let believed = Pose2::new(truth.x + 0.5, truth.y - 0.3, truth.theta + 0.2);
+            assert!(close(nearest(&poses, believed).unwrap().pose, truth), "{truth:?}");
+        }
+    }
+
+    #[test]
+    fn one_direction_of_lines_or_none_fixes_no_pose() {
+        let map = FieldMap::default();
+        let params = HoughParams::default();
+        assert!(hough_lines(&[], &params).is_empty());
+        assert!(self_localize(&map, &[], &[], &params).is_empty());
+        // Only the north side line: the heading, one coordinate, not the other.
+        let points: Vec<Point2> =
+            (0..30).map(|k| Point2::new(-1.5 + 0.1 * k as f64, 2.0)).collect();
+        let lines = hough_lines(&points, &params);
+        assert_eq!(lines.len(), 1);
+        assert!(self_localize(&map, &points, &lines, &params).is_empty());
+        // Non-finite points are left out, not a panic.
+        let odd = [Point2::new(f64::NAN, 1.0), Point2::new(f64::INFINITY, 0.0)];
+        assert!(hough_lines(&odd, &params).is_empty());
+    }
+
+    #[test]
+    fn the_same_points_give_the_same_poses() {
+        let map = FieldMap::default();
+        let params = HoughParams::default();
+        let points = seen(Pose2::new(1.0, -3.0, 0.7), 4.0, 0.02, 10, 9);
+        let run = || {
+            let lines = hough_lines(&points, &params);
+            self_localize(&map, &points, &lines, &params)
+        };
+        assert_eq!(run(), run());
+    }
+}
