@@ -173,22 +173,37 @@ pub fn find_ball(classes: &[u8], camera: &Pinhole, radius: f64) -> Option<BallPe
         let range = (centre - camera.centre()).norm();
         let expected = ball_diameter_px(radius, camera.intrinsics.fx, range) / 2.0;
         let area = std::f64::consts::PI * expected * expected;
+        if let Some(ball) = BallPercept::sized(&blob, area, at, foot) {
+            return Some(ball);
+        }
+    }
+    None
+}
+
+impl BallPercept {
+    /// The ball `blob` shows, standing at `at` and seen from `foot` (robot frame), when its
+    /// pixels fit the `expected` area ([`BALL_AREA_RANGE`]).
+    pub(crate) fn sized(
+        blob: &Blob,
+        expected: f64,
+        at: Point2<f64>,
+        foot: Point2<f64>,
+    ) -> Option<BallPercept> {
         let (lo, hi) = BALL_AREA_RANGE;
         let n = f64::from(blob.pixels);
-        if n < lo * area || n > hi * area {
-            continue;
+        if n < lo * expected || n > hi * expected {
+            return None;
         }
         let d = at - foot;
-        return Some(BallPercept {
+        Some(BallPercept {
             pixel: blob.centroid,
             radius_px: (n / std::f64::consts::PI).sqrt(),
             at,
             distance: d.norm(),
             bearing: d.y.atan2(d.x),
             pixels: blob.pixels,
-        });
+        })
     }
-    None
 }
 
 #[cfg(test)]

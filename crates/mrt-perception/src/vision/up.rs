@@ -36,7 +36,7 @@
 //! # Ok::<(), String>(())
 //! ```
 
-use super::blobs::{blobs, BallPercept, BALL_AREA_RANGE};
+use super::blobs::{blobs, BallPercept};
 use super::colors::ColorClass;
 use crate::camera::{Camera, Omni, Pixel};
 use nalgebra::{Point2, Point3, Vector3};
@@ -153,20 +153,12 @@ pub fn find_ball_up(classes: &[u8], omni: &Omni, radius: f64) -> Option<BallPerc
             area = Some(a);
         }
         let Some(area) = area else { continue };
-        let (lo, hi) = BALL_AREA_RANGE;
-        let n = f64::from(blob.pixels);
-        if n < lo * area || n > hi * area || !omni.images(at) {
+        if !omni.images(at) {
             continue;
         }
-        let d = at.coords;
-        return Some(BallPercept {
-            pixel: blob.centroid,
-            radius_px: (n / std::f64::consts::PI).sqrt(),
-            at,
-            distance: d.norm(),
-            bearing: d.y.atan2(d.x),
-            pixels: blob.pixels,
-        });
+        if let Some(ball) = BallPercept::sized(&blob, area, at, Point2::origin()) {
+            return Some(ball);
+        }
     }
     None
 }
