@@ -157,6 +157,10 @@ pub struct CameraFrame {
     /// and stands where its camera file puts it).
     #[serde(default)]
     pub pan: Option<f64>,
+    /// The omnidirectional up camera's image taken at the same time, when the robot has one
+    /// (ISocRob seed `003` §2.2: a camera under a mirror on the robot's top).
+    #[serde(default)]
+    pub up_image: Option<Image>,
 }
 
 /// What the vision µAgent found in one camera image (ISocRob seed `003` §3.2.1), robot frame:

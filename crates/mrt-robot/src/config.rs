@@ -5,7 +5,7 @@
 //! file from its world configuration (`mrt_sim::config::SimConfig::robot_file`).
 
 use crate::base::Base;
-use mrt_perception::camera::{CameraFile, Pinhole};
+use mrt_perception::camera::{CameraFile, Omni, OmniFile, Pinhole};
 use mrt_perception::mice::MiceOdometry;
 use mrt_perception::vision::colors::ColorTable;
 use mrt_perception::vision::posts::PostShape;
@@ -63,6 +63,8 @@ pub struct VisionSetup {
     pub colors: ColorTable,
     /// The landmark posts' shape.
     pub posts: PostShape,
+    /// The omnidirectional up camera, when the robot has one.
+    pub up_camera: Option<Omni>,
 }
 
 impl RobotConfig {
@@ -201,6 +203,10 @@ pub struct VisionSection {
     pub post_radius: f64,
     /// The landmark posts' height, m (three bands of equal height).
     pub post_height: f64,
+    /// ISocRob's omnidirectional up camera (`[vision.up_camera]`, an omni camera file's keys,
+    /// `configs/vision/omni.toml`), when the robot has one: the ball all around it.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub up_camera: Option<OmniFile>,
 }
 
 impl Default for VisionSection {
@@ -212,6 +218,7 @@ impl Default for VisionSection {
             colors: ColorTable::shipped(),
             post_radius: posts.radius,
             post_height: posts.height,
+            up_camera: None,
         }
     }
 }
@@ -434,7 +441,11 @@ impl RobotFile {
                 radius: positive("vision.post_radius", v.post_radius)?,
                 height: positive("vision.post_height", v.post_height)?,
             };
-            v.enabled.then(|| VisionSetup { camera, colors: v.colors.clone(), posts })
+            let up_camera = match &v.up_camera {
+                Some(f) => Some(f.camera().map_err(|e| format!("vision.up_camera: {e}"))?),
+                None => None,
+            };
+            v.enabled.then(|| VisionSetup { camera, colors: v.colors.clone(), posts, up_camera })
         };
         Ok(RobotConfig {
             control_period,

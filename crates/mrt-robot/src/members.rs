@@ -179,7 +179,7 @@ impl Member for Vision {
         // Where the pan joint was when the frame was taken (the gaze control turns it), or,
         // for a camera without a joint, where its camera file puts it.
         let pan = frame.pan.unwrap_or(self.agent.camera().pan);
-        match self.agent.see(image, frame.time, pan) {
+        match self.agent.see_with_up(image, frame.up_image.as_ref(), frame.time, pan) {
             Ok(p) => {
                 ctx.publish(p);
             }
@@ -459,9 +459,12 @@ fn add_cycle(
     };
     let mut ids = vec![agora.add_member(odometry, every), agora.add_member(camera, every)];
     if let Some(v) = &cfg.vision {
-        let agent = VisionAgent::new(v.camera, &v.colors, cfg.ball_radius)
+        let mut agent = VisionAgent::new(v.camera, &v.colors, cfg.ball_radius)
             .post_shape(v.posts)
             .goal_width(cfg.field.goal_width);
+        if let Some(up) = v.up_camera {
+            agent = agent.up_camera(up);
+        }
         ids.push(agora.add_member(Vision { robot, agent, refused: 0 }, every));
     }
     ids.extend([

@@ -414,6 +414,7 @@ impl SimConfig {
                 colors: mrt_perception::vision::colors::ColorTable::shipped(),
                 post_radius: self.render.post_radius,
                 post_height: self.render.post_height,
+                up_camera: self.up_camera.clone(),
             },
             gaze: GazeSection {
                 half_fov: self.gaze.half_fov.or(match self.sensor.percepts {
@@ -456,6 +457,12 @@ pub struct SimConfig {
     /// Every robot's camera: a camera file's keys (`mrt_perception::camera::CameraFile`;
     /// all of them when the table is given, the shipped `configs/vision/camera.toml` when not).
     pub camera: mrt_perception::camera::CameraFile,
+    /// Every robot's omnidirectional up camera, when the robots carry one (`[up_camera]`, an
+    /// omni camera file's keys, `configs/vision/omni.toml`; none by default): with vision
+    /// percepts, the simulator renders its image too and the robots' vision finds the ball
+    /// all around in it (ISocRob seed `003` §2.2, §3.2.1).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub up_camera: Option<mrt_perception::camera::OmniFile>,
     /// What the cameras draw.
     pub render: RenderConfig,
     /// Every robot's camera pan joint and gaze control (a robot file's `[gaze]`; off by
@@ -609,6 +616,9 @@ impl SimConfig {
         }
         self.render.validate()?;
         self.camera.camera().map_err(|e| format!("camera: {e}"))?;
+        if let Some(up) = &self.up_camera {
+            up.camera().map_err(|e| format!("up_camera: {e}"))?;
+        }
         self.check_derived()?;
         self.odometry.mice()?;
         self.robot()?;

@@ -15,6 +15,7 @@ use mrt_core::{normalize_angle, Pose2};
 use mrt_msgs::robot::{GameState, RobotCommand};
 use mrt_msgs::Sonar;
 use mrt_msgs::{CameraFrame, GameInfo, Localization, Odometry};
+use mrt_perception::camera::CameraModel;
 use mrt_robot::base::Base;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
@@ -126,6 +127,39 @@ pub struct Kidnap {
 /// A kidnapped robot is recovered when its position estimate is this close to the truth (m).
 pub const RECOVERED: f64 = 0.3;
 
+/// The robots' cameras when they see through rendered images: the front camera's renderer,
+/// the up camera's when the robots carry one, and each camera's state (its noise stream and
+/// last frame).
+#[derive(Debug)]
+struct Eyes {
+    front: Renderer,
+    up: Option<Renderer>,
+    states: Vec<CameraState>,
+    up_states: Vec<CameraState>,
+}
+
+impl Eyes {
+    fn new(cfg: &SimConfig, robots: usize, seed: u64) -> Result<Eyes, String> {
+        let stream = |i: u64, salt: u64| {
+            CameraState::new(seed.wrapping_mul(0x2545_F491_4F6C_DD1D) ^ i ^ salt)
+        };
+        let up = match &cfg.up_camera {
+            Some(f) => Some(Renderer::with_camera(cfg, CameraModel::Omni(f.camera()?))?),
+            None => None,
+        };
+        let up_states = match up {
+            Some(_) => (0..robots as u64).map(|i| stream(i, 0x7570_0000)).collect(),
+            None => Vec::new(),
+        };
+        Ok(Eyes {
+            front: Renderer::new(cfg)?,
+            up,
+            states: (0..robots as u64).map(|i| stream(i, 0)).collect(),
+            up_states,
+        })
+    }
+}
+
 /// The physical side of a match, whatever drives the robots: the world, the referee, the
 /// robots' eyes with their random streams, and the book (statistics, hash, calls, frames).
 pub struct Pitch {
@@ -147,7 +181,7 @@ pub struct Pitch {
     /// Kicks asked this cycle, fired when the physics runs.
     kicks: Vec<usize>,
     /// The cameras' renderer and each robot's camera state, when percepts come from vision.
-    eyes: Option<(Renderer, Vec<CameraState>)>,
+    eyes: Option<Eyes>,
     /// Each robot's camera pan joint, rad (the camera file's pan until a robot turns it).
     pans: Vec<f64>,
     /// Kidnaps still to come: `(simulated time, robot)`, latest first; and their random
@@ -212,12 +246,7 @@ impl Pitch {
             kicks: Vec::new(),
             eyes: match cfg.sensor.percepts {
                 PerceptSource::Oracle => None,
-                PerceptSource::Vision => Some((
-                    Renderer::new(cfg)?,
-                    (0..robots as u64)
-                        .map(|i| CameraState::new(seed.wrapping_mul(0x2545_F491_4F6C_DD1D) ^ i))
-                        .collect(),
-                )),
+                PerceptSource::Vision => Some(Eyes::new(cfg, robots, seed)?),
             },
             pans: vec![cfg.camera.camera().map_or(0.0, |c| c.pan); robots],
             kidnap_plan,
@@ -313,7 +342,7 @@ impl Pitch {
     /// sightings (oracle percepts).
     pub fn camera(&mut self, i: usize) -> CameraFrame {
         let pan = self.pans.get(i).copied().unwrap_or(0.0);
-        let Some((renderer, states)) = &mut self.eyes else {
+        let Some(eyes) = &mut self.eyes else {
             let frame = sensor::look(&self.world, i, pan, &self.cfg.sensor, &mut self.rngs[i]);
             return CameraFrame { pan: Some(pan), ..frame };
         };
@@ -327,12 +356,16 @@ impl Pitch {
                 .collect(),
         };
         let viewer = self.world.robot(i).unwrap_or_default();
-        let image = match states.get_mut(i) {
-            Some(state) => renderer.render(&scene, viewer, pan, Some(i), state),
-            None => return CameraFrame { time: self.world.time(), ..Default::default() },
-        };
         let time = self.world.time();
-        CameraFrame { time, image: Some(image), pan: Some(pan), ..Default::default() }
+        let Some(state) = eyes.states.get_mut(i) else {
+            return CameraFrame { time, ..Default::default() };
+        };
+        let image = eyes.front.render(&scene, viewer, pan, Some(i), state);
+        let up_image = match (&eyes.up, eyes.up_states.get_mut(i)) {
+            (Some(up), Some(state)) => Some(up.render(&scene, viewer, 0.0, Some(i), state)),
+            _ => None,
+        };
+        CameraFrame { time, image: Some(image), pan: Some(pan), up_image, ..Default::default() }
     }
 
     /// Robot `i`'s camera pan joint now, rad.

@@ -267,3 +267,32 @@ fn a_chaser_plays_through_vision_and_roughly_knows_where_it_is() {
     );
     assert!(median < 1.0, "pose error median {median:.3} m");
 }
+
+/// Robots that carry ISocRob's up camera too (`[up_camera]` in a simulator file): the
+/// simulator renders both images each cycle and the robots' vision reads both; a match plays
+/// through them without a fault, and a robot knows where the ball is more often than with
+/// the front camera alone (the up camera sees it all around).
+#[test]
+fn robots_with_an_up_camera_see_the_ball_more_often() {
+    let text = "[rules]\nhalf_duration = 20.0\nteam_size = 1\n\n[up_camera]\nmodel = \"omni\"\n\
+                width = 480\nheight = 480\ncx = 240.0\ncy = 240.0\nscale_px_per_m = 50.0\n";
+    let with_up = SimConfig::from_toml(text, "up.toml").unwrap();
+    assert!(with_up.up_camera.is_some());
+    assert_eq!(SimConfig::from_toml(&with_up.to_toml().unwrap(), "again.toml").unwrap(), with_up);
+    let mut front_only = with_up.clone();
+    front_only.up_camera = None;
+    let seen = |cfg: &SimConfig| {
+        let m = BusMatch::with_brains(
+            cfg,
+            3,
+            vec![Box::new(Chaser { keeper: false })],
+            vec![Box::new(Chaser { keeper: true })],
+        )
+        .unwrap();
+        let report = m.play_until(40.0, |_| {}).unwrap();
+        assert!(report.faults.is_empty(), "{:?}", report.faults);
+        report.localization.ball.len()
+    };
+    let (up, front) = (seen(&with_up), seen(&front_only));
+    assert!(up > front, "frames with the ball seen: {up} with the up camera, {front} without");
+}

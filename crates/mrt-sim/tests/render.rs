@@ -474,3 +474,40 @@ fn the_up_camera_sees_the_ball_all_around() {
     let floor = image.pixel(140, 240).unwrap();
     assert!(floor == palette::CARPET || floor == palette::LINE, "{floor:?}");
 }
+
+/// The µAgent's front and up modes multiplexed (seed `003` §3.2.1): with the ball behind the
+/// robot the front camera sees no ball, and the up camera's image gives it, within 5 % of its
+/// distance and 1.5° of its bearing; in front, the front camera's ball is kept.
+#[test]
+fn the_up_camera_gives_the_ball_the_front_camera_cannot_see() {
+    use mrt_perception::camera::{CameraModel, OmniFile};
+    use mrt_perception::vision::agent::VisionAgent;
+    use mrt_perception::vision::colors::ColorTable;
+    let cfg = SimConfig { up_camera: Some(OmniFile::default()), ..Default::default() };
+    cfg.validate().unwrap();
+    let front = Renderer::new(&cfg).unwrap();
+    let omni = OmniFile::default().camera().unwrap();
+    let up = Renderer::with_camera(&cfg, CameraModel::Omni(omni)).unwrap();
+    let mut agent =
+        VisionAgent::new(*front.pinhole().unwrap(), &ColorTable::shipped(), cfg.ball.radius)
+            .up_camera(omni);
+    let viewer = Pose2::new(1.0, -1.0, 0.3);
+    for (d, bearing) in [(2.5f64, 2.8f64), (1.8, 0.0)] {
+        let (s, c) = (viewer.theta + bearing).sin_cos();
+        let scene = Scene { ball: Some((viewer.x + d * c, viewer.y + d * s)), robots: vec![] };
+        let a = front.render(&scene, viewer, 0.0, None, &mut CameraState::default());
+        let b = up.render(&scene, viewer, 0.0, None, &mut CameraState::default());
+        assert!(agent.see(&a, 0.0, 0.0).unwrap().sightings[0].is_some() == (bearing == 0.0));
+        let p = agent.see_with_up(&a, Some(&b), 0.0, 0.0).unwrap();
+        let ball = p.sightings[0].unwrap_or_else(|| panic!("the ball at {bearing} rad"));
+        assert!((ball.distance - d).abs() < 0.05 * d, "{ball:?}");
+        let off = (ball.bearing - bearing + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU)
+            - std::f64::consts::PI;
+        assert!(off.abs() < 1.5f64.to_radians(), "{ball:?}");
+        assert!(p.sigmas[0].is_some() && p.pixels[0] > 0);
+    }
+    // An up image of the wrong size is refused, not misread.
+    let small = mrt_msgs::Image::new(10, 10);
+    let a = front.render(&Scene::default(), viewer, 0.0, None, &mut CameraState::default());
+    assert!(agent.see_with_up(&a, Some(&small), 0.0, 0.0).is_err());
+}

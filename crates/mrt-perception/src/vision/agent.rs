@@ -16,7 +16,8 @@ use super::colors::{ColorClass, ColorTable, Lut};
 use super::goals::{find_goal, goal_columns, open_space, GoalPercept};
 use super::lines::line_points;
 use super::posts::{find_posts_in, PostPercept, PostShape};
-use crate::camera::{Camera, Pinhole, Pixel};
+use super::up::find_ball_up;
+use crate::camera::{Camera, Omni, Pinhole, Pixel};
 use mrt_msgs::{Image, Percepts, PostSighting, Sighting};
 use nalgebra::{Point2, Vector2};
 
@@ -95,6 +96,8 @@ pub struct VisionAgent {
     posts: PostShape,
     goal_width: f64,
     classes: Vec<u8>,
+    /// The up camera, when the robot has one, and its image's classes.
+    up: Option<(Omni, Vec<u8>)>,
 }
 
 impl VisionAgent {
@@ -109,7 +112,59 @@ impl VisionAgent {
             posts: PostShape::default(),
             goal_width: 2.0,
             classes: Vec::new(),
+            up: None,
         }
+    }
+
+    /// The robot's omnidirectional up camera too (ISocRob seed `003` §2.2): its images give
+    /// the ball all around the robot ([`VisionAgent::see_with_up`]).
+    pub fn up_camera(mut self, omni: Omni) -> VisionAgent {
+        self.up = Some((omni, Vec::new()));
+        self
+    }
+
+    /// The up camera, if the robot has one.
+    pub fn up(&self) -> Option<&Omni> {
+        self.up.as_ref().map(|(omni, _)| omni)
+    }
+
+    /// [`VisionAgent::see`] on the front camera's image, multiplexed with the up camera's
+    /// (seed `003` §3.2.1: the µAgent's front and up modes): when the front camera does not
+    /// see the ball and the up camera does ([`crate::vision::up::find_ball_up`]), the ball is
+    /// the up camera's, with one pixel of the mirror's floor for its error. Without an up
+    /// camera (or image) this is `see`.
+    pub fn see_with_up(
+        &mut self,
+        front: &Image,
+        up: Option<&Image>,
+        time: f64,
+        pan: f64,
+    ) -> Result<Percepts, VisionError> {
+        let mut p = self.see(front, time, pan)?;
+        let (Some(image), Some((omni, classes))) = (up, self.up.as_mut()) else { return Ok(p) };
+        let (w, h) = omni.size();
+        if (image.width, image.height) != (w, h) || !image.is_consistent() {
+            return Err(VisionError::WrongSize {
+                width: image.width,
+                height: image.height,
+                bytes: image.rgb.len(),
+                cam_w: w,
+                cam_h: h,
+            });
+        }
+        if p.sightings[BALL].is_some() {
+            return Ok(p);
+        }
+        classes.resize(w as usize * h as usize, 0);
+        self.lut.classify(&image.rgb, classes);
+        if let Some(ball) = find_ball_up(classes, omni, self.ball_radius) {
+            p.sightings[BALL] = Some(sighting(ball.at));
+            // One pixel of the mirror's floor, across and along the line of sight.
+            let metre_per_px = 1.0 / omni.a.determinant().abs().sqrt().max(1e-9);
+            p.sigmas[BALL] = Some((metre_per_px, metre_per_px / ball.distance.max(0.1)));
+            p.pixels[BALL] = ball.pixels;
+        }
+        Ok(p)
     }
 
     /// The colour of the east goal (the other goal colour is the west's).
