@@ -511,3 +511,36 @@ fn the_up_camera_gives_the_ball_the_front_camera_cannot_see() {
     let a = front.render(&Scene::default(), viewer, 0.0, None, &mut CameraState::default());
     assert!(agent.see_with_up(&a, Some(&small), 0.0, 0.0).is_err());
 }
+
+/// The self mode's input from the up camera: radial scan lines find field-line points all
+/// around the robot, and from the true pose nearly all of them lie on the field's lines.
+#[test]
+fn the_up_camera_finds_field_line_points_all_around() {
+    use mrt_perception::camera::{CameraModel, OmniFile};
+    use mrt_perception::vision::up::line_points_up;
+    let cfg = SimConfig::default();
+    let omni = OmniFile::default().camera().unwrap();
+    let up = Renderer::with_camera(&cfg, CameraModel::Omni(omni)).unwrap();
+    let map = cfg.field.map();
+    let lut = lut();
+    for viewer in
+        [Pose2::new(-6.0, 1.5, 2.6), Pose2::new(1.0, -4.0, 0.4), Pose2::new(0.5, 0.5, -1.0)]
+    {
+        let image = up.render(&Scene::default(), viewer, 0.0, None, &mut CameraState::default());
+        let points = line_points_up(&classes(&lut, &image), &omni, 32, 12);
+        let (s, c) = viewer.theta.sin_cos();
+        let on_a_line = points
+            .iter()
+            .filter(|l| {
+                let p = mrt_core::Point2::new(
+                    viewer.x + c * l.at.x - s * l.at.y,
+                    viewer.y + s * l.at.x + c * l.at.y,
+                );
+                (p.coords.norm() - map.centre_circle_radius).abs() < 0.1
+                    || map.lines().iter().any(|seg| seg.distance(p) < 0.1)
+            })
+            .count();
+        assert!(points.len() >= 8, "{viewer:?}: {} points", points.len());
+        assert!(on_a_line * 10 >= points.len() * 9, "{viewer:?}: {on_a_line} of {}", points.len());
+    }
+}

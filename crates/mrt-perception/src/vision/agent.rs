@@ -16,7 +16,7 @@ use super::colors::{ColorClass, ColorTable, Lut};
 use super::goals::{find_goal, goal_columns, open_space, GoalPercept};
 use super::lines::line_points;
 use super::posts::{find_posts_in, PostPercept, PostShape};
-use super::up::find_ball_up;
+use super::up::{find_ball_up, line_points_up};
 use crate::camera::{Camera, Omni, Pinhole, Pixel};
 use mrt_msgs::{Image, Percepts, PostSighting, Sighting};
 use nalgebra::{Point2, Vector2};
@@ -38,6 +38,11 @@ pub const SAME_ROBOT: f64 = 0.4;
 pub const LINE_STEP: usize = 8;
 /// The longest white run that is a line, pixels.
 pub const LINE_MAX_RUN: usize = 24;
+/// The up camera's radial scan lines for field-line points (every 11.25°).
+pub const UP_RAYS: usize = 32;
+/// The longest white run along a radial scan line of the up camera that is a line, pixels (a
+/// 10 cm line crossed at a slant, at 50 px/m).
+pub const UP_LINE_MAX_RUN: usize = 12;
 
 /// Why an image was not processed.
 #[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
@@ -129,10 +134,11 @@ impl VisionAgent {
     }
 
     /// [`VisionAgent::see`] on the front camera's image, multiplexed with the up camera's
-    /// (seed `003` §3.2.1: the µAgent's front and up modes): when the front camera does not
-    /// see the ball and the up camera does ([`crate::vision::up::find_ball_up`]), the ball is
-    /// the up camera's, with one pixel of the mirror's floor for its error. Without an up
-    /// camera (or image) this is `see`.
+    /// (seed `003` §3.2.1: the µAgent's front, up and self modes): the up camera's field-line
+    /// points all around join the front camera's ([`crate::vision::up::line_points_up`]), and
+    /// when the front camera does not see the ball and the up camera does
+    /// ([`crate::vision::up::find_ball_up`]), the ball is the up camera's, with one pixel of
+    /// the mirror's floor for its error. Without an up camera (or image) this is `see`.
     pub fn see_with_up(
         &mut self,
         front: &Image,
@@ -152,11 +158,14 @@ impl VisionAgent {
                 cam_h: h,
             });
         }
+        classes.resize(w as usize * h as usize, 0);
+        self.lut.classify(&image.rgb, classes);
+        // The self mode's input: the field lines all around.
+        let around = line_points_up(classes, omni, UP_RAYS, UP_LINE_MAX_RUN);
+        p.line_points.extend(around.into_iter().map(|l| (l.at.x, l.at.y)));
         if p.sightings[BALL].is_some() {
             return Ok(p);
         }
-        classes.resize(w as usize * h as usize, 0);
-        self.lut.classify(&image.rgb, classes);
         if let Some(ball) = find_ball_up(classes, omni, self.ball_radius) {
             p.sightings[BALL] = Some(sighting(ball.at));
             // One pixel of the mirror's floor, across and along the line of sight.

@@ -163,6 +163,82 @@ pub fn find_ball_up(classes: &[u8], omni: &Omni, radius: f64) -> Option<BallPerc
     None
 }
 
+/// The field-line points an omnidirectional camera's class map shows (the µAgent's "self"
+/// mode, seed `003` §3.2.1; research notes §7 step 1): `rays` radial scan lines from the
+/// robot's blind disc out to the mirror's reach, evenly spread round the robot, each looking
+/// (like [`super::lines::line_points`] in a front image) for runs of at most `max_run` line
+/// pixels between carpet; each run's middle is a floor point, robot frame, through the
+/// mirror's affine map (exact for the floor).
+pub fn line_points_up(
+    classes: &[u8],
+    omni: &Omni,
+    rays: usize,
+    max_run: usize,
+) -> Vec<super::lines::LinePoint> {
+    let (w, h) = omni.size();
+    let (w, h) = (w as usize, h as usize);
+    if classes.len() < w.saturating_mul(h) || !omni.range.is_finite() {
+        return Vec::new();
+    }
+    let (line, field) = (ColorClass::Line as u8, ColorClass::Field as u8);
+    let mut out = Vec::new();
+    for k in 0..rays {
+        let a = std::f64::consts::TAU * k as f64 / rays.max(1) as f64;
+        let (s, c) = a.sin_cos();
+        // The ray's pixels, one pixel apart, from the blind disc to the reach.
+        let (Some(near), Some(far)) = (
+            omni.project(Point3::new(omni.blind * c, omni.blind * s, 0.0)),
+            omni.project(Point3::new(omni.range * c, omni.range * s, 0.0)),
+        ) else {
+            continue;
+        };
+        let steps = (far - near).norm().ceil() as usize;
+        let step = (far - near) / steps.max(1) as f64;
+        let mut after_field = false;
+        let mut run: Option<(Pixel, usize)> = None;
+        let mut last = None;
+        for i in 0..=steps {
+            let p = near + step * i as f64;
+            let (x, y) = (p.x.floor(), p.y.floor());
+            if x < 0.0 || y < 0.0 || x >= w as f64 || y >= h as f64 {
+                break;
+            }
+            let cell = (x as usize, y as usize);
+            if last == Some(cell) {
+                continue;
+            }
+            last = Some(cell);
+            match classes[cell.1 * w + cell.0] {
+                c if c == line => {
+                    if after_field && run.is_none() {
+                        run = Some((Pixel::new(x + 0.5, y + 0.5), 0));
+                    }
+                    if let Some((_, n)) = run.as_mut() {
+                        *n += 1;
+                    }
+                }
+                c if c == field => {
+                    if let Some((start, n)) = run.take() {
+                        let end = Pixel::new(x + 0.5, y + 0.5) - step;
+                        let middle = Pixel::from((start.coords + end.coords) / 2.0);
+                        if n <= max_run {
+                            if let Some(at) = omni.floor_of(middle) {
+                                out.push(super::lines::LinePoint { pixel: middle, at });
+                            }
+                        }
+                    }
+                    after_field = true;
+                }
+                _ => {
+                    after_field = false;
+                    run = None;
+                }
+            }
+        }
+    }
+    out
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
