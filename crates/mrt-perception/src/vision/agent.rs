@@ -105,6 +105,20 @@ pub struct VisionAgent {
     up: Option<(Omni, Vec<u8>)>,
 }
 
+/// Refuses an image that is not `(cam_w, cam_h)` or whose buffer does not hold its pixels.
+fn check_size(image: &Image, (cam_w, cam_h): (u32, u32)) -> Result<(), VisionError> {
+    if (image.width, image.height) == (cam_w, cam_h) && image.is_consistent() {
+        return Ok(());
+    }
+    Err(VisionError::WrongSize {
+        width: image.width,
+        height: image.height,
+        bytes: image.rgb.len(),
+        cam_w,
+        cam_h,
+    })
+}
+
 impl VisionAgent {
     /// The µAgent of `camera` with the colour classes of `colors`, for a ball of `ball_radius`
     /// (m).
@@ -149,15 +163,7 @@ impl VisionAgent {
         let mut p = self.see(front, time, pan)?;
         let (Some(image), Some((omni, classes))) = (up, self.up.as_mut()) else { return Ok(p) };
         let (w, h) = omni.size();
-        if (image.width, image.height) != (w, h) || !image.is_consistent() {
-            return Err(VisionError::WrongSize {
-                width: image.width,
-                height: image.height,
-                bytes: image.rgb.len(),
-                cam_w: w,
-                cam_h: h,
-            });
-        }
+        check_size(image, (w, h))?;
         classes.resize(w as usize * h as usize, 0);
         self.lut.classify(&image.rgb, classes);
         // The self mode's input: the field lines all around.
@@ -241,15 +247,7 @@ impl VisionAgent {
         pan: f64,
     ) -> Result<(Percepts, Option<BallPercept>, Vec<PostPercept>), VisionError> {
         let (w, h) = self.camera.size();
-        if (image.width, image.height) != (w, h) || !image.is_consistent() {
-            return Err(VisionError::WrongSize {
-                width: image.width,
-                height: image.height,
-                bytes: image.rgb.len(),
-                cam_w: w,
-                cam_h: h,
-            });
-        }
+        check_size(image, (w, h))?;
         self.camera.pan = pan;
         self.classes.resize(w as usize * h as usize, 0);
         self.lut.classify(&image.rgb, &mut self.classes);
