@@ -12,7 +12,7 @@
 //! The goal colour breaks the tie ([`HoughPose::facing`]: which goal the robot sees where),
 //! or the pose the robot believed ([`nearest`]).
 //!
-//! Design choices (the research notes' [DES] tags): 1° × 5 cm cells; after a line is taken,
+//! Design choices (the research notes' \[DES\] tags): 1° × 5 cm cells; after a line is taken,
 //! its points leave the vote, so a second line is not the first one's neighbour cell; a line
 //! needs [`HoughParams::min_votes`] points; a point is on a line within
 //! [`HoughParams::tolerance`].
