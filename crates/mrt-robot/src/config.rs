@@ -71,8 +71,14 @@ impl RobotConfig {
     /// The robot's world model as it starts: its field map, its mice, its camera's noise, the
     /// pose unknown until it is put down.
     pub fn world_model(&self) -> WorldModel {
-        WorldModel::new(self.field, self.mice, self.camera.distance, self.camera.bearing)
-            .with_localizer(self.localizer)
+        let model =
+            WorldModel::new(self.field, self.mice, self.camera.distance, self.camera.bearing)
+                .with_localizer(self.localizer);
+        // A robot with the up camera sees the field lines all around: ISocRob's self mode.
+        match self.vision.as_ref().and_then(|v| v.up_camera) {
+            Some(_) => model.with_self_mode(),
+            None => model,
+        }
     }
 
     /// The control period as a `Duration` (a non-finite or negative period is 0).

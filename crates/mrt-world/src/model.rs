@@ -147,6 +147,15 @@ impl WorldModel {
         self
     }
 
+    /// The same model with its relocalizer in ISocRob's self mode (a robot whose up camera
+    /// sees the field lines all around; [`Relocalizer::with_self_mode`]). Without MUREA as
+    /// the localizer this changes nothing.
+    pub fn with_self_mode(mut self) -> Self {
+        let map = self.map;
+        self.relocalizer = self.relocalizer.map(|r| Box::new(r.with_self_mode(&map)));
+        self
+    }
+
     /// The same model for a ball whose rolling friction damps its velocity by `damping` (1/s).
     pub fn with_ball_damping(mut self, damping: f64) -> Self {
         self.ball_track = Track::new(damping, BALL_ACCEL);
@@ -448,6 +457,9 @@ impl WorldModel {
     /// whose ball velocity is estimated here from the ball's successive places on the field.
     /// Call after this cycle's [`WorldModel::odometry`].
     pub fn percepts(&mut self, p: &Percepts) -> WorldSnapshot {
+        if let Some(r) = &mut self.relocalizer {
+            r.lines(&p.line_points);
+        }
         // The relocalizer takes the posts by their pattern: naming them rests on the pose.
         let perceived = self.relocalizer.as_ref().map(|_| {
             let noise = self.noise;

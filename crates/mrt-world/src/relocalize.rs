@@ -33,6 +33,14 @@
 //!    the coarse search found no other pose far from it that explains nearly as much (on a
 //!    symmetric field, the mirrored pose).
 //!
+//! 4. In ISocRob's **self mode** ([`Relocalizer::with_self_mode`], for a robot whose up
+//!    camera sees the field lines all around it, seed `003` §3.2.1), a frame with
+//!    [`SELF_POINTS`] line points or more is searched even without two goals or posts: the
+//!    Hough transform of its lines ([`crate::hough`]) gives the pose up to the field's
+//!    half-turn symmetry, MUREA refines both twins on the window, and the fix is taken, on
+//!    the same terms as above, when one of them explains [`MARGIN`] more than the other (a
+//!    single goal or post in the window tells them apart).
+//!
 //! A robot carried elsewhere (the kidnapped robot of every RoboCup match) or one whose
 //! tracker locked onto the wrong landmark is found again this way; a robot started anywhere
 //! needs no placement.
@@ -40,6 +48,7 @@
 //! [`WorldModel`]: crate::model::WorldModel
 
 use crate::field::FieldMap;
+use crate::hough::{hough_lines, self_localize, HoughParams};
 use crate::murea::{Fix, Kind, Map, Murea, Perception};
 use mrt_core::{normalize_angle, Point2, Pose2};
 use mrt_msgs::{PostSighting, Sighting, FIELD_OBJECTS};
@@ -112,6 +121,8 @@ pub const WINDOW_PERCEPTIONS: usize = 24;
 pub const SAME_OBJECT: f64 = 0.5;
 /// The goals and posts of the window must weigh this much together for a search.
 pub const MARKS: f64 = 1.5;
+/// The self mode searches without such marks when a frame has this many field-line points.
+pub const SELF_POINTS: usize = 24;
 /// At most this many line points of one frame become perceptions (evenly picked).
 pub const LINE_POINTS: usize = 12;
 /// Weight of one line point (a line point says less than a goal: it fits any point of any
@@ -214,6 +225,9 @@ pub struct Relocalizer {
     driven: (f64, f64),
     last_search: Option<f64>,
     counts: RelocalizerCounts,
+    /// The self mode (module doc, 4.): the field, and this frame's field-line points (robot
+    /// frame), when on.
+    self_mode: Option<(FieldMap, Vec<Point2>)>,
 }
 
 impl Relocalizer {
@@ -235,6 +249,28 @@ impl Relocalizer {
             driven: (0.0, 0.0),
             last_search: None,
             counts: RelocalizerCounts::default(),
+            self_mode: None,
+        }
+    }
+
+    /// The same relocalizer in ISocRob's self mode too (module doc, 4.; seed `003` §3.2.1):
+    /// for a robot whose camera sees the field lines all around (the up camera).
+    pub fn with_self_mode(mut self, field: &FieldMap) -> Relocalizer {
+        self.self_mode = Some((*field, Vec::new()));
+        self
+    }
+
+    /// Whether it runs the self mode.
+    pub fn self_mode(&self) -> bool {
+        self.self_mode.is_some()
+    }
+
+    /// This frame's field-line points (robot frame, m), for the self mode; call before
+    /// [`Relocalizer::frame`].
+    pub fn lines(&mut self, points: &[(f64, f64)]) {
+        if let Some((_, lines)) = &mut self.self_mode {
+            lines.clear();
+            lines.extend(points.iter().map(|&(x, y)| Point2::new(x, y)));
         }
     }
 
@@ -353,7 +389,9 @@ impl Relocalizer {
         // almost anywhere, and one object puts the robot anywhere on a circle round it.
         let marks: Vec<Perception> =
             window.iter().filter(|p| p.kind != Kind::LINE).copied().collect();
-        if marks.len() < 2 || marks.iter().map(|p| p.weight).sum::<f64>() < MARKS {
+        let enough_marks = marks.len() >= 2 && marks.iter().map(|p| p.weight).sum::<f64>() >= MARKS;
+        let lines_around = self.self_mode.as_ref().is_some_and(|(_, l)| l.len() >= SELF_POINTS);
+        if !enough_marks && !lines_around {
             return None;
         }
         let tracked = self.murea.quality_at(pose, &window);
@@ -362,6 +400,9 @@ impl Relocalizer {
         }
         self.last_search = Some(now);
         self.counts.searches += 1;
+        if !enough_marks {
+            return self.self_search(&window, pose, tracked);
+        }
         // Globally on the goals and posts (the lines would keep every cell's bound high), then
         // around that pose with everything.
         let global = self.coarse.localize(&marks, self.coarse.whole_field());
@@ -376,6 +417,40 @@ impl Relocalizer {
         let apart = (fix.pose.x - pose.x).hypot(fix.pose.y - pose.y) > 0.3
             || normalize_angle(fix.pose.theta - pose.theta).abs() > 0.2;
         if fix.timed_out || fix.quality < ACCEPT || fix.quality < tracked + MARGIN || !apart {
+            return None;
+        }
+        self.counts.accepted += 1;
+        Some(fix)
+    }
+
+    /// The self mode's search (module doc, 4.): this frame's field lines through the Hough
+    /// transform give a pose up to the field's half-turn symmetry; each of the two is refined
+    /// on the window, whose goals or posts (one is enough) tell them apart.
+    fn self_search(&mut self, window: &[Perception], pose: Pose2, tracked: f64) -> Option<Fix> {
+        let (field, points) = self.self_mode.as_ref()?;
+        let params = HoughParams::default();
+        let lines = hough_lines(points, &params);
+        let candidates = self_localize(field, points, &lines, &params);
+        let best = candidates.first()?.explained;
+        if best * 10 < points.len() * 8 {
+            return None;
+        }
+        let mut fixes: Vec<Fix> = candidates
+            .iter()
+            .take_while(|c| c.explained == best)
+            .take(2)
+            .map(|c| self.murea.localize(window, Murea::around(c.pose, 0.4, 0.15)))
+            .filter(|f| !f.timed_out)
+            .collect();
+        fixes.sort_by(|a, b| b.quality.total_cmp(&a.quality));
+        let fix = fixes.first()?.clone();
+        if fixes.get(1).is_some_and(|twin| twin.quality > fix.quality - MARGIN) {
+            self.counts.ambiguous += 1;
+            return None;
+        }
+        let apart = (fix.pose.x - pose.x).hypot(fix.pose.y - pose.y) > 0.3
+            || normalize_angle(fix.pose.theta - pose.theta).abs() > 0.2;
+        if fix.quality < ACCEPT || fix.quality < tracked + MARGIN || !apart {
             return None;
         }
         self.counts.accepted += 1;
@@ -439,6 +514,62 @@ mod tests {
         let lines = p.iter().filter(|q| q.kind == Kind::LINE).count();
         assert!((LINE_POINTS - 2..=LINE_POINTS).contains(&lines), "{lines}");
         assert!(p.iter().filter(|q| q.kind == Kind::LINE).all(|q| q.weight == LINE_WEIGHT));
+    }
+
+    /// The field-line points within 4 m of `pose`, every 10 cm, robot frame (an up camera's
+    /// view, less its noise).
+    fn lines_around(pose: Pose2) -> Vec<(f64, f64)> {
+        let mut out = Vec::new();
+        for seg in field().lines() {
+            let n = (seg.length() / 0.1) as usize;
+            for k in 0..=n {
+                let p = seg.a + (seg.b - seg.a) * (k as f64 / n as f64);
+                let q = pose.inverse_transform_point(p);
+                if q.coords.norm() <= 4.0 {
+                    out.push((q.x, q.y));
+                }
+            }
+        }
+        out
+    }
+
+    /// Seed `003` §3.2.1's self mode: a robot carried to a place where it sees one net only
+    /// (no search: two goals or posts are needed) is found again from the field lines all
+    /// around it, the net telling the half-turn twins apart; without the self mode it is not.
+    #[test]
+    fn the_self_mode_finds_a_carried_robot_from_the_lines_and_one_net() {
+        let f = field();
+        let truth = Pose2::new(-6.0, 1.5, 2.6);
+        let wrong = Pose2::new(2.0, -2.0, 0.5);
+        let mut seen = [None; FIELD_OBJECTS];
+        seen[WEST_NET] = seen_from(truth)[WEST_NET];
+        assert!(seen[WEST_NET].is_some());
+        let lines = lines_around(truth);
+        assert!(lines.len() >= SELF_POINTS);
+        for self_mode in [false, true] {
+            let mut r = Relocalizer::new(&f);
+            if self_mode {
+                r = r.with_self_mode(&f);
+            }
+            let mut fix = None;
+            for k in 0..20 {
+                r.lines(&lines);
+                let p = perceptions(&f, NOISE, &seen, &[None; FIELD_OBJECTS], &[], &lines);
+                if let Some(found) = r.frame(0.1 * f64::from(k), p, wrong) {
+                    fix = Some(found);
+                    break;
+                }
+            }
+            match (self_mode, fix) {
+                (false, fix) => assert!(fix.is_none(), "{fix:?}"),
+                (true, Some(fix)) => {
+                    let err = (fix.pose.x - truth.x).hypot(fix.pose.y - truth.y);
+                    let turn = normalize_angle(fix.pose.theta - truth.theta).abs();
+                    assert!(err < 0.2 && turn < 0.05, "{fix:?}");
+                }
+                (true, None) => panic!("not found: {:?}", r.counts()),
+            }
+        }
     }
 
     #[test]
