@@ -9,12 +9,12 @@
 use anyhow::{anyhow, bail, Context as _, Result};
 use image::{Rgb, RgbImage};
 use mrt_msgs::Image;
-use mrt_perception::camera::{Camera, CameraFile, CameraModel, Omni};
+use mrt_perception::camera::{Camera, CameraFile, CameraModel};
 use mrt_perception::source::{load_image, ImageSequence, ImageSource};
 use mrt_perception::vision::agent::VisionAgent;
 use mrt_perception::vision::blobs::BallPercept;
 use mrt_perception::vision::colors::{ColorClass, ColorTable, Lut};
-use mrt_perception::vision::up::find_ball_up;
+use mrt_perception::vision::up::UpMode;
 use std::io::Write as _;
 use std::path::{Path, PathBuf};
 
@@ -90,7 +90,7 @@ pub fn detect(args: &DetectArgs) -> Result<()> {
     let mut detector = match camera {
         CameraModel::Pinhole(c) => Detector::Front(VisionAgent::new(c, &colors, args.ball_radius)),
         CameraModel::Omni(omni) => {
-            Detector::Up { omni, lut: Lut::new(&colors), radius: args.ball_radius, classes: vec![] }
+            Detector::Up { up: UpMode::new(omni), lut: Lut::new(&colors), radius: args.ball_radius }
         }
     };
     let stdout = std::io::stdout();
@@ -132,7 +132,7 @@ fn open_device(device: &Path, _: (u32, u32)) -> Result<Box<dyn ImageSource>> {
 /// the up mode's ball finder on an omnidirectional camera's image (seed `003` §3.2.1).
 enum Detector {
     Front(VisionAgent),
-    Up { omni: Omni, lut: Lut, radius: f64, classes: Vec<u8> },
+    Up { up: UpMode, lut: Lut, radius: f64 },
 }
 
 fn detect_one(
@@ -144,7 +144,7 @@ fn detect_one(
     let (w, h) = (img.width, img.height);
     let camera = match detector {
         Detector::Front(agent) => agent.camera().size(),
-        Detector::Up { omni, .. } => omni.size(),
+        Detector::Up { up, .. } => up.omni().size(),
     };
     if (w, h) != camera {
         bail!("{name}: the image is {w}×{h}, the camera file says {}×{}", camera.0, camera.1);
@@ -184,12 +184,11 @@ fn detect_one(
             }
             (sight.ball, sight.posts, agent.classes())
         }
-        Detector::Up { omni, lut, radius, classes } => {
-            classes.resize((w * h) as usize, 0);
-            lut.classify(&img.rgb, classes);
-            let ball = find_ball_up(classes, omni, *radius);
+        Detector::Up { up, lut, radius } => {
+            up.classify(lut, img).map_err(|e| anyhow!("{name}: {e}"))?;
+            let ball = up.ball(*radius);
             objects.extend(ball.as_ref().map(ball_json));
-            (ball, Vec::new(), &classes[..])
+            (ball, Vec::new(), up.classes())
         }
     };
     if let Some(out) = png {

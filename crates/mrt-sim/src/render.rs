@@ -366,18 +366,23 @@ impl Renderer {
         let w = image.width as usize;
         let turn = |v: [f64; 3]| [c * v[0] - s * v[1], s * v[0] + c * v[1]];
         let wall_height = self.cfg.wall_height;
-        // Paints the pixels `cols` of a row whose rays `r + k·dr` miss the floor inside the
-        // walls.
-        let background = |px: &mut [u8], cols: Range<usize>, r: [f64; 2], dr: [f64; 2], rz| {
+        // Paints the pixels `parts` of a row whose rays `r + k·dr` miss the floor inside the
+        // walls (where the wall's top cuts the row is solved for once a row).
+        let background = |px: &mut [u8], parts: [Range<usize>; 2], r, dr, rz| {
+            if parts.iter().all(Range::is_empty) {
+                return;
+            }
             let (span, wall) = self.floor.walls(eye, r, dr, rz, wall_height);
             let (inner, outer) =
                 if wall { (colours.wall, colours.hall) } else { (colours.hall, colours.wall) };
             let within = pixels(span, px.len() / 3);
-            let mid =
-                within.start.clamp(cols.start, cols.end)..within.end.clamp(cols.start, cols.end);
-            fill(px, cols.start..mid.start, outer);
-            fill(px, mid.clone(), inner);
-            fill(px, mid.end..cols.end, outer);
+            for cols in parts {
+                let mid = within.start.clamp(cols.start, cols.end)
+                    ..within.end.clamp(cols.start, cols.end);
+                fill(px, cols.start..mid.start, outer);
+                fill(px, mid.clone(), inner);
+                fill(px, mid.end..cols.end, outer);
+            }
         };
         match &self.rays {
             Rays::Rows(rows) => {
@@ -402,8 +407,7 @@ impl Renderer {
                     } else {
                         0..0
                     };
-                    background(px, 0..floor.start, r, dr, rz);
-                    background(px, floor.end.max(floor.start)..w, r, dr, rz);
+                    background(px, [0..floor.start, floor.end.max(floor.start)..w], r, dr, rz);
                 }
             }
             Rays::Pixels { rays, floor, texture } => {
@@ -417,7 +421,7 @@ impl Renderer {
                         None => {
                             let d = rays[k].map(f64::from);
                             let mut one = [0u8; 3];
-                            background(&mut one, 0..1, turn(d), [0.0, 0.0], d[2]);
+                            background(&mut one, [0..1, 0..0], turn(d), [0.0, 0.0], d[2]);
                             one
                         }
                     };
@@ -467,8 +471,8 @@ impl Renderer {
                     match omni.project(p) {
                         Some(px) => take(px),
                         None => {
-                            take(Pixel::new(-1e9, -1e9));
-                            take(Pixel::new(1e9, 1e9));
+                            let (w, h) = omni.size();
+                            return self.clip_box((0.0, 0.0), (f64::from(w), f64::from(h)));
                         }
                     }
                 }

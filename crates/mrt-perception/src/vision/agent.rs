@@ -16,7 +16,7 @@ use super::colors::{ColorClass, ColorTable, Lut};
 use super::goals::{find_goal, goal_columns, open_space, GoalPercept};
 use super::lines::line_points;
 use super::posts::{find_posts_in, PostPercept, PostShape};
-use super::up::{find_ball_up, line_points_up};
+use super::up::UpMode;
 use crate::camera::{Camera, Omni, Pinhole, Pixel};
 use mrt_msgs::{Image, Percepts, PostSighting, Sighting};
 use nalgebra::{Point2, Vector2};
@@ -38,11 +38,6 @@ pub const SAME_ROBOT: f64 = 0.4;
 pub const LINE_STEP: usize = 8;
 /// The longest white run that is a line, pixels.
 pub const LINE_MAX_RUN: usize = 24;
-/// The up camera's radial scan lines for field-line points (every 11.25°).
-pub const UP_RAYS: usize = 32;
-/// The longest white run along a radial scan line of the up camera that is a line, pixels (a
-/// 10 cm line crossed at a slant, at 50 px/m).
-pub const UP_LINE_MAX_RUN: usize = 12;
 
 /// Why an image was not processed.
 #[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
@@ -101,12 +96,12 @@ pub struct VisionAgent {
     posts: PostShape,
     goal_width: f64,
     classes: Vec<u8>,
-    /// The up camera, when the robot has one, and its image's classes.
-    up: Option<(Omni, Vec<u8>)>,
+    /// The up camera, when the robot has one.
+    up: Option<UpMode>,
 }
 
 /// Refuses an image that is not `(cam_w, cam_h)` or whose buffer does not hold its pixels.
-fn check_size(image: &Image, (cam_w, cam_h): (u32, u32)) -> Result<(), VisionError> {
+pub(crate) fn check_size(image: &Image, (cam_w, cam_h): (u32, u32)) -> Result<(), VisionError> {
     if (image.width, image.height) == (cam_w, cam_h) && image.is_consistent() {
         return Ok(());
     }
@@ -138,13 +133,13 @@ impl VisionAgent {
     /// The robot's omnidirectional up camera too (ISocRob seed `003` §2.2): its images give
     /// the ball all around the robot ([`VisionAgent::see_with_up`]).
     pub fn up_camera(mut self, omni: Omni) -> VisionAgent {
-        self.up = Some((omni, Vec::new()));
+        self.up = Some(UpMode::new(omni));
         self
     }
 
     /// The up camera, if the robot has one.
     pub fn up(&self) -> Option<&Omni> {
-        self.up.as_ref().map(|(omni, _)| omni)
+        self.up.as_ref().map(UpMode::omni)
     }
 
     /// [`VisionAgent::see`] on the front camera's image, multiplexed with the up camera's
@@ -161,21 +156,17 @@ impl VisionAgent {
         pan: f64,
     ) -> Result<Percepts, VisionError> {
         let mut p = self.see(front, time, pan)?;
-        let (Some(image), Some((omni, classes))) = (up, self.up.as_mut()) else { return Ok(p) };
-        let (w, h) = omni.size();
-        check_size(image, (w, h))?;
-        classes.resize(w as usize * h as usize, 0);
-        self.lut.classify(&image.rgb, classes);
+        let (Some(image), Some(up)) = (up, self.up.as_mut()) else { return Ok(p) };
+        up.classify(&self.lut, image)?;
         // The self mode's input: the field lines all around.
-        let around = line_points_up(classes, omni, UP_RAYS, UP_LINE_MAX_RUN);
-        p.line_points.extend(around.into_iter().map(|l| (l.at.x, l.at.y)));
+        p.line_points.extend(up.lines().into_iter().map(|l| (l.at.x, l.at.y)));
         if p.sightings[BALL].is_some() {
             return Ok(p);
         }
-        if let Some(ball) = find_ball_up(classes, omni, self.ball_radius) {
+        if let Some(ball) = up.ball(self.ball_radius) {
             p.sightings[BALL] = Some(sighting(ball.at));
             // One pixel of the mirror's floor, across and along the line of sight.
-            let metre_per_px = 1.0 / omni.a.determinant().abs().sqrt().max(1e-9);
+            let metre_per_px = 1.0 / up.omni().a.determinant().abs().sqrt().max(1e-9);
             p.sigmas[BALL] = Some((metre_per_px, metre_per_px / ball.distance.max(0.1)));
             p.pixels[BALL] = ball.pixels;
         }

@@ -36,13 +36,67 @@
 //! # Ok::<(), String>(())
 //! ```
 
+use super::agent::{check_size, VisionError};
 use super::blobs::{blobs, BallPercept};
-use super::colors::ColorClass;
+use super::colors::{ColorClass, Lut};
 use crate::camera::{Camera, Omni, Pixel};
+use mrt_msgs::Image;
 use nalgebra::{Point2, Point3, Vector3};
 
 /// Points on a silhouette's outline.
 const OUTLINE: usize = 32;
+
+/// The up camera's radial scan lines for field-line points (every 11.25°).
+pub const UP_RAYS: usize = 32;
+/// The longest white run along a radial scan line of the up camera that is a line, pixels (a
+/// 10 cm line crossed at a slant, at 50 px/m).
+pub const UP_LINE_MAX_RUN: usize = 12;
+
+/// The up mode on one omnidirectional camera: its last image's classes, and the ball and the
+/// field-line points in them. The vision µAgent multiplexes it with its front camera
+/// ([`super::agent::VisionAgent::see_with_up`]); `mrt vision detect` runs it alone.
+#[derive(Clone, Debug)]
+pub struct UpMode {
+    omni: Omni,
+    classes: Vec<u8>,
+}
+
+impl UpMode {
+    /// The up mode of `omni`.
+    pub fn new(omni: Omni) -> UpMode {
+        UpMode { omni, classes: Vec::new() }
+    }
+
+    /// Its camera.
+    pub fn omni(&self) -> &Omni {
+        &self.omni
+    }
+
+    /// The class of every pixel of the last image (`ColorClass as u8`, row after row).
+    pub fn classes(&self) -> &[u8] {
+        &self.classes
+    }
+
+    /// Classifies an image of its camera through `lut`; an image of another size (or whose
+    /// buffer does not hold its pixels) is refused.
+    pub fn classify(&mut self, lut: &Lut, image: &Image) -> Result<(), VisionError> {
+        let (w, h) = self.omni.size();
+        check_size(image, (w, h))?;
+        self.classes.resize(w as usize * h as usize, 0);
+        lut.classify(&image.rgb, &mut self.classes);
+        Ok(())
+    }
+
+    /// The ball of `radius` (m) in the last image ([`find_ball_up`]).
+    pub fn ball(&self, radius: f64) -> Option<BallPercept> {
+        find_ball_up(&self.classes, &self.omni, radius)
+    }
+
+    /// The field-line points of the last image ([`line_points_up`], [`UP_RAYS`] scan lines).
+    pub fn lines(&self) -> Vec<super::lines::LinePoint> {
+        line_points_up(&self.classes, &self.omni, UP_RAYS, UP_LINE_MAX_RUN)
+    }
+}
 
 /// The outline (pixels) of a ball of `radius` standing on the floor at `at` (robot frame) as
 /// the mirror images it: the circle along which lines from the viewpoint touch the sphere,
