@@ -13,6 +13,11 @@ use serde::{de::DeserializeOwned, Serialize};
 /// [`RESERVED_TYPES_START`] up are reserved for MRT's own standard messages, listed in one
 /// table (`mrt_msgs::ids`).
 ///
+/// A message must decode to what it encoded (postcard): it is encoded when it leaves the
+/// process, and a small one of plain data is also copied encoded into each subscriber's
+/// mailbox slot inside the process (`mrt-dcdt`'s `PMQ`). A field skipped by serde is lost on
+/// both ways.
+///
 /// ```
 /// use mrt_core::{Message, MsgType};
 /// use serde::{Deserialize, Serialize};

@@ -247,6 +247,43 @@ fn throughput(c: &mut Criterion) {
         for t in threads {
             t.join().unwrap();
         }
+        // Second baseline: the same channels carrying what a bus must pass, one shared,
+        // reference-counted message per publish (`Arc`), as DCDT shares a message among its
+        // subscribers.
+        let seen: Vec<Arc<AtomicU64>> = (0..fanout).map(|_| Arc::new(AtomicU64::new(0))).collect();
+        let mut senders = Vec::new();
+        let mut threads = Vec::new();
+        for s in &seen {
+            let (tx, rx) = unbounded::<Arc<Sample>>();
+            senders.push(tx);
+            let s = s.clone();
+            threads.push(std::thread::spawn(move || {
+                while let Ok(m) = rx.recv() {
+                    s.store(m.seq, Ordering::Release);
+                }
+            }));
+        }
+        let mut next = 1u64;
+        g.bench_function(BenchmarkId::new("crossbeam", "shared"), |b| {
+            b.iter_custom(|iters| {
+                let start = Instant::now();
+                for _ in 0..iters {
+                    for _ in 0..BATCH {
+                        let m = Arc::new(Sample { seq: next, value: 0.5 });
+                        for tx in &senders {
+                            tx.send(m.clone()).unwrap();
+                        }
+                        next += 1;
+                    }
+                    wait_all(&seen, next - 1);
+                }
+                start.elapsed()
+            })
+        });
+        drop(senders);
+        for t in threads {
+            t.join().unwrap();
+        }
         g.finish();
     }
 }

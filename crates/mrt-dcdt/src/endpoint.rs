@@ -7,6 +7,7 @@
 use crate::agora::AgoraShared;
 use crate::error::DcdtError;
 use crate::msg::{DeliveryWarranty, Message, Msg, MsgHeader, MsgRef, RawPayload};
+use crate::parcel::{InlineMsg, Make, Parcel};
 use crate::policy::{MailboxBounds, MailboxRef, RequestType};
 use crate::pool::MsgPool;
 use mrt_core::{AgoraId, MemberId, MsgType, Time};
@@ -174,25 +175,9 @@ impl Endpoint {
         warranty: DeliveryWarranty,
         priority: u8,
     ) -> usize {
-        let mut value = Some(value);
-        let shared = &self.shared;
-        let member = self.member;
-        let pool = &self.pool;
-        self.route(T::TYPE, &mut || {
-            let header = MsgHeader {
-                msg_type: T::TYPE,
-                member_id: member,
-                agora_id: shared.id,
-                priority,
-                warranty,
-                creation_time: shared.clock.now(),
-            };
-            match value.take() {
-                Some(v) => pool.make(header, v),
-                // `make` is called at most once by every route; this arm is never reached.
-                None => Msg::new(header, RawPayload::new(Vec::new())).into_ref(),
-            }
-        })
+        let mut publish =
+            Publish { endpoint: self, value: Some(value), inlined: None, warranty, priority };
+        self.route(T::TYPE, &mut publish)
     }
 
     /// Shares an already built message as it is (its header is kept: a message relayed from
@@ -205,7 +190,7 @@ impl Endpoint {
     }
 
     #[inline]
-    fn route(&self, ty: MsgType, make: &mut dyn FnMut() -> MsgRef) -> usize {
+    fn route(&self, ty: MsgType, make: &mut dyn Make) -> usize {
         let Some(outlet) = self.shared.outlet.for_type(ty) else {
             let n = self.shared.route.share(self.shared.id, ty, make);
             self.shared.post_office.count_shared(n);
@@ -217,8 +202,8 @@ impl Endpoint {
         let n = self
             .shared
             .route
-            .share(self.shared.id, ty, &mut || built.get_or_insert_with(&mut *make).clone());
-        let msg = built.get_or_insert_with(make);
+            .share(self.shared.id, ty, &mut || built.get_or_insert_with(|| make.shared()).clone());
+        let msg = built.get_or_insert_with(|| make.shared());
         outlet.send(msg);
         n
     }
@@ -226,7 +211,7 @@ impl Endpoint {
     /// Takes the next message from this Member's mailbox (`ReceiveMsg`); it also becomes the
     /// current message until the next call or [`remove_curr_msg`](Self::remove_curr_msg).
     pub fn receive_msg(&mut self) -> Option<MsgRef> {
-        self.current = self.shared.post_office.policy.pop(&mut self.mailbox);
+        self.current = self.shared.post_office.policy.pop(&mut self.mailbox, &self.pool);
         self.current.clone()
     }
 
@@ -286,6 +271,65 @@ impl Endpoint {
     /// cycle and `lets_work` returns.
     pub fn shutdown(&self) {
         self.shared.request_shutdown(Some(self.member));
+    }
+}
+
+/// One typed publish: builds the header when somebody subscribed, and gives the value by value
+/// when it can travel so (see `parcel`), else a shared message from the endpoint's pool.
+struct Publish<'a, T> {
+    endpoint: &'a Endpoint,
+    /// The value, until it is built into a message.
+    value: Option<T>,
+    /// The value by value, once built so (several PostOffices may ask for it).
+    inlined: Option<InlineMsg>,
+    warranty: DeliveryWarranty,
+    priority: u8,
+}
+
+impl<T: Message> Publish<'_, T> {
+    fn header(&self) -> MsgHeader {
+        let shared = &self.endpoint.shared;
+        MsgHeader {
+            msg_type: T::TYPE,
+            member_id: self.endpoint.member,
+            agora_id: shared.id,
+            priority: self.priority,
+            warranty: self.warranty,
+            creation_time: shared.clock.now(),
+        }
+    }
+}
+
+impl<T: Message> Make for Publish<'_, T> {
+    #[inline]
+    fn shared(&mut self) -> MsgRef {
+        if let Some(v) = self.value.take() {
+            return self.endpoint.pool.make(self.header(), v);
+        }
+        if let Some(inline) = self.inlined {
+            // A PostOffice that shares after others took the value by value.
+            return Parcel::Inline(inline).open(&self.endpoint.pool);
+        }
+        // Every route builds its message at most once; never reached.
+        Msg::new(self.header(), RawPayload::new(Vec::new())).into_ref()
+    }
+
+    #[inline]
+    fn inline(&mut self) -> Option<InlineMsg> {
+        if !InlineMsg::fits::<T>() || self.inlined.is_some() {
+            return self.inlined;
+        }
+        let header = self.header();
+        match InlineMsg::new(header, self.value.take()?) {
+            Ok(inline) => {
+                self.inlined = Some(inline);
+                self.inlined
+            }
+            Err(value) => {
+                self.value = Some(value);
+                None
+            }
+        }
     }
 }
 

@@ -94,6 +94,7 @@ mod executor;
 mod member;
 mod msg;
 pub mod outlet;
+mod parcel;
 mod policy;
 mod pool;
 mod postoffice;

@@ -4,7 +4,9 @@
 //! in the process reads the same allocation, and it is freed when the last one is done with it.
 //! The payload is either a typed Rust value (a [`Message`]) or raw bytes (what
 //! [`create_msg`](crate::Endpoint::create_msg) builds, and what arrives from another process).
-//! Typed payloads are serialized only when a message leaves the process ([`crate::wire`]).
+//! Typed payloads are serialized when a message leaves the process ([`crate::wire`]) and, under
+//! `PMQ`, when a small one of plain data travels by value in a mailbox slot (`parcel`): its
+//! readers then each get an equal copy instead of the one allocation.
 
 use crate::error::DcdtError;
 use mrt_core::{AgoraId, MemberId, MsgType, Time};

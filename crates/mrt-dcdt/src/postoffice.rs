@@ -3,6 +3,7 @@
 
 use crate::config::PolicyKind;
 use crate::msg::MsgRef;
+use crate::parcel::{InlineMsg, Make};
 use crate::policy::{MailboxBounds, MailboxReport, Policy, RequestType, LOCAL, REMOTE};
 use crate::waker::Waker;
 use arc_swap::ArcSwap;
@@ -160,26 +161,31 @@ impl Route {
     /// Shares a message created in `from` with every matching subscriber; `make` builds it
     /// once, and only if somebody subscribed. Returns the number of mailboxes reached.
     #[inline]
-    pub(crate) fn share(
-        &self,
-        from: AgoraId,
-        ty: MsgType,
-        make: &mut dyn FnMut() -> MsgRef,
-    ) -> usize {
+    pub(crate) fn share(&self, from: AgoraId, ty: MsgType, make: &mut dyn Make) -> usize {
         match self {
             Route::Alone(po) => po.policy.deliver(ty, po.origin(from), make),
             Route::Community(c) => {
                 let list = c.post_offices.load();
-                let mut built: Option<MsgRef> = None;
-                let mut n = 0;
-                for po in list.iter() {
-                    n += po.policy.deliver(ty, po.origin(from), &mut || {
-                        built.get_or_insert_with(&mut *make).clone()
-                    });
-                }
-                n
+                let mut once = BuiltOnce { make, shared: None, inline: None };
+                list.iter().map(|po| po.policy.deliver(ty, po.origin(from), &mut once)).sum()
             }
         }
+    }
+}
+
+/// A message built once for the PostOffices of a community, in whichever form each asks.
+struct BuiltOnce<'a> {
+    make: &'a mut dyn Make,
+    shared: Option<MsgRef>,
+    inline: Option<Option<InlineMsg>>,
+}
+
+impl Make for BuiltOnce<'_> {
+    fn shared(&mut self) -> MsgRef {
+        self.shared.get_or_insert_with(|| self.make.shared()).clone()
+    }
+    fn inline(&mut self) -> Option<InlineMsg> {
+        *self.inline.get_or_insert_with(|| self.make.inline())
     }
 }
 

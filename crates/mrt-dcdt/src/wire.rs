@@ -1,6 +1,7 @@
 //! The wire form of a DCDT message: what crosses a link when a message leaves the process.
 //!
-//! Inside a process messages are shared by reference and never serialized. A link encodes a
+//! Inside a process messages are shared by reference (small plain ones copied into the
+//! mailbox slots, see `parcel`). A link encodes a
 //! message as one frame: a fixed 32-byte little-endian header, then the payload (postcard for
 //! typed messages, as-is for raw ones). The receiver gets a raw message whose typed payload is
 //! decoded once, on first typed access ([`Msg::get`](crate::Msg::get)).

@@ -200,6 +200,66 @@ fn a_message_is_shared_not_copied_and_freed_by_the_last_reader() {
     assert_eq!(DROPS.load(Ordering::SeqCst), before + 1);
 }
 
+/// Under PMQ a small plain message travels by value inside each mailbox slot (`parcel`): every
+/// reader gets an equal value under the publisher's header, in a block of its own. A message
+/// that owns memory is shared: both readers read one allocation.
+#[test]
+fn small_plain_messages_are_copied_and_others_shared() {
+    let clock = SimClock::new();
+    let mut a =
+        mrt_dcdt::Agora::builder(1).clock(std::sync::Arc::new(clock.clone())).build().unwrap();
+    let tx = a.endpoint();
+    let mut r1 = a.endpoint();
+    r1.subscribe_to::<Count>(RequestType::All);
+    clock.advance(std::time::Duration::from_millis(250));
+    assert_eq!(tx.publish_with(Count(7), DeliveryWarranty::Reliable, 200), 1);
+    let m = r1.receive_msg().unwrap();
+    assert_eq!(m.get::<Count>().unwrap(), &Count(7));
+    let h = m.header();
+    assert_eq!((h.msg_type, h.member_id, h.agora_id), (Count::TYPE, tx.member_id(), a.id()));
+    assert_eq!((h.warranty, h.priority), (DeliveryWarranty::Reliable, 200));
+    assert_eq!(h.creation_time, mrt_core::Time::from_secs_f64(0.25));
+
+    let mut r2 = a.endpoint();
+    r2.subscribe_to::<Count>(RequestType::All);
+    assert_eq!(tx.publish(Count(8)), 2);
+    let (m1, m2) = (r1.receive_msg().unwrap(), r2.receive_msg().unwrap());
+    let (c1, c2) = (m1.get::<Count>().unwrap(), m2.get::<Count>().unwrap());
+    assert_eq!((c1, c2), (&Count(8), &Count(8)));
+    assert!(!std::ptr::eq(c1, c2));
+
+    r1.subscribe_to::<Status>(RequestType::All);
+    r2.subscribe_to::<Status>(RequestType::All);
+    assert_eq!(tx.publish(Status("kick".into())), 2);
+    let (m1, m2) = (r1.receive_msg().unwrap(), r2.receive_msg().unwrap());
+    assert!(std::ptr::eq(m1.get::<Status>().unwrap(), m2.get::<Status>().unwrap()));
+}
+
+/// In a community of Agoras under different policies, one publish reaches every subscriber
+/// with an equal value and the same header, whether its PostOffice takes it by value (PMQ) or
+/// shared (the single-lock policies), in either order of the Agoras.
+#[test]
+fn mixed_policies_in_a_community_read_the_same_message() {
+    for (first, second) in
+        [(PolicyKind::Pmq, PolicyKind::Slwb), (PolicyKind::Slwb, PolicyKind::Pmq)]
+    {
+        let ilm = InnerLinkManager::new();
+        let mut a1 = mrt_dcdt::Agora::builder(1).policy(first).inner_link(&ilm).build().unwrap();
+        let mut a2 = mrt_dcdt::Agora::builder(2).policy(second).inner_link(&ilm).build().unwrap();
+        let tx = a1.endpoint();
+        let mut r1 = a1.endpoint();
+        let mut r2 = a2.endpoint();
+        r1.subscribe_to::<Count>(RequestType::All);
+        r2.subscribe_to::<Count>(RequestType::All);
+        assert_eq!(tx.publish_with(Count(3), DeliveryWarranty::Retransmit, 5), 2);
+        let (m1, m2) = (r1.receive_msg().unwrap(), r2.receive_msg().unwrap());
+        assert_eq!(m1.get::<Count>().unwrap(), &Count(3), "{first} then {second}");
+        assert_eq!(m2.get::<Count>().unwrap(), &Count(3), "{first} then {second}");
+        assert_eq!(m1.header(), m2.header());
+        assert_eq!(m1.header().warranty, DeliveryWarranty::Retransmit);
+    }
+}
+
 /// Sharing a type nobody subscribed to allocates nothing and is not an error.
 #[test]
 fn publishing_to_nobody_is_cheap_and_not_an_error() {

@@ -24,6 +24,8 @@ pub(crate) use single_lock::SingleLock;
 use crate::config::PolicyKind;
 use crate::error::DcdtError;
 use crate::msg::MsgRef;
+use crate::parcel::Make;
+use crate::pool::MsgPool;
 use crate::waker::Waker;
 use mrt_core::{AgoraId, MsgType};
 use rustc_hash::FxHashMap;
@@ -258,12 +260,7 @@ impl Policy {
     }
     /// Delivers `msg` (built on demand by `make`) to matching subscribers; returns how many.
     #[inline]
-    pub(crate) fn deliver(
-        &self,
-        ty: MsgType,
-        origin: u8,
-        make: &mut dyn FnMut() -> MsgRef,
-    ) -> usize {
+    pub(crate) fn deliver(&self, ty: MsgType, origin: u8, make: &mut dyn Make) -> usize {
         each!(self, p => p.deliver(ty, origin, make))
     }
     /// A handle on one Member's mailbox, for its endpoint to receive without looking it up.
@@ -273,9 +270,11 @@ impl Policy {
             Policy::SingleLock(_) => MailboxRef::Index(member),
         }
     }
-    pub(crate) fn pop(&self, mailbox: &mut MailboxRef) -> Option<MsgRef> {
+    /// The next message; one that travelled by value is put into a block of `pool` (the
+    /// receiving endpoint's, see `parcel`).
+    pub(crate) fn pop(&self, mailbox: &mut MailboxRef, pool: &MsgPool) -> Option<MsgRef> {
         match (self, mailbox) {
-            (_, MailboxRef::Pmq(r)) => r.pop(),
+            (_, MailboxRef::Pmq(r)) => r.pop().map(|p| p.open(pool)),
             (Policy::SingleLock(p), MailboxRef::Index(i)) => p.pop(*i),
             // A PMQ endpoint always has a reader: its mailbox is registered before it exists.
             (Policy::Pmq(_), MailboxRef::Index(_)) => None,

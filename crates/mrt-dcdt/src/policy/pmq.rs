@@ -20,7 +20,8 @@
 //! order they arrived, as with one queue. (A Member with one lane needs no number.)
 
 use super::{MailboxBounds, MailboxReport, Subscriptions};
-use crate::msg::{DeliveryWarranty, MsgRef};
+use crate::msg::DeliveryWarranty;
+use crate::parcel::{Make, Parcel};
 use crate::waker::Waker;
 use arc_swap::ArcSwap;
 use crossbeam_queue::ArrayQueue;
@@ -31,7 +32,7 @@ use std::sync::atomic::{AtomicBool, AtomicU64, AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex, MutexGuard};
 
 /// A message in a lane, with its number in the Member's arrival order.
-type Entry = (u64, MsgRef);
+type Entry = (u64, Parcel);
 
 /// Where [`Lane::push`] put a message.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -89,7 +90,7 @@ impl Lane {
     /// Puts a message in the lane, applying the overflow policy.
     #[inline]
     fn push(&self, entry: Entry) -> Pushed {
-        if entry.1.header().warranty == DeliveryWarranty::Reliable
+        if entry.1.warranty() == DeliveryWarranty::Reliable
             && !self.reliable.load(Ordering::Acquire)
         {
             let _spill = self.spill();
@@ -126,7 +127,7 @@ impl Lane {
             return Pushed::Ring;
         }
         if reliable_lane && self.ring.len() + spill.len() >= self.reliable_limit {
-            if entry.1.header().warranty != DeliveryWarranty::Reliable {
+            if entry.1.warranty() != DeliveryWarranty::Reliable {
                 // A best-effort message in a lane that must not drop `Reliable` ones: the
                 // newest goes.
                 self.dropped.fetch_add(1, Ordering::Relaxed);
@@ -218,7 +219,7 @@ pub(crate) struct Mailbox {
 impl Mailbox {
     /// Delivers into one of its lanes and wakes the Member; `false` when the lane refused.
     #[inline]
-    fn push(&self, lane: &Lane, msg: MsgRef) -> bool {
+    fn push(&self, lane: &Lane, msg: Parcel) -> bool {
         // Arrival numbers only order lanes against each other: a Member with one lane needs
         // none. Messages numbered 0 before its second lane came are older than all the new
         // lane's, and the merge takes the first lane on a tie.
@@ -274,7 +275,7 @@ impl Reader {
 
     /// The waiting message that arrived first.
     #[inline]
-    pub(crate) fn pop(&mut self) -> Option<MsgRef> {
+    pub(crate) fn pop(&mut self) -> Option<Parcel> {
         self.refresh();
         if self.lanes.len() == 1 && self.staged.is_empty() {
             return self.lanes[0].pop().map(|(_, m)| m);
@@ -282,7 +283,7 @@ impl Reader {
         self.pop_merged()
     }
 
-    fn pop_merged(&mut self) -> Option<MsgRef> {
+    fn pop_merged(&mut self) -> Option<Parcel> {
         if self.staged.len() < self.lanes.len() {
             self.staged.resize_with(self.lanes.len(), || None);
         }
@@ -421,29 +422,32 @@ impl Pmq {
     }
 
     #[inline]
-    pub(crate) fn deliver(
-        &self,
-        ty: MsgType,
-        origin: u8,
-        make: &mut dyn FnMut() -> MsgRef,
-    ) -> usize {
+    pub(crate) fn deliver(&self, ty: MsgType, origin: u8, make: &mut dyn Make) -> usize {
         let table = self.table.load();
         let Some(subs) = table.by_type.get(&ty) else {
             return 0;
         };
-        // The last matching mailbox gets the reference itself, the others a clone: one
-        // reference-count increment per extra subscriber, none for a single one.
         let mut matching = subs.iter().filter(|t| t.mask & origin != 0);
         let Some(mut target) = matching.next() else {
             return 0;
         };
-        let msg = make();
+        if let Some(value) = make.inline() {
+            // A small plain message: a copy by value in each slot (see `parcel`).
+            let mut n = usize::from(target.mailbox.push(&target.lane, Parcel::Inline(value)));
+            for t in matching {
+                n += usize::from(t.mailbox.push(&t.lane, Parcel::Inline(value)));
+            }
+            return n;
+        }
+        // Shared: the last matching mailbox gets the reference itself, the others a clone (one
+        // reference-count increment per extra subscriber, none for a single one).
+        let msg = make.shared();
         let mut n = 0;
         for next in matching {
-            n += usize::from(target.mailbox.push(&target.lane, msg.clone()));
+            n += usize::from(target.mailbox.push(&target.lane, Parcel::Shared(msg.clone())));
             target = next;
         }
-        n + usize::from(target.mailbox.push(&target.lane, msg))
+        n + usize::from(target.mailbox.push(&target.lane, Parcel::Shared(msg)))
     }
 
     /// The consumer side of a Member's mailbox, for its endpoint.

@@ -11,6 +11,7 @@
 use super::{MailboxBounds, MailboxReport, Subscriptions};
 use crate::config::PolicyKind;
 use crate::msg::{DeliveryWarranty, MsgRef};
+use crate::parcel::Make;
 use crate::waker::Waker;
 use mrt_core::MsgType;
 use rustc_hash::FxHashMap;
@@ -181,26 +182,21 @@ impl SingleLock {
         self.lock().subs.matching(ty, origin).next().is_some()
     }
 
-    pub(crate) fn deliver(
-        &self,
-        ty: MsgType,
-        origin: u8,
-        make: &mut dyn FnMut() -> MsgRef,
-    ) -> usize {
+    pub(crate) fn deliver(&self, ty: MsgType, origin: u8, make: &mut dyn Make) -> usize {
         let mut guard = self.lock();
         let s = &mut *guard;
         let mut n = 0;
         let mut msg: Option<MsgRef> = None;
         if self.kind == PolicyKind::Slwdwcv {
             if s.subs.matching(ty, origin).next().is_some() {
-                s.main.push_back((make(), origin));
+                s.main.push_back((make.shared(), origin));
                 n = 1;
                 self.cv.notify_one();
             }
             return n;
         }
         for member in s.subs.matching(ty, origin) {
-            let m = msg.get_or_insert_with(&mut *make).clone();
+            let m = msg.get_or_insert_with(|| make.shared()).clone();
             let Some(b) = s.boxes.get_mut(member) else {
                 continue;
             };
