@@ -66,7 +66,8 @@ pub struct SimArgs {
     #[arg(long, value_enum)]
     pub percepts: Option<Percepts>,
     /// Which estimator keeps each robot's pose: murea (the EKF tracks, MUREA finds the robot
-    /// again when it is lost) or ekf (the EKF alone). Default: the configuration's
+    /// again when it is lost), gm (the EKF tracks, ThinkingCap's fuzzy grid follows and moves
+    /// it when sure it is elsewhere) or ekf (the EKF alone). Default: the configuration's
     /// `[localization] localizer`.
     #[arg(long)]
     pub localizer: Option<mrt_robot::config::Localizer>,

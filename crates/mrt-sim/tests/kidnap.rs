@@ -20,7 +20,17 @@ fn config(kidnaps: u32, localizer: Localizer) -> SimConfig {
 /// a few seconds, and the pooled metrics say so.
 #[test]
 fn kidnapped_robots_find_themselves_again() {
-    let cfg = config(1, Localizer::Murea);
+    kidnapped_robots_find_themselves_again_with(Localizer::Murea);
+}
+
+/// The same with ThinkingCap's fuzzy grid (GM) watching the EKF instead of MUREA.
+#[test]
+fn kidnapped_robots_find_themselves_again_with_the_fuzzy_grid() {
+    kidnapped_robots_find_themselves_again_with(Localizer::Gm);
+}
+
+fn kidnapped_robots_find_themselves_again_with(localizer: Localizer) {
+    let cfg = config(1, localizer);
     let r = mrt_sim::play(&cfg, 3, (Stack::Milan, Stack::Chaos), None, false, |_| {}).unwrap();
     let robots = 2 * cfg.rules.team_size;
     assert!(r.kidnaps.len() >= robots * 2 - 1, "{} kidnaps", r.kidnaps.len());
@@ -34,7 +44,8 @@ fn kidnapped_robots_find_themselves_again() {
     assert_eq!(m.kidnap.count as usize, r.kidnaps.len());
     assert_eq!(m.kidnap.recovered, m.kidnap.count);
     assert!(m.kidnap.median_recovery_s.is_some_and(|t| t < 2.0), "{m:?}");
-    // MUREA found some of them (the EKF, matching named landmarks, the others), never wrongly.
+    // The global localizer found some of them (the EKF, matching named landmarks, the others),
+    // never wrongly.
     let l = &m.localization;
     assert!(l.relocalized > 0 && l.falsely_relocalized == 0, "{l:?}");
 }

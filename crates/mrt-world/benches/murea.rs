@@ -2,7 +2,8 @@
 //! one frame of a robot on the MSL field that sees 6 landmarks and 16 field-line points, with
 //! noise of a third of the tolerances, localized globally (the whole field, every heading) and
 //! in tracking mode (±0.5 m, ±0.3 rad round a prediction), under several cell budgets, and
-//! the world model's relocalizer finding the robot from that frame alone. The
+//! the world model's relocalizer finding the robot from that frame alone; ThinkingCap's fuzzy
+//! grid (GM) on the same frame; ISocRob's Hough self mode. The
 //! position error of each setting is printed once before it is timed.
 //!
 //! Run: `cargo bench -p mrt-world --bench murea`.
@@ -101,6 +102,40 @@ fn bench(c: &mut Criterion) {
             criterion::BatchSize::SmallInput,
         )
     });
+    g.finish();
+
+    // ThinkingCap's fuzzy grid (mrt_world::gm) on the same frame (it reads the goals and
+    // posts, not the lines): one frame from "anywhere", one frame that agrees with the belief,
+    // one control cycle's odometry, and the estimate.
+    use mrt_world::gm::FuzzyGrid;
+    let mut g = c.benchmark_group("gm");
+    let anywhere = FuzzyGrid::field(&field);
+    let mut found = anywhere.clone();
+    found.observe(&seen);
+    let e = found.estimate();
+    let err = (e.pose.x - truth.x).hypot(e.pose.y - truth.y);
+    let turn = normalize_angle(e.pose.theta - truth.theta).abs().to_degrees();
+    let (nx, ny, nk) = found.shape();
+    println!("gm: {nx} × {ny} cells × {nk} headings, one frame: error {err:.3} m {turn:.2}°");
+    g.bench_function("observe_from_anywhere", |b| {
+        b.iter_batched(
+            || anywhere.clone(),
+            |mut grid| grid.observe(black_box(&seen)),
+            criterion::BatchSize::LargeInput,
+        )
+    });
+    g.bench_function("observe_tracking", |b| {
+        b.iter_batched(
+            || found.clone(),
+            |mut grid| grid.observe(black_box(&seen)),
+            criterion::BatchSize::LargeInput,
+        )
+    });
+    let mut moving = found.clone();
+    g.bench_function("predict_one_cycle", |b| {
+        b.iter(|| moving.predict(black_box(Pose2::new(0.02, 0.0, 0.01))))
+    });
+    g.bench_function("estimate", |b| b.iter(|| black_box(&found).estimate()));
     g.finish();
 
     // ISocRob's self mode (mrt_world::hough): the field-line points within 4 m of a robot near

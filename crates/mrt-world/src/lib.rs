@@ -39,6 +39,7 @@
 
 pub mod field;
 pub mod gaze;
+pub mod gm;
 pub mod hough;
 pub mod model;
 pub mod murea;

@@ -25,6 +25,7 @@
 //! robot sees the landmarks, falling as it goes without them.
 
 use crate::field::FieldMap;
+use crate::gm::{FuzzyGrid, GmCounts};
 use crate::murea::{Fix, Perception};
 use crate::relocalize::{self, CameraNoise, Localizer, Relocalizer};
 use crate::track::{sighting_covariance, Track, TrackCounts, BALL_ACCEL};
@@ -72,6 +73,13 @@ const FLOOR: (f64, f64) = (0.002, 0.002);
 const PLACED_SIGMA: (f64, f64) = (0.05, 0.05);
 /// Uncertainty after a relocalization (m, rad): MUREA's tolerances, about.
 const RELOCATED_SIGMA: (f64, f64) = (0.15, 0.08);
+/// The fuzzy grid is sure of its estimate when its spread is below this (m, rad)...
+const GRID_SURE: (f64, f64) = (0.5, 0.3);
+/// ... and sure the filter is elsewhere when they are farther apart than three spreads and
+/// at least this (m, rad) ...
+const GRID_ELSEWHERE: (f64, f64) = (0.5, 0.35);
+/// ... in this many frames in a row: then the filter is moved to the grid's estimate.
+const GRID_PATIENCE: u32 = 3;
 /// Uncertainty added when the filter finds itself lost (m, rad).
 const LOST_SIGMA: (f64, f64) = (1.0, 0.5);
 
@@ -107,6 +115,10 @@ pub struct WorldModel {
     ball_track: Track,
     /// MUREA watching the filter, with [`Localizer::Murea`].
     relocalizer: Option<Box<Relocalizer>>,
+    /// The fuzzy grid watching the filter, with [`Localizer::Gm`].
+    grid: Option<Box<FuzzyGrid>>,
+    /// Frames in a row the grid was sure the filter is elsewhere.
+    grid_disagrees: u32,
     /// The last frame's time, s.
     now: f64,
     /// The ball's velocity in the field frame (m/s) when the last frame gave one.
@@ -133,6 +145,8 @@ impl WorldModel {
             game: GameInfo::default(),
             ball_track: Track::new(BALL_DAMPING, BALL_ACCEL),
             relocalizer: None,
+            grid: None,
+            grid_disagrees: 0,
             now: 0.0,
             ball_velocity: None,
         }
@@ -141,9 +155,10 @@ impl WorldModel {
     /// The same model keeping its pose with `localizer` (the EKF alone unless told).
     pub fn with_localizer(mut self, localizer: Localizer) -> Self {
         self.relocalizer = match localizer {
-            Localizer::Ekf => None,
             Localizer::Murea => Some(Box::new(Relocalizer::new(&self.map))),
+            Localizer::Ekf | Localizer::Gm => None,
         };
+        self.grid = (localizer == Localizer::Gm).then(|| Box::new(FuzzyGrid::field(&self.map)));
         self
     }
 
@@ -171,9 +186,16 @@ impl WorldModel {
     pub fn localizer(&self) -> Localizer {
         if self.relocalizer.is_some() {
             Localizer::Murea
+        } else if self.grid.is_some() {
+            Localizer::Gm
         } else {
             Localizer::Ekf
         }
+    }
+
+    /// The fuzzy grid's counts, with [`Localizer::Gm`].
+    pub fn grid_counts(&self) -> Option<GmCounts> {
+        self.grid.as_ref().map(|g| g.counts())
     }
 
     /// The pose estimate (field frame, m).
@@ -233,6 +255,9 @@ impl WorldModel {
         if let Some(r) = &mut self.relocalizer {
             r.forget();
         }
+        if let Some(g) = &mut self.grid {
+            g.place(pose.inner);
+        }
         // The ball's track lies in the field frame of the pose that was.
         self.ball_track.reset();
     }
@@ -240,9 +265,13 @@ impl WorldModel {
     /// Puts the filter where the relocalizer's `fix` says, as sure as MUREA's accuracy and
     /// the perceptions' tolerances allow.
     fn relocate(&mut self, fix: &Fix) {
-        self.pose = fix.pose;
-        let (xy, theta) = RELOCATED_SIGMA;
-        let (xy, theta) = (xy.max(fix.cell.0), theta.max(fix.cell.2));
+        self.relocate_to(fix.pose, fix.cell.0, fix.cell.2);
+    }
+
+    /// Puts the filter at `pose`, at least `xy` (m) and `theta` (rad) unsure.
+    fn relocate_to(&mut self, pose: Pose2, xy: f64, theta: f64) {
+        self.pose = pose;
+        let (xy, theta) = (RELOCATED_SIGMA.0.max(xy), RELOCATED_SIGMA.1.max(theta));
         self.cov = Matrix3::from_diagonal(&Vector3::new(xy * xy, xy * xy, theta * theta));
         self.counts.relocalized += 1;
         self.ball_track.reset();
@@ -315,6 +344,9 @@ impl WorldModel {
         self.pose = Pose2::new(p.x, p.y, normalize_angle(p.theta));
         if let Some(r) = &mut self.relocalizer {
             r.moved(d.as_pose());
+        }
+        if let Some(g) = &mut self.grid {
+            g.predict(d.as_pose());
         }
     }
 
@@ -399,7 +431,7 @@ impl WorldModel {
     /// LPS memory, and the snapshot is built. Call after this cycle's [`WorldModel::odometry`].
     pub fn camera(&mut self, frame: &CameraFrame) -> WorldSnapshot {
         let none = [None; FIELD_OBJECTS];
-        let perceived = self.relocalizer.as_ref().map(|_| {
+        let perceived = self.global().then(|| {
             relocalize::perceptions(&self.map, self.noise, &frame.sightings, &none, &[], &[])
         });
         self.observe(frame, &none, perceived)
@@ -411,15 +443,31 @@ impl WorldModel {
         &mut self,
         frame: &CameraFrame,
         sigmas: &[Option<(f64, f64)>; FIELD_OBJECTS],
-        perceived: Option<Vec<Perception>>,
+        mut perceived: Option<Vec<Perception>>,
     ) -> WorldSnapshot {
         // MUREA first checks the odometry's prediction against what the robot sees.
-        if let (Some(r), Some(perceived)) = (&mut self.relocalizer, perceived) {
+        let for_murea = if self.relocalizer.is_some() { perceived.take() } else { None };
+        if let (Some(r), Some(perceived)) = (&mut self.relocalizer, for_murea) {
             let searches = r.counts().searches;
             let fix = r.frame(frame.time, perceived, self.pose);
             self.counts.searches += r.counts().searches - searches;
             if let Some(fix) = fix {
                 self.relocate(&fix);
+            }
+        }
+        // Or the fuzzy grid follows the frame, and moves the filter when sure it is elsewhere.
+        if let (Some(g), Some(perceived)) = (&mut self.grid, &perceived) {
+            g.observe(perceived);
+            let e = g.estimate();
+            let off = (e.pose.position() - self.pose.position()).norm();
+            let turn = normalize_angle(e.pose.theta - self.pose.theta).abs();
+            let sure = !e.ambiguous && e.sigma_xy < GRID_SURE.0 && e.sigma_theta < GRID_SURE.1;
+            let elsewhere = off > (3.0 * e.sigma_xy).max(GRID_ELSEWHERE.0)
+                || turn > (3.0 * e.sigma_theta).max(GRID_ELSEWHERE.1);
+            self.grid_disagrees = if sure && elsewhere { self.grid_disagrees + 1 } else { 0 };
+            if self.grid_disagrees >= GRID_PATIENCE {
+                self.grid_disagrees = 0;
+                self.relocate_to(e.pose, e.sigma_xy, e.sigma_theta);
             }
         }
         let (seen, rejected) = self.correct_all(frame, sigmas);
@@ -461,7 +509,7 @@ impl WorldModel {
             r.lines(&p.line_points);
         }
         // The relocalizer takes the posts by their pattern: naming them rests on the pose.
-        let perceived = self.relocalizer.as_ref().map(|_| {
+        let perceived = self.global().then(|| {
             let noise = self.noise;
             relocalize::perceptions(
                 &self.map,
@@ -513,6 +561,11 @@ impl WorldModel {
             frame.ball_velocity = Some((c * vx + s * vy, -s * vx + c * vy));
         }
         self.observe(&frame, &sigmas, perceived)
+    }
+
+    /// Whether a global localizer (MUREA or the grid) reads the frames' perceptions.
+    fn global(&self) -> bool {
+        self.relocalizer.is_some() || self.grid.is_some()
     }
 
     /// Corrects the pose with every net and landmark of `frame`. Returns how many were seen
@@ -747,6 +800,12 @@ mod tests {
         let k = murea.unwrap_or_else(|| panic!("MUREA never found it: {counts:?}"));
         assert!(k <= 3, "found after {k} frames");
         assert_eq!(counts.relocalized, 1, "{counts:?}");
+        // The fuzzy grid: the old belief fades by the bias each frame, the new pose rises from
+        // the floor; three frames in a row sure of it, and the filter moves.
+        let (gm, counts) = run(Localizer::Gm);
+        let k = gm.unwrap_or_else(|| panic!("GM never found it: {counts:?}"));
+        assert!(k <= 8, "found after {k} frames");
+        assert!(counts.relocalized >= 1, "{counts:?}");
     }
 
     /// Nobody said where it starts: from a handful of frames it knows, wherever it stands.

@@ -114,6 +114,11 @@ impl Map {
         self
     }
 
+    /// The point elements, with their kinds.
+    pub fn points(&self) -> &[(Kind, Point2)] {
+        &self.points
+    }
+
     /// The map with a segment element of `kind`.
     pub fn segment(mut self, kind: Kind, segment: Segment) -> Map {
         self.segments.push((kind, segment));

@@ -69,11 +69,14 @@ pub enum Localizer {
     /// what the robot sees (module doc).
     #[default]
     Murea,
+    /// The EKF tracking, ThinkingCap's fuzzy grid (GM, [`crate::gm`]) following every frame
+    /// and moving the EKF when it is sure the EKF is elsewhere.
+    Gm,
 }
 
 impl Localizer {
     /// Every localizer's name, as the files and the command line spell them.
-    pub const NAMES: [&'static str; 2] = ["ekf", "murea"];
+    pub const NAMES: [&'static str; 3] = ["ekf", "murea", "gm"];
 }
 
 impl fmt::Display for Localizer {
@@ -81,6 +84,7 @@ impl fmt::Display for Localizer {
         f.write_str(match self {
             Localizer::Ekf => "ekf",
             Localizer::Murea => "murea",
+            Localizer::Gm => "gm",
         })
     }
 }
@@ -92,6 +96,7 @@ impl FromStr for Localizer {
         match s {
             "ekf" => Ok(Localizer::Ekf),
             "murea" => Ok(Localizer::Murea),
+            "gm" => Ok(Localizer::Gm),
             _ => Err(format!(
                 "unknown localizer `{s}` (expected one of: {})",
                 Self::NAMES.join(", ")
@@ -489,7 +494,7 @@ mod tests {
             assert_eq!(l.to_string(), name);
         }
         let err = "amcl".parse::<Localizer>().err().unwrap_or_default();
-        assert!(err.contains("ekf, murea"), "{err}");
+        assert!(err.contains("ekf, murea, gm"), "{err}");
     }
 
     #[test]
