@@ -111,6 +111,9 @@ pub struct GmEstimate {
     pub sigma_theta: f64,
     /// Another mode, more than 1.5 m away, is nearly as possible (at least 0.9 of the best).
     pub ambiguous: bool,
+    /// The highest possibility more than 1.5 m from the best cell, relative to the best: how
+    /// much the next other answer is worth, 0 to 1.
+    pub second: f64,
 }
 
 /// What the grid did, counted since it started.
@@ -595,15 +598,15 @@ impl FuzzyGrid {
         let cut = height * self.params.alpha as f32;
         let (mut w, mut sx, mut sy, mut sxx, mut syy) = (0.0, 0.0, 0.0, 0.0, 0.0);
         let (mut hs, mut hc, mut hw) = (0.0, 0.0, 0.0);
-        let mut ambiguous = false;
+        let mut second = 0f32;
         for (i, &m) in cell_best.iter().enumerate() {
-            if m < cut {
-                continue;
-            }
             let p = at(i);
             let far = (p - top_at).norm();
             if far > 1.5 {
-                ambiguous |= m >= 0.9 * height;
+                second = second.max(m);
+                continue;
+            }
+            if m < cut {
                 continue;
             }
             if far > 0.75 {
@@ -636,7 +639,8 @@ impl FuzzyGrid {
             pose: Pose2::new(x, y, normalize_angle(hs.atan2(hc))),
             sigma_xy,
             sigma_theta,
-            ambiguous,
+            ambiguous: second >= 0.9 * height,
+            second: if height > 0.0 { f64::from(second / height) } else { 0.0 },
         }
     }
 }

@@ -73,11 +73,12 @@ const FLOOR: (f64, f64) = (0.002, 0.002);
 const PLACED_SIGMA: (f64, f64) = (0.05, 0.05);
 /// Uncertainty after a relocalization (m, rad): MUREA's tolerances, about.
 const RELOCATED_SIGMA: (f64, f64) = (0.15, 0.08);
-/// The fuzzy grid is sure of its estimate when its spread is below this (m, rad)...
-const GRID_SURE: (f64, f64) = (0.5, 0.3);
+/// The fuzzy grid is sure of its estimate when its spread is below this (m, rad) and no other
+/// answer 1.5 m away is worth this much of it...
+const GRID_SURE: (f64, f64, f64) = (0.5, 0.3, 0.5);
 /// ... and sure the filter is elsewhere when they are farther apart than three spreads and
-/// at least this (m, rad) ...
-const GRID_ELSEWHERE: (f64, f64) = (0.5, 0.35);
+/// at least this (m, rad), and the grid holds the filter's pose possible less than this ...
+const GRID_ELSEWHERE: (f64, f64, f64) = (0.5, 0.35, 0.1);
 /// ... in this many frames in a row: then the filter is moved to the grid's estimate.
 const GRID_PATIENCE: u32 = 3;
 /// Uncertainty added when the filter finds itself lost (m, rad).
@@ -461,9 +462,11 @@ impl WorldModel {
             let e = g.estimate();
             let off = (e.pose.position() - self.pose.position()).norm();
             let turn = normalize_angle(e.pose.theta - self.pose.theta).abs();
-            let sure = !e.ambiguous && e.sigma_xy < GRID_SURE.0 && e.sigma_theta < GRID_SURE.1;
-            let elsewhere = off > (3.0 * e.sigma_xy).max(GRID_ELSEWHERE.0)
-                || turn > (3.0 * e.sigma_theta).max(GRID_ELSEWHERE.1);
+            let sure =
+                e.second < GRID_SURE.2 && e.sigma_xy < GRID_SURE.0 && e.sigma_theta < GRID_SURE.1;
+            let elsewhere = (off > (3.0 * e.sigma_xy).max(GRID_ELSEWHERE.0)
+                || turn > (3.0 * e.sigma_theta).max(GRID_ELSEWHERE.1))
+                && g.possibility(self.pose) < GRID_ELSEWHERE.2;
             self.grid_disagrees = if sure && elsewhere { self.grid_disagrees + 1 } else { 0 };
             if self.grid_disagrees >= GRID_PATIENCE {
                 self.grid_disagrees = 0;
