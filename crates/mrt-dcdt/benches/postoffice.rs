@@ -8,7 +8,10 @@
 //! baseline: threads blocked in `Receiver::recv`). The payload is a 16-byte struct.
 #![allow(missing_docs, clippy::unwrap_used, clippy::expect_used)]
 
-use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
+use criterion::measurement::WallTime;
+use criterion::{
+    criterion_group, criterion_main, BenchmarkGroup, BenchmarkId, Criterion, Throughput,
+};
 use crossbeam_channel::{unbounded, Receiver, Sender};
 use mrt_dcdt::prelude::*;
 use mrt_dcdt::{Endpoint, MailboxBounds, ShutdownHandle};
@@ -214,77 +217,63 @@ fn throughput(c: &mut Criterion) {
         }
         // Baseline: one unbounded crossbeam channel per consumer; the producer sends a copy
         // into each.
-        let seen: Vec<Arc<AtomicU64>> = (0..fanout).map(|_| Arc::new(AtomicU64::new(0))).collect();
-        let mut senders = Vec::new();
-        let mut threads = Vec::new();
-        for s in &seen {
-            let (tx, rx) = unbounded::<Sample>();
-            senders.push(tx);
-            let s = s.clone();
-            threads.push(std::thread::spawn(move || {
-                while let Ok(m) = rx.recv() {
-                    s.store(m.seq, Ordering::Release);
-                }
-            }));
-        }
-        let mut next = 1u64;
-        g.bench_function(BenchmarkId::new("crossbeam", "channel"), |b| {
-            b.iter_custom(|iters| {
-                let start = Instant::now();
-                for _ in 0..iters {
-                    for _ in 0..BATCH {
-                        for tx in &senders {
-                            tx.send(Sample { seq: next, value: 0.5 }).unwrap();
-                        }
-                        next += 1;
-                    }
-                    wait_all(&seen, next - 1);
-                }
-                start.elapsed()
-            })
-        });
-        drop(senders);
-        for t in threads {
-            t.join().unwrap();
-        }
+        crossbeam_baseline(&mut g, "channel", fanout, |seq| Sample { seq, value: 0.5 }, |m| m.seq);
         // Second baseline: the same channels carrying what a bus must pass, one shared,
         // reference-counted message per publish (`Arc`), as DCDT shares a message among its
         // subscribers.
-        let seen: Vec<Arc<AtomicU64>> = (0..fanout).map(|_| Arc::new(AtomicU64::new(0))).collect();
-        let mut senders = Vec::new();
-        let mut threads = Vec::new();
-        for s in &seen {
-            let (tx, rx) = unbounded::<Arc<Sample>>();
-            senders.push(tx);
-            let s = s.clone();
-            threads.push(std::thread::spawn(move || {
-                while let Ok(m) = rx.recv() {
-                    s.store(m.seq, Ordering::Release);
-                }
-            }));
-        }
-        let mut next = 1u64;
-        g.bench_function(BenchmarkId::new("crossbeam", "shared"), |b| {
-            b.iter_custom(|iters| {
-                let start = Instant::now();
-                for _ in 0..iters {
-                    for _ in 0..BATCH {
-                        let m = Arc::new(Sample { seq: next, value: 0.5 });
-                        for tx in &senders {
-                            tx.send(m.clone()).unwrap();
-                        }
-                        next += 1;
-                    }
-                    wait_all(&seen, next - 1);
-                }
-                start.elapsed()
-            })
-        });
-        drop(senders);
-        for t in threads {
-            t.join().unwrap();
-        }
+        crossbeam_baseline(
+            &mut g,
+            "shared",
+            fanout,
+            |seq| Arc::new(Sample { seq, value: 0.5 }),
+            |m| m.seq,
+        );
         g.finish();
+    }
+}
+
+/// A crossbeam baseline of throughput: one unbounded channel per consumer (a thread blocked in
+/// `recv`); each publish builds one value with `make` and sends a clone into every channel.
+fn crossbeam_baseline<T: Clone + Send + 'static>(
+    g: &mut BenchmarkGroup<'_, WallTime>,
+    name: &str,
+    fanout: usize,
+    make: impl Fn(u64) -> T,
+    seq: fn(&T) -> u64,
+) {
+    let seen: Vec<Arc<AtomicU64>> = (0..fanout).map(|_| Arc::new(AtomicU64::new(0))).collect();
+    let mut senders = Vec::new();
+    let mut threads = Vec::new();
+    for s in &seen {
+        let (tx, rx) = unbounded::<T>();
+        senders.push(tx);
+        let s = s.clone();
+        threads.push(std::thread::spawn(move || {
+            while let Ok(m) = rx.recv() {
+                s.store(seq(&m), Ordering::Release);
+            }
+        }));
+    }
+    let mut next = 1u64;
+    g.bench_function(BenchmarkId::new("crossbeam", name), |b| {
+        b.iter_custom(|iters| {
+            let start = Instant::now();
+            for _ in 0..iters {
+                for _ in 0..BATCH {
+                    let m = make(next);
+                    for tx in &senders {
+                        tx.send(m.clone()).unwrap();
+                    }
+                    next += 1;
+                }
+                wait_all(&seen, next - 1);
+            }
+            start.elapsed()
+        })
+    });
+    drop(senders);
+    for t in threads {
+        t.join().unwrap();
     }
 }
 
