@@ -146,8 +146,9 @@ pub struct CameraFrame {
     /// What was seen, in [`FIELD_OBJECTS`] order: ball, east net, west net, then the
     /// landmarks of the field map (`None`: not seen this frame).
     pub sightings: [Option<Sighting>; FIELD_OBJECTS],
-    /// The ball's velocity in the robot's frame (m/s), when the ball is seen: the stand-in
-    /// for a ball tracker.
+    /// The ball's velocity in the robot's frame (m/s). No camera measures one: MRT's devices
+    /// leave it `None`, and the world model's ball tracker (MAP) fills it in the frame it
+    /// reads.
     pub ball_velocity: Option<(f64, f64)>,
     /// The camera's image, when the camera renders or grabs one (the vision µAgent's input,
     /// ISocRob seed `003` §3.2.1); `None` from the object sensor alone.

@@ -52,6 +52,8 @@ pub struct RobotConfig {
     pub gaze: Option<GazeConfig>,
     /// Which estimator keeps the robot's pose ([`mrt_world::relocalize`]).
     pub localizer: Localizer,
+    /// The ball's rolling friction as its tracker assumes it, 1/s.
+    pub ball_damping: f64,
 }
 
 /// What the vision µAgent needs (ISocRob seed `003` §3.2.1).
@@ -73,7 +75,8 @@ impl RobotConfig {
     pub fn world_model(&self) -> WorldModel {
         let model =
             WorldModel::new(self.field, self.mice, self.camera.distance, self.camera.bearing)
-                .with_localizer(self.localizer);
+                .with_localizer(self.localizer)
+                .with_ball_damping(self.ball_damping);
         // A robot with the up camera sees the field lines all around: ISocRob's self mode.
         match self.vision.as_ref().and_then(|v| v.up_camera) {
             Some(_) => model.with_self_mode(),
@@ -293,13 +296,26 @@ impl GazeSection {
 }
 
 /// `[localization]`: how the robot knows where it is (MRT manual ch. 7,
-/// [`mrt_world::relocalize`]).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+/// [`mrt_world::relocalize`]) and how it follows the ball.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct LocalizationSection {
     /// `murea` (the default: the EKF tracks, MUREA finds the robot again when it is lost or
-    /// was carried) or `ekf` (the EKF alone).
+    /// was carried), `gm` (ThinkingCap's fuzzy grid does) or `ekf` (the EKF alone).
     pub localizer: Localizer,
+    /// The carpet's rolling friction as the ball's tracker assumes it: linear damping of the
+    /// ball's velocity, 1/s (MAP's Kalman tracker, [`mrt_world::track`]). Measure it on your
+    /// carpet: a ball rolled at `v` stops after about `v / ball_damping` metres.
+    pub ball_damping: f64,
+}
+
+impl Default for LocalizationSection {
+    fn default() -> Self {
+        LocalizationSection {
+            localizer: Localizer::default(),
+            ball_damping: mrt_world::model::BALL_DAMPING,
+        }
+    }
 }
 
 /// `[devices]`: what the robot's drivers talk to.
@@ -470,6 +486,10 @@ impl RobotFile {
             gaze: self.gaze.config(vision.as_ref().map(|v| &v.camera))?,
             vision,
             localizer: self.localization.localizer,
+            ball_damping: non_negative(
+                "localization.ball_damping",
+                self.localization.ball_damping,
+            )?,
         })
     }
 }
@@ -523,6 +543,19 @@ mod tests {
             let e = e.to_string();
             assert!(e.starts_with("r.toml: gaze"), "{bad}: {e}");
         }
+    }
+
+    #[test]
+    fn the_ball_damping_reaches_the_world_model_and_is_checked() {
+        let read = |t: &str| RobotFile::from_toml(t, "r.toml").map(|f| f.config().unwrap());
+        let c = read("").unwrap();
+        assert_eq!(c.ball_damping, mrt_world::model::BALL_DAMPING);
+        assert_eq!(c.world_model().ball_damping(), 0.4);
+        let c = read("[localization]\nball_damping = 0.9\nlocalizer = \"gm\"\n").unwrap();
+        assert_eq!(c.world_model().ball_damping(), 0.9);
+        assert_eq!(c.world_model().localizer(), Localizer::Gm);
+        let e = read("[localization]\nball_damping = -0.1\n").unwrap_err().to_string();
+        assert_eq!(e, "r.toml: localization.ball_damping must be a finite number >= 0, not -0.1");
     }
 
     proptest! {

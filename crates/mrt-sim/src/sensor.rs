@@ -118,11 +118,7 @@ pub fn look(
             frame.sightings[k] = Some(Sighting { distance, bearing });
         }
     }
-    if frame.sightings[lps::BALL].is_some() {
-        let (vx, vy) = world.ball_velocity();
-        let (s, c) = me.theta.sin_cos();
-        frame.ball_velocity = Some((c * vx + s * vy, -s * vx + c * vy));
-    }
+    // No velocity: a camera does not measure one (the world model tracks the ball).
     frame
 }
 
@@ -252,8 +248,9 @@ mod tests {
         assert_eq!(game_info(&r, 5).attack, -1.0);
         assert_eq!(g.kickoff_pose.map(|p| p.inner), r.kickoff_pose(1));
         assert_eq!(f.time, w.time());
-        // A still ball: zero velocity, reported because the ball is seen.
-        assert_eq!(f.ball_velocity, Some((0.0, 0.0)));
+        // No velocity, though the ball is seen: a camera does not measure one.
+        assert!(f.sightings[lps::BALL].is_some());
+        assert_eq!(f.ball_velocity, None);
     }
 
     #[test]

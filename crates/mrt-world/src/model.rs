@@ -178,6 +178,11 @@ impl WorldModel {
         self
     }
 
+    /// The ball's rolling friction as its tracker assumes it, 1/s.
+    pub fn ball_damping(&self) -> f64 {
+        self.ball_track.damping
+    }
+
     /// What the ball's tracker did with the sightings so far.
     pub fn ball_track_counts(&self) -> TrackCounts {
         self.ball_track.counts()
@@ -429,13 +434,22 @@ impl WorldModel {
     }
 
     /// One camera frame: the nets and landmarks correct the pose, every sighting refreshes the
-    /// LPS memory, and the snapshot is built. Call after this cycle's [`WorldModel::odometry`].
+    /// LPS memory, the ball's tracker gives its velocity (a velocity in the frame is not read:
+    /// no camera measures one), and the snapshot is built. Call after this cycle's
+    /// [`WorldModel::odometry`].
     pub fn camera(&mut self, frame: &CameraFrame) -> WorldSnapshot {
         let none = [None; FIELD_OBJECTS];
         let perceived = self.global().then(|| {
             relocalize::perceptions(&self.map, self.noise, &frame.sightings, &none, &[], &[])
         });
-        self.observe(frame, &none, perceived)
+        let velocity = frame.sightings[lps::BALL].map(|z| self.track_ball(frame.time, &z, None));
+        let frame = CameraFrame {
+            time: frame.time,
+            sightings: frame.sightings,
+            ball_velocity: velocity,
+            ..Default::default()
+        };
+        self.observe(&frame, &none, perceived)
     }
 
     /// [`WorldModel::camera`] with each sighting's own standard deviations, where known, and
@@ -537,33 +551,35 @@ impl WorldModel {
                 self.counts.posts_named += 1;
             }
         }
-        if let Some(z) = p.sightings[lps::BALL] {
-            // MAP's tracker, in the field frame: the sighting's own error and the pose's. It
-            // gives the velocity; the place stays the sighting's (the tracker's lags behind
-            // kicks and a relocalized pose: 0.33 m mean error against 0.20 m, session 22).
-            let at = Framed::<Field, _>::new(self.pose).at_range_bearing(z.distance, z.bearing);
-            let sigma = self.noise.sigma(z.distance, p.sigmas[lps::BALL]);
-            let pose_xy = self.cov.fixed_view::<2, 2>(0, 0).into_owned();
-            let r = sighting_covariance(
-                z.distance,
-                z.bearing,
-                self.pose.theta,
-                sigma,
-                pose_xy,
-                self.cov[(2, 2)],
-            );
-            let velocity = if self.ball_track.update(p.time, (at.inner.x, at.inner.y), r) {
-                self.ball_track.velocity()
-            } else {
-                // Gated out (a false sighting, or the first after a kick): the prediction.
-                self.ball_track.predicted(p.time).map_or((0.0, 0.0), |(_, _, vx, vy)| (vx, vy))
-            };
-            // In the robot's frame, as a camera frame carries it.
-            let (s, c) = self.pose.theta.sin_cos();
-            let (vx, vy) = velocity;
-            frame.ball_velocity = Some((c * vx + s * vy, -s * vx + c * vy));
-        }
+        frame.ball_velocity =
+            p.sightings[lps::BALL].map(|z| self.track_ball(p.time, &z, p.sigmas[lps::BALL]));
         self.observe(&frame, &sigmas, perceived)
+    }
+
+    /// MAP's tracker fed with one sighting of the ball, in the field frame, with the sighting's
+    /// own error and the pose's; returns the ball's velocity in the robot's frame. The place
+    /// stays the sighting's (the track lags behind kicks and a relocalized pose: 0.33 m mean
+    /// error against 0.20 m, session 22).
+    fn track_ball(&mut self, time: f64, z: &Sighting, sigma: Option<(f64, f64)>) -> (f64, f64) {
+        let at = Framed::<Field, _>::new(self.pose).at_range_bearing(z.distance, z.bearing);
+        let sigma = self.noise.sigma(z.distance, sigma);
+        let pose_xy = self.cov.fixed_view::<2, 2>(0, 0).into_owned();
+        let r = sighting_covariance(
+            z.distance,
+            z.bearing,
+            self.pose.theta,
+            sigma,
+            pose_xy,
+            self.cov[(2, 2)],
+        );
+        let (vx, vy) = if self.ball_track.update(time, (at.inner.x, at.inner.y), r) {
+            self.ball_track.velocity()
+        } else {
+            // Gated out (a false sighting, or the first after a kick): the prediction.
+            self.ball_track.predicted(time).map_or((0.0, 0.0), |(_, _, vx, vy)| (vx, vy))
+        };
+        let (s, c) = self.pose.theta.sin_cos();
+        (c * vx + s * vy, -s * vx + c * vy)
     }
 
     /// Whether a global localizer (MUREA or the grid) reads the frames' perceptions.
