@@ -34,6 +34,15 @@ pub struct SimArgs {
     /// Draw the match (field, trajectories, shots) to this SVG file.
     #[arg(long)]
     pub plot: Option<PathBuf>,
+    /// With --plot: draw robot N's belief over time instead (where it believed it was over
+    /// where it was, the ball as it saw it with the velocity it estimated, the moments it was
+    /// carried). Robots are numbered from 0: home's, then away's.
+    #[arg(long, value_name = "N", requires = "plot")]
+    pub belief: Option<usize>,
+    /// With --belief: only the simulated seconds FROM:TO (e.g. 120:180). Default: the whole
+    /// match.
+    #[arg(long, value_name = "FROM:TO", requires = "belief", value_parser = parse_window)]
+    pub window: Option<(f64, f64)>,
     /// Run at wall-clock speed, for watching.
     #[arg(long)]
     pub realtime: bool,
@@ -178,6 +187,19 @@ fn wiring_name(args: &SimArgs) -> &'static str {
     }
 }
 
+/// `--window FROM:TO`: two times in seconds, `FROM` ≤ `TO`.
+fn parse_window(s: &str) -> Result<(f64, f64), String> {
+    let (a, b) = s.split_once(':').ok_or("expected FROM:TO in seconds, e.g. 120:180")?;
+    let num = |t: &str| {
+        t.trim().parse::<f64>().ok().filter(|v| v.is_finite()).ok_or(format!("`{t}` is not a time"))
+    };
+    let (from, to) = (num(a)?, num(b)?);
+    if from > to {
+        return Err(format!("{from} comes after {to}"));
+    }
+    Ok((from, to))
+}
+
 /// The most matches of a series or a benchmark.
 pub const MAX_MATCHES: u64 = 1_000_000;
 
@@ -186,6 +208,9 @@ pub const MAX_MATCHES: u64 = 1_000_000;
 fn check_counts(args: &SimArgs) -> Result<()> {
     if !(1..=MAX_MATCHES).contains(&args.matches) {
         anyhow::bail!("--matches must be 1 to {MAX_MATCHES}, not {}", args.matches);
+    }
+    if args.belief.is_some() && args.matches > 1 {
+        anyhow::bail!("--belief draws one match: leave out --matches");
     }
     let n = if args.bench && args.matches == 1 { 3 } else { args.matches };
     if args.seed.checked_add(n - 1).is_none() {
@@ -215,6 +240,10 @@ pub fn run(args: &SimArgs) -> Result<()> {
             anyhow::bail!("--distributed plays one match at a time: use --bench for several");
         }
         return series(args, &cfg, stacks);
+    }
+    let robots = 2 * cfg.rules.team_size;
+    if let Some(n) = args.belief.filter(|&n| n >= robots) {
+        anyhow::bail!("--belief {n}: the match has robots 0 to {}", robots - 1);
     }
     let length = 2.0 * cfg.rules.half_duration;
     let bar = ProgressBar::new(length.ceil() as u64).with_style(
@@ -319,8 +348,11 @@ pub fn run(args: &SimArgs) -> Result<()> {
         outln!("  {note}");
     }
     if let Some(p) = &args.plot {
-        std::fs::write(p, report.to_svg(&cfg, (h, a)))
-            .with_context(|| format!("cannot write {}", p.display()))?;
+        let svg = match args.belief {
+            Some(n) => report.belief_svg(&cfg, n, args.window.unwrap_or((0.0, f64::INFINITY))),
+            None => report.to_svg(&cfg, (h, a)),
+        };
+        std::fs::write(p, svg).with_context(|| format!("cannot write {}", p.display()))?;
         outln!("  drawing: {}", p.display());
     }
     Ok(())

@@ -58,6 +58,26 @@ fn the_match_is_drawn_as_svg() {
     std::fs::remove_file(&svg).unwrap();
 }
 
+/// Issue 20 item 9: one robot's belief over time, in a window of the match.
+#[test]
+fn one_robots_belief_is_drawn_as_svg() {
+    let svg = std::env::temp_dir().join(format!("mrt-sim-belief-{}.svg", std::process::id()));
+    let path = svg.to_str().unwrap();
+    let common = ["--half", "10", "--percepts", "oracle", "--plot", path];
+    let (ok, out, err) = run(&[&common[..], &["--belief", "1", "--window", "2:12"]].concat());
+    assert!(ok && out.contains("drawing: "), "{out}{err}");
+    let text = std::fs::read_to_string(&svg).unwrap();
+    assert!(text.contains("robot 1's belief, seed 1, "), "{text}");
+    assert!(text.contains("stroke-dasharray") && text.contains("position error median"));
+    std::fs::remove_file(&svg).unwrap();
+    let (ok, _, err) = run(&[&common[..], &["--belief", "8"]].concat());
+    assert!(!ok && err.contains("--belief 8: the match has robots 0 to 7"), "{err}");
+    let (ok, _, err) = run(&[&common[..], &["--belief", "1", "--window", "9:3"]].concat());
+    assert!(!ok && err.contains("9 comes after 3"), "{err}");
+    let (ok, _, err) = run(&["--half", "10", "--belief", "1"]);
+    assert!(!ok && err.contains("--plot"), "--belief needs --plot: {err}");
+}
+
 #[test]
 fn a_series_reports_wins_draws_and_losses_with_intervals() {
     let (ok, out, err) =

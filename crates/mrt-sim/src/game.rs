@@ -14,7 +14,7 @@ use crate::world::{Drive, World};
 use mrt_core::{normalize_angle, Pose2};
 use mrt_msgs::robot::{GameState, RobotCommand};
 use mrt_msgs::Sonar;
-use mrt_msgs::{CameraFrame, GameInfo, Localization, Odometry};
+use mrt_msgs::{BallBelief, CameraFrame, GameInfo, Localization, Odometry};
 use mrt_perception::camera::CameraModel;
 use mrt_robot::base::Base;
 use rand::SeedableRng;
@@ -56,6 +56,24 @@ pub struct Frame {
     pub robots: Vec<(f64, f64, f64)>,
 }
 
+/// One robot's belief at one of its estimates, beside the truth (kept with the frames, for
+/// drawing a robot's belief over time: [`MatchReport::belief_svg`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BeliefSample {
+    /// The robot.
+    pub robot: usize,
+    /// Simulated time, s.
+    pub time: f64,
+    /// Where it believed it was (field frame, m, rad).
+    pub estimate: Pose2,
+    /// Where it was.
+    pub truth: Pose2,
+    /// Where it believed the ball was and how fast it rolled (m, m/s), when it saw the ball.
+    pub ball: Option<BallBelief>,
+    /// Where the ball was.
+    pub true_ball: (f64, f64),
+}
+
 /// How a match ended.
 #[derive(Clone, Debug)]
 pub struct MatchReport {
@@ -75,6 +93,8 @@ pub struct MatchReport {
     pub shots: Vec<(f64, usize, (f64, f64))>,
     /// Positions, one frame per control cycle (empty unless recorded).
     pub frames: Vec<Frame>,
+    /// Every robot's belief at each of its estimates, when frames were recorded.
+    pub beliefs: Vec<BeliefSample>,
     /// Robots whose software failed during the match, by robot.
     pub faults: Vec<RobotFault>,
     /// How far each robot's own pose estimate was from the truth (every robot's
@@ -175,6 +195,7 @@ pub struct Pitch {
     calls: Vec<(f64, Call)>,
     shots: Vec<(f64, usize, (f64, f64))>,
     frames: Vec<Frame>,
+    beliefs: Vec<BeliefSample>,
     record: bool,
     faults: Vec<RobotFault>,
     localization: LocalizationErrors,
@@ -240,6 +261,7 @@ impl Pitch {
             calls: Vec::new(),
             shots: Vec::new(),
             frames: Vec::new(),
+            beliefs: Vec::new(),
             record: false,
             faults: Vec::new(),
             localization: LocalizationErrors::default(),
@@ -417,11 +439,22 @@ impl Pitch {
     pub fn book_estimate(&mut self, i: usize, estimate: &Localization) {
         let Some(truth) = self.world.robot(i) else { return };
         let p = estimate.pose.inner;
+        let seen = estimate.ball.filter(|b| b.seen_ago <= 0.0);
+        if self.record {
+            self.beliefs.push(BeliefSample {
+                robot: i,
+                time: self.world.time(),
+                estimate: p,
+                truth,
+                ball: seen,
+                true_ball: self.world.ball(),
+            });
+        }
         let l = &mut self.localization;
         let off = (p.x - truth.x).hypot(p.y - truth.y);
         l.position.push(off);
         l.heading.push(normalize_angle(p.theta - truth.theta).abs());
-        if let Some(ball) = estimate.ball.filter(|b| b.seen_ago <= 0.0) {
+        if let Some(ball) = seen {
             let (bx, by) = self.world.ball();
             l.ball.push((ball.at.0 - bx).hypot(ball.at.1 - by));
             if let Some((vx, vy)) = ball.velocity {
@@ -539,7 +572,8 @@ impl Pitch {
         }
     }
 
-    /// Keeps one [`Frame`] per control cycle for drawings.
+    /// Keeps one [`Frame`] per control cycle, and every robot's belief at each estimate, for
+    /// drawings.
     pub fn record_frames(&mut self, on: bool) {
         self.record = on;
     }
@@ -555,6 +589,7 @@ impl Pitch {
             calls: self.calls,
             shots: self.shots,
             frames: self.frames,
+            beliefs: self.beliefs,
             faults: self.faults,
             localization: self.localization,
             kidnaps: self.kidnaps,

@@ -231,6 +231,7 @@ mod tests {
             calls: Vec::new(),
             shots: Vec::new(),
             frames: Vec::new(),
+            beliefs: Vec::new(),
             faults: Vec::new(),
             localization,
             kidnaps,

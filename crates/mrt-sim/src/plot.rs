@@ -1,21 +1,35 @@
 //! Drawing a match: the field, trajectories, kicks and the score as SVG.
 
 use crate::config::SimConfig;
-use crate::game::MatchReport;
+use crate::game::{BeliefSample, MatchReport};
 use crate::referee::Call;
+use mrt_msgs::BallBelief;
 use std::fmt::Write as _;
 
-impl MatchReport {
-    /// The match as SVG: the field, every robot's and the ball's trajectory (frames must
-    /// have been recorded), the kicks and the score; `names` are the teams' names.
-    pub fn to_svg(&self, cfg: &SimConfig, names: (&str, &str)) -> String {
-        let r = self;
+/// The drawing's scale and origin: field metres to SVG pixels, a 40 px title band on top.
+struct Canvas {
+    hl: f64,
+    hw: f64,
+    border: f64,
+    scale: f64,
+}
+
+impl Canvas {
+    fn px(&self, x: f64) -> f64 {
+        (x + self.hl + self.border) * self.scale
+    }
+    fn py(&self, y: f64) -> f64 {
+        (self.hw + self.border - y) * self.scale + 40.0
+    }
+
+    /// The SVG's opening and the field (carpet, lines, goals, penalty areas) of `cfg`.
+    fn field(cfg: &SimConfig) -> (Canvas, String) {
         let f = &cfg.field;
-        let (hl, hw, b) = (f.length / 2.0, f.width / 2.0, f.border);
-        let scale = 50.0; // px per m
-        let (w, h) = ((f.length + 2.0 * b) * scale, (f.width + 2.0 * b) * scale + 40.0);
-        let px = |x: f64| (x + hl + b) * scale;
-        let py = |y: f64| (hw + b - y) * scale + 40.0;
+        let c = Canvas { hl: f.length / 2.0, hw: f.width / 2.0, border: f.border, scale: 50.0 };
+        let (hl, hw, scale) = (c.hl, c.hw, c.scale);
+        let (w, h) =
+            ((f.length + 2.0 * c.border) * scale, (f.width + 2.0 * c.border) * scale + 40.0);
+        let (px, py) = (|x| c.px(x), |y| c.py(y));
         let mut s = String::new();
         let _ = writeln!(
             s,
@@ -68,6 +82,17 @@ impl MatchReport {
                 f.penalty_area_width * scale
             );
         }
+        (c, s)
+    }
+}
+
+impl MatchReport {
+    /// The match as SVG: the field, every robot's and the ball's trajectory (frames must
+    /// have been recorded), the kicks and the score; `names` are the teams' names.
+    pub fn to_svg(&self, cfg: &SimConfig, names: (&str, &str)) -> String {
+        let r = self;
+        let (c, mut s) = Canvas::field(cfg);
+        let (px, py) = (|x| c.px(x), |y| c.py(y));
         let n = cfg.rules.team_size;
         let robots = r.frames.first().map_or(0, |fr| fr.robots.len());
         for i in 0..robots {
@@ -126,6 +151,125 @@ impl MatchReport {
     }
 }
 
+/// A polyline through `points`, broken where two in a row are more than `jump` m apart (a
+/// robot carried, an estimate relocalized, a ball put back by the referee).
+fn broken_path(c: &Canvas, points: impl IntoIterator<Item = (f64, f64)>, jump: f64) -> String {
+    let mut d = String::new();
+    let mut last: Option<(f64, f64)> = None;
+    for (x, y) in points {
+        let gap = last.is_none_or(|(lx, ly)| (x - lx).hypot(y - ly) > jump);
+        let _ = write!(d, "{}{:.1},{:.1} ", if gap { "M" } else { "L" }, c.px(x), c.py(y));
+        last = Some((x, y));
+    }
+    d
+}
+
+/// Seconds of roll a velocity arrow shows.
+const ARROW_SECONDS: f64 = 0.5;
+
+impl MatchReport {
+    /// Robot `robot`'s belief over the match as SVG (frames must have been recorded): its
+    /// estimated path (orange, dashed) over its true one (white), the ball where it believed
+    /// it saw it (orange dots, with arrows for the velocity it estimated, half a second of roll,
+    /// once a second) over the true ball (light blue), and the moments it was carried (a cross
+    /// where it was put down, with how soon it found itself again). Only the simulated seconds
+    /// `from ..= to` are drawn.
+    pub fn belief_svg(&self, cfg: &SimConfig, robot: usize, (from, to): (f64, f64)) -> String {
+        let (c, mut s) = Canvas::field(cfg);
+        let _ = writeln!(
+            s,
+            r##"<defs><marker id="arrow" viewBox="0 0 10 10" refX="9" refY="5" markerWidth="5" markerHeight="5" orient="auto"><path d="M0,0 L10,5 L0,10 z" fill="#ff9800"/></marker></defs>"##
+        );
+        let mine: Vec<&BeliefSample> = self
+            .beliefs
+            .iter()
+            .filter(|b| b.robot == robot && b.time >= from && b.time <= to)
+            .collect();
+        let ball = broken_path(&c, mine.iter().map(|b| b.true_ball), 1.5);
+        let _ = writeln!(
+            s,
+            r##"<path d="{ball}" stroke="#81d4fa" stroke-width="1.2" fill="none" opacity="0.8"/>"##
+        );
+        let truth = broken_path(&c, mine.iter().map(|b| (b.truth.x, b.truth.y)), 1.0);
+        let _ = writeln!(
+            s,
+            r##"<path d="{truth}" stroke="white" stroke-width="2" fill="none" opacity="0.9"/>"##
+        );
+        let belief = broken_path(&c, mine.iter().map(|b| (b.estimate.x, b.estimate.y)), 1.0);
+        let _ = writeln!(
+            s,
+            r##"<path d="{belief}" stroke="#ff9800" stroke-width="1.5" stroke-dasharray="5,3" fill="none"/>"##
+        );
+        let mut next_arrow = f64::NEG_INFINITY;
+        for b in &mine {
+            let Some(BallBelief { at: (x, y), velocity, .. }) = b.ball else { continue };
+            let _ = writeln!(
+                s,
+                r##"<circle cx="{:.1}" cy="{:.1}" r="1.8" fill="#ff9800"/>"##,
+                c.px(x),
+                c.py(y)
+            );
+            if let Some((vx, vy)) = velocity.filter(|_| b.time >= next_arrow) {
+                next_arrow = b.time + 1.0;
+                let (tx, ty) = (x + vx * ARROW_SECONDS, y + vy * ARROW_SECONDS);
+                let _ = writeln!(
+                    s,
+                    r##"<line x1="{:.1}" y1="{:.1}" x2="{:.1}" y2="{:.1}" stroke="#ff9800" stroke-width="1.5" marker-end="url(#arrow)"/>"##,
+                    c.px(x),
+                    c.py(y),
+                    c.px(tx),
+                    c.py(ty)
+                );
+            }
+        }
+        for k in self.kidnaps.iter().filter(|k| k.robot == robot && k.at >= from && k.at <= to) {
+            let (x, y) = (c.px(k.to.x), c.py(k.to.y));
+            let found =
+                k.recovered_after.map_or("not found".to_string(), |t| format!("found {t:.1} s"));
+            let _ = writeln!(
+                s,
+                r##"<path d="M{:.1},{:.1} l12,12 M{:.1},{:.1} l-12,12" stroke="#e53935" stroke-width="3"/>"##,
+                x - 6.0,
+                y - 6.0,
+                x + 6.0,
+                y - 6.0
+            );
+            let _ = writeln!(
+                s,
+                r##"<text x="{:.1}" y="{:.1}" font-size="13" fill="white">carried at {:.1} s, {found}</text>"##,
+                x + 9.0,
+                y - 8.0,
+                k.at
+            );
+        }
+        let mut errors: Vec<f64> = mine
+            .iter()
+            .map(|b| (b.estimate.x - b.truth.x).hypot(b.estimate.y - b.truth.y))
+            .collect();
+        errors.sort_by(f64::total_cmp);
+        let at = |q: f64| errors.get(((errors.len().max(1) - 1) as f64 * q) as usize).copied();
+        let summary = match (at(0.5), at(0.95)) {
+            (Some(m), Some(p)) => format!("position error median {m:.2} m, 95 % {p:.2} m"),
+            _ => "no estimate recorded".to_string(),
+        };
+        let (first, last) = match (mine.first(), mine.last()) {
+            (Some(a), Some(b)) => (a.time, b.time),
+            _ => (from, to),
+        };
+        let _ = writeln!(
+            s,
+            r##"<text x="10" y="17" font-size="15">robot {robot}'s belief, seed {}, {first:.0} to {last:.0} s: {summary}</text>"##,
+            self.seed
+        );
+        let _ = writeln!(
+            s,
+            r##"<text x="10" y="35" font-size="12">white: where it was · orange dashed: where it believed it was · orange dots, arrows: the ball it saw, its velocity (0.5 s) · blue: the ball · ×: carried</text>"##
+        );
+        s.push_str("</svg>\n");
+        s
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -152,5 +296,42 @@ mod tests {
         assert!(svg.contains(r#"width="900.0" height="600.0""#), "{svg}");
         assert_eq!(svg.matches("<path").count(), 3, "two robots and the ball");
         assert!(svg.contains(&format!("red (home, red) {} : {} blue", r.score.0, r.score.1)));
+    }
+
+    #[test]
+    fn a_robots_belief_is_drawn_over_the_truth_with_its_carries() {
+        let mut cfg = SimConfig::oracle();
+        cfg.rules.half_duration = 20.0;
+        cfg.rules.team_size = 1;
+        cfg.rules.kidnaps = 1;
+        let mut m = BusMatch::with_brains(
+            &cfg,
+            3,
+            vec![Box::new(Chaser::default())],
+            vec![Box::new(Chaser::default())],
+        )
+        .unwrap();
+        m.record_frames(true);
+        let r = m.play(|_| {}).unwrap();
+        assert!(r.beliefs.iter().any(|b| b.robot == 0) && r.beliefs.iter().any(|b| b.robot == 1));
+        let carried = r.kidnaps.iter().filter(|k| k.robot == 0).count();
+        assert!(carried >= 1, "{:?}", r.kidnaps);
+        let svg = r.belief_svg(&cfg, 0, (0.0, f64::INFINITY));
+        assert!(svg.starts_with("<svg") && svg.trim_end().ends_with("</svg>"));
+        let paths = svg.matches("<path d=\"M").count();
+        assert_eq!(paths, 4 + carried, "arrowhead, ball, truth, belief, crosses");
+        assert_eq!(svg.matches("carried at").count(), carried);
+        assert!(svg.contains("stroke-dasharray"), "the belief is dashed");
+        assert!(
+            svg.contains("robot 0's belief, seed 3, ") && svg.contains("position error median")
+        );
+        let seen = r.beliefs.iter().filter(|b| b.robot == 0 && b.ball.is_some()).count();
+        assert_eq!(svg.matches("r=\"1.8\"").count(), seen, "one dot per sighting");
+        // A robot with no estimate gets the field and says so.
+        assert!(r.belief_svg(&cfg, 9, (0.0, 1e9)).contains("no estimate recorded"));
+        // A window: only its samples (none before the kickoff's first estimate).
+        assert!(r.belief_svg(&cfg, 0, (-5.0, -1.0)).contains("no estimate recorded"));
+        let early = r.belief_svg(&cfg, 0, (0.0, 5.0));
+        assert!(early.matches("r=\"1.8\"").count() < seen);
     }
 }
