@@ -16,12 +16,21 @@ pub struct MateReport {
     pub pose: Estimate,
     /// Where it believes the ball is (quality 0 when it has no idea).
     pub ball: Estimate,
+    /// One standard deviation of `ball`'s position, mm (0: not known; the team then reads it
+    /// from the quality).
+    #[serde(default)]
+    pub ball_sigma: f64,
 }
 
 impl MateReport {
     /// The report of robot `id` on its world snapshot (before the team's reports are merged
-    /// into it).
+    /// into it), with no ball uncertainty ([`MateReport::with_ball_sigma`] adds it).
     pub fn of(id: u32, keeper: bool, w: &WorldSnapshot) -> MateReport {
-        MateReport { id, keeper, pose: w.my_pos, ball: w.global_ball }
+        MateReport { id, keeper, pose: w.my_pos, ball: w.global_ball, ball_sigma: 0.0 }
+    }
+
+    /// The same report with the ball's standard deviation, mm.
+    pub fn with_ball_sigma(self, ball_sigma: f64) -> MateReport {
+        MateReport { ball_sigma, ..self }
     }
 }

@@ -136,9 +136,11 @@ impl Member for WorldState {
             Err(_) => self.model.camera(frame.get::<CameraFrame>()?),
         };
         let id = u32::try_from(self.robot).unwrap_or(u32::MAX);
-        let report = MateReport::of(id, self.keeper, &w);
+        // The ball's uncertainty in mm, as the reports and the team ball count it.
+        let ball_sigma = self.model.ball_sigma().map(|s| s * 1000.0);
+        let report = MateReport::of(id, self.keeper, &w).with_ball_sigma(ball_sigma.unwrap_or(0.0));
         // Teammates and their ball as the bus told them, not as the simulator knows them.
-        merge_team(&mut w, self.mates.values());
+        merge_team(&mut w, ball_sigma, self.mates.values());
         ctx.publish(report);
         ctx.publish(self.model.localization());
         self.body.perceive(&mut w);

@@ -89,13 +89,18 @@ const LOST_SIGMA: (f64, f64) = (1.0, 0.5);
 /// field's south-west one, and so on.
 const ATTACKING_WEST: [usize; FIELD_OBJECTS] = [0, 2, 1, 6, 5, 4, 3, 8, 7];
 
-/// Where one object was last seen (field frame, m), how reliable that is, and when (s).
+/// Where one object was last seen (field frame, m), how reliable that is, when (s), and how
+/// sure the place was then (one standard deviation, m: the sighting's and the pose's).
 #[derive(Clone, Copy, Debug)]
 struct Memory {
     at: Framed<Field, Point2>,
     reliability: f64,
     seen: f64,
+    sigma: f64,
 }
+
+/// How fast the uncertainty of an unseen ball grows, m/s (it may roll away).
+pub const BALL_SPREAD: f64 = 0.5;
 
 pub use mrt_msgs::FilterCounts;
 
@@ -181,6 +186,12 @@ impl WorldModel {
     /// The ball's rolling friction as its tracker assumes it, 1/s.
     pub fn ball_damping(&self) -> f64 {
         self.ball_track.damping
+    }
+
+    /// One standard deviation of where the robot believes the ball is (m): the last sighting's
+    /// and the pose's then, growing by [`BALL_SPREAD`] a second since (`None`: never seen).
+    pub fn ball_sigma(&self) -> Option<f64> {
+        self.memory[lps::BALL].map(|m| m.sigma + BALL_SPREAD * (self.now - m.seen).max(0.0))
     }
 
     /// What the ball's tracker did with the sightings so far.
@@ -502,11 +513,22 @@ impl WorldModel {
             let (s, c) = self.pose.theta.sin_cos();
             (c * vx - s * vy, s * vx + c * vy)
         });
+        let pose_xy = self.cov.fixed_view::<2, 2>(0, 0).into_owned();
         for (k, z) in frame.sightings.iter().enumerate() {
             match z {
                 Some(z) => {
                     let at = me.at_range_bearing(z.distance, z.bearing);
-                    self.memory[k] = Some(Memory { at, reliability: 1.0, seen: frame.time });
+                    let sd = self.noise.sigma(z.distance, sigmas[k]);
+                    let r = sighting_covariance(
+                        z.distance,
+                        z.bearing,
+                        self.pose.theta,
+                        sd,
+                        pose_xy,
+                        self.cov[(2, 2)],
+                    );
+                    let sigma = (r.trace() / 2.0).max(0.0).sqrt();
+                    self.memory[k] = Some(Memory { at, reliability: 1.0, seen: frame.time, sigma });
                 }
                 None => {
                     if let Some(m) = &mut self.memory[k] {
@@ -625,7 +647,7 @@ impl WorldModel {
         };
         for (slot, lpo) in w.lps.iter_mut().enumerate() {
             let object = if attack == Attack::West { ATTACKING_WEST[slot] } else { slot };
-            let Some(Memory { at, reliability, seen }) = self.memory[object] else {
+            let Some(Memory { at, reliability, seen, .. }) = self.memory[object] else {
                 continue;
             };
             let (range, bearing) = me.range_bearing(at);

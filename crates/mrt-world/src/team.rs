@@ -2,62 +2,228 @@
 //! with its teammates; TeamChaos seed `001` §2.1: the global ball): teammates' poses from their
 //! [`MateReport`]s and the best ball sighting, one's own or a teammate's.
 
+use mrt_core::Pose2;
 use mrt_msgs::{Estimate, Mate, MateReport, WorldSnapshot};
 
 /// A teammate's ball counts this much of its own quality: a second-hand sighting, one cycle
 /// old, is trusted a little less than one's own.
 pub const SHARED_BALL: f64 = 0.9;
 
-/// The team side of the world state: `w.mates` from the teammates' reports (in their order),
-/// and the global ball replaced by a teammate's sighting when that is better than one's own
-/// (quality × [`SHARED_BALL`]). The LPS stays what the robot itself perceived.
-pub fn merge_team<'a>(w: &mut WorldSnapshot, reports: impl IntoIterator<Item = &'a MateReport>) {
+/// A teammate's ball is one cycle old: the ball may have rolled this far meanwhile, mm (added
+/// to its uncertainty).
+pub const SHARED_DRIFT: f64 = 50.0;
+
+/// Two estimates of the ball are of the same ball when they are within this many standard
+/// deviations of each other (their variances summed).
+pub const SAME_BALL: f64 = 3.0;
+
+/// A robot whose own ball estimate is at least this good (a sighting of this frame has 1)
+/// keeps it: the team ball fills in for the robots that do not see the ball.
+pub const SEES_BALL: f64 = 0.99;
+
+/// The standard deviation (mm) of a ball estimate that gives none: read from its quality (a
+/// fresh sighting, quality 1, 100 mm; ten times that at quality 0.1).
+pub fn sigma_from_quality(quality: f64) -> f64 {
+    100.0 / quality.clamp(0.01, 1.0)
+}
+
+/// One ball estimate in the team's fusion (team frame, mm).
+#[derive(Clone, Copy, Debug)]
+struct Sighting {
+    x: f64,
+    y: f64,
+    sigma: f64,
+    quality: f64,
+}
+
+impl Sighting {
+    fn new(e: &Estimate, sigma: Option<f64>, quality: f64) -> Option<Sighting> {
+        let sigma = sigma.filter(|s| s.is_finite() && *s > 0.0);
+        let ok = e.pose.x.is_finite() && e.pose.y.is_finite() && quality.is_finite();
+        (ok && quality > 0.0).then(|| Sighting {
+            x: e.pose.x,
+            y: e.pose.y,
+            sigma: sigma.unwrap_or_else(|| sigma_from_quality(e.quality)),
+            quality: quality.min(1.0),
+        })
+    }
+
+    /// Its weight in the fused estimate: its quality over its variance.
+    fn weight(&self) -> f64 {
+        self.quality / (self.sigma * self.sigma)
+    }
+
+    fn agrees(&self, other: &Sighting) -> bool {
+        let d2 = (self.x - other.x).powi(2) + (self.y - other.y).powi(2);
+        d2 <= SAME_BALL * SAME_BALL * (self.sigma.powi(2) + other.sigma.powi(2))
+    }
+}
+
+/// The team side of the world state (TeamChaos' global ball, seed `001` §2.1; MAP's team
+/// level): `w.mates` from the teammates' reports (in their order), and the **team ball**: the
+/// robot's own ball estimate (`own_sigma`, mm, its uncertainty; `None` reads it from the
+/// quality) fused with its teammates'.
+///
+/// The fusion: every estimate (a teammate's with [`SHARED_BALL`] of its quality and
+/// [`SHARED_DRIFT`] more uncertainty) gathers those that agree with it (within [`SAME_BALL`]
+/// standard deviations); the largest gathering by weight (quality over variance) wins, an
+/// estimate that disagrees with it (a false sighting, a robot that is lost) is left out, and
+/// the team ball is the gathering's inverse-variance weighted mean, with the best quality in
+/// it. A robot that sees the ball this frame ([`SEES_BALL`]) keeps its own estimate; one that
+/// does not gets where its team thinks it is, its own fading memory counting with the rest.
+/// The LPS stays what the robot itself perceived.
+pub fn merge_team<'a>(
+    w: &mut WorldSnapshot,
+    own_sigma: Option<f64>,
+    reports: impl IntoIterator<Item = &'a MateReport>,
+) {
     w.mates.clear();
+    // A robot that sees the ball now trusts its own eyes: the ball it is about to play is the
+    // one it sees, not an average with teammates further away.
+    let sees = w.global_ball.quality >= SEES_BALL;
+    let mut all: Vec<Sighting> = Vec::new();
+    all.extend(Sighting::new(&w.global_ball, own_sigma, w.global_ball.quality));
+    let own = !all.is_empty();
     for r in reports {
         w.mates.push(Mate { id: r.id, at: r.pose, keeper: r.keeper });
-        let shared = r.ball.quality * SHARED_BALL;
-        if shared > w.global_ball.quality {
-            w.global_ball = Estimate { pose: r.ball.pose, quality: shared };
+        if sees {
+            continue;
         }
+        let given = (r.ball_sigma > 0.0).then_some(r.ball_sigma);
+        let sigma = given.unwrap_or_else(|| sigma_from_quality(r.ball.quality)) + SHARED_DRIFT;
+        all.extend(Sighting::new(&r.ball, Some(sigma), r.ball.quality * SHARED_BALL));
     }
+    let gathering =
+        |seed: &Sighting| -> Vec<&Sighting> { all.iter().filter(|s| seed.agrees(s)).collect() };
+    let weigh = |seed: &Sighting| gathering(seed).iter().map(|s| s.weight()).sum::<f64>();
+    // On a tie the first (one's own) gathering wins.
+    let Some(best) = all.iter().reduce(|a, b| if weigh(b) > weigh(a) { b } else { a }) else {
+        return;
+    };
+    let members = gathering(best);
+    if own && members.len() == 1 && std::ptr::eq(members[0], &all[0]) {
+        return; // only its own: nothing to fuse
+    }
+    let total: f64 = members.iter().map(|s| s.weight()).sum();
+    if !(total.is_finite() && total > 0.0) {
+        return;
+    }
+    let x = members.iter().map(|s| s.weight() * s.x).sum::<f64>() / total;
+    let y = members.iter().map(|s| s.weight() * s.y).sum::<f64>() / total;
+    let quality = members.iter().map(|s| s.quality).fold(0.0, f64::max);
+    w.global_ball = Estimate { pose: Pose2::new(x, y, 0.0), quality };
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use mrt_core::Pose2;
 
-    #[test]
-    fn teammates_and_their_better_ball_sightings_merge_into_the_world_state() {
-        let mut w = WorldSnapshot {
-            global_ball: Estimate { pose: Pose2::new(100.0, 0.0, 0.0), quality: 0.5 },
-            ..Default::default()
-        };
-        let report = |id, q, x| MateReport {
+    fn report(id: u32, ball: (f64, f64), quality: f64, sigma: f64) -> MateReport {
+        MateReport {
             id,
             keeper: id == 0,
             pose: Estimate { pose: Pose2::new(-1000.0 * f64::from(id), 0.0, 0.0), quality: 0.9 },
-            ball: Estimate { pose: Pose2::new(x, 50.0, 0.0), quality: q },
-        };
-        // 0.9 × 0.5 = 0.45 < 0.5: one's own sighting stays; 0.9 × 0.8 = 0.72 wins.
-        let reports = [report(0, 0.5, 200.0), report(2, 0.8, 300.0), report(3, 0.7, 400.0)];
-        merge_team(&mut w, &reports);
+            ball: Estimate { pose: Pose2::new(ball.0, ball.1, 0.0), quality },
+            ball_sigma: sigma,
+        }
+    }
+
+    fn seeing(x: f64, y: f64, quality: f64) -> WorldSnapshot {
+        WorldSnapshot {
+            global_ball: Estimate { pose: Pose2::new(x, y, 0.0), quality },
+            ..Default::default()
+        }
+    }
+
+    #[test]
+    fn teammates_are_listed_in_their_order() {
+        let mut w = WorldSnapshot::default();
+        let reports = [report(0, (0.0, 0.0), 0.0, 0.0), report(2, (0.0, 0.0), 0.0, 0.0)];
+        merge_team(&mut w, None, &reports);
         assert_eq!(
             w.mates.iter().map(|m| (m.id, m.keeper)).collect::<Vec<_>>(),
-            [(0, true), (2, false), (3, false)]
+            [(0, true), (2, false)]
         );
         assert_eq!(w.mates[1].at.pose.x, -2000.0);
-        assert!((w.global_ball.quality - 0.72).abs() < 1e-12, "{:?}", w.global_ball);
-        assert_eq!((w.global_ball.pose.x, w.global_ball.pose.y), (300.0, 50.0));
-        // A robot that sees the ball well keeps its own estimate.
-        let mut sharp = WorldSnapshot {
-            global_ball: Estimate { quality: 1.0, ..Default::default() },
-            ..Default::default()
-        };
-        merge_team(&mut sharp, &reports);
-        assert_eq!(sharp.global_ball.quality, 1.0);
-        // The report carries the robot's own sighting, not the merged one.
-        let r = MateReport::of(7, false, &w);
-        assert_eq!((r.id, r.ball.quality), (7, w.global_ball.quality));
+        assert_eq!(w.global_ball.quality, 0.0, "nobody saw the ball");
+    }
+
+    #[test]
+    fn agreeing_estimates_fuse_by_inverse_variance() {
+        // Own, remembered from the last frame: (1000, 0), σ 100 mm, quality 0.95: weight
+        // 0.95 / 100² = 9.5e-5. Mate 2: (1200, 0), σ 150 + 50 (one cycle's drift) = 200 mm,
+        // quality 1 × 0.9: weight 0.9 / 200² = 2.25e-5. They agree: 200 mm apart, within
+        // 3 × √(100² + 200²) = 671. Fused x = (9.5e-5 × 1000 + 2.25e-5 × 1200) / 1.175e-4
+        // = 1038.30 mm, quality max(0.95, 0.9).
+        let mut w = seeing(1000.0, 0.0, 0.95);
+        merge_team(&mut w, Some(100.0), &[report(2, (1200.0, 0.0), 1.0, 150.0)]);
+        assert!((w.global_ball.pose.x - 1038.2979).abs() < 1e-3, "{:?}", w.global_ball);
+        assert_eq!((w.global_ball.pose.y, w.global_ball.quality), (0.0, 0.95));
+    }
+
+    #[test]
+    fn a_robot_that_sees_the_ball_keeps_its_own() {
+        let mut w = seeing(1000.0, 0.0, 1.0);
+        merge_team(&mut w, Some(100.0), &[report(2, (1200.0, 0.0), 1.0, 150.0)]);
+        assert_eq!((w.global_ball.pose.x, w.global_ball.quality), (1000.0, 1.0));
+        assert_eq!(w.mates.len(), 1, "the mates are listed all the same");
+    }
+
+    #[test]
+    fn a_robot_that_does_not_see_the_ball_gets_its_teams() {
+        // Two mates, (2000, 500) and (2100, 500), σ 100 + 50 each, quality 0.8 × 0.9 = 0.72:
+        // equal weights, the mean (2050, 500), quality 0.72.
+        let mut w = WorldSnapshot::default();
+        let reports =
+            [report(1, (2000.0, 500.0), 0.8, 100.0), report(3, (2100.0, 500.0), 0.8, 100.0)];
+        merge_team(&mut w, None, &reports);
+        let b = w.global_ball;
+        assert!((b.pose.x - 2050.0).abs() < 1e-9 && (b.pose.y - 500.0).abs() < 1e-9, "{b:?}");
+        assert!((b.quality - 0.72).abs() < 1e-12);
+    }
+
+    #[test]
+    fn an_estimate_the_others_contradict_is_left_out() {
+        // Own (0, 0) σ 100 and mate 1 (100, 0) σ 100 (+50) agree; mate 2 (5000, 3000) σ 100
+        // (+50), a robot that is lost, agrees with nobody: the gathering of two wins.
+        // Weights: own 0.95e-4, mate 1 0.9 / 150² = 4e-5: x = 4e-5 × 100 / 1.35e-4 = 29.63.
+        let mut w = seeing(0.0, 0.0, 0.95);
+        let reports =
+            [report(1, (100.0, 0.0), 1.0, 100.0), report(2, (5000.0, 3000.0), 1.0, 100.0)];
+        merge_team(&mut w, Some(100.0), &reports);
+        assert!((w.global_ball.pose.x - 29.6296).abs() < 1e-3, "{:?}", w.global_ball);
+        assert_eq!(w.global_ball.pose.y, 0.0);
+    }
+
+    #[test]
+    fn a_sharp_own_sighting_outweighs_a_vague_contradiction() {
+        // Own: σ 50 mm, quality 0.95 (weight 3.8e-4). A far mate says (4000, 0) with σ 1000 + 50 and quality
+        // 0.5 × 0.9 (weight 4.1e-7): they do not agree (4000 > 3 × √(50² + 1050²) = 3154);
+        // own wins alone.
+        let mut w = seeing(0.0, 0.0, 0.95);
+        merge_team(&mut w, Some(50.0), &[report(4, (4000.0, 0.0), 0.5, 1000.0)]);
+        assert_eq!((w.global_ball.pose.x, w.global_ball.quality), (0.0, 0.95));
+    }
+
+    #[test]
+    fn without_sigmas_the_quality_sets_the_weights() {
+        // Old reports give no σ: 100 / quality. Own quality 0.5: σ 200, weight 0.5 / 4e4 =
+        // 1.25e-5; mate quality 1 → σ 100 + 50, quality 0.9, weight 4e-5.
+        // x = (1.25e-5 × 0 + 4e-5 × 300) / 5.25e-5 = 228.57; the best quality, 0.9.
+        let mut w = seeing(0.0, 0.0, 0.5);
+        merge_team(&mut w, None, &[report(5, (300.0, 0.0), 1.0, 0.0)]);
+        assert!((w.global_ball.pose.x - 228.5714).abs() < 1e-3, "{:?}", w.global_ball);
+        assert!((w.global_ball.quality - 0.9).abs() < 1e-12);
+        // The report carries the robot's own sighting, not the merged one, and its σ.
+        let r = MateReport::of(7, false, &w).with_ball_sigma(80.0);
+        assert_eq!((r.id, r.ball.quality, r.ball_sigma), (7, w.global_ball.quality, 80.0));
+    }
+
+    #[test]
+    fn non_finite_reports_are_ignored() {
+        let mut w = seeing(10.0, 0.0, 0.95);
+        let bad = [report(1, (f64::NAN, 0.0), 1.0, 100.0), report(2, (0.0, 0.0), f64::NAN, 1.0)];
+        merge_team(&mut w, Some(100.0), &bad);
+        assert_eq!((w.global_ball.pose.x, w.global_ball.quality), (10.0, 0.95));
     }
 }
