@@ -276,20 +276,23 @@ mod tests {
     use crate::bus::BusMatch;
     use mrt_robot::stacks::Chaser;
 
-    #[test]
-    fn the_drawing_shows_the_field_the_paths_and_the_score() {
+    /// A recorded one-a-side match of chasers, halves of `half` s, `kidnaps` carries a half.
+    fn recorded(seed: u64, half: f64, kidnaps: u32) -> (SimConfig, MatchReport) {
         let mut cfg = SimConfig::oracle();
-        cfg.rules.half_duration = 5.0;
+        cfg.rules.half_duration = half;
         cfg.rules.team_size = 1;
-        let mut m = BusMatch::with_brains(
-            &cfg,
-            2,
-            vec![Box::new(Chaser::default())],
-            vec![Box::new(Chaser::default())],
-        )
-        .unwrap();
+        cfg.rules.kidnaps = kidnaps;
+        let chaser =
+            || vec![Box::new(Chaser::default()) as Box<dyn mrt_robot::brain::Brain + Send>];
+        let mut m = BusMatch::with_brains(&cfg, seed, chaser(), chaser()).unwrap();
         m.record_frames(true);
         let r = m.play(|_| {}).unwrap();
+        (cfg, r)
+    }
+
+    #[test]
+    fn the_drawing_shows_the_field_the_paths_and_the_score() {
+        let (cfg, r) = recorded(2, 5.0, 0);
         let svg = r.to_svg(&cfg, ("red", "blue"));
         assert!(svg.starts_with("<svg") && svg.trim_end().ends_with("</svg>"));
         // The field outline is 18 m × 12 m at 50 px/m: 900 × 600 px.
@@ -300,19 +303,7 @@ mod tests {
 
     #[test]
     fn a_robots_belief_is_drawn_over_the_truth_with_its_carries() {
-        let mut cfg = SimConfig::oracle();
-        cfg.rules.half_duration = 20.0;
-        cfg.rules.team_size = 1;
-        cfg.rules.kidnaps = 1;
-        let mut m = BusMatch::with_brains(
-            &cfg,
-            3,
-            vec![Box::new(Chaser::default())],
-            vec![Box::new(Chaser::default())],
-        )
-        .unwrap();
-        m.record_frames(true);
-        let r = m.play(|_| {}).unwrap();
+        let (cfg, r) = recorded(3, 20.0, 1);
         assert!(r.beliefs.iter().any(|b| b.robot == 0) && r.beliefs.iter().any(|b| b.robot == 1));
         let carried = r.kidnaps.iter().filter(|k| k.robot == 0).count();
         assert!(carried >= 1, "{:?}", r.kidnaps);
