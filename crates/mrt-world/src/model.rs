@@ -25,7 +25,7 @@
 //! robot sees the landmarks, falling as it goes without them.
 
 use crate::field::FieldMap;
-use crate::gm::{FuzzyGrid, GmCounts};
+use crate::gm::FuzzyGrid;
 use crate::murea::{Fix, Perception};
 use crate::relocalize::{self, CameraNoise, Localizer, Relocalizer};
 use crate::track::{sighting_covariance, Track, TrackCounts, BALL_ACCEL};
@@ -89,14 +89,12 @@ const LOST_SIGMA: (f64, f64) = (1.0, 0.5);
 /// field's south-west one, and so on.
 const ATTACKING_WEST: [usize; FIELD_OBJECTS] = [0, 2, 1, 6, 5, 4, 3, 8, 7];
 
-/// Where one object was last seen (field frame, m), how reliable that is, when (s), and how
-/// sure the place was then (one standard deviation, m: the sighting's and the pose's).
+/// Where one object was last seen (field frame, m), how reliable that is, and when (s).
 #[derive(Clone, Copy, Debug)]
 struct Memory {
     at: Framed<Field, Point2>,
     reliability: f64,
     seen: f64,
-    sigma: f64,
 }
 
 /// How fast the uncertainty of an unseen ball grows, m/s (it may roll away).
@@ -127,6 +125,8 @@ pub struct WorldModel {
     grid_disagrees: u32,
     /// The last frame's time, s.
     now: f64,
+    /// One standard deviation of the ball's place when it was last seen, m.
+    ball_seen_sigma: f64,
     /// The ball's velocity in the field frame (m/s) when the last frame gave one.
     ball_velocity: Option<(f64, f64)>,
 }
@@ -155,6 +155,7 @@ impl WorldModel {
             grid_disagrees: 0,
             now: 0.0,
             ball_velocity: None,
+            ball_seen_sigma: 0.0,
         }
     }
 
@@ -191,7 +192,8 @@ impl WorldModel {
     /// One standard deviation of where the robot believes the ball is (m): the last sighting's
     /// and the pose's then, growing by [`BALL_SPREAD`] a second since (`None`: never seen).
     pub fn ball_sigma(&self) -> Option<f64> {
-        self.memory[lps::BALL].map(|m| m.sigma + BALL_SPREAD * (self.now - m.seen).max(0.0))
+        self.memory[lps::BALL]
+            .map(|m| self.ball_seen_sigma + BALL_SPREAD * (self.now - m.seen).max(0.0))
     }
 
     /// What the ball's tracker did with the sightings so far.
@@ -208,11 +210,6 @@ impl WorldModel {
         } else {
             Localizer::Ekf
         }
-    }
-
-    /// The fuzzy grid's counts, with [`Localizer::Gm`].
-    pub fn grid_counts(&self) -> Option<GmCounts> {
-        self.grid.as_ref().map(|g| g.counts())
     }
 
     /// The pose estimate (field frame, m).
@@ -513,22 +510,25 @@ impl WorldModel {
             let (s, c) = self.pose.theta.sin_cos();
             (c * vx - s * vy, s * vx + c * vy)
         });
-        let pose_xy = self.cov.fixed_view::<2, 2>(0, 0).into_owned();
+        if let Some(z) = frame.sightings[lps::BALL] {
+            // How sure the ball's place is: the sighting's error and the corrected pose's.
+            let sd = self.noise.sigma(z.distance, sigmas[lps::BALL]);
+            let pose_xy = self.cov.fixed_view::<2, 2>(0, 0).into_owned();
+            let r = sighting_covariance(
+                z.distance,
+                z.bearing,
+                self.pose.theta,
+                sd,
+                pose_xy,
+                self.cov[(2, 2)],
+            );
+            self.ball_seen_sigma = (r.trace() / 2.0).max(0.0).sqrt();
+        }
         for (k, z) in frame.sightings.iter().enumerate() {
             match z {
                 Some(z) => {
                     let at = me.at_range_bearing(z.distance, z.bearing);
-                    let sd = self.noise.sigma(z.distance, sigmas[k]);
-                    let r = sighting_covariance(
-                        z.distance,
-                        z.bearing,
-                        self.pose.theta,
-                        sd,
-                        pose_xy,
-                        self.cov[(2, 2)],
-                    );
-                    let sigma = (r.trace() / 2.0).max(0.0).sqrt();
-                    self.memory[k] = Some(Memory { at, reliability: 1.0, seen: frame.time, sigma });
+                    self.memory[k] = Some(Memory { at, reliability: 1.0, seen: frame.time });
                 }
                 None => {
                     if let Some(m) = &mut self.memory[k] {
@@ -647,7 +647,7 @@ impl WorldModel {
         };
         for (slot, lpo) in w.lps.iter_mut().enumerate() {
             let object = if attack == Attack::West { ATTACKING_WEST[slot] } else { slot };
-            let Some(Memory { at, reliability, seen, .. }) = self.memory[object] else {
+            let Some(Memory { at, reliability, seen }) = self.memory[object] else {
                 continue;
             };
             let (range, bearing) = me.range_bearing(at);

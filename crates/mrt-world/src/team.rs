@@ -95,16 +95,21 @@ pub fn merge_team<'a>(
     }
     let gathering =
         |seed: &Sighting| -> Vec<&Sighting> { all.iter().filter(|s| seed.agrees(s)).collect() };
-    let weigh = |seed: &Sighting| gathering(seed).iter().map(|s| s.weight()).sum::<f64>();
-    // On a tie the first (one's own) gathering wins.
-    let Some(best) = all.iter().reduce(|a, b| if weigh(b) > weigh(a) { b } else { a }) else {
+    // The heaviest gathering; on a tie the first (one's own).
+    let mut best: Option<(Vec<&Sighting>, f64)> = None;
+    for seed in &all {
+        let members = gathering(seed);
+        let weight: f64 = members.iter().map(|s| s.weight()).sum();
+        if best.as_ref().is_none_or(|(_, w)| weight > *w) {
+            best = Some((members, weight));
+        }
+    }
+    let Some((members, total)) = best else {
         return;
     };
-    let members = gathering(best);
     if own && members.len() == 1 && std::ptr::eq(members[0], &all[0]) {
         return; // only its own: nothing to fuse
     }
-    let total: f64 = members.iter().map(|s| s.weight()).sum();
     if !(total.is_finite() && total > 0.0) {
         return;
     }
