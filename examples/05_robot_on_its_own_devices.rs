@@ -74,7 +74,7 @@ impl Devices for TableRobot {
     }
 
     fn game(&mut self) -> Result<GameInfo, String> {
-        Ok(GameInfo { state: GameState::Playing, attack: 1.0, kickoff_pose: None })
+        Ok(GameInfo { state: GameState::Playing, attack: 1.0, kickoff_pose: None, marker: None })
     }
 
     fn sonars(&mut self) -> Result<Vec<Sonar>, String> {

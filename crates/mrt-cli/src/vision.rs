@@ -66,6 +66,8 @@ fn paint(c: ColorClass) -> Rgb<u8> {
         ColorClass::Robot => [0, 0, 0],
         ColorClass::Line => [255, 255, 255],
         ColorClass::Field => [0, 130, 0],
+        ColorClass::MarkerMagenta => [255, 0, 255],
+        ColorClass::MarkerCyan => [0, 255, 255],
     })
 }
 

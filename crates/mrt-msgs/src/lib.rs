@@ -50,10 +50,13 @@ pub use behavior::{BehaviorStatus, ReloadRequest};
 pub use device::{DeviceAct, DeviceFrame, FinalWhistle, MemberFault, RobotEnd};
 pub use localization::{BallBelief, FilterCounts, Localization};
 pub use mrt_core::{Message, MsgType};
-pub use robot::{lps, Estimate, Field, GameState, Lpo, Mate, RobotCommand, Target, WorldSnapshot};
+pub use robot::{
+    lps, AnchoredRobot, Estimate, Field, GameState, Lpo, Mate, RobotClass, RobotCommand, Target,
+    WorldSnapshot,
+};
 pub use sensing::{
-    CameraFrame, Displacement, GameInfo, Image, MiceReadings, Odometry, Percepts, PostSighting,
-    Sighting, Sonar, SonarScan, FIELD_OBJECTS,
+    CameraFrame, Displacement, GameInfo, Image, Marker, MiceReadings, Odometry, Percepts,
+    PostSighting, RobotSighting, Sighting, Sonar, SonarScan, FIELD_OBJECTS,
 };
 pub use team::MateReport;
 
@@ -117,7 +120,12 @@ mod tests {
         let pose = Pose2::new(-1.5, 2.0, 0.25);
         let framed: Framed<Field, Pose2> = Framed::new(pose);
         assert_eq!(serde_json::to_string(&framed).unwrap(), serde_json::to_string(&pose).unwrap());
-        let g = GameInfo { state: GameState::Ready, attack: -1.0, kickoff_pose: Some(framed) };
+        let g = GameInfo {
+            state: GameState::Ready,
+            attack: -1.0,
+            kickoff_pose: Some(framed),
+            marker: Some(Marker::Cyan),
+        };
         let back: GameInfo = serde_json::from_str(&serde_json::to_string(&g).unwrap()).unwrap();
         assert_eq!(back, g);
     }

@@ -59,6 +59,63 @@ pub struct Mate {
     pub keeper: bool,
 }
 
+/// What kind of robot an anchor is: MAP's conceptual model, Robot ▸ {Teammate, Opponent}
+/// (MRT manual ch. 8). A robot whose marker was never seen and who is where no teammate says
+/// it is stays a generic Robot.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum RobotClass {
+    /// A robot of unknown team.
+    #[default]
+    Robot,
+    /// One of ours.
+    Teammate,
+    /// One of theirs.
+    Opponent,
+}
+
+impl RobotClass {
+    /// The name scripts see: `robot`, `teammate`, `opponent`.
+    pub fn name(self) -> &'static str {
+        match self {
+            RobotClass::Robot => "robot",
+            RobotClass::Teammate => "teammate",
+            RobotClass::Opponent => "opponent",
+        }
+    }
+}
+
+/// Another robot anchored by the world model (MAP's anchors, MRT manual ch. 8; TeamChaos'
+/// perceptual anchoring, seed `001` §2.1): a track with an identity that lasts while the robot
+/// is seen, is predicted while it is not, and fades.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct AnchoredRobot {
+    /// The anchor's identity: the same robot keeps it from frame to frame.
+    pub id: u32,
+    /// Teammate, opponent or unknown.
+    pub class: RobotClass,
+    /// Its centre in the team frame, mm (x towards the opponent's net).
+    pub x: f64,
+    /// See `x`.
+    pub y: f64,
+    /// Its velocity in the team frame, mm/s.
+    pub vx: f64,
+    /// See `vx`.
+    pub vy: f64,
+    /// One standard deviation of its place, mm.
+    pub sigma: f64,
+    /// Distance from this robot's centre to its centre, mm (as an [`Lpo`]).
+    pub rho: f64,
+    /// Its bearing, rad, counter-clockwise positive, 0 straight ahead.
+    pub theta: f64,
+    /// How much the anchor is to be trusted, 0 to 1: 1 when seen this frame, fading while
+    /// unseen.
+    pub reliability: f64,
+    /// Seconds since it was last perceived.
+    pub seen_ago: f64,
+}
+
 /// The field as the world model's map knows it (`getField`), in millimetres: behaviors read
 /// their geometry from here instead of assuming one field size.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -131,6 +188,9 @@ pub struct WorldSnapshot {
     pub global_ball: Estimate,
     /// Teammates (`getMates`).
     pub mates: Vec<Mate>,
+    /// Other robots anchored by the world model, teammates and opponents (`getRobots`),
+    /// nearest first.
+    pub robots: Vec<AnchoredRobot>,
     /// The current role (`getRole`), e.g. `attacker`.
     pub role: String,
     /// Whether this robot holds the ball booking (`haveBookedBall`).
@@ -154,12 +214,51 @@ impl Default for WorldSnapshot {
             ball_vel: Vec2::zeros(),
             global_ball: Estimate::default(),
             mates: Vec::new(),
+            robots: Vec::new(),
             role: String::new(),
             ball_booked: false,
             game_state: GameState::default(),
             field: Field::default(),
             kickoff_pose: None,
         }
+    }
+}
+
+impl WorldSnapshot {
+    /// The nearest robot that is not known to be a teammate, with at least `min_reliability`
+    /// (`getNearestOpponent`): an opponent, or a robot of unknown team (a careful player
+    /// treats a robot it cannot place as an opponent).
+    pub fn nearest_opponent(&self, min_reliability: f64) -> Option<&AnchoredRobot> {
+        self.robots
+            .iter()
+            .filter(|r| r.class != RobotClass::Teammate && r.reliability >= min_reliability)
+            .min_by(|a, b| a.rho.total_cmp(&b.rho))
+    }
+
+    /// The free direction nearest to `desired` (rad, robot frame; `getFreeDirection`): the
+    /// bearing of a corridor `2·clearance` wide (mm: this robot's radius plus another's) and
+    /// `reach` long (mm) in which no anchored robot of at least `min_reliability` stands.
+    /// Bearings are tried every 5° outwards from `desired`, left before right; `None` when
+    /// every one is blocked.
+    pub fn free_direction(
+        &self,
+        desired: f64,
+        reach: f64,
+        clearance: f64,
+        min_reliability: f64,
+    ) -> Option<f64> {
+        const STEP: f64 = std::f64::consts::PI / 36.0;
+        let blocks = |bearing: f64| {
+            self.robots.iter().filter(|r| r.reliability >= min_reliability).any(|r| {
+                let (s, c) = (r.theta - bearing).sin_cos();
+                let (along, lateral) = (r.rho * c, (r.rho * s).abs());
+                along > 0.0 && along < reach + clearance && lateral < clearance
+            })
+        };
+        (0..=36)
+            .flat_map(|k| [k, -k])
+            .map(|k| mrt_core::normalize_angle(desired + f64::from(k) * STEP))
+            .find(|&b| !blocks(b))
     }
 }
 
@@ -222,5 +321,54 @@ mod tests {
         c.needs.push((lps::NET1, 0.4));
         assert_eq!(c.need(lps::NET1), 0.7, "needs combine by max");
         assert_eq!(GameState::Playing.name(), "PLAYING");
+    }
+
+    fn robot(class: RobotClass, rho: f64, theta: f64, reliability: f64) -> AnchoredRobot {
+        AnchoredRobot { class, rho, theta, reliability, ..Default::default() }
+    }
+
+    #[test]
+    fn the_nearest_opponent_skips_teammates_and_faded_anchors() {
+        let mut w = WorldSnapshot::default();
+        assert!(w.nearest_opponent(0.0).is_none());
+        w.robots = vec![
+            robot(RobotClass::Teammate, 500.0, 0.0, 1.0),
+            robot(RobotClass::Opponent, 3000.0, 0.5, 1.0),
+            robot(RobotClass::Robot, 2000.0, -0.5, 0.2),
+        ];
+        assert_eq!(w.nearest_opponent(0.0).map(|r| r.rho), Some(2000.0), "unknown team counts");
+        assert_eq!(w.nearest_opponent(0.5).map(|r| r.rho), Some(3000.0));
+    }
+
+    #[test]
+    fn the_free_direction_goes_round_a_robot_in_the_way() {
+        let mut w = WorldSnapshot::default();
+        // Nothing in the way: the desired bearing itself.
+        assert_eq!(w.free_direction(0.3, 2000.0, 500.0, 0.5), Some(0.3));
+        // A robot 1 m straight ahead, corridor half-width 0.45 m: blocked while
+        // |1000·sin(b)| < 450, i.e. |b| < 26.7°; the first free bearing on the 5° grid is 30°,
+        // left first.
+        w.robots = vec![robot(RobotClass::Opponent, 1000.0, 0.0, 1.0)];
+        let b = w.free_direction(0.0, 2000.0, 450.0, 0.5).unwrap();
+        assert!((b - 30f64.to_radians()).abs() < 1e-9, "{b}");
+        // A second robot on the left at 35°, 1.2 m (1200·sin 5° = 105 mm off the 30° line)
+        // pushes it to the right.
+        w.robots.push(robot(RobotClass::Robot, 1200.0, 35f64.to_radians(), 1.0));
+        let b = w.free_direction(0.0, 2000.0, 450.0, 0.5).unwrap();
+        assert!((b + 30f64.to_radians()).abs() < 1e-9, "{b}");
+        // Robots behind, beyond the reach or faded do not block.
+        w.robots = vec![
+            robot(RobotClass::Opponent, 1000.0, std::f64::consts::PI, 1.0),
+            robot(RobotClass::Opponent, 3000.0, 0.0, 1.0),
+            robot(RobotClass::Opponent, 1000.0, 0.0, 0.1),
+        ];
+        assert_eq!(w.free_direction(0.0, 2000.0, 500.0, 0.5), Some(0.0));
+        // Surrounded: none.
+        w.robots = (0..12)
+            .map(|k| {
+                robot(RobotClass::Opponent, 400.0, f64::from(k) * std::f64::consts::FRAC_PI_6, 1.0)
+            })
+            .collect();
+        assert_eq!(w.free_direction(0.0, 2000.0, 500.0, 0.5), None);
     }
 }

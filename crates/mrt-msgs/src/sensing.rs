@@ -123,6 +123,44 @@ pub struct Sighting {
     pub bearing: f64,
 }
 
+/// The colour of the marker band a robot wears round its top (RoboCup Middle Size League:
+/// magenta or cyan, one per team for a match), which tells its team: MAP's classifier reads it
+/// to make a Robot a Teammate or an Opponent (MRT manual ch. 8).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Marker {
+    /// Magenta (the simulator's home team).
+    Magenta,
+    /// Cyan (the simulator's away team).
+    Cyan,
+}
+
+impl Marker {
+    /// The other team's colour.
+    pub fn other(self) -> Marker {
+        match self {
+            Marker::Magenta => Marker::Cyan,
+            Marker::Cyan => Marker::Magenta,
+        }
+    }
+}
+
+/// Another robot in one camera frame (object sensor or vision): the percept MAP anchors as a
+/// Robot, a Teammate or an Opponent (MRT manual ch. 8).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct RobotSighting {
+    /// Distance and bearing of its nearest point (its foot on the floor) from the robot's
+    /// centre, m and rad.
+    pub sighting: Sighting,
+    /// Standard deviations `(distance m, bearing rad)`, when the sensor knows them.
+    #[serde(default)]
+    pub sigma: Option<(f64, f64)>,
+    /// The colour of its marker, when seen; `None`: a robot of unknown team (its top out of
+    /// view, too far, hidden).
+    #[serde(default)]
+    pub marker: Option<Marker>,
+}
+
 /// What the game controller tells every robot each cycle (field frame, m): the referee's
 /// state of TeamChaos' `getCurrentState()` (seed `001` §3.3) and the robot's place in the
 /// kickoff formation. Its own message, published by the game controller's driver (a radio
@@ -135,6 +173,10 @@ pub struct GameInfo {
     pub attack: f64,
     /// The robot's place in the kickoff formation (field frame, m), in READY.
     pub kickoff_pose: Option<Framed<Field, Pose2>>,
+    /// The marker colour the robot's own team wears in this match (`None`: not told; then
+    /// every other robot stays of unknown team).
+    #[serde(default)]
+    pub marker: Option<Marker>,
 }
 
 /// One frame of the object sensor, published by the camera driver: distance and bearing of the
@@ -146,6 +188,9 @@ pub struct CameraFrame {
     /// What was seen, in [`FIELD_OBJECTS`] order: ball, east net, west net, then the
     /// landmarks of the field map (`None`: not seen this frame).
     pub sightings: [Option<Sighting>; FIELD_OBJECTS],
+    /// Other robots in view.
+    #[serde(default)]
+    pub robots: Vec<RobotSighting>,
     /// The ball's velocity in the robot's frame (m/s). No camera measures one: MRT's devices
     /// leave it `None`, and the world model's ball tracker (MAP) fills it in the frame it
     /// reads.
@@ -180,8 +225,10 @@ pub struct Percepts {
     pub pixels: [u32; FIELD_OBJECTS],
     /// Points of the white field lines on the floor (robot frame, m).
     pub line_points: Vec<(f64, f64)>,
-    /// Other robots: the nearest point of each, from the robot's centre.
-    pub obstacles: Vec<Sighting>,
+    /// Other robots: the nearest point of each, from the robot's centre, with its marker
+    /// when the image shows it.
+    #[serde(default)]
+    pub robots: Vec<RobotSighting>,
     /// The landmark posts seen, each with the half of the field it stands on but not which
     /// post of that half it is (the world model tells them apart).
     #[serde(default)]

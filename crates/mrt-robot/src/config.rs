@@ -71,12 +71,13 @@ pub struct VisionSetup {
 
 impl RobotConfig {
     /// The robot's world model as it starts: its field map, its mice, its camera's noise, the
-    /// pose unknown until it is put down.
+    /// pose unknown until it is put down; other robots are taken to be its own size.
     pub fn world_model(&self) -> WorldModel {
         let model =
             WorldModel::new(self.field, self.mice, self.camera.distance, self.camera.bearing)
                 .with_localizer(self.localizer)
-                .with_ball_damping(self.ball_damping);
+                .with_ball_damping(self.ball_damping)
+                .with_robot_radius(self.radius);
         // A robot with the up camera sees the field lines all around: ISocRob's self mode.
         match self.vision.as_ref().and_then(|v| v.up_camera) {
             Some(_) => model.with_self_mode(),

@@ -365,7 +365,10 @@ impl Pitch {
     pub fn camera(&mut self, i: usize) -> CameraFrame {
         let pan = self.pans.get(i).copied().unwrap_or(0.0);
         let Some(eyes) = &mut self.eyes else {
-            let frame = sensor::look(&self.world, i, pan, &self.cfg.sensor, &mut self.rngs[i]);
+            let referee = &self.referee;
+            let marker_of = |k: usize| referee.team_of(k).marker();
+            let frame =
+                sensor::look(&self.world, i, pan, &self.cfg.sensor, marker_of, &mut self.rngs[i]);
             return CameraFrame { pan: Some(pan), ..frame };
         };
         let scene = Scene {

@@ -32,6 +32,15 @@ impl Team {
         }
     }
 
+    /// The marker colour its robots wear: magenta home, cyan away (the renderer paints it,
+    /// the game controller tells each robot its own).
+    pub fn marker(self) -> mrt_msgs::Marker {
+        match self {
+            Team::Home => mrt_msgs::Marker::Magenta,
+            Team::Away => mrt_msgs::Marker::Cyan,
+        }
+    }
+
     /// 0 for home, 1 for away.
     pub fn index(self) -> usize {
         match self {

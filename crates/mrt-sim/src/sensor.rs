@@ -72,7 +72,7 @@ fn blocks(a: (f64, f64), b: (f64, f64), c: (f64, f64), radius: f64) -> bool {
     t > 0.0 && t < 1.0 && (px - c.0).hypot(py - c.1) < radius
 }
 
-pub use mrt_msgs::{CameraFrame, GameInfo, Sighting, FIELD_OBJECTS};
+pub use mrt_msgs::{CameraFrame, GameInfo, Marker, RobotSighting, Sighting, FIELD_OBJECTS};
 
 /// What the game controller tells robot `robot` now: the referee's state, the direction its
 /// team attacks, its place in the kickoff formation.
@@ -81,41 +81,64 @@ pub fn game_info(referee: &Referee, robot: usize) -> GameInfo {
         state: referee.state(),
         attack: referee.attack_direction(referee.team_of(robot)),
         kickoff_pose: referee.kickoff_pose(robot).map(Framed::new),
+        marker: Some(referee.team_of(robot).marker()),
     }
 }
 
 /// What the camera of robot `robot`, its pan joint at `pan` (rad), sees now (the object
 /// sensor): every object within its range and field of view, not hidden behind another robot
-/// (the ball) and not missed, as distance and bearing (robot frame) with range-dependent
-/// noise.
+/// (the ball, the other robots) and not missed, as distance and bearing (robot frame) with
+/// range-dependent noise; the other robots at their nearest point, with the marker colour
+/// `marker_of` gives each (within the ball's range the band round a robot's top is always
+/// seen: the object sensor does not model a marker out of view).
 pub fn look(
     world: &World,
     robot: usize,
     pan: f64,
     cfg: &SensorConfig,
+    marker_of: impl Fn(usize) -> Marker,
     rng: &mut dyn RngCore,
 ) -> CameraFrame {
     let me = world.robot(robot).unwrap_or_default();
     let r_robot = world.config().robot.radius;
-    let robots: Vec<(f64, f64)> = (0..world.robot_count())
+    let robots: Vec<(usize, (f64, f64))> = (0..world.robot_count())
         .filter(|&i| i != robot)
-        .filter_map(|i| world.robot(i).map(|p| (p.x, p.y)))
+        .filter_map(|i| world.robot(i).map(|p| (i, (p.x, p.y))))
         .collect();
     let mut frame = CameraFrame { time: world.time(), ..Default::default() };
+    let noisy = |dist: f64, bearing: f64, rng: &mut dyn RngCore| Sighting {
+        distance: (dist * (1.0 + cfg.distance_noise * gauss(rng))).max(0.0),
+        bearing: normalize_angle(bearing + cfg.bearing_noise * gauss(rng)),
+    };
+    let in_view = |bearing: f64| normalize_angle(bearing - pan).abs() <= cfg.half_fov;
+    let miss = cfg.miss_probability.clamp(0.0, 1.0);
     for (k, target) in targets(world).into_iter().enumerate() {
         // The truth, in the robot's frame: what a perfect camera would measure.
         let (dist, bearing) = Framed::<Field, _>::new(me)
             .range_bearing(Framed::new(mrt_core::Point2::new(target.0, target.1)));
         let occluded =
-            k == lps::BALL && robots.iter().any(|&c| blocks((me.x, me.y), target, c, r_robot));
+            k == lps::BALL && robots.iter().any(|&(_, c)| blocks((me.x, me.y), target, c, r_robot));
         let range = if k == lps::BALL { cfg.range } else { cfg.landmark_range };
-        let in_view = normalize_angle(bearing - pan).abs() <= cfg.half_fov;
-        let visible = dist <= range && in_view && !occluded;
-        let missed = rng.random_bool(cfg.miss_probability.clamp(0.0, 1.0));
+        let visible = dist <= range && in_view(bearing) && !occluded;
+        let missed = rng.random_bool(miss);
         if visible && !missed {
-            let distance = (dist * (1.0 + cfg.distance_noise * gauss(rng))).max(0.0);
-            let bearing = normalize_angle(bearing + cfg.bearing_noise * gauss(rng));
-            frame.sightings[k] = Some(Sighting { distance, bearing });
+            frame.sightings[k] = Some(noisy(dist, bearing, rng));
+        }
+    }
+    // The other robots, after the fixed objects (whose random draws stay where they were).
+    for &(i, c) in &robots {
+        let (dist, bearing) =
+            Framed::<Field, _>::new(me).range_bearing(Framed::new(mrt_core::Point2::new(c.0, c.1)));
+        let occluded =
+            robots.iter().any(|&(j, other)| j != i && blocks((me.x, me.y), c, other, r_robot));
+        let visible = dist <= cfg.range && in_view(bearing) && !occluded;
+        let missed = rng.random_bool(miss);
+        if visible && !missed {
+            frame.robots.push(RobotSighting {
+                sighting: noisy((dist - r_robot).max(0.0), bearing, rng),
+                sigma: None,
+                marker: Some(marker_of(i)),
+            });
         }
     }
     // No velocity: a camera does not measure one (the world model tracks the ball).
@@ -227,7 +250,7 @@ mod tests {
         // the heading (bearing -π/4).
         w.place_robot(1, Pose2::new(-2.0, 0.0, std::f64::consts::FRAC_PI_2));
         w.place_ball(0.0, 2.0);
-        let f = look(&w, 1, 0.0, &exact(), &mut rng);
+        let f = look(&w, 1, 0.0, &exact(), |_| Marker::Cyan, &mut rng);
         let ball = f.sightings[lps::BALL].unwrap();
         assert!((ball.distance - 2.828427).abs() < 1e-5, "{ball:?}");
         assert!((ball.bearing + std::f64::consts::FRAC_PI_4).abs() < 1e-6, "{ball:?}"); // f32
@@ -240,7 +263,7 @@ mod tests {
         );
         assert!((f.sightings[EAST_NET].unwrap().distance - 11.0).abs() < 1e-5);
         let short = SensorConfig { landmark_range: 9.0, ..exact() };
-        let f2 = look(&w, 1, 0.0, &short, &mut rng);
+        let f2 = look(&w, 1, 0.0, &short, |_| Marker::Cyan, &mut rng);
         assert_eq!(f2.sightings[EAST_NET], None, "11 m: beyond a 9 m landmark range");
         // The game controller's news: home attacks east in the first half, away west.
         let g = game_info(&r, 1);
@@ -259,9 +282,11 @@ mod tests {
         let mut rng = ChaCha8Rng::seed_from_u64(2);
         w.place_robot(1, Pose2::new(-3.0, 0.0, 0.0));
         w.place_ball(0.0, 0.0);
-        assert!(look(&w, 1, 0.0, &exact(), &mut rng).sightings[lps::BALL].is_some());
+        assert!(
+            look(&w, 1, 0.0, &exact(), |_| Marker::Cyan, &mut rng).sightings[lps::BALL].is_some()
+        );
         w.place_robot(6, Pose2::new(-1.5, 0.05, 0.0)); // in the line of sight
-        let hidden = look(&w, 1, 0.0, &exact(), &mut rng);
+        let hidden = look(&w, 1, 0.0, &exact(), |_| Marker::Cyan, &mut rng);
         assert_eq!((hidden.sightings[lps::BALL], hidden.ball_velocity), (None, None));
         assert!(hidden.sightings[WEST_NET].is_some(), "landmarks stand above the robots");
     }
@@ -273,14 +298,14 @@ mod tests {
         let cfg = SensorConfig { half_fov: 0.5, range: 5.0, landmark_range: 5.0, ..exact() };
         w.place_robot(1, Pose2::new(-5.0, 0.0, std::f64::consts::PI)); // facing west
         w.place_ball(-1.0, 0.0);
-        let f = look(&w, 1, 0.0, &cfg, &mut rng);
+        let f = look(&w, 1, 0.0, &cfg, |_| Marker::Cyan, &mut rng);
         assert_eq!(f.sightings[lps::BALL], None, "4 m behind the robot");
         assert!(f.sightings[WEST_NET].is_some(), "west net 4 m ahead");
         assert_eq!(f.sightings[EAST_NET], None, "east net 14 m behind");
         assert_eq!(f.sightings[NW_CORNER], None, "corner (-9, 6): 7.2 m, out of range");
         // The pan joint turned half round: the camera looks east, at the ball, and the
         // bearing stays in the robot's frame.
-        let turned = look(&w, 1, std::f64::consts::PI, &cfg, &mut rng);
+        let turned = look(&w, 1, std::f64::consts::PI, &cfg, |_| Marker::Cyan, &mut rng);
         let ball = turned.sightings[lps::BALL].expect("the ball is in view");
         assert!((ball.bearing.abs() - std::f64::consts::PI).abs() < 1e-6, "{ball:?}");
         assert_eq!(turned.sightings[WEST_NET], None, "now behind the camera");
@@ -375,7 +400,9 @@ mod tests {
         let sample = |seed| {
             let mut rng = ChaCha8Rng::seed_from_u64(seed);
             (0..400)
-                .filter_map(|_| look(&w, 1, 0.0, &cfg, &mut rng).sightings[lps::BALL])
+                .filter_map(|_| {
+                    look(&w, 1, 0.0, &cfg, |_| Marker::Cyan, &mut rng).sightings[lps::BALL]
+                })
                 .map(|s| s.distance * 1000.0)
                 .collect::<Vec<_>>()
         };

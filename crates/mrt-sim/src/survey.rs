@@ -272,7 +272,8 @@ pub fn survey(cfg: &SimConfig, seed: u64, scenes: usize) -> Result<SurveyReport,
                 (near, visible("obstacle", q.x, q.y, 0.0))
             })
             .collect();
-        obstacle_t.add(&truth, &p.obstacles);
+        let seen: Vec<Sighting> = p.robots.iter().map(|q| q.sighting).collect();
+        obstacle_t.add(&truth, &seen);
     }
     Ok(SurveyReport {
         scenes,

@@ -36,7 +36,9 @@ fn the_palette_is_classified_by_the_shipped_colour_table() {
     assert_eq!(class(palette::BLUE), ColorClass::GoalBlue);
     assert_eq!(class(palette::BALL), ColorClass::Ball);
     assert_eq!(class(palette::ROBOT), ColorClass::Robot);
-    for other in [palette::MAGENTA, palette::CYAN, palette::WALL, palette::HALL] {
+    assert_eq!(class(palette::MAGENTA), ColorClass::MarkerMagenta);
+    assert_eq!(class(palette::CYAN), ColorClass::MarkerCyan);
+    for other in [palette::WALL, palette::HALL] {
         assert_eq!(class(other), ColorClass::Unknown, "{other:?}");
     }
     // Shading darkens a sphere's underside to 60 %: still a ball.
@@ -294,14 +296,19 @@ fn the_vision_agent_finds_ball_nets_and_robots_in_a_rendered_frame() {
     assert!(p.sightings[2].is_none(), "the west net is behind");
     assert!(p.sigmas[0].is_some_and(|(sd, sb)| sd > 0.0 && sd < 0.1 && sb > 0.0));
     assert!(p.pixels[0] > 50);
-    // The opponent: its nearest point is its radius short of its centre.
+    // The opponent: its nearest point is its radius short of its centre, and its marker is
+    // the away team's cyan.
     let (d, b) = truth(me, 7.0, 1.2);
     assert!(
-        p.obstacles
-            .iter()
-            .any(|o| (o.distance - (d - 0.25)).abs() < 0.2 && (o.bearing - b).abs() < 0.1),
+        p.robots.iter().any(|o| {
+            let o_ = o.sighting;
+            (o_.distance - (d - 0.25)).abs() < 0.2
+                && (o_.bearing - b).abs() < 0.1
+                && o.marker == Some(mrt_msgs::Marker::Cyan)
+                && o.sigma.is_some()
+        }),
         "{:?} vs {d} {b}",
-        p.obstacles
+        p.robots
     );
     assert!(!p.line_points.is_empty(), "the penalty area's lines");
     // The west net, turning round.
@@ -322,6 +329,45 @@ fn the_vision_agent_finds_ball_nets_and_robots_in_a_rendered_frame() {
 /// The open space (seed `003` eq. 18) on a rendered frame: an empty goal's is in its mouth;
 /// with a keeper on its left half, it lies right of the keeper. `look` reports the
 /// same goals by their nearest points.
+/// The vision tells the teams apart by the marker band round each robot's top (MAP's
+/// classifier reads it, MRT manual ch. 8): robots of both teams side by side, from 0.8 to
+/// 7 m away, each with its team's colour and never the other's.
+#[test]
+fn the_vision_tells_each_robot_s_team_by_its_marker() {
+    use mrt_msgs::Marker;
+    use mrt_perception::vision::agent::VisionAgent;
+    let cfg = SimConfig::default();
+    let renderer = Renderer::new(&cfg).unwrap();
+    let mut agent = VisionAgent::new(
+        *renderer.pinhole().unwrap(),
+        &mrt_perception::vision::colors::ColorTable::shipped(),
+        cfg.ball.radius,
+    );
+    let me = Pose2::new(-4.0, 0.0, 0.0);
+    let mut told = Vec::new();
+    for d in [0.8, 1.5, 2.5, 3.5, 4.5, 6.0, 7.0] {
+        let lateral = 0.35 * d;
+        let scene = Scene {
+            ball: None,
+            robots: vec![
+                (Pose2::new(me.x + d, lateral, 0.0), true),
+                (Pose2::new(me.x + d, -lateral, 0.0), false),
+            ],
+        };
+        let image = renderer.render(&scene, me, 0.0, None, &mut CameraState::default());
+        let p = agent.see(&image, 0.0, 0.0).unwrap();
+        assert_eq!(p.robots.len(), 2, "at {d} m: {:?}", p.robots);
+        for r in &p.robots {
+            // Left of the heading: the home robot (magenta).
+            let home = r.sighting.bearing > 0.0;
+            let right = if home { Marker::Magenta } else { Marker::Cyan };
+            assert!(r.marker.is_none_or(|m| m == right), "at {d} m: {r:?}");
+        }
+        told.push(p.robots.iter().filter(|r| r.marker.is_some()).count());
+    }
+    assert_eq!(told, [2; 7], "robots whose team was told, at each distance");
+}
+
 #[test]
 fn the_open_space_of_a_goal_with_a_keeper_is_beside_the_keeper() {
     use mrt_perception::vision::agent::VisionAgent;

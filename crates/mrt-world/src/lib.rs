@@ -24,7 +24,7 @@
 //! // Put down on the centre spot, facing east (a field-frame pose, as its type says).
 //! model.place(Framed::new(Pose2::new(0.0, 0.0, 0.0)));
 //! // The camera sees the east net 9 m straight ahead and the ball 2 m to the front left.
-//! model.game(GameInfo { state: GameState::Playing, attack: 1.0, kickoff_pose: None });
+//! model.game(GameInfo { state: GameState::Playing, attack: 1.0, kickoff_pose: None, marker: None });
 //! let mut frame = CameraFrame::default();
 //! frame.sightings[mrt_world::field::EAST_NET] = Some(Sighting { distance: 9.0, bearing: 0.0 });
 //! frame.sightings[lps::BALL] = Some(Sighting { distance: 2.0, bearing: 0.5 });
@@ -37,6 +37,7 @@
 //! ```
 #![deny(missing_docs)]
 
+pub mod anchor;
 pub mod field;
 pub mod gaze;
 pub mod gm;

@@ -17,6 +17,9 @@
 //!   where it was last seen, computed from the pose estimate; an object not seen in a frame
 //!   keeps it, so its robot-relative position moves with the robot's own estimated motion,
 //!   and its reliability decays by [`DECAY`] per cycle.
+//! - **Other robots** (MAP, manual ch. 8): each robot percept, its centre a robot's radius
+//!   beyond the nearest point the camera saw, is placed on the field with the pose's
+//!   uncertainty and anchored ([`crate::anchor`]): classified by its marker, associated, tracked.
 //! - **Snapshot**: everything in the team frame of [`WorldSnapshot`] (mm, x towards the
 //!   opponent's net, whichever half the team plays in, as the game controller says).
 //!
@@ -24,6 +27,7 @@
 //! (`σ_xy` the root mean square of the x and y standard deviations): above 0.9 when the
 //! robot sees the landmarks, falling as it goes without them.
 
+use crate::anchor::{AnchorCounts, Anchors, Phase, RobotPercept};
 use crate::field::FieldMap;
 use crate::gm::FuzzyGrid;
 use crate::murea::{Fix, Perception};
@@ -31,10 +35,10 @@ use crate::relocalize::{self, CameraNoise, Localizer, Relocalizer};
 use crate::track::{sighting_covariance, Track, TrackCounts, BALL_ACCEL};
 use mrt_core::frames::{Attack, Field, Framed, Team, MM_PER_M};
 use mrt_core::{normalize_angle, Point2, Pose2, Time, Vec2};
-use mrt_msgs::robot::{lps, Estimate, Lpo, WorldSnapshot};
+use mrt_msgs::robot::{lps, AnchoredRobot, Estimate, Lpo, WorldSnapshot};
 use mrt_msgs::{
-    BallBelief, CameraFrame, GameInfo, Localization, Odometry, Percepts, PostSighting, Sighting,
-    FIELD_OBJECTS,
+    BallBelief, CameraFrame, GameInfo, Localization, Odometry, Percepts, PostSighting,
+    RobotSighting, Sighting, FIELD_OBJECTS,
 };
 use mrt_perception::mice::{Displacement, MiceOdometry, MiceReadings};
 use mrt_perception::PerceptionError;
@@ -129,7 +133,16 @@ pub struct WorldModel {
     ball_seen_sigma: f64,
     /// The ball's velocity in the field frame (m/s) when the last frame gave one.
     ball_velocity: Option<(f64, f64)>,
+    /// MAP's anchors of the other robots.
+    robots: Anchors,
+    /// The radius this model gives the other robots, m (their centre is this far beyond the
+    /// nearest point the camera sees).
+    robot_radius: f64,
 }
+
+/// The radius of the other robots unless told ([`WorldModel::with_robot_radius`]), m: a Middle
+/// Size robot's (the simulator's default).
+pub const ROBOT_RADIUS: f64 = 0.25;
 
 /// The rolling friction of the ball on the carpet, as a linear damping of its velocity (1/s):
 /// the simulator's default; [`WorldModel::with_ball_damping`] sets another carpet's.
@@ -156,7 +169,26 @@ impl WorldModel {
             now: 0.0,
             ball_velocity: None,
             ball_seen_sigma: 0.0,
+            robots: Anchors::default(),
+            robot_radius: ROBOT_RADIUS,
         }
+    }
+
+    /// The same model for other robots of radius `radius` (m; a positive number, else
+    /// [`ROBOT_RADIUS`]).
+    pub fn with_robot_radius(mut self, radius: f64) -> Self {
+        self.robot_radius = if radius.is_finite() && radius > 0.0 { radius } else { ROBOT_RADIUS };
+        self
+    }
+
+    /// The anchors of the other robots (MAP, [`crate::anchor`]).
+    pub fn robot_anchors(&self) -> &Anchors {
+        &self.robots
+    }
+
+    /// What the anchoring of the other robots did so far.
+    pub fn robot_anchor_counts(&self) -> AnchorCounts {
+        self.robots.counts()
     }
 
     /// The same model keeping its pose with `localizer` (the EKF alone unless told).
@@ -272,8 +304,9 @@ impl WorldModel {
         if let Some(g) = &mut self.grid {
             g.place(pose.inner);
         }
-        // The ball's track lies in the field frame of the pose that was.
+        // The ball's and the robots' tracks lie in the field frame of the pose that was.
         self.ball_track.reset();
+        self.robots.reset();
     }
 
     /// Puts the filter where the relocalizer's `fix` says, as sure as MUREA's accuracy and
@@ -289,6 +322,7 @@ impl WorldModel {
         self.cov = Matrix3::from_diagonal(&Vector3::new(xy * xy, xy * xy, theta * theta));
         self.counts.relocalized += 1;
         self.ball_track.reset();
+        self.robots.reset();
     }
 
     /// One cycle's odometry: a placement resets the pose, then the motion moves it.
@@ -454,6 +488,7 @@ impl WorldModel {
         let frame = CameraFrame {
             time: frame.time,
             sightings: frame.sightings,
+            robots: frame.robots.clone(),
             ball_velocity: velocity,
             ..Default::default()
         };
@@ -537,7 +572,33 @@ impl WorldModel {
                 }
             }
         }
+        self.anchor_robots(frame.time, &frame.robots);
         self.snapshot(frame)
+    }
+
+    /// MAP on the frame's robot percepts: each placed on the field from the corrected pose,
+    /// with its covariance (the sighting's error and the pose's), then anchored.
+    fn anchor_robots(&mut self, time: f64, robots: &[RobotSighting]) {
+        let me: Framed<Field, Pose2> = Framed::new(self.pose);
+        let pose_xy = self.cov.fixed_view::<2, 2>(0, 0).into_owned();
+        let percepts: Vec<RobotPercept> = robots
+            .iter()
+            .map(|z| {
+                let centre = z.sighting.distance + self.robot_radius;
+                let at = me.at_range_bearing(centre, z.sighting.bearing);
+                let sd = self.noise.sigma(z.sighting.distance, z.sigma);
+                let r = sighting_covariance(
+                    centre,
+                    z.sighting.bearing,
+                    self.pose.theta,
+                    sd,
+                    pose_xy,
+                    self.cov[(2, 2)],
+                );
+                RobotPercept { at: (at.inner.x, at.inner.y), r, marker: z.marker }
+            })
+            .collect();
+        self.robots.update(time, &percepts);
     }
 
     /// What the vision µAgent found in one image (a [`Percepts`]): read like a camera frame
@@ -559,7 +620,12 @@ impl WorldModel {
                 &p.line_points,
             )
         });
-        let mut frame = CameraFrame { time: p.time, sightings: p.sightings, ..Default::default() };
+        let mut frame = CameraFrame {
+            time: p.time,
+            sightings: p.sightings,
+            robots: p.robots.clone(),
+            ..Default::default()
+        };
         let mut sigmas = p.sigmas;
         // The posts, named by where the robot believes it is; a landmark claimed by two posts
         // is left out (one of them is wrong).
@@ -664,6 +730,7 @@ impl WorldModel {
             let (x, y) = mm(at.to_team(attack));
             w.global_ball = Estimate { pose: Pose2::new(x, y, 0.0), quality: reliability };
         }
+        w.robots = self.anchored_robots(frame.time, attack);
         if let Some((vx, vy)) = self.ball_velocity {
             // The velocity turned by the estimated heading into the field frame (`observe`),
             // then into the team's.
@@ -672,6 +739,41 @@ impl WorldModel {
             w.ball_vel = Vec2::new(fx, fy);
         }
         w
+    }
+
+    /// The anchored robots out of the find phase, in the team frame (mm), nearest first.
+    fn anchored_robots(&self, time: f64, attack: Attack) -> Vec<AnchoredRobot> {
+        let me: Framed<Field, Pose2> = Framed::new(self.pose);
+        let own = self.game.marker;
+        let mut out: Vec<AnchoredRobot> = self
+            .robots
+            .anchors()
+            .iter()
+            .filter(|a| a.phase(time) != Phase::Find)
+            .map(|a| {
+                let (x, y) = a.position(time);
+                let at: Framed<Field, Point2> = Framed::new(Point2::new(x, y));
+                let (rho, theta) = me.range_bearing(at);
+                let team = at.to_team(attack).inner;
+                let (vx, vy) = a.velocity();
+                let v = Framed::<Field, _>::new(Point2::new(vx, vy)).to_team(attack).inner;
+                AnchoredRobot {
+                    id: a.id(),
+                    class: a.class(own),
+                    x: team.x * MM_PER_M,
+                    y: team.y * MM_PER_M,
+                    vx: v.x * MM_PER_M,
+                    vy: v.y * MM_PER_M,
+                    sigma: a.sigma(time) * MM_PER_M,
+                    rho: rho * MM_PER_M,
+                    theta,
+                    reliability: a.reliability(time),
+                    seen_ago: time - a.last_seen(),
+                }
+            })
+            .collect();
+        out.sort_by(|a, b| a.rho.total_cmp(&b.rho));
+        out
     }
 }
 
@@ -688,7 +790,7 @@ mod tests {
 
     /// The game controller's news while playing, attacking east (`attack` 1) or west (−1).
     fn playing(attack: f64) -> GameInfo {
-        GameInfo { state: GameState::Playing, attack, kickoff_pose: None }
+        GameInfo { state: GameState::Playing, attack, kickoff_pose: None, marker: None }
     }
 
     /// Exact sightings, from `at`, of the field objects at `objects` (field frame, m).
@@ -905,6 +1007,56 @@ mod tests {
         m.odometry(&o);
         assert_eq!(m.counts().wheels, 3);
         assert!(m.pose().inner.x.is_finite());
+    }
+
+    /// MAP on the object sensor's robots: a cyan robot 3 m ahead and a magenta one 2 m to
+    /// the left of a magenta robot at (−2, 0) facing north, seen at their nearest points;
+    /// after two frames both are anchored at their centres, an opponent and a teammate, in
+    /// the team frame (attacking west: turned half round), nearest first.
+    #[test]
+    fn robots_seen_are_anchored_as_teammates_and_opponents_in_the_team_frame() {
+        use mrt_msgs::{Marker, RobotClass, RobotSighting};
+        let mut m = model().with_robot_radius(0.3);
+        let at = Pose2::new(-2.0, 0.0, PI / 2.0);
+        m.place(Framed::new(at));
+        m.game(GameInfo { marker: Some(Marker::Magenta), ..playing(-1.0) });
+        let robot = |distance: f64, bearing: f64, marker| RobotSighting {
+            sighting: Sighting { distance, bearing },
+            sigma: None,
+            marker,
+        };
+        let mut f = frame(at, 1.0, &landmarks());
+        // Their centres: (−2, 3) straight ahead and (−4, 0) on the left, 0.3 m beyond the
+        // nearest points.
+        f.robots = vec![robot(2.7, 0.0, Some(Marker::Cyan)), robot(1.7, PI / 2.0, None)];
+        let w = m.camera(&f);
+        assert!(w.robots.is_empty(), "one frame finds, it does not anchor");
+        f.time = 1.1;
+        f.robots[1].marker = Some(Marker::Magenta);
+        let w = m.camera(&f);
+        assert_eq!(w.robots.len(), 2, "{:?}", w.robots);
+        let (mate, opponent) = (&w.robots[0], &w.robots[1]);
+        assert_eq!((mate.class, opponent.class), (RobotClass::Teammate, RobotClass::Opponent));
+        // Team frame attacking west: (x, y) → (−x, −y), mm.
+        assert!((mate.x - 4000.0).abs() < 1.0 && mate.y.abs() < 1.0, "{mate:?}");
+        assert!((opponent.x - 2000.0).abs() < 1.0 && (opponent.y + 3000.0).abs() < 1.0);
+        assert!((opponent.rho - 3000.0).abs() < 1.0 && opponent.theta.abs() < 1e-6);
+        assert_eq!((opponent.reliability, opponent.seen_ago), (1.0, 0.0));
+        assert!(opponent.sigma > 0.0 && opponent.sigma < 200.0, "{}", opponent.sigma);
+        assert_eq!(w.nearest_opponent(0.5).map(|r| r.id), Some(opponent.id));
+        // Unseen for a second: still there, half as reliable.
+        f.time = 2.1;
+        f.robots.clear();
+        let w = m.camera(&f);
+        assert_eq!(w.robots.len(), 2);
+        assert!(
+            (w.robots[1].reliability - 0.5).abs() < 1e-9
+                && (w.robots[1].seen_ago - 1.0).abs() < 1e-9
+        );
+        // The robot is put down elsewhere by hand: its anchors lay in the old pose's frame.
+        m.place(Framed::new(Pose2::new(3.0, 3.0, 0.0)));
+        f.time = 2.2;
+        assert!(m.camera(&f).robots.is_empty());
     }
 
     #[test]

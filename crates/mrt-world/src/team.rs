@@ -1,9 +1,10 @@
 //! The team side of the world state (ISocRob seed `003` §3.1: each robot shares what it knows
 //! with its teammates; TeamChaos seed `001` §2.1: the global ball): teammates' poses from their
-//! [`MateReport`]s and the best ball sighting, one's own or a teammate's.
+//! [`MateReport`]s, the team ball fused from everyone's, and the anchored robots of unknown
+//! team that stand where a teammate says it is, made teammates.
 
 use mrt_core::Pose2;
-use mrt_msgs::{Estimate, Mate, MateReport, WorldSnapshot};
+use mrt_msgs::{Estimate, Mate, MateReport, RobotClass, WorldSnapshot};
 
 /// A teammate's ball counts this much of its own quality: a second-hand sighting, one cycle
 /// old, is trusted a little less than one's own.
@@ -93,6 +94,7 @@ pub fn merge_team<'a>(
         let sigma = given.unwrap_or_else(|| sigma_from_quality(r.ball.quality)) + SHARED_DRIFT;
         all.extend(Sighting::new(&r.ball, Some(sigma), r.ball.quality * SHARED_BALL));
     }
+    recognize_mates(w);
     let gathering =
         |seed: &Sighting| -> Vec<&Sighting> { all.iter().filter(|s| seed.agrees(s)).collect() };
     // The heaviest gathering; on a tie the first (one's own).
@@ -119,6 +121,26 @@ pub fn merge_team<'a>(
     w.global_ball = Estimate { pose: Pose2::new(x, y, 0.0), quality };
 }
 
+/// A robot of unknown team anchored within this distance (mm), or three of its standard
+/// deviations if more, of where a teammate reports being is that teammate.
+pub const SAME_ROBOT: f64 = 500.0;
+
+/// MAP's classifier specialised by the team (research note MODULES.md §3: "a track's concept
+/// can be specialised later"): an anchored Robot whose marker was never seen, standing where a
+/// teammate's report puts it, becomes a Teammate.
+fn recognize_mates(w: &mut WorldSnapshot) {
+    let mates = &w.mates;
+    for r in w.robots.iter_mut().filter(|r| r.class == RobotClass::Robot) {
+        let gate = SAME_ROBOT.max(3.0 * r.sigma);
+        if mates
+            .iter()
+            .any(|m| m.at.quality > 0.0 && (m.at.pose.x - r.x).hypot(m.at.pose.y - r.y) <= gate)
+        {
+            r.class = RobotClass::Teammate;
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -138,6 +160,33 @@ mod tests {
             global_ball: Estimate { pose: Pose2::new(x, y, 0.0), quality },
             ..Default::default()
         }
+    }
+
+    #[test]
+    fn a_robot_of_unknown_team_where_a_teammate_says_it_is_becomes_that_teammate() {
+        use mrt_msgs::AnchoredRobot;
+        let robot = |x: f64, class| AnchoredRobot {
+            x,
+            class,
+            sigma: 100.0,
+            reliability: 1.0,
+            ..Default::default()
+        };
+        let mut w = WorldSnapshot {
+            robots: vec![
+                robot(-2300.0, RobotClass::Robot), // 300 mm from teammate 2 at −2000
+                robot(-1000.0, RobotClass::Opponent), // its marker said opponent: it stays so
+                robot(3000.0, RobotClass::Robot),  // nobody reports being there
+            ],
+            ..Default::default()
+        };
+        merge_team(
+            &mut w,
+            None,
+            &[report(1, (0.0, 0.0), 0.0, 0.0), report(2, (0.0, 0.0), 0.0, 0.0)],
+        );
+        let classes: Vec<RobotClass> = w.robots.iter().map(|r| r.class).collect();
+        assert_eq!(classes, [RobotClass::Teammate, RobotClass::Opponent, RobotClass::Robot]);
     }
 
     #[test]

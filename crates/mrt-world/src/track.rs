@@ -63,6 +63,15 @@ struct State {
     p: Matrix4<f64>,
 }
 
+/// A prediction and one sighting's innovation against it.
+struct Innovation {
+    x: Vector4<f64>,
+    p: Matrix4<f64>,
+    innovation: Vector2<f64>,
+    s_inv: Matrix2<f64>,
+    d2: f64,
+}
+
 /// What a track did with its sightings.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct TrackCounts {
@@ -161,16 +170,11 @@ impl Track {
         if time < s.time {
             return false;
         }
-        let (f, n) = self.transition(time - s.time);
-        let x = f * s.x;
-        let p = f * s.p * f.transpose() + n;
-        let h = Matrix4x2::<f64>::identity().transpose();
-        let innovation = Vector2::new(at.0, at.1) - h * x;
-        let s_cov = h * p * h.transpose() + r;
-        let Some(s_inv) = s_cov.try_inverse() else {
+        let Some(Innovation { x, p, innovation, s_inv, d2 }) = self.innovation(s, time, at, r)
+        else {
             return false;
         };
-        let d2 = (innovation.transpose() * s_inv * innovation)[0];
+        let h = Matrix4x2::<f64>::identity().transpose();
         if d2 > GATE {
             self.gated += 1;
             self.counts.gated += 1;
@@ -189,6 +193,46 @@ impl Track {
         self.state = Some(State { time, x, p });
         self.counts.updates += 1;
         true
+    }
+
+    /// The squared Mahalanobis distance of a sighting at `time` of `at` (m) with covariance
+    /// `r` from where the track expects the object then (what the gate and the data
+    /// association compare with [`GATE`]), without changing the track; `None` before the first
+    /// sighting or for a sighting that is not a number.
+    pub fn distance2(&self, time: f64, at: (f64, f64), r: Matrix2<f64>) -> Option<f64> {
+        let finite = at.0.is_finite() && at.1.is_finite() && time.is_finite();
+        if !finite || r.iter().any(|v| !v.is_finite()) {
+            return None;
+        }
+        let s = self.state?;
+        Some(self.innovation(s, time.max(s.time), at, r)?.d2)
+    }
+
+    /// One standard deviation of the object's place, m (the root of the position
+    /// covariance's mean diagonal), predicted to `time`; `None` before the first sighting.
+    pub fn sigma(&self, time: f64) -> Option<f64> {
+        let s = self.state?;
+        let (f, n) = self.transition((time - s.time).max(0.0));
+        let p = f * s.p * f.transpose() + n;
+        Some(((p[(0, 0)] + p[(1, 1)]) / 2.0).max(0.0).sqrt())
+    }
+
+    /// The prediction from `s` to `time` and a sighting's innovation against it.
+    fn innovation(
+        &self,
+        s: State,
+        time: f64,
+        at: (f64, f64),
+        r: Matrix2<f64>,
+    ) -> Option<Innovation> {
+        let (f, n) = self.transition(time - s.time);
+        let x = f * s.x;
+        let p = f * s.p * f.transpose() + n;
+        let h = Matrix4x2::<f64>::identity().transpose();
+        let innovation = Vector2::new(at.0, at.1) - h * x;
+        let s_inv = (h * p * h.transpose() + r).try_inverse()?;
+        let d2 = (innovation.transpose() * s_inv * innovation)[0];
+        Some(Innovation { x, p, innovation, s_inv, d2 })
     }
 
     fn start(&mut self, time: f64, at: (f64, f64), r: Matrix2<f64>) {

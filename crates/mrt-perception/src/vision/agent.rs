@@ -1,6 +1,6 @@
 //! The vision µAgent (ISocRob seed `003` §3.2.1): one camera image in, [`Percepts`] out. The
 //! pieces of this module put together: the colour lookup table, the ball (size test and centre
-//! correction), the goals, the field-line points, other robots as obstacles.
+//! correction), the goals, the field-line points, other robots with their team markers.
 //!
 //! The nets of the world model's sightings ([`mrt_msgs::CameraFrame::sightings`]) are the
 //! centres of the goal lines. The goal's outermost columns whose lowest goal pixel has carpet
@@ -18,7 +18,7 @@ use super::lines::line_points;
 use super::posts::{find_posts_in, PostPercept, PostShape};
 use super::up::UpMode;
 use crate::camera::{Camera, Omni, Pinhole, Pixel};
-use mrt_msgs::{Image, Percepts, PostSighting, Sighting};
+use mrt_msgs::{Image, Marker, Percepts, PostSighting, RobotSighting, Sighting};
 use nalgebra::{Point2, Vector2};
 
 /// Sighting index of the ball, the east and the west net (the world model's order).
@@ -34,6 +34,11 @@ pub const OBSTACLE_STEP: usize = 4;
 pub const OBSTACLE_MIN_RUN: usize = 3;
 /// Neighbouring obstacle feet closer than this on the floor are one robot, m.
 pub const SAME_ROBOT: f64 = 0.4;
+/// Marker pixels a robot must show, up its scanned columns, for its team to be told.
+pub const MARKER_MIN_PIXELS: u32 = 2;
+/// Pixels of neither the robot's body nor a marker (edges, blur) crossed going up a robot
+/// before its top is taken as reached.
+pub const MARKER_GAP: usize = 2;
 /// Field-line scan lines: every this many columns.
 pub const LINE_STEP: usize = 8;
 /// The longest white run that is a line, pixels.
@@ -275,7 +280,7 @@ impl VisionAgent {
             .into_iter()
             .map(|l| (l.at.x, l.at.y))
             .collect();
-        p.obstacles = self.obstacles();
+        p.robots = self.robots();
         p.posts = posts
             .iter()
             .filter_map(|post| {
@@ -352,9 +357,10 @@ impl VisionAgent {
     /// Other robots: scanning every [`OBSTACLE_STEP`]-th column from the bottom up over the
     /// carpet, the first run of robot pixels is a robot's foot; neighbouring columns whose
     /// feet are within [`SAME_ROBOT`] of each other on the floor are one robot, seen at its
-    /// lowest foot.
+    /// lowest foot, with the colour of the marker band its columns show above the foot
+    /// ([`VisionAgent::marker`]).
     /// (Cheaper than labelling the dark blobs, which are large, and it gives the foot.)
-    fn obstacles(&self) -> Vec<Sighting> {
+    fn robots(&self) -> Vec<RobotSighting> {
         let (w, h) = self.camera.size();
         let (w, h) = (w as usize, h as usize);
         let (robot, field, line) =
@@ -415,10 +421,50 @@ impl VisionAgent {
             }
             let px = Pixel::new((g.0 + g.1) as f64 / 2.0 + 0.5, g.2 as f64 + 1.0);
             if let Some(at) = self.camera.unproject(px) {
-                out.push(sighting(at));
+                out.push(RobotSighting {
+                    sighting: sighting(at),
+                    sigma: self.sigma(px, 1.0),
+                    marker: self.marker((g.0..=g.1).step_by(OBSTACLE_STEP), g.2),
+                });
             }
         }
         out
+    }
+
+    /// The team marker of a robot whose scanned `columns` stand on the floor at row `foot`:
+    /// going up each column from the foot through the robot's body (robot and marker pixels,
+    /// gaps of at most [`MARKER_GAP`] others), the marker colour with at least
+    /// [`MARKER_MIN_PIXELS`] pixels and twice the other's; `None` when the band is out of the
+    /// image, too small, or both colours show alike (two robots one behind the other).
+    fn marker(&self, columns: impl Iterator<Item = usize>, foot: usize) -> Option<Marker> {
+        let w = self.camera.size().0 as usize;
+        let (robot, magenta, cyan) = (
+            ColorClass::Robot as u8,
+            ColorClass::MarkerMagenta as u8,
+            ColorClass::MarkerCyan as u8,
+        );
+        let (mut m, mut c) = (0u32, 0u32);
+        for col in columns {
+            let mut gap = 0;
+            for row in (0..=foot).rev() {
+                match self.classes.get(row * w + col).copied() {
+                    Some(k) if k == robot => gap = 0,
+                    Some(k) if k == magenta => (m, gap) = (m + 1, 0),
+                    Some(k) if k == cyan => (c, gap) = (c + 1, 0),
+                    _ => {
+                        gap += 1;
+                        if gap > MARKER_GAP {
+                            break;
+                        }
+                    }
+                }
+            }
+        }
+        match (m, c) {
+            (m, c) if m >= MARKER_MIN_PIXELS && m >= 2 * c => Some(Marker::Magenta),
+            (m, c) if c >= MARKER_MIN_PIXELS && c >= 2 * m => Some(Marker::Cyan),
+            _ => None,
+        }
     }
 
     /// One pixel's worth of error at `px`, whose floor point is `scale` times as far as the
@@ -466,7 +512,7 @@ mod tests {
         fn random_frames_give_finite_percepts(bytes in proptest::collection::vec(any::<u8>(), 2304)) {
             let image = Image { width: 32, height: 24, rgb: bytes };
             let p = agent().see(&image, 1.0, 0.2).unwrap();
-            for s in p.sightings.iter().flatten().chain(&p.obstacles) {
+            for s in p.sightings.iter().flatten().chain(p.robots.iter().map(|r| &r.sighting)) {
                 prop_assert!(s.distance.is_finite() && s.bearing.is_finite());
             }
         }

@@ -91,7 +91,7 @@ impl ClassHistogram {
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
 pub struct Histograms {
     /// Indexed by `ColorClass as usize` (`Unknown` first).
-    classes: [ClassHistogram; 7],
+    classes: [ClassHistogram; ColorClass::COUNT],
 }
 
 impl Histograms {
@@ -136,7 +136,7 @@ mod tests {
         let mut h = Histograms::default();
         h.add(&lut, &rgb);
         assert_eq!(h.pixels(), 1 << 15);
-        let mut by_class = [0u64; 7];
+        let mut by_class = [0u64; ColorClass::COUNT];
         for c in 0u16..1 << 15 {
             by_class[lut.class15(c) as usize] += 1;
         }

@@ -40,14 +40,23 @@ pub enum ColorClass {
     Line = 5,
     /// The green carpet.
     Field = 6,
+    /// A magenta robot marker (one team's colour).
+    MarkerMagenta = 7,
+    /// A cyan robot marker (the other team's).
+    MarkerCyan = 8,
 }
 
 impl ColorClass {
+    /// How many byte values name a class, `Unknown` included (`class as usize` is below it).
+    pub const COUNT: usize = 9;
+
     /// The classes in their order of precedence.
-    pub const ALL: [ColorClass; 6] = [
+    pub const ALL: [ColorClass; 8] = [
         ColorClass::Ball,
         ColorClass::GoalYellow,
         ColorClass::GoalBlue,
+        ColorClass::MarkerMagenta,
+        ColorClass::MarkerCyan,
         ColorClass::Robot,
         ColorClass::Line,
         ColorClass::Field,
@@ -62,6 +71,8 @@ impl ColorClass {
             4 => ColorClass::Robot,
             5 => ColorClass::Line,
             6 => ColorClass::Field,
+            7 => ColorClass::MarkerMagenta,
+            8 => ColorClass::MarkerCyan,
             _ => ColorClass::Unknown,
         }
     }
@@ -76,6 +87,8 @@ impl ColorClass {
             ColorClass::Robot => "robot",
             ColorClass::Line => "line",
             ColorClass::Field => "field",
+            ColorClass::MarkerMagenta => "marker_magenta",
+            ColorClass::MarkerCyan => "marker_cyan",
         }
     }
 }
@@ -154,6 +167,12 @@ pub struct ColorTable {
     pub line: Option<Thresholds>,
     /// The carpet.
     pub field: Option<Thresholds>,
+    /// Magenta robot markers.
+    #[serde(default)]
+    pub marker_magenta: Option<Thresholds>,
+    /// Cyan robot markers.
+    #[serde(default)]
+    pub marker_cyan: Option<Thresholds>,
 }
 
 impl ColorTable {
@@ -200,6 +219,8 @@ impl ColorTable {
             ColorClass::Robot => self.robot.as_ref(),
             ColorClass::Line => self.line.as_ref(),
             ColorClass::Field => self.field.as_ref(),
+            ColorClass::MarkerMagenta => self.marker_magenta.as_ref(),
+            ColorClass::MarkerCyan => self.marker_cyan.as_ref(),
         }
     }
 
@@ -357,7 +378,9 @@ mod tests {
     fn class_bytes_round_trip() {
         for c in ColorClass::ALL {
             assert_eq!(ColorClass::from_u8(c as u8), c);
+            assert!((c as usize) < ColorClass::COUNT);
         }
+        assert_eq!(ColorClass::ALL.len() + 1, ColorClass::COUNT, "every class and Unknown");
         assert_eq!(ColorClass::from_u8(0), ColorClass::Unknown);
         assert_eq!(ColorClass::from_u8(200), ColorClass::Unknown);
     }

@@ -1,0 +1,453 @@
+//! MAP's anchors of the other robots (MRT manual ch. 8; TeamChaos' perceptual anchoring, seed
+//! `001` §2.1; research note MODULES.md §3): every robot the camera sees becomes an anchor, a
+//! symbol with an identity that lasts, whose place and velocity a Kalman [`Track`] estimates.
+//!
+//! Each frame, in MAP's three steps:
+//! 1. **Classification.** A robot percept is a Robot; the colour of its marker band, when the
+//!    camera saw it, makes it a Teammate or an Opponent ([`Anchor::class`]: the marker seen
+//!    most often on the anchor against the team's own colour). Partial information stays
+//!    generic: a robot whose marker was never seen stays a Robot (the team side may still make
+//!    it a Teammate: `team::merge_team`, when a teammate reports being there).
+//! 2. **Data association** (global nearest neighbour): the squared Mahalanobis distance of
+//!    every percept from every anchor's prediction, gated at χ²₂ 99 % ([`GATE`]), and the
+//!    assignment of least total distance (Kuhn–Munkres, `pathfinding`), so two robots that
+//!    cross keep their identities.
+//! 3. **Tracking.** A matched anchor's track is corrected. An unmatched one is predicted and
+//!    its reliability fades, halving every second unseen ([`FADE`]); below [`FORGET`] it is
+//!    forgotten, but for [`REACQUIRE_FOR`] seconds a percept within a wider gate
+//!    ([`REACQUIRE_GATE`]) takes it back, identity and all, before a new anchor is made.
+//!
+//! The anchoring phases: an anchor is in **find** until it has been seen [`CONFIRM`] times
+//! (one stray percept makes no robot), in **track** while seen, in **reacquire** while
+//! predicted unseen ([`Phase`]).
+//!
+//! ```
+//! use mrt_world::anchor::{Anchors, Phase, RobotPercept};
+//! use mrt_msgs::Marker;
+//! use nalgebra::Matrix2;
+//! let mut anchors = Anchors::default();
+//! let r = Matrix2::from_diagonal_element(0.05 * 0.05);
+//! // A robot walking east at 1 m/s, seen every 0.1 s with its cyan marker.
+//! for k in 0..10 {
+//!     let t = 0.1 * f64::from(k);
+//!     anchors.update(t, &[RobotPercept { at: (t, 2.0), r, marker: Some(Marker::Cyan) }]);
+//! }
+//! let a = &anchors.anchors()[0];
+//! assert_eq!(a.phase(0.9), Phase::Track);
+//! assert_eq!(a.class(Some(Marker::Magenta)), mrt_msgs::RobotClass::Opponent);
+//! assert!((a.velocity().0 - 1.0).abs() < 0.2);
+//! ```
+
+use crate::track::{Track, GATE};
+use mrt_msgs::{Marker, RobotClass};
+use nalgebra::Matrix2;
+use pathfinding::kuhn_munkres::kuhn_munkres_min;
+use pathfinding::matrix::Matrix;
+
+/// Random acceleration of a robot, m/s² (research note MODULES.md §3: ~1 m/s², a design
+/// choice).
+pub const ROBOT_ACCEL: f64 = 1.0;
+/// An unseen robot's predicted velocity fades at this rate, 1/s: robots stop and turn, and a
+/// constant-velocity prediction over seconds would carry the anchor far from any robot.
+pub const ROBOT_DAMPING: f64 = 0.5;
+/// An unseen anchor's reliability is multiplied by this every second (λ of the research note).
+pub const FADE: f64 = 0.5;
+/// Below this reliability an anchor is forgotten (≈ 3.3 s unseen).
+pub const FORGET: f64 = 0.1;
+/// Sightings an anchor needs before it leaves the find phase.
+pub const CONFIRM: u32 = 2;
+/// Seconds a forgotten anchor may still be reacquired.
+pub const REACQUIRE_FOR: f64 = 3.0;
+/// The gate (squared Mahalanobis distance) within which a forgotten anchor is reacquired:
+/// wider than [`GATE`], since its prediction is old.
+pub const REACQUIRE_GATE: f64 = 4.0 * GATE;
+
+/// The cost the assignment gives a pair outside the gate: more than any number of pairs
+/// inside it, so it is used only where no gated pair is left (and then dropped).
+const FORBIDDEN: i64 = 1 << 40;
+/// Gated squared distances are compared in these units (the assignment takes integers).
+const COST_SCALE: f64 = 1e6;
+
+/// One robot percept, in the field frame: its centre (m), the covariance of that place (m²)
+/// and the marker colour seen on it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RobotPercept {
+    /// The robot's centre, m.
+    pub at: (f64, f64),
+    /// Covariance of `at`, m².
+    pub r: Matrix2<f64>,
+    /// The marker's colour, if the camera saw it.
+    pub marker: Option<Marker>,
+}
+
+/// An anchor's phase in the anchoring process (seed `001` §2.1; research note §3: find,
+/// track, reacquire).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Phase {
+    /// New: seen fewer than [`CONFIRM`] times.
+    Find,
+    /// Seen in the last frame.
+    Track,
+    /// Unseen since, predicted, fading, waiting to be seen again.
+    Reacquire,
+}
+
+/// One anchored robot (module doc).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Anchor {
+    id: u32,
+    track: Track,
+    hits: u32,
+    last_seen: f64,
+    /// Frames in which its marker was seen magenta and cyan.
+    markers: (u32, u32),
+}
+
+impl Anchor {
+    fn new(id: u32, time: f64, p: &RobotPercept) -> Anchor {
+        let mut a = Anchor {
+            id,
+            track: Track::new(ROBOT_DAMPING, ROBOT_ACCEL),
+            hits: 0,
+            last_seen: time,
+            markers: (0, 0),
+        };
+        a.see(time, p);
+        a
+    }
+
+    /// Its identity.
+    pub fn id(&self) -> u32 {
+        self.id
+    }
+
+    /// Where it is at `time`, m (field frame): the track's prediction.
+    pub fn position(&self, time: f64) -> (f64, f64) {
+        self.track.predicted(time).map_or(self.track.position(), |(x, y, _, _)| (x, y))
+    }
+
+    /// Its velocity at its last sighting, m/s.
+    pub fn velocity(&self) -> (f64, f64) {
+        self.track.velocity()
+    }
+
+    /// One standard deviation of its place at `time`, m.
+    pub fn sigma(&self, time: f64) -> f64 {
+        self.track.sigma(time).unwrap_or(f64::INFINITY)
+    }
+
+    /// How much it is to be trusted at `time`: 1 when seen then, [`FADE`] per second unseen.
+    pub fn reliability(&self, time: f64) -> f64 {
+        FADE.powf((time - self.last_seen).max(0.0))
+    }
+
+    /// When it was last seen, s.
+    pub fn last_seen(&self) -> f64 {
+        self.last_seen
+    }
+
+    /// Its phase at `time`.
+    pub fn phase(&self, time: f64) -> Phase {
+        if self.hits < CONFIRM {
+            Phase::Find
+        } else if time <= self.last_seen {
+            Phase::Track
+        } else {
+            Phase::Reacquire
+        }
+    }
+
+    /// Teammate or opponent by the marker seen most often on it, against the team's own
+    /// colour `own`; a Robot while no marker was seen, or a tie, or `own` is unknown.
+    pub fn class(&self, own: Option<Marker>) -> RobotClass {
+        let (m, c) = self.markers;
+        let seen = match m.cmp(&c) {
+            std::cmp::Ordering::Greater => Marker::Magenta,
+            std::cmp::Ordering::Less => Marker::Cyan,
+            std::cmp::Ordering::Equal => return RobotClass::Robot,
+        };
+        match own {
+            Some(own) if own == seen => RobotClass::Teammate,
+            Some(_) => RobotClass::Opponent,
+            None => RobotClass::Robot,
+        }
+    }
+
+    fn see(&mut self, time: f64, p: &RobotPercept) {
+        if !self.track.update(time, p.at, p.r) {
+            // Refused by the track's own gate (a reacquisition far from the old prediction):
+            // the track starts again where the robot is, the identity stays.
+            self.track.reset();
+            self.track.update(time, p.at, p.r);
+        }
+        self.hits = self.hits.saturating_add(1);
+        self.last_seen = time;
+        match p.marker {
+            Some(Marker::Magenta) => self.markers.0 = self.markers.0.saturating_add(1),
+            Some(Marker::Cyan) => self.markers.1 = self.markers.1.saturating_add(1),
+            None => {}
+        }
+    }
+}
+
+/// What the anchoring did so far.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct AnchorCounts {
+    /// Percepts that corrected an anchor.
+    pub updates: u64,
+    /// Anchors made.
+    pub created: u64,
+    /// Forgotten anchors taken back.
+    pub reacquired: u64,
+    /// Anchors forgotten.
+    pub forgotten: u64,
+    /// Percepts refused (not numbers).
+    pub refused: u64,
+}
+
+/// The anchored robots (module doc).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Anchors {
+    live: Vec<Anchor>,
+    /// Forgotten anchors, with when they were forgotten, for reacquisition.
+    forgotten: Vec<(f64, Anchor)>,
+    next_id: u32,
+    counts: AnchorCounts,
+}
+
+impl Anchors {
+    /// The live anchors (in every phase).
+    pub fn anchors(&self) -> &[Anchor] {
+        &self.live
+    }
+
+    /// What it did so far.
+    pub fn counts(&self) -> AnchorCounts {
+        self.counts
+    }
+
+    /// Forgets every anchor (the robot's own pose jumped: the anchors' places were computed
+    /// from the pose it had). Identities are not reused.
+    pub fn reset(&mut self) {
+        self.live.clear();
+        self.forgotten.clear();
+    }
+
+    /// One frame's robot percepts at `time` (module doc). Frames must come in time order; a
+    /// percept that is not a number is refused and counted.
+    pub fn update(&mut self, time: f64, percepts: &[RobotPercept]) {
+        if !time.is_finite() {
+            self.counts.refused += percepts.len() as u64;
+            return;
+        }
+        let finite = |p: &&RobotPercept| {
+            p.at.0.is_finite() && p.at.1.is_finite() && p.r.iter().all(|v| v.is_finite())
+        };
+        let percepts: Vec<&RobotPercept> = percepts.iter().filter(finite).collect();
+        let used = assign(&self.live, &percepts, |a, p| a.track.distance2(time, p.at, p.r), GATE);
+        let mut taken = vec![false; percepts.len()];
+        for (a, j) in self.live.iter_mut().zip(&used) {
+            if let Some(j) = *j {
+                a.see(time, percepts[j]);
+                taken[j] = true;
+                self.counts.updates += 1;
+            }
+        }
+        // The unseen fade; the faded are forgotten (kept a while for reacquisition).
+        let (keep, gone): (Vec<Anchor>, Vec<Anchor>) =
+            self.live.drain(..).partition(|a| a.reliability(time) >= FORGET);
+        self.live = keep;
+        self.counts.forgotten += gone.len() as u64;
+        self.forgotten.extend(gone.into_iter().map(|a| (time, a)));
+        self.forgotten.retain(|(when, _)| time - when <= REACQUIRE_FOR);
+        // The percepts no live anchor took: a forgotten anchor within the wider gate, or a
+        // new anchor.
+        let left: Vec<&RobotPercept> =
+            percepts.iter().zip(&taken).filter(|(_, t)| !**t).map(|(p, _)| *p).collect();
+        let old: Vec<&Anchor> = self.forgotten.iter().map(|(_, a)| a).collect();
+        let back = assign(&old, &left, |a, p| a.track.distance2(time, p.at, p.r), REACQUIRE_GATE);
+        let mut revived = vec![false; left.len()];
+        // Taken out of the forgotten list highest index first, so the others stay put.
+        for (k, j) in back.iter().enumerate().rev() {
+            let Some(j) = *j else { continue };
+            revived[j] = true;
+            let (_, mut a) = self.forgotten.remove(k);
+            a.see(time, left[j]);
+            self.live.push(a);
+            self.counts.reacquired += 1;
+        }
+        for (p, _) in left.iter().zip(&revived).filter(|(_, r)| !**r) {
+            let id = self.next_id;
+            self.next_id = self.next_id.wrapping_add(1);
+            self.live.push(Anchor::new(id, time, p));
+            self.counts.created += 1;
+        }
+        self.live.sort_by_key(|a| a.id);
+    }
+}
+
+/// The global-nearest-neighbour assignment of `percepts` to `anchors`: for each anchor the
+/// percept it takes, if any, such that every pair's `distance` is within `gate` and the sum of
+/// the pairs' distances is least among the assignments that pair the most.
+fn assign<A, P>(
+    anchors: &[A],
+    percepts: &[&P],
+    distance: impl Fn(&A, &P) -> Option<f64>,
+    gate: f64,
+) -> Vec<Option<usize>> {
+    let (n, m) = (anchors.len(), percepts.len());
+    let mut out = vec![None; n];
+    if n == 0 || m == 0 {
+        return out;
+    }
+    let cost = |i: usize, j: usize| match distance(&anchors[i], percepts[j]) {
+        Some(d2) if d2 <= gate => (d2 * COST_SCALE).round() as i64,
+        _ => FORBIDDEN,
+    };
+    // Kuhn–Munkres wants no more rows than columns: rows are the smaller side.
+    let by_anchor = n <= m;
+    let (rows, cols) = if by_anchor { (n, m) } else { (m, n) };
+    let values: Vec<i64> = (0..rows)
+        .flat_map(|r| (0..cols).map(move |c| (r, c)))
+        .map(|(r, c)| if by_anchor { cost(r, c) } else { cost(c, r) })
+        .collect();
+    let Ok(weights) = Matrix::from_vec(rows, cols, values) else {
+        return out;
+    };
+    let (_, assignment) = kuhn_munkres_min(&weights);
+    for (r, &c) in assignment.iter().enumerate() {
+        if weights[(r, c)] >= FORBIDDEN {
+            continue;
+        }
+        let (i, j) = if by_anchor { (r, c) } else { (c, r) };
+        out[i] = Some(j);
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn r(sigma: f64) -> Matrix2<f64> {
+        Matrix2::from_diagonal_element(sigma * sigma)
+    }
+
+    fn percept(x: f64, y: f64, marker: Option<Marker>) -> RobotPercept {
+        RobotPercept { at: (x, y), r: r(0.05), marker }
+    }
+
+    #[test]
+    fn two_robots_crossing_keep_their_identities() {
+        // Robot A walks east along y = 0.1, robot B west along y = −0.1, 1 m/s each: they
+        // meet at x = 0 at t = 1 s and pass within 0.2 m of each other. Percepts come in
+        // an order that alternates, so the order cannot tell them apart.
+        let mut anchors = Anchors::default();
+        let mut ids = None;
+        for k in 0..=20 {
+            let t = 0.1 * f64::from(k);
+            let a = percept(-1.0 + t, 0.1, None);
+            let b = percept(1.0 - t, -0.1, None);
+            let frame = if k % 2 == 0 { [a, b] } else { [b, a] };
+            anchors.update(t, &frame);
+            let live = anchors.anchors();
+            assert_eq!(live.len(), 2, "t = {t}");
+            // Which anchor is the eastbound one: the one whose velocity points east.
+            let east = live.iter().find(|x| x.velocity().0 > 0.0 || x.hits < 3).map(|x| x.id);
+            if k == 5 {
+                ids = east;
+            }
+            if k > 5 {
+                assert_eq!(east, ids, "t = {t}");
+            }
+        }
+        // At the end the eastbound anchor is at x = 1, the westbound at x = −1.
+        let live = anchors.anchors();
+        let a = live.iter().find(|x| Some(x.id) == ids).unwrap();
+        assert!((a.position(2.0).0 - 1.0).abs() < 0.1, "{:?}", a.position(2.0));
+        assert!((a.velocity().0 - 1.0).abs() < 0.25, "{:?}", a.velocity());
+        assert_eq!(anchors.counts().created, 2);
+    }
+
+    #[test]
+    fn an_anchor_is_found_tracked_kept_while_hidden_and_forgotten_when_long_gone() {
+        let mut anchors = Anchors::default();
+        anchors.update(0.0, &[percept(2.0, 1.0, None)]);
+        assert_eq!(anchors.anchors()[0].phase(0.0), Phase::Find, "one percept is no robot");
+        anchors.update(0.1, &[percept(2.0, 1.0, None)]);
+        assert_eq!(anchors.anchors()[0].phase(0.1), Phase::Track);
+        // Hidden for 2 s: kept, predicted, reliability 0.5² = 0.25.
+        anchors.update(2.1, &[]);
+        let a = &anchors.anchors()[0];
+        assert_eq!(a.phase(2.1), Phase::Reacquire);
+        assert!((a.reliability(2.1) - 0.25).abs() < 1e-12);
+        // Seen again where it was: the same anchor.
+        anchors.update(2.2, &[percept(2.05, 1.0, None)]);
+        assert_eq!(anchors.anchors().len(), 1);
+        assert_eq!(anchors.anchors()[0].id(), 0);
+        // Hidden 3.4 s: 0.5^3.4 < 0.1, forgotten.
+        anchors.update(5.6, &[]);
+        assert!(anchors.anchors().is_empty());
+        assert_eq!(anchors.counts().forgotten, 1);
+        // Seen 0.5 m away 1 s later: reacquired within the wider gate, identity kept.
+        anchors.update(6.6, &[percept(2.5, 1.0, None)]);
+        assert_eq!(anchors.anchors()[0].id(), 0);
+        assert_eq!(anchors.counts().reacquired, 1);
+        // Much later, elsewhere: a new anchor.
+        anchors.update(20.0, &[]);
+        anchors.update(30.0, &[percept(-3.0, 0.0, None)]);
+        assert_eq!(anchors.anchors()[0].id(), 1);
+    }
+
+    #[test]
+    fn the_marker_makes_a_robot_a_teammate_or_an_opponent() {
+        let mut anchors = Anchors::default();
+        // Seen twice without its marker: a Robot, whatever our colour.
+        anchors.update(0.0, &[percept(1.0, 1.0, None)]);
+        anchors.update(0.1, &[percept(1.0, 1.0, None)]);
+        let a = &anchors.anchors()[0];
+        assert_eq!(a.class(Some(Marker::Magenta)), RobotClass::Robot);
+        // Then its cyan marker, once: an opponent of the magenta team, a teammate of the cyan.
+        anchors.update(0.2, &[percept(1.0, 1.0, Some(Marker::Cyan))]);
+        let a = &anchors.anchors()[0];
+        assert_eq!(a.class(Some(Marker::Magenta)), RobotClass::Opponent);
+        assert_eq!(a.class(Some(Marker::Cyan)), RobotClass::Teammate);
+        assert_eq!(a.class(None), RobotClass::Robot, "our colour unknown");
+        // One misread magenta does not flip it: a tie is a Robot, the majority decides.
+        anchors.update(0.3, &[percept(1.0, 1.0, Some(Marker::Magenta))]);
+        assert_eq!(anchors.anchors()[0].class(Some(Marker::Magenta)), RobotClass::Robot);
+        anchors.update(0.4, &[percept(1.0, 1.0, Some(Marker::Cyan))]);
+        assert_eq!(anchors.anchors()[0].class(Some(Marker::Magenta)), RobotClass::Opponent);
+    }
+
+    #[test]
+    fn a_percept_that_is_not_a_number_is_refused() {
+        let mut anchors = Anchors::default();
+        anchors.update(0.0, &[percept(f64::NAN, 0.0, None), percept(1.0, 0.0, None)]);
+        assert_eq!(anchors.anchors().len(), 1);
+        assert_eq!(anchors.counts().created, 1);
+        anchors.update(f64::INFINITY, &[percept(1.0, 0.0, None)]);
+        assert_eq!(anchors.counts().refused, 1);
+    }
+
+    #[test]
+    fn the_assignment_is_the_least_total_distance_not_the_greedy_one() {
+        // Anchors at 0 and 1 (on a line), percepts at 0.6 and 1.7, distance = gap²: greedy
+        // takes the nearest pair first (anchor 1 ↔ 0.6, 0.16) and leaves anchor 0 with 1.7
+        // (2.89, gated out at 1.0); the optimal assignment pairs 0 ↔ 0.6 (0.36) and 1 ↔ 1.7
+        // (0.49).
+        let anchors = [0.0, 1.0];
+        let percepts = [0.6, 1.7];
+        let refs: Vec<&f64> = percepts.iter().collect();
+        let out = assign(&anchors, &refs, |a, p| Some((a - *p).powi(2)), 1.0);
+        assert_eq!(out, [Some(0), Some(1)]);
+        // More percepts than anchors, and the other way round.
+        let three = [0.1, 5.0, 0.9];
+        let refs: Vec<&f64> = three.iter().collect();
+        assert_eq!(assign(&anchors, &refs, |a, p| Some((a - *p).powi(2)), 1.0), [Some(0), Some(2)]);
+        let one = [0.95];
+        let refs: Vec<&f64> = one.iter().collect();
+        assert_eq!(assign(&anchors, &refs, |a, p| Some((a - *p).powi(2)), 1.0), [None, Some(0)]);
+        assert_eq!(assign(&anchors, &[], |a, p: &f64| Some((a - *p).powi(2)), 1.0), [None, None]);
+    }
+}
