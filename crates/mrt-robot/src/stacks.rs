@@ -210,6 +210,14 @@ pub struct MilanBrain {
     keeper: bool,
 }
 
+/// The reliability an anchored robot needs to count in the Parser's inputs (as for
+/// `chaos.getNearestOpponent`).
+pub const ANCHORED: f64 = 0.3;
+/// How far ahead `FreeDirection` looks, mm.
+pub const FREE_REACH: f64 = 2000.0;
+/// Half the width of the corridor `FreeDirection` keeps free, mm (two robots' radii).
+pub const FREE_CLEARANCE: f64 = 500.0;
+
 /// Degrees in [0, 360) of an angle in radians.
 fn deg360(a: f64) -> f64 {
     a.to_degrees().rem_euclid(360.0)
@@ -260,6 +268,17 @@ impl MilanBrain {
         if let Some((dx, dy)) = nearest {
             v.push(("ObstacleDistance", dx.hypot(dy), 1.0));
             v.push(("ObstacleBearing", deg360(dy.atan2(dx) - me.theta), 1.0));
+        }
+        // The robots MAP anchored (MRT manual ch. 8): the nearest opponent, and the free
+        // direction nearest to the opponent's net (where it is by the robot's own pose).
+        if let Some(o) = w.nearest_opponent(ANCHORED) {
+            v.push(("OpponentDistance", o.rho, o.reliability));
+            v.push(("OpponentBearing", deg360(o.theta), o.reliability));
+        }
+        let net = (field.half_length - me.x, -me.y);
+        let toward = net.1.atan2(net.0) - me.theta;
+        if let Some(free) = w.free_direction(toward, FREE_REACH, FREE_CLEARANCE, ANCHORED) {
+            v.push(("FreeDirection", deg360(free), q));
         }
         v
     }
@@ -410,5 +429,50 @@ impl Brain for Chaser {
             }
         }
         c
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use mrt_msgs::{AnchoredRobot, RobotClass};
+
+    /// The Parser gives Mr. BRIAN the robots MAP anchored: the nearest opponent (a teammate
+    /// nearer is skipped) and the free direction towards the opponent's net.
+    #[test]
+    fn milan_reads_the_nearest_opponent_and_the_free_direction() {
+        let dir = embedded_milan().unwrap();
+        let mut brain = MilanBrain::new(&dir, false).unwrap();
+        let mut w = WorldSnapshot::default();
+        // At (−3, 0) m facing the opponent's net (east, 12 m away).
+        w.my_pos.pose = Pose2::new(-3000.0, 0.0, 0.0);
+        w.my_pos.quality = 0.9;
+        let robot = |class, rho: f64, theta: f64| AnchoredRobot {
+            class,
+            rho,
+            theta,
+            reliability: 0.8,
+            ..Default::default()
+        };
+        w.robots =
+            vec![robot(RobotClass::Teammate, 600.0, 1.0), robot(RobotClass::Opponent, 950.0, 0.0)];
+        let inputs = brain.inputs(&w);
+        let get = |name: &str| inputs.iter().find(|(n, _, _)| *n == name).map(|(_, v, r)| (*v, *r));
+        assert_eq!(get("OpponentDistance"), Some((950.0, 0.8)));
+        assert_eq!(get("OpponentBearing"), Some((0.0, 0.8)));
+        // The opponent 0.95 m straight ahead blocks |b| < 31.8° (950·sin b < 500); the
+        // teammate 57° left (600 mm) blocks 30° to 90° too: the first free bearing on the 5°
+        // grid is 35° right.
+        let (free, q) = get("FreeDirection").unwrap();
+        assert!((free - 325.0).abs() < 1e-6 && q == 0.9, "{free}");
+        // Nobody anchored: no opponent input, and the way to the net is free.
+        w.robots.clear();
+        let inputs = brain.inputs(&w);
+        assert!(!inputs.iter().any(|(n, _, _)| *n == "OpponentDistance"));
+        let free = inputs.iter().find(|(n, _, _)| *n == "FreeDirection").map(|(_, v, _)| *v);
+        assert!(free.is_some_and(|f| f.abs() < 1e-9), "{free:?}");
+        // Mr. BRIAN takes every input the Parser gives (they are in ctof.txt).
+        let c = brain.cycle(&w);
+        assert!(c.vlin.is_finite());
     }
 }

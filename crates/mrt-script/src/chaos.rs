@@ -3,7 +3,7 @@
 //!
 //! | group | functions |
 //! |---|---|
-//! | data access | `lps_getLpo(i)` → `{rho, theta, reliability, seen_ago}`, `gsGetMyPos()` → `{x, y, theta, quality}`, `getBallVel()` → `{x, y}`, `getGlobalBall()` → `{x, y, quality}`, `getMates()` → `{{id, x, y, theta, quality, keeper}, ...}`, `getField()` → `{half_length, half_width, goal_half_width, penalty_area_depth}` (mm), `getKickoffPose()` → `{x, y, theta}` in `READY`, else `nil` |
+//! | data access | `lps_getLpo(i)` → `{rho, theta, reliability, seen_ago}`, `gsGetMyPos()` → `{x, y, theta, quality}`, `getBallVel()` → `{x, y}`, `getGlobalBall()` → `{x, y, quality}`, `getMates()` → `{{id, x, y, theta, quality, keeper}, ...}`, `getRobots()` → the robots MAP anchored, nearest first, `{{id, class ("teammate", "opponent", "robot": team unknown), x, y, vx, vy, sigma, rho, theta, reliability, seen_ago}, ...}`, `getNearestOpponent([min_reliability])` → one of those (not a teammate; reliability ≥ 0.3 unless told) or `nil`, `getFreeDirection([theta [, reach [, clearance]]])` → the bearing (rad) nearest `theta` (default: the opponent's net) of a corridor `2·clearance` wide (500 mm) and `reach` long (2000 mm) free of anchored robots, or `nil`, `getField()` → `{half_length, half_width, goal_half_width, penalty_area_depth}` (mm), `getKickoffPose()` → `{x, y, theta}` in `READY`, else `nil` |
 //! | control | `setVlin(v)`, `setVrot(v)`, `setVlat(v)`, `setKick(id)`, `setNeeded(i, v)`, `trackLandMarks()`, `setBehavior(name)`, `setTarget(x, y, theta[, avoid])` (a posture for guidance: position mode, or potential field round obstacles when `avoid`, the default) |
 //! | coordination | `getRole()` → `{name}`, `haveBookedBall()` → `{booked}`, `bookBall()`, `releaseBookedBall()` |
 //! | persistence | `getBehaviorInfo()` → `{timer (ms), isNew (1/0)}`, `setGlobal(key, type, value)`, `getGlobal(key)`, `getCurrentState()` → `"PLAYING"`... |
@@ -191,6 +191,32 @@ impl Keys {
     }
 }
 
+/// The reliability an anchored robot needs to count for `getNearestOpponent` (unless told)
+/// and `getFreeDirection`: about 1.7 s unseen.
+pub const ANCHORED: f64 = 0.3;
+/// How far ahead `getFreeDirection` looks unless told, mm.
+pub const FREE_REACH: f64 = 2000.0;
+/// Half the width of the corridor `getFreeDirection` keeps free unless told, mm: two Middle
+/// Size robots' radii.
+pub const FREE_CLEARANCE: f64 = 500.0;
+
+/// One anchored robot as scripts see it: `{id, class, x, y, vx, vy, sigma, rho, theta,
+/// reliability, seen_ago}` (team frame mm, mm/s; robot frame mm, rad).
+fn robot_table(lua: &Lua, keys: &Keys, r: &mrt_msgs::AnchoredRobot) -> mlua::Result<Table> {
+    let t = lua.create_table_with_capacity(0, 11)?;
+    keys.fill_pose(&t, r.x, r.y, None, None)?;
+    t.raw_set("id", r.id)?;
+    t.raw_set("class", r.class.name())?;
+    t.raw_set("vx", r.vx)?;
+    t.raw_set("vy", r.vy)?;
+    t.raw_set("sigma", r.sigma)?;
+    t.raw_set(&keys.rho, r.rho)?;
+    t.raw_set(&keys.theta, r.theta)?;
+    t.raw_set(&keys.reliability, r.reliability)?;
+    t.raw_set(&keys.seen_ago, r.seen_ago)?;
+    Ok(t)
+}
+
 /// A table filled at most once per cycle (see `RobotIo::generation`).
 #[derive(Default)]
 struct CycleTable(RefCell<Option<(u64, Table)>>);
@@ -324,6 +350,46 @@ fn install_inner(lua: &Lua, io: Rc<RefCell<RobotIo>>, memory_limit: usize) -> ml
             }
             Ok(())
         })
+    });
+
+    // The other robots MAP anchored (MRT manual ch. 8), nearest first.
+    let k = keys.clone();
+    let robots = CycleTable::default();
+    func!("getRobots", io, |lua, (): ()| {
+        let keys = &k;
+        let io = io.borrow();
+        robots.get(lua, io.generation, |t| {
+            t.clear()?;
+            for (n, r) in io.world.robots.iter().enumerate() {
+                t.raw_set(n + 1, robot_table(lua, keys, r)?)?;
+            }
+            Ok(())
+        })
+    });
+    let k = keys.clone();
+    func!("getNearestOpponent", io, |lua, min: Option<f64>| {
+        let min = finite("getNearestOpponent", min.unwrap_or(ANCHORED))?;
+        let io = io.borrow();
+        match io.world.nearest_opponent(min) {
+            Some(r) => Ok(Value::Table(robot_table(lua, &k, r)?)),
+            None => Ok(Value::Nil),
+        }
+    });
+    func!("getFreeDirection", io, |_lua,
+                                   (theta, reach, clearance): (
+        Option<f64>,
+        Option<f64>,
+        Option<f64>
+    )| {
+        let io = io.borrow();
+        let w = &io.world;
+        // Towards the opponent's net when known, else straight ahead.
+        let net = w.lps[lps::NET1];
+        let toward = if net.reliability > 0.0 { net.theta } else { 0.0 };
+        let theta = finite("getFreeDirection", theta.unwrap_or(toward))?;
+        let reach = finite("getFreeDirection", reach.unwrap_or(FREE_REACH))?;
+        let clearance = finite("getFreeDirection", clearance.unwrap_or(FREE_CLEARANCE))?;
+        Ok(w.free_direction(theta, reach, clearance, ANCHORED))
     });
 
     let k = keys.clone();

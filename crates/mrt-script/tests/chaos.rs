@@ -89,6 +89,57 @@ fn every_data_access_function_reads_the_snapshot() {
     );
 }
 
+/// The robots MAP anchored (issue 20 item 4): `getRobots`, `getNearestOpponent`,
+/// `getFreeDirection`, read from the snapshot's anchors.
+#[test]
+fn behaviors_read_the_anchored_robots_the_nearest_opponent_and_a_free_direction() {
+    use mrt_msgs::{AnchoredRobot, RobotClass};
+    let (rt, io) = setup();
+    let mut w = world_with_ball(0.0, 100);
+    // The opponent's net straight ahead; a teammate 0.8 m ahead in the way, an opponent 1.5 m
+    // away on the left at 40°, and an old robot of unknown team behind.
+    w.lps[lps::NET1] = Lpo { rho: 5000.0, theta: 0.0, reliability: 1.0, seen_ago: 0.0 };
+    let robot = |id, class, rho: f64, theta: f64, reliability| AnchoredRobot {
+        id,
+        class,
+        x: rho * f64::cos(theta),
+        y: rho * f64::sin(theta),
+        rho,
+        theta,
+        reliability,
+        sigma: 80.0,
+        ..Default::default()
+    };
+    w.robots = vec![
+        robot(4, RobotClass::Teammate, 800.0, 0.0, 1.0),
+        robot(7, RobotClass::Opponent, 1500.0, 40f64.to_radians(), 0.9),
+        robot(9, RobotClass::Robot, 1200.0, 3.0, 0.2),
+    ];
+    io.borrow_mut().begin_cycle(w, "probe");
+    let probe = r#"
+        local r, o = chaos.getRobots(), chaos.getNearestOpponent()
+        local weak = chaos.getNearestOpponent(0.1)
+        local free = chaos.getFreeDirection()
+        local wide = chaos.getFreeDirection(0, 2000, 5000)
+        return string.format("%d %s %g|%d %s %g %g|%d|%.0f|%.0f", #r, r[1].class, r[2].reliability,
+            o.id, o.class, o.rho, o.sigma, weak.id, math.deg(free), math.deg(wide))"#;
+    let s = Script::from_source(&rt, "probe.lua", probe, LoadStrategy::Compiled).unwrap();
+    // The free direction: straight ahead is the teammate (800 mm, inside 500 mm of the line
+    // for |b| < 38.7°); 40° is the opponent's; the first free bearing going out 5° at a time,
+    // left first, is −40° (800·sin 40° = 514 > 500, the opponent 80° off). A 10 m wide
+    // corridor is blocked by anything ahead of it: the first bearing with both the teammate
+    // and the opponent behind is −95° (the robot of unknown team is too faded to count).
+    assert_eq!(s.call::<String>(&rt).unwrap(), "3 teammate 0.9|7 opponent 1500 80|9|-40|-95");
+    let bad = Script::from_source(
+        &rt,
+        "bad.lua",
+        "return chaos.getFreeDirection(0/0)",
+        LoadStrategy::Compiled,
+    )
+    .unwrap();
+    assert!(bad.call::<Option<f64>>(&rt).is_err(), "not a number: a Lua error");
+}
+
 #[test]
 fn control_coordination_and_persistence_write_the_command() {
     let (rt, io) = setup();
