@@ -302,6 +302,16 @@ pub fn run(args: &SimArgs) -> Result<()> {
             .map_or(String::new(), |v| format!("; velocity {v:.2} m/s mean"));
         outln!("  ball error while seen: {mean:.2} m mean, {p95:.2} m p95{velocity}");
     }
+    let r = &m.robots;
+    if let (Some(median), Some(p95)) = (r.median_m, r.p95_m) {
+        outln!(
+            "  other robots anchored while seen: {median:.2} m median, {p95:.2} m p95; team right {}, wrong {}, unknown {}; {} phantoms",
+            r.class_right,
+            r.class_wrong,
+            r.class_unknown,
+            r.phantoms
+        );
+    }
     if m.localization.relocalized > 0 {
         outln!(
             "  relocalized {} times, {} of them falsely (> 1 m from the truth)",

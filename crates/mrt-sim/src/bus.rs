@@ -13,7 +13,7 @@ use crate::game::{MatchReport, Pitch};
 use crate::referee::Call;
 use mrt_core::SimClock;
 use mrt_dcdt::{InnerLinkManager, SteppedExecutor};
-use mrt_msgs::{Localization, MemberFault};
+use mrt_msgs::{Localization, MemberFault, WorldSnapshot};
 use mrt_robot::brain::Brain;
 use mrt_robot::config::RobotConfig;
 use mrt_robot::devices::SharedDevices;
@@ -44,8 +44,9 @@ pub fn book_fault(fault: &MemberFault, pitch: &mut Pitch, robot: usize) {
 }
 
 /// The simulator's observer in each robot's Agora: it books every pose estimate the robot
-/// publishes ([`Localization`]) against where the robot really is
-/// ([`MatchReport::localization`]). It only reads the robot's messages; nothing goes back.
+/// publishes ([`Localization`]) against where the robot really is, and the robots its world
+/// snapshots anchored against where they are ([`MatchReport::localization`]). It only reads
+/// the robot's messages; nothing goes back.
 struct EstimateWatch {
     pitch: Shared,
     robot: usize,
@@ -54,6 +55,7 @@ struct EstimateWatch {
 impl mrt_dcdt::Member for EstimateWatch {
     fn init(&mut self, ctx: &mut mrt_dcdt::Context<'_>) -> Result<(), mrt_dcdt::MemberError> {
         ctx.subscribe_to::<Localization>(mrt_dcdt::RequestType::Local);
+        ctx.subscribe_to::<WorldSnapshot>(mrt_dcdt::RequestType::Local);
         Ok(())
     }
 
@@ -62,6 +64,10 @@ impl mrt_dcdt::Member for EstimateWatch {
         ctx: &mut mrt_dcdt::Context<'_>,
     ) -> Result<(), mrt_dcdt::MemberError> {
         while let Some(m) = ctx.receive_msg() {
+            if let Ok(w) = m.get::<WorldSnapshot>() {
+                lock_pitch(&self.pitch)?.book_robots(self.robot, &w.robots);
+                continue;
+            }
             let estimate = m.get::<Localization>()?;
             lock_pitch(&self.pitch)?.book_estimate(self.robot, estimate);
         }

@@ -11,10 +11,13 @@ use crate::referee::{Call, Referee, Team};
 use crate::render::{CameraState, Renderer, Scene};
 use crate::sensor::{self, sonar_ring, Odometer};
 use crate::world::{Drive, World};
+use mrt_core::frames::MM_PER_M;
 use mrt_core::{normalize_angle, Pose2};
 use mrt_msgs::robot::{GameState, RobotCommand};
 use mrt_msgs::Sonar;
-use mrt_msgs::{BallBelief, CameraFrame, GameInfo, Localization, Odometry};
+use mrt_msgs::{
+    AnchoredRobot, BallBelief, CameraFrame, GameInfo, Localization, Odometry, RobotClass,
+};
 use mrt_perception::camera::CameraModel;
 use mrt_robot::base::Base;
 use rand::SeedableRng;
@@ -123,9 +126,30 @@ pub struct LocalizationErrors {
     pub relocalized: u64,
     /// Those of them that left the estimate more than [`FALSELY_RELOCALIZED`] from the truth.
     pub falsely_relocalized: u64,
+    /// The other robots MAP anchored, against the truth.
+    pub robots: RobotErrors,
     /// Each robot's count of relocalizations at its last estimate.
     seen_relocalized: Vec<u64>,
 }
+
+/// The anchored robots (MAP, `mrt_world::anchor`) against the truth: every anchor a robot's
+/// snapshot had seen in that frame, matched with the real robot nearest to it.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct RobotErrors {
+    /// Distances from each anchor seen in its frame to the nearest other robot, m.
+    pub position: Vec<f64>,
+    /// Anchors whose class (teammate or opponent) is the nearest robot's team.
+    pub class_right: u64,
+    /// Anchors of the other team's class.
+    pub class_wrong: u64,
+    /// Anchors of unknown team.
+    pub class_unknown: u64,
+    /// Anchors with no robot within [`PHANTOM`]: seen where nobody is.
+    pub phantoms: u64,
+}
+
+/// An anchor farther than this (m) from every other robot is a phantom.
+pub const PHANTOM: f64 = 1.0;
 
 /// A relocalization that leaves the estimate this far from the truth (m) was false.
 pub const FALSELY_RELOCALIZED: f64 = 1.0;
@@ -478,6 +502,38 @@ impl Pitch {
         if let Some(k) = self.kidnaps.iter_mut().rev().find(|k| k.robot == i) {
             if k.recovered_after.is_none() && now > k.at && off < RECOVERED {
                 k.recovered_after = Some(now - k.at);
+            }
+        }
+    }
+
+    /// Books the robots robot `i`'s world snapshot anchored (team frame, mm) against where
+    /// the other robots are now ([`RobotErrors`]); anchors not seen in this frame are left out.
+    pub fn book_robots(&mut self, i: usize, robots: &[AnchoredRobot]) {
+        let mine = self.referee.team_of(i);
+        let attack = self.referee.attack_direction(mine);
+        let others: Vec<((f64, f64), Team)> = (0..self.world.robot_count())
+            .filter(|&k| k != i)
+            .filter_map(|k| self.world.robot(k).map(|p| ((p.x, p.y), self.referee.team_of(k))))
+            .collect();
+        let e = &mut self.localization.robots;
+        for r in robots.iter().filter(|r| r.seen_ago <= 0.0) {
+            // The team frame turned back into the field's (half a turn when attacking west).
+            let (x, y) = (attack * r.x / MM_PER_M, attack * r.y / MM_PER_M);
+            let nearest = others
+                .iter()
+                .map(|&((ox, oy), team)| ((ox - x).hypot(oy - y), team))
+                .min_by(|a, b| a.0.total_cmp(&b.0));
+            let Some((d, team)) = nearest else { continue };
+            e.position.push(d);
+            if d > PHANTOM {
+                e.phantoms += 1;
+                continue;
+            }
+            let truth = if team == mine { RobotClass::Teammate } else { RobotClass::Opponent };
+            match r.class {
+                RobotClass::Robot => e.class_unknown += 1,
+                c if c == truth => e.class_right += 1,
+                _ => e.class_wrong += 1,
             }
         }
     }

@@ -1,5 +1,5 @@
 //! What the robots believed against the truth, over a match or a series (`mrt sim --metrics
-//! FILE.json`): localization, the ball, the kidnapped robots' recovery.
+//! FILE.json`): localization, the ball, the other robots, the kidnapped robots' recovery.
 //!
 //! Every key of the JSON file ([`Metrics`]) is documented in `docs/localization.md`. Errors
 //! are pooled over every robot and every published estimate; quantiles come from histograms of
@@ -68,6 +68,9 @@ pub struct MetricsBook {
     recoveries: Vec<f64>,
     relocalized: u64,
     falsely_relocalized: u64,
+    robots: Histogram,
+    robot_classes: [u64; 3],
+    phantoms: u64,
 }
 
 impl Default for MetricsBook {
@@ -82,6 +85,9 @@ impl Default for MetricsBook {
             recoveries: Vec::new(),
             relocalized: 0,
             falsely_relocalized: 0,
+            robots: Histogram::new(0.001, 30.0),
+            robot_classes: [0; 3],
+            phantoms: 0,
         }
     }
 }
@@ -99,6 +105,14 @@ impl MetricsBook {
         self.recoveries.extend(r.kidnaps.iter().filter_map(|k| k.recovered_after));
         self.relocalized += l.relocalized;
         self.falsely_relocalized += l.falsely_relocalized;
+        let e = &l.robots;
+        e.position.iter().for_each(|&v| self.robots.add(v));
+        for (slot, n) in
+            self.robot_classes.iter_mut().zip([e.class_right, e.class_wrong, e.class_unknown])
+        {
+            *slot += n;
+        }
+        self.phantoms += e.phantoms;
     }
 
     /// The metrics so far.
@@ -128,6 +142,16 @@ impl MetricsBook {
                 velocity_p95_mps: self.ball_velocity.quantile(0.95),
                 velocity_samples: self.ball_velocity.n,
             },
+            robots: RobotMetrics {
+                mean_m: self.robots.mean(),
+                median_m: self.robots.quantile(0.5),
+                p95_m: self.robots.quantile(0.95),
+                samples: self.robots.n,
+                class_right: self.robot_classes[0],
+                class_wrong: self.robot_classes[1],
+                class_unknown: self.robot_classes[2],
+                phantoms: self.phantoms,
+            },
             kidnap: KidnapMetrics {
                 count: self.kidnaps,
                 recovered: rec.len() as u64,
@@ -148,6 +172,8 @@ pub struct Metrics {
     pub localization: LocalizationMetrics,
     /// The ball, while seen.
     pub ball: BallMetrics,
+    /// The other robots the robots anchored (MAP), while seen.
+    pub robots: RobotMetrics,
     /// The kidnapped robots.
     pub kidnap: KidnapMetrics,
 }
@@ -196,6 +222,29 @@ pub struct BallMetrics {
     pub velocity_samples: u64,
 }
 
+/// The other robots as each robot's world model anchored them (MAP, `mrt_world::anchor`), in
+/// every snapshot, for the anchors seen in that frame: the distance to the nearest real robot,
+/// and whether the anchor's class is that robot's team.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct RobotMetrics {
+    /// Mean distance to the nearest real robot, m.
+    pub mean_m: Option<f64>,
+    /// Median distance, m.
+    pub median_m: Option<f64>,
+    /// 95th percentile, m.
+    pub p95_m: Option<f64>,
+    /// Anchors compared.
+    pub samples: u64,
+    /// Anchors whose class (teammate or opponent) was right.
+    pub class_right: u64,
+    /// Anchors of the wrong team.
+    pub class_wrong: u64,
+    /// Anchors of unknown team (marker not seen, no teammate reporting there).
+    pub class_unknown: u64,
+    /// Anchors more than 1 m from every robot ([`crate::game::PHANTOM`]).
+    pub phantoms: u64,
+}
+
 /// Robots carried elsewhere without being told (`mrt sim --kidnap N`).
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct KidnapMetrics {
@@ -222,6 +271,13 @@ mod tests {
         localization.position = position;
         localization.ball = vec![0.1, 0.3];
         (localization.relocalized, localization.falsely_relocalized) = (3, 1);
+        localization.robots = crate::game::RobotErrors {
+            position: vec![0.1, 0.2, 1.5],
+            class_right: 1,
+            class_wrong: 0,
+            class_unknown: 1,
+            phantoms: 1,
+        };
         MatchReport {
             seed: 1,
             score: (0, 0),
@@ -264,6 +320,11 @@ mod tests {
         assert_eq!(json["kidnap"]["recovered"], 3);
         assert_eq!((m.localization.relocalized, m.localization.falsely_relocalized), (6, 2));
         assert!(json["ball"]["velocity_mean_mps"].is_null());
+        // The anchored robots of both matches: 0.1, 0.2, 1.5 m twice.
+        assert_eq!(m.robots.samples, 6);
+        assert!(near(m.robots.mean_m, 0.6), "{m:?}");
+        assert_eq!((m.robots.class_right, m.robots.class_unknown, m.robots.phantoms), (2, 2, 2));
+        assert_eq!(json["robots"]["class_wrong"], 0);
     }
 
     #[test]

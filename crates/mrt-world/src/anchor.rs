@@ -4,14 +4,15 @@
 //!
 //! Each frame, in MAP's three steps:
 //! 1. **Classification.** A robot percept is a Robot; the colour of its marker band, when the
-//!    camera saw it, makes it a Teammate or an Opponent ([`Anchor::class`]: the marker seen
-//!    most often on the anchor against the team's own colour). Partial information stays
+//!    camera saw it, makes it a Teammate or an Opponent ([`Anchor::class`]: the marker its
+//!    recent sightings show, against the team's own colour). Partial information stays
 //!    generic: a robot whose marker was never seen stays a Robot (the team side may still make
 //!    it a Teammate: `team::merge_team`, when a teammate reports being there).
 //! 2. **Data association** (global nearest neighbour): the squared Mahalanobis distance of
 //!    every percept from every anchor's prediction, gated at χ²₂ 99 % ([`GATE`]), and the
 //!    assignment of least total distance (Kuhn–Munkres, `pathfinding`), so two robots that
-//!    cross keep their identities.
+//!    cross keep their identities; a percept whose marker contradicts an anchor's is never
+//!    that anchor (two robots of different teams in a scrum do not swap).
 //! 3. **Tracking.** A matched anchor's track is corrected. An unmatched one is predicted and
 //!    its reliability fades, halving every second unseen ([`FADE`]); below [`FORGET`] it is
 //!    forgotten, but for [`REACQUIRE_FOR`] seconds a percept within a wider gate
@@ -62,6 +63,12 @@ pub const REACQUIRE_FOR: f64 = 3.0;
 /// wider than [`GATE`], since its prediction is old.
 pub const REACQUIRE_GATE: f64 = 4.0 * GATE;
 
+/// Each sighting of a marker keeps this much of the marker evidence gathered before it.
+pub const MARKER_MEMORY: f64 = 0.7;
+/// Marker evidence (about two sightings) past which a percept of the other colour is another
+/// robot, not this one.
+pub const SETTLED: f64 = 1.5;
+
 /// The cost the assignment gives a pair outside the gate: more than any number of pairs
 /// inside it, so it is used only where no gated pair is left (and then dropped).
 const FORBIDDEN: i64 = 1 << 40;
@@ -99,8 +106,9 @@ pub struct Anchor {
     track: Track,
     hits: u32,
     last_seen: f64,
-    /// Frames in which its marker was seen magenta and cyan.
-    markers: (u32, u32),
+    /// Evidence of its marker being magenta and cyan: each sighting of a marker multiplies
+    /// both by [`MARKER_MEMORY`] and adds 1 to its colour's (recent sightings count most).
+    markers: (f64, f64),
 }
 
 impl Anchor {
@@ -110,7 +118,7 @@ impl Anchor {
             track: Track::new(ROBOT_DAMPING, ROBOT_ACCEL),
             hits: 0,
             last_seen: time,
-            markers: (0, 0),
+            markers: (0.0, 0.0),
         };
         a.see(time, p);
         a
@@ -157,19 +165,38 @@ impl Anchor {
         }
     }
 
-    /// Teammate or opponent by the marker seen most often on it, against the team's own
-    /// colour `own`; a Robot while no marker was seen, or a tie, or `own` is unknown.
-    pub fn class(&self, own: Option<Marker>) -> RobotClass {
+    /// The marker colour its sightings show: the one with more evidence, when that is at
+    /// least half a sighting's and twice the other's.
+    pub fn marker(&self) -> Option<Marker> {
         let (m, c) = self.markers;
-        let seen = match m.cmp(&c) {
-            std::cmp::Ordering::Greater => Marker::Magenta,
-            std::cmp::Ordering::Less => Marker::Cyan,
-            std::cmp::Ordering::Equal => return RobotClass::Robot,
-        };
-        match own {
-            Some(own) if own == seen => RobotClass::Teammate,
-            Some(_) => RobotClass::Opponent,
-            None => RobotClass::Robot,
+        if m >= 0.5 && m >= 2.0 * c {
+            Some(Marker::Magenta)
+        } else if c >= 0.5 && c >= 2.0 * m {
+            Some(Marker::Cyan)
+        } else {
+            None
+        }
+    }
+
+    /// Teammate or opponent by its [`marker`](Self::marker) against the team's own colour
+    /// `own`; a Robot while its marker is unclear or `own` unknown.
+    pub fn class(&self, own: Option<Marker>) -> RobotClass {
+        match (own, self.marker()) {
+            (Some(own), Some(seen)) if own == seen => RobotClass::Teammate,
+            (Some(_), Some(_)) => RobotClass::Opponent,
+            _ => RobotClass::Robot,
+        }
+    }
+
+    /// Whether a percept may be this robot: not when it shows the other marker than this
+    /// anchor's settled one ([`SETTLED`]; MAP's merging keeps concepts on one path of the hierarchy: a cyan robot is
+    /// never a magenta one's next sighting, however near).
+    fn admits(&self, p: &RobotPercept) -> bool {
+        let (m, c) = self.markers;
+        match p.marker {
+            Some(Marker::Magenta) => !(c >= SETTLED && c >= 2.0 * m),
+            Some(Marker::Cyan) => !(m >= SETTLED && m >= 2.0 * c),
+            None => true,
         }
     }
 
@@ -182,9 +209,11 @@ impl Anchor {
         }
         self.hits = self.hits.saturating_add(1);
         self.last_seen = time;
+        let (m, c) = self.markers;
         match p.marker {
-            Some(Marker::Magenta) => self.markers.0 = self.markers.0.saturating_add(1),
-            Some(Marker::Cyan) => self.markers.1 = self.markers.1.saturating_add(1),
+            Some(Marker::Magenta) => self.markers = (m * MARKER_MEMORY + 1.0, c * MARKER_MEMORY),
+            Some(Marker::Cyan) => self.markers = (m * MARKER_MEMORY, c * MARKER_MEMORY + 1.0),
+            // A sighting without a marker (too near, too far, hidden) changes nothing.
             None => {}
         }
     }
@@ -244,7 +273,10 @@ impl Anchors {
             p.at.0.is_finite() && p.at.1.is_finite() && p.r.iter().all(|v| v.is_finite())
         };
         let percepts: Vec<&RobotPercept> = percepts.iter().filter(finite).collect();
-        let used = assign(&self.live, &percepts, |a, p| a.track.distance2(time, p.at, p.r), GATE);
+        let distance = |a: &Anchor, p: &RobotPercept| {
+            a.admits(p).then(|| a.track.distance2(time, p.at, p.r)).flatten()
+        };
+        let used = assign(&self.live, &percepts, distance, GATE);
         let mut taken = vec![false; percepts.len()];
         for (a, j) in self.live.iter_mut().zip(&used) {
             if let Some(j) = *j {
@@ -265,7 +297,7 @@ impl Anchors {
         let left: Vec<&RobotPercept> =
             percepts.iter().zip(&taken).filter(|(_, t)| !**t).map(|(p, _)| *p).collect();
         let old: Vec<&Anchor> = self.forgotten.iter().map(|(_, a)| a).collect();
-        let back = assign(&old, &left, |a, p| a.track.distance2(time, p.at, p.r), REACQUIRE_GATE);
+        let back = assign(&old, &left, |a, p| distance(a, p), REACQUIRE_GATE);
         let mut revived = vec![false; left.len()];
         // Taken out of the forgotten list highest index first, so the others stay put.
         for (k, j) in back.iter().enumerate().rev() {
@@ -407,17 +439,32 @@ mod tests {
         anchors.update(0.1, &[percept(1.0, 1.0, None)]);
         let a = &anchors.anchors()[0];
         assert_eq!(a.class(Some(Marker::Magenta)), RobotClass::Robot);
-        // Then its cyan marker, once: an opponent of the magenta team, a teammate of the cyan.
+        // Then its cyan marker, twice: an opponent of the magenta team, a teammate of the cyan.
         anchors.update(0.2, &[percept(1.0, 1.0, Some(Marker::Cyan))]);
+        anchors.update(0.25, &[percept(1.0, 1.0, Some(Marker::Cyan))]);
         let a = &anchors.anchors()[0];
         assert_eq!(a.class(Some(Marker::Magenta)), RobotClass::Opponent);
         assert_eq!(a.class(Some(Marker::Cyan)), RobotClass::Teammate);
         assert_eq!(a.class(None), RobotClass::Robot, "our colour unknown");
-        // One misread magenta does not flip it: a tie is a Robot, the majority decides.
+        // A magenta robot where the cyan one is: another robot (a scrum), not the same one
+        // misread: a new anchor, and the cyan one stays an opponent.
         anchors.update(0.3, &[percept(1.0, 1.0, Some(Marker::Magenta))]);
-        assert_eq!(anchors.anchors()[0].class(Some(Marker::Magenta)), RobotClass::Robot);
-        anchors.update(0.4, &[percept(1.0, 1.0, Some(Marker::Cyan))]);
-        assert_eq!(anchors.anchors()[0].class(Some(Marker::Magenta)), RobotClass::Opponent);
+        let live = anchors.anchors();
+        assert_eq!(live.len(), 2);
+        assert_eq!(live[0].class(Some(Marker::Magenta)), RobotClass::Opponent);
+        assert_eq!((live[1].marker(), live[1].phase(0.3)), (Some(Marker::Magenta), Phase::Find));
+        // Before a marker is settled, mixed evidence leaves it unknown: cyan then magenta
+        // (0.7 against 1: not twice), then magenta again settles it (0.49 against 1.7).
+        let mut fresh = Anchors::default();
+        fresh.update(0.0, &[percept(1.0, 1.0, Some(Marker::Cyan))]);
+        fresh.update(0.1, &[percept(1.0, 1.0, Some(Marker::Magenta))]);
+        assert_eq!(fresh.anchors().len(), 1);
+        assert_eq!(fresh.anchors()[0].marker(), None);
+        fresh.update(0.2, &[percept(1.0, 1.0, Some(Marker::Magenta))]);
+        assert_eq!(fresh.anchors()[0].marker(), Some(Marker::Magenta));
+        // Sightings without a marker keep it.
+        fresh.update(0.3, &[percept(1.0, 1.0, None)]);
+        assert_eq!(fresh.anchors()[0].marker(), Some(Marker::Magenta));
     }
 
     #[test]
