@@ -263,16 +263,23 @@ impl Anchors {
     }
 
     /// One frame's robot percepts at `time` (module doc). Frames must come in time order; a
-    /// percept that is not a number is refused and counted.
+    /// percept that is not a number, or whose covariance has a negative variance, is refused
+    /// and counted.
     pub fn update(&mut self, time: f64, percepts: &[RobotPercept]) {
+        let percepts_len = percepts.len();
         if !time.is_finite() {
             self.counts.refused += percepts.len() as u64;
             return;
         }
         let finite = |p: &&RobotPercept| {
-            p.at.0.is_finite() && p.at.1.is_finite() && p.r.iter().all(|v| v.is_finite())
+            p.at.0.is_finite()
+                && p.at.1.is_finite()
+                && p.r.iter().all(|v| v.is_finite())
+                && p.r[(0, 0)] >= 0.0
+                && p.r[(1, 1)] >= 0.0
         };
         let percepts: Vec<&RobotPercept> = percepts.iter().filter(finite).collect();
+        self.counts.refused += (percepts_len - percepts.len()) as u64;
         let distance = |a: &Anchor, p: &RobotPercept| {
             a.admits(p).then(|| a.track.distance2(time, p.at, p.r)).flatten()
         };
@@ -333,7 +340,8 @@ fn assign<A, P>(
         return out;
     }
     let cost = |i: usize, j: usize| match distance(&anchors[i], percepts[j]) {
-        Some(d2) if d2 <= gate => (d2 * COST_SCALE).round() as i64,
+        // A negative distance comes only from a covariance that is not one: never a pair.
+        Some(d2) if (0.0..=gate).contains(&d2) => (d2 * COST_SCALE).round() as i64,
         _ => FORBIDDEN,
     };
     // Kuhn–Munkres wants no more rows than columns: rows are the smaller side.
@@ -472,9 +480,13 @@ mod tests {
         let mut anchors = Anchors::default();
         anchors.update(0.0, &[percept(f64::NAN, 0.0, None), percept(1.0, 0.0, None)]);
         assert_eq!(anchors.anchors().len(), 1);
-        assert_eq!(anchors.counts().created, 1);
+        assert_eq!((anchors.counts().created, anchors.counts().refused), (1, 1));
         anchors.update(f64::INFINITY, &[percept(1.0, 0.0, None)]);
-        assert_eq!(anchors.counts().refused, 1);
+        assert_eq!(anchors.counts().refused, 2);
+        let negative =
+            RobotPercept { r: Matrix2::new(-1.0, 0.0, 0.0, 1.0), ..percept(1.0, 0.0, None) };
+        anchors.update(0.1, &[negative]);
+        assert_eq!(anchors.counts().refused, 3);
     }
 
     #[test]
@@ -496,5 +508,50 @@ mod tests {
         let refs: Vec<&f64> = one.iter().collect();
         assert_eq!(assign(&anchors, &refs, |a, p| Some((a - *p).powi(2)), 1.0), [None, Some(0)]);
         assert_eq!(assign(&anchors, &[], |a, p: &f64| Some((a - *p).powi(2)), 1.0), [None, None]);
+    }
+}
+
+#[cfg(test)]
+mod properties {
+    use super::*;
+    use proptest::prelude::*;
+
+    fn any_percept() -> impl Strategy<Value = RobotPercept> {
+        let coord = prop_oneof![-20.0..20.0f64, any::<f64>()];
+        let var = prop_oneof![1e-6..1.0f64, any::<f64>()];
+        let marker = prop_oneof![Just(None), Just(Some(Marker::Magenta)), Just(Some(Marker::Cyan))];
+        (coord.clone(), coord, var.clone(), var, marker).prop_map(|(x, y, a, b, marker)| {
+            RobotPercept { at: (x, y), r: Matrix2::new(a, 0.0, 0.0, b), marker }
+        })
+    }
+
+    proptest! {
+        /// Percepts of any numbers (a camera frame from the network) never panic the
+        /// anchoring, and every live anchor stays a finite place with a reliability in
+        /// [0, 1]; identities are never shared.
+        #[test]
+        fn any_percepts_leave_the_anchors_sane(
+            frames in proptest::collection::vec(
+                (0.0..0.5f64, proptest::collection::vec(any_percept(), 0..10)),
+                1..12,
+            )
+        ) {
+            let mut anchors = Anchors::default();
+            let mut time = 0.0;
+            for (dt, percepts) in frames {
+                time += dt;
+                anchors.update(time, &percepts);
+                let mut ids: Vec<u32> = anchors.anchors().iter().map(Anchor::id).collect();
+                ids.sort_unstable();
+                ids.dedup();
+                prop_assert_eq!(ids.len(), anchors.anchors().len());
+                for a in anchors.anchors() {
+                    let (x, y) = a.position(time);
+                    prop_assert!(x.is_finite() && y.is_finite(), "{:?}", a);
+                    let r = a.reliability(time);
+                    prop_assert!((0.0..=1.0).contains(&r));
+                }
+            }
+        }
     }
 }
