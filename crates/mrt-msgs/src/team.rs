@@ -1,12 +1,12 @@
 //! What teammates tell each other (ISocRob seed `003` §3.1, TeamChaos seed `001` §2.3): each
-//! robot's own pose and ball, every cycle.
+//! robot's own pose, ball and the robots it sees, every cycle.
 
-use crate::robot::{Estimate, WorldSnapshot};
+use crate::robot::{Estimate, RobotClass, WorldSnapshot};
 use serde::{Deserialize, Serialize};
 
 /// What a robot tells its teammates every cycle (team frame, mm): its own pose and its own
 /// sighting of the ball (never what it heard from others, so stale news does not circulate).
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct MateReport {
     /// The robot's player number.
     pub id: u32,
@@ -20,13 +20,37 @@ pub struct MateReport {
     /// from the quality).
     #[serde(default)]
     pub ball_sigma: f64,
+    /// The robots it sees this frame (MAP's team level: a teammate is an intelligent sensor
+    /// whose anchors the others fuse, MRT manual ch. 8).
+    #[serde(default)]
+    pub robots: Vec<SharedRobot>,
+}
+
+/// A robot a teammate anchored and sees this frame (team frame, mm).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct SharedRobot {
+    /// Teammate, opponent or unknown, as the teammate classified it (one team, one meaning).
+    pub class: RobotClass,
+    /// Its centre, mm.
+    pub x: f64,
+    /// See `x`.
+    pub y: f64,
+    /// One standard deviation of its place, mm.
+    pub sigma: f64,
 }
 
 impl MateReport {
     /// The report of robot `id` on its world snapshot (before the team's reports are merged
-    /// into it), with no ball uncertainty ([`MateReport::with_ball_sigma`] adds it).
+    /// into it: the robots it sees itself), with no ball uncertainty ([`MateReport::with_ball_sigma`] adds it).
     pub fn of(id: u32, keeper: bool, w: &WorldSnapshot) -> MateReport {
-        MateReport { id, keeper, pose: w.my_pos, ball: w.global_ball, ball_sigma: 0.0 }
+        let robots = w
+            .robots
+            .iter()
+            .filter(|r| r.seen_ago <= 0.0)
+            .map(|r| SharedRobot { class: r.class, x: r.x, y: r.y, sigma: r.sigma })
+            .collect();
+        MateReport { id, keeper, pose: w.my_pos, ball: w.global_ball, ball_sigma: 0.0, robots }
     }
 
     /// The same report with the ball's standard deviation, mm.

@@ -127,7 +127,7 @@ impl Member for WorldState {
                 self.model.game(*g);
             } else {
                 let r = m.get::<MateReport>()?;
-                self.mates.insert(r.id, *r);
+                self.mates.insert(r.id, r.clone());
             }
         }
         let Some(frame) = frame else { return Ok(()) };

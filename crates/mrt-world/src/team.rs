@@ -1,10 +1,11 @@
 //! The team side of the world state (ISocRob seed `003` §3.1: each robot shares what it knows
 //! with its teammates; TeamChaos seed `001` §2.1: the global ball): teammates' poses from their
-//! [`MateReport`]s, the team ball fused from everyone's, and the anchored robots of unknown
-//! team that stand where a teammate says it is, made teammates.
+//! [`MateReport`]s, the team ball fused from everyone's, the anchored robots of unknown team
+//! that stand where a teammate says it is made teammates, and the robots teammates see that
+//! this robot does not.
 
 use mrt_core::Pose2;
-use mrt_msgs::{Estimate, Mate, MateReport, RobotClass, WorldSnapshot};
+use mrt_msgs::{AnchoredRobot, Estimate, Mate, MateReport, RobotClass, SharedRobot, WorldSnapshot};
 
 /// A teammate's ball counts this much of its own quality: a second-hand sighting, one cycle
 /// old, is trusted a little less than one's own.
@@ -85,8 +86,10 @@ pub fn merge_team<'a>(
     let mut all: Vec<Sighting> = Vec::new();
     all.extend(Sighting::new(&w.global_ball, own_sigma, w.global_ball.quality));
     let own = !all.is_empty();
+    let mut shared: Vec<(u32, usize, SharedRobot)> = Vec::new();
     for r in reports {
         w.mates.push(Mate { id: r.id, at: r.pose, keeper: r.keeper });
+        shared.extend(r.robots.iter().enumerate().map(|(k, s)| (r.id, k, *s)));
         if sees {
             continue;
         }
@@ -95,6 +98,7 @@ pub fn merge_team<'a>(
         all.extend(Sighting::new(&r.ball, Some(sigma), r.ball.quality * SHARED_BALL));
     }
     recognize_mates(w);
+    adopt_shared_robots(w, &shared);
     let gathering =
         |seed: &Sighting| -> Vec<&Sighting> { all.iter().filter(|s| seed.agrees(s)).collect() };
     // The heaviest gathering; on a tie the first (one's own).
@@ -141,6 +145,64 @@ fn recognize_mates(w: &mut WorldSnapshot) {
     }
 }
 
+/// Identities of the robots adopted from teammates' reports have this bit set (then the
+/// teammate's number times 256 plus the robot's place in its report): never an own anchor's.
+pub const SHARED_ID: u32 = 1 << 31;
+
+/// How old a teammate's sighting is when it arrives, s (one control cycle): a shared robot's
+/// `seen_ago`.
+pub const SHARED_AGE: f64 = 0.1;
+
+/// MAP's team level (research note MODULES.md §3: a teammate is an intelligent sensor whose
+/// instances go into the local fusion): a robot a teammate sees this frame and this robot does
+/// not is added to its anchored robots, [`SHARED_BALL`] as reliable and [`SHARED_DRIFT`] less
+/// sure. One this robot anchors too (within [`SAME_ROBOT`] or three standard deviations) is not
+/// added twice, but a class the teammate knows specialises an own anchor of unknown team. A
+/// shared robot where this robot stands (the teammate sees it) is left out, as is a second
+/// teammate's report of one already adopted.
+fn adopt_shared_robots(w: &mut WorldSnapshot, shared: &[(u32, usize, SharedRobot)]) {
+    let me = w.my_pos;
+    let first_adopted = w.robots.len();
+    for &(mate, k, s) in shared {
+        let finite = s.x.is_finite() && s.y.is_finite() && s.sigma.is_finite();
+        if !finite || s.sigma < 0.0 {
+            continue;
+        }
+        let sigma = s.sigma + SHARED_DRIFT;
+        if me.quality > 0.0 && (me.pose.x - s.x).hypot(me.pose.y - s.y) <= SAME_ROBOT {
+            continue;
+        }
+        let same = |r: &AnchoredRobot| {
+            let gate = SAME_ROBOT.max(3.0 * r.sigma.hypot(sigma));
+            (r.x - s.x).hypot(r.y - s.y) <= gate
+        };
+        if let Some(r) = w.robots[..first_adopted].iter_mut().find(|r| same(r)) {
+            if r.class == RobotClass::Robot {
+                r.class = s.class;
+            }
+            continue;
+        }
+        if w.robots[first_adopted..].iter().any(same) {
+            continue;
+        }
+        let (dx, dy) = (s.x - me.pose.x, s.y - me.pose.y);
+        w.robots.push(AnchoredRobot {
+            id: SHARED_ID | (mate.min(0x7F_FFFF) << 8) | (k.min(255) as u32),
+            class: s.class,
+            x: s.x,
+            y: s.y,
+            vx: 0.0,
+            vy: 0.0,
+            sigma,
+            rho: dx.hypot(dy),
+            theta: mrt_core::normalize_angle(dy.atan2(dx) - me.pose.theta),
+            reliability: SHARED_BALL,
+            seen_ago: SHARED_AGE,
+        });
+    }
+    w.robots.sort_by(|a, b| a.rho.total_cmp(&b.rho));
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -152,6 +214,7 @@ mod tests {
             pose: Estimate { pose: Pose2::new(-1000.0 * f64::from(id), 0.0, 0.0), quality: 0.9 },
             ball: Estimate { pose: Pose2::new(ball.0, ball.1, 0.0), quality },
             ball_sigma: sigma,
+            robots: Vec::new(),
         }
     }
 
@@ -187,6 +250,52 @@ mod tests {
         );
         let classes: Vec<RobotClass> = w.robots.iter().map(|r| r.class).collect();
         assert_eq!(classes, [RobotClass::Teammate, RobotClass::Opponent, RobotClass::Robot]);
+    }
+
+    /// MAP's team level: the robots teammates see fill in what this robot does not see.
+    #[test]
+    fn robots_teammates_see_are_adopted_once_and_specialise_own_anchors() {
+        let shared = |class, x: f64, y: f64, sigma| SharedRobot { class, x, y, sigma };
+        let mut w = WorldSnapshot {
+            my_pos: Estimate { pose: Pose2::new(0.0, 0.0, 0.0), quality: 0.9 },
+            robots: vec![AnchoredRobot {
+                id: 3,
+                class: RobotClass::Robot,
+                x: 2000.0,
+                sigma: 100.0,
+                rho: 2000.0,
+                reliability: 1.0,
+                ..Default::default()
+            }],
+            ..Default::default()
+        };
+        let mut one = report(1, (0.0, 0.0), 0.0, 0.0);
+        one.robots = vec![
+            shared(RobotClass::Opponent, 2050.0, 30.0, 100.0), // own anchor 3: now an opponent
+            shared(RobotClass::Teammate, 0.0, 100.0, 80.0),    // this robot itself
+            shared(RobotClass::Opponent, -3000.0, 2000.0, 150.0), // unseen here: adopted
+        ];
+        let mut two = report(2, (0.0, 0.0), 0.0, 0.0);
+        two.robots = vec![
+            shared(RobotClass::Opponent, -3100.0, 2050.0, 150.0), // the same, told twice
+            shared(RobotClass::Opponent, f64::NAN, 0.0, 100.0),   // not a place
+        ];
+        merge_team(&mut w, None, &[one, two]);
+        assert_eq!(w.robots.len(), 2, "{:?}", w.robots);
+        let (own, adopted) = (&w.robots[0], &w.robots[1]);
+        assert_eq!((own.id, own.class), (3, RobotClass::Opponent));
+        assert_eq!(adopted.id, SHARED_ID | (1 << 8) | 2);
+        assert_eq!(adopted.class, RobotClass::Opponent);
+        assert_eq!((adopted.x, adopted.y, adopted.sigma), (-3000.0, 2000.0, 150.0 + SHARED_DRIFT));
+        assert_eq!((adopted.reliability, adopted.seen_ago), (SHARED_BALL, SHARED_AGE));
+        // Distance and bearing from this robot: √(3000² + 2000²), atan2(2000, −3000).
+        assert!((adopted.rho - 3605.551).abs() < 1e-3);
+        assert!((adopted.theta - 2000f64.atan2(-3000.0)).abs() < 1e-12);
+        // What this robot tells its team: only what it sees itself this frame (the adopted
+        // robot is a cycle old: hearsay does not circulate).
+        let mine = MateReport::of(5, false, &w);
+        assert_eq!(mine.robots.len(), 1, "{mine:?}");
+        assert_eq!((mine.robots[0].x, mine.robots[0].class), (2000.0, RobotClass::Opponent));
     }
 
     #[test]
