@@ -225,6 +225,15 @@ impl Default for WorldSnapshot {
 }
 
 impl WorldSnapshot {
+    /// The reliability an anchored robot needs to count for the behaviors' default queries
+    /// (`getNearestOpponent`, `getFreeDirection`, Team Milan's inputs): about 1.7 s unseen.
+    pub const ANCHORED: f64 = 0.3;
+    /// How far ahead the behaviors' free direction looks unless told, mm.
+    pub const FREE_REACH: f64 = 2000.0;
+    /// Half the width of the corridor the behaviors' free direction keeps free unless told,
+    /// mm: two Middle Size robots' radii.
+    pub const FREE_CLEARANCE: f64 = 500.0;
+
     /// The nearest robot that is not known to be a teammate, with at least `min_reliability`
     /// (`getNearestOpponent`): an opponent, or a robot of unknown team (a careful player
     /// treats a robot it cannot place as an opponent).

@@ -11,8 +11,9 @@
 //! 1. **`vision-<n>`** (periodic, when the robot's configuration has
 //!    [`vision`](RobotConfig::vision)): the vision µAgent (ISocRob seed `003` §3.2.1) turns
 //!    the camera's latest image into [`Percepts`];
-//! 2. **`WorldState`** (periodic): fuses odometry, camera percepts and game controller into the robot's
-//!    own pose and LPS ([`WorldModel`]), takes its teammates' poses from their reports
+//! 2. **`WorldState`** (periodic): fuses odometry, camera percepts, sonar echoes and game
+//!    controller into the robot's own pose, LPS and anchored robots ([`WorldModel`]), takes
+//!    its teammates' poses and the robots they see from their reports
 //!    received over the bus, and publishes the [`WorldSnapshot`] and, for monitors, its
 //!    [`Localization`](mrt_msgs::Localization); it also publishes a [`MateReport`] (its pose
 //!    and its ball estimate) that the teammates' Agoras receive through their team's link — a
@@ -107,6 +108,7 @@ impl Member for WorldState {
         ctx.subscribe_to::<CameraFrame>(RequestType::Local);
         ctx.subscribe_to::<Percepts>(RequestType::Local);
         ctx.subscribe_to::<GameInfo>(RequestType::Local);
+        ctx.subscribe_to::<SonarScan>(RequestType::Local);
         ctx.subscribe_to::<MateReport>(RequestType::Remote);
         Ok(())
     }
@@ -125,6 +127,9 @@ impl Member for WorldState {
                 frame = Some(m);
             } else if let Ok(g) = m.get::<GameInfo>() {
                 self.model.game(*g);
+            } else if let Ok(scan) = m.get::<SonarScan>() {
+                // Read with the next frame (MAP's merger: echoes of robots out of view).
+                self.model.sonars(scan);
             } else {
                 let r = m.get::<MateReport>()?;
                 self.mates.insert(r.id, r.clone());
@@ -471,8 +476,11 @@ fn add_cycle(
     }
     ids.extend([
         agora.add_member(game, every),
-        agora.add_member(world, every),
+        // The sonars before the world state, which reads their echoes with this cycle's frame
+        // (still after the camera: the simulator's sensors draw in the order odometry,
+        // camera, sonars).
         agora.add_member(sonars, every),
+        agora.add_member(world, every),
         agora.add_boxed_member(behavior, every),
     ]);
     if let Some(g) = cfg.gaze {

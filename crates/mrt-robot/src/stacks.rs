@@ -210,14 +210,6 @@ pub struct MilanBrain {
     keeper: bool,
 }
 
-/// The reliability an anchored robot needs to count in the Parser's inputs (as for
-/// `chaos.getNearestOpponent`).
-pub const ANCHORED: f64 = 0.3;
-/// How far ahead `FreeDirection` looks, mm.
-pub const FREE_REACH: f64 = 2000.0;
-/// Half the width of the corridor `FreeDirection` keeps free, mm (two robots' radii).
-pub const FREE_CLEARANCE: f64 = 500.0;
-
 /// Degrees in [0, 360) of an angle in radians.
 fn deg360(a: f64) -> f64 {
     a.to_degrees().rem_euclid(360.0)
@@ -271,13 +263,18 @@ impl MilanBrain {
         }
         // The robots MAP anchored (MRT manual ch. 8): the nearest opponent, and the free
         // direction nearest to the opponent's net (where it is by the robot's own pose).
-        if let Some(o) = w.nearest_opponent(ANCHORED) {
+        if let Some(o) = w.nearest_opponent(WorldSnapshot::ANCHORED) {
             v.push(("OpponentDistance", o.rho, o.reliability));
             v.push(("OpponentBearing", deg360(o.theta), o.reliability));
         }
         let net = (field.half_length - me.x, -me.y);
         let toward = net.1.atan2(net.0) - me.theta;
-        if let Some(free) = w.free_direction(toward, FREE_REACH, FREE_CLEARANCE, ANCHORED) {
+        if let Some(free) = w.free_direction(
+            toward,
+            WorldSnapshot::FREE_REACH,
+            WorldSnapshot::FREE_CLEARANCE,
+            WorldSnapshot::ANCHORED,
+        ) {
             v.push(("FreeDirection", deg360(free), q));
         }
         v

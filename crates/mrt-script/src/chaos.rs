@@ -191,15 +191,6 @@ impl Keys {
     }
 }
 
-/// The reliability an anchored robot needs to count for `getNearestOpponent` (unless told)
-/// and `getFreeDirection`: about 1.7 s unseen.
-pub const ANCHORED: f64 = 0.3;
-/// How far ahead `getFreeDirection` looks unless told, mm.
-pub const FREE_REACH: f64 = 2000.0;
-/// Half the width of the corridor `getFreeDirection` keeps free unless told, mm: two Middle
-/// Size robots' radii.
-pub const FREE_CLEARANCE: f64 = 500.0;
-
 /// One anchored robot as scripts see it: `{id, class, x, y, vx, vy, sigma, rho, theta,
 /// reliability, seen_ago}` (team frame mm, mm/s; robot frame mm, rad).
 fn robot_table(lua: &Lua, keys: &Keys, r: &mrt_msgs::AnchoredRobot) -> mlua::Result<Table> {
@@ -368,7 +359,7 @@ fn install_inner(lua: &Lua, io: Rc<RefCell<RobotIo>>, memory_limit: usize) -> ml
     });
     let k = keys.clone();
     func!("getNearestOpponent", io, |lua, min: Option<f64>| {
-        let min = finite("getNearestOpponent", min.unwrap_or(ANCHORED))?;
+        let min = finite("getNearestOpponent", min.unwrap_or(WorldSnapshot::ANCHORED))?;
         let io = io.borrow();
         match io.world.nearest_opponent(min) {
             Some(r) => Ok(Value::Table(robot_table(lua, &k, r)?)),
@@ -387,9 +378,10 @@ fn install_inner(lua: &Lua, io: Rc<RefCell<RobotIo>>, memory_limit: usize) -> ml
         let net = w.lps[lps::NET1];
         let toward = if net.reliability > 0.0 { net.theta } else { 0.0 };
         let theta = finite("getFreeDirection", theta.unwrap_or(toward))?;
-        let reach = finite("getFreeDirection", reach.unwrap_or(FREE_REACH))?;
-        let clearance = finite("getFreeDirection", clearance.unwrap_or(FREE_CLEARANCE))?;
-        Ok(w.free_direction(theta, reach, clearance, ANCHORED))
+        let reach = finite("getFreeDirection", reach.unwrap_or(WorldSnapshot::FREE_REACH))?;
+        let clearance =
+            finite("getFreeDirection", clearance.unwrap_or(WorldSnapshot::FREE_CLEARANCE))?;
+        Ok(w.free_direction(theta, reach, clearance, WorldSnapshot::ANCHORED))
     });
 
     let k = keys.clone();

@@ -57,6 +57,9 @@ pub const FADE: f64 = 0.5;
 pub const FORGET: f64 = 0.1;
 /// Sightings an anchor needs before it leaves the find phase.
 pub const CONFIRM: u32 = 2;
+/// Seconds after the camera last saw an anchor during which sonar echoes may keep it in
+/// track.
+pub const ECHO_KEEP: f64 = 2.0;
 /// Seconds a forgotten anchor may still be reacquired.
 pub const REACQUIRE_FOR: f64 = 3.0;
 /// The gate (squared Mahalanobis distance) within which a forgotten anchor is reacquired:
@@ -106,6 +109,8 @@ pub struct Anchor {
     track: Track,
     hits: u32,
     last_seen: f64,
+    /// When the camera (not a sonar) last saw it, s.
+    last_camera: f64,
     /// Evidence of its marker being magenta and cyan: each sighting of a marker multiplies
     /// both by [`MARKER_MEMORY`] and adds 1 to its colour's (recent sightings count most).
     markers: (f64, f64),
@@ -118,6 +123,7 @@ impl Anchor {
             track: Track::new(ROBOT_DAMPING, ROBOT_ACCEL),
             hits: 0,
             last_seen: time,
+            last_camera: time,
             markers: (0.0, 0.0),
         };
         a.see(time, p);
@@ -232,6 +238,8 @@ pub struct AnchorCounts {
     pub forgotten: u64,
     /// Percepts refused (not numbers).
     pub refused: u64,
+    /// Sonar echoes that kept an anchor the camera did not see in track.
+    pub echoes: u64,
 }
 
 /// The anchored robots (module doc).
@@ -266,30 +274,70 @@ impl Anchors {
     /// percept that is not a number, or whose covariance has a negative variance, is refused
     /// and counted.
     pub fn update(&mut self, time: f64, percepts: &[RobotPercept]) {
-        let percepts_len = percepts.len();
+        self.observe(time, percepts, &[]);
+    }
+
+    /// [`update`](Self::update) with sonar `echoes` as well (MAP's merger, MRT manual ch. 8:
+    /// percepts of several sensors): after the camera's percepts are associated, the echoes
+    /// are associated with every anchor; one that falls to an anchor no percept took keeps it
+    /// in track (a robot beside or behind the robot, out of the camera's view) for
+    /// [`ECHO_KEEP`] after the camera last saw it. An echo never makes an anchor nor takes a
+    /// forgotten one back: a sonar cannot tell a robot from a wall or a goal post.
+    pub fn observe(&mut self, time: f64, percepts: &[RobotPercept], echoes: &[RobotPercept]) {
+        let given = percepts.len() + echoes.len();
         if !time.is_finite() {
-            self.counts.refused += percepts.len() as u64;
+            self.counts.refused += given as u64;
             return;
         }
-        let finite = |p: &&RobotPercept| {
+        let sane = |p: &&RobotPercept| {
             p.at.0.is_finite()
                 && p.at.1.is_finite()
                 && p.r.iter().all(|v| v.is_finite())
                 && p.r[(0, 0)] >= 0.0
                 && p.r[(1, 1)] >= 0.0
         };
-        let percepts: Vec<&RobotPercept> = percepts.iter().filter(finite).collect();
-        self.counts.refused += (percepts_len - percepts.len()) as u64;
+        let percepts: Vec<&RobotPercept> = percepts.iter().filter(sane).collect();
+        let echoes: Vec<&RobotPercept> = echoes.iter().filter(sane).collect();
+        self.counts.refused += (given - percepts.len() - echoes.len()) as u64;
         let distance = |a: &Anchor, p: &RobotPercept| {
             a.admits(p).then(|| a.track.distance2(time, p.at, p.r)).flatten()
         };
         let used = assign(&self.live, &percepts, distance, GATE);
         let mut taken = vec![false; percepts.len()];
-        for (a, j) in self.live.iter_mut().zip(&used) {
+        let mut seen = vec![false; self.live.len()];
+        for ((a, j), seen) in self.live.iter_mut().zip(&used).zip(&mut seen) {
             if let Some(j) = *j {
                 a.see(time, percepts[j]);
+                a.last_camera = time;
                 taken[j] = true;
+                *seen = true;
                 self.counts.updates += 1;
+            }
+        }
+        // The echoes, against every anchor: one that falls to an anchor the camera saw is
+        // that robot's and is spent; one that falls to an unseen anchor keeps it in track.
+        // (Offered to the unseen alone, a seen robot's echo would keep a stale anchor beside
+        // it alive.)
+        // An echo keeps an anchor only for ECHO_KEEP after the camera last saw it: a sonar
+        // cannot tell whose echo it is, and a stale anchor's wide prediction would catch
+        // stray echoes for ever.
+        // An echo within the gate of two anchors (a scrum) could be either robot's: it is
+        // left out, or it would hand an anchor from one robot to its neighbour.
+        let live = &self.live;
+        let echoes: Vec<&RobotPercept> = echoes
+            .into_iter()
+            .filter(|e| {
+                live.iter().filter(|a| distance(a, e).is_some_and(|d| d <= GATE)).count() <= 1
+            })
+            .collect();
+        let heard = assign(&self.live, &echoes, distance, GATE);
+        for ((a, j), seen) in self.live.iter_mut().zip(heard).zip(&seen) {
+            if let (Some(j), false) = (j, *seen) {
+                if time - a.last_camera > ECHO_KEEP {
+                    continue;
+                }
+                a.see(time, echoes[j]);
+                self.counts.echoes += 1;
             }
         }
         // The unseen fade; the faded are forgotten (kept a while for reacquisition).
@@ -437,6 +485,36 @@ mod tests {
         anchors.update(20.0, &[]);
         anchors.update(30.0, &[percept(-3.0, 0.0, None)]);
         assert_eq!(anchors.anchors()[0].id(), 1);
+    }
+
+    /// MAP's merger with the sonars: an echo keeps a robot the camera lost sight of in track,
+    /// but never makes an anchor, and the camera's percept wins where both see one.
+    #[test]
+    fn sonar_echoes_keep_unseen_anchors_in_track_and_make_none() {
+        let mut anchors = Anchors::default();
+        let echo = |x: f64, y: f64| RobotPercept { at: (x, y), r: r(0.1), marker: None };
+        // An echo alone: nothing.
+        anchors.observe(0.0, &[], &[echo(1.0, 1.0)]);
+        assert!(anchors.anchors().is_empty());
+        // Seen by the camera twice, walking east at 0.5 m/s with its cyan marker.
+        anchors.observe(0.1, &[percept(1.0, 1.0, Some(Marker::Cyan))], &[]);
+        anchors.observe(0.2, &[percept(1.05, 1.0, Some(Marker::Cyan))], &[]);
+        // Out of the camera's view for 2 s, heard by the sonars all along: still tracked,
+        // fully reliable, where the echoes put it, its team kept.
+        for k in 1..=20 {
+            let t = 0.2 + 0.1 * f64::from(k);
+            anchors.observe(t, &[], &[echo(1.05 + 0.05 * f64::from(k), 1.0)]);
+        }
+        let a = &anchors.anchors()[0];
+        assert_eq!((anchors.anchors().len(), a.phase(2.2)), (1, Phase::Track));
+        assert_eq!(a.reliability(2.2), 1.0);
+        assert!((a.position(2.2).0 - 2.05).abs() < 0.1, "{:?}", a.position(2.2));
+        assert_eq!(a.marker(), Some(Marker::Cyan));
+        assert_eq!(anchors.counts().echoes, 20);
+        // The camera and the sonar both: the camera's percept is used, the echo left over.
+        anchors.observe(2.3, &[percept(2.1, 1.0, None)], &[echo(2.1, 1.05)]);
+        assert_eq!(anchors.counts().echoes, 20);
+        assert_eq!(anchors.anchors().len(), 1);
     }
 
     #[test]

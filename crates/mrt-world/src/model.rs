@@ -38,7 +38,7 @@ use mrt_core::{normalize_angle, Point2, Pose2, Time, Vec2};
 use mrt_msgs::robot::{lps, AnchoredRobot, Estimate, Lpo, WorldSnapshot};
 use mrt_msgs::{
     BallBelief, CameraFrame, GameInfo, Localization, Odometry, Percepts, PostSighting,
-    RobotSighting, Sighting, FIELD_OBJECTS,
+    RobotSighting, Sighting, Sonar, SonarScan, FIELD_OBJECTS,
 };
 use mrt_perception::mice::{Displacement, MiceOdometry, MiceReadings};
 use mrt_perception::PerceptionError;
@@ -138,7 +138,26 @@ pub struct WorldModel {
     /// The radius this model gives the other robots, m (their centre is this far beyond the
     /// nearest point the camera sees).
     robot_radius: f64,
+    /// The sonar ring's latest reading.
+    sonars: Vec<Sonar>,
 }
+
+/// A sonar echo's range error, m (the ISocRob ring's: a centimetre; `[sonar] noise` of the
+/// simulator).
+pub const SONAR_RANGE_SIGMA: f64 = 0.02;
+/// A sonar echo's bearing error, rad: anywhere in a beam of ±0.2 rad (the simulator's
+/// `[sonar] half_beam`), the standard deviation of a uniform spread.
+pub const SONAR_BEARING_SIGMA: f64 = 0.2 / 1.732;
+/// Echoes within this distance of where the robot believes the ball is are the ball's, and
+/// within it of a goal post the post's, m.
+pub const BALL_ECHO: f64 = 0.3;
+/// Echoes farther than this outside the field lines are walls, goals or posts, m.
+pub const OFF_FIELD: f64 = 0.3;
+/// Echoes farther than this are not read as robots, m: the beam's width there (±0.2 rad)
+/// spans more than a robot.
+pub const ECHO_RANGE: f64 = 1.5;
+/// Echoes of neighbouring sonars within this distance of each other are one robot's, m.
+pub const SAME_ECHO: f64 = 0.35;
 
 /// The radius of the other robots unless told ([`WorldModel::with_robot_radius`]), m: a Middle
 /// Size robot's (the simulator's default).
@@ -171,7 +190,14 @@ impl WorldModel {
             ball_seen_sigma: 0.0,
             robots: Anchors::default(),
             robot_radius: ROBOT_RADIUS,
+            sonars: Vec::new(),
         }
+    }
+
+    /// The sonar ring's reading (ISocRob seed `003` §2): kept for the next frame's anchoring,
+    /// where an echo keeps a robot the camera does not see in track ([`Anchors::observe`]).
+    pub fn sonars(&mut self, scan: &SonarScan) {
+        self.sonars.clone_from(&scan.sonars);
     }
 
     /// The same model for other robots of radius `radius` (m; a positive number, else
@@ -598,7 +624,73 @@ impl WorldModel {
                 RobotPercept { at: (at.inner.x, at.inner.y), r, marker: z.marker }
             })
             .collect();
-        self.robots.update(time, &percepts);
+        let echoes = self.echoes(&me);
+        self.robots.observe(time, &percepts, &echoes);
+    }
+
+    /// The sonar echoes that may be robots, as percepts of their centres: an echo is a
+    /// robot's near side, so its centre is a radius beyond; echoes of the ball (where the
+    /// robot believes it is), of the goals' posts and of what stands off the field are left
+    /// out.
+    fn echoes(&self, me: &Framed<Field, Pose2>) -> Vec<RobotPercept> {
+        let pose_xy = self.cov.fixed_view::<2, 2>(0, 0).into_owned();
+        let ball = self.memory[lps::BALL].filter(|m| m.reliability >= 0.5).map(|m| m.at.inner);
+        let (hl, hw) = (self.map.half_length() + OFF_FIELD, self.map.half_width() + OFF_FIELD);
+        // Each sonar's echo point (field frame), in ring order; `None`: no echo, or not a
+        // robot's.
+        let points: Vec<Option<(Point2, &Sonar)>> = self
+            .sonars
+            .iter()
+            .map(|s| {
+                if !(s.range.is_finite() && s.range > 0.0 && s.bearing.is_finite()) {
+                    return None;
+                }
+                if s.range > ECHO_RANGE {
+                    return None;
+                }
+                let echo = me.at_range_bearing(s.range, s.bearing).inner;
+                let off = echo.x.abs() > hl || echo.y.abs() > hw;
+                let at_ball = ball.is_some_and(|b| (b - echo).norm() <= BALL_ECHO);
+                // A goal's posts stand on its line: (±half length, ±half the goal's width).
+                let post = (echo.x.abs() - self.map.half_length())
+                    .hypot(echo.y.abs() - self.map.goal_width / 2.0);
+                (!(off || at_ball || post <= BALL_ECHO)).then_some((echo, s))
+            })
+            .collect();
+        // One robot echoes in two or three neighbouring sonars: echoes of neighbours within
+        // SAME_ECHO of each other are one robot, seen at its nearest echo.
+        let n = points.len();
+        let apart = |a: usize, b: usize| match (points[a % n], points[b % n]) {
+            (Some((p, _)), Some((q, _))) => (p - q).norm() > SAME_ECHO,
+            _ => true,
+        };
+        // Start after a break so that no group wraps round the ring.
+        let start = (0..n).find(|&k| apart(k + n - 1, k)).unwrap_or(0);
+        let mut out = Vec::new();
+        let mut nearest: Option<&Sonar> = None;
+        for k in start..start + n {
+            if let Some((_, s)) = points[k % n] {
+                if nearest.is_none_or(|m| s.range < m.range) {
+                    nearest = Some(s);
+                }
+            }
+            if apart(k, k + 1) || k + 1 == start + n {
+                if let Some(s) = nearest.take() {
+                    let centre = s.range + self.robot_radius;
+                    let at = me.at_range_bearing(centre, s.bearing).inner;
+                    let r = sighting_covariance(
+                        centre,
+                        s.bearing,
+                        self.pose.theta,
+                        (SONAR_RANGE_SIGMA, SONAR_BEARING_SIGMA),
+                        pose_xy,
+                        self.cov[(2, 2)],
+                    );
+                    out.push(RobotPercept { at: (at.x, at.y), r, marker: None });
+                }
+            }
+        }
+        out
     }
 
     /// What the vision µAgent found in one image (a [`Percepts`]): read like a camera frame
@@ -1057,6 +1149,45 @@ mod tests {
         m.place(Framed::new(Pose2::new(3.0, 3.0, 0.0)));
         f.time = 2.2;
         assert!(m.camera(&f).robots.is_empty());
+    }
+
+    /// The sonar ring keeps a robot the camera no longer sees anchored: its echo, a robot's
+    /// radius short of its centre, is read with the next frame. Echoes of the wall and of the
+    /// ball are not robots.
+    #[test]
+    fn a_robot_out_of_view_is_kept_by_its_sonar_echo() {
+        use mrt_msgs::{RobotSighting, Sonar, SonarScan};
+        let mut m = model();
+        let at = Pose2::new(8.0, 0.0, 0.0);
+        m.place(Framed::new(at));
+        m.game(playing(1.0));
+        // A robot 1.5 m ahead (centre), the ball 1 m to the left.
+        let mut f = frame(at, 1.0, &[(lps::BALL, (8.0, 1.0))]);
+        let foot = Sighting { distance: 1.25, bearing: 0.0 };
+        f.robots = vec![RobotSighting { sighting: foot, sigma: None, marker: None }];
+        m.camera(&f);
+        f.time = 1.1;
+        assert_eq!(m.camera(&f).robots.len(), 1);
+        // Then only the sonars, for two seconds of frames without robot percepts: the robot's
+        // echo straight ahead at 1.25 m, the ball's on the left at 0.89 m, and one from
+        // beyond the east goal line (more than 0.3 m off the 18 m field).
+        let scan = SonarScan {
+            sonars: vec![
+                Sonar::new(0.0, 1.25),
+                Sonar::new(std::f64::consts::FRAC_PI_2, 0.89),
+                Sonar::new(-0.3, 1.6), // (9.53, −0.47): beyond the goal line, a wall
+            ],
+        };
+        for k in 1..=20 {
+            m.sonars(&scan);
+            f.time = 1.1 + 0.1 * f64::from(k);
+            f.robots.clear();
+            let w = m.camera(&f);
+            assert_eq!(w.robots.len(), 1, "only the robot: {:?}", w.robots);
+            assert_eq!(w.robots[0].reliability, 1.0, "heard at {}", f.time);
+        }
+        assert_eq!(m.robot_anchor_counts().echoes, 20);
+        assert_eq!(m.robot_anchor_counts().created, 1);
     }
 
     #[test]
