@@ -521,9 +521,10 @@ impl Pitch {
             let (x, y) = (attack * r.x / MM_PER_M, attack * r.y / MM_PER_M);
             let nearest = others
                 .iter()
-                .map(|&((ox, oy), team)| ((ox - x).hypot(oy - y), team))
+                .map(|&((ox, oy), team)| ((ox - x).powi(2) + (oy - y).powi(2), team))
                 .min_by(|a, b| a.0.total_cmp(&b.0));
-            let Some((d, team)) = nearest else { continue };
+            let Some((d2, team)) = nearest else { continue };
+            let d = d2.sqrt();
             e.position.push(d);
             if d > PHANTOM {
                 e.phantoms += 1;

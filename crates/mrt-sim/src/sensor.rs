@@ -69,7 +69,7 @@ fn blocks(a: (f64, f64), b: (f64, f64), c: (f64, f64), radius: f64) -> bool {
     let t = (((c.0 - a.0) * dx + (c.1 - a.1) * dy) / len2).clamp(0.0, 1.0);
     let (px, py) = (a.0 + t * dx, a.1 + t * dy);
     // Only objects strictly between the two ends hide the target.
-    t > 0.0 && t < 1.0 && (px - c.0).hypot(py - c.1) < radius
+    t > 0.0 && t < 1.0 && (px - c.0).powi(2) + (py - c.1).powi(2) < radius * radius
 }
 
 pub use mrt_msgs::{CameraFrame, GameInfo, Marker, RobotSighting, Sighting, FIELD_OBJECTS};

@@ -39,7 +39,7 @@
 //! assert!((a.velocity().0 - 1.0).abs() < 0.2);
 //! ```
 
-use crate::track::{Track, GATE};
+use crate::track::{squared_distance, Track, GATE};
 use mrt_msgs::{Marker, RobotClass};
 use nalgebra::Matrix2;
 use pathfinding::kuhn_munkres::kuhn_munkres_min;
@@ -71,6 +71,9 @@ pub const MARKER_MEMORY: f64 = 0.7;
 /// Marker evidence (about two sightings) past which a percept of the other colour is another
 /// robot, not this one.
 pub const SETTLED: f64 = 1.5;
+
+/// A track's predicted place and its covariance ([`Track::predicted_place`]).
+type Predicted = ((f64, f64), Matrix2<f64>);
 
 /// The cost the assignment gives a pair outside the gate: more than any number of pairs
 /// inside it, so it is used only where no gated pair is left (and then dropped).
@@ -299,45 +302,46 @@ impl Anchors {
         let percepts: Vec<&RobotPercept> = percepts.iter().filter(sane).collect();
         let echoes: Vec<&RobotPercept> = echoes.iter().filter(sane).collect();
         self.counts.refused += (given - percepts.len() - echoes.len()) as u64;
-        let distance = |a: &Anchor, p: &RobotPercept| {
-            a.admits(p).then(|| a.track.distance2(time, p.at, p.r)).flatten()
+        // Each anchor's prediction once a frame: a pair then costs a 2 × 2 inverse.
+        let predicted: Vec<Option<Predicted>> =
+            self.live.iter().map(|a| a.track.predicted_place(time)).collect();
+        let anchors: Vec<(&Anchor, Option<Predicted>)> = self.live.iter().zip(predicted).collect();
+        let distance = |(a, pred): &(&Anchor, Option<Predicted>), p: &RobotPercept| {
+            squared_distance(pred.filter(|_| a.admits(p))?, p.at, p.r)
         };
-        let used = assign(&self.live, &percepts, distance, GATE);
+        let used = assign(&anchors, &percepts, distance, GATE);
+        // The echoes, against every anchor: one that falls to an anchor the camera saw is
+        // that robot's and is spent; one that falls to an unseen anchor keeps it in track.
+        // (Offered to the unseen alone, a seen robot's echo would keep a stale anchor beside
+        // it alive.) An echo within the gate of two anchors (a scrum) could be either
+        // robot's: it is left out, or it would hand an anchor from one robot to its
+        // neighbour.
+        let echoes: Vec<&RobotPercept> = echoes
+            .into_iter()
+            .filter(|e| {
+                let near = |a: &&(&Anchor, Option<Predicted>)| {
+                    distance(a, e).is_some_and(|d| (0.0..=GATE).contains(&d))
+                };
+                anchors.iter().filter(near).count() <= 1
+            })
+            .collect();
+        let heard = assign(&anchors, &echoes, distance, GATE);
+        drop(anchors);
         let mut taken = vec![false; percepts.len()];
-        let mut seen = vec![false; self.live.len()];
-        for ((a, j), seen) in self.live.iter_mut().zip(&used).zip(&mut seen) {
+        for ((a, j), echo) in self.live.iter_mut().zip(&used).zip(heard) {
             if let Some(j) = *j {
                 a.see(time, percepts[j]);
                 a.last_camera = time;
                 taken[j] = true;
-                *seen = true;
                 self.counts.updates += 1;
-            }
-        }
-        // The echoes, against every anchor: one that falls to an anchor the camera saw is
-        // that robot's and is spent; one that falls to an unseen anchor keeps it in track.
-        // (Offered to the unseen alone, a seen robot's echo would keep a stale anchor beside
-        // it alive.)
-        // An echo keeps an anchor only for ECHO_KEEP after the camera last saw it: a sonar
-        // cannot tell whose echo it is, and a stale anchor's wide prediction would catch
-        // stray echoes for ever.
-        // An echo within the gate of two anchors (a scrum) could be either robot's: it is
-        // left out, or it would hand an anchor from one robot to its neighbour.
-        let live = &self.live;
-        let echoes: Vec<&RobotPercept> = echoes
-            .into_iter()
-            .filter(|e| {
-                live.iter().filter(|a| distance(a, e).is_some_and(|d| d <= GATE)).count() <= 1
-            })
-            .collect();
-        let heard = assign(&self.live, &echoes, distance, GATE);
-        for ((a, j), seen) in self.live.iter_mut().zip(heard).zip(&seen) {
-            if let (Some(j), false) = (j, *seen) {
-                if time - a.last_camera > ECHO_KEEP {
-                    continue;
+            } else if let Some(e) = echo {
+                // An echo keeps an anchor only for ECHO_KEEP after the camera last saw it: a
+                // sonar cannot tell whose echo it is, and a stale anchor's wide prediction
+                // would catch stray echoes for ever.
+                if time - a.last_camera <= ECHO_KEEP {
+                    a.see(time, echoes[e]);
+                    self.counts.echoes += 1;
                 }
-                a.see(time, echoes[j]);
-                self.counts.echoes += 1;
             }
         }
         // The unseen fade; the faded are forgotten (kept a while for reacquisition).
@@ -351,8 +355,9 @@ impl Anchors {
         // new anchor.
         let left: Vec<&RobotPercept> =
             percepts.iter().zip(&taken).filter(|(_, t)| !**t).map(|(p, _)| *p).collect();
-        let old: Vec<&Anchor> = self.forgotten.iter().map(|(_, a)| a).collect();
-        let back = assign(&old, &left, |a, p| distance(a, p), REACQUIRE_GATE);
+        let old: Vec<(&Anchor, Option<Predicted>)> =
+            self.forgotten.iter().map(|(_, a)| (a, a.track.predicted_place(time))).collect();
+        let back = assign(&old, &left, distance, REACQUIRE_GATE);
         let mut revived = vec![false; left.len()];
         // Taken out of the forgotten list highest index first, so the others stay put.
         for (k, j) in back.iter().enumerate().rev() {
@@ -375,7 +380,8 @@ impl Anchors {
 
 /// The global-nearest-neighbour assignment of `percepts` to `anchors`: for each anchor the
 /// percept it takes, if any, such that every pair's `distance` is within `gate` and the sum of
-/// the pairs' distances is least among the assignments that pair the most.
+/// the pairs' distances is least among the assignments that pair the most. Kuhn–Munkres
+/// runs only when some percept or anchor has two candidates within the gate.
 fn assign<A, P>(
     anchors: &[A],
     percepts: &[&P],
@@ -387,11 +393,27 @@ fn assign<A, P>(
     if n == 0 || m == 0 {
         return out;
     }
-    let cost = |i: usize, j: usize| match distance(&anchors[i], percepts[j]) {
-        // A negative distance comes only from a covariance that is not one: never a pair.
-        Some(d2) if (0.0..=gate).contains(&d2) => (d2 * COST_SCALE).round() as i64,
-        _ => FORBIDDEN,
-    };
+    // Every pair's cost once, anchor by anchor.
+    let costs: Vec<i64> = (0..n)
+        .flat_map(|i| (0..m).map(move |j| (i, j)))
+        .map(|(i, j)| match distance(&anchors[i], percepts[j]) {
+            // A negative distance comes only from a covariance that is not one: never a pair.
+            Some(d2) if (0.0..=gate).contains(&d2) => (d2 * COST_SCALE).round() as i64,
+            _ => FORBIDDEN,
+        })
+        .collect();
+    let cost = |i: usize, j: usize| costs[i * m + j];
+    // The usual frame: every percept within the gate of at most one anchor and every anchor
+    // of at most one percept. Then the pairs are the assignment, with no search.
+    let gated = |i: usize, j: usize| cost(i, j) < FORBIDDEN;
+    let lone_rows = (0..n).all(|i| (0..m).filter(|&j| gated(i, j)).count() <= 1);
+    let lone_cols = (0..m).all(|j| (0..n).filter(|&i| gated(i, j)).count() <= 1);
+    if lone_rows && lone_cols {
+        for (i, slot) in out.iter_mut().enumerate() {
+            *slot = (0..m).find(|&j| gated(i, j));
+        }
+        return out;
+    }
     // Kuhn–Munkres wants no more rows than columns: rows are the smaller side.
     let by_anchor = n <= m;
     let (rows, cols) = if by_anchor { (n, m) } else { (m, n) };

@@ -511,14 +511,14 @@ impl WorldModel {
             relocalize::perceptions(&self.map, self.noise, &frame.sightings, &none, &[], &[])
         });
         let velocity = frame.sightings[lps::BALL].map(|z| self.track_ball(frame.time, &z, None));
+        let robots = &frame.robots;
         let frame = CameraFrame {
             time: frame.time,
             sightings: frame.sightings,
-            robots: frame.robots.clone(),
             ball_velocity: velocity,
             ..Default::default()
         };
-        self.observe(&frame, &none, perceived)
+        self.observe(&frame, &none, robots, perceived)
     }
 
     /// [`WorldModel::camera`] with each sighting's own standard deviations, where known, and
@@ -527,6 +527,7 @@ impl WorldModel {
         &mut self,
         frame: &CameraFrame,
         sigmas: &[Option<(f64, f64)>; FIELD_OBJECTS],
+        robots: &[RobotSighting],
         mut perceived: Option<Vec<Perception>>,
     ) -> WorldSnapshot {
         // MUREA first checks the odometry's prediction against what the robot sees.
@@ -598,7 +599,7 @@ impl WorldModel {
                 }
             }
         }
-        self.anchor_robots(frame.time, &frame.robots);
+        self.anchor_robots(frame.time, robots);
         self.snapshot(frame)
     }
 
@@ -712,12 +713,7 @@ impl WorldModel {
                 &p.line_points,
             )
         });
-        let mut frame = CameraFrame {
-            time: p.time,
-            sightings: p.sightings,
-            robots: p.robots.clone(),
-            ..Default::default()
-        };
+        let mut frame = CameraFrame { time: p.time, sightings: p.sightings, ..Default::default() };
         let mut sigmas = p.sigmas;
         // The posts, named by where the robot believes it is; a landmark claimed by two posts
         // is left out (one of them is wrong).
@@ -733,7 +729,7 @@ impl WorldModel {
         }
         frame.ball_velocity =
             p.sightings[lps::BALL].map(|z| self.track_ball(p.time, &z, p.sigmas[lps::BALL]));
-        self.observe(&frame, &sigmas, perceived)
+        self.observe(&frame, &sigmas, &p.robots, perceived)
     }
 
     /// MAP's tracker fed with one sighting of the ball, in the field frame, with the sighting's

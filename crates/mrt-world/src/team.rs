@@ -172,9 +172,10 @@ fn adopt_shared_robots(w: &mut WorldSnapshot, shared: &[(u32, usize, SharedRobot
         if me.quality > 0.0 && (me.pose.x - s.x).hypot(me.pose.y - s.y) <= SAME_ROBOT {
             continue;
         }
+        // Squared distances against squared gates: no root per pair.
         let same = |r: &AnchoredRobot| {
-            let gate = SAME_ROBOT.max(3.0 * r.sigma.hypot(sigma));
-            (r.x - s.x).hypot(r.y - s.y) <= gate
+            let gate2 = (SAME_ROBOT * SAME_ROBOT).max(9.0 * (r.sigma * r.sigma + sigma * sigma));
+            (r.x - s.x).powi(2) + (r.y - s.y).powi(2) <= gate2
         };
         if let Some(r) = w.robots[..first_adopted].iter_mut().find(|r| same(r)) {
             if r.class == RobotClass::Robot {
