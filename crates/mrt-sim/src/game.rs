@@ -61,7 +61,7 @@ pub struct Frame {
 
 /// One robot's belief at one of its estimates, beside the truth (kept with the frames, for
 /// drawing a robot's belief over time: [`MatchReport::belief_svg`]).
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct BeliefSample {
     /// The robot.
     pub robot: usize,
@@ -75,6 +75,11 @@ pub struct BeliefSample {
     pub ball: Option<BallBelief>,
     /// Where the ball was.
     pub true_ball: (f64, f64),
+    /// The robots its world model anchored and saw in that frame (field frame, m), with the
+    /// class it gave each.
+    pub anchors: Vec<((f64, f64), RobotClass)>,
+    /// Where the other robots were, and whether each is its teammate.
+    pub others: Vec<((f64, f64), bool)>,
 }
 
 /// How a match ended.
@@ -475,6 +480,8 @@ impl Pitch {
                 truth,
                 ball: seen,
                 true_ball: self.world.ball(),
+                anchors: Vec::new(),
+                others: Vec::new(),
             });
         }
         let l = &mut self.localization;
@@ -515,10 +522,26 @@ impl Pitch {
             .filter(|&k| k != i)
             .filter_map(|k| self.world.robot(k).map(|p| ((p.x, p.y), self.referee.team_of(k))))
             .collect();
+        // Kept with the robot's belief of this cycle, for drawing (its `Localization` came
+        // first in the cycle).
+        let now = self.world.time();
+        let sample = self
+            .beliefs
+            .iter_mut()
+            .rev()
+            .take_while(|b| b.time >= now)
+            .find(|b| b.robot == i)
+            .filter(|_| self.record);
+        let field = |r: &AnchoredRobot| (attack * r.x / MM_PER_M, attack * r.y / MM_PER_M);
+        if let Some(b) = sample {
+            b.anchors =
+                robots.iter().filter(|r| r.seen_ago <= 0.0).map(|r| (field(r), r.class)).collect();
+            b.others = others.iter().map(|&(at, team)| (at, team == mine)).collect();
+        }
         let e = &mut self.localization.robots;
         for r in robots.iter().filter(|r| r.seen_ago <= 0.0) {
             // The team frame turned back into the field's (half a turn when attacking west).
-            let (x, y) = (attack * r.x / MM_PER_M, attack * r.y / MM_PER_M);
+            let (x, y) = field(r);
             let nearest = others
                 .iter()
                 .map(|&((ox, oy), team)| ((ox - x).powi(2) + (oy - y).powi(2), team))

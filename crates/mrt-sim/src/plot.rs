@@ -3,7 +3,7 @@
 use crate::config::SimConfig;
 use crate::game::{BeliefSample, MatchReport};
 use crate::referee::Call;
-use mrt_msgs::BallBelief;
+use mrt_msgs::{BallBelief, RobotClass};
 use std::fmt::Write as _;
 
 /// The drawing's scale and origin: field metres to SVG pixels, a 40 px title band on top.
@@ -222,6 +222,38 @@ impl MatchReport {
                 );
             }
         }
+        // Once a second: the other robots where they were (rings: green its teammates, red
+        // its opponents) and where it anchored them (crosses in the colour of the class it
+        // gave them, grey for a robot of unknown team).
+        let mut next_robots = f64::NEG_INFINITY;
+        for b in mine.iter().filter(|b| !b.others.is_empty()) {
+            if b.time < next_robots {
+                continue;
+            }
+            next_robots = b.time + 1.0;
+            for &((x, y), mate) in &b.others {
+                let colour = if mate { "#66bb6a" } else { "#ef5350" };
+                let _ = writeln!(
+                    s,
+                    r##"<circle class="true-robot" cx="{:.1}" cy="{:.1}" r="5" fill="none" stroke="{colour}" stroke-width="1" opacity="0.6"/>"##,
+                    c.px(x),
+                    c.py(y)
+                );
+            }
+            for &((x, y), class) in &b.anchors {
+                let colour = match class {
+                    RobotClass::Teammate => "#66bb6a",
+                    RobotClass::Opponent => "#ef5350",
+                    RobotClass::Robot => "#bdbdbd",
+                };
+                let _ = writeln!(
+                    s,
+                    r##"<path class="anchor" d="M{:.1},{:.1} l6,6 m0,-6 l-6,6" stroke="{colour}" stroke-width="1.5"/>"##,
+                    c.px(x) - 3.0,
+                    c.py(y) - 3.0
+                );
+            }
+        }
         for k in self.kidnaps.iter().filter(|k| k.robot == robot && k.at >= from && k.at <= to) {
             let (x, y) = (c.px(k.to.x), c.py(k.to.y));
             let found =
@@ -234,10 +266,12 @@ impl MatchReport {
                 x + 6.0,
                 y - 6.0
             );
+            // The label on the side of the cross towards the middle, so that it stays in the
+            // picture.
+            let (tx, anchor) = if k.to.x > 0.0 { (x - 9.0, "end") } else { (x + 9.0, "start") };
             let _ = writeln!(
                 s,
-                r##"<text x="{:.1}" y="{:.1}" font-size="13" fill="white">carried at {:.1} s, {found}</text>"##,
-                x + 9.0,
+                r##"<text x="{tx:.1}" y="{:.1}" font-size="13" fill="white" text-anchor="{anchor}">carried at {:.1} s, {found}</text>"##,
                 y - 8.0,
                 k.at
             );
@@ -263,7 +297,13 @@ impl MatchReport {
         );
         let _ = writeln!(
             s,
-            r##"<text x="10" y="35" font-size="12">white: where it was · orange dashed: where it believed it was · orange dots, arrows: the ball it saw, its velocity (0.5 s) · blue: the ball · ×: carried</text>"##
+            r##"<text x="10" y="35" font-size="12">white: where it was · orange dashed: where it believed it was · orange dots, arrows: the ball it saw, its velocity (0.5 s) · blue: the ball · red ×: carried</text>"##
+        );
+        // The robots' legend at the bottom of the carpet, below the field.
+        let _ = writeln!(
+            s,
+            r##"<text x="10" y="{:.0}" font-size="12" fill="white">each second, rings: the other robots (green: teammates, red: opponents) · crosses: where it anchored them, coloured by the team it gave them (grey: unknown)</text>"##,
+            c.py(-(c.hw + c.border)) - 10.0
         );
         s.push_str("</svg>\n");
         s
@@ -310,7 +350,7 @@ mod tests {
         let svg = r.belief_svg(&cfg, 0, (0.0, f64::INFINITY));
         assert!(svg.starts_with("<svg") && svg.trim_end().ends_with("</svg>"));
         let paths = svg.matches("<path d=\"M").count();
-        assert_eq!(paths, 4 + carried, "arrowhead, ball, truth, belief, crosses");
+        assert_eq!(paths, 4 + carried, "arrowhead, ball, truth, belief, carries");
         assert_eq!(svg.matches("carried at").count(), carried);
         assert!(svg.contains("stroke-dasharray"), "the belief is dashed");
         assert!(
@@ -318,6 +358,15 @@ mod tests {
         );
         let seen = r.beliefs.iter().filter(|b| b.robot == 0 && b.ball.is_some()).count();
         assert_eq!(svg.matches("r=\"1.8\"").count(), seen, "one dot per sighting");
+        // The other robot (an opponent: one a side) once a second, and where robot 0 anchored
+        // it: a red cross, near the red ring.
+        let rings = svg.matches("class=\"true-robot\"").count();
+        assert!((35..=42).contains(&rings), "{rings} rings in 40 s");
+        assert!(svg.matches("class=\"anchor\"").count() >= rings / 2, "{svg}");
+        assert!(
+            !svg.contains("class=\"anchor\" d=\"M0")
+                && svg.contains("stroke=\"#ef5350\" stroke-width=\"1.5\"")
+        );
         // A robot with no estimate gets the field and says so.
         assert!(r.belief_svg(&cfg, 9, (0.0, 1e9)).contains("no estimate recorded"));
         // A window: only its samples (none before the kickoff's first estimate).

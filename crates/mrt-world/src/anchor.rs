@@ -18,6 +18,9 @@
 //!    forgotten, but for [`REACQUIRE_FOR`] seconds a percept within a wider gate
 //!    ([`REACQUIRE_GATE`]) takes it back, identity and all, before a new anchor is made.
 //!
+//! MAP's merger takes the sonars too ([`Anchors::observe`]): an echo keeps an anchor the
+//! camera does not see in track for [`ECHO_KEEP`], never makes one.
+//!
 //! The anchoring phases: an anchor is in **find** until it has been seen [`CONFIRM`] times
 //! (one stray percept makes no robot), in **track** while seen, in **reacquire** while
 //! predicted unseen ([`Phase`]).
