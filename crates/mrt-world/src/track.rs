@@ -195,23 +195,9 @@ impl Track {
         true
     }
 
-    /// The squared Mahalanobis distance of a sighting at `time` of `at` (m) with covariance
-    /// `r` from where the track expects the object then (what the gate and the data
-    /// association compare with [`GATE`]), without changing the track; `None` before the first
-    /// sighting or for a sighting that is not a number.
-    pub fn distance2(&self, time: f64, at: (f64, f64), r: Matrix2<f64>) -> Option<f64> {
-        let finite = at.0.is_finite() && at.1.is_finite() && time.is_finite();
-        if !finite || r.iter().any(|v| !v.is_finite()) {
-            return None;
-        }
-        let s = self.state?;
-        Some(self.innovation(s, time.max(s.time), at, r)?.d2)
-    }
-
     /// Where the track expects the object at `time` (m) and the covariance of that place
-    /// (m²), without changing the track; `None` before the first sighting. (Many sightings
-    /// compared with one prediction: [`squared_distance`] on this costs a 2 × 2 inverse each,
-    /// against a 4 × 4 prediction each with [`Track::distance2`].)
+    /// (m²), without changing the track; `None` before the first sighting. With
+    /// [`squared_distance`], what the gate and the data association compare with [`GATE`].
     pub fn predicted_place(&self, time: f64) -> Option<((f64, f64), Matrix2<f64>)> {
         let s = self.state?;
         let (f, n) = self.transition((time - s.time).max(0.0));
@@ -260,8 +246,8 @@ impl Track {
 }
 
 /// The squared Mahalanobis distance of a sighting at `at` with covariance `r` from a
-/// predicted place `mean` with covariance `p` (what [`Track::distance2`] computes, from
-/// [`Track::predicted_place`]); `None` when the summed covariance has no inverse.
+/// predicted place `mean` with covariance `p` ([`Track::predicted_place`]); `None` when the
+/// summed covariance has no inverse.
 pub fn squared_distance(
     (mean, p): ((f64, f64), Matrix2<f64>),
     at: (f64, f64),
@@ -306,15 +292,17 @@ mod tests {
     /// velocity within 10 % after about 10 updates (here with up to 1 cm of noise per
     /// sighting, and the ball's random acceleration, [`BALL_ACCEL`]).
     #[test]
-    fn the_cached_prediction_gives_the_same_distance_as_the_track() {
+    fn the_predicted_place_gives_the_update_s_distance() {
         let mut t = Track::new(0.5, 1.0);
         let r = Matrix2::new(0.01, 0.002, 0.002, 0.02);
         for k in 0..5 {
             t.update(0.1 * f64::from(k), (0.3 * f64::from(k), 1.0), r);
         }
         assert_eq!(t.predicted_place(0.9).map(|p| p.0), t.predicted(0.9).map(|p| (p.0, p.1)));
+        let state = t.state.unwrap();
         for at in [(1.5, 1.1), (2.0, 0.0), (-1.0, 3.0)] {
-            let by_track = t.distance2(0.9, at, r).unwrap();
+            // The update's own innovation, through the whole 4 × 4 prediction.
+            let by_track = t.innovation(state, 0.9, at, r).unwrap().d2;
             let cached = squared_distance(t.predicted_place(0.9).unwrap(), at, r).unwrap();
             assert!((by_track - cached).abs() <= 1e-9 * by_track.max(1.0), "{by_track} {cached}");
         }
