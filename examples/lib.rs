@@ -2,6 +2,8 @@
 //! example code. Run one with `cargo run -p mrt-examples --example 01_hello_agora`.
 #![allow(clippy::print_stdout)]
 
+#[path = "06_anchoring_robots.rs"]
+pub mod anchoring_robots;
 #[path = "03_fuzzy_controller.rs"]
 pub mod fuzzy_controller;
 #[path = "01_hello_agora.rs"]
@@ -26,6 +28,39 @@ mod tests {
         assert_eq!(names[0], ("Greeter", 5));
         assert_eq!(names[1].0, "Listener");
         assert!(names[1].1 >= 1 && names[1].1 <= 5);
+    }
+
+    /// MAP in the world model: the crossing robots keep their identities and their teams, the
+    /// hidden opponent is kept (fading) and found again, and the free way to the net opens
+    /// once both have passed.
+    #[test]
+    fn two_crossing_robots_keep_their_identities_and_teams() {
+        use mrt_msgs::RobotClass;
+        let moments = super::anchoring_robots::run(false).unwrap();
+        let at = |t: f64| moments.iter().find(|m| (m.time - t).abs() < 1e-9).unwrap();
+        // From 0.5 s on, one anchor per team, always the same identities.
+        let ids = |t: f64, class| -> Vec<u32> {
+            at(t).robots.iter().filter(|r| r.class == class).map(|r| r.id).collect()
+        };
+        let (mate, opponent) = (ids(0.5, RobotClass::Teammate), ids(0.5, RobotClass::Opponent));
+        assert_eq!((mate.len(), opponent.len()), (1, 1), "{:?}", at(0.5).robots);
+        for t in [1.0, 2.0, 3.0, 4.0] {
+            assert_eq!(ids(t, RobotClass::Teammate), mate, "t = {t}");
+            assert_eq!(ids(t, RobotClass::Opponent), opponent, "t = {t}: {:?}", at(t).robots);
+        }
+        // Hidden from 1.5 s: at 2.0 s unseen for 0.6 s, reliability 0.5^0.6 ≈ 0.66, predicted
+        // near where it is (x −0.1, y 0 m).
+        let hidden = at(2.0).robots.iter().find(|r| r.class == RobotClass::Opponent).unwrap();
+        assert!((hidden.reliability - 0.5f64.powf(0.6)).abs() < 1e-6, "{hidden:?}");
+        assert!((hidden.x + 100.0).abs() < 150.0 && hidden.y.abs() < 300.0, "{hidden:?}");
+        // At the end the teammate is 2 m north, the opponent 2 m south, both seen.
+        let end = &at(4.0).robots;
+        let mate = end.iter().find(|r| r.class == RobotClass::Teammate).unwrap();
+        assert!((mate.y - 2000.0).abs() < 100.0 && mate.reliability == 1.0);
+        // Straight ahead is blocked while they cross, and free at the start and the end.
+        assert_eq!(at(0.0).free_direction, Some(0.0));
+        assert_ne!(at(2.0).free_direction, Some(0.0));
+        assert_eq!(at(4.0).free_direction, Some(0.0));
     }
 
     /// The robot program runs on a team's own `Devices` with no simulator: the baseline walks
