@@ -312,6 +312,13 @@ pub fn run(args: &SimArgs) -> Result<()> {
             r.phantoms
         );
     }
+    if let (Some(median), Some(p95)) = (r.remembered_median_m, r.remembered_p95_m) {
+        outln!(
+            "  other robots remembered unseen (reliability ≥ 0.3): {median:.2} m median, {p95:.2} m p95; {} phantoms of {}",
+            r.remembered_phantoms,
+            r.remembered_samples
+        );
+    }
     if m.localization.relocalized > 0 {
         outln!(
             "  relocalized {} times, {} of them falsely (> 1 m from the truth)",

@@ -124,7 +124,7 @@ fn result_lines(stdout: &str) -> Vec<String> {
         .filter(|l| {
             !l.starts_with("  localization error")
                 && !l.starts_with("  ball error")
-                && !l.starts_with("  other robots anchored")
+                && !l.starts_with("  other robots")
                 && !l.starts_with("  relocalized")
         })
         .map(|l| l.split(" simulated in ").next().unwrap_or(l).to_string())

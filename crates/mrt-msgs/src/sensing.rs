@@ -238,6 +238,10 @@ pub struct Percepts {
     /// east and the west goal, when the whole goal is in view.
     #[serde(default)]
     pub open_space: [Option<f64>; 2],
+    /// The camera's pan joint when the image was taken, rad (`None`: not known): where the
+    /// camera looked, so that the world model knows what it should have seen.
+    #[serde(default)]
+    pub pan: Option<f64>,
 }
 
 /// A landmark post in a camera image (ISocRob seed `003` §3.2.1: landmarks told apart by

@@ -69,6 +69,10 @@ pub struct VisionSetup {
     pub up_camera: Option<Omni>,
 }
 
+/// How far the vision finds robots, m (the markers are told to 7 m on rendered frames:
+/// `crates/mrt-sim/tests/render.rs`).
+pub const VISION_ROBOT_RANGE: f64 = 7.0;
+
 impl RobotConfig {
     /// The robot's world model as it starts: its field map, its mice, its camera's noise, the
     /// pose unknown until it is put down; other robots are taken to be its own size.
@@ -78,6 +82,12 @@ impl RobotConfig {
                 .with_localizer(self.localizer)
                 .with_ball_damping(self.ball_damping)
                 .with_robot_radius(self.radius);
+        // With vision the camera's view is known: a robot it should see and does not fades
+        // fast. (The simulator's object sensor tells no view: its anchors fade alike.)
+        let model = match &self.vision {
+            Some(v) => model.with_view(v.camera.half_fov(), VISION_ROBOT_RANGE),
+            None => model,
+        };
         // A robot with the up camera sees the field lines all around: ISocRob's self mode.
         match self.vision.as_ref().and_then(|v| v.up_camera) {
             Some(_) => model.with_self_mode(),

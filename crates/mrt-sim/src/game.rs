@@ -17,9 +17,11 @@ use mrt_msgs::robot::{GameState, RobotCommand};
 use mrt_msgs::Sonar;
 use mrt_msgs::{
     AnchoredRobot, BallBelief, CameraFrame, GameInfo, Localization, Odometry, RobotClass,
+    WorldSnapshot,
 };
 use mrt_perception::camera::CameraModel;
 use mrt_robot::base::Base;
+use mrt_world::team::SHARED_ID;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 
@@ -151,6 +153,11 @@ pub struct RobotErrors {
     pub class_unknown: u64,
     /// Anchors with no robot within [`PHANTOM`]: seen where nobody is.
     pub phantoms: u64,
+    /// Distances to the nearest robot of the anchors not seen in their frame but still
+    /// reliable enough for the behaviors (`WorldSnapshot::ANCHORED`): the remembered ones, m.
+    pub remembered: Vec<f64>,
+    /// Those of them with no robot within [`PHANTOM`].
+    pub remembered_phantoms: u64,
 }
 
 /// An anchor farther than this (m) from every other robot is a phantom.
@@ -539,14 +546,24 @@ impl Pitch {
             b.others = others.iter().map(|&(at, team)| (at, team == mine)).collect();
         }
         let e = &mut self.localization.robots;
-        for r in robots.iter().filter(|r| r.seen_ago <= 0.0) {
-            // The team frame turned back into the field's (half a turn when attacking west).
-            let (x, y) = field(r);
-            let nearest = others
+        let nearest = |(x, y): (f64, f64)| {
+            others
                 .iter()
                 .map(|&((ox, oy), team)| ((ox - x).powi(2) + (oy - y).powi(2), team))
-                .min_by(|a, b| a.0.total_cmp(&b.0));
-            let Some((d2, team)) = nearest else { continue };
+                .min_by(|a, b| a.0.total_cmp(&b.0))
+        };
+        let remembered = |r: &&AnchoredRobot| {
+            r.seen_ago > 0.0 && r.reliability >= WorldSnapshot::ANCHORED && r.id & SHARED_ID == 0
+        };
+        for r in robots.iter().filter(remembered) {
+            let Some((d2, _)) = nearest(field(r)) else { continue };
+            let d = d2.sqrt();
+            e.remembered.push(d);
+            e.remembered_phantoms += u64::from(d > PHANTOM);
+        }
+        for r in robots.iter().filter(|r| r.seen_ago <= 0.0) {
+            // The team frame turned back into the field's (half a turn when attacking west).
+            let Some((d2, team)) = nearest(field(r)) else { continue };
             let d = d2.sqrt();
             e.position.push(d);
             if d > PHANTOM {

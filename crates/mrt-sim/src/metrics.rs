@@ -71,6 +71,8 @@ pub struct MetricsBook {
     robots: Histogram,
     robot_classes: [u64; 3],
     phantoms: u64,
+    remembered: Histogram,
+    remembered_phantoms: u64,
 }
 
 impl Default for MetricsBook {
@@ -88,6 +90,8 @@ impl Default for MetricsBook {
             robots: Histogram::new(0.001, 30.0),
             robot_classes: [0; 3],
             phantoms: 0,
+            remembered: Histogram::new(0.001, 30.0),
+            remembered_phantoms: 0,
         }
     }
 }
@@ -113,6 +117,8 @@ impl MetricsBook {
             *slot += n;
         }
         self.phantoms += e.phantoms;
+        e.remembered.iter().for_each(|&v| self.remembered.add(v));
+        self.remembered_phantoms += e.remembered_phantoms;
     }
 
     /// The metrics so far.
@@ -151,6 +157,10 @@ impl MetricsBook {
                 class_wrong: self.robot_classes[1],
                 class_unknown: self.robot_classes[2],
                 phantoms: self.phantoms,
+                remembered_median_m: self.remembered.quantile(0.5),
+                remembered_p95_m: self.remembered.quantile(0.95),
+                remembered_samples: self.remembered.n,
+                remembered_phantoms: self.remembered_phantoms,
             },
             kidnap: KidnapMetrics {
                 count: self.kidnaps,
@@ -243,6 +253,15 @@ pub struct RobotMetrics {
     pub class_unknown: u64,
     /// Anchors more than 1 m from every robot ([`crate::game::PHANTOM`]).
     pub phantoms: u64,
+    /// For the anchors not seen in their frame but still reliable enough for the behaviors
+    /// (0.3): median distance to the nearest robot, m.
+    pub remembered_median_m: Option<f64>,
+    /// Their 95th percentile, m.
+    pub remembered_p95_m: Option<f64>,
+    /// Such anchors compared.
+    pub remembered_samples: u64,
+    /// Those more than 1 m from every robot.
+    pub remembered_phantoms: u64,
 }
 
 /// Robots carried elsewhere without being told (`mrt sim --kidnap N`).
@@ -277,6 +296,8 @@ mod tests {
             class_wrong: 0,
             class_unknown: 1,
             phantoms: 1,
+            remembered: vec![0.5],
+            remembered_phantoms: 0,
         };
         MatchReport {
             seed: 1,

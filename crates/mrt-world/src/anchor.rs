@@ -56,6 +56,11 @@ pub const ROBOT_ACCEL: f64 = 1.0;
 pub const ROBOT_DAMPING: f64 = 0.5;
 /// An unseen anchor's reliability is multiplied by this every second (λ of the research note).
 pub const FADE: f64 = 0.5;
+/// An anchor's reliability is multiplied by this every second the camera looks where it is
+/// predicted and does not see it (the research note: fading faster when the object should have
+/// been visible): a robot gone from in front of the camera is forgotten within a second
+/// instead of three.
+pub const MISSED: f64 = 0.05;
 /// Below this reliability an anchor is forgotten (≈ 3.3 s unseen).
 pub const FORGET: f64 = 0.1;
 /// Sightings an anchor needs before it leaves the find phase.
@@ -117,6 +122,9 @@ pub struct Anchor {
     last_seen: f64,
     /// When the camera (not a sonar) last saw it, s.
     last_camera: f64,
+    /// Its reliability at `faded`, s: it fades from there at [`FADE`] a second.
+    reliability: f64,
+    faded: f64,
     /// Evidence of its marker being magenta and cyan: each sighting of a marker multiplies
     /// both by [`MARKER_MEMORY`] and adds 1 to its colour's (recent sightings count most).
     markers: (f64, f64),
@@ -130,6 +138,8 @@ impl Anchor {
             hits: 0,
             last_seen: time,
             last_camera: time,
+            reliability: 1.0,
+            faded: time,
             markers: (0.0, 0.0),
         };
         a.see(time, p);
@@ -156,9 +166,17 @@ impl Anchor {
         self.track.sigma(time).unwrap_or(f64::INFINITY)
     }
 
-    /// How much it is to be trusted at `time`: 1 when seen then, [`FADE`] per second unseen.
+    /// How much it is to be trusted at `time`: 1 when seen then, [`FADE`] per second unseen
+    /// ([`MISSED`] per second while it should have been in view and was not).
     pub fn reliability(&self, time: f64) -> f64 {
-        FADE.powf((time - self.last_seen).max(0.0))
+        self.reliability * FADE.powf((time - self.faded).max(0.0))
+    }
+
+    /// Fades it to `time`, at [`MISSED`] a second if the camera should have seen it.
+    fn fade(&mut self, time: f64, in_view: bool) {
+        let dt = (time - self.faded).max(0.0);
+        self.reliability *= if in_view { MISSED } else { FADE }.powf(dt);
+        self.faded = self.faded.max(time);
     }
 
     /// When it was last seen, s.
@@ -221,6 +239,8 @@ impl Anchor {
         }
         self.hits = self.hits.saturating_add(1);
         self.last_seen = time;
+        self.reliability = 1.0;
+        self.faded = time;
         let (m, c) = self.markers;
         match p.marker {
             Some(Marker::Magenta) => self.markers = (m * MARKER_MEMORY + 1.0, c * MARKER_MEMORY),
@@ -280,7 +300,7 @@ impl Anchors {
     /// percept that is not a number, or whose covariance has a negative variance, is refused
     /// and counted.
     pub fn update(&mut self, time: f64, percepts: &[RobotPercept]) {
-        self.observe(time, percepts, &[]);
+        self.observe(time, percepts, &[], |_| false);
     }
 
     /// [`update`](Self::update) with sonar `echoes` as well (MAP's merger, MRT manual ch. 8:
@@ -289,7 +309,16 @@ impl Anchors {
     /// in track (a robot beside or behind the robot, out of the camera's view) for
     /// [`ECHO_KEEP`] after the camera last saw it. An echo never makes an anchor nor takes a
     /// forgotten one back: a sonar cannot tell a robot from a wall or a goal post.
-    pub fn observe(&mut self, time: f64, percepts: &[RobotPercept], echoes: &[RobotPercept]) {
+    ///
+    /// `in_view` says whether the camera looked at a place (field frame, m) this frame: an
+    /// anchor predicted there and not seen fades at [`MISSED`] a second instead of [`FADE`].
+    pub fn observe(
+        &mut self,
+        time: f64,
+        percepts: &[RobotPercept],
+        echoes: &[RobotPercept],
+        in_view: impl Fn((f64, f64)) -> bool,
+    ) {
         let given = percepts.len() + echoes.len();
         if !time.is_finite() {
             self.counts.refused += given as u64;
@@ -347,7 +376,12 @@ impl Anchors {
                 }
             }
         }
-        // The unseen fade; the faded are forgotten (kept a while for reacquisition).
+        // The unseen fade, faster where the camera looked; the faded are forgotten (kept a
+        // while for reacquisition).
+        for a in self.live.iter_mut().filter(|a| a.last_seen < time) {
+            let looked = in_view(a.position(time));
+            a.fade(time, looked);
+        }
         let (keep, gone): (Vec<Anchor>, Vec<Anchor>) =
             self.live.drain(..).partition(|a| a.reliability(time) >= FORGET);
         self.live = keep;
@@ -519,16 +553,16 @@ mod tests {
         let mut anchors = Anchors::default();
         let echo = |x: f64, y: f64| RobotPercept { at: (x, y), r: r(0.1), marker: None };
         // An echo alone: nothing.
-        anchors.observe(0.0, &[], &[echo(1.0, 1.0)]);
+        anchors.observe(0.0, &[], &[echo(1.0, 1.0)], |_| false);
         assert!(anchors.anchors().is_empty());
         // Seen by the camera twice, walking east at 0.5 m/s with its cyan marker.
-        anchors.observe(0.1, &[percept(1.0, 1.0, Some(Marker::Cyan))], &[]);
-        anchors.observe(0.2, &[percept(1.05, 1.0, Some(Marker::Cyan))], &[]);
+        anchors.observe(0.1, &[percept(1.0, 1.0, Some(Marker::Cyan))], &[], |_| false);
+        anchors.observe(0.2, &[percept(1.05, 1.0, Some(Marker::Cyan))], &[], |_| false);
         // Out of the camera's view for 2 s, heard by the sonars all along: still tracked,
         // fully reliable, where the echoes put it, its team kept.
         for k in 1..=20 {
             let t = 0.2 + 0.1 * f64::from(k);
-            anchors.observe(t, &[], &[echo(1.05 + 0.05 * f64::from(k), 1.0)]);
+            anchors.observe(t, &[], &[echo(1.05 + 0.05 * f64::from(k), 1.0)], |_| false);
         }
         let a = &anchors.anchors()[0];
         assert_eq!((anchors.anchors().len(), a.phase(2.2)), (1, Phase::Track));
@@ -537,9 +571,37 @@ mod tests {
         assert_eq!(a.marker(), Some(Marker::Cyan));
         assert_eq!(anchors.counts().echoes, 20);
         // The camera and the sonar both: the camera's percept is used, the echo left over.
-        anchors.observe(2.3, &[percept(2.1, 1.0, None)], &[echo(2.1, 1.05)]);
+        anchors.observe(2.3, &[percept(2.1, 1.0, None)], &[echo(2.1, 1.05)], |_| false);
         assert_eq!(anchors.counts().echoes, 20);
         assert_eq!(anchors.anchors().len(), 1);
+    }
+
+    /// "Faster if the object should have been visible" (research note §3): where the camera
+    /// looks and does not see an anchor, it fades at MISSED a second; elsewhere at FADE.
+    #[test]
+    fn an_anchor_the_camera_should_see_and_does_not_fades_fast() {
+        let mut anchors = Anchors::default();
+        anchors.update(0.0, &[percept(1.0, 0.0, None), percept(-1.0, 0.0, None)]);
+        anchors.update(0.1, &[percept(1.0, 0.0, None), percept(-1.0, 0.0, None)]);
+        // The camera looks east (x > 0): the eastern robot has gone, the western one is
+        // behind the camera.
+        let east = |(x, _): (f64, f64)| x > 0.0;
+        for k in 2..=6 {
+            anchors.observe(0.1 * f64::from(k), &[], &[], east);
+        }
+        let r: Vec<f64> = anchors.anchors().iter().map(|a| a.reliability(0.6)).collect();
+        assert!((r[0] - MISSED.powf(0.5)).abs() < 1e-9, "{r:?}");
+        assert!((r[1] - FADE.powf(0.5)).abs() < 1e-9, "{r:?}");
+        // 0.05^0.8 < 0.1: the eastern one is forgotten after 0.8 s, the western one kept.
+        for k in 7..=9 {
+            anchors.observe(0.1 * f64::from(k), &[], &[], east);
+        }
+        assert_eq!(anchors.anchors().len(), 1);
+        assert_eq!(anchors.anchors()[0].position(0.9).0, -1.0);
+        // Seen again: fully reliable, fading from there.
+        anchors.update(1.0, &[percept(-1.0, 0.0, None)]);
+        assert_eq!(anchors.anchors()[0].reliability(1.0), 1.0);
+        assert!((anchors.anchors()[0].reliability(2.0) - FADE).abs() < 1e-12);
     }
 
     #[test]

@@ -140,7 +140,14 @@ pub struct WorldModel {
     robot_radius: f64,
     /// The sonar ring's latest reading.
     sonars: Vec<Sonar>,
+    /// What the camera covers, when known: half its horizontal field of view (rad) and how far
+    /// it sees robots (m).
+    view: Option<(f64, f64)>,
 }
+
+/// An anchor this close to the edge of the camera's view (rad) is not counted as in view: a
+/// robot half out of the image is not found whole.
+pub const VIEW_MARGIN: f64 = 0.1;
 
 /// A sonar echo's range error, m (the ISocRob ring's: a centimetre; `[sonar] noise` of the
 /// simulator).
@@ -191,7 +198,18 @@ impl WorldModel {
             robots: Anchors::default(),
             robot_radius: ROBOT_RADIUS,
             sonars: Vec::new(),
+            view: None,
         }
+    }
+
+    /// The same model knowing what its camera covers: `half_fov` either side of where the pan
+    /// joint points (rad) and robots up to `range` (m). An anchored robot predicted in view and
+    /// not seen then fades at [`crate::anchor::MISSED`] a second (the camera should have seen
+    /// it). Without it (the default) every unseen anchor fades alike.
+    pub fn with_view(mut self, half_fov: f64, range: f64) -> Self {
+        let ok = half_fov.is_finite() && half_fov > 0.0 && range.is_finite() && range > 0.0;
+        self.view = ok.then_some((half_fov, range));
+        self
     }
 
     /// The sonar ring's reading (ISocRob seed `003` §2): kept for the next frame's anchoring,
@@ -512,13 +530,14 @@ impl WorldModel {
         });
         let velocity = frame.sightings[lps::BALL].map(|z| self.track_ball(frame.time, &z, None));
         let robots = &frame.robots;
+        let frame_pan = frame.pan;
         let frame = CameraFrame {
             time: frame.time,
             sightings: frame.sightings,
             ball_velocity: velocity,
             ..Default::default()
         };
-        self.observe(&frame, &none, robots, perceived)
+        self.observe(&frame, &none, robots, frame_pan, perceived)
     }
 
     /// [`WorldModel::camera`] with each sighting's own standard deviations, where known, and
@@ -528,6 +547,7 @@ impl WorldModel {
         frame: &CameraFrame,
         sigmas: &[Option<(f64, f64)>; FIELD_OBJECTS],
         robots: &[RobotSighting],
+        pan: Option<f64>,
         mut perceived: Option<Vec<Perception>>,
     ) -> WorldSnapshot {
         // MUREA first checks the odometry's prediction against what the robot sees.
@@ -599,13 +619,13 @@ impl WorldModel {
                 }
             }
         }
-        self.anchor_robots(frame.time, robots);
+        self.anchor_robots(frame.time, robots, pan);
         self.snapshot(frame)
     }
 
     /// MAP on the frame's robot percepts: each placed on the field from the corrected pose,
     /// with its covariance (the sighting's error and the pose's), then anchored.
-    fn anchor_robots(&mut self, time: f64, robots: &[RobotSighting]) {
+    fn anchor_robots(&mut self, time: f64, robots: &[RobotSighting], pan: Option<f64>) {
         let me: Framed<Field, Pose2> = Framed::new(self.pose);
         let pose_xy = self.cov.fixed_view::<2, 2>(0, 0).into_owned();
         let percepts: Vec<RobotPercept> = robots
@@ -626,7 +646,15 @@ impl WorldModel {
             })
             .collect();
         let echoes = self.echoes(&me);
-        self.robots.observe(time, &percepts, &echoes);
+        // Where the camera looked: within its view, less a margin, and its range.
+        let view = self.view.map(|(half, range)| (half - VIEW_MARGIN, range, pan.unwrap_or(0.0)));
+        let in_view = |(x, y): (f64, f64)| {
+            view.is_some_and(|(half, range, pan)| {
+                let (r, b) = me.range_bearing(Framed::new(Point2::new(x, y)));
+                r <= range && normalize_angle(b - pan).abs() <= half
+            })
+        };
+        self.robots.observe(time, &percepts, &echoes, in_view);
     }
 
     /// The sonar echoes that may be robots, as percepts of their centres: an echo is a
@@ -729,7 +757,7 @@ impl WorldModel {
         }
         frame.ball_velocity =
             p.sightings[lps::BALL].map(|z| self.track_ball(p.time, &z, p.sigmas[lps::BALL]));
-        self.observe(&frame, &sigmas, &p.robots, perceived)
+        self.observe(&frame, &sigmas, &p.robots, p.pan, perceived)
     }
 
     /// MAP's tracker fed with one sighting of the ball, in the field frame, with the sighting's

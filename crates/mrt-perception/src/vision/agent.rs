@@ -247,7 +247,7 @@ impl VisionAgent {
         self.camera.pan = pan;
         self.classes.resize(w as usize * h as usize, 0);
         self.lut.classify(&image.rgb, &mut self.classes);
-        let mut p = Percepts { time, ..Default::default() };
+        let mut p = Percepts { time, pan: Some(pan), ..Default::default() };
         let ball = find_ball(&self.classes, &self.camera, self.ball_radius);
         if let Some(ball) = ball {
             p.sightings[BALL] = Some(sighting(ball.at));
