@@ -337,7 +337,8 @@ impl Anchors {
         // Each anchor's prediction once a frame: a pair then costs a 2 × 2 inverse.
         let predicted: Vec<Option<Predicted>> =
             self.live.iter().map(|a| a.track.predicted_place(time)).collect();
-        let anchors: Vec<(&Anchor, Option<Predicted>)> = self.live.iter().zip(predicted).collect();
+        let anchors: Vec<(&Anchor, Option<Predicted>)> =
+            self.live.iter().zip(predicted.iter().copied()).collect();
         let distance = |(a, pred): &(&Anchor, Option<Predicted>), p: &RobotPercept| {
             squared_distance(pred.filter(|_| a.admits(p))?, p.at, p.r)
         };
@@ -378,9 +379,9 @@ impl Anchors {
         }
         // The unseen fade, faster where the camera looked; the faded are forgotten (kept a
         // while for reacquisition).
-        for a in self.live.iter_mut().filter(|a| a.last_seen < time) {
-            let looked = in_view(a.position(time));
-            a.fade(time, looked);
+        // (Their predictions are this frame's, made before the updates that passed them by.)
+        for (a, pred) in self.live.iter_mut().zip(&predicted).filter(|(a, _)| a.last_seen < time) {
+            a.fade(time, pred.is_some_and(|(at, _)| in_view(at)));
         }
         let (keep, gone): (Vec<Anchor>, Vec<Anchor>) =
             self.live.drain(..).partition(|a| a.reliability(time) >= FORGET);

@@ -595,15 +595,7 @@ impl WorldModel {
         if let Some(z) = frame.sightings[lps::BALL] {
             // How sure the ball's place is: the sighting's error and the corrected pose's.
             let sd = self.noise.sigma(z.distance, sigmas[lps::BALL]);
-            let pose_xy = self.cov.fixed_view::<2, 2>(0, 0).into_owned();
-            let r = sighting_covariance(
-                z.distance,
-                z.bearing,
-                self.pose.theta,
-                sd,
-                pose_xy,
-                self.cov[(2, 2)],
-            );
+            let (_, r) = self.sighted_at(z.distance, z.bearing, sd);
             self.ball_seen_sigma = (r.trace() / 2.0).max(0.0).sqrt();
         }
         for (k, z) in frame.sightings.iter().enumerate() {
@@ -627,22 +619,13 @@ impl WorldModel {
     /// with its covariance (the sighting's error and the pose's), then anchored.
     fn anchor_robots(&mut self, time: f64, robots: &[RobotSighting], pan: Option<f64>) {
         let me: Framed<Field, Pose2> = Framed::new(self.pose);
-        let pose_xy = self.cov.fixed_view::<2, 2>(0, 0).into_owned();
         let percepts: Vec<RobotPercept> = robots
             .iter()
             .map(|z| {
                 let centre = z.sighting.distance + self.robot_radius;
-                let at = me.at_range_bearing(centre, z.sighting.bearing);
                 let sd = self.noise.sigma(z.sighting.distance, z.sigma);
-                let r = sighting_covariance(
-                    centre,
-                    z.sighting.bearing,
-                    self.pose.theta,
-                    sd,
-                    pose_xy,
-                    self.cov[(2, 2)],
-                );
-                RobotPercept { at: (at.inner.x, at.inner.y), r, marker: z.marker }
+                let (at, r) = self.sighted_at(centre, z.sighting.bearing, sd);
+                RobotPercept { at, r, marker: z.marker }
             })
             .collect();
         let echoes = self.echoes(&me);
@@ -662,7 +645,6 @@ impl WorldModel {
     /// robot believes it is), of the goals' posts and of what stands off the field are left
     /// out.
     fn echoes(&self, me: &Framed<Field, Pose2>) -> Vec<RobotPercept> {
-        let pose_xy = self.cov.fixed_view::<2, 2>(0, 0).into_owned();
         let ball = self.memory[lps::BALL].filter(|m| m.reliability >= 0.5).map(|m| m.at.inner);
         let (hl, hw) = (self.map.half_length() + OFF_FIELD, self.map.half_width() + OFF_FIELD);
         // Each sonar's echo point (field frame), in ring order; `None`: no echo, or not a
@@ -705,17 +687,9 @@ impl WorldModel {
             }
             if apart(k, k + 1) || k + 1 == start + n {
                 if let Some(s) = nearest.take() {
-                    let centre = s.range + self.robot_radius;
-                    let at = me.at_range_bearing(centre, s.bearing).inner;
-                    let r = sighting_covariance(
-                        centre,
-                        s.bearing,
-                        self.pose.theta,
-                        (SONAR_RANGE_SIGMA, SONAR_BEARING_SIGMA),
-                        pose_xy,
-                        self.cov[(2, 2)],
-                    );
-                    out.push(RobotPercept { at: (at.x, at.y), r, marker: None });
+                    let sd = (SONAR_RANGE_SIGMA, SONAR_BEARING_SIGMA);
+                    let (at, r) = self.sighted_at(s.range + self.robot_radius, s.bearing, sd);
+                    out.push(RobotPercept { at, r, marker: None });
                 }
             }
         }
@@ -765,18 +739,8 @@ impl WorldModel {
     /// stays the sighting's (the track lags behind kicks and a relocalized pose: 0.33 m mean
     /// error against 0.20 m, session 22).
     fn track_ball(&mut self, time: f64, z: &Sighting, sigma: Option<(f64, f64)>) -> (f64, f64) {
-        let at = Framed::<Field, _>::new(self.pose).at_range_bearing(z.distance, z.bearing);
-        let sigma = self.noise.sigma(z.distance, sigma);
-        let pose_xy = self.cov.fixed_view::<2, 2>(0, 0).into_owned();
-        let r = sighting_covariance(
-            z.distance,
-            z.bearing,
-            self.pose.theta,
-            sigma,
-            pose_xy,
-            self.cov[(2, 2)],
-        );
-        let (vx, vy) = if self.ball_track.update(time, (at.inner.x, at.inner.y), r) {
+        let (at, r) = self.sighted_at(z.distance, z.bearing, self.noise.sigma(z.distance, sigma));
+        let (vx, vy) = if self.ball_track.update(time, at, r) {
             self.ball_track.velocity()
         } else {
             // Gated out (a false sighting, or the first after a kick): the prediction.
@@ -784,6 +748,22 @@ impl WorldModel {
         };
         let (s, c) = self.pose.theta.sin_cos();
         (c * vx + s * vy, -s * vx + c * vy)
+    }
+
+    /// Where an object seen at `range` (m) and `bearing` (rad, robot frame) with standard
+    /// deviations `sigma` stands on the field by the pose estimate (m), and that place's
+    /// covariance (m²): the sighting's error and the pose's ([`sighting_covariance`]).
+    fn sighted_at(
+        &self,
+        range: f64,
+        bearing: f64,
+        sigma: (f64, f64),
+    ) -> ((f64, f64), Matrix2<f64>) {
+        let at = Framed::<Field, _>::new(self.pose).at_range_bearing(range, bearing).inner;
+        let pose_xy = self.cov.fixed_view::<2, 2>(0, 0).into_owned();
+        let r =
+            sighting_covariance(range, bearing, self.pose.theta, sigma, pose_xy, self.cov[(2, 2)]);
+        ((at.x, at.y), r)
     }
 
     /// Whether a global localizer (MUREA or the grid) reads the frames' perceptions.
