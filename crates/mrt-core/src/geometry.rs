@@ -161,9 +161,36 @@ pub fn arc_velocity(dx: f64, dy: f64, dtheta: f64) -> (f64, f64) {
     (k * (c * dx + s * dy), k * (-s * dx + c * dy))
 }
 
+/// The runs of neighbours on a ring of `n` items in order, the last next to the first (a sonar
+/// ring round a body): items `k` and `k + 1` are in one run while `joined(k, k + 1)` (indices
+/// taken round the ring). Each run lists its items' indices in ring order; the first run
+/// starts after a break, so that no run wraps, and a ring joined all round is one run.
+pub fn ring_runs(n: usize, joined: impl Fn(usize, usize) -> bool) -> Vec<Vec<usize>> {
+    let start = (0..n).find(|&k| !joined((k + n - 1) % n, k)).unwrap_or(0);
+    let mut runs = Vec::new();
+    let mut run = Vec::new();
+    for k in start..start + n {
+        run.push(k % n);
+        if !joined(k % n, (k + 1) % n) || k + 1 == start + n {
+            runs.push(std::mem::take(&mut run));
+        }
+    }
+    runs
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn ring_runs_split_at_breaks_and_never_wrap() {
+        // Items 0..6; joined pairs (5, 0), (0, 1) and (3, 4): runs {5, 0, 1}, {2}, {3, 4}.
+        let joined = |a: usize, b: usize| matches!((a, b), (5, 0) | (0, 1) | (3, 4));
+        assert_eq!(ring_runs(6, joined), [vec![2], vec![3, 4], vec![5, 0, 1]]);
+        assert_eq!(ring_runs(3, |_, _| true), [vec![0, 1, 2]], "joined all round");
+        assert_eq!(ring_runs(3, |_, _| false), [vec![0], vec![1], vec![2]]);
+        assert!(ring_runs(0, |_, _| true).is_empty());
+    }
     use proptest::prelude::*;
     use std::f64::consts::FRAC_PI_2;
 

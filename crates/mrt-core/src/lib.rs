@@ -47,8 +47,8 @@ mod time;
 
 pub use file_error::{line_column, FileError};
 pub use geometry::{
-    angle_diff, arc_displacement, arc_velocity, normalize_angle, normalize_angle_positive, sinc,
-    Point2, Pose2, Vec2,
+    angle_diff, arc_displacement, arc_velocity, normalize_angle, normalize_angle_positive,
+    ring_runs, sinc, Point2, Pose2, Vec2,
 };
 pub use ids::{AgoraId, MemberId, MsgType};
 pub use message::{Message, RESERVED_TYPES_START};

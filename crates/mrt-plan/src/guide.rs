@@ -177,28 +177,17 @@ pub fn echo_obstacles(pose: &Pose2, sonars: &[Sonar]) -> Vec<Obstacle> {
             })
         })
         .collect();
-    // Start after a silent sonar (or a break between echoes) so that no cluster wraps.
-    let n = points.len();
-    let apart = |a: &Option<Point2>, b: &Option<Point2>| match (a, b) {
-        (Some(a), Some(b)) => (a - b).norm() > SAME_OBSTACLE,
-        _ => true,
+    let joined = |a: usize, b: usize| match (points[a], points[b]) {
+        (Some(a), Some(b)) => (a - b).norm() <= SAME_OBSTACLE,
+        _ => false,
     };
-    let start = (0..n).find(|&k| apart(&points[(k + n - 1) % n], &points[k])).unwrap_or(0);
-    let mut obstacles = Vec::new();
-    let mut cluster: Vec<Point2> = Vec::new();
-    for k in 0..n {
-        let (here, next) = (&points[(start + k) % n], &points[(start + k + 1) % n]);
-        if let Some(p) = here {
-            cluster.push(*p);
-        }
-        if apart(here, next) || k + 1 == n {
-            if let Some(o) = circle(pose, &cluster) {
-                obstacles.push(o);
-            }
-            cluster.clear();
-        }
-    }
-    obstacles
+    mrt_core::ring_runs(points.len(), joined)
+        .iter()
+        .filter_map(|run| {
+            let cluster: Vec<Point2> = run.iter().filter_map(|&k| points[k]).collect();
+            circle(pose, &cluster)
+        })
+        .collect()
 }
 
 /// The circle standing for echoes `points` seen from `pose`: near side at their mean.

@@ -670,30 +670,23 @@ impl WorldModel {
             .collect();
         // One robot echoes in two or three neighbouring sonars: echoes of neighbours within
         // SAME_ECHO of each other are one robot, seen at its nearest echo.
-        let n = points.len();
-        let apart = |a: usize, b: usize| match (points[a % n], points[b % n]) {
-            (Some((p, _)), Some((q, _))) => (p - q).norm() > SAME_ECHO,
-            _ => true,
+        let joined = |a: usize, b: usize| match (points[a], points[b]) {
+            (Some((p, _)), Some((q, _))) => (p - q).norm() <= SAME_ECHO,
+            _ => false,
         };
-        // Start after a break so that no group wraps round the ring.
-        let start = (0..n).find(|&k| apart(k + n - 1, k)).unwrap_or(0);
-        let mut out = Vec::new();
-        let mut nearest: Option<&Sonar> = None;
-        for k in start..start + n {
-            if let Some((_, s)) = points[k % n] {
-                if nearest.is_none_or(|m| s.range < m.range) {
-                    nearest = Some(s);
-                }
-            }
-            if apart(k, k + 1) || k + 1 == start + n {
-                if let Some(s) = nearest.take() {
-                    let sd = (SONAR_RANGE_SIGMA, SONAR_BEARING_SIGMA);
-                    let (at, r) = self.sighted_at(s.range + self.robot_radius, s.bearing, sd);
-                    out.push(RobotPercept { at, r, marker: None });
-                }
-            }
-        }
-        out
+        mrt_core::ring_runs(points.len(), joined)
+            .iter()
+            .filter_map(|run| {
+                let nearest = run
+                    .iter()
+                    .filter_map(|&k| points[k].map(|(_, s)| s))
+                    .min_by(|a, b| a.range.total_cmp(&b.range))?;
+                let sd = (SONAR_RANGE_SIGMA, SONAR_BEARING_SIGMA);
+                let (at, r) =
+                    self.sighted_at(nearest.range + self.robot_radius, nearest.bearing, sd);
+                Some(RobotPercept { at, r, marker: None })
+            })
+            .collect()
     }
 
     /// What the vision µAgent found in one image (a [`Percepts`]): read like a camera frame
