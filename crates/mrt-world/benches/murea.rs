@@ -162,6 +162,25 @@ fn bench(c: &mut Criterion) {
     g.bench_function("hough_self_localize", |b| {
         b.iter(|| self_localize(&field, black_box(&points), &lines, &params))
     });
+    // The lines as MUREA perceptions (issue 20 item 3) beside the goals and posts, against the
+    // same goals and posts with 16 line points: one global search each.
+    let landmarks: Vec<Perception> =
+        frame(&field, at).into_iter().filter(|p| p.kind != Kind::LINE).collect();
+    let with_points = frame(&field, at);
+    let mut with_lines = landmarks.clone();
+    with_lines.extend(lines.iter().map(|l| l.perception(&params)));
+    let murea = Murea::new(Map::field(&field, true));
+    for (name, seen) in [("murea_line_points", &with_points), ("murea_hough_lines", &with_lines)] {
+        let fix = murea.localize(seen, murea.whole_field());
+        let err = (fix.pose.x - at.x).hypot(fix.pose.y - at.y);
+        let turn = normalize_angle(fix.pose.theta - at.theta).abs().to_degrees();
+        println!(
+            "{name}: {} perceptions, error {err:.3} m {turn:.2}°, {} cells",
+            seen.len(),
+            fix.cells
+        );
+        g.bench_function(name, |b| b.iter(|| murea.localize(black_box(seen), murea.whole_field())));
+    }
     g.finish();
 }
 

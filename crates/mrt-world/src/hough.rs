@@ -50,7 +50,8 @@
 //! ```
 
 use crate::field::{FieldMap, Segment};
-use mrt_core::{Point2, Pose2};
+use crate::murea::{Kind, Perception};
+use mrt_core::{normalize_angle, Point2, Pose2};
 use std::f64::consts::{FRAC_PI_2, PI, TAU};
 
 /// The Hough transform's and the matching's settings (module doc).
@@ -89,6 +90,84 @@ pub struct HoughLine {
     pub rho: f64,
     /// The points on it.
     pub votes: usize,
+    /// Where its points lie along it, from and to, m from the foot of the perpendicular from
+    /// the robot, in the direction `φ + π/2`.
+    pub extent: (f64, f64),
+}
+
+impl HoughLine {
+    /// The line as a MUREA perception ([`Perception::line`], kind [`Kind::LINE`]): its normal
+    /// turned to point from the robot to the line, with the tolerances of the Hough cell it
+    /// was found in: `params.tolerance` (at least a cell) across, two cells' angle.
+    pub fn perception(&self, params: &HoughParams) -> Perception {
+        let (range, bearing, extent) = if self.rho >= 0.0 {
+            (self.rho, self.phi, self.extent)
+        } else {
+            // The normal turned a half turn: the line's direction turns too.
+            (-self.rho, self.phi - PI, (-self.extent.1, -self.extent.0))
+        };
+        Perception::line(Kind::LINE, range, normalize_angle(bearing), extent)
+            .tolerances(params.tolerance.max(params.rho_step), (2.0 * params.angle_step).max(1e-3))
+    }
+}
+
+/// The line through `points` that fits them best (least squares across it: the normal is the
+/// direction of their least spread), as `(φ, ρ)` with `φ` in `[0, π)`, the way round nearest
+/// the Hough cell's `cell_phi`: the cell's 1° steps alone leave up to half a degree of error.
+fn fit(points: &[Point2], cell_phi: f64) -> (f64, f64) {
+    let n = points.len().max(1) as f64;
+    let mean = points.iter().fold(Point2::origin(), |m, p| m + p.coords / n);
+    let (mut sxx, mut sxy, mut syy) = (0.0, 0.0, 0.0);
+    for p in points {
+        let d = p - mean;
+        sxx += d.x * d.x;
+        sxy += d.x * d.y;
+        syy += d.y * d.y;
+    }
+    // The spread's major axis is at ½·atan2(2sxy, sxx − syy); the normal is a quarter turn on.
+    let mut phi = 0.5 * (2.0 * sxy).atan2(sxx - syy) + FRAC_PI_2;
+    if !phi.is_finite() || sxx + syy <= 0.0 {
+        phi = cell_phi;
+    }
+    phi += ((cell_phi - phi) / PI).round() * PI;
+    let rho = mean.x * phi.cos() + mean.y * phi.sin();
+    if phi < 0.0 {
+        (phi + PI, -rho)
+    } else if phi >= PI {
+        (phi - PI, -rho)
+    } else {
+        (phi, rho)
+    }
+}
+
+/// Two points of one piece of line lie at most this far apart along it, m: a stray point
+/// that happens to lie on the line's extension does not stretch the piece.
+const PIECE_GAP: f64 = 0.5;
+
+/// The line of the points on a Hough cell's line (`cell_phi`): the longest run of them along
+/// it without a gap wider than [`PIECE_GAP`], fitted by least squares, and the run's extent.
+fn piece(points: &[Point2], cell_phi: f64) -> (f64, f64, (f64, f64)) {
+    let (s, c) = cell_phi.sin_cos();
+    let mut along: Vec<(f64, Point2)> = points.iter().map(|p| (p.y * c - p.x * s, *p)).collect();
+    along.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let mut best = (0, 0);
+    let mut start = 0;
+    for k in 1..=along.len() {
+        if k == along.len() || along[k].0 - along[k - 1].0 > PIECE_GAP {
+            if k - start > best.1 - best.0 {
+                best = (start, k);
+            }
+            start = k;
+        }
+    }
+    let run: Vec<Point2> = along[best.0..best.1].iter().map(|a| a.1).collect();
+    let (phi, rho) = fit(&run, cell_phi);
+    let (s, c) = phi.sin_cos();
+    let extent = run
+        .iter()
+        .map(|p| p.y * c - p.x * s)
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), t| (lo.min(t), hi.max(t)));
+    (phi, rho, extent)
 }
 
 /// The strongest lines through `points` (robot frame, m), strongest first: the Hough cell
@@ -133,8 +212,8 @@ pub fn hough_lines(points: &[Point2], params: &HoughParams) -> Vec<HoughLine> {
         if inliers.len() < params.min_votes {
             break;
         }
-        let rho = inliers.iter().map(|p| p.x * c + p.y * s).sum::<f64>() / inliers.len() as f64;
-        lines.push(HoughLine { phi: k as f64 * PI / angles as f64, rho, votes: inliers.len() });
+        let (phi, rho, extent) = piece(&inliers, k as f64 * PI / angles as f64);
+        lines.push(HoughLine { phi, rho, votes: inliers.len(), extent });
         left.retain(|p| !on(p));
     }
     lines
@@ -382,5 +461,73 @@ mod tests {
             self_localize(&map, &points, &lines, &params)
         };
         assert_eq!(run(), run());
+    }
+
+    /// Issue 20 item 3: the Hough lines as MUREA's percept source. From the same noisy points
+    /// with 30 % outliers, the lines (a handful of perceptions instead of a hundred points)
+    /// put MUREA on the truth or its half-turn twin, both explaining every line; one goal
+    /// sighting settles it. The lines' own numbers: each lies where a field line does.
+    #[test]
+    fn hough_lines_are_murea_perceptions_and_a_goal_breaks_their_symmetry() {
+        use crate::murea::{Map, Murea};
+        let field = FieldMap::default();
+        let params = HoughParams::default();
+        let murea = Murea::new(Map::field(&field, true));
+        let truths =
+            [Pose2::new(-5.0, 2.0, 0.5), Pose2::new(6.5, -4.0, 2.0), Pose2::new(-7.5, -5.0, -1.2)];
+        for (i, truth) in truths.into_iter().enumerate() {
+            let mut points = seen(truth, 4.0, 0.02, 0, i as u64);
+            let real = points.len();
+            points.extend(
+                seen(truth, 4.0, 0.0, real * 3 / 10, 100 + i as u64).into_iter().skip(real),
+            );
+            let lines: Vec<Perception> =
+                hough_lines(&points, &params).iter().map(|l| l.perception(&params)).collect();
+            assert!(lines.len() >= 2, "{truth:?}: {lines:?}");
+            // Every line the truth explains (each is a piece of a field line), by hand: the
+            // truth's quality is the lines' weight less their residuals.
+            // Lines alone fit many poses (any two crossing field lines): the truth is among
+            // the best, and it explains every straight line it sees.
+            let fix = murea.localize(&lines, murea.whole_field());
+            let truth_evidence = murea.quality_at(truth, &lines) * lines.len() as f64;
+            eprintln!(
+                "{truth:?}: truth {truth_evidence} fix {} of {} lines, {} cells",
+                fix.evidence,
+                lines.len(),
+                fix.cells
+            );
+            assert!(truth_evidence >= 0.8 * fix.evidence, "{truth:?}: {truth_evidence} {fix:?}");
+            // The east goal where the truth sees it: the twin sees the west one there.
+            let (dx, dy) = (9.0 - truth.x, 0.0 - truth.y);
+            let goal = Perception::point(
+                Kind::EAST_GOAL,
+                dx.hypot(dy),
+                normalize_angle(dy.atan2(dx) - truth.theta),
+            );
+            let mut with_goal = lines.clone();
+            with_goal.push(goal);
+            let fix = murea.localize(&with_goal, murea.whole_field());
+            assert!(close(fix.pose, truth), "{truth:?}: {fix:?}");
+            assert!(murea.quality_at(twin(truth), &with_goal) < fix.quality, "{fix:?}");
+        }
+    }
+
+    #[test]
+    fn a_line_with_a_negative_distance_turns_into_a_perception_facing_it() {
+        let params = HoughParams::default();
+        // The line y = −2 in the robot frame: φ = π/2, ρ = −2; its points from x = 1 to 3.
+        let points: Vec<Point2> =
+            (0..21).map(|k| Point2::new(1.0 + 0.1 * k as f64, -2.0)).collect();
+        let lines = hough_lines(&points, &params);
+        assert_eq!(lines.len(), 1, "{lines:?}");
+        let l = lines[0];
+        assert!((l.phi - FRAC_PI_2).abs() < 1e-9 && (l.rho + 2.0).abs() < 1e-9, "{l:?}");
+        // Along (−sin φ, cos φ) = (−1, 0): x = 1..3 is t = −3..−1.
+        assert!((l.extent.0 + 3.0).abs() < 1e-9 && (l.extent.1 + 1.0).abs() < 1e-9, "{l:?}");
+        let p = l.perception(&params);
+        // Turned: the foot 2 m away at −90°, the direction now (1, 0), so t = 1..3.
+        assert!((p.range.unwrap_or(0.0) - 2.0).abs() < 1e-9);
+        assert!((p.bearing.unwrap_or(0.0) + FRAC_PI_2).abs() < 1e-9, "{p:?}");
+        assert_eq!(p.extent.map(|(a, b)| ((a * 1e6).round(), (b * 1e6).round())), Some((1e6, 3e6)));
     }
 }

@@ -10,6 +10,10 @@
 //!   nearest map element of its [`Kind`], in tolerances) is below 1 counts its weight times
 //!   `1 − d²`. The pose that the perceptions fit best wins, not merely one that they all
 //!   tolerate: the tolerances are as wide as the sensor's errors.
+//! - **Lines** ([`Perception::line`], e.g. a [`crate::hough`] line): a straight piece seen at
+//!   a distance and a normal's bearing. Its residual against a map segment is `dρ² + dφ²` in
+//!   tolerances, when the segment runs that way and overlaps the seen piece. A cell's bound
+//!   asks only the direction (over the cell's headings) and the distance (over its box).
 //! - **Evidence** of a cell `C` of poses, an upper bound of its poses': the summed weight of
 //!   the perceptions that some pose in `C` may explain, i.e. some map element of the
 //!   perception's kind lies where the perception puts it (range ± tolerance, bearing ±
@@ -208,6 +212,13 @@ fn clips(s: &Segment, (x0, x1): (f64, f64), (y0, y1): (f64, f64)) -> bool {
     t0 <= t1
 }
 
+/// The two directions normal to segment `s`, rad.
+fn normals(s: &Segment) -> [f64; 2] {
+    let d = s.b - s.a;
+    let along = d.y.atan2(d.x);
+    [along + 0.5 * PI, along - 0.5 * PI]
+}
+
 /// One perception (MRT manual ch. 7: sensor-agnostic): something of a [`Kind`] seen at a
 /// range and/or a bearing from the robot, each with its tolerance, and how much it counts.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -224,6 +235,11 @@ pub struct Perception {
     pub bearing_tolerance: f64,
     /// Its weight in the evidence, in (0, 1].
     pub weight: f64,
+    /// `Some` for a straight piece of line ([`Perception::line`]): then `range` and `bearing`
+    /// are its normal's (the foot of the perpendicular from the robot), and this is the seen
+    /// piece, from and to, along the line's direction (the normal turned a quarter turn
+    /// counter-clockwise), m from the foot.
+    pub extent: Option<(f64, f64)>,
 }
 
 impl Perception {
@@ -237,6 +253,22 @@ impl Perception {
             bearing: Some(bearing),
             bearing_tolerance: 2f64.to_radians(),
             weight: 1.0,
+            extent: None,
+        }
+    }
+
+    /// A straight piece of `kind` (a field line found by [`crate::hough`]): the foot of the
+    /// perpendicular from the robot lies at `range` ≥ 0 and `bearing` (so the line's normal
+    /// points that way), and the piece runs from `extent.0` to `extent.1` along the line,
+    /// counted from the foot in the direction `bearing + π/2`. Tolerances 5 cm and 2°,
+    /// weight 1. A map segment explains it when it runs the same way, lies at that distance
+    /// and overlaps the seen piece; the centre circle's short chords rarely do.
+    pub fn line(kind: Kind, range: f64, bearing: f64, extent: (f64, f64)) -> Perception {
+        let extent = (extent.0.min(extent.1), extent.0.max(extent.1));
+        Perception {
+            range_tolerance: 0.05,
+            extent: Some(extent),
+            ..Perception::point(kind, range, bearing)
         }
     }
 
@@ -258,7 +290,17 @@ impl Perception {
     /// Whether the numbers make a perception (finite, tolerances ≥ 0, weight in (0, 1]).
     fn is_valid(&self) -> bool {
         let ok = |v: Option<f64>| v.is_none_or(f64::is_finite);
-        ok(self.range)
+        let line = match self.extent {
+            None => true,
+            Some((a, b)) => {
+                a.is_finite()
+                    && b.is_finite()
+                    && a <= b
+                    && self.range.is_some_and(|r| r >= 0.0)
+                    && self.bearing.is_some()
+            }
+        };
+        line && ok(self.range)
             && ok(self.bearing)
             && self.range_tolerance.is_finite()
             && self.range_tolerance >= 0.0
@@ -443,15 +485,84 @@ impl Murea {
         let mut sum = 0.0;
         for &k in among {
             let p = &perceptions[usize::from(k)];
-            let (sx, sy) = self.sector(cell.theta, p);
-            let xs = (cell.x.0 + sx.0, cell.x.1 + sx.1);
-            let ys = (cell.y.0 + sy.0, cell.y.1 + sy.1);
-            if self.map.meets(p.kind, xs, ys) {
+            let explained = if p.extent.is_some() {
+                self.some_segment_runs_along(cell, p)
+            } else {
+                let (sx, sy) = self.sector(cell.theta, p);
+                let xs = (cell.x.0 + sx.0, cell.x.1 + sx.1);
+                let ys = (cell.y.0 + sy.0, cell.y.1 + sy.1);
+                self.map.meets(p.kind, xs, ys)
+            };
+            if explained {
                 sum += p.weight;
                 support.push(k);
             }
         }
         (sum, support)
+    }
+
+    /// Whether some map segment of line perception `p`'s kind runs the way `p` says from some
+    /// pose of `cell`: its normal (either way round) within the bearing tolerance of `p`'s
+    /// over the cell's headings, and its distance along that normal within the range
+    /// tolerance over the cell's positions. The seen piece's overlap is left out: a bound
+    /// may be loose, and [`Murea::score`] asks for it.
+    fn some_segment_runs_along(&self, cell: &Cell, p: &Perception) -> bool {
+        let (Some(range), Some(bearing)) = (p.range, p.bearing) else {
+            return false;
+        };
+        let (a0, a1) = (
+            cell.theta.0 + bearing - p.bearing_tolerance,
+            cell.theta.1 + bearing + p.bearing_tolerance,
+        );
+        let (r0, r1) = (range - p.range_tolerance, range + p.range_tolerance);
+        self.map.segments.iter().filter(|(kind, _)| *kind == p.kind).any(|(_, s)| {
+            normals(s).into_iter().any(|psi| {
+                let turns = ((a0 - psi) / TAU).ceil();
+                if psi + turns * TAU > a1 {
+                    return false;
+                }
+                // n·(a − pos) over the cell's box: n·pos is extreme at the box's corners.
+                let (s_, c) = psi.sin_cos();
+                let at = c * s.a.x + s_ * s.a.y;
+                let xs = (c * cell.x.0, c * cell.x.1);
+                let ys = (s_ * cell.y.0, s_ * cell.y.1);
+                let lo = at - xs.0.max(xs.1) - ys.0.max(ys.1);
+                let hi = at - xs.0.min(xs.1) - ys.0.min(ys.1);
+                hi >= r0 && lo <= r1
+            })
+        })
+    }
+
+    /// The residual of line perception `p` against segment `s` from `pose`, squared, in
+    /// tolerances (`dρ² + dφ²`), when the segment explains it (module doc), else `None`.
+    fn line_residual(pose: Pose2, p: &Perception, s: &Segment) -> Option<f64> {
+        let (Some(range), Some(bearing), Some((t0, t1))) = (p.range, p.bearing, p.extent) else {
+            return None;
+        };
+        let tol_r = p.range_tolerance.max(1e-6);
+        let tol_b = p.bearing_tolerance.max(1e-6);
+        let normal = pose.theta + bearing;
+        let (ns, nc) = normal.sin_cos();
+        // The seen piece's ends in the field frame.
+        let foot = Point2::new(pose.x + range * nc, pose.y + range * ns);
+        let ends = [t0, t1].map(|t| Point2::new(foot.x - t * ns, foot.y + t * nc));
+        normals(s)
+            .into_iter()
+            .filter_map(|psi| {
+                let db = normalize_angle(psi - normal) / tol_b;
+                let (s_, c) = psi.sin_cos();
+                let dr = (c * (s.a.x - pose.x) + s_ * (s.a.y - pose.y) - range) / tol_r;
+                if db.abs() >= 1.0 || dr.abs() >= 1.0 {
+                    return None;
+                }
+                // The seen piece and the segment overlap along the segment (± the tolerance).
+                let dir = s.b - s.a;
+                let len = dir.norm().max(1e-9);
+                let along = ends.map(|e| (e - s.a).dot(&dir) / len);
+                let (lo, hi) = (along[0].min(along[1]), along[0].max(along[1]));
+                (hi >= -tol_r && lo <= len + tol_r).then_some(dr * dr + db * db)
+            })
+            .fold(None, |best: Option<f64>, d| Some(best.map_or(d, |b| b.min(d))))
     }
 
     /// The box `(x, y)` bounding where perception `p` puts its object relative to the robot's
@@ -544,7 +655,8 @@ impl Murea {
 
     /// The evidence of one pose: each perception that `support` names counts `w·(1 − d²)`
     /// when its residual `d` (in tolerances: range and bearing to the nearest map point of its
-    /// kind, or the distance to the nearest segment for lines) is below 1, nothing otherwise.
+    /// kind, the distance to the nearest segment for line points, distance and direction for
+    /// lines) is below 1, nothing otherwise.
     /// A perception that counts here lies inside its conservative region of every cell that
     /// holds the pose, so a cell's evidence bounds this (the search's correctness rests on it).
     fn score(&self, pose: Pose2, perceptions: &[Perception], support: &[u16]) -> f64 {
@@ -554,6 +666,15 @@ impl Murea {
             let tol_r = p.range_tolerance.max(1e-6);
             let tol_b = p.bearing_tolerance.max(1e-6);
             let mut best = f64::INFINITY;
+            if p.extent.is_some() {
+                for (_, seg) in self.map.segments.iter().filter(|(kind, _)| *kind == p.kind) {
+                    if let Some(d) = Murea::line_residual(pose, p, seg) {
+                        best = best.min(d);
+                    }
+                }
+                sum += p.weight * (1.0 - best).max(0.0);
+                continue;
+            }
             for (_, at) in self.map.points.iter().filter(|(kind, _)| *kind == p.kind) {
                 let (dx, dy) = (at.x - pose.x, at.y - pose.y);
                 let dr = p.range.map_or(0.0, |r| (dx.hypot(dy) - r) / tol_r);
@@ -902,13 +1023,15 @@ mod tests {
         fn a_cell_bounds_the_evidence_of_its_children_and_poses(
             x in -9.0..9.0f64, y in -6.0..6.0f64, th in -3.2..3.2f64,
             sx in 0.1..4.0f64, sth in 0.02..2.0f64, at in (0.0..1.0f64, 0.0..1.0f64, 0.0..1.0f64),
-            range in 0.3..12.0f64, bearing in -3.2..3.2f64, kind in 0u16..5, ranged in any::<bool>(),
+            range in 0.3..12.0f64, bearing in -3.2..3.2f64, kind in 0u16..5, shape in 0u8..3,
+            extent in (-6.0..6.0f64, 0.0..4.0f64),
         ) {
             let murea = Murea::new(Map::field(&FieldMap::default(), true));
-            let mut p = Perception::point(Kind(kind), range, bearing);
-            if !ranged {
-                p = Perception::bearing_only(Kind(kind), bearing);
-            }
+            let p = match shape {
+                0 => Perception::point(Kind(kind), range, bearing),
+                1 => Perception::bearing_only(Kind(kind), bearing),
+                _ => Perception::line(Kind::LINE, range, bearing, (extent.0, extent.0 + extent.1)),
+            };
             let cell = Cell { x: (x, x + sx), y: (y, y + sx), theta: (th, th + sth) };
             let parent = murea.evidence(&cell, &[p], &[0]).0;
             for child in murea.split(&cell) {
