@@ -6,6 +6,8 @@
 //! - `mrt demo [hello-agora|two-agoras]` runs a numbered example and prints what happens;
 //! - `mrt behave FILE [--world world.json] [--cycles N]` runs a Lua behavior or HFSM offline;
 //! - `mrt hfsm dot FILE [--dot out.dot] [--svg out.svg]` draws an HFSM;
+//! - `mrt plan path --from X,Y --to X,Y [--obstacles ...] [--json] [--svg out.svg]` plans a
+//!   path with SPIKE;
 //! - `mrt soak matches|hour` runs the soak campaigns of `docs/reliability.md`;
 //! - `mrt check FILE...` checks DCDT Agora configuration files (MRT manual §3.3.1) and
 //!   prints each in canonical form, or the first error with file, line and column.
@@ -24,6 +26,7 @@ mod behave;
 mod brian;
 #[cfg(feature = "net")]
 mod distributed;
+mod plan;
 mod sim;
 mod soak;
 mod vision;
@@ -38,6 +41,13 @@ use std::path::PathBuf;
 struct Cli {
     #[command(subcommand)]
     command: Command,
+}
+
+#[derive(Subcommand)]
+enum PlanCommand {
+    /// A path from --from to --to that keeps the robot's radius and a safety distance from
+    /// every obstacle: its corners, its length and the time it took (docs/planning.md).
+    Path(plan::PathArgs),
 }
 
 #[derive(Subcommand)]
@@ -104,6 +114,12 @@ enum Command {
         /// Simulated time between cycles, for worlds without a time, 1 to 3 600 000 ms.
         #[arg(long, default_value_t = 100)]
         period_ms: u64,
+    },
+    /// SPIKE, the path planner (MRT manual ch. 9): plan a path on the soccer field or a map
+    /// file.
+    Plan {
+        #[command(subcommand)]
+        command: PlanCommand,
     },
     /// Hierarchical state machines (ThinkingCap HFSM).
     Hfsm {
@@ -243,6 +259,7 @@ fn run(command: Command) -> Result<()> {
         Command::Vision { command: VisionCommand::Render(args) } => vision::render(&args)?,
         Command::Vision { command: VisionCommand::Calibrate(args) } => vision::calibrate(&args)?,
         Command::Vision { command: VisionCommand::Survey(args) } => vision::survey(&args)?,
+        Command::Plan { command: PlanCommand::Path(args) } => plan::path(&args)?,
         Command::Behave { file, world, cycles, period_ms } => {
             behave::behave(&file, world.as_deref(), cycles, period_ms)?
         }

@@ -41,6 +41,7 @@ smoke_tests! {
     sim_config => "sim-config",
     robot_file => "robot-file",
     vision_files => "vision-files",
+    plan_map => "plan-map",
     bb_config => "bb-config",
     relay_line => "relay-line",
     lua_script => "lua-script",

@@ -31,6 +31,19 @@ pub enum PlanError {
         /// Which input.
         name: &'static str,
     },
+    /// SPIKE found no path (`mrt_plan::spike`).
+    #[error("no path: {reason}")]
+    NoPath {
+        /// Why: the start or the goal shut in, or nothing joining them.
+        reason: &'static str,
+    },
+    /// SPIKE would need more cells than it may make (`mrt_plan::spike::MAX_CELLS`): the map is
+    /// too large for its accuracy.
+    #[error("the plan needs more than {cells} cells: use a coarser accuracy or a smaller map")]
+    TooManyCells {
+        /// The limit.
+        cells: usize,
+    },
     /// "Behind the ball" needs a line from the goal through the ball.
     #[error("ball and goal coincide at ({x}, {y}): no line to stand behind")]
     BallOnGoal {

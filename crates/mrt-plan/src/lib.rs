@@ -1,6 +1,7 @@
-//! # mrt-plan: kinematics and guidance
+//! # mrt-plan: kinematics, guidance and the SPIKE planner
 //!
-//! The acting end of an MRT robot as a plain library (no bus, no Lua): from a wanted velocity
+//! The acting end of an MRT robot as a plain library (no bus, no Lua): SPIKE, the path planner
+//! of the MRT manual's ch. 9 ([`spike`], docs/planning.md), and from a wanted velocity
 //! to wheel speeds for the two MRT bases (MRT manual ch. 12: IANUS3, Triskar; the AIRBoard of
 //! ch. 5 takes one set point per motor), and the three guidance modes of the ISocRob Guidance µAgent (seed `003`
 //! §3.2.3): velocity with a sonar stop, go-to-posture, and potential fields around obstacles,
@@ -37,6 +38,7 @@
 //! | velocity mode, halted by the sonars (ISocRob §3.2.3) | [`guidance::VelocityGuard`], [`guidance::Sonar`] |
 //! | position mode | [`guidance::PositionMode`] |
 //! | the Guidance µAgent: the mode a command asks for, sonar echoes, ball echoes told apart | [`guide::Guidance`] |
+//! | SPIKE, multi-resolution path planning with doors and moving objects (manual ch. 9) | [`spike::Spike`], [`spike::PlanMap`], [`spike::Plan`] |
 //! | potential field mode, ball as a repelling obstacle | [`guidance::PotentialField`], [`guidance::Obstacle`], [`guidance::behind_ball`], [`guidance::sonar_obstacles`] |
 //!
 //! No feature flags. Errors: [`PlanError`].
@@ -46,5 +48,6 @@ mod error;
 pub mod guidance;
 pub mod guide;
 pub mod kinematics;
+pub mod spike;
 
 pub use error::PlanError;

@@ -174,6 +174,40 @@ impl Harness for VisionToml {
     }
 }
 
+/// SPIKE's map files (`mrt plan path --map`): a map that reads is planned on.
+pub(super) const PLAN_MAP: Target = Target {
+    name: "plan-map",
+    about: "a SPIKE map file (PlanMap::from_toml); a map that reads is planned on across its area, at 5 cm",
+    keywords: &["[area]", "[field]", "[[disc]]", "[[wall]]", "[[polygon]]", "[[door]]", "min", "max", "centre", "radius", "from", "to", "corners", "length", "width", "=", "[]", "nan", "inf", "-inf", "1e400", "-1", "0", "1e12"],
+    structured: Some(crate::mutate::mutate_toml),
+    seeds: |root| files_under(&root.join("configs/plan"), |s| s.ends_with(".toml")),
+    harness: |_| Ok(Box::new(PlanToml)),
+};
+
+struct PlanToml;
+
+impl Harness for PlanToml {
+    fn exec(&mut self, _seed: &Seed, input: &[u8]) -> bool {
+        use mrt_plan::spike::{PlanMap, Spike, SpikeParams};
+        let Ok(text) = std::str::from_utf8(input) else { return false };
+        let Ok(map) = PlanMap::from_toml(text, "fuzz.toml") else { return false };
+        let (lo, hi) = (map.min, map.max);
+        let params = SpikeParams { accuracy: 0.05, ..SpikeParams::default() };
+        let Ok(spike) = Spike::new(map, params) else { return true };
+        let at = |t: f64| mrt_core::Point2::new(lo.x + t * (hi.x - lo.x), lo.y + t * (hi.y - lo.y));
+        // Documented: a plan that is made keeps its clearance at its corners past the start.
+        if let Ok(plan) = spike.plan(at(0.2), at(0.8)) {
+            for c in plan.waypoints.iter().skip(1).take(plan.waypoints.len().saturating_sub(2)) {
+                let d = spike.map().clearance(*c);
+                if d < spike.clearance() - 1e-6 {
+                    panic!("corner {c:?} of a plan is {d} m from an obstacle");
+                }
+            }
+        }
+        true
+    }
+}
+
 /// A robot's file (`mrt robot --config`).
 pub(super) const ROBOT_FILE: Target = Target {
     name: "robot-file",

@@ -70,6 +70,7 @@ pub static TARGETS: &[Target] = &[
     files::SIM_CONFIG,
     files::ROBOT_FILE,
     files::VISION_FILES,
+    files::PLAN_MAP,
     files::BB_CONFIG,
     files::RELAY_LINE,
     lua::LUA_SCRIPT,
