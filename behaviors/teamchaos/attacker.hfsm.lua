@@ -4,11 +4,18 @@
 
 local function ball() return chaos.lps_getLpo(BALL) end
 
+-- The attacker keeps the ball booked while it attacks (seed 001 §3.3: a teammate that also
+-- goes for the ball waits for the booking); a booking not asked for again lapses in 5 s.
+local function attack(behavior)
+  chaos.bookBall()
+  chaos.setBehavior(behavior)
+end
+
 machine "Attacker" {
   initial = "FaceBall",
   states = {
     -- Turn towards the ball.
-    FaceBall = function() chaos.setBehavior("faceball") end,
+    FaceBall = function() attack("faceball") end,
     -- Walk to the ball, keeping localized on the long way (the seed's GoToBall code).
     GoToBall = function()
       if chaos.gsGetMyPos().quality < 0.6 then
@@ -17,7 +24,7 @@ machine "Attacker" {
       if chaos.lps_getLpo(NET1).seen_ago > 5 and chaos.lps_getLpo(NET2).seen_ago > 5 then
         chaos.setNeeded(NET1, 0.5) -- no net seen for a while: look for the opponent's
       end
-      chaos.setBehavior("go2ball")
+      attack("go2ball")
     end,
     -- Close to the ball (about 50 cm): score.
     Score = meta "Score",
@@ -40,9 +47,9 @@ machine "Score" {
   initial = "ApproachBall",
   states = {
     -- Precise approach: no localization tasks, eyes on the ball.
-    ApproachBall = function() chaos.setBehavior("go2ball") end,
-    Align = function() chaos.setBehavior("alignbnet1") end,
-    DoKick = function() chaos.setBehavior("dokick") end,
+    ApproachBall = function() attack("go2ball") end,
+    Align = function() attack("alignbnet1") end,
+    DoKick = function() attack("dokick") end,
   },
   transitions = {
     -- The seed's Kickable: the ball is closer than 60 cm.

@@ -278,6 +278,16 @@ pub fn run(args: &SimArgs) -> Result<()> {
             100.0 * s.possession_cycles as f64 / total
         );
     }
+    for (i, name) in [(0, h), (1, a)] {
+        let s = &report.stats[i];
+        if s.booked_cycles > 0 {
+            outln!(
+                "  {name:<8} ball booked in {} robot cycles, by two robots at once in {}",
+                s.booked_cycles,
+                s.booking_conflicts
+            );
+        }
+    }
     for (t, call) in &report.calls {
         if let Call::Goal(team) = call {
             let who = if *team == Team::Home { h } else { a };

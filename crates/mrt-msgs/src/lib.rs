@@ -58,7 +58,7 @@ pub use sensing::{
     CameraFrame, Displacement, GameInfo, Image, Marker, MiceReadings, Odometry, Percepts,
     PostSighting, RobotSighting, Sighting, Sonar, SonarScan, FIELD_OBJECTS,
 };
-pub use team::{MateReport, SharedRobot};
+pub use team::{BookingReport, MateReport, SharedRobot};
 
 /// Declares the [`Message`] impls of the catalogue, each with its id from [`ids`] and its name
 /// as the table gives it.

@@ -24,6 +24,26 @@ pub struct MateReport {
     /// whose anchors the others fuse, MRT manual ch. 8).
     #[serde(default)]
     pub robots: Vec<SharedRobot>,
+    /// Its part in the team's ball booking (TeamChaos' distributed mutual exclusion, seed
+    /// `001` §3.3; `mrt_team::booking`).
+    #[serde(default)]
+    pub booking: BookingReport,
+}
+
+/// What a robot tells its teammates about the ball booking (`mrt_team::booking`): whether it
+/// wants the ball, whose claim it supports, and the latest report it heard from each of them.
+/// Times are the sender's own clock, s.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct BookingReport {
+    /// When it sent this report.
+    pub stamp: f64,
+    /// When it began wanting the ball (`bookBall`), while it does.
+    pub claim: Option<f64>,
+    /// The claim it supports: the claimant's number and its claim's time.
+    pub grant: Option<(u32, f64)>,
+    /// For each teammate heard: its number and the stamp of its latest report heard.
+    pub echo: Vec<(u32, f64)>,
 }
 
 /// A robot a teammate anchored and sees this frame (team frame, mm).
@@ -50,7 +70,15 @@ impl MateReport {
             .filter(|r| r.seen_ago <= 0.0)
             .map(|r| SharedRobot { class: r.class, x: r.x, y: r.y, sigma: r.sigma })
             .collect();
-        MateReport { id, keeper, pose: w.my_pos, ball: w.global_ball, ball_sigma: 0.0, robots }
+        MateReport {
+            id,
+            keeper,
+            pose: w.my_pos,
+            ball: w.global_ball,
+            ball_sigma: 0.0,
+            robots,
+            booking: BookingReport::default(),
+        }
     }
 
     /// The same report with the ball's standard deviation, mm.

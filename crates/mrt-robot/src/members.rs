@@ -48,12 +48,13 @@ use mrt_core::Point2;
 use mrt_dcdt::{Activation, Agora, Context, Member, MemberError, Message, RequestType, RunReport};
 use mrt_msgs::robot::{lps, Lpo};
 use mrt_msgs::{
-    BehaviorStatus, CameraFrame, GameInfo, MateReport, MemberFault, MotorCommand, Odometry,
-    Percepts, RobotCommand, Sonar, SonarScan, WorldSnapshot,
+    BehaviorStatus, BookingReport, CameraFrame, GameInfo, MateReport, MemberFault, MotorCommand,
+    Odometry, Percepts, RobotCommand, Sonar, SonarScan, WorldSnapshot,
 };
 use mrt_perception::vision::agent::VisionAgent;
 use mrt_plan::guide::Guidance;
 use mrt_script::member::BehaviorMember;
+use mrt_team::booking::{BallBooking, BookingParams};
 use mrt_world::gaze::Gaze;
 use mrt_world::{merge_team, WorldModel};
 use std::collections::BTreeMap;
@@ -96,6 +97,13 @@ struct WorldState {
     body: Commander,
     model: WorldModel,
     mates: BTreeMap<u32, MateReport>,
+    /// The team's ball booking (TeamChaos seed `001` §3.3, [`mrt_team::booking`]): fed by the
+    /// behaviors' `bookBall`/`releaseBookedBall` and the teammates' reports.
+    booking: BallBooking,
+    /// Teammates' booking reports received since the last frame.
+    booking_news: Vec<(u32, BookingReport)>,
+    /// The behaviors' latest `bookBall` (true) or `releaseBookedBall` (false) not yet applied.
+    book: Option<bool>,
 }
 
 impl Member for WorldState {
@@ -110,6 +118,7 @@ impl Member for WorldState {
         ctx.subscribe_to::<GameInfo>(RequestType::Local);
         ctx.subscribe_to::<SonarScan>(RequestType::Local);
         ctx.subscribe_to::<MateReport>(RequestType::Remote);
+        ctx.subscribe_to::<RobotCommand>(RequestType::Local);
         Ok(())
     }
 
@@ -130,8 +139,11 @@ impl Member for WorldState {
             } else if let Ok(scan) = m.get::<SonarScan>() {
                 // Read with the next frame (MAP's merger: echoes of robots out of view).
                 self.model.sonars(scan);
+            } else if let Ok(c) = m.get::<RobotCommand>() {
+                self.book = c.book_ball.or(self.book);
             } else {
                 let r = m.get::<MateReport>()?;
+                self.booking_news.push((r.id, r.booking.clone()));
                 self.mates.insert(r.id, r.clone());
             }
         }
@@ -143,7 +155,19 @@ impl Member for WorldState {
         let id = u32::try_from(self.robot).unwrap_or(u32::MAX);
         // The ball's uncertainty in mm, as the reports and the team ball count it.
         let ball_sigma = self.model.ball_sigma().map(|s| s * 1000.0);
-        let report = MateReport::of(id, self.keeper, &w).with_ball_sigma(ball_sigma.unwrap_or(0.0));
+        let mut report =
+            MateReport::of(id, self.keeper, &w).with_ball_sigma(ball_sigma.unwrap_or(0.0));
+        // The ball booking on this frame's clock: the news, the behaviors' wish, the report.
+        let now = w.time.as_secs_f64();
+        for (from, b) in self.booking_news.drain(..) {
+            self.booking.receive(now, from, &b);
+        }
+        if let Some(yes) = self.book.take() {
+            self.booking.want(now, yes);
+        }
+        self.booking.update(now);
+        report.booking = self.booking.report(now);
+        w.ball_booked = self.booking.holds(now);
         // Teammates and their ball as the bus told them, not as the simulator knows them.
         merge_team(&mut w, ball_sigma, self.mates.values());
         ctx.publish(report);
@@ -456,6 +480,12 @@ fn add_cycle(
         body: commander,
         model: cfg.world_model(),
         mates: BTreeMap::new(),
+        booking: BallBooking::new(
+            u32::try_from(robot).unwrap_or(u32::MAX),
+            BookingParams::default(),
+        ),
+        booking_news: Vec::new(),
+        book: None,
     };
     let guide = Guide {
         robot,

@@ -712,15 +712,26 @@ fn field_players_share_the_roles_by_their_distance_to_the_ball() {
             })
             .collect::<Vec<_>>()
     };
-    let alone = run4(&|w| w);
+    // Behind the ball, the attacker-to-be waits for the ball booking (seed 001 §3.3): it
+    // asks for it, and attacks once its world snapshot says it holds it.
+    let unbooked = run4(&|w| w);
+    let paths: Vec<&str> = unbooked.iter().map(|c| c.path.as_str()).collect();
+    assert_eq!(paths, ["Player/Wait", "Player/Search", "Player/GetBehind", "Player/GetBehind"]);
+    assert_eq!(unbooked[3].command.book_ball, Some(true));
+    let alone = run4(&|mut w| {
+        w.0.ball_booked = true;
+        w
+    });
     let paths: Vec<&str> = alone.iter().map(|c| c.path.as_str()).collect();
     assert_eq!(
         paths,
         ["Player/Wait", "Player/Search", "Player/GetBehind", "Player/Attack/FaceBall"]
     );
+    assert_eq!(alone[3].command.book_ball, Some(true), "the Attacker keeps asking");
 
     let second = run4(&|w| w.mate(2, -1000.0, 300.0, false));
     assert_eq!(second[2].path, "Player/Support");
+    assert_eq!(second[2].command.book_ball, Some(false), "a supporter gives the booking back");
     assert_eq!(second[2].behavior.as_deref(), Some("gotopos"));
     let c = &second[2].command;
     close(c.vlin, -250.0);

@@ -65,7 +65,9 @@ impl mrt_dcdt::Member for EstimateWatch {
     ) -> Result<(), mrt_dcdt::MemberError> {
         while let Some(m) = ctx.receive_msg() {
             if let Ok(w) = m.get::<WorldSnapshot>() {
-                lock_pitch(&self.pitch)?.book_robots(self.robot, &w.robots);
+                let mut pitch = lock_pitch(&self.pitch)?;
+                pitch.book_robots(self.robot, &w.robots);
+                pitch.book_booking(self.robot, w.ball_booked);
                 continue;
             }
             let estimate = m.get::<Localization>()?;

@@ -48,6 +48,12 @@ pub struct TeamStats {
     pub shots: u32,
     /// Control cycles in which this team had the robot closest to the ball (within 1 m).
     pub possession_cycles: u64,
+    /// Robot cycles in which one of its robots believed it held the ball booking (TeamChaos
+    /// seed `001` §3.3, `mrt_team::booking`).
+    pub booked_cycles: u64,
+    /// Robot cycles in which a robot believed it held the booking while a teammate did too
+    /// in the same cycle (the booking's promise: never).
+    pub booking_conflicts: u64,
 }
 
 /// One control cycle's positions, for drawings: ball, then every robot (m).
@@ -237,6 +243,8 @@ pub struct Pitch {
     localization: LocalizationErrors,
     /// Kicks asked this cycle, fired when the physics runs.
     kicks: Vec<usize>,
+    /// The simulated time at which each robot last believed it held the ball booking.
+    booked_at: Vec<f64>,
     /// The cameras' renderer and each robot's camera state, when percepts come from vision.
     eyes: Option<Eyes>,
     /// Each robot's camera pan joint, rad (the camera file's pan until a robot turns it).
@@ -302,6 +310,7 @@ impl Pitch {
             faults: Vec::new(),
             localization: LocalizationErrors::default(),
             kicks: Vec::new(),
+            booked_at: vec![f64::NEG_INFINITY; robots],
             eyes: match cfg.sensor.percepts {
                 PerceptSource::Oracle => None,
                 PerceptSource::Vision => Some(Eyes::new(cfg, robots, seed)?),
@@ -517,6 +526,25 @@ impl Pitch {
             if k.recovered_after.is_none() && now > k.at && off < RECOVERED {
                 k.recovered_after = Some(now - k.at);
             }
+        }
+    }
+
+    /// Books robot `i`'s belief that it holds the ball booking in this cycle, and whether a
+    /// teammate believed so in the same cycle ([`TeamStats::booking_conflicts`]).
+    pub fn book_booking(&mut self, i: usize, held: bool) {
+        if !held {
+            return;
+        }
+        let now = self.world.time();
+        let team = self.referee.team_of(i);
+        let Some(at) = self.booked_at.get_mut(i) else { return };
+        *at = now;
+        let stats = &mut self.stats[team.index()];
+        stats.booked_cycles += 1;
+        let mate_holds = (0..self.booked_at.len())
+            .any(|k| k != i && self.referee.team_of(k) == team && self.booked_at[k] == now);
+        if mate_holds {
+            stats.booking_conflicts += 1;
         }
     }
 

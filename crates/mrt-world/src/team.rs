@@ -216,6 +216,7 @@ mod tests {
             ball: Estimate { pose: Pose2::new(ball.0, ball.1, 0.0), quality },
             ball_sigma: sigma,
             robots: Vec::new(),
+            booking: Default::default(),
         }
     }
 

@@ -1,0 +1,26 @@
+//! # mrt-team: team coordination
+//!
+//! How the robots of one team agree who does what, as plain libraries fed by the reports the
+//! teammates send each other (`mrt_msgs::MateReport`) and their own clock:
+//!
+//! | seed name | Rust |
+//! |---|---|
+//! | TeamChaos' ball booking, a distributed mutual exclusion: `bookBall`, `releaseBookedBall`, `haveBookedBall` (seed `001` §3.3) | [`booking::BallBooking`] |
+//!
+//! SCARE, the MRT manual's coordination (ch. 11), comes here next (issue 21).
+//!
+//! ```
+//! use mrt_team::booking::{BallBooking, BookingParams};
+//!
+//! // A robot that hears no teammate books for itself alone.
+//! let mut me = BallBooking::new(3, BookingParams::default());
+//! me.want(10.0, true);
+//! me.update(10.0);
+//! assert!(me.holds(10.0) && me.alone(10.0));
+//! ```
+//!
+//! No feature flags, no errors: bad input (late, repeated or odd reports) is dropped and
+//! counted.
+#![deny(missing_docs)]
+
+pub mod booking;
