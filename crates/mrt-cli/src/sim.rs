@@ -4,7 +4,7 @@ use anyhow::{anyhow, Context as _, Result};
 use indicatif::{ProgressBar, ProgressStyle};
 use mrt_robot::stacks::Stack;
 use mrt_sim::config::SimConfig;
-use mrt_sim::game::MatchReport;
+use mrt_sim::game::{MatchReport, TeamStats};
 use mrt_sim::metrics::MetricsBook;
 use mrt_sim::play;
 use mrt_sim::referee::{Call, Team};
@@ -272,9 +272,10 @@ pub fn run(args: &SimArgs) -> Result<()> {
     for (i, name) in [(0, h), (1, a)] {
         let s = &report.stats[i];
         outln!(
-            "  {name:<8} goals {:>2}  shots {:>3}  possession {:>5.1} %",
+            "  {name:<8} goals {:>2}  shots {:>3} ({:>3} on target)  possession {:>5.1} %",
             s.goals,
             s.shots,
+            s.shots_on_target,
             100.0 * s.possession_cycles as f64 / total
         );
     }
@@ -470,7 +471,7 @@ fn series(args: &SimArgs, cfg: &SimConfig, stacks: (Stack, Stack)) -> Result<()>
                         book.add(r);
                     }
                     if let Ok(mut v) = results.lock() {
-                        v.push(r.map(|r| (seed, r.score)));
+                        v.push(r.map(|r| (seed, r.score, r.stats)));
                     }
                     bar.inc(1);
                 }
@@ -480,8 +481,15 @@ fn series(args: &SimArgs, cfg: &SimConfig, stacks: (Stack, Stack)) -> Result<()>
     bar.finish_and_clear();
     let results = results.into_inner().map_err(|_| anyhow!("a match thread failed"))?;
     let mut scores = Vec::new();
+    let mut stats = [TeamStats::default(), TeamStats::default()];
     for r in results {
-        scores.push(r?);
+        let (seed, score, s) = r?;
+        for (total, one) in stats.iter_mut().zip(&s) {
+            total.shots += one.shots;
+            total.shots_on_target += one.shots_on_target;
+            total.possession_cycles += one.possession_cycles;
+        }
+        scores.push((seed, score));
     }
     scores.sort();
     let n = scores.len();
@@ -509,6 +517,16 @@ fn series(args: &SimArgs, cfg: &SimConfig, stacks: (Stack, Stack)) -> Result<()>
         goals.0 as f64 / n as f64,
         goals.1 as f64 / n as f64
     );
+    let possession = (stats[0].possession_cycles + stats[1].possession_cycles).max(1) as f64;
+    for (name, s) in [(h, &stats[0]), (a, &stats[1])] {
+        outln!(
+            "  {name:<8} shots {:>5} ({:>4} on target, {:.1} a match)  possession {:>5.1} %",
+            s.shots,
+            s.shots_on_target,
+            f64::from(s.shots_on_target) / n.max(1) as f64,
+            100.0 * s.possession_cycles as f64 / possession
+        );
+    }
     let book = book.into_inner().map_err(|_| anyhow!("a match thread failed"))?;
     write_metrics(args, &book)
 }

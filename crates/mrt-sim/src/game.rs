@@ -46,6 +46,9 @@ pub struct TeamStats {
     pub goals: u32,
     /// Kicks that reached the ball.
     pub shots: u32,
+    /// Shots that left the kicker heading into the opponent's goal mouth (the ball's path,
+    /// unobstructed, would cross the goal line between the posts).
+    pub shots_on_target: u32,
     /// Control cycles in which this team had the robot closest to the ball (within 1 m).
     pub possession_cycles: u64,
     /// Robot cycles in which one of its robots believed it held the ball booking (TeamChaos
@@ -629,11 +632,24 @@ impl Pitch {
         }
     }
 
+    /// Whether robot `i`'s kick (the ball sent along its heading) heads into the goal that
+    /// `team` attacks: the line from the ball along the heading crosses that goal line
+    /// between the posts, less the ball's radius.
+    fn on_target(&self, i: usize, team: Team) -> bool {
+        let Some(pose) = self.world.robot(i) else { return false };
+        let line = self.referee.attack_direction(team) * self.cfg.field.length / 2.0;
+        let mouth = self.cfg.field.goal_width / 2.0 - self.cfg.ball.radius;
+        heads_into_goal(self.world.ball(), pose.theta, line, mouth)
+    }
+
     fn fire_kicks(&mut self) {
         for i in std::mem::take(&mut self.kicks) {
             if self.referee.state() == GameState::Playing && self.world.kick(i) {
                 let team = self.referee.team_of(i);
                 self.stats[team.index()].shots += 1;
+                if self.on_target(i, team) {
+                    self.stats[team.index()].shots_on_target += 1;
+                }
                 self.shots.push((self.world.time(), i, self.world.ball()));
             }
         }
@@ -722,5 +738,34 @@ impl Pitch {
             localization: self.localization,
             kidnaps: self.kidnaps,
         }
+    }
+}
+
+/// Whether a ball at `ball` sent along `heading` (rad) crosses the goal line `x = line`
+/// within `mouth` of its centre (m).
+fn heads_into_goal((bx, by): (f64, f64), heading: f64, line: f64, mouth: f64) -> bool {
+    let (c, s) = (heading.cos(), heading.sin());
+    if (line - bx) * c <= 0.0 || c.abs() < 1e-9 {
+        return false;
+    }
+    (by + (line - bx) / c * s).abs() < mouth
+}
+
+#[cfg(test)]
+mod shot_tests {
+    use super::heads_into_goal;
+
+    /// By hand, the east goal line at x = 9 m with a 0.89 m half mouth: from (5, 0) straight
+    /// east, in; at 10° the ball crosses at y = 4·tan 10° = 0.705 m, in; at 15°, 1.07 m, wide;
+    /// away from the goal, never; the west goal from (5, 0) heading west, in.
+    #[test]
+    fn a_shot_is_on_target_when_its_line_crosses_the_goal_mouth() {
+        let deg = f64::to_radians;
+        assert!(heads_into_goal((5.0, 0.0), 0.0, 9.0, 0.89));
+        assert!(heads_into_goal((5.0, 0.0), deg(10.0), 9.0, 0.89));
+        assert!(!heads_into_goal((5.0, 0.0), deg(15.0), 9.0, 0.89));
+        assert!(!heads_into_goal((5.0, 0.0), deg(180.0), 9.0, 0.89));
+        assert!(!heads_into_goal((5.0, 0.0), deg(90.0), 9.0, 0.89));
+        assert!(heads_into_goal((5.0, 0.0), deg(180.0), -9.0, 0.89));
     }
 }

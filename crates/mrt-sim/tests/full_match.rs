@@ -40,6 +40,10 @@ fn a_full_match_finishes_and_reproduces_its_trajectory_hash() {
     assert_eq!(placed.len(), kickoffs, "{:?}", a.calls);
     assert!(placed.iter().sum::<usize>() * 10 <= kickoffs * 8, "placed by the referee: {placed:?}");
     assert!(a.stats[0].possession_cycles > 0 && a.stats[1].possession_cycles > 0);
+    // Some shots head into the goal mouth, not all (seed 1: Milan 10 of 50, Chaos 14 of 24).
+    for s in &a.stats {
+        assert!(s.shots_on_target > 0 && s.shots_on_target < s.shots, "{s:?}");
+    }
     // Chaos' attackers book the ball (TeamChaos seed 001 §3.3) through the team's reports on
     // the bus: often, and never two at once. Milan does not book.
     assert!(a.stats[1].booked_cycles > 1000, "{:?}", a.stats[1]);
