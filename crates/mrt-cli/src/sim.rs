@@ -288,6 +288,14 @@ pub fn run(args: &SimArgs) -> Result<()> {
                 s.booking_conflicts
             );
         }
+        // What the robots believed is watched in one process only (not with --distributed).
+        if s.attacker_cycles > 0 {
+            outln!(
+                "  {name:<8} attacker (getRole) in {} robot cycles, two at once in {}",
+                s.attacker_cycles,
+                s.attacker_conflicts
+            );
+        }
     }
     for (t, call) in &report.calls {
         if let Call::Goal(team) = call {

@@ -115,9 +115,9 @@ fn a_closed_standard_output_ends_the_program_quietly() {
     assert!(out.status.success() && !err.contains("panicked"), "{:?}: {err}", out.status);
 }
 
-/// Everything but the line that says how long it took and how the robots were wired, and the
-/// localization and ball errors (the in-process match's observer books them; robots in other
-/// processes are not watched).
+/// Everything but the line that says how long it took and how the robots were wired, and
+/// what the robots believed: the localization and ball errors, the ball booking and the roles
+/// (the in-process match's observer books them; robots in other processes are not watched).
 fn result_lines(stdout: &str) -> Vec<String> {
     stdout
         .lines()
@@ -126,6 +126,8 @@ fn result_lines(stdout: &str) -> Vec<String> {
                 && !l.starts_with("  ball error")
                 && !l.starts_with("  other robots")
                 && !l.starts_with("  relocalized")
+                && !l.contains(" ball booked in ")
+                && !l.contains(" attacker (getRole) ")
         })
         .map(|l| l.split(" simulated in ").next().unwrap_or(l).to_string())
         .collect()

@@ -28,6 +28,10 @@ pub struct MateReport {
     /// `001` §3.3; `mrt_team::booking`).
     #[serde(default)]
     pub booking: BookingReport,
+    /// The role it plays (`getRole`: `goalkeeper`, `attacker`, `supporter`, `defender`;
+    /// `mrt_team::roles`), so that every teammate allocates from the same data.
+    #[serde(default)]
+    pub role: String,
 }
 
 /// What a robot tells its teammates about the ball booking (`mrt_team::booking`): whether it
@@ -78,6 +82,7 @@ impl MateReport {
             ball_sigma: 0.0,
             robots,
             booking: BookingReport::default(),
+            role: String::new(),
         }
     }
 

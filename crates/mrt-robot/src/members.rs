@@ -55,6 +55,11 @@ use mrt_perception::vision::agent::VisionAgent;
 use mrt_plan::guide::Guidance;
 use mrt_script::member::BehaviorMember;
 use mrt_team::booking::{BallBooking, BookingParams};
+use mrt_team::roles::{allocate, Player, Role};
+
+/// A team ball of at least this quality is known to the role allocation (the Lua players'
+/// `ballKnown`).
+const BALL_KNOWN: f64 = 0.2;
 use mrt_world::gaze::Gaze;
 use mrt_world::{merge_team, WorldModel};
 use std::collections::BTreeMap;
@@ -104,7 +109,16 @@ struct WorldState {
     booking_news: Vec<(u32, BookingReport)>,
     /// The behaviors' latest `bookBall` (true) or `releaseBookedBall` (false) not yet applied.
     book: Option<bool>,
+    /// When each teammate's latest report came (this robot's clock, s), and the teammates
+    /// heard since the last frame.
+    heard: BTreeMap<u32, f64>,
+    fresh: Vec<u32>,
+    /// The role the team agreed on at the last frame ([`mrt_team::roles`], `getRole`).
+    role: Role,
 }
+
+/// Teammates not heard for this long are left out of the role allocation, s.
+const ROLE_SILENT: f64 = 1.0;
 
 impl Member for WorldState {
     fn name(&self) -> String {
@@ -144,6 +158,7 @@ impl Member for WorldState {
             } else {
                 let r = m.get::<MateReport>()?;
                 self.booking_news.push((r.id, r.booking.clone()));
+                self.fresh.push(r.id);
                 self.mates.insert(r.id, r.clone());
             }
         }
@@ -170,6 +185,32 @@ impl Member for WorldState {
         w.ball_booked = self.booking.holds(now);
         // Teammates and their ball as the bus told them, not as the simulator knows them.
         merge_team(&mut w, ball_sigma, self.mates.values());
+        // The roles, from the teammates heard lately and the team ball.
+        for id in self.fresh.drain(..) {
+            self.heard.insert(id, now);
+        }
+        let me = Player {
+            id,
+            at: (w.my_pos.pose.x, w.my_pos.pose.y),
+            keeper: self.keeper,
+            said: self.role,
+        };
+        let mates = self.mates.values().filter(|r| {
+            self.heard.get(&r.id).is_some_and(|&t| now - t <= ROLE_SILENT) && r.id != id
+        });
+        let players: Vec<Player> = std::iter::once(me)
+            .chain(mates.map(|r| Player {
+                id: r.id,
+                at: (r.pose.pose.x, r.pose.pose.y),
+                keeper: r.keeper,
+                said: Role::from_name(&r.role).unwrap_or(Role::Defender),
+            }))
+            .collect();
+        let ball = (w.global_ball.quality > BALL_KNOWN)
+            .then_some((w.global_ball.pose.x, w.global_ball.pose.y));
+        self.role = allocate(&players, ball).first().map_or(self.role, |r| r.1);
+        report.role = self.role.name().to_string();
+        w.role = self.role.name().to_string();
         ctx.publish(report);
         ctx.publish(self.model.localization());
         self.body.perceive(&mut w);
@@ -486,6 +527,9 @@ fn add_cycle(
         ),
         booking_news: Vec::new(),
         book: None,
+        heard: BTreeMap::new(),
+        fresh: Vec::new(),
+        role: if keeper { Role::Goalkeeper } else { Role::Defender },
     };
     let guide = Guide {
         robot,

@@ -57,6 +57,12 @@ pub struct TeamStats {
     /// Robot cycles in which a robot believed it held the booking while a teammate did too
     /// in the same cycle (the booking's promise: never).
     pub booking_conflicts: u64,
+    /// Robot cycles in which a robot's world model gave it the attacker's role
+    /// (`getRole`, `mrt_team::roles`).
+    pub attacker_cycles: u64,
+    /// Robot cycles in which a teammate was the attacker too in the same cycle (the two
+    /// allocated from reports a cycle apart).
+    pub attacker_conflicts: u64,
 }
 
 /// One control cycle's positions, for drawings: ball, then every robot (m).
@@ -246,8 +252,10 @@ pub struct Pitch {
     localization: LocalizationErrors,
     /// Kicks asked this cycle, fired when the physics runs.
     kicks: Vec<usize>,
-    /// The simulated time at which each robot last believed it held the ball booking.
+    /// The simulated time at which each robot last believed it held the ball booking, and
+    /// last was the attacker.
     booked_at: Vec<f64>,
+    attacker_at: Vec<f64>,
     /// The cameras' renderer and each robot's camera state, when percepts come from vision.
     eyes: Option<Eyes>,
     /// Each robot's camera pan joint, rad (the camera file's pan until a robot turns it).
@@ -314,6 +322,7 @@ impl Pitch {
             localization: LocalizationErrors::default(),
             kicks: Vec::new(),
             booked_at: vec![f64::NEG_INFINITY; robots],
+            attacker_at: vec![f64::NEG_INFINITY; robots],
             eyes: match cfg.sensor.percepts {
                 PerceptSource::Oracle => None,
                 PerceptSource::Vision => Some(Eyes::new(cfg, robots, seed)?),
@@ -532,22 +541,31 @@ impl Pitch {
         }
     }
 
-    /// Books robot `i`'s belief that it holds the ball booking in this cycle, and whether a
-    /// teammate believed so in the same cycle ([`TeamStats::booking_conflicts`]).
-    pub fn book_booking(&mut self, i: usize, held: bool) {
-        if !held {
-            return;
-        }
+    /// Books robot `i`'s beliefs of this cycle that it holds the ball booking and that it is
+    /// the attacker, and whether a teammate believed so in the same cycle
+    /// ([`TeamStats::booking_conflicts`], [`TeamStats::attacker_conflicts`]).
+    pub fn book_booking(&mut self, i: usize, held: bool, attacker: bool) {
         let now = self.world.time();
         let team = self.referee.team_of(i);
-        let Some(at) = self.booked_at.get_mut(i) else { return };
-        *at = now;
+        let referee = &self.referee;
+        // Marks robot `i` in `at` for this cycle; whether a teammate was marked in it too.
+        let mark = |at: &mut Vec<f64>| {
+            let slot = at.get_mut(i)?;
+            *slot = now;
+            Some((0..at.len()).any(|k| k != i && referee.team_of(k) == team && at[k] == now))
+        };
         let stats = &mut self.stats[team.index()];
-        stats.booked_cycles += 1;
-        let mate_holds = (0..self.booked_at.len())
-            .any(|k| k != i && self.referee.team_of(k) == team && self.booked_at[k] == now);
-        if mate_holds {
-            stats.booking_conflicts += 1;
+        if held {
+            if let Some(mate) = mark(&mut self.booked_at) {
+                stats.booked_cycles += 1;
+                stats.booking_conflicts += u64::from(mate);
+            }
+        }
+        if attacker {
+            if let Some(mate) = mark(&mut self.attacker_at) {
+                stats.attacker_cycles += 1;
+                stats.attacker_conflicts += u64::from(mate);
+            }
         }
     }
 

@@ -6,6 +6,7 @@
 //! | seed name | Rust |
 //! |---|---|
 //! | TeamChaos' ball booking, a distributed mutual exclusion: `bookBall`, `releaseBookedBall`, `haveBookedBall` (seed `001` §3.3) | [`booking::BallBooking`] |
+//! | the role the team agreed on: `getRole` (seed `001` §3.3, figure 8's roles) | [`roles::allocate`], [`roles::Role`] |
 //!
 //! SCARE, the MRT manual's coordination (ch. 11), comes here next (issue 21).
 //!
@@ -24,3 +25,4 @@
 #![deny(missing_docs)]
 
 pub mod booking;
+pub mod roles;

@@ -217,6 +217,7 @@ mod tests {
             ball_sigma: sigma,
             robots: Vec::new(),
             booking: Default::default(),
+            role: String::new(),
         }
     }
 
