@@ -46,6 +46,10 @@ pub const GAME_INFO: MsgType = reserved(0x49);
 pub const LOCALIZATION: MsgType = reserved(0x4A);
 /// [`crate::Percepts`]: what the vision µAgent found in a camera image.
 pub const PERCEPTS: MsgType = reserved(0x4B);
+/// [`crate::PlanRequest`]: guidance (or SCARE) → planner.
+pub const PLAN_REQUEST: MsgType = reserved(0x4C);
+/// [`crate::PlannedPath`]: planner → guidance, monitors.
+pub const PLANNED_PATH: MsgType = reserved(0x4D);
 /// The blackboard's `BbUpdate` (ISocRob seed `003` §3.1; `mrt_blackboard::proxy`).
 pub const BB_UPDATE: MsgType = reserved(0x50);
 /// `mrt-net`'s probe: a ping (for `mrt-net-node` and the network tests).
@@ -76,6 +80,8 @@ pub const TABLE: &[(MsgType, &str)] = &[
     (GAME_INFO, "GameInfo"),
     (LOCALIZATION, "Localization"),
     (PERCEPTS, "Percepts"),
+    (PLAN_REQUEST, "PlanRequest"),
+    (PLANNED_PATH, "PlannedPath"),
     (BB_UPDATE, "BbUpdate"),
     (NET_PING, "Ping"),
     (NET_PROBE, "Probe"),
@@ -123,6 +129,8 @@ mod tests {
             (0xFFFF_0049, "GameInfo"),
             (0xFFFF_004A, "Localization"),
             (0xFFFF_004B, "Percepts"),
+            (0xFFFF_004C, "PlanRequest"),
+            (0xFFFF_004D, "PlannedPath"),
             (0xFFFF_0050, "BbUpdate"),
             (0x4E45_5401, "Ping"),
             (0x4E45_5402, "Probe"),

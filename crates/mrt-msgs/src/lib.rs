@@ -18,6 +18,7 @@
 //! | [`WorldSnapshot`] | world model → behaviors, guidance | TeamChaos `001` §3.3 (LPS, GS) |
 //! | [`RobotCommand`] | behaviors → guidance | TeamChaos `001` §3.3 |
 //! | [`MotorCommand`] | guidance → motor and kicker driver | ISocRob `003` §3.2.3 |
+//! | [`PlanRequest`], [`PlannedPath`] | guidance (or SCARE) ↔ planner | manual ch. 9 (SPIKE) |
 //! | [`BehaviorStatus`], [`ReloadRequest`] | behavior Member ↔ monitors, editors | TeamChaos `001` §3.2 |
 //! | [`DeviceFrame`], [`DeviceAct`], [`FinalWhistle`], [`RobotEnd`] | distributed simulator ↔ robot | MRT's own |
 //!
@@ -45,7 +46,7 @@ pub mod robot;
 mod sensing;
 mod team;
 
-pub use acting::MotorCommand;
+pub use acting::{MotorCommand, PlanRequest, PlannedPath};
 pub use behavior::{BehaviorStatus, ReloadRequest};
 pub use device::{DeviceAct, DeviceFrame, FinalWhistle, MemberFault, RobotEnd};
 pub use localization::{BallBelief, FilterCounts, Localization};
@@ -92,6 +93,8 @@ messages! {
     GameInfo => GAME_INFO,
     Localization => LOCALIZATION,
     Percepts => PERCEPTS,
+    PlanRequest => PLAN_REQUEST,
+    PlannedPath => PLANNED_PATH,
 }
 
 #[cfg(test)]

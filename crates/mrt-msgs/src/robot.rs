@@ -306,6 +306,10 @@ pub struct Target {
     pub pose: Pose2,
     /// Go round obstacles (potential-field mode) rather than straight (position mode).
     pub avoid: bool,
+    /// Go along a path the planner (SPIKE) plans round the robots the world model anchored,
+    /// in position mode from pose to pose, the sonars still halting the robot (`avoid` is
+    /// then used only until the first path comes).
+    pub plan: bool,
 }
 
 impl RobotCommand {

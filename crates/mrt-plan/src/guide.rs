@@ -32,7 +32,7 @@
 //! assert!(!g.halted && g.command.vlin == 1000.0);
 //! // Go to (1 m, 0) in position mode: straight ahead, at most 1.2 m/s.
 //! let to = RobotCommand {
-//!     target: Some(Target { pose: Pose2::new(1000.0, 0.0, 0.0), avoid: false }),
+//!     target: Some(Target { pose: Pose2::new(1000.0, 0.0, 0.0), avoid: false, plan: false }),
 //!     ..Default::default()
 //! };
 //! let g = guidance.guide(&to, &me, None, &[]);
@@ -114,7 +114,7 @@ impl Guidance {
         sonars: &[Sonar],
     ) -> Guided {
         let pose = Pose2::new(me.x / 1000.0, me.y / 1000.0, me.theta);
-        let Some(Target { pose: target, avoid }) = cmd.target else {
+        let Some(Target { pose: target, avoid, .. }) = cmd.target else {
             // Velocity mode: the reference itself, or its turn only.
             let ball = ball.map(|b| Point2::new(b.x / 1000.0, b.y / 1000.0));
             let echoes: Vec<Sonar> =
@@ -288,7 +288,7 @@ mod tests {
     fn position_mode_by_hand() {
         let g = Guidance::default();
         let cmd = RobotCommand {
-            target: Some(Target { pose: Pose2::new(500.0, 200.0, 0.0), avoid: false }),
+            target: Some(Target { pose: Pose2::new(500.0, 200.0, 0.0), avoid: false, plan: false }),
             ..Default::default()
         };
         let out = g.guide(&cmd, &Pose2::new(0.0, 0.0, 0.0), None, &ring(0.3));
@@ -330,7 +330,7 @@ mod tests {
                 })
                 .collect()
         };
-        let target = Target { pose: Pose2::new(2000.0, 0.0, 0.0), avoid: true };
+        let target = Target { pose: Pose2::new(2000.0, 0.0, 0.0), avoid: true, plan: false };
         let cmd = RobotCommand { target: Some(target), ..Default::default() };
         let mut me = Pose2::new(0.0, 0.0, 0.0);
         let mut closest = f64::INFINITY;

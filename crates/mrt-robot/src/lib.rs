@@ -7,7 +7,8 @@
 //!   motors, kicker) and the **base** ([`base::Base`]: kinematics and the AIRBoard-style
 //!   [`base::MotorDriver`], manual ch. 5);
 //! - the **robot cycle**, defined once ([`members`]): the driver Members, the world state
-//!   (`mrt-world`), the behaviors, guidance (`mrt-plan`), the motor driver and the fault book,
+//!   (`mrt-world`), the behaviors, the planner and guidance (`mrt-plan`, [`planner`]), the
+//!   motor driver and the fault book,
 //!   put into the robot's Agora by [`members::add_robot`];
 //! - the **[`commander::Commander`]** (TeamChaos' Commander Module) that adapts a team's
 //!   behaviors to the body, and the **behavior stacks** ([`stacks`]: TeamChaos on ThinkingCap,
@@ -40,5 +41,6 @@ pub mod config;
 pub mod devices;
 pub mod files;
 pub mod members;
+pub mod planner;
 pub mod remote;
 pub mod stacks;

@@ -24,9 +24,13 @@
 //! 4. **`gaze-<n>`** (periodic, when the robot's configuration has
 //!    [`gaze`](RobotConfig::gaze)): the PAM's camera control (seed `001` §2.1) turns the
 //!    camera's pan joint to the object the behaviors need most ([`Devices::set_pan`]);
+//! 4. **`planner-<n>`** (SPIKE, MRT manual ch. 9, on message): plans a path for each
+//!    [`PlanRequest`] round the robots the world model anchored ([`crate::planner`]);
 //! 4. **`Guide`** (guidance, ISocRob §3.2.3, on message): turns the behaviors'
 //!    [`RobotCommand`] into a [`MotorCommand`] with [`mrt_plan::guide::Guidance`]: velocity
-//!    mode halted by the sonars, or position and potential-field modes to a target posture;
+//!    mode halted by the sonars, or position and potential-field modes to a target posture,
+//!    or, for a target with `plan`, position mode along the planner's path, halted by the
+//!    sonars;
 //! 5. **`Motor`** (the motor and kicker driver, on message): turns each [`MotorCommand`] into
 //!    wheel duty cycles (the AIRBoard's processing side, [`Base::duties`]) and kicks;
 //! 6. **`FaultBook`** (on message): books the behavior Member's script errors against the
@@ -43,14 +47,16 @@ use crate::commander::Commander;
 use crate::config::RobotConfig;
 use crate::devices::{Devices, SharedDevices};
 use crate::files::FilesDir;
+use crate::planner::{carrot, plans_for, Planner, REPLAN};
 use crate::stacks::{embedded_teamchaos, send_brain, Stack, CHAOS_KEEPER, CHAOS_PLAYER};
-use mrt_core::Point2;
+use mrt_core::{Point2, Pose2};
 use mrt_dcdt::{Activation, Agora, Context, Member, MemberError, Message, RequestType, RunReport};
 use mrt_msgs::robot::{lps, Lpo};
 use mrt_msgs::{
     BehaviorStatus, BookingReport, CameraFrame, GameInfo, MateReport, MemberFault, MotorCommand,
     Odometry, Percepts, RobotCommand, Sonar, SonarScan, WorldSnapshot,
 };
+use mrt_msgs::{PlanRequest, PlannedPath, Target};
 use mrt_perception::vision::agent::VisionAgent;
 use mrt_plan::guide::Guidance;
 use mrt_script::member::BehaviorMember;
@@ -330,6 +336,35 @@ struct Guide {
     guidance: Guidance,
     world: WorldSnapshot,
     scan: SonarScan,
+    /// The planner's latest path, and when it came (s, the world's clock).
+    path: Option<(PlannedPath, f64)>,
+    /// The goal last asked of the planner, and when.
+    asked: Option<(Pose2, f64)>,
+}
+
+impl Guide {
+    /// A target to reach along a planned path (`plan`): the planner is asked when its path
+    /// is for another goal or a second old; meanwhile the command drives to the path's
+    /// carrot in position mode, or, before any path, as the target says without planning.
+    fn follow(&mut self, cmd: &mut RobotCommand, ctx: &mut Context<'_>) {
+        let Some(target) = cmd.target.filter(|t| t.plan) else { return };
+        let now = self.world.time.as_secs_f64();
+        let to = target.pose;
+        let current = self.path.as_ref().filter(|(p, _)| plans_for(p, to));
+        let stale = current.is_none_or(|(_, at)| now - at >= REPLAN);
+        let waiting = self.asked.is_some_and(|(goal, at)| {
+            (goal.x - to.x).hypot(goal.y - to.y) <= 200.0 && now - at < REPLAN / 2.0
+        });
+        if stale && !waiting {
+            ctx.publish(PlanRequest { to });
+            self.asked = Some((to, now));
+        }
+        let next = current.and_then(|(p, _)| carrot(&p.poses, self.world.my_pos.pose));
+        cmd.target = Some(match next {
+            Some(pose) => Target { pose, avoid: false, plan: false },
+            None => Target { plan: false, ..target },
+        });
+    }
 }
 
 impl Member for Guide {
@@ -341,6 +376,7 @@ impl Member for Guide {
         ctx.subscribe_to::<RobotCommand>(RequestType::Local);
         ctx.subscribe_to::<WorldSnapshot>(RequestType::Local);
         ctx.subscribe_to::<SonarScan>(RequestType::Local);
+        ctx.subscribe_to::<PlannedPath>(RequestType::Local);
         Ok(())
     }
 
@@ -351,13 +387,22 @@ impl Member for Guide {
                 last = Some(c.clone());
             } else if let Ok(w) = m.get::<WorldSnapshot>() {
                 self.world.clone_from(w);
+            } else if let Ok(p) = m.get::<PlannedPath>() {
+                self.path = Some((p.clone(), self.world.time.as_secs_f64()));
             } else {
                 self.scan.clone_from(m.get::<SonarScan>()?);
             }
         }
         if let Some(mut cmd) = last {
             self.body.act(&mut cmd);
-            ctx.publish(MotorCommand(guide(&self.guidance, &cmd, &self.world, &self.scan.sonars)));
+            let planned = cmd.target.is_some_and(|t| t.plan);
+            self.follow(&mut cmd, ctx);
+            let mut out = guide(&self.guidance, &cmd, &self.world, &self.scan.sonars);
+            if planned {
+                // Position mode along the path, halted by the sonars as velocity mode is.
+                out = guide(&self.guidance, &out, &self.world, &self.scan.sonars);
+            }
+            ctx.publish(MotorCommand(out));
         }
         Ok(())
     }
@@ -537,6 +582,8 @@ fn add_cycle(
         guidance: cfg.guidance,
         world: WorldSnapshot::default(),
         scan: SonarScan::default(),
+        path: None,
+        asked: None,
     };
     let mut ids = vec![agora.add_member(odometry, every), agora.add_member(camera, every)];
     if let Some(v) = &cfg.vision {
@@ -571,6 +618,7 @@ fn add_cycle(
         ids.push(agora.add_member(gaze, every));
     }
     ids.extend([
+        agora.add_member(Planner::new(robot, cfg.radius), Activation::OnMessage),
         agora.add_member(guide, Activation::OnMessage),
         agora.add_member(Motor { devices: dev(), robot, base: cfg.base }, Activation::OnMessage),
         agora.add_member(FaultBook { devices, robot }, Activation::OnMessage),

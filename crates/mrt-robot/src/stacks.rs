@@ -369,7 +369,7 @@ impl Chaser {
 pub fn walk_to_kickoff(w: &WorldSnapshot) -> Option<RobotCommand> {
     let pose = w.kickoff_pose.filter(|_| w.game_state == GameState::Ready)?;
     Some(RobotCommand {
-        target: Some(Target { pose, avoid: true }),
+        target: Some(Target { pose, avoid: true, plan: false }),
         needs: vec![(lps::BALL, 1.0)],
         ..RobotCommand::default()
     })

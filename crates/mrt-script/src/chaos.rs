@@ -4,7 +4,7 @@
 //! | group | functions |
 //! |---|---|
 //! | data access | `lps_getLpo(i)` → `{rho, theta, reliability, seen_ago}`, `gsGetMyPos()` → `{x, y, theta, quality}`, `getBallVel()` → `{x, y}`, `getGlobalBall()` → `{x, y, quality}`, `getMates()` → `{{id, x, y, theta, quality, keeper}, ...}`, `getRobots()` → the robots MAP anchored, nearest first, `{{id, class ("teammate", "opponent", "robot": team unknown), x, y, vx, vy, sigma, rho, theta, reliability, seen_ago}, ...}`, `getNearestOpponent([min_reliability])` → one of those (not a teammate; reliability ≥ 0.3 unless told) or `nil`, `getFreeDirection([theta [, reach [, clearance]]])` → the bearing (rad) nearest `theta` (default: the opponent's net) of a corridor `2·clearance` wide (500 mm) and `reach` long (2000 mm) free of anchored robots, or `nil`, `getField()` → `{half_length, half_width, goal_half_width, penalty_area_depth}` (mm), `getKickoffPose()` → `{x, y, theta}` in `READY`, else `nil` |
-//! | control | `setVlin(v)`, `setVrot(v)`, `setVlat(v)`, `setKick(id)`, `setNeeded(i, v)`, `trackLandMarks()`, `setBehavior(name)`, `setTarget(x, y, theta[, avoid])` (a posture for guidance: position mode, or potential field round obstacles when `avoid`, the default) |
+//! | control | `setVlin(v)`, `setVrot(v)`, `setVlat(v)`, `setKick(id)`, `setNeeded(i, v)`, `trackLandMarks()`, `setBehavior(name)`, `setTarget(x, y, theta[, avoid[, plan]])` (a posture for guidance: position mode, or potential field round obstacles when `avoid`, the default; with `plan`, along a path SPIKE plans round the anchored robots) |
 //! | coordination | `getRole()` → `{name}`, `haveBookedBall()` → `{booked}`, `bookBall()`, `releaseBookedBall()` |
 //! | persistence | `getBehaviorInfo()` → `{timer (ms), isNew (1/0)}`, `setGlobal(key, type, value)`, `getGlobal(key)`, `getCurrentState()` → `"PLAYING"`... |
 //!
@@ -393,15 +393,19 @@ fn install_inner(lua: &Lua, io: Rc<RefCell<RobotIo>>, memory_limit: usize) -> ml
     });
 
     // Control actions.
-    func!("setTarget", io, |_lua, (x, y, theta, avoid): (f64, f64, f64, Option<bool>)| {
+    type TargetArgs = (f64, f64, f64, Option<bool>, Option<bool>);
+    func!("setTarget", io, |_lua, (x, y, theta, avoid, plan): TargetArgs| {
         if !(x.is_finite() && y.is_finite() && theta.is_finite()) {
             return Err(mlua::Error::runtime(format!(
                 "bad argument: setTarget needs finite numbers, not ({x}, {y}, {theta})"
             )));
         }
         let pose = mrt_core::Pose2::new(x, y, theta);
-        io.borrow_mut().command.target =
-            Some(mrt_msgs::robot::Target { pose, avoid: avoid.unwrap_or(true) });
+        io.borrow_mut().command.target = Some(mrt_msgs::robot::Target {
+            pose,
+            avoid: avoid.unwrap_or(true),
+            plan: plan.unwrap_or(false),
+        });
         Ok(())
     });
     // A set-point that is not a finite number is the script's fault, reported as one: NaN

@@ -212,13 +212,26 @@ fn kickoff_pose_and_targets() {
     };
     let (r, target) = run(ready, go);
     r.unwrap();
-    assert_eq!(target, Some(Target { pose: Pose2::new(-4000.0, 1500.0, 0.5), avoid: true }));
+    assert_eq!(
+        target,
+        Some(Target { pose: Pose2::new(-4000.0, 1500.0, 0.5), avoid: true, plan: false })
+    );
     let (r, target) = run(WorldSnapshot::default(), go);
     r.unwrap();
     assert_eq!(target, None, "no kickoff pose outside READY");
+    let (r, target) = run(WorldSnapshot::default(), "chaos.setTarget(100, 200, 0, false, true)");
+    r.unwrap();
+    assert_eq!(
+        target,
+        Some(Target { pose: Pose2::new(100.0, 200.0, 0.0), avoid: false, plan: true }),
+        "a target reached along a planned path"
+    );
     let (r, target) = run(WorldSnapshot::default(), "chaos.setTarget(100, 200, 0, false)");
     r.unwrap();
-    assert_eq!(target, Some(Target { pose: Pose2::new(100.0, 200.0, 0.0), avoid: false }));
+    assert_eq!(
+        target,
+        Some(Target { pose: Pose2::new(100.0, 200.0, 0.0), avoid: false, plan: false })
+    );
     let (r, _) = run(WorldSnapshot::default(), "chaos.setTarget(0/0, 0, 0)");
     assert!(r.unwrap_err().to_string().contains("setTarget needs finite numbers"));
 }

@@ -774,7 +774,7 @@ fn in_ready_the_players_and_the_goalkeeper_walk_to_their_kickoff_places() {
         w.0.kickoff_pose = Some(place);
         w
     };
-    let want = Some(mrt_msgs::robot::Target { pose: place, avoid: true });
+    let want = Some(mrt_msgs::robot::Target { pose: place, avoid: true, plan: false });
     let mut player =
         ThinkingCap::with_hfsm(dir(), dir().join("player.hfsm.lua"), Sandbox::default()).unwrap();
     let c = player.cycle(ready(World::at(0).me(-5000.0, -5000.0, 1.57, 0.9).ball(4000.0, 0.5)).0);
