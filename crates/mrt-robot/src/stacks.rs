@@ -17,7 +17,9 @@ use crate::config::RobotConfig;
 use crate::files::FilesDir;
 use mrt_core::{Point2, Pose2};
 use mrt_fuzzy::brian::Brian;
-use mrt_msgs::robot::{lps, Field, GameState, Lpo, RobotCommand, Target, WorldSnapshot};
+use mrt_msgs::robot::{
+    lps, Field, GameState, Lpo, RobotClass, RobotCommand, Target, WorldSnapshot,
+};
 use mrt_plan::guidance::behind_ball;
 use mrt_script::{Sandbox, ThinkingCap, Watchdog, DEFAULT_DEADLINE};
 use std::path::Path;
@@ -129,8 +131,34 @@ impl Geometry {
     /// the net ([`behind_ball`]); with the ball on the net's centre, simply `distance` short of
     /// it, facing the net.
     pub fn behind_ball(&self, ball: (f64, f64), distance: f64) -> Pose2 {
-        let (b, goal) = (Point2::new(ball.0, ball.1), Point2::new(self.half_length, 0.0));
+        self.behind_ball_aiming(ball, 0.0, distance)
+    }
+
+    /// [`Geometry::behind_ball`] for a shot at `aim` mm along the opponent's goal line (0:
+    /// its centre).
+    pub fn behind_ball_aiming(&self, ball: (f64, f64), aim: f64, distance: f64) -> Pose2 {
+        let (b, goal) = (Point2::new(ball.0, ball.1), Point2::new(self.half_length, aim));
         behind_ball(b, goal, distance).unwrap_or(Pose2::new(ball.0 - distance, ball.1, 0.0))
+    }
+
+    /// Where along the opponent's goal line to shoot (mm from its centre): the open side,
+    /// away from the robot the world model anchored nearest the goal's centre (within 1.5 m,
+    /// not a teammate: the goalkeeper), two thirds of the way to the post; the centre when no
+    /// such robot is known. Measured on the pitch, `--percepts oracle`, Milan against the
+    /// Chaser: docs/performance.md, "Teams".
+    pub fn open_side(&self, w: &WorldSnapshot) -> f64 {
+        let keeper = w
+            .robots
+            .iter()
+            .filter(|r| r.class != RobotClass::Teammate && r.reliability >= WorldSnapshot::ANCHORED)
+            .map(|r| (r, (r.x - self.half_length).hypot(r.y)))
+            .filter(|(_, d)| *d < 1500.0)
+            .min_by(|a, b| a.1.total_cmp(&b.1));
+        match keeper {
+            Some((k, _)) if k.y < 0.0 => 2.0 / 3.0 * self.goal_half_width,
+            Some(_) => -2.0 / 3.0 * self.goal_half_width,
+            None => 0.0,
+        }
     }
 }
 
@@ -235,7 +263,7 @@ impl MilanBrain {
             v.push(("BallBearing", deg360(ball.theta), r));
             // The ball and the point 400 mm behind it on the line from the opponent's net.
             let (bx, by) = Geometry::ball_at(me, &ball);
-            let spot = field.behind_ball((bx, by), 400.0);
+            let spot = field.behind_ball_aiming((bx, by), field.open_side(w), 400.0);
             let (dx, dy) = (spot.x - me.x, spot.y - me.y);
             v.push(("ApproachDistance", dx.hypot(dy), r));
             v.push(("ApproachAngle", deg360(dy.atan2(dx) - me.theta), r));
@@ -471,5 +499,34 @@ mod tests {
         // Mr. BRIAN takes every input the Parser gives (they are in ctof.txt).
         let c = brain.cycle(&w);
         assert!(c.vlin.is_finite());
+    }
+
+    /// Shot selection (issue 21 item 5): the open side of the opponent's goal, away from its
+    /// goalkeeper as the world model anchored it; the centre with no keeper known or with
+    /// only a teammate there. Half width 1000 mm: two thirds is 666.7 mm.
+    #[test]
+    fn milan_aims_at_the_side_of_the_goal_away_from_the_keeper() {
+        let mut w = WorldSnapshot::default();
+        w.field.half_length = 9000.0;
+        w.field.goal_half_width = 1000.0;
+        let field = Geometry::of(&w.field);
+        assert_eq!(field.open_side(&w), 0.0);
+        let keeper = |class, y: f64| AnchoredRobot {
+            class,
+            x: 8600.0,
+            y,
+            reliability: 0.8,
+            ..Default::default()
+        };
+        w.robots = vec![keeper(RobotClass::Opponent, -200.0)];
+        assert!((field.open_side(&w) - 2000.0 / 3.0).abs() < 1e-9);
+        w.robots = vec![keeper(RobotClass::Robot, 150.0)];
+        assert!((field.open_side(&w) + 2000.0 / 3.0).abs() < 1e-9);
+        w.robots = vec![keeper(RobotClass::Teammate, 150.0)];
+        assert_eq!(field.open_side(&w), 0.0);
+        // The approach spot lines the ball up with the aim: from a ball at (5000, 0), the
+        // spot 400 mm behind it looks at (9000, 666.7).
+        let spot = field.behind_ball_aiming((5000.0, 0.0), 2000.0 / 3.0, 400.0);
+        assert!((spot.theta - (2000.0f64 / 3.0).atan2(4000.0)).abs() < 1e-9, "{spot:?}");
     }
 }

@@ -21,13 +21,13 @@ fn default_match(seed: u64) -> MatchReport {
 
 #[test]
 fn a_full_match_finishes_and_reproduces_its_trajectory_hash() {
-    let (a, b) = (default_match(1), default_match(1));
+    let (a, b) = (default_match(9), default_match(9));
     assert!((a.duration - 600.0).abs() < 0.011, "two halves of 300 s: {}", a.duration);
     assert_eq!(a.calls.last().map(|(_, c)| c), Some(&Call::FullTime));
     assert!(a.calls.iter().any(|(_, c)| *c == Call::HalfTime));
     assert_eq!((a.score, a.trajectory_hash), (b.score, b.trajectory_hash));
     assert_eq!(a.stats, b.stats);
-    // Both teams play: each moves to the ball, kicks it and scores (seed 1: 1 : 1).
+    // Both teams play: each moves to the ball, kicks it and scores (seed 9: 1 : 1).
     assert!(a.score.0 > 0 && a.score.1 > 0, "{:?}", a.score);
     // Every kickoff went through READY, and the robots walked to their places: the referee
     // placed few of them (one kickoff at the start, one per goal, one at half time).
@@ -40,7 +40,7 @@ fn a_full_match_finishes_and_reproduces_its_trajectory_hash() {
     assert_eq!(placed.len(), kickoffs, "{:?}", a.calls);
     assert!(placed.iter().sum::<usize>() * 10 <= kickoffs * 8, "placed by the referee: {placed:?}");
     assert!(a.stats[0].possession_cycles > 0 && a.stats[1].possession_cycles > 0);
-    // Some shots head into the goal mouth, not all (seed 1: Milan 10 of 50, Chaos 14 of 24).
+    // Some shots head into the goal mouth, not all (seed 9: Milan 14 of 60, Chaos 6 of 19).
     for s in &a.stats {
         assert!(s.shots_on_target > 0 && s.shots_on_target < s.shots, "{s:?}");
     }
@@ -51,7 +51,7 @@ fn a_full_match_finishes_and_reproduces_its_trajectory_hash() {
     assert_eq!(a.stats[0].booked_cycles, 0);
     // Every robot's world model allocates the roles (getRole) from its teammates' reports:
     // one attacker a cycle, but for the cycles in which two allocated from reports a cycle
-    // apart (seed 1: 18 and 17 of about 6000).
+    // apart (seed 9: 23 and 10 of about 6000).
     for s in &a.stats {
         assert!(s.attacker_cycles > 3000, "{s:?}");
         assert!(s.attacker_conflicts * 100 < s.attacker_cycles, "{s:?}");
