@@ -8,6 +8,8 @@ pub mod anchoring_robots;
 pub mod fuzzy_controller;
 #[path = "01_hello_agora.rs"]
 pub mod hello_agora;
+#[path = "07_planning_a_path.rs"]
+pub mod planning_a_path;
 #[path = "05_robot_on_its_own_devices.rs"]
 pub mod robot_on_its_own_devices;
 #[path = "04_teamchaos_behaviors.rs"]
@@ -17,6 +19,32 @@ pub mod two_agoras;
 
 #[cfg(test)]
 mod tests {
+    /// Example 07: the door is taken when the building is empty, a visitor in the doorway
+    /// blocks the first path and leaves no other, and a visitor on the path in the right
+    /// room blocks it and is gone round (0.25 + 0.3 + 0.1 m from the visitor's centre).
+    #[test]
+    fn planning_a_path_takes_the_door_unless_someone_stands_in_it() {
+        let out = super::planning_a_path::run(false).unwrap();
+        let empty = out[0].plan.as_ref().unwrap();
+        // The door's gap is x = 0, y from 0.55 to 1.45: the path crosses x = 0 inside it.
+        let crossing = empty.waypoints.windows(2).find_map(|w| {
+            let t = (0.0 - w[0].x) / (w[1].x - w[0].x);
+            (0.0..=1.0).contains(&t).then(|| w[0].y + t * (w[1].y - w[0].y))
+        });
+        assert!(crossing.is_some_and(|y| (0.55..=1.45).contains(&y)), "{crossing:?}");
+        assert!(!out[0].first_blocked);
+        assert!(out[1].first_blocked && out[1].plan.is_err(), "the doorway is shut");
+        let round = out[2].plan.as_ref().unwrap();
+        assert!(out[2].first_blocked && round.length > empty.length);
+        let visitor = mrt_core::Point2::new(2.7, -1.7);
+        let gap = round
+            .waypoints
+            .windows(2)
+            .map(|w| mrt_plan::spike::Shape::Wall { a: w[0], b: w[1] }.distance(visitor))
+            .fold(f64::INFINITY, f64::min);
+        assert!(gap >= 0.65 - 1e-9, "{gap}");
+    }
+
     use mrt_dcdt::ExitReason;
     use std::time::Duration;
 
