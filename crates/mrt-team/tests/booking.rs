@@ -239,3 +239,32 @@ proptest! {
         prop_assert!(wanted == 0 || f64::from(held) >= 0.33 * f64::from(wanted), "held {} of {}", held, wanted);
     }
 }
+
+proptest! {
+    /// Reports off the network may hold anything: any stamp, claim, grant and echo from any
+    /// number. The booking drops what it cannot use, never panics, and its answers stay
+    /// answers (a robot that hears only odd reports holds its own claim alone).
+    #[test]
+    fn any_report_is_taken_or_dropped_never_a_panic(
+        reports in prop::collection::vec(
+            (any::<u32>(), any::<f64>(), prop::option::of(any::<f64>()),
+             prop::option::of((any::<u32>(), any::<f64>())),
+             prop::collection::vec((any::<u32>(), any::<f64>()), 0..8)),
+            0..64),
+        now in -1e9..1e9f64,
+    ) {
+        let mut me = BallBooking::new(7, BookingParams::default());
+        me.want(now, true);
+        for (from, stamp, claim, grant, echo) in reports {
+            me.receive(now, from, &BookingReport { stamp, claim, grant, echo });
+            me.update(now);
+        }
+        let report = me.report(now);
+        prop_assert!(report.echo.len() <= mrt_team::booking::MAX_TEAMMATES);
+        prop_assert!(me.claims());
+        let _ = (me.holds(now), me.alone(now));
+        me.want(now, false);
+        me.update(now);
+        prop_assert!(!me.holds(now));
+    }
+}
