@@ -47,7 +47,7 @@ use crate::commander::Commander;
 use crate::config::RobotConfig;
 use crate::devices::{Devices, SharedDevices};
 use crate::files::FilesDir;
-use crate::planner::{carrot, plans_for, Planner, REPLAN};
+use crate::planner::{carrot, plans_for, same_goal, Planner, REPLAN};
 use crate::stacks::{embedded_teamchaos, send_brain, Stack, CHAOS_KEEPER, CHAOS_PLAYER};
 use mrt_core::{Point2, Pose2};
 use mrt_dcdt::{Activation, Agora, Context, Member, MemberError, Message, RequestType, RunReport};
@@ -115,16 +115,9 @@ struct WorldState {
     booking_news: Vec<(u32, BookingReport)>,
     /// The behaviors' latest `bookBall` (true) or `releaseBookedBall` (false) not yet applied.
     book: Option<bool>,
-    /// When each teammate's latest report came (this robot's clock, s), and the teammates
-    /// heard since the last frame.
-    heard: BTreeMap<u32, f64>,
-    fresh: Vec<u32>,
     /// The role the team agreed on at the last frame ([`mrt_team::roles`], `getRole`).
     role: Role,
 }
-
-/// Teammates not heard for this long are left out of the role allocation, s.
-const ROLE_SILENT: f64 = 1.0;
 
 impl Member for WorldState {
     fn name(&self) -> String {
@@ -164,7 +157,6 @@ impl Member for WorldState {
             } else {
                 let r = m.get::<MateReport>()?;
                 self.booking_news.push((r.id, r.booking.clone()));
-                self.fresh.push(r.id);
                 self.mates.insert(r.id, r.clone());
             }
         }
@@ -191,19 +183,15 @@ impl Member for WorldState {
         w.ball_booked = self.booking.holds(now);
         // Teammates and their ball as the bus told them, not as the simulator knows them.
         merge_team(&mut w, ball_sigma, self.mates.values());
-        // The roles, from the teammates heard lately and the team ball.
-        for id in self.fresh.drain(..) {
-            self.heard.insert(id, now);
-        }
+        // The roles, from the teammates heard lately (within the booking's `silent`: the
+        // booking already keeps when each was last heard) and the team ball.
         let me = Player {
             id,
             at: (w.my_pos.pose.x, w.my_pos.pose.y),
             keeper: self.keeper,
             said: self.role,
         };
-        let mates = self.mates.values().filter(|r| {
-            self.heard.get(&r.id).is_some_and(|&t| now - t <= ROLE_SILENT) && r.id != id
-        });
+        let mates = self.mates.values().filter(|r| self.booking.hears(r.id, now) && r.id != id);
         let players: Vec<Player> = std::iter::once(me)
             .chain(mates.map(|r| Player {
                 id: r.id,
@@ -352,9 +340,8 @@ impl Guide {
         let to = target.pose;
         let current = self.path.as_ref().filter(|(p, _)| plans_for(p, to));
         let stale = current.is_none_or(|(_, at)| now - at >= REPLAN);
-        let waiting = self.asked.is_some_and(|(goal, at)| {
-            (goal.x - to.x).hypot(goal.y - to.y) <= 200.0 && now - at < REPLAN / 2.0
-        });
+        let waiting =
+            self.asked.is_some_and(|(goal, at)| same_goal(goal, to) && now - at < REPLAN / 2.0);
         if stale && !waiting {
             ctx.publish(PlanRequest { to });
             self.asked = Some((to, now));
@@ -572,8 +559,6 @@ fn add_cycle(
         ),
         booking_news: Vec::new(),
         book: None,
-        heard: BTreeMap::new(),
-        fresh: Vec::new(),
         role: if keeper { Role::Goalkeeper } else { Role::Defender },
     };
     let guide = Guide {

@@ -13,7 +13,7 @@
 //! ([`carrot`]), with the sonars halting the robot as in velocity mode.
 
 use mrt_core::{Point2, Pose2};
-use mrt_dcdt::{Context, Member, MemberError, RequestType};
+use mrt_dcdt::{Context, Member, MemberError, MsgRef, RequestType};
 use mrt_msgs::{PlanRequest, PlannedPath, WorldSnapshot};
 use mrt_plan::spike::{PlanMap, Shape, Spike, SpikeParams};
 
@@ -30,7 +30,9 @@ pub const REPLAN: f64 = 1.0;
 pub(crate) struct Planner {
     robot: usize,
     params: SpikeParams,
-    world: WorldSnapshot,
+    /// The latest world snapshot, kept as received and read only when a request comes (no
+    /// copy each cycle).
+    world: Option<MsgRef>,
     /// SPIKE on the field last planned on: its size between the lines, mm.
     spike: Option<((f64, f64), Spike)>,
 }
@@ -39,12 +41,12 @@ impl Planner {
     /// The planner of robot `robot`, whose footprint has radius `radius` (m).
     pub(crate) fn new(robot: usize, radius: f64) -> Planner {
         let params = SpikeParams { robot_radius: radius, ..SpikeParams::default() };
-        Planner { robot, params, world: WorldSnapshot::default(), spike: None }
+        Planner { robot, params, world: None, spike: None }
     }
 
     /// SPIKE on the field the world snapshot names (made again when the field changes).
-    fn spike(&mut self) -> Result<&Spike, String> {
-        let size = (2.0 * self.world.field.half_length, 2.0 * self.world.field.half_width);
+    fn spike(&mut self, field: &mrt_msgs::Field) -> Result<&Spike, String> {
+        let size = (2.0 * field.half_length, 2.0 * field.half_width);
         if self.spike.as_ref().is_none_or(|(s, _)| *s != size) {
             let map = PlanMap::soccer_field(size.0 / 1000.0, size.1 / 1000.0)
                 .map_err(|e| e.to_string())?;
@@ -54,12 +56,11 @@ impl Planner {
         self.spike.as_ref().map(|(_, s)| s).ok_or_else(|| "no planner".to_string())
     }
 
-    /// The answer to a request for `to` (team frame, mm).
-    fn plan(&mut self, to: Pose2) -> PlannedPath {
-        let me = self.world.my_pos.pose;
+    /// The answer to a request for `to` (team frame, mm), from world snapshot `w`.
+    fn plan(&mut self, w: &WorldSnapshot, to: Pose2) -> PlannedPath {
+        let me = w.my_pos.pose;
         let radius = self.params.robot_radius;
-        let moving: Vec<Shape> = self
-            .world
+        let moving: Vec<Shape> = w
             .robots
             .iter()
             .filter(|r| r.reliability >= PLAN_RELIABILITY)
@@ -67,8 +68,9 @@ impl Planner {
             .collect();
         let from = Point2::new(me.x / 1000.0, me.y / 1000.0);
         let goal = Point2::new(to.x / 1000.0, to.y / 1000.0);
-        let planned =
-            self.spike().and_then(|s| s.plan_among(from, goal, &moving).map_err(|e| e.to_string()));
+        let planned = self
+            .spike(&w.field)
+            .and_then(|s| s.plan_among(from, goal, &moving).map_err(|e| e.to_string()));
         match planned {
             Ok(plan) => {
                 let mut poses: Vec<Pose2> = plan
@@ -100,14 +102,16 @@ impl Member for Planner {
     fn do_your_job(&mut self, ctx: &mut Context<'_>) -> Result<(), MemberError> {
         let mut request = None;
         while let Some(m) = ctx.receive_msg() {
-            if let Ok(w) = m.get::<WorldSnapshot>() {
-                self.world.clone_from(w);
+            if m.is::<WorldSnapshot>() {
+                self.world = Some(m);
             } else {
                 request = Some(*m.get::<PlanRequest>()?);
             }
         }
         if let Some(r) = request {
-            let path = self.plan(r.to);
+            let latest = self.world.clone();
+            let w = latest.as_ref().map(|m| m.get::<WorldSnapshot>()).transpose()?;
+            let path = self.plan(w.unwrap_or(&WorldSnapshot::default()), r.to);
             ctx.publish(path);
         }
         Ok(())
@@ -123,10 +127,15 @@ pub fn carrot(path: &[Pose2], me: Pose2) -> Option<Pose2> {
     path[nearest..].iter().find(|p| d(p) >= LOOKAHEAD).or(path.last()).copied()
 }
 
-/// Whether `path` was planned for `to`: goals within 200 mm and 0.3 rad.
+/// Whether `path` was planned for `to` ([`same_goal`]).
 pub fn plans_for(path: &PlannedPath, to: Pose2) -> bool {
-    (path.to.x - to.x).hypot(path.to.y - to.y) <= 200.0
-        && mrt_core::normalize_angle(path.to.theta - to.theta).abs() <= 0.3
+    same_goal(path.to, to)
+}
+
+/// Whether two goals are one for the planner: within 200 mm and 0.3 rad.
+pub fn same_goal(a: Pose2, b: Pose2) -> bool {
+    (a.x - b.x).hypot(a.y - b.y) <= 200.0
+        && mrt_core::normalize_angle(a.theta - b.theta).abs() <= 0.3
 }
 
 #[cfg(test)]
@@ -153,23 +162,24 @@ mod tests {
     #[test]
     fn the_planner_goes_round_an_anchored_robot() {
         let mut planner = Planner::new(0, 0.25);
-        planner.world.field.half_length = 9000.0;
-        planner.world.field.half_width = 6000.0;
-        planner.world.my_pos.pose = Pose2::new(-3000.0, 0.0, 0.0);
-        planner.world.robots.push(mrt_msgs::AnchoredRobot {
+        let mut w = WorldSnapshot::default();
+        w.field.half_length = 9000.0;
+        w.field.half_width = 6000.0;
+        w.my_pos.pose = Pose2::new(-3000.0, 0.0, 0.0);
+        w.robots.push(mrt_msgs::AnchoredRobot {
             x: 0.0,
             y: 0.0,
             reliability: 0.9,
             ..Default::default()
         });
-        let path = planner.plan(Pose2::new(3000.0, 0.0, 1.0));
+        let path = planner.plan(&w, Pose2::new(3000.0, 0.0, 1.0));
         assert!(path.error.is_empty(), "{path:?}");
         assert!(path.length > 6.0 && path.length < 6.5, "{}", path.length);
         let nearest = path.poses.iter().map(|p| p.x.hypot(p.y)).fold(f64::INFINITY, f64::min);
         assert!(nearest >= 590.0, "{nearest}");
         assert_eq!(path.poses.last().map(|p| p.theta), Some(1.0));
         // A goal inside the walls' band is moved out; one far outside the field is refused.
-        let outside = planner.plan(Pose2::new(50_000.0, 0.0, 0.0));
+        let outside = planner.plan(&w, Pose2::new(50_000.0, 0.0, 0.0));
         assert!(outside.poses.is_empty() && outside.error.contains("no path"), "{outside:?}");
     }
 }

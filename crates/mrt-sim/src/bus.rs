@@ -67,7 +67,7 @@ impl mrt_dcdt::Member for EstimateWatch {
             if let Ok(w) = m.get::<WorldSnapshot>() {
                 let mut pitch = lock_pitch(&self.pitch)?;
                 pitch.book_robots(self.robot, &w.robots);
-                pitch.book_booking(self.robot, w.ball_booked, w.role == "attacker");
+                pitch.book_team_beliefs(self.robot, w.ball_booked, w.role == "attacker");
                 continue;
             }
             let estimate = m.get::<Localization>()?;

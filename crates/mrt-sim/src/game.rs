@@ -544,7 +544,7 @@ impl Pitch {
     /// Books robot `i`'s beliefs of this cycle that it holds the ball booking and that it is
     /// the attacker, and whether a teammate believed so in the same cycle
     /// ([`TeamStats::booking_conflicts`], [`TeamStats::attacker_conflicts`]).
-    pub fn book_booking(&mut self, i: usize, held: bool, attacker: bool) {
+    pub fn book_team_beliefs(&mut self, i: usize, held: bool, attacker: bool) {
         let now = self.world.time();
         let team = self.referee.team_of(i);
         let referee = &self.referee;
