@@ -262,7 +262,7 @@ impl Endpoint {
         let waker = self.shared.waker(self.member);
         if let Some(w) = &waker {
             w.bind_current();
-            w.wait(Some(timeout), &|| self.has_pending() || self.shared.is_shutting_down());
+            w.wait(Some(timeout), true, &|| self.has_pending() || self.shared.is_shutting_down());
         }
         self.has_pending()
     }

@@ -11,6 +11,20 @@ use std::sync::OnceLock;
 use std::thread::Thread;
 use std::time::{Duration, Instant};
 
+/// Busy-wait rounds before a sleep (1, 2, 4 ... 64 pause instructions each, about 500 in all).
+const SPIN_ROUNDS: u32 = 48;
+/// `yield_now` rounds after the spinning, before the sleep.
+const YIELD_ROUNDS: u32 = 16;
+
+/// Whether threads that wait for messages should spin before they sleep: only when `threads`
+/// of them leave a core free for a producer. With more threads than cores, spinning steals the
+/// producer's time: on this project's 2-core machines, four consumers that skipped the spin
+/// read 5.0–5.5 M msgs/s of one producer instead of 2.7–4.8 (`docs/performance.md`, PostOffice
+/// 1→4).
+pub(crate) fn should_spin(threads: usize) -> bool {
+    std::thread::available_parallelism().map_or(1, |n| n.get()) > threads
+}
+
 /// Wakes one Member's thread.
 #[derive(Debug, Default)]
 pub(crate) struct Waker {
@@ -57,14 +71,17 @@ impl Waker {
     }
 
     /// Sleeps until woken, `has_work` is true, or `timeout` passes (when given).
-    /// Spins and yields briefly first: a message that arrives within microseconds is picked
-    /// up without a system call on either side.
-    pub(crate) fn wait(&self, timeout: Option<Duration>, has_work: &dyn Fn() -> bool) {
-        for i in 0..64u32 {
+    /// Yields briefly first, and with `spin` spins before that: a message that arrives within
+    /// microseconds is picked up without a system call on either side. Spinning only pays
+    /// when the producer has a core of its own; when the waiting threads outnumber the cores,
+    /// a spinning consumer takes the core its producer needs (see [`should_spin`]).
+    pub(crate) fn wait(&self, timeout: Option<Duration>, spin: bool, has_work: &dyn Fn() -> bool) {
+        let spins = if spin { SPIN_ROUNDS } else { 0 };
+        for i in 0..spins + YIELD_ROUNDS {
             if has_work() {
                 return;
             }
-            if i < 48 {
+            if i < spins {
                 for _ in 0..(1u32 << (i / 8).min(6)) {
                     std::hint::spin_loop();
                 }
@@ -114,9 +131,17 @@ mod tests {
                 waker.wake();
             })
         };
-        waker.wait(Some(Duration::from_secs(10)), &|| work.load(Ordering::SeqCst));
+        waker.wait(Some(Duration::from_secs(10)), true, &|| work.load(Ordering::SeqCst));
         assert!(work.load(Ordering::SeqCst), "woke before the work arrived");
         producer.join().unwrap();
+    }
+
+    #[test]
+    fn waiting_threads_spin_only_when_they_leave_a_core_free() {
+        let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+        assert!(should_spin(cores - 1), "{cores} cores, {} waiting threads", cores - 1);
+        assert!(!should_spin(cores), "as many waiting threads as cores");
+        assert!(!should_spin(usize::MAX));
     }
 
     #[test]
@@ -125,7 +150,7 @@ mod tests {
         waker.bind_current();
         std::thread::current().unpark();
         let t = Instant::now();
-        waker.wait(Some(Duration::from_millis(20)), &|| false);
+        waker.wait(Some(Duration::from_millis(20)), false, &|| false);
         assert!(t.elapsed() >= Duration::from_millis(20), "{:?}", t.elapsed());
     }
 }

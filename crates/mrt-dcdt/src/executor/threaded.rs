@@ -41,6 +41,8 @@ impl ThreadedExecutor {
         }
         let runners = agora.take_runners();
         let gate = StartGate::new(runners.len());
+        // Waiting Members spin before they sleep only if they leave a core for a producer.
+        let spin = crate::waker::should_spin(runners.len());
         let stop_dispatcher = AtomicBool::new(false);
         let mut spawn_error = None;
         let mut reports = Vec::new();
@@ -69,7 +71,7 @@ impl ThreadedExecutor {
                 let (shared, gate) = (&shared, &gate);
                 match thread::Builder::new()
                     .name(format!("mrt:{name}"))
-                    .spawn_scoped(s, move || run_member(runner, shared, gate))
+                    .spawn_scoped(s, move || run_member(runner, shared, gate, spin))
                 {
                     Ok(h) => handles.push(h),
                     Err(e) => {
@@ -109,7 +111,12 @@ impl ThreadedExecutor {
     }
 }
 
-fn run_member(mut r: Runner, shared: &Arc<AgoraShared>, gate: &StartGate) -> MemberReport {
+fn run_member(
+    mut r: Runner,
+    shared: &Arc<AgoraShared>,
+    gate: &StartGate,
+    spin: bool,
+) -> MemberReport {
     let waker = shared.waker(r.endpoint.member_id());
     if let Some(w) = &waker {
         w.bind_current();
@@ -140,7 +147,7 @@ fn run_member(mut r: Runner, shared: &Arc<AgoraShared>, gate: &StartGate) -> Mem
             Activation::OnMessage if !r.has_mail() => {
                 if r.init_if_needed() {
                     if let Some(w) = &waker {
-                        w.wait(None, &|| r.has_mail() || shared.is_shutting_down());
+                        w.wait(None, spin, &|| r.has_mail() || shared.is_shutting_down());
                     }
                 }
                 continue;
