@@ -8,7 +8,9 @@
 //! | TeamChaos' ball booking, a distributed mutual exclusion: `bookBall`, `releaseBookedBall`, `haveBookedBall` (seed `001` §3.3) | [`booking::BallBooking`] |
 //! | the role the team agreed on: `getRole` (seed `001` §3.3, figure 8's roles) | [`roles::allocate`], [`roles::Role`] |
 //!
-//! SCARE, the MRT manual's coordination (ch. 11), comes here next (issue 21).
+//! | SCARE (MRT manual ch. 11): jobs and schemata, attitude and opportunity, the agenda, the allocation | [`scare::allocate`], [`scare::Activities`] |
+//! | SCARE's sequencer and monitor | [`scare::sequencer::Sequencer`] |
+//! | Team Milan's activities (BringBall, PassageToMate, Defense, ...) | [`scare::soccer`] |
 //!
 //! ```
 //! use mrt_team::booking::{BallBooking, BookingParams};
@@ -26,3 +28,4 @@
 
 pub mod booking;
 pub mod roles;
+pub mod scare;

@@ -1,0 +1,379 @@
+//! Team Milan's SCARE activities (MRT manual §2.3 and ch. 12: "several jobs
+//! (RecoverWanderingBall, BringBall, Defense, etc.) and schemata (DefensiveDoubling,
+//! PassageToMate, Blocking, etc.)"): the table, how a robot rates its attitudes, how the team
+//! rates opportunities, each activity's sub-tasks, and the goal each sub-task gives Mr.
+//! BRIAN's parametric behaviors.
+//!
+//! Everything is in the team frame (mm, x towards the opponent's net at `(half_length, 0)`),
+//! read from a [`Situation`]: what one robot believes. The numbers (distances, priorities,
+//! time limits) are design choices tuned on the simulated pitch (`docs/teams.md`).
+//!
+//! | activity | kind | robots | opportunity | attitude |
+//! |---|---|---|---|---|
+//! | Goalie | job | 1 | always | the goalkeeper only |
+//! | PassageToMate | schema: passer, receiver | 2 | the ball carrier's way is blocked and a mate is open ahead | passer: as BringBall; receiver: open and ahead of the ball |
+//! | BringBall | job | 1 | the ball is known | near the ball, on its own side of it |
+//! | RecoverWanderingBall | job | 1–2 | the ball is not known | any field player |
+//! | DefensiveDoubling | schema: block, cover | 2 | the ball in the own third | near the blocking and the covering spot |
+//! | Defense | job | 0–1 | the ball is known | near the spot between the ball and the own goal |
+//! | Support | job (default) | any | always | any field player |
+
+use super::sequencer::SubTask;
+use super::{Activities, Activity, Assignment};
+
+/// Indices of Team Milan's activities in [`table`].
+pub mod ids {
+    /// Goalie.
+    pub const GOALIE: usize = 0;
+    /// PassageToMate (functionalities: passer 0, receiver 1).
+    pub const PASSAGE: usize = 1;
+    /// BringBall.
+    pub const BRING_BALL: usize = 2;
+    /// RecoverWanderingBall.
+    pub const RECOVER: usize = 3;
+    /// DefensiveDoubling (functionalities: block 0, cover 1).
+    pub const DOUBLING: usize = 4;
+    /// Defense.
+    pub const DEFENSE: usize = 5;
+    /// Support (the default).
+    pub const SUPPORT: usize = 6;
+}
+
+/// Team Milan's activity table (module doc).
+pub fn table() -> Activities {
+    Activities::new(vec![
+        Activity::job("Goalie", 1, 1, 6),
+        Activity::schema("PassageToMate", &["passer", "receiver"], 5),
+        Activity::job("BringBall", 1, 1, 4),
+        Activity::job("RecoverWanderingBall", 1, 2, 4),
+        Activity::schema("DefensiveDoubling", &["block", "cover"], 3),
+        Activity::job("Defense", 0, 1, 2),
+        Activity::job("Support", 0, 16, 0),
+    ])
+    .with_default("Support")
+}
+
+/// What one robot believes, as the soccer activities read it (team frame, mm, rad).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Situation {
+    /// Its own pose: x, y, heading.
+    pub me: (f64, f64, f64),
+    /// Whether it keeps goal.
+    pub keeper: bool,
+    /// The team ball, when known.
+    pub ball: Option<(f64, f64)>,
+    /// Its teammates heard lately: number, position, and whether it keeps goal.
+    pub mates: Vec<(u32, (f64, f64), bool)>,
+    /// The opponents (and robots of unknown team) it anchored.
+    pub opponents: Vec<(f64, f64)>,
+    /// From the centre spot to a goal line.
+    pub half_length: f64,
+    /// From the middle of a goal to a post.
+    pub goal_half_width: f64,
+}
+
+/// An opponent this near the ball, ahead of the robot that carries it, blocks its way.
+const BLOCKED: f64 = 1200.0;
+/// A receiver this far ahead of the ball, with no opponent within [`OPEN`], is worth a pass.
+const AHEAD: f64 = 1500.0;
+/// No opponent within this of a receiver.
+const OPEN: f64 = 1500.0;
+/// Attitudes fall to a half at this cost, mm.
+const HALF_AT: f64 = 3000.0;
+
+fn dist(a: (f64, f64), b: (f64, f64)) -> f64 {
+    (a.0 - b.0).hypot(a.1 - b.1)
+}
+
+/// Near 1 at no cost, ½ at [`HALF_AT`].
+fn closeness(cost: f64) -> f64 {
+    if cost.is_finite() {
+        1.0 / (1.0 + cost.max(0.0) / HALF_AT)
+    } else {
+        0.0
+    }
+}
+
+impl Situation {
+    fn pos(&self) -> (f64, f64) {
+        (self.me.0, self.me.1)
+    }
+
+    /// How far a robot at `p` is from being behind the ball, ready to play it towards the
+    /// opponent's net: its distance to the ball, plus the way round when it stands ahead of
+    /// the ball.
+    fn ball_cost(&self, p: (f64, f64), ball: (f64, f64)) -> f64 {
+        let ahead = (p.0 - ball.0).max(0.0);
+        dist(p, ball) + ahead.min(1000.0)
+    }
+
+    /// The robot of the team (itself or a mate) nearest the ball by [`ball_cost`], by
+    /// number on a tie: who carries the ball.
+    fn carrier(&self, me: u32, ball: (f64, f64)) -> (u32, (f64, f64)) {
+        self.field_players(me)
+            .min_by(|a, b| {
+                self.ball_cost(a.1, ball).total_cmp(&self.ball_cost(b.1, ball)).then(a.0.cmp(&b.0))
+            })
+            .unwrap_or((me, self.pos()))
+    }
+
+    /// The team's field players: itself (unless it keeps goal) and its mates that do not.
+    fn field_players(&self, me: u32) -> impl Iterator<Item = (u32, (f64, f64))> + '_ {
+        let mine = (!self.keeper).then_some((me, self.pos()));
+        mine.into_iter().chain(self.mates.iter().filter(|m| !m.2).map(|m| (m.0, m.1)))
+    }
+
+    /// The nearest opponent's distance from `p` (infinite with none anchored).
+    fn nearest_opponent(&self, p: (f64, f64)) -> f64 {
+        self.opponents.iter().map(|o| dist(*o, p)).fold(f64::INFINITY, f64::min)
+    }
+
+    /// Whether a robot at `p` is open for a pass of the ball: well ahead of it, no opponent
+    /// near.
+    fn open_ahead(&self, p: (f64, f64), ball: (f64, f64)) -> bool {
+        p.0 > ball.0 + AHEAD && self.nearest_opponent(p) > OPEN
+    }
+
+    /// Where Defense stands: on the line from the ball to the middle of the own goal, a third
+    /// of the way from the goal, at least 1.5 m out of it.
+    pub fn defense_spot(&self, ball: (f64, f64)) -> (f64, f64) {
+        let goal = (-self.half_length, 0.0);
+        let d = dist(ball, goal);
+        let out = (d / 3.0).max(1500.0).min(d);
+        if d < 1.0 {
+            return (goal.0 + 1500.0, 0.0);
+        }
+        (goal.0 + (ball.0 - goal.0) * out / d, (ball.1 - goal.1) * out / d)
+    }
+
+    /// Where DefensiveDoubling's `block` stands: 1 m from the ball towards the own goal.
+    pub fn block_spot(&self, ball: (f64, f64)) -> (f64, f64) {
+        let goal = (-self.half_length, 0.0);
+        let d = dist(ball, goal).max(1.0);
+        let k = (1000.0 / d).min(1.0);
+        (ball.0 + (goal.0 - ball.0) * k, ball.1 + (goal.1 - ball.1) * k)
+    }
+
+    /// Where DefensiveDoubling's `cover` stands: 1.2 m out of the own goal, on the ball's
+    /// side of it, within the posts.
+    pub fn cover_spot(&self, ball: (f64, f64)) -> (f64, f64) {
+        let y = ball.1.clamp(-self.goal_half_width, self.goal_half_width) / 2.0;
+        (-self.half_length + 1200.0, y)
+    }
+
+    /// Where Support stands: 2 m behind the ball level with it across, 1.5 m to the side of
+    /// it towards the middle of the field, out of the own penalty area.
+    pub fn support_spot(&self, ball: (f64, f64)) -> (f64, f64) {
+        let side = if ball.1 > 0.0 { -1500.0 } else { 1500.0 };
+        let x = (ball.0 - 2000.0).max(-self.half_length + 2500.0);
+        (x, ball.1 + side)
+    }
+
+    /// Where a receiver goes: its own position moved forward to 2 m ahead of the ball when
+    /// it is not that far ahead, away from the touch lines.
+    pub fn receive_spot(&self, ball: (f64, f64)) -> (f64, f64) {
+        let (x, y) = self.pos();
+        (x.max(ball.0 + 2000.0).min(self.half_length - 1000.0), y.clamp(-2500.0, 2500.0))
+    }
+
+    /// The opportunity of each activity of [`table`], as robot `me` rates it.
+    pub fn opportunity(&self, me: u32) -> Vec<f64> {
+        let mut o = vec![0.0; 7];
+        o[ids::GOALIE] = 1.0;
+        o[ids::SUPPORT] = 1.0;
+        let Some(ball) = self.ball else {
+            o[ids::RECOVER] = 1.0;
+            return o;
+        };
+        o[ids::BRING_BALL] = 1.0;
+        o[ids::DEFENSE] = 1.0;
+        if ball.0 < -self.half_length / 3.0 {
+            o[ids::DOUBLING] = 1.0;
+        }
+        let (carrier, at) = self.carrier(me, ball);
+        let blocked = self
+            .opponents
+            .iter()
+            .any(|op| dist(*op, ball) < BLOCKED && op.0 > ball.0 && op.0 > at.0);
+        let open = self.field_players(me).any(|(id, p)| id != carrier && self.open_ahead(p, ball));
+        if blocked && open && ball.0 < self.half_length - 2000.0 {
+            o[ids::PASSAGE] = 1.0;
+        }
+        o
+    }
+
+    /// This robot's attitude for every slot of [`table`] (in slot order: Goalie, passer,
+    /// receiver, BringBall, RecoverWanderingBall, block, cover, Defense, Support).
+    pub fn attitudes(&self) -> Vec<f64> {
+        let keeper = if self.keeper { 1.0 } else { 0.0 };
+        if self.keeper {
+            return vec![keeper, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0];
+        }
+        let me = self.pos();
+        let (bring, receive, block, cover, defense) = match self.ball {
+            Some(ball) => (
+                closeness(self.ball_cost(me, ball)),
+                if self.open_ahead(me, ball) {
+                    closeness(dist(me, self.receive_spot(ball)))
+                } else {
+                    0.0
+                },
+                closeness(dist(me, self.block_spot(ball))),
+                closeness(dist(me, self.cover_spot(ball))),
+                closeness(dist(me, self.defense_spot(ball))),
+            ),
+            None => (0.0, 0.0, 0.0, 0.0, 0.0),
+        };
+        vec![0.0, bring, receive, bring, 0.5, block, cover, defense, 0.3]
+    }
+}
+
+/// The sub-tasks of one assignment (for the [`Sequencer`](super::sequencer::Sequencer)).
+pub fn subtasks(a: Assignment) -> Vec<SubTask> {
+    match (a.activity, a.functionality) {
+        (ids::BRING_BALL, _) => vec![SubTask::new("ReachBall", 12.0), SubTask::new("Shoot", 3.0)],
+        (ids::PASSAGE, 0) => vec![SubTask::new("ReachBall", 8.0), SubTask::new("Pass", 3.0)],
+        (ids::PASSAGE, _) => vec![SubTask::new("GetOpen", 8.0), SubTask::new("Receive", 4.0)],
+        (ids::RECOVER, _) => vec![SubTask::new("SearchBall", f64::INFINITY)],
+        (ids::GOALIE, _) => vec![SubTask::new("KeepGoal", f64::INFINITY)],
+        _ => vec![SubTask::new("HoldPosition", f64::INFINITY)],
+    }
+}
+
+/// What a sub-task asks of Mr. BRIAN's parametric behaviors (the goals SCARE puts in MAP,
+/// manual §2.3).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Goal {
+    /// Keep goal.
+    Keep,
+    /// Look for the ball.
+    Search,
+    /// Go behind the ball and play it towards `aim` (a point: the net, or a mate).
+    PlayBall {
+        /// Where the ball should go.
+        aim: (f64, f64),
+        /// Kick it (true) or only get behind it.
+        kick: bool,
+    },
+    /// Stand at a point, facing the ball.
+    Position {
+        /// Where.
+        at: (f64, f64),
+    },
+}
+
+impl Situation {
+    /// The goal of sub-task `step` of assignment `a` for this robot; `mates` locate the
+    /// receiver of a pass (`receiver`: its number). `shot` is where along the opponent's
+    /// goal line to shoot (mm from its centre).
+    pub fn goal(&self, a: Assignment, step: usize, receiver: Option<u32>, shot: f64) -> Goal {
+        let Some(ball) = self.ball else {
+            return if a.activity == ids::GOALIE { Goal::Keep } else { Goal::Search };
+        };
+        let net = (self.half_length, shot);
+        match (a.activity, a.functionality) {
+            (ids::GOALIE, _) => Goal::Keep,
+            (ids::RECOVER, _) => Goal::Search,
+            (ids::BRING_BALL, _) => Goal::PlayBall { aim: net, kick: step >= 1 },
+            (ids::PASSAGE, 0) => {
+                let mate = receiver.and_then(|r| self.mates.iter().find(|m| m.0 == r));
+                match mate {
+                    Some((_, at, _)) => Goal::PlayBall { aim: *at, kick: step >= 1 },
+                    None => Goal::PlayBall { aim: net, kick: step >= 1 },
+                }
+            }
+            (ids::PASSAGE, _) => Goal::Position { at: self.receive_spot(ball) },
+            (ids::DOUBLING, 0) => Goal::Position { at: self.block_spot(ball) },
+            (ids::DOUBLING, _) => Goal::Position { at: self.cover_spot(ball) },
+            (ids::DEFENSE, _) => Goal::Position { at: self.defense_spot(ball) },
+            _ => Goal::Position { at: self.support_spot(ball) },
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::{allocate, Agent, Params};
+    use super::*;
+
+    fn field() -> Situation {
+        Situation { half_length: 9000.0, goal_half_width: 1000.0, ..Situation::default() }
+    }
+
+    /// Four robots, each rating its own attitudes from the same beliefs, allocate: keeper,
+    /// the nearest to the ball brings it, the others defend and support.
+    #[test]
+    fn a_team_of_four_allocates_goalie_bringball_defense_support() {
+        let ball = Some((1000.0, 500.0));
+        let pos = [(-8500.0, 0.0), (0.0, 0.0), (-4000.0, -1000.0), (3000.0, 2000.0)];
+        let sit = |i: usize| {
+            let mut s = field();
+            s.me = (pos[i].0, pos[i].1, 0.0);
+            s.keeper = i == 0;
+            s.ball = ball;
+            s.mates = (0..4).filter(|j| *j != i).map(|j| (j as u32 + 1, pos[j], j == 0)).collect();
+            s
+        };
+        let t = table();
+        assert_eq!(t.slots(), sit(1).attitudes().len());
+        let agents: Vec<Agent> =
+            (0..4).map(|i| Agent::new(i as u32 + 1, sit(i).attitudes())).collect();
+        let a = allocate(&t, &sit(0).opportunity(1), &agents, &Params::default());
+        assert_eq!(
+            a.names(&t),
+            vec![(1, "Goalie"), (2, "BringBall"), (3, "Defense"), (4, "Support")]
+        );
+        // Robot 2 is on the ball's own side: its goal is to play it to the net and, in its
+        // second sub-task, to kick.
+        let g = sit(1).goal(a.of(2).unwrap(), 1, None, 0.0);
+        assert_eq!(g, Goal::PlayBall { aim: (9000.0, 0.0), kick: true });
+        // Defense stands on the ball–goal line, a third of the way out.
+        let Goal::Position { at } = sit(2).goal(a.of(3).unwrap(), 0, None, 0.0) else { panic!() };
+        let (bx, by): (f64, f64) = (1000.0 + 9000.0, 500.0);
+        let k = (bx.hypot(by) / 3.0) / bx.hypot(by);
+        assert!((at.0 - (-9000.0 + bx * k)).abs() < 1e-6 && (at.1 - by * k).abs() < 1e-6, "{at:?}");
+    }
+
+    #[test]
+    fn a_blocked_carrier_with_an_open_mate_makes_a_passage() {
+        let mut s = field();
+        s.me = (-1500.0, 0.0, 0.0);
+        s.ball = Some((-1000.0, 0.0));
+        s.mates = vec![(3, (2000.0, 2000.0), false)];
+        s.opponents = vec![(-200.0, 0.0), (4000.0, -2500.0)];
+        let o = s.opportunity(2);
+        assert_eq!(o[ids::PASSAGE], 1.0, "{o:?}");
+        // Robot 3 rates itself as receiver (open, ahead); robot 2 as passer.
+        let mut r = s.clone();
+        r.me = (2000.0, 2000.0, 0.0);
+        r.mates = vec![(2, (-1500.0, 0.0), false)];
+        let agents = [Agent::new(2, s.attitudes()), Agent::new(3, r.attitudes())];
+        let t = table();
+        let a = allocate(&t, &o, &agents, &Params::default());
+        assert_eq!(a.of(2), Some(Assignment { activity: ids::PASSAGE, functionality: 0 }));
+        assert_eq!(a.of(3), Some(Assignment { activity: ids::PASSAGE, functionality: 1 }));
+        // The passer aims at its receiver.
+        let g = s.goal(a.of(2).unwrap(), 0, Some(3), 0.0);
+        assert_eq!(g, Goal::PlayBall { aim: (2000.0, 2000.0), kick: false });
+        // Without the blocking opponent there is no passage: robot 2 brings the ball.
+        s.opponents.remove(0);
+        assert_eq!(s.opportunity(2)[ids::PASSAGE], 0.0);
+    }
+
+    #[test]
+    fn no_ball_means_search_and_the_own_third_means_doubling() {
+        let mut s = field();
+        let o = s.opportunity(1);
+        assert_eq!((o[ids::RECOVER], o[ids::BRING_BALL]), (1.0, 0.0));
+        assert_eq!(
+            s.goal(Assignment { activity: ids::SUPPORT, functionality: 0 }, 0, None, 0.0),
+            Goal::Search
+        );
+        s.ball = Some((-6000.0, 1000.0));
+        assert_eq!(s.opportunity(1)[ids::DOUBLING], 1.0);
+        // The block stands 1 m from the ball towards the own goal.
+        let b = s.block_spot((-6000.0, 1000.0));
+        assert!((dist(b, (-6000.0, 1000.0)) - 1000.0).abs() < 1e-6);
+        assert!(b.0 < -6000.0);
+    }
+}
