@@ -296,6 +296,13 @@ pub fn run(args: &SimArgs) -> Result<()> {
                 s.attacker_conflicts
             );
         }
+        if s.ball_job_cycles > 0 {
+            outln!(
+                "  {name:<8} SCARE job on the ball in {} robot cycles, two at once in {}",
+                s.ball_job_cycles,
+                s.ball_job_conflicts
+            );
+        }
     }
     for (t, call) in &report.calls {
         if let Call::Goal(team) = call {

@@ -116,8 +116,9 @@ fn a_closed_standard_output_ends_the_program_quietly() {
 }
 
 /// Everything but the line that says how long it took and how the robots were wired, and
-/// what the robots believed: the localization and ball errors, the ball booking and the roles
-/// (the in-process match's observer books them; robots in other processes are not watched).
+/// what the robots believed: the localization and ball errors, the ball booking, the roles and
+/// SCARE's jobs (the in-process match's observer books them; robots in other processes are not
+/// watched).
 fn result_lines(stdout: &str) -> Vec<String> {
     stdout
         .lines()
@@ -128,6 +129,7 @@ fn result_lines(stdout: &str) -> Vec<String> {
                 && !l.starts_with("  relocalized")
                 && !l.contains(" ball booked in ")
                 && !l.contains(" attacker (getRole) ")
+                && !l.contains(" SCARE job on the ball ")
         })
         .map(|l| l.split(" simulated in ").next().unwrap_or(l).to_string())
         .collect()

@@ -52,14 +52,14 @@ pub use device::{DeviceAct, DeviceFrame, FinalWhistle, MemberFault, RobotEnd};
 pub use localization::{BallBelief, FilterCounts, Localization};
 pub use mrt_core::{Message, MsgType};
 pub use robot::{
-    lps, AnchoredRobot, Estimate, Field, GameState, Lpo, Mate, RobotClass, RobotCommand, Target,
-    WorldSnapshot,
+    lps, AnchoredRobot, Estimate, Field, GameState, Lpo, Mate, RobotClass, RobotCommand, ScareJob,
+    Target, WorldSnapshot,
 };
 pub use sensing::{
     CameraFrame, Displacement, GameInfo, Image, Marker, MiceReadings, Odometry, Percepts,
     PostSighting, RobotSighting, Sighting, Sonar, SonarScan, FIELD_OBJECTS,
 };
-pub use team::{BookingReport, MateReport, SharedRobot};
+pub use team::{BookingReport, MateReport, ScareReport, SharedRobot};
 
 /// Declares the [`Message`] impls of the catalogue, each with its id from [`ids`] and its name
 /// as the table gives it.

@@ -202,6 +202,29 @@ pub struct WorldSnapshot {
     /// In `READY`: where the referee's kickoff formation wants this robot (team frame, mm,
     /// heading in radians; `getKickoffPose`). `None` in the other states.
     pub kickoff_pose: Option<Pose2>,
+    /// The SCARE activity this robot was given, its current sub-task and the goal the
+    /// sub-task sets (MRT manual ch. 11: "parametric modules ... use coordination information
+    /// introduced in MAP by SCARE"); `None` when the robot runs no SCARE.
+    pub job: Option<ScareJob>,
+}
+
+/// A robot's SCARE activity as its behaviors read it (MRT manual ch. 11, §2.3): names, and
+/// the goal of the current sub-task in the team frame (mm).
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct ScareJob {
+    /// The activity, e.g. `BringBall`, `PassageToMate`.
+    pub activity: String,
+    /// In a schema, the robot's functionality (e.g. `receiver`); a job's own name otherwise.
+    pub functionality: String,
+    /// The current sub-task, e.g. `ReachBall`.
+    pub subtask: String,
+    /// Where to stand (facing the ball), for position goals.
+    pub position: Option<(f64, f64)>,
+    /// Where to play the ball (the net, or a mate), for ball goals.
+    pub aim: Option<(f64, f64)>,
+    /// Whether the sub-task kicks the ball (a shot or a pass), not only reaches it.
+    pub kick: bool,
 }
 
 impl Default for WorldSnapshot {
@@ -220,6 +243,7 @@ impl Default for WorldSnapshot {
             game_state: GameState::default(),
             field: Field::default(),
             kickoff_pose: None,
+            job: None,
         }
     }
 }

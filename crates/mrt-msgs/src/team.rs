@@ -32,6 +32,26 @@ pub struct MateReport {
     /// `mrt_team::roles`), so that every teammate allocates from the same data.
     #[serde(default)]
     pub role: String,
+    /// Its part in SCARE's allocation (MRT manual ch. 11; `mrt_team::scare`).
+    #[serde(default)]
+    pub scare: ScareReport,
+}
+
+/// What a robot tells its teammates for SCARE's allocation (`mrt_team::scare`): every robot
+/// allocates from these, so all that heard the same reports agree.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct ScareReport {
+    /// The fingerprint of its activity table (`Activities::fingerprint`): attitudes are read
+    /// slot by slot only from a robot that runs the same table.
+    pub table: u32,
+    /// Its attitude for each (activity, functionality) slot of the table, `0..=1`.
+    pub attitudes: Vec<f32>,
+    /// Its rating of each activity's opportunity, `0..=1` (the team uses one robot's: the
+    /// lowest-numbered heard).
+    pub opportunity: Vec<f32>,
+    /// What it does now: activity and functionality indices in the table.
+    pub doing: Option<(u16, u8)>,
 }
 
 /// What a robot tells its teammates about the ball booking (`mrt_team::booking`): whether it
@@ -83,6 +103,7 @@ impl MateReport {
             robots,
             booking: BookingReport::default(),
             role: String::new(),
+            scare: ScareReport::default(),
         }
     }
 

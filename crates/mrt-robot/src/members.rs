@@ -48,10 +48,10 @@ use crate::config::RobotConfig;
 use crate::devices::{Devices, SharedDevices};
 use crate::files::FilesDir;
 use crate::planner::{carrot, plans_for, same_goal, Planner, REPLAN};
-use crate::stacks::{embedded_teamchaos, send_brain, Stack, CHAOS_KEEPER, CHAOS_PLAYER};
+use crate::stacks::{embedded_teamchaos, send_brain, Geometry, Stack, CHAOS_KEEPER, CHAOS_PLAYER};
 use mrt_core::{Point2, Pose2};
 use mrt_dcdt::{Activation, Agora, Context, Member, MemberError, Message, RequestType, RunReport};
-use mrt_msgs::robot::{lps, Lpo};
+use mrt_msgs::robot::{lps, Lpo, RobotClass};
 use mrt_msgs::{
     BehaviorStatus, BookingReport, CameraFrame, GameInfo, MateReport, MemberFault, MotorCommand,
     Odometry, Percepts, RobotCommand, Sonar, SonarScan, WorldSnapshot,
@@ -62,6 +62,7 @@ use mrt_plan::guide::Guidance;
 use mrt_script::member::BehaviorMember;
 use mrt_team::booking::{BallBooking, BookingParams};
 use mrt_team::roles::{allocate, Player, Role};
+use mrt_team::scare::soccer::{Coordinator, Situation};
 
 /// A team ball of at least this quality is known to the role allocation (the Lua players'
 /// `ballKnown`).
@@ -117,6 +118,10 @@ struct WorldState {
     book: Option<bool>,
     /// The role the team agreed on at the last frame ([`mrt_team::roles`], `getRole`).
     role: Role,
+    /// SCARE (MRT manual ch. 11, [`mrt_team::scare`]): the activity the team gives this
+    /// robot, its sub-task and goal, into the snapshot's `job` for Team Milan's parametric
+    /// behaviors (Team Milan only).
+    scare: Option<Coordinator>,
 }
 
 impl Member for WorldState {
@@ -205,11 +210,50 @@ impl Member for WorldState {
         self.role = allocate(&players, ball).first().map_or(self.role, |r| r.1);
         report.role = self.role.name().to_string();
         w.role = self.role.name().to_string();
+        // SCARE, on the same teammates and team ball.
+        if let Some(scare) = &mut self.scare {
+            let heard: Vec<&MateReport> = self
+                .mates
+                .values()
+                .filter(|r| self.booking.hears(r.id, now) && r.id != id)
+                .collect();
+            let sit = situation(&w, self.keeper, ball, &heard);
+            let shot = Geometry::of(&w.field).open_side(&w);
+            let reports: Vec<_> = heard.iter().map(|r| (r.id, &r.scare)).collect();
+            let cycle = scare.cycle(now, &sit, &reports, shot);
+            report.scare = cycle.report;
+            w.job = Some(cycle.job);
+        }
         ctx.publish(report);
         ctx.publish(self.model.localization());
         self.body.perceive(&mut w);
         ctx.publish(w);
         Ok(())
+    }
+}
+
+/// What SCARE's soccer activities read of a robot's beliefs: its pose, the team ball when
+/// known, the teammates heard lately, the robots it anchored as opponents (or of unknown
+/// team), the field.
+fn situation(
+    w: &WorldSnapshot,
+    keeper: bool,
+    ball: Option<(f64, f64)>,
+    heard: &[&MateReport],
+) -> Situation {
+    Situation {
+        me: (w.my_pos.pose.x, w.my_pos.pose.y, w.my_pos.pose.theta),
+        keeper,
+        ball,
+        mates: heard.iter().map(|r| (r.id, (r.pose.pose.x, r.pose.pose.y), r.keeper)).collect(),
+        opponents: w
+            .robots
+            .iter()
+            .filter(|r| r.class != RobotClass::Teammate && r.reliability >= WorldSnapshot::ANCHORED)
+            .map(|r| (r.x, r.y))
+            .collect(),
+        half_length: w.field.half_length,
+        goal_half_width: w.field.goal_half_width,
     }
 }
 
@@ -505,7 +549,10 @@ pub fn add_robot(
         ),
         other => (Box::new(BrainMember::new(send_brain(other, keeper)?)), Commander::PLAIN),
     };
-    add_cycle(agora, cfg, (robot, keeper), behavior, commander, devices)
+    // Team Milan's parametric behaviors read SCARE's job (MRT manual ch. 11); the others
+    // coordinate their own way (TeamChaos: booking and roles).
+    let scare = stack == Stack::Milan;
+    add_cycle(agora, cfg, (robot, keeper, scare), behavior, commander, devices)
 }
 
 /// [`add_robot`] with any `Send` [`Brain`](crate::brain::Brain) as the behaviors (a team's
@@ -519,16 +566,17 @@ pub fn add_robot_with_brain(
     devices: SharedDevices,
 ) -> Result<(), String> {
     let behavior = Box::new(BrainMember::new(brain));
-    add_cycle(agora, cfg, (robot, keeper), behavior, Commander::PLAIN, devices)
+    add_cycle(agora, cfg, (robot, keeper, false), behavior, Commander::PLAIN, devices)
 }
 
 /// **The robot cycle**, defined once: the Members of robot `robot` in their order, each with
 /// its activation (module doc). Every wiring runs it: the simulator's in-process match, its
-/// distributed match and `mrt robot` on a real robot's devices.
+/// distributed match and `mrt robot` on a real robot's devices. With `scare`, the world
+/// state runs SCARE and puts the robot's job in its snapshots.
 fn add_cycle(
     agora: &mut Agora,
     cfg: &RobotConfig,
-    (robot, keeper): (usize, bool),
+    (robot, keeper, scare): (usize, bool, bool),
     behavior: Box<dyn Member>,
     commander: Commander,
     devices: SharedDevices,
@@ -560,6 +608,7 @@ fn add_cycle(
         booking_news: Vec::new(),
         book: None,
         role: if keeper { Role::Goalkeeper } else { Role::Defender },
+        scare: scare.then(|| Coordinator::new(u32::try_from(robot).unwrap_or(u32::MAX))),
     };
     let guide = Guide {
         robot,

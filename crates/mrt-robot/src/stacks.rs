@@ -92,6 +92,10 @@ const MILAN: &[(&str, &str)] = &[
         include_str!("../../../configs/brian/milan/behaviors/AvoidObstacle.rul"),
     ),
     ("behaviors/GoToBall.rul", include_str!("../../../configs/brian/milan/behaviors/GoToBall.rul")),
+    (
+        "behaviors/HoldPosition.rul",
+        include_str!("../../../configs/brian/milan/behaviors/HoldPosition.rul"),
+    ),
     ("behaviors/KeepGoal.rul", include_str!("../../../configs/brian/milan/behaviors/KeepGoal.rul")),
     ("behaviors/KickBall.rul", include_str!("../../../configs/brian/milan/behaviors/KickBall.rul")),
     (
@@ -256,15 +260,61 @@ impl MilanBrain {
         let field = Geometry::of(&w.field);
         let mut v = vec![("Keeper", f64::from(u8::from(self.keeper)), 1.0), ("Always", 1.0, 1.0)];
         v.push(("HeadingBearing", deg360(me.theta), q));
+        // SCARE's job (MRT manual ch. 11 and §2.3: goals for the parametric behaviors). A
+        // robot without one plays the ball, as the team did before SCARE.
+        let job = w.job.as_ref();
+        let flag = |b: bool| f64::from(u8::from(b));
+        v.push(("PlayBall", flag(job.is_none_or(|j| j.aim.is_some())), 1.0));
+        v.push(("KickAllowed", flag(job.is_none_or(|j| j.kick)), 1.0));
+        v.push(("HoldPosition", flag(job.is_some_and(|j| j.position.is_some())), 1.0));
+        if let Some((px, py)) = job.and_then(|j| j.position) {
+            let (dx, dy) = (px - me.x, py - me.y);
+            v.push(("PositionDistance", dx.hypot(dy), q));
+            v.push(("PositionAngle", deg360(dy.atan2(dx) - me.theta), q));
+        }
         let ball = w.lps[lps::BALL];
         if ball.reliability >= 0.1 {
             let r = ball.reliability;
             v.push(("BallDistance", ball.rho, r));
             v.push(("BallBearing", deg360(ball.theta), r));
-            // The ball and the point 400 mm behind it on the line from the opponent's net.
+            // The ball and the point 400 mm behind it on the line from where it should go:
+            // the job's aim (the net's open side, or a mate for a pass).
             let (bx, by) = Geometry::ball_at(me, &ball);
-            let spot = field.behind_ball_aiming((bx, by), field.open_side(w), 400.0);
-            let (dx, dy) = (spot.x - me.x, spot.y - me.y);
+            let aim = job.and_then(|j| j.aim).unwrap_or((field.half_length, field.open_side(w)));
+            let spot = behind_ball(Point2::new(bx, by), Point2::new(aim.0, aim.1), 400.0)
+                .unwrap_or(Pose2::new(bx - 400.0, by, 0.0));
+            // How far (degrees) the kick, along the robot's heading, would miss what it aims
+            // at: the goal mouth less a ball's margin at each post for a shot at the net, a
+            // 0.8 m wide target round a mate for a pass; 0 on target.
+            let half = if (aim.0 - field.half_length).abs() < 1.0 {
+                let off = (field.goal_half_width - 250.0).max(0.0);
+                let (lo, hi) = ((aim.1 - off).max(-off), (aim.1 + off).min(off));
+                let lo = (lo - by).atan2(aim.0 - bx);
+                let hi = (hi - by).atan2(aim.0 - bx);
+                let mid = 0.5 * (lo + hi);
+                (mid, 0.5 * (hi - lo).abs())
+            } else {
+                let d = (aim.0 - bx).hypot(aim.1 - by).max(1.0);
+                ((aim.1 - by).atan2(aim.0 - bx), (400.0 / d).atan())
+            };
+            // In the own half any kick that clears the ball forwards will do.
+            let miss = if bx < 0.0 && (aim.0 - field.half_length).abs() < 1.0 {
+                0.0
+            } else {
+                mrt_core::normalize_angle(me.theta - half.0).abs() - half.1
+            };
+            v.push(("AimError", miss.max(0.0).to_degrees(), r));
+            // A robot in front of the ball steps round it, 600 mm to the side it is on, instead
+            // of driving back through it.
+            let (ux, uy) = (spot.theta.cos(), spot.theta.sin());
+            let (rx, ry) = (bx - me.x, by - me.y);
+            let (mut tx, mut ty) = (spot.x, spot.y);
+            if rx * ux + ry * uy < 0.0 {
+                let side = if (me.x - bx) * uy - (me.y - by) * ux > 0.0 { 1.0 } else { -1.0 };
+                tx += side * 600.0 * uy;
+                ty -= side * 600.0 * ux;
+            }
+            let (dx, dy) = (tx - me.x, ty - me.y);
             v.push(("ApproachDistance", dx.hypot(dy), r));
             v.push(("ApproachAngle", deg360(dy.atan2(dx) - me.theta), r));
             let a = me.theta + ball.theta;

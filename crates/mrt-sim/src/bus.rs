@@ -67,7 +67,8 @@ impl mrt_dcdt::Member for EstimateWatch {
             if let Ok(w) = m.get::<WorldSnapshot>() {
                 let mut pitch = lock_pitch(&self.pitch)?;
                 pitch.book_robots(self.robot, &w.robots);
-                pitch.book_team_beliefs(self.robot, w.ball_booked, w.role == "attacker");
+                let ball_job = w.job.as_ref().is_some_and(|j| j.aim.is_some());
+                pitch.book_team_beliefs(self.robot, w.ball_booked, w.role == "attacker", ball_job);
                 continue;
             }
             let estimate = m.get::<Localization>()?;

@@ -63,6 +63,11 @@ pub struct TeamStats {
     /// Robot cycles in which a teammate was the attacker too in the same cycle (the two
     /// allocated from reports a cycle apart).
     pub attacker_conflicts: u64,
+    /// Robot cycles in which SCARE gave a robot a job that plays the ball (BringBall,
+    /// PassageToMate's passer: `mrt_team::scare::soccer`).
+    pub ball_job_cycles: u64,
+    /// Robot cycles in which a teammate had a ball-playing job too in the same cycle.
+    pub ball_job_conflicts: u64,
 }
 
 /// One control cycle's positions, for drawings: ball, then every robot (m).
@@ -256,6 +261,8 @@ pub struct Pitch {
     /// last was the attacker.
     booked_at: Vec<f64>,
     attacker_at: Vec<f64>,
+    /// The same for a SCARE job that plays the ball.
+    ball_job_at: Vec<f64>,
     /// The cameras' renderer and each robot's camera state, when percepts come from vision.
     eyes: Option<Eyes>,
     /// Each robot's camera pan joint, rad (the camera file's pan until a robot turns it).
@@ -323,6 +330,7 @@ impl Pitch {
             kicks: Vec::new(),
             booked_at: vec![f64::NEG_INFINITY; robots],
             attacker_at: vec![f64::NEG_INFINITY; robots],
+            ball_job_at: vec![f64::NEG_INFINITY; robots],
             eyes: match cfg.sensor.percepts {
                 PerceptSource::Oracle => None,
                 PerceptSource::Vision => Some(Eyes::new(cfg, robots, seed)?),
@@ -541,10 +549,11 @@ impl Pitch {
         }
     }
 
-    /// Books robot `i`'s beliefs of this cycle that it holds the ball booking and that it is
-    /// the attacker, and whether a teammate believed so in the same cycle
-    /// ([`TeamStats::booking_conflicts`], [`TeamStats::attacker_conflicts`]).
-    pub fn book_team_beliefs(&mut self, i: usize, held: bool, attacker: bool) {
+    /// Books robot `i`'s beliefs of this cycle that it holds the ball booking, that it is
+    /// the attacker, and that SCARE gave it a job that plays the ball, and whether a teammate
+    /// believed so in the same cycle ([`TeamStats::booking_conflicts`],
+    /// [`TeamStats::attacker_conflicts`], [`TeamStats::ball_job_conflicts`]).
+    pub fn book_team_beliefs(&mut self, i: usize, held: bool, attacker: bool, ball_job: bool) {
         let now = self.world.time();
         let team = self.referee.team_of(i);
         let referee = &self.referee;
@@ -565,6 +574,12 @@ impl Pitch {
             if let Some(mate) = mark(&mut self.attacker_at) {
                 stats.attacker_cycles += 1;
                 stats.attacker_conflicts += u64::from(mate);
+            }
+        }
+        if ball_job {
+            if let Some(mate) = mark(&mut self.ball_job_at) {
+                stats.ball_job_cycles += 1;
+                stats.ball_job_conflicts += u64::from(mate);
             }
         }
     }

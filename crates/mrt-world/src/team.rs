@@ -218,6 +218,7 @@ mod tests {
             robots: Vec::new(),
             booking: Default::default(),
             role: String::new(),
+            scare: Default::default(),
         }
     }
 

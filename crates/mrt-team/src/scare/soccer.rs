@@ -18,8 +18,9 @@
 //! | Defense | job | 0–1 | the ball is known | near the spot between the ball and the own goal |
 //! | Support | job (default) | any | always | any field player |
 
-use super::sequencer::SubTask;
-use super::{Activities, Activity, Assignment};
+use super::sequencer::{Progress, Sequencer, SubTask, Verdict};
+use super::{allocate, Activities, Activity, Agent, Allocation, Assignment, Params};
+use mrt_msgs::{ScareJob, ScareReport};
 
 /// Indices of Team Milan's activities in [`table`].
 pub mod ids {
@@ -288,6 +289,210 @@ impl Situation {
             (ids::DEFENSE, _) => Goal::Position { at: self.defense_spot(ball) },
             _ => Goal::Position { at: self.support_spot(ball) },
         }
+    }
+}
+
+/// Seconds a robot stays off an activity it failed at, so that the allocation hands it to
+/// another robot (the monitor's "re-allocate").
+pub const COOL_DOWN: f64 = 2.0;
+
+/// One robot's SCARE, cycle after cycle: its attitudes and opportunities into its report,
+/// the allocation from its own report and its teammates', the sequencer and monitor of what
+/// it was given, and the goal for its behaviors.
+#[derive(Clone, Debug)]
+pub struct Coordinator {
+    id: u32,
+    table: Activities,
+    fingerprint: u32,
+    params: Params,
+    doing: Option<Assignment>,
+    sequencer: Option<Sequencer>,
+    /// Per activity: until when (s) this robot rates itself 0 for it, after a failure.
+    off_until: Vec<f64>,
+    /// Teammates' reports that could not be read (another table, wrong lengths).
+    ignored: u64,
+    /// Activities this robot failed at, and finished.
+    failures: u64,
+    done: u64,
+}
+
+/// What one cycle of a [`Coordinator`] gives: the report for the teammates, the job for
+/// the behaviors, and the allocation it came from.
+#[derive(Clone, Debug)]
+pub struct Cycle {
+    /// This robot's report (for its `MateReport`).
+    pub report: ScareReport,
+    /// What its behaviors pursue.
+    pub job: ScareJob,
+    /// Everyone's activity, as this robot computed it.
+    pub allocation: Allocation,
+}
+
+impl Coordinator {
+    /// Robot `id`'s coordinator on Team Milan's [`table`].
+    pub fn new(id: u32) -> Coordinator {
+        let table = table();
+        let n = table.list().len();
+        Coordinator {
+            id,
+            fingerprint: table.fingerprint(),
+            table,
+            params: Params::default(),
+            doing: None,
+            sequencer: None,
+            off_until: vec![f64::NEG_INFINITY; n],
+            ignored: 0,
+            failures: 0,
+            done: 0,
+        }
+    }
+
+    /// Teammates' reports that could not be read (another activity table, wrong lengths).
+    pub fn ignored(&self) -> u64 {
+        self.ignored
+    }
+
+    /// Activities this robot finished (`done`) and failed at (`failures`, each followed by
+    /// [`COOL_DOWN`] off that activity).
+    pub fn outcomes(&self) -> (u64, u64) {
+        (self.done, self.failures)
+    }
+
+    /// One cycle at `now` (s): `sit` is what this robot believes, `heard` the SCARE reports
+    /// of the teammates heard lately (a robot that hears nobody allocates for itself alone),
+    /// `shot` where along the opponent's goal line to shoot (mm from its centre).
+    pub fn cycle(
+        &mut self,
+        now: f64,
+        sit: &Situation,
+        heard: &[(u32, &ScareReport)],
+        shot: f64,
+    ) -> Cycle {
+        let mut attitudes = sit.attitudes();
+        for (a, until) in self.off_until.iter().enumerate() {
+            if now < *until {
+                for f in 0..self.table.list()[a].functionalities.len() {
+                    if let Some(v) = self.table.slot(a, f).and_then(|s| attitudes.get_mut(s)) {
+                        *v = 0.0;
+                    }
+                }
+            }
+        }
+        let opportunity = sit.opportunity(self.id);
+        let mut agents = vec![Agent::new(self.id, attitudes.clone()).doing(self.doing)];
+        let mut leader = (self.id, opportunity.clone());
+        for (id, r) in heard {
+            let n = self.table.list().len();
+            if *id == self.id
+                || r.table != self.fingerprint
+                || r.attitudes.len() != self.table.slots()
+                || r.opportunity.len() != n
+            {
+                self.ignored += u64::from(*id != self.id);
+                continue;
+            }
+            let doing =
+                r.doing.map(|(a, f)| Assignment { activity: a.into(), functionality: f.into() });
+            agents.push(
+                Agent::new(*id, r.attitudes.iter().map(|v| f64::from(*v)).collect()).doing(doing),
+            );
+            if *id < leader.0 {
+                leader = (*id, r.opportunity.iter().map(|v| f64::from(*v)).collect());
+            }
+        }
+        let allocation = allocate(&self.table, &leader.1, &agents, &self.params);
+        let given = allocation.of(self.id);
+        if given != self.doing || self.sequencer.is_none() {
+            self.doing = given;
+            self.sequencer = given.map(|a| Sequencer::new(subtasks(a), now));
+        }
+        let receiver = allocation
+            .assignments
+            .iter()
+            .find(|(_, a)| *a == Some(Assignment { activity: ids::PASSAGE, functionality: 1 }))
+            .map(|(id, _)| *id);
+        let job = match (given, self.sequencer.as_mut()) {
+            (Some(a), Some(seq)) => {
+                let goal = sit.goal(a, seq.step(), receiver, shot);
+                let verdict = judge(sit, seq.current().map_or("", |t| t.name.as_str()), goal);
+                match seq.tick(now, verdict) {
+                    Progress::Done => {
+                        self.done += 1;
+                        seq.restart(now);
+                    }
+                    Progress::Failed { .. } => {
+                        self.failures += 1;
+                        if let Some(until) = self.off_until.get_mut(a.activity) {
+                            *until = now + COOL_DOWN;
+                        }
+                        seq.restart(now);
+                    }
+                    Progress::Running { .. } | Progress::Advanced { .. } => {}
+                }
+                let goal = sit.goal(a, seq.step(), receiver, shot);
+                job_of(&self.table, a, seq, goal)
+            }
+            _ => ScareJob::default(),
+        };
+        let report = ScareReport {
+            table: self.fingerprint,
+            attitudes: attitudes.iter().map(|v| *v as f32).collect(),
+            opportunity: opportunity.iter().map(|v| *v as f32).collect(),
+            doing: self.doing.map(|a| (a.activity as u16, a.functionality as u8)),
+        };
+        Cycle { report, job, allocation }
+    }
+}
+
+/// The job a robot's behaviors read: names, sub-task and goal.
+fn job_of(table: &Activities, a: Assignment, seq: &Sequencer, goal: Goal) -> ScareJob {
+    let Some(act) = table.list().get(a.activity) else { return ScareJob::default() };
+    let mut job = ScareJob {
+        activity: act.name.clone(),
+        functionality: act.functionalities.get(a.functionality).cloned().unwrap_or_default(),
+        subtask: seq.current().map(|t| t.name.clone()).unwrap_or_default(),
+        ..ScareJob::default()
+    };
+    match goal {
+        Goal::PlayBall { aim, kick } => {
+            job.aim = Some(aim);
+            job.kick = kick;
+        }
+        Goal::Position { at } => job.position = Some(at),
+        Goal::Keep | Goal::Search => {}
+    }
+    job
+}
+
+/// The monitor's success and failure conditions of Team Milan's sub-tasks.
+fn judge(sit: &Situation, subtask: &str, goal: Goal) -> Verdict {
+    let me = sit.pos();
+    let Some(ball) = sit.ball else {
+        // Searching succeeds by finding the ball; everything else needs it.
+        return if matches!(subtask, "SearchBall" | "KeepGoal") {
+            Verdict::Running
+        } else {
+            Verdict::Failure
+        };
+    };
+    match (subtask, goal) {
+        ("ReachBall", Goal::PlayBall { aim, .. }) => {
+            // Within 0.7 m of the ball, on the line from the aim, within 25°.
+            let (to_ball, to_aim) =
+                ((ball.1 - me.1).atan2(ball.0 - me.0), (aim.1 - ball.1).atan2(aim.0 - ball.0));
+            let off = (to_ball - to_aim + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU)
+                - std::f64::consts::PI;
+            if dist(me, ball) < 700.0 && off.abs() < 25f64.to_radians() {
+                Verdict::Success
+            } else {
+                Verdict::Running
+            }
+        }
+        // The ball is off: kicked, or lost to someone.
+        ("Shoot" | "Pass", _) if dist(me, ball) > 1200.0 => Verdict::Success,
+        ("GetOpen", Goal::Position { at }) if dist(me, at) < 400.0 => Verdict::Success,
+        ("Receive", _) if dist(me, ball) < 700.0 => Verdict::Success,
+        _ => Verdict::Running,
     }
 }
 
