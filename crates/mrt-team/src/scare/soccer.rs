@@ -229,7 +229,7 @@ impl Situation {
     }
 }
 
-/// The sub-tasks of one assignment (for the [`Sequencer`](super::sequencer::Sequencer)).
+/// The sub-tasks of one assignment (for the [`Sequencer`]).
 pub fn subtasks(a: Assignment) -> Vec<SubTask> {
     match (a.activity, a.functionality) {
         (ids::BRING_BALL, _) => vec![SubTask::new("ReachBall", 12.0), SubTask::new("Shoot", 3.0)],
