@@ -319,16 +319,17 @@ impl MilanBrain {
             v.push(("ApproachAngle", deg360(dy.atan2(dx) - me.theta), r));
             let a = me.theta + ball.theta;
             let mis = mrt_core::normalize_angle(a - spot.theta).abs().to_degrees();
-            let gw = field.goal_half_width;
             v.push(("Misalignment", mis, r));
-            if self.keeper {
-                // Stand 500 mm out of the goal line, facing the field, level with the ball
-                // within the posts.
-                v.push(("KeeperOffset", by.clamp(-(gw - 100.0), gw - 100.0) - me.y, r));
-            }
         }
         if self.keeper {
-            v.push(("KeeperDepth", me.x - (-field.half_length + 500.0), q));
+            // The keeper's spot: 300 mm out of the goal line, level with the ball within the
+            // posts (the middle of the goal when the ball is not seen); it faces the ball.
+            let gw = field.goal_half_width;
+            let y = if ball.reliability >= 0.1 { Geometry::ball_at(me, &ball).1 } else { 0.0 };
+            let (kx, ky) = (-field.half_length + 300.0, y.clamp(-(gw - 100.0), gw - 100.0));
+            let (dx, dy) = (kx - me.x, ky - me.y);
+            v.push(("KeeperSpotDistance", dx.hypot(dy), q));
+            v.push(("KeeperSpotAngle", deg360(dy.atan2(dx) - me.theta), q));
         }
         let nearest = w
             .mates
