@@ -21,14 +21,14 @@ fn default_match(seed: u64) -> MatchReport {
 
 #[test]
 fn a_full_match_finishes_and_reproduces_its_trajectory_hash() {
-    let (a, b) = (default_match(4), default_match(4));
+    let (a, b) = (default_match(1), default_match(1));
     assert!((a.duration - 600.0).abs() < 0.011, "two halves of 300 s: {}", a.duration);
     assert_eq!(a.calls.last().map(|(_, c)| c), Some(&Call::FullTime));
     assert!(a.calls.iter().any(|(_, c)| *c == Call::HalfTime));
     assert_eq!((a.score, a.trajectory_hash), (b.score, b.trajectory_hash));
     assert_eq!(a.stats, b.stats);
-    // Both teams play: each moves to the ball and kicks it on target; Milan scores (seed 4:
-    // 4 : 0. Chaos has not scored against Milan since Milan plays with SCARE and its new
+    // Both teams play: each moves to the ball and kicks it on target; Milan scores (seed 1:
+    // 3 : 0. Chaos has not scored against Milan since Milan plays with SCARE and its new
     // goalkeeper: seeds 1 to 16 all end with Chaos at 0, docs/teams.md).
     assert!(a.score.0 > 0, "{:?}", a.score);
     // Every kickoff went through READY, and the robots walked to their places: the referee
@@ -42,7 +42,7 @@ fn a_full_match_finishes_and_reproduces_its_trajectory_hash() {
     assert_eq!(placed.len(), kickoffs, "{:?}", a.calls);
     assert!(placed.iter().sum::<usize>() * 10 <= kickoffs * 8, "placed by the referee: {placed:?}");
     assert!(a.stats[0].possession_cycles > 0 && a.stats[1].possession_cycles > 0);
-    // Some shots head into the goal mouth, not all (seed 4: Milan 19 of 59, Chaos 7 of 20).
+    // Some shots head into the goal mouth, not all (seed 1: Milan 26 of 78, Chaos 6 of 20).
     for s in &a.stats {
         assert!(s.shots_on_target > 0 && s.shots_on_target < s.shots, "{s:?}");
     }
@@ -53,22 +53,18 @@ fn a_full_match_finishes_and_reproduces_its_trajectory_hash() {
     assert_eq!(a.stats[0].booked_cycles, 0);
     // Every robot's world model allocates the roles (getRole) from its teammates' reports:
     // one attacker a cycle, but for the cycles in which two allocated from reports a cycle
-    // apart (seed 4: 19 and 16 of about 6000).
+    // apart (about 20 of 6000 each).
     for s in &a.stats {
         assert!(s.attacker_cycles > 3000, "{s:?}");
         assert!(s.attacker_conflicts * 100 < s.attacker_cycles, "{s:?}");
     }
     // Milan's robots run SCARE (MRT manual ch. 11) and allocate its activities from each
     // other's reports: one robot on the ball a cycle (BringBall or a passer), but for the
-    // cycles in which two allocated from reports a cycle apart (seed 4: 75 of 5733, 1.3 %;
-    // the booking is the strict mutual exclusion). Chaos coordinates by booking and roles,
+    // cycles in which two allocated from reports a cycle apart (seed 1: 22 of 5850; the
+    // booking is the strict mutual exclusion). Chaos coordinates by booking and roles,
     // without SCARE.
     assert!(a.stats[0].ball_job_cycles > 3000, "{:?}", a.stats[0]);
-    assert!(
-        a.stats[0].ball_job_conflicts * 100 < 3 * a.stats[0].ball_job_cycles,
-        "{:?}",
-        a.stats[0]
-    );
+    assert!(a.stats[0].ball_job_conflicts * 100 < a.stats[0].ball_job_cycles, "{:?}", a.stats[0]);
     assert_eq!(a.stats[1].ball_job_cycles, 0);
     assert!(a.faults.is_empty(), "{:?}", a.faults);
 }

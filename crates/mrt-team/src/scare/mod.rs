@@ -25,7 +25,9 @@
 //!   and each schema the best cover of all its functionalities by free robots of non-zero
 //!   attitude (a maximum-weight matching, Kuhn–Munkres, from `pathfinding`; a schema that
 //!   cannot be covered is skipped); the second pass fills jobs up to `card_max`, in agenda
-//!   order. Robots left over get the table's default activity. A robot's current activity
+//!   order. Robots left over get the table's default activity. Activities of one *group* are
+//!   alternatives ([`Activity::in_group`]): the first of a group given robots skips the
+//!   others (a passage and a plain BringBall both play the ball). A robot's current activity
 //!   counts [`Params::hysteresis`] more, so that two robots rated 0.50 and 0.52 do not swap
 //!   back and forth. Robots are taken in number order and ties go to the lower number: the
 //!   result depends on the data, not on the order they arrived in.
@@ -75,6 +77,10 @@ pub struct Activity {
     pub card_max: usize,
     /// Higher first on the agenda.
     pub priority: u8,
+    /// Activities of one group are alternatives (two ways of doing one thing: PassageToMate
+    /// and BringBall both play the ball): once one of them is given, the others of the group
+    /// are skipped. `None`: in no group.
+    pub group: Option<String>,
 }
 
 impl Activity {
@@ -87,6 +93,7 @@ impl Activity {
             card_min,
             card_max: card_max.max(card_min),
             priority,
+            group: None,
         }
     }
 
@@ -99,7 +106,14 @@ impl Activity {
             card_min: functionalities.len(),
             card_max: functionalities.len(),
             priority,
+            group: None,
         }
+    }
+
+    /// The same activity in group `group` (see [`Activity::group`]).
+    pub fn in_group(mut self, group: &str) -> Activity {
+        self.group = Some(group.to_string());
+        self
     }
 }
 
@@ -172,6 +186,7 @@ impl Activities {
                 eat(f.as_bytes());
             }
             eat(&[1, u8::from(a.schema), a.card_min as u8, a.card_max as u8, a.priority]);
+            eat(a.group.as_deref().unwrap_or("").as_bytes());
         }
         h
     }
@@ -310,24 +325,30 @@ pub fn allocate(
         c.into_iter().map(|(i, _)| i).collect()
     };
     let mut admitted = Vec::new();
+    let mut groups_done: Vec<&str> = Vec::new();
     for &a in &agenda {
         let act = &table.list[a];
+        if act.group.as_deref().is_some_and(|g| groups_done.contains(&g)) {
+            continue;
+        }
         if act.schema {
-            if let Some(cover) = cover_schema(act, &given, n, |i, f| score(i, a, f)) {
-                for (f, i) in cover.into_iter().enumerate() {
-                    given[i] = Some(Assignment { activity: a, functionality: f });
-                }
+            let Some(cover) = cover_schema(act, &given, n, |i, f| score(i, a, f)) else {
+                continue;
+            };
+            for (f, i) in cover.into_iter().enumerate() {
+                given[i] = Some(Assignment { activity: a, functionality: f });
             }
-            continue;
+        } else {
+            let c = candidates(&given, a);
+            if c.len() < act.card_min {
+                continue;
+            }
+            for &i in c.iter().take(act.card_min) {
+                given[i] = Some(Assignment { activity: a, functionality: 0 });
+            }
+            admitted.push(a);
         }
-        let c = candidates(&given, a);
-        if c.len() < act.card_min {
-            continue;
-        }
-        for &i in c.iter().take(act.card_min) {
-            given[i] = Some(Assignment { activity: a, functionality: 0 });
-        }
-        admitted.push(a);
+        groups_done.extend(act.group.as_deref());
     }
     for a in admitted {
         let act = &table.list[a];
@@ -455,6 +476,30 @@ mod tests {
         let a = allocate(&t, &[1.0, 1.0], &two, &Params::default());
         assert_eq!(a.of(2), Some(Assignment { activity: 0, functionality: 0 }));
         assert_eq!(a.of(1), Some(Assignment { activity: 0, functionality: 1 }));
+    }
+
+    #[test]
+    fn activities_of_one_group_are_alternatives() {
+        let t = Activities::new(vec![
+            Activity::schema("PassageToMate", &["passer", "receiver"], 2).in_group("ball"),
+            Activity::job("BringBall", 1, 1, 1).in_group("ball"),
+            Activity::job("Support", 0, 9, 0),
+        ]);
+        // Slots: passer, receiver, BringBall, Support.
+        let agents = [
+            Agent::new(1, vec![0.9, 0.2, 0.9, 0.3]),
+            Agent::new(2, vec![0.1, 0.8, 0.5, 0.3]),
+            Agent::new(3, vec![0.0, 0.0, 0.7, 0.3]),
+        ];
+        let a = allocate(&t, &[1.0, 1.0, 1.0], &agents, &Params::default());
+        // The passage is given; robot 3 would bring the ball, but that is the passage's
+        // purpose: it supports.
+        assert_eq!(a.names(&t), vec![(1, "PassageToMate"), (2, "PassageToMate"), (3, "Support")]);
+        // Without a receiver the passage is skipped and BringBall is open again.
+        let agents =
+            [Agent::new(1, vec![0.9, 0.0, 0.9, 0.3]), Agent::new(3, vec![0.0, 0.0, 0.7, 0.3])];
+        let a = allocate(&t, &[1.0, 1.0, 1.0], &agents, &Params::default());
+        assert_eq!(a.names(&t), vec![(1, "BringBall"), (3, "Support")]);
     }
 
     #[test]

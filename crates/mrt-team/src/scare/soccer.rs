@@ -44,8 +44,8 @@ pub mod ids {
 pub fn table() -> Activities {
     Activities::new(vec![
         Activity::job("Goalie", 1, 1, 6),
-        Activity::schema("PassageToMate", &["passer", "receiver"], 5),
-        Activity::job("BringBall", 1, 1, 4),
+        Activity::schema("PassageToMate", &["passer", "receiver"], 5).in_group("ball"),
+        Activity::job("BringBall", 1, 1, 4).in_group("ball"),
         Activity::job("RecoverWanderingBall", 1, 2, 4),
         Activity::schema("DefensiveDoubling", &["block", "cover"], 3),
         Activity::job("Defense", 0, 1, 2),
