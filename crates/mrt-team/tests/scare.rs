@@ -20,8 +20,11 @@ fn field_xy() -> impl Strategy<Value = (f64, f64)> {
     (-9000.0..9000.0f64, -6000.0..6000.0f64)
 }
 
-/// A team of `n` robots (robot 1 keeps goal), the ball (or none) and some opponents.
-fn team() -> impl Strategy<Value = (Vec<(f64, f64)>, Option<(f64, f64)>, Vec<(f64, f64)>)> {
+/// Robot positions, the ball (or none), opponents.
+type Team = (Vec<(f64, f64)>, Option<(f64, f64)>, Vec<(f64, f64)>);
+
+/// A team of 2 to 5 robots (robot 1 keeps goal), the ball (or none) and some opponents.
+fn team() -> impl Strategy<Value = Team> {
     (
         prop::collection::vec(field_xy(), 2..6),
         prop::option::weighted(0.85, field_xy()),
