@@ -4,6 +4,8 @@
 
 #[path = "06_anchoring_robots.rs"]
 pub mod anchoring_robots;
+#[path = "08_coordinating_with_scare.rs"]
+pub mod coordinating_with_scare;
 #[path = "03_fuzzy_controller.rs"]
 pub mod fuzzy_controller;
 #[path = "01_hello_agora.rs"]
@@ -19,6 +21,28 @@ pub mod two_agoras;
 
 #[cfg(test)]
 mod tests {
+    /// Example 08: every robot computes the same allocation; with the opponent in front of
+    /// the ball robots 2 and 3 run the passage, the keeper keeps goal, robot 4 defends;
+    /// without it robot 2 brings the ball.
+    #[test]
+    fn coordinating_with_scare_gives_every_robot_the_same_allocation() {
+        use super::coordinating_with_scare::run;
+        let (views, job) = run(&[(-200.0, 0.0)], false);
+        assert!(views.windows(2).all(|w| w[0] == w[1]), "{views:?}");
+        let expect =
+            |v: &[(u32, &str)]| v.iter().map(|(r, a)| (*r, a.to_string())).collect::<Vec<_>>();
+        assert_eq!(
+            views[0],
+            expect(&[(1, "Goalie"), (2, "PassageToMate"), (3, "PassageToMate"), (4, "Defense")])
+        );
+        assert_eq!(job, "PassageToMate (passer), sub-task ReachBall");
+        let (views, job) = run(&[], false);
+        assert!(views.windows(2).all(|w| w[0] == w[1]), "{views:?}");
+        assert_eq!(views[0][1], (2, "BringBall".to_string()));
+        // Robot 2 stands 0.5 m behind the ball on the line to the net: ReachBall is done.
+        assert_eq!(job, "BringBall, sub-task Shoot");
+    }
+
     /// Example 07: the door is taken when the building is empty, a visitor in the doorway
     /// blocks the first path and leaves no other, and a visitor on the path in the right
     /// room blocks it and is gone round (0.25 + 0.3 + 0.1 m from the visitor's centre).
