@@ -15,9 +15,10 @@ use std::thread;
 /// first message is not lost to a consumer that has not subscribed yet.
 ///
 /// Periodic Members sleep until their next deadline (a missed deadline is skipped, not made
-/// up in a burst); cyclic Members run back to back; on-message Members spin briefly, then
-/// park until a message arrives. A `SLWDWCV` PostOffice gets its dispatcher thread (the
-/// manual's *MsgManager*).
+/// up in a burst); cyclic Members run back to back; on-message Members yield briefly (and
+/// spin before that when the Agora has fewer Members than the machine has cores, so that a
+/// spinning Member never takes its producer's core), then park until a message arrives. A
+/// `SLWDWCV` PostOffice gets its dispatcher thread (the manual's *MsgManager*).
 #[derive(Debug, Default)]
 pub struct ThreadedExecutor {
     _private: (),
