@@ -262,10 +262,15 @@ impl WorldSnapshot {
     /// (`getNearestOpponent`): an opponent, or a robot of unknown team (a careful player
     /// treats a robot it cannot place as an opponent).
     pub fn nearest_opponent(&self, min_reliability: f64) -> Option<&AnchoredRobot> {
+        self.opponents(min_reliability).min_by(|a, b| a.rho.total_cmp(&b.rho))
+    }
+
+    /// The anchored robots not known to be teammates, with at least `min_reliability`:
+    /// opponents, and robots of unknown team (treated as opponents).
+    pub fn opponents(&self, min_reliability: f64) -> impl Iterator<Item = &AnchoredRobot> {
         self.robots
             .iter()
-            .filter(|r| r.class != RobotClass::Teammate && r.reliability >= min_reliability)
-            .min_by(|a, b| a.rho.total_cmp(&b.rho))
+            .filter(move |r| r.class != RobotClass::Teammate && r.reliability >= min_reliability)
     }
 
     /// The free direction nearest to `desired` (rad, robot frame; `getFreeDirection`): the

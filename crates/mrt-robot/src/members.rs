@@ -51,7 +51,7 @@ use crate::planner::{carrot, plans_for, same_goal, Planner, REPLAN};
 use crate::stacks::{embedded_teamchaos, send_brain, Geometry, Stack, CHAOS_KEEPER, CHAOS_PLAYER};
 use mrt_core::{Point2, Pose2};
 use mrt_dcdt::{Activation, Agora, Context, Member, MemberError, Message, RequestType, RunReport};
-use mrt_msgs::robot::{lps, Lpo, RobotClass};
+use mrt_msgs::robot::{lps, Lpo};
 use mrt_msgs::{
     BehaviorStatus, BookingReport, CameraFrame, GameInfo, MateReport, MemberFault, MotorCommand,
     Odometry, Percepts, RobotCommand, Sonar, SonarScan, WorldSnapshot,
@@ -196,9 +196,10 @@ impl Member for WorldState {
             keeper: self.keeper,
             said: self.role,
         };
-        let mates = self.mates.values().filter(|r| self.booking.hears(r.id, now) && r.id != id);
+        let heard: Vec<&MateReport> =
+            self.mates.values().filter(|r| self.booking.hears(r.id, now) && r.id != id).collect();
         let players: Vec<Player> = std::iter::once(me)
-            .chain(mates.map(|r| Player {
+            .chain(heard.iter().map(|r| Player {
                 id: r.id,
                 at: (r.pose.pose.x, r.pose.pose.y),
                 keeper: r.keeper,
@@ -212,11 +213,6 @@ impl Member for WorldState {
         w.role = self.role.name().to_string();
         // SCARE, on the same teammates and team ball.
         if let Some(scare) = &mut self.scare {
-            let heard: Vec<&MateReport> = self
-                .mates
-                .values()
-                .filter(|r| self.booking.hears(r.id, now) && r.id != id)
-                .collect();
             let sit = situation(&w, self.keeper, ball, &heard);
             let shot = Geometry::of(&w.field).open_side(&w);
             let reports: Vec<_> = heard.iter().map(|r| (r.id, &r.scare)).collect();
@@ -246,12 +242,7 @@ fn situation(
         keeper,
         ball,
         mates: heard.iter().map(|r| (r.id, (r.pose.pose.x, r.pose.pose.y), r.keeper)).collect(),
-        opponents: w
-            .robots
-            .iter()
-            .filter(|r| r.class != RobotClass::Teammate && r.reliability >= WorldSnapshot::ANCHORED)
-            .map(|r| (r.x, r.y))
-            .collect(),
+        opponents: w.opponents(WorldSnapshot::ANCHORED).map(|r| (r.x, r.y)).collect(),
         half_length: w.field.half_length,
         goal_half_width: w.field.goal_half_width,
     }

@@ -17,9 +17,7 @@ use crate::config::RobotConfig;
 use crate::files::FilesDir;
 use mrt_core::{Point2, Pose2};
 use mrt_fuzzy::brian::Brian;
-use mrt_msgs::robot::{
-    lps, Field, GameState, Lpo, RobotClass, RobotCommand, Target, WorldSnapshot,
-};
+use mrt_msgs::robot::{lps, Field, GameState, Lpo, RobotCommand, Target, WorldSnapshot};
 use mrt_plan::guidance::behind_ball;
 use mrt_script::{Sandbox, ThinkingCap, Watchdog, DEFAULT_DEADLINE};
 use std::path::Path;
@@ -145,6 +143,22 @@ impl Geometry {
         behind_ball(b, goal, distance).unwrap_or(Pose2::new(ball.0 - distance, ball.1, 0.0))
     }
 
+    /// Where to go to get `behind` the ball (a posture from [`Geometry::behind_ball`]): the
+    /// posture's point itself, or, for a robot at `me` in front of the ball (ahead of it along
+    /// the posture's heading), that point 600 mm to the robot's side, so that it steps round
+    /// the ball instead of driving back through it.
+    pub fn step_round(me: Pose2, ball: (f64, f64), behind: Pose2) -> (f64, f64) {
+        let (ux, uy) = (behind.theta.cos(), behind.theta.sin());
+        let (rx, ry) = (ball.0 - me.x, ball.1 - me.y);
+        let (mut px, mut py) = (behind.x, behind.y);
+        if rx * ux + ry * uy < 0.0 {
+            let side = if (me.x - ball.0) * uy - (me.y - ball.1) * ux > 0.0 { 1.0 } else { -1.0 };
+            px += side * 600.0 * uy;
+            py -= side * 600.0 * ux;
+        }
+        (px, py)
+    }
+
     /// Where along the opponent's goal line to shoot (mm from its centre): the open side,
     /// away from the robot the world model anchored nearest the goal's centre (within 1.5 m,
     /// not a teammate: the goalkeeper), two thirds of the way to the post; the centre when no
@@ -152,9 +166,7 @@ impl Geometry {
     /// Chaser: docs/performance.md, "Teams".
     pub fn open_side(&self, w: &WorldSnapshot) -> f64 {
         let keeper = w
-            .robots
-            .iter()
-            .filter(|r| r.class != RobotClass::Teammate && r.reliability >= WorldSnapshot::ANCHORED)
+            .opponents(WorldSnapshot::ANCHORED)
             .map(|r| (r, (r.x - self.half_length).hypot(r.y)))
             .filter(|(_, d)| *d < 1500.0)
             .min_by(|a, b| a.1.total_cmp(&b.1));
@@ -273,47 +285,37 @@ impl MilanBrain {
             v.push(("PositionAngle", deg360(dy.atan2(dx) - me.theta), q));
         }
         let ball = w.lps[lps::BALL];
-        if ball.reliability >= 0.1 {
+        let ball_at = (ball.reliability >= 0.1).then(|| Geometry::ball_at(me, &ball));
+        if let Some((bx, by)) = ball_at {
             let r = ball.reliability;
             v.push(("BallDistance", ball.rho, r));
             v.push(("BallBearing", deg360(ball.theta), r));
             // The ball and the point 400 mm behind it on the line from where it should go:
             // the job's aim (the net's open side, or a mate for a pass).
-            let (bx, by) = Geometry::ball_at(me, &ball);
             let aim = job.and_then(|j| j.aim).unwrap_or((field.half_length, field.open_side(w)));
+            let at_net = (aim.0 - field.half_length).abs() < 1.0;
             let spot = behind_ball(Point2::new(bx, by), Point2::new(aim.0, aim.1), 400.0)
                 .unwrap_or(Pose2::new(bx - 400.0, by, 0.0));
             // How far (degrees) the kick, along the robot's heading, would miss what it aims
             // at: the goal mouth less a ball's margin at each post for a shot at the net, a
-            // 0.8 m wide target round a mate for a pass; 0 on target.
-            let half = if (aim.0 - field.half_length).abs() < 1.0 {
-                let off = (field.goal_half_width - 250.0).max(0.0);
-                let (lo, hi) = ((aim.1 - off).max(-off), (aim.1 + off).min(off));
-                let lo = (lo - by).atan2(aim.0 - bx);
-                let hi = (hi - by).atan2(aim.0 - bx);
-                let mid = 0.5 * (lo + hi);
-                (mid, 0.5 * (hi - lo).abs())
-            } else {
-                let d = (aim.0 - bx).hypot(aim.1 - by).max(1.0);
-                ((aim.1 - by).atan2(aim.0 - bx), (400.0 / d).atan())
-            };
-            // In the own half any kick that clears the ball forwards will do.
-            let miss = if bx < 0.0 && (aim.0 - field.half_length).abs() < 1.0 {
+            // 0.8 m wide target round a mate for a pass; 0 on target. In the own half any
+            // kick that clears the ball forwards will do.
+            let miss = if at_net && bx < 0.0 {
                 0.0
             } else {
-                mrt_core::normalize_angle(me.theta - half.0).abs() - half.1
+                let (mid, half) = if at_net {
+                    let off = (field.goal_half_width - 250.0).max(0.0);
+                    let lo = ((aim.1 - off).max(-off) - by).atan2(aim.0 - bx);
+                    let hi = ((aim.1 + off).min(off) - by).atan2(aim.0 - bx);
+                    (0.5 * (lo + hi), 0.5 * (hi - lo).abs())
+                } else {
+                    let d = (aim.0 - bx).hypot(aim.1 - by).max(1.0);
+                    ((aim.1 - by).atan2(aim.0 - bx), (400.0 / d).atan())
+                };
+                mrt_core::normalize_angle(me.theta - mid).abs() - half
             };
             v.push(("AimError", miss.max(0.0).to_degrees(), r));
-            // A robot in front of the ball steps round it, 600 mm to the side it is on, instead
-            // of driving back through it.
-            let (ux, uy) = (spot.theta.cos(), spot.theta.sin());
-            let (rx, ry) = (bx - me.x, by - me.y);
-            let (mut tx, mut ty) = (spot.x, spot.y);
-            if rx * ux + ry * uy < 0.0 {
-                let side = if (me.x - bx) * uy - (me.y - by) * ux > 0.0 { 1.0 } else { -1.0 };
-                tx += side * 600.0 * uy;
-                ty -= side * 600.0 * ux;
-            }
+            let (tx, ty) = Geometry::step_round(me, (bx, by), spot);
             let (dx, dy) = (tx - me.x, ty - me.y);
             v.push(("ApproachDistance", dx.hypot(dy), r));
             v.push(("ApproachAngle", deg360(dy.atan2(dx) - me.theta), r));
@@ -325,7 +327,7 @@ impl MilanBrain {
             // The keeper's spot: 300 mm out of the goal line, level with the ball within the
             // posts (the middle of the goal when the ball is not seen); it faces the ball.
             let gw = field.goal_half_width;
-            let y = if ball.reliability >= 0.1 { Geometry::ball_at(me, &ball).1 } else { 0.0 };
+            let y = ball_at.map_or(0.0, |b| b.1);
             let (kx, ky) = (-field.half_length + 300.0, y.clamp(-(gw - 100.0), gw - 100.0));
             let (dx, dy) = (kx - me.x, ky - me.y);
             v.push(("KeeperSpotDistance", dx.hypot(dy), q));
@@ -495,13 +497,7 @@ impl Brain for Chaser {
                 }
             } else {
                 // Go round: to a point behind the ball, stepping aside first when in front.
-                let (mut px, mut py) = (behind.x, behind.y);
-                if along < 0.0 {
-                    let side = if (me.x - bx) * uy - (me.y - by) * ux > 0.0 { 1.0 } else { -1.0 };
-                    px += side * 600.0 * uy;
-                    py -= side * 600.0 * ux;
-                }
-                Chaser::go(me, (px, py), a, &mut c);
+                Chaser::go(me, Geometry::step_round(me, (bx, by), behind), a, &mut c);
             }
         }
         c

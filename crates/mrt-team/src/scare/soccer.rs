@@ -38,6 +38,8 @@ pub mod ids {
     pub const DEFENSE: usize = 5;
     /// Support (the default).
     pub const SUPPORT: usize = 6;
+    /// How many activities the table has.
+    pub const COUNT: usize = 7;
 }
 
 /// Team Milan's activity table (module doc).
@@ -181,7 +183,7 @@ impl Situation {
 
     /// The opportunity of each activity of [`table`], as robot `me` rates it.
     pub fn opportunity(&self, me: u32) -> Vec<f64> {
-        let mut o = vec![0.0; 7];
+        let mut o = vec![0.0; ids::COUNT];
         o[ids::GOALIE] = 1.0;
         o[ids::SUPPORT] = 1.0;
         let Some(ball) = self.ball else {
@@ -208,9 +210,8 @@ impl Situation {
     /// This robot's attitude for every slot of [`table`] (in slot order: Goalie, passer,
     /// receiver, BringBall, RecoverWanderingBall, block, cover, Defense, Support).
     pub fn attitudes(&self) -> Vec<f64> {
-        let keeper = if self.keeper { 1.0 } else { 0.0 };
         if self.keeper {
-            return vec![keeper, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0];
+            return vec![1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0];
         }
         let me = self.pos();
         let (bring, receive, block, cover, defense) = match self.ball {
@@ -383,8 +384,8 @@ impl Coordinator {
         let opportunity = sit.opportunity(self.id);
         let mut agents = vec![Agent::new(self.id, attitudes.clone()).doing(self.doing)];
         let mut leader = (self.id, opportunity.clone());
+        let n = self.table.list().len();
         for (id, r) in heard {
-            let n = self.table.list().len();
             if *id == self.id
                 || r.table != self.fingerprint
                 || r.attitudes.len() != self.table.slots()
@@ -523,6 +524,8 @@ mod tests {
         };
         let t = table();
         assert_eq!(t.slots(), sit(1).attitudes().len());
+        assert_eq!(t.list().len(), ids::COUNT);
+        assert_eq!(t.find("Support"), Some(ids::SUPPORT));
         let agents: Vec<Agent> =
             (0..4).map(|i| Agent::new(i as u32 + 1, sit(i).attitudes())).collect();
         let a = allocate(&t, &sit(0).opportunity(1), &agents, &Params::default());
