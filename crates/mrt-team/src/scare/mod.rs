@@ -325,10 +325,14 @@ pub fn allocate(
         c.into_iter().map(|(i, _)| i).collect()
     };
     let mut admitted = Vec::new();
-    let mut groups_done: Vec<&str> = Vec::new();
+    // Each group and the activity of it that was given robots first.
+    let mut owners: Vec<(&str, usize)> = Vec::new();
+    let taken_by_other = |owners: &[(&str, usize)], a: usize| {
+        table.list[a].group.as_deref().is_some_and(|g| owners.iter().any(|o| o.0 == g && o.1 != a))
+    };
     for &a in &agenda {
         let act = &table.list[a];
-        if act.group.as_deref().is_some_and(|g| groups_done.contains(&g)) {
+        if taken_by_other(&owners, a) {
             continue;
         }
         if act.schema {
@@ -347,14 +351,27 @@ pub fn allocate(
                 given[i] = Some(Assignment { activity: a, functionality: 0 });
             }
             admitted.push(a);
+            if act.card_min == 0 {
+                // No robot yet: the group stays open until the second pass gives it some.
+                continue;
+            }
         }
-        groups_done.extend(act.group.as_deref());
+        owners.extend(act.group.as_deref().map(|g| (g, a)));
     }
     for a in admitted {
+        if taken_by_other(&owners, a) {
+            continue;
+        }
         let act = &table.list[a];
         let have = given.iter().filter(|g| g.is_some_and(|g| g.activity == a)).count();
-        for i in candidates(&given, a).into_iter().take(act.card_max.saturating_sub(have)) {
+        let more = candidates(&given, a).into_iter().take(act.card_max.saturating_sub(have));
+        let mut any = have > 0;
+        for i in more {
             given[i] = Some(Assignment { activity: a, functionality: 0 });
+            any = true;
+        }
+        if any {
+            owners.extend(act.group.as_deref().map(|g| (g, a)));
         }
     }
     if let Some(d) = table.default {
@@ -500,6 +517,17 @@ mod tests {
             [Agent::new(1, vec![0.9, 0.0, 0.9, 0.3]), Agent::new(3, vec![0.0, 0.0, 0.7, 0.3])];
         let a = allocate(&t, &[1.0, 1.0, 1.0], &agents, &Params::default());
         assert_eq!(a.names(&t), vec![(1, "BringBall"), (3, "Support")]);
+        // A job of the group with no minimum does not close the group before it has robots
+        // (Press would otherwise shut BringBall out in the first pass and take robot 2 in the
+        // second), and once BringBall has its robot the others of the group get none.
+        let t = Activities::new(vec![
+            Activity::job("Press", 0, 1, 3).in_group("ball"),
+            Activity::job("BringBall", 1, 1, 2).in_group("ball"),
+            Activity::job("Chase", 0, 1, 1).in_group("ball"),
+        ]);
+        let agents = [Agent::new(1, vec![0.2, 0.9, 0.5]), Agent::new(2, vec![0.8, 0.3, 0.9])];
+        let a = allocate(&t, &[1.0, 1.0, 1.0], &agents, &Params::default());
+        assert_eq!(a.names(&t), vec![(1, "BringBall")]);
     }
 
     #[test]
