@@ -31,6 +31,9 @@ pub struct FilterCounts {
     /// Times the relocalizer's fix replaced the filter's pose.
     #[serde(default)]
     pub relocalized: u64,
+    /// Field-line points that corrected the pose.
+    #[serde(default)]
+    pub line_corrections: u64,
 }
 
 /// A robot's own pose estimate after a cycle, in the field frame (m, rad; not the team frame

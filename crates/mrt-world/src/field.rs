@@ -9,7 +9,7 @@
 //! ends of the half-way line. This table exists once: the simulator computes what a camera
 //! sees from it, and the world model corrects its pose with it.
 
-use mrt_core::Point2;
+use mrt_core::{Point2, Vec2};
 use mrt_msgs::{Field, FIELD_OBJECTS};
 use serde::{Deserialize, Serialize};
 
@@ -142,6 +142,42 @@ impl FieldMap {
         lines
     }
 
+    /// The field line that a point `p` seen on the floor (field frame, m) lies on, when only
+    /// one line can explain it: the nearest line (a straight one it lies beside, within
+    /// [`LINE_END_SLACK`] of its ends, or the centre circle), when the next one is farther
+    /// by at least `clearance` (m). The tracker corrects its pose with such points
+    /// ([`crate::model::WorldModel`]).
+    pub fn line_fit(&self, p: Point2, clearance: f64) -> Option<LineFit> {
+        let straight = self.lines().into_iter().filter_map(|s| {
+            let d = s.b - s.a;
+            let len = d.norm();
+            let u = d / len.max(1e-12);
+            let along = (p - s.a).dot(&u);
+            if along < -LINE_END_SLACK || along > len + LINE_END_SLACK {
+                return None;
+            }
+            let normal = Vec2::new(-u.y, u.x);
+            Some(LineFit { normal, residual: (p - s.a).dot(&normal) })
+        });
+        let r = p.coords.norm();
+        let circle = (r > 1e-6)
+            .then(|| LineFit { normal: p.coords / r, residual: r - self.centre_circle_radius });
+        let (mut best, mut second): (Option<LineFit>, f64) = (None, f64::INFINITY);
+        for fit in straight.chain(circle) {
+            let d = fit.residual.abs();
+            match best {
+                Some(b) if d >= b.residual.abs() => second = second.min(d),
+                _ => {
+                    if let Some(b) = best {
+                        second = b.residual.abs();
+                    }
+                    best = Some(fit);
+                }
+            }
+        }
+        best.filter(|b| second - b.residual.abs() >= clearance)
+    }
+
     /// The field as behaviors read it in their [`mrt_msgs::WorldSnapshot`]: half sizes in
     /// millimetres (the unit of TeamChaos' `getField`, seed `001` §3.3).
     pub fn snapshot(&self) -> Field {
@@ -152,6 +188,21 @@ impl FieldMap {
             penalty_area_depth: self.penalty_area_depth * 1000.0,
         }
     }
+}
+
+/// A floor point beside a straight field line counts as on it up to this far beyond its
+/// ends, m (a line's end is where another meets it, or a corner).
+pub const LINE_END_SLACK: f64 = 0.1;
+
+/// How a point lies against the field line it was matched to ([`FieldMap::line_fit`]): the
+/// line's unit normal (for the centre circle, pointing away from its centre) and the point's
+/// signed distance along it from the line, m. The point lies on the line at residual 0.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LineFit {
+    /// The line's unit normal at the point.
+    pub normal: Vec2,
+    /// The point's signed distance from the line along `normal`, m.
+    pub residual: f64,
 }
 
 /// How many fixed objects the map holds (every camera object but the ball).
@@ -205,6 +256,42 @@ mod tests {
         assert!(lines.iter().all(|s| [s.a, s.b]
             .iter()
             .all(|p| p.x.abs() <= 9.0 + 1e-12 && p.y.abs() <= 6.0 + 1e-12)));
+    }
+
+    #[test]
+    fn a_floor_point_is_matched_to_the_one_line_it_lies_beside() {
+        let map = FieldMap::default();
+        // 4 cm north of the north touch line, half-way between the corner and the middle (the
+        // normal's sign follows the segment's direction; the residual along it is +4 cm north).
+        let fit = map.line_fit(Point2::new(4.5, 6.04), 0.5).unwrap();
+        assert!((fit.normal.y.abs() - 1.0).abs() < 1e-12 && fit.normal.x.abs() < 1e-12);
+        assert!((fit.residual * fit.normal.y - 0.04).abs() < 1e-12, "{fit:?}");
+        // On the centre circle, 3 cm outside it, 45° round: the normal points outwards.
+        let p = Point2::new(2.03 * 0.5f64.sqrt(), 2.03 * 0.5f64.sqrt());
+        let fit = map.line_fit(p, 0.5).unwrap();
+        assert!(
+            (fit.residual - 0.03).abs() < 1e-12 && (fit.normal.x - 0.5f64.sqrt()).abs() < 1e-12
+        );
+        // Beside the half-way line inside the centre circle, 5 cm from the line and 1.95 m
+        // from the circle: the line.
+        let fit = map.line_fit(Point2::new(0.05, 0.0), 0.5).unwrap();
+        assert!(
+            (fit.residual.abs() - 0.05).abs() < 1e-12 && (fit.normal.x.abs() - 1.0).abs() < 1e-12
+        );
+        // Where the half-way line crosses the circle both fit: no answer.
+        assert_eq!(map.line_fit(Point2::new(0.02, 1.99), 0.5), None);
+        // In a corner both lines fit: no answer.
+        assert_eq!(map.line_fit(Point2::new(9.0, 6.0), 0.5), None, "the corner");
+        // Far from every line, the nearest still counts when it is clear of the next: at
+        // (4.5, 3) the penalty area's front line (x = 6.75) is 2.25 m away, the north touch
+        // line 3 m, the centre circle 3.41 m, the half-way line 4.5 m.
+        let fit = map.line_fit(Point2::new(4.5, 3.0), 0.5).unwrap();
+        assert!((fit.residual.abs() - 2.25).abs() < 1e-12, "{fit:?}");
+        // Beyond a line's end by more than the slack, the line is not a candidate: 0.5 m past
+        // the end of the penalty area's north line (y = 3.25 from x = 6.75 to 9) at x = 6.25,
+        // 1 cm off it, the nearest candidate is another line.
+        let fit = map.line_fit(Point2::new(6.25, 3.26), 0.0).unwrap();
+        assert!(fit.residual.abs() > 0.4, "{fit:?}");
     }
 
     #[test]

@@ -279,6 +279,12 @@ impl Relocalizer {
         }
     }
 
+    /// Whether the tracker's pose explained the last frame with perceptions: `None` before
+    /// the first, or when that frame weighed too little to say (a few line points).
+    pub fn last_fits(&self) -> Option<bool> {
+        self.glimpses.back().and_then(|g| g.fits)
+    }
+
     /// What it did so far.
     pub fn counts(&self) -> RelocalizerCounts {
         self.counts
