@@ -11,6 +11,7 @@
 //! | SCARE (MRT manual ch. 11): jobs and schemata, attitude and opportunity, the agenda, the allocation | [`scare::allocate`], [`scare::Activities`] |
 //! | SCARE's sequencer and monitor | [`scare::sequencer::Sequencer`] |
 //! | Team Milan's activities (BringBall, PassageToMate, Defense, ...) | [`scare::soccer`] |
+//! | ISocRob's Machine µAgent: modes, roles, the attacker's state machine, the goalkeeper's modes, `should_I_go` (seed `003` §3.2.2) | [`isocrob`] |
 //!
 //! ```
 //! use mrt_team::booking::{BallBooking, BookingParams};
@@ -27,5 +28,6 @@
 #![deny(missing_docs)]
 
 pub mod booking;
+pub mod isocrob;
 pub mod roles;
 pub mod scare;
