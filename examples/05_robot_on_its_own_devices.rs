@@ -132,7 +132,7 @@ pub fn run(cycles: usize, verbose: bool) -> Result<Outcome> {
     let devices = Arc::new(Mutex::new(robot));
     let mut exec = SteppedExecutor::new(SimClock::new(), cfg.period());
     let mut agora = exec.agora_builder(2).build()?;
-    let spec = RobotSpec { robot: 1, keeper: false, stack: Stack::Chaser };
+    let spec = RobotSpec { robot: 1, keeper: false, mate: 1, stack: Stack::Chaser };
     add_robot(&mut agora, &cfg, &spec, std::path::Path::new(""), devices.clone())
         .map_err(|e| anyhow!(e))?;
     exec.add_agora(agora)?;

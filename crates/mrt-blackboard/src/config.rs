@@ -113,7 +113,13 @@ pub fn parse(text: &str, file: &Path) -> Result<Vec<Binding>, ConfigError> {
 pub fn load_file(bb: &Blackboard, file: &Path) -> Result<usize, ConfigError> {
     let text = std::fs::read_to_string(file)
         .map_err(|source| ConfigError::Io { file: file.to_path_buf(), source })?;
-    let bindings = parse(&text, file)?;
+    load_text(bb, &text, file)
+}
+
+/// Binds the values of a configuration file's `text` on `bb` (`file` names it in errors: a
+/// file compiled into the program needs no copy on disk). Returns how many bindings it had.
+pub fn load_text(bb: &Blackboard, text: &str, file: &Path) -> Result<usize, ConfigError> {
+    let bindings = parse(text, file)?;
     for b in &bindings {
         bb.set(&b.symbol.to_string(), b.value.clone()).map_err(|e| ConfigError::Parse {
             file: file.to_path_buf(),

@@ -21,7 +21,8 @@ pub struct SimArgs {
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
     /// The home team's stack: milan (Mr. BRIAN fuzzy behaviors), chaos (TeamChaos' Lua
-    /// state machines and fuzzy behaviors) or chaser (a hand-written baseline).
+    /// state machines and fuzzy behaviors), isocrob (ISocRob's role state machines on a shared
+    /// blackboard) or chaser (a hand-written baseline).
     #[arg(long, default_value = "milan")]
     pub home: String,
     /// The away team's stack (same choices).

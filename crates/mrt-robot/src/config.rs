@@ -411,7 +411,7 @@ impl RobotFile {
         if r.id >= 2 * n {
             return Err(format!("robot.id must be below 2 × team_size = {}, not {}", 2 * n, r.id));
         }
-        Ok(crate::members::RobotSpec { robot: r.id, keeper: r.id % n == 0, stack })
+        Ok(crate::members::RobotSpec { robot: r.id, keeper: r.id % n == 0, mate: r.id % n, stack })
     }
 
     /// The robot's configuration, every value checked.

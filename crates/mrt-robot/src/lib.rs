@@ -12,7 +12,8 @@
 //!   put into the robot's Agora by [`members::add_robot`];
 //! - the **[`commander::Commander`]** (TeamChaos' Commander Module) that adapts a team's
 //!   behaviors to the body, and the **behavior stacks** ([`stacks`]: TeamChaos on ThinkingCap,
-//!   Team Milan on Mr. BRIAN, the hand-written `Chaser`) behind the [`brain::Brain`] trait;
+//!   Team Milan on Mr. BRIAN, Team ISocRob's Machine on a blackboard ([`isocrob`]), the
+//!   hand-written `Chaser`) behind the [`brain::Brain`] trait;
 //! - the **[`config::RobotConfig`]**: what belongs to the robot (base, sensors, field, stack),
 //!   apart from any simulator's world;
 //! - the runner of a robot whose devices are reached over the bus ([`remote::RemoteRobot`]).
@@ -40,6 +41,7 @@ pub mod commander;
 pub mod config;
 pub mod devices;
 pub mod files;
+pub mod isocrob;
 pub mod members;
 pub mod planner;
 pub mod remote;

@@ -47,8 +47,10 @@ use crate::commander::Commander;
 use crate::config::RobotConfig;
 use crate::devices::{Devices, SharedDevices};
 use crate::files::FilesDir;
+use crate::isocrob::IsocrobBrain;
 use crate::planner::{carrot, plans_for, same_goal, Planner, REPLAN};
 use crate::stacks::{embedded_teamchaos, send_brain, Geometry, Stack, CHAOS_KEEPER, CHAOS_PLAYER};
+use mrt_blackboard::{Blackboard, Proxy};
 use mrt_core::{Point2, Pose2};
 use mrt_dcdt::{Activation, Agora, Context, Member, MemberError, Message, RequestType, RunReport};
 use mrt_msgs::robot::{lps, Lpo};
@@ -61,6 +63,7 @@ use mrt_perception::vision::agent::VisionAgent;
 use mrt_plan::guide::Guidance;
 use mrt_script::member::BehaviorMember;
 use mrt_team::booking::{BallBooking, BookingParams};
+use mrt_team::isocrob::Role as IsocrobRole;
 use mrt_team::roles::{allocate, Player, Role};
 use mrt_team::scare::soccer::{Coordinator, Situation};
 
@@ -499,6 +502,8 @@ pub struct RobotSpec {
     pub robot: usize,
     /// Keeps goal (robot 0 of each team).
     pub keeper: bool,
+    /// Its number within its team (0: the goalkeeper).
+    pub mate: usize,
     /// What drives it.
     pub stack: Stack,
 }
@@ -508,7 +513,12 @@ impl RobotSpec {
     /// and the away team `away`.
     pub fn of(robot: usize, team_size: usize, (home, away): (Stack, Stack)) -> RobotSpec {
         let n = team_size.max(1);
-        RobotSpec { robot, keeper: robot % n == 0, stack: if robot < n { home } else { away } }
+        RobotSpec {
+            robot,
+            keeper: robot % n == 0,
+            mate: robot % n,
+            stack: if robot < n { home } else { away },
+        }
     }
 
     /// The id of the robot's Agora.
@@ -529,8 +539,22 @@ pub fn add_robot(
     behaviors: &Path,
     devices: SharedDevices,
 ) -> Result<(), String> {
-    let RobotSpec { robot, keeper, stack } = *spec;
+    let RobotSpec { robot, keeper, mate, stack } = *spec;
     let (behavior, commander): (Box<dyn Member>, _) = match stack {
+        Stack::Isocrob => {
+            // The robot's blackboard, shared with its teammates' through the Proxy.
+            let id = spec.agora_id()?;
+            let bb = Blackboard::new(id, agora.clock().clone());
+            let role = match mate {
+                0 if keeper => IsocrobRole::Goalkeeper,
+                1 => IsocrobRole::Defender,
+                _ => IsocrobRole::Attacker,
+            };
+            let brain = IsocrobBrain::new(id, role, mate, bb.clone())?;
+            let proxy = agora.add_member(Proxy::new(bb), Activation::Periodic(cfg.period()));
+            agora.activate_member(proxy).map_err(|e| e.to_string())?;
+            (Box::new(BrainMember::new(Box::new(brain))) as Box<dyn Member>, Commander::PLAIN)
+        }
         Stack::Chaos if keeper => {
             (Box::new(BehaviorMember::hbm(behaviors, CHAOS_KEEPER)), Commander::chaos(cfg))
         }

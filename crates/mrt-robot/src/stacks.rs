@@ -6,6 +6,8 @@
 //!   setup; `--behaviors DIR` runs edited copies instead.
 //! - **Milan**: the MRT manual's team on Mr. BRIAN (`configs/brian/milan`, compiled in):
 //!   [`MilanBrain`] is the manual's Parser and Messenger around the engine.
+//! - **ISocRob**: the Machine µAgent's roles on a blackboard shared through the Proxy
+//!   ([`crate::isocrob::IsocrobBrain`], `configs/isocrob/config.dat`, compiled in).
 //! - **Chaser**: the hand-written baseline player ([`Chaser`]).
 //!
 //! TeamChaos tuned its behaviors for AIBO walking speeds (about 0.3 m/s); on a Middle Size
@@ -31,6 +33,9 @@ pub enum Stack {
     Milan,
     /// The hand-written baseline.
     Chaser,
+    /// Team ISocRob: the Machine µAgent's role state machines on a shared blackboard
+    /// ([`crate::isocrob`]).
+    Isocrob,
 }
 
 impl Stack {
@@ -40,7 +45,8 @@ impl Stack {
             "chaos" => Ok(Stack::Chaos),
             "milan" => Ok(Stack::Milan),
             "chaser" => Ok(Stack::Chaser),
-            other => Err(format!("unknown team stack '{other}' (chaos, milan, chaser)")),
+            "isocrob" => Ok(Stack::Isocrob),
+            other => Err(format!("unknown team stack '{other}' (chaos, milan, isocrob, chaser)")),
         }
     }
 
@@ -50,6 +56,7 @@ impl Stack {
             Stack::Chaos => "chaos",
             Stack::Milan => "milan",
             Stack::Chaser => "chaser",
+            Stack::Isocrob => "isocrob",
         }
     }
 }
@@ -416,6 +423,9 @@ pub fn send_brain(stack: Stack, keeper: bool) -> Result<Box<dyn Brain + Send>, S
         Stack::Chaser => Ok(Box::new(Chaser { keeper })),
         Stack::Chaos => {
             Err("the Chaos stack runs in a Lua state (ChaosBrain, BehaviorMember)".into())
+        }
+        Stack::Isocrob => {
+            Err("an ISocRob robot needs its blackboard and Proxy (members::add_robot)".into())
         }
     }
 }

@@ -1,0 +1,463 @@
+//! Team ISocRob (seed `003` §3.2): robots whose Machine µAgent ([`mrt_team::isocrob`]) reads
+//! its parameters from the blackboard (`configs/isocrob/config.dat`, compiled in), talks to its
+//! teammates only through the blackboard (each posts its `should_I_go` heuristic as
+//! `*.var.machine.heuristic.<robot>`, carried by the [`Proxy`](mrt_blackboard::Proxy) Member),
+//! and fires the kicker through `local.var.kicker.kick`, which the Kicker µAgent watches.
+//!
+//! What the Machine posts for a person to watch with `mrt bb watch` (the seed's Monitor
+//! µAgent printed the same): `local.var.machine.mode`, `.role`, `.state`, `.heuristic`, `.slg`.
+//!
+//! The predicates come from the robot's world snapshot, never from the simulator:
+//! - `ffb()`: the ball was seen within `seen-ball` seconds (the front camera's LPS ball);
+//! - `ffog()`: the opponent's goal centre lies within `facing` of straight ahead (the world
+//!   model's LPS net, placed by the pose estimate when not in sight);
+//! - `fnb()`: the ball is seen, nearer than `att.near-ball` and before the kicker (in
+//!   FACE_GOAL, which goes round the ball, near is enough);
+//! - `r(360)`: the search turned the robot round once (its estimated heading, unwrapped);
+//! - `rp()`: the robot is within `reached` of its home posture;
+//! - `kb()`: the Kicker fired in this cycle;
+//! - `slg()`: [`should_i_go`] on the heuristics heard within `heard` seconds.
+//!
+//! The seed's robots "stand still" in SHOULD_I_GO; these walk to their home posture meanwhile,
+//! facing the ball, so that a robot that is not going for the ball stays in the game.
+
+use crate::brain::Brain;
+use crate::stacks::{walk_to_kickoff, Geometry};
+use mrt_blackboard::config::load_text;
+use mrt_blackboard::Blackboard;
+use mrt_core::{normalize_angle, Pose2};
+use mrt_msgs::robot::{lps, GameState, RobotCommand, Target, WorldSnapshot};
+use mrt_team::isocrob::{
+    heuristic, keeper, should_i_go, Attacker, AttackerState, KeeperBall, KeeperParams, Mode,
+    Predicates, Role,
+};
+use std::path::Path;
+
+/// The team's configuration, compiled in (`configs/isocrob/config.dat`).
+pub const CONFIG: &str = include_str!("../../../configs/isocrob/config.dat");
+
+/// The prefix of the heuristics the robots post; the robot's number follows.
+pub const HEURISTIC: &str = "*.var.machine.heuristic.";
+
+/// `fnb()` needs the near ball within this bearing, rad: before the kicker, not beside it
+/// (except in FACE_GOAL, which goes round the ball).
+const NEAR_FRONT: f64 = 0.6;
+
+/// Millimetres in a metre: the world snapshot's unit at the edge.
+const MM: f64 = 1000.0;
+
+/// Velocities towards `(tx, ty)` (team frame, mm), turning to `face` (rad): the holonomic
+/// base's forward and sideways components, at up to 1.5 m/s, slowing within 0.75 m.
+fn go(me: Pose2, (tx, ty): (f64, f64), face: f64, c: &mut RobotCommand) {
+    let (dx, dy) = (tx - me.x, ty - me.y);
+    c.vrot = (normalize_angle(face - me.theta).to_degrees() * 3.0).clamp(-200.0, 200.0);
+    let (s, co) = me.theta.sin_cos();
+    let (forward, left) = (dx * co + dy * s, -dx * s + dy * co);
+    let d = dx.hypot(dy).max(1.0);
+    let speed = (d * 2.0).min(1500.0);
+    c.vlin = forward / d * speed;
+    c.vlat = left / d * speed;
+}
+
+/// One ISocRob robot: the Machine µAgent and the Kicker µAgent on a shared blackboard.
+pub struct IsocrobBrain {
+    /// The robot's number on the blackboard (its Agora's id).
+    id: u32,
+    role: Role,
+    /// Among the field players of its team, which one (0, 1, ...): spreads the homes.
+    index: usize,
+    bb: Blackboard,
+    attacker: Attacker,
+    /// The heading when the search started and how far it has turned since, rad.
+    search: Option<(f64, f64)>,
+    /// When the kicker's valve opened, s (the Kicker µAgent).
+    pulse_from: Option<f64>,
+    faults: Vec<String>,
+}
+
+/// The Machine's parameters, read from the blackboard every cycle (a person may change them
+/// while the robot runs).
+#[derive(Clone, Copy, Debug)]
+struct Params {
+    near_ball: f64,
+    k1: f64,
+    facing: f64,
+    seen_ball: f64,
+    kick_distance: f64,
+    behind: f64,
+    heard: f64,
+    home_x: f64,
+    home_spread: f64,
+    reached: f64,
+    search_speed: f64,
+    keeper: KeeperParams,
+    pulse: f64,
+}
+
+impl IsocrobBrain {
+    /// Robot `id` (its number on the blackboard) of the team, playing `role`; `index` orders
+    /// the field players. Loads the team's configuration onto `bb`.
+    pub fn new(id: u32, role: Role, index: usize, bb: Blackboard) -> Result<IsocrobBrain, String> {
+        load_text(&bb, CONFIG, Path::new("configs/isocrob/config.dat"))
+            .map_err(|e| e.to_string())?;
+        bb.set("local.var.machine.role", role.name()).map_err(|e| e.to_string())?;
+        Ok(IsocrobBrain {
+            id,
+            role,
+            index,
+            bb,
+            attacker: Attacker::default(),
+            search: None,
+            pulse_from: None,
+            faults: Vec::new(),
+        })
+    }
+
+    /// The state of the attacker's machine.
+    pub fn state(&self) -> AttackerState {
+        self.attacker.state()
+    }
+
+    fn float(&self, name: &str, default: f64) -> f64 {
+        self.bb.get::<f64>(&format!("local.var.machine.config.{name}")).unwrap_or(default)
+    }
+
+    fn params(&self) -> Params {
+        let d = KeeperParams::default();
+        let home = if self.role == Role::Defender { "def.home-x" } else { "att.home-x" };
+        Params {
+            near_ball: self.float("att.near-ball", 0.5),
+            k1: self.float("k1", -0.5),
+            facing: self.float("facing", 0.25),
+            seen_ball: self.float("seen-ball", 0.3),
+            kick_distance: self.float("kick-distance", 5.0),
+            behind: self.float("behind", 0.45),
+            heard: self.float("heard", 1.0),
+            home_x: self.float(home, -1.0),
+            home_spread: self.float("home-spread", 2.5),
+            reached: self.float("reached", 0.3),
+            search_speed: self.float("search-speed", 1.5),
+            keeper: KeeperParams {
+                axis: self.float("gk.axis", d.axis),
+                reach: self.float("gk.reach", d.reach),
+                home_after: self.float("gk.home-after", d.home_after),
+                danger_time: self.float("gk.danger-time", d.danger_time),
+            },
+            pulse: self.bb.get::<i64>("local.var.kicker.config.pulse").unwrap_or(125) as f64
+                / 1000.0,
+        }
+    }
+
+    /// Posts a value for the monitor; a blackboard that refuses it is a fault, not a stop.
+    fn post(&mut self, symbol: &str, value: impl Into<mrt_blackboard::Value>) {
+        if let Err(e) = self.bb.set(symbol, value) {
+            self.faults.push(format!("blackboard {symbol}: {e}"));
+        }
+    }
+
+    /// The teammates' heuristics heard within `heard` seconds.
+    fn heard(&self, heard: f64) -> Vec<(u32, f64)> {
+        let now = self.bb.now().as_secs_f64();
+        self.bb
+            .list(None)
+            .into_iter()
+            .filter_map(|(symbol, value)| {
+                let id = symbol.strip_prefix(HEURISTIC)?.parse::<u32>().ok()?;
+                let v = value?;
+                let h = match v.value {
+                    mrt_blackboard::Value::Float(h) => h,
+                    _ => return None,
+                };
+                (now - v.time.as_secs_f64() <= heard).then_some((id, h))
+            })
+            .collect()
+    }
+
+    /// The Kicker µAgent (seed `003` §3.2.4): when `local.var.kicker.kick` is set it opens
+    /// the valve for the configured pulse (the kick command held that long) and clears the
+    /// variable. Returns whether the pulse ended in this cycle (`kb()`).
+    fn kicker(&mut self, now: f64, pulse: f64, cmd: &mut RobotCommand) -> bool {
+        if self.pulse_from.is_none() && self.bb.get::<bool>("local.var.kicker.kick") == Ok(true) {
+            self.pulse_from = Some(now);
+            self.post("local.var.kicker.kick", false);
+        }
+        match self.pulse_from {
+            Some(from) if now - from < pulse => {
+                cmd.kick = Some(1);
+                false
+            }
+            Some(_) => {
+                self.pulse_from = None;
+                true
+            }
+            None => false,
+        }
+    }
+
+    fn field_player(&mut self, w: &WorldSnapshot, p: &Params, kicked: bool) -> RobotCommand {
+        let me = w.my_pos.pose;
+        let me_m = Pose2::new(me.x / MM, me.y / MM, me.theta);
+        let ball = w.lps[lps::BALL];
+        let net = w.lps[lps::NET1];
+        let ffb = ball.reliability > 0.0 && ball.seen_ago <= p.seen_ball;
+        let ffog = net.theta.abs() <= p.facing && net.rho > 0.0;
+        // Near, and before the kicker; while going round the ball (FACE_GOAL) near is enough.
+        let near = ffb && ball.rho / MM <= p.near_ball;
+        let fnb = near
+            && (ball.theta.abs() < NEAR_FRONT || self.attacker.state() == AttackerState::FaceGoal);
+        let h = heuristic(ffb.then_some(ball.rho / MM), ffog, p.k1);
+        self.post(&format!("{HEURISTIC}{}", self.id), h);
+        self.post("local.var.machine.heuristic", h);
+        let slg = should_i_go(self.id, h, &self.heard(p.heard));
+        self.post("local.var.machine.slg", slg);
+        // The home posture: attackers spread across the field, the defender back.
+        let side = if self.index % 2 == 0 { 1.0 } else { -1.0 };
+        let lane = side * p.home_spread * (self.index / 2 + 1) as f64 / 2.0;
+        let home = (p.home_x, lane);
+        let rp = (me_m.x - home.0).hypot(me_m.y - home.1) <= p.reached;
+        // r(360): the heading turned since the search began.
+        let rotated = match (self.attacker.state(), &mut self.search) {
+            (AttackerState::SearchBall, Some((last, turned))) => {
+                *turned += normalize_angle(me.theta - *last).abs();
+                *last = me.theta;
+                *turned >= std::f64::consts::TAU
+            }
+            _ => false,
+        };
+        let pred = Predicates { ffb, ffog, fnb, rotated, rp, kb: kicked, slg };
+        let state = self.attacker.step(&pred);
+        self.search = match (state, self.search) {
+            (AttackerState::SearchBall, Some(s)) => Some(s),
+            (AttackerState::SearchBall, None) => Some((me.theta, 0.0)),
+            _ => None,
+        };
+        self.post("local.var.machine.state", state.name());
+        let field = Geometry::of(&w.field);
+        let towards_ball = me.theta + ball.theta;
+        let ball_at = Geometry::ball_at(me, &ball);
+        let mut c = RobotCommand { needs: vec![(lps::BALL, 1.0)], ..RobotCommand::default() };
+        match state {
+            // ET_go_home(), also while another robot goes for the ball (module doc).
+            AttackerState::Home | AttackerState::ShouldIGo => {
+                let face = if ball.reliability > 0.0 { towards_ball } else { 0.0 };
+                c.target = Some(Target {
+                    pose: Pose2::new(home.0 * MM, home.1 * MM, face),
+                    avoid: true,
+                    plan: false,
+                });
+            }
+            // move_close2ball(): straight at the ball, turning to it.
+            AttackerState::ApproachBall => go(me, ball_at, towards_ball, &mut c),
+            // The arc round the ball until the robot faces the goal with the ball before it:
+            // to the posture behind the ball on the line from the goal, stepping round the
+            // ball when on its wrong side (a robot with no dribbler cannot turn holding it).
+            AttackerState::FaceGoal => {
+                let behind = field.behind_ball(ball_at, p.behind * MM);
+                go(me, Geometry::step_round(me, ball_at, behind), behind.theta, &mut c);
+            }
+            // push_ball(): through the ball towards the goal; kick_ball() when the goal is
+            // near enough and the ball lies before the kicker.
+            AttackerState::RunAndKick => {
+                let shot = field.behind_ball(ball_at, p.behind * MM).theta;
+                let through = (ball_at.0 + 200.0 * shot.cos(), ball_at.1 + 200.0 * shot.sin());
+                go(me, through, shot, &mut c);
+                let goal = (field.half_length - me.x).hypot(me.y) / MM;
+                let lined_up = normalize_angle(me.theta - shot).abs() < p.facing;
+                if goal <= p.kick_distance && ball.theta.abs() < 0.3 && lined_up {
+                    self.post("local.var.kicker.kick", true);
+                }
+            }
+            // rotate2find_ball().
+            AttackerState::SearchBall => {
+                c.vrot = p.search_speed.to_degrees();
+            }
+        }
+        c
+    }
+
+    fn goalkeeper(&mut self, w: &WorldSnapshot, p: &Params) -> RobotCommand {
+        let ball = w.lps[lps::BALL];
+        let me = w.my_pos.pose;
+        let hl = w.field.half_length / MM;
+        let seen = (ball.reliability > 0.0).then(|| {
+            let (x, y) = Geometry::ball_at(me, &ball);
+            KeeperBall {
+                at: (x / MM, y / MM),
+                velocity: (w.ball_vel.x / MM, w.ball_vel.y / MM),
+                seen_ago: ball.seen_ago,
+            }
+        });
+        let (mode, y) = keeper(seen, hl, &p.keeper);
+        self.post("local.var.machine.state", mode.name());
+        let face = if ball.reliability > 0.0 { me.theta + ball.theta } else { 0.0 };
+        RobotCommand {
+            target: Some(Target {
+                pose: Pose2::new((-hl + p.keeper.axis) * MM, y * MM, face),
+                avoid: false,
+                plan: false,
+            }),
+            needs: vec![(lps::BALL, 1.0)],
+            ..RobotCommand::default()
+        }
+    }
+}
+
+impl Brain for IsocrobBrain {
+    fn cycle(&mut self, w: &WorldSnapshot) -> RobotCommand {
+        let mode = match w.game_state {
+            GameState::Playing => Mode::Play,
+            GameState::Ready | GameState::Set => Mode::Setup,
+            _ => Mode::Pause,
+        };
+        self.post("local.var.machine.mode", mode.name());
+        let p = self.params();
+        if mode != Mode::Play {
+            // Setup: to the kickoff posture; pause: still. The machine starts again.
+            self.attacker = Attacker::default();
+            self.search = None;
+            return walk_to_kickoff(w).unwrap_or_default();
+        }
+        let now = w.time.as_secs_f64();
+        let mut kick = RobotCommand::default();
+        let kicked = self.kicker(now, p.pulse, &mut kick);
+        let mut c = match self.role {
+            Role::Goalkeeper => self.goalkeeper(w, &p),
+            Role::Attacker | Role::Defender => self.field_player(w, &p, kicked),
+        };
+        // The kick this cycle, or the one the Machine just asked for.
+        if kick.kick.is_none() && !kicked {
+            self.kicker(now, p.pulse, &mut kick);
+        }
+        c.kick = c.kick.or(kick.kick);
+        c
+    }
+
+    fn take_faults(&mut self) -> Vec<String> {
+        std::mem::take(&mut self.faults)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use mrt_core::{SimClock, Time};
+    use mrt_msgs::robot::Lpo;
+    use std::sync::Arc;
+
+    /// A playing robot at `me` (team frame, mm) that sees the ball at `ball` (mm), at `time`.
+    fn world(time: f64, me: Pose2, ball: (f64, f64)) -> WorldSnapshot {
+        let mut w = WorldSnapshot {
+            game_state: GameState::Playing,
+            time: Time::from_secs_f64(time),
+            ..WorldSnapshot::default()
+        };
+        w.my_pos.pose = me;
+        w.my_pos.quality = 0.9;
+        let lpo = |(x, y): (f64, f64)| {
+            let (dx, dy) = (x - me.x, y - me.y);
+            Lpo {
+                rho: dx.hypot(dy),
+                theta: normalize_angle(dy.atan2(dx) - me.theta),
+                reliability: 1.0,
+                seen_ago: 0.0,
+            }
+        };
+        w.lps[lps::BALL] = lpo(ball);
+        w.lps[lps::NET1] = lpo((w.field.half_length, 0.0));
+        w
+    }
+
+    fn board(id: u32, clock: &Arc<SimClock>) -> Blackboard {
+        Blackboard::new(id, clock.clone())
+    }
+
+    /// Two attackers that hear each other only through their blackboards (what the Proxy
+    /// carries, applied by hand): the one nearer the ball goes for it, the other waits in
+    /// SHOULD_I_GO; when the ball rolls to the other, they swap.
+    #[test]
+    fn the_robot_nearer_the_ball_goes_and_the_other_waits() {
+        let clock = Arc::new(SimClock::new());
+        let (bb2, bb3) = (board(2, &clock), board(3, &clock));
+        let (out2, out3) = (bb2.outbox(), bb3.outbox());
+        let mut r2 = IsocrobBrain::new(2, Role::Attacker, 1, bb2.clone()).unwrap();
+        let mut r3 = IsocrobBrain::new(3, Role::Attacker, 2, bb3.clone()).unwrap();
+        let (me2, me3) = (Pose2::new(-2000.0, 1000.0, 0.0), Pose2::new(-2000.0, -1500.0, 0.0));
+        let mut cycle = |t: f64, ball: (f64, f64)| {
+            clock.set(Time::from_secs_f64(t));
+            r2.cycle(&world(t, me2, ball));
+            r3.cycle(&world(t, me3, ball));
+            // The Proxy's job: each robot's shared changes to the other.
+            out2.try_iter().for_each(|u| bb3.apply(&u).unwrap());
+            out3.try_iter().for_each(|u| bb2.apply(&u).unwrap());
+            (r2.state(), r3.state())
+        };
+        // The ball 1.1 m before robot 2, 3.3 m from robot 3. In the first cycle each hears
+        // nobody yet and goes; from the second, robot 3 knows it is the farther.
+        cycle(0.0, (-900.0, 1000.0));
+        let (s2, s3) = cycle(0.1, (-900.0, 1000.0));
+        assert_eq!((s2, s3), (AttackerState::ApproachBall, AttackerState::ShouldIGo));
+        // Eq 19: 1.1 m, less k₁ = 0.5 m for facing the opponent's goal.
+        let h2 = bb3.get::<f64>("*.var.machine.heuristic.2").unwrap();
+        assert!((h2 - 0.6).abs() < 1e-9, "{h2}");
+        assert_eq!(bb3.get::<bool>("local.var.machine.slg"), Ok(false));
+        // The ball rolls to robot 3's side.
+        cycle(0.2, (-900.0, -1500.0));
+        let (s2, s3) = cycle(0.3, (-900.0, -1500.0));
+        assert_eq!((s2, s3), (AttackerState::ShouldIGo, AttackerState::ApproachBall));
+        // A teammate not heard for longer than `heard` (1 s) is not a rival.
+        clock.set(Time::from_secs_f64(2.0));
+        r2.cycle(&world(2.0, me2, (-900.0, -1500.0)));
+        assert_eq!(r2.state(), AttackerState::ApproachBall);
+    }
+
+    /// The Kicker µAgent: the Machine sets `local.var.kicker.kick`; the kick command is held
+    /// for the 125 ms pulse, the variable is cleared, and `kb()` holds when the pulse ends.
+    #[test]
+    fn the_kicker_holds_the_valve_open_for_its_pulse() {
+        let clock = Arc::new(SimClock::new());
+        let bb = board(2, &clock);
+        let mut r = IsocrobBrain::new(2, Role::Attacker, 1, bb.clone()).unwrap();
+        let mut cmd = RobotCommand::default();
+        assert!(!r.kicker(1.0, 0.125, &mut cmd) && cmd.kick.is_none(), "nothing asked");
+        bb.set("local.var.kicker.kick", true).unwrap();
+        assert!(!r.kicker(1.0, 0.125, &mut cmd));
+        assert_eq!(cmd.kick, Some(1));
+        assert_eq!(bb.get::<bool>("local.var.kicker.kick"), Ok(false), "cleared");
+        let mut cmd = RobotCommand::default();
+        assert!(!r.kicker(1.1, 0.125, &mut cmd) && cmd.kick == Some(1), "still open");
+        let mut cmd = RobotCommand::default();
+        assert!(r.kicker(1.2, 0.125, &mut cmd), "kb(): the pulse ended");
+        assert!(cmd.kick.is_none());
+    }
+
+    /// Lined up 2 m before the opponent's goal with the ball at its kicker, an attacker runs
+    /// and kicks: RUN_AND_KICK, and the kick command in the same cycle.
+    #[test]
+    fn an_attacker_lined_up_before_the_goal_kicks() {
+        let clock = Arc::new(SimClock::new());
+        let mut r = IsocrobBrain::new(2, Role::Attacker, 1, board(2, &clock)).unwrap();
+        let me = Pose2::new(7000.0, 0.0, 0.0);
+        let w = world(0.0, me, (7350.0, 0.0));
+        r.cycle(&w); // APPROACH_BALL → FACE_GOAL (near, before it)
+        r.cycle(&w); // FACE_GOAL → RUN_AND_KICK (facing the goal)
+        assert_eq!(r.state(), AttackerState::RunAndKick);
+        let c = r.cycle(&w);
+        assert_eq!(c.kick, Some(1), "{c:?}");
+        assert!(c.vlin > 0.0);
+    }
+
+    /// The goalkeeper stands on its axis (0.4 m before its goal line) in front of the ball,
+    /// and posts its mode.
+    #[test]
+    fn the_goalkeeper_stands_before_the_ball_on_its_axis() {
+        let clock = Arc::new(SimClock::new());
+        let bb = board(1, &clock);
+        let mut r = IsocrobBrain::new(1, Role::Goalkeeper, 0, bb.clone()).unwrap();
+        let me = Pose2::new(-8600.0, 0.0, 0.0);
+        let c = r.cycle(&world(0.0, me, (-5000.0, 500.0)));
+        let t = c.target.unwrap().pose;
+        assert!((t.x + 8600.0).abs() < 1e-9 && (t.y - 500.0).abs() < 1e-9, "{t:?}");
+        assert_eq!(bb.get::<String>("local.var.machine.state").unwrap(), "FOLLOW");
+        assert_eq!(bb.get::<String>("local.var.machine.role").unwrap(), "goalkeeper");
+    }
+}
