@@ -50,7 +50,9 @@ pub struct SimArgs {
     /// Length of a half in seconds (default from the configuration: 300).
     #[arg(long)]
     pub half: Option<f64>,
-    /// Run the TeamChaos behaviors of this directory instead of the built-in ones.
+    /// Run the TeamChaos behaviors of this directory instead of the built-in ones; for
+    /// isocrob, its `config.dat` and `config-<robot>.dat` (where there) override the built-in
+    /// `configs/isocrob/config.dat`.
     #[arg(long)]
     pub behaviors: Option<PathBuf>,
     /// Run each robot's Agora in a process of its own, talking to the simulator and its

@@ -131,7 +131,7 @@ impl IsocrobBrain {
             facing: self.float("facing", 0.25),
             seen_ball: self.float("seen-ball", 0.3),
             kick_distance: self.float("kick-distance", 5.0),
-            behind: self.float("behind", 0.45),
+            behind: self.float("behind", 0.35),
             heard: self.float("heard", 1.0),
             home_x: self.float(home, -1.0),
             home_spread: self.float("home-spread", 2.5),
@@ -267,9 +267,17 @@ impl IsocrobBrain {
                     self.post("local.var.kicker.kick", true);
                 }
             }
-            // rotate2find_ball().
+            // rotate2find_ball(): the shorter way round to where the team believes the ball
+            // is (the teammates' sightings, MAP's team ball), to the left when it has none.
             AttackerState::SearchBall => {
-                c.vrot = p.search_speed.to_degrees();
+                let team = w.global_ball;
+                let turn = if team.quality > 0.0 {
+                    let (dx, dy) = (team.pose.x - me.x, team.pose.y - me.y);
+                    normalize_angle(dy.atan2(dx) - me.theta).signum()
+                } else {
+                    1.0
+                };
+                c.vrot = turn * p.search_speed.to_degrees();
             }
         }
         c

@@ -551,6 +551,11 @@ pub fn add_robot(
                 _ => IsocrobRole::Attacker,
             };
             let brain = IsocrobBrain::new(id, role, mate, bb.clone())?;
+            // A team's own `config.dat` and `config-<robot>.dat` beside the built-in one (the
+            // seed's way to configure robot by robot), when the behaviors directory has them.
+            if !behaviors.as_os_str().is_empty() {
+                mrt_blackboard::config::load_dir(&bb, behaviors).map_err(|e| e.to_string())?;
+            }
             let proxy = agora.add_member(Proxy::new(bb), Activation::Periodic(cfg.period()));
             agora.activate_member(proxy).map_err(|e| e.to_string())?;
             (Box::new(BrainMember::new(Box::new(brain))) as Box<dyn Member>, Commander::PLAIN)
