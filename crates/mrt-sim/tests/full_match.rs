@@ -68,3 +68,19 @@ fn a_full_match_finishes_and_reproduces_its_trajectory_hash() {
     assert_eq!(a.stats[1].ball_job_cycles, 0);
     assert!(a.faults.is_empty(), "{:?}", a.faults);
 }
+
+/// Team ISocRob (seed `003` §3.2.2) plays a whole match against the baseline: its robots talk
+/// only through their blackboards (the heuristics of `should_I_go` carried by the Proxy), no
+/// Member of theirs fails, they shoot on target and score (seed 3, oracle: 3 : 0; 100 seeds:
+/// 165 : 53, docs/teams.md), and the same seed gives the same match.
+#[test]
+fn team_isocrob_plays_a_match_on_its_blackboards() {
+    let cfg = SimConfig::oracle();
+    let game = || play(&cfg, 3, (Stack::Isocrob, Stack::Chaser), None, false, |_| {}).unwrap();
+    let (a, b) = (game(), game());
+    assert_eq!((a.score, a.trajectory_hash), (b.score, b.trajectory_hash));
+    assert!(a.faults.iter().all(|f| f.robot >= 4), "{:?}", a.faults);
+    let s = &a.stats[0];
+    assert!(s.shots_on_target > 0 && s.possession_cycles > 0, "{s:?}");
+    assert!(a.score.0 > 0, "{:?}", a.score);
+}
