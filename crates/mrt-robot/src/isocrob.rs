@@ -22,7 +22,7 @@
 //! facing the ball, so that a robot that is not going for the ball stays in the game.
 
 use crate::brain::Brain;
-use crate::stacks::{walk_to_kickoff, Geometry};
+use crate::stacks::{drive_to, walk_to_kickoff, Geometry};
 use mrt_blackboard::config::load_text;
 use mrt_blackboard::Blackboard;
 use mrt_core::{normalize_angle, Pose2};
@@ -46,17 +46,9 @@ const NEAR_FRONT: f64 = 0.6;
 /// Millimetres in a metre: the world snapshot's unit at the edge.
 const MM: f64 = 1000.0;
 
-/// Velocities towards `(tx, ty)` (team frame, mm), turning to `face` (rad): the holonomic
-/// base's forward and sideways components, at up to 1.5 m/s, slowing within 0.75 m.
-fn go(me: Pose2, (tx, ty): (f64, f64), face: f64, c: &mut RobotCommand) {
-    let (dx, dy) = (tx - me.x, ty - me.y);
-    c.vrot = (normalize_angle(face - me.theta).to_degrees() * 3.0).clamp(-200.0, 200.0);
-    let (s, co) = me.theta.sin_cos();
-    let (forward, left) = (dx * co + dy * s, -dx * s + dy * co);
-    let d = dx.hypot(dy).max(1.0);
-    let speed = (d * 2.0).min(1500.0);
-    c.vlin = forward / d * speed;
-    c.vlat = left / d * speed;
+/// [`drive_to`] at up to 1.5 m/s.
+fn go(me: Pose2, target: (f64, f64), face: f64, c: &mut RobotCommand) {
+    drive_to(me, target, face, 1500.0, c);
 }
 
 /// One ISocRob robot: the Machine µAgent and the Kicker µAgent on a shared blackboard.
@@ -313,14 +305,15 @@ impl IsocrobBrain {
 impl Brain for IsocrobBrain {
     fn cycle(&mut self, w: &WorldSnapshot) -> RobotCommand {
         let mode = match w.game_state {
-            GameState::Playing => Mode::Play,
+            GameState::Initial => Mode::None,
             GameState::Ready | GameState::Set => Mode::Setup,
-            _ => Mode::Pause,
+            GameState::Playing => Mode::Play,
+            GameState::Finished => Mode::Pause,
         };
         self.post("local.var.machine.mode", mode.name());
         let p = self.params();
         if mode != Mode::Play {
-            // Setup: to the kickoff posture; pause: still. The machine starts again.
+            // Setup: to the kickoff posture; none and pause: still. The machine starts again.
             self.attacker = Attacker::default();
             self.search = None;
             return walk_to_kickoff(w).unwrap_or_default();

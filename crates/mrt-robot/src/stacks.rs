@@ -439,19 +439,27 @@ pub struct Chaser {
     pub keeper: bool,
 }
 
+/// Velocities towards a target point `(tx, ty)` (team frame, mm), turning to `face` (rad):
+/// the holonomic base's forward and sideways components at up to `max_speed` mm/s, slowing
+/// within `max_speed / 2` mm of the point, and a turn of 3°/s per degree off, at most 200°/s.
+/// The hand-written players' way to drive (the Chaser, ISocRob's Machine).
+pub fn drive_to(me: Pose2, (tx, ty): (f64, f64), face: f64, max_speed: f64, c: &mut RobotCommand) {
+    let (dx, dy) = (tx - me.x, ty - me.y);
+    let err = mrt_core::normalize_angle(face - me.theta);
+    c.vrot = (err.to_degrees() * 3.0).clamp(-200.0, 200.0);
+    // Move in the robot frame (holonomic base): forward and sideways components.
+    let (s, co) = (me.theta.sin(), me.theta.cos());
+    let (fw, left) = (dx * co + dy * s, -dx * s + dy * co);
+    let d = dx.hypot(dy).max(1.0);
+    let speed = (d * 2.0).min(max_speed);
+    c.vlin = fw / d * speed;
+    c.vlat = left / d * speed;
+}
+
 impl Chaser {
-    /// Velocities towards a target point `(tx, ty)` (team frame, mm), facing `face` (rad).
-    fn go(me: mrt_core::Pose2, (tx, ty): (f64, f64), face: f64, c: &mut RobotCommand) {
-        let (dx, dy) = (tx - me.x, ty - me.y);
-        let err = mrt_core::normalize_angle(face - me.theta);
-        c.vrot = (err.to_degrees() * 3.0).clamp(-200.0, 200.0);
-        // Move in the robot frame (holonomic base): forward and sideways components.
-        let (s, co) = (me.theta.sin(), me.theta.cos());
-        let (fw, left) = (dx * co + dy * s, -dx * s + dy * co);
-        let d = dx.hypot(dy).max(1.0);
-        let speed = (d * 2.0).min(1200.0);
-        c.vlin = fw / d * speed;
-        c.vlat = left / d * speed;
+    /// [`drive_to`] at up to 1.2 m/s.
+    fn go(me: Pose2, target: (f64, f64), face: f64, c: &mut RobotCommand) {
+        drive_to(me, target, face, 1200.0, c);
     }
 }
 
