@@ -59,7 +59,7 @@ impl Mode {
 /// A robot's role in the play mode (seed `003` §3.2.2).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Role {
-    /// Moves across its goal to stand in front of the ball ([`Keeper`]).
+    /// Moves across its goal to stand in front of the ball ([`keeper()`]).
     Goalkeeper,
     /// Goes for the ball and leads it to the opponent's goal ([`Attacker`]).
     Attacker,
