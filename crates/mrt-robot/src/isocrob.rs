@@ -5,7 +5,8 @@
 //! and fires the kicker through `local.var.kicker.kick`, which the Kicker µAgent watches.
 //!
 //! What the Machine posts for a person to watch with `mrt bb watch` (the seed's Monitor
-//! µAgent printed the same): `local.var.machine.mode`, `.role`, `.state`, `.heuristic`, `.slg`.
+//! µAgent printed the same): `local.var.machine.mode`, `.role`, `.state`, `.slg`, and its
+//! heuristic as the teammates read it, `*.var.machine.heuristic.<robot>`.
 //!
 //! The predicates come from the robot's world snapshot, never from the simulator:
 //! - `ffb()`: the ball was seen within `seen-ball` seconds (the front camera's LPS ball);
@@ -15,7 +16,7 @@
 //!   FACE_GOAL, which goes round the ball, near is enough);
 //! - `r(360)`: the search turned the robot round once (its estimated heading, unwrapped);
 //! - `rp()`: the robot is within `reached` of its home posture;
-//! - `kb()`: the Kicker fired in this cycle;
+//! - `kb()`: the Kicker's pulse ended in the last cycle;
 //! - `slg()`: [`should_i_go`] on the heuristics heard within `heard` seconds.
 //!
 //! The seed's robots "stand still" in SHOULD_I_GO; these walk to their home posture meanwhile,
@@ -24,7 +25,7 @@
 use crate::brain::Brain;
 use crate::stacks::{drive_to, walk_to_kickoff, Geometry};
 use mrt_blackboard::config::load_text;
-use mrt_blackboard::Blackboard;
+use mrt_blackboard::{Blackboard, Pattern};
 use mrt_core::{normalize_angle, Pose2};
 use mrt_msgs::robot::{lps, GameState, RobotCommand, Target, WorldSnapshot};
 use mrt_team::isocrob::{
@@ -64,6 +65,10 @@ pub struct IsocrobBrain {
     search: Option<(f64, f64)>,
     /// When the kicker's valve opened, s (the Kicker µAgent).
     pulse_from: Option<f64>,
+    /// Whether the valve closed in the last cycle (`kb()` for this one).
+    kicked: bool,
+    /// The teammates' heuristics: `*.var.machine.heuristic.*`.
+    shared: Pattern,
     faults: Vec<String>,
 }
 
@@ -101,6 +106,8 @@ impl IsocrobBrain {
             attacker: Attacker::default(),
             search: None,
             pulse_from: None,
+            kicked: false,
+            shared: Pattern::parse("*.var.machine.heuristic.*").map_err(|e| e.to_string())?,
             faults: Vec::new(),
         })
     }
@@ -151,7 +158,7 @@ impl IsocrobBrain {
     fn heard(&self, heard: f64) -> Vec<(u32, f64)> {
         let now = self.bb.now().as_secs_f64();
         self.bb
-            .list(None)
+            .list(Some(&self.shared))
             .into_iter()
             .filter_map(|(symbol, value)| {
                 let id = symbol.strip_prefix(HEURISTIC)?.parse::<u32>().ok()?;
@@ -199,7 +206,6 @@ impl IsocrobBrain {
             && (ball.theta.abs() < NEAR_FRONT || self.attacker.state() == AttackerState::FaceGoal);
         let h = heuristic(ffb.then_some(ball.rho / MM), ffog, p.k1);
         self.post(&format!("{HEURISTIC}{}", self.id), h);
-        self.post("local.var.machine.heuristic", h);
         let slg = should_i_go(self.id, h, &self.heard(p.heard));
         self.post("local.var.machine.slg", slg);
         // The home posture: attackers spread across the field, the defender back.
@@ -255,7 +261,9 @@ impl IsocrobBrain {
                 go(me, through, shot, &mut c);
                 let goal = (field.half_length - me.x).hypot(me.y) / MM;
                 let lined_up = normalize_angle(me.theta - shot).abs() < p.facing;
-                if goal <= p.kick_distance && ball.theta.abs() < 0.3 && lined_up {
+                // One request a kick: none while the valve is open.
+                let idle = self.pulse_from.is_none();
+                if idle && goal <= p.kick_distance && ball.theta.abs() < 0.3 && lined_up {
                     self.post("local.var.kicker.kick", true);
                 }
             }
@@ -316,20 +324,16 @@ impl Brain for IsocrobBrain {
             // Setup: to the kickoff posture; none and pause: still. The machine starts again.
             self.attacker = Attacker::default();
             self.search = None;
+            self.kicked = false;
             return walk_to_kickoff(w).unwrap_or_default();
         }
-        let now = w.time.as_secs_f64();
-        let mut kick = RobotCommand::default();
-        let kicked = self.kicker(now, p.pulse, &mut kick);
+        // The Machine, then the Kicker: a kick the Machine asks for now fires in this cycle;
+        // the end of the pulse is the Machine's `kb()` in the next.
         let mut c = match self.role {
             Role::Goalkeeper => self.goalkeeper(w, &p),
-            Role::Attacker | Role::Defender => self.field_player(w, &p, kicked),
+            Role::Attacker | Role::Defender => self.field_player(w, &p, self.kicked),
         };
-        // The kick this cycle, or the one the Machine just asked for.
-        if kick.kick.is_none() && !kicked {
-            self.kicker(now, p.pulse, &mut kick);
-        }
-        c.kick = c.kick.or(kick.kick);
+        self.kicked = self.kicker(w.time.as_secs_f64(), p.pulse, &mut c);
         c
     }
 

@@ -123,23 +123,31 @@ impl FieldMap {
     /// The field lines: the boundary (two touch lines, two goal lines), the half-way line and
     /// the three lines of each penalty area. The centre circle is [`FieldMap::centre_circle_radius`]
     /// around the origin.
-    pub fn lines(&self) -> Vec<Segment> {
+    pub fn lines(&self) -> [Segment; FIELD_LINES] {
         let (hl, hw) = (self.half_length(), self.half_width());
         let (pd, pw) = (self.penalty_area_depth, self.penalty_area_width / 2.0);
-        let mut lines = vec![
+        let area = |side: f64| {
+            let (line, front) = (side * hl, side * (hl - pd));
+            [
+                Segment::new(front, -pw, front, pw),
+                Segment::new(line, pw, front, pw),
+                Segment::new(line, -pw, front, -pw),
+            ]
+        };
+        let ([e0, e1, e2], [w0, w1, w2]) = (area(1.0), area(-1.0));
+        [
             Segment::new(-hl, hw, hl, hw),
             Segment::new(-hl, -hw, hl, -hw),
             Segment::new(hl, -hw, hl, hw),
             Segment::new(-hl, -hw, -hl, hw),
             Segment::new(0.0, -hw, 0.0, hw),
-        ];
-        for side in [1.0, -1.0] {
-            let (line, front) = (side * hl, side * (hl - pd));
-            lines.push(Segment::new(front, -pw, front, pw));
-            lines.push(Segment::new(line, pw, front, pw));
-            lines.push(Segment::new(line, -pw, front, -pw));
-        }
-        lines
+            e0,
+            e1,
+            e2,
+            w0,
+            w1,
+            w2,
+        ]
     }
 
     /// The field line that a point `p` seen on the floor (field frame, m) lies on, when only
@@ -189,6 +197,9 @@ impl FieldMap {
         }
     }
 }
+
+/// How many straight lines the field has ([`FieldMap::lines`]).
+pub const FIELD_LINES: usize = 11;
 
 /// A floor point beside a straight field line counts as on it up to this far beyond its
 /// ends, m (a line's end is where another meets it, or a corner).

@@ -840,17 +840,18 @@ impl WorldModel {
             .collect();
         near.sort_by(|a, b| a.0.total_cmp(&b.0));
         for &(d, x, y) in near.iter().take(LINE_CORRECTIONS) {
-            let (s, c) = self.pose.theta.sin_cos();
-            let at = Point2::new(self.pose.x + c * x - s * y, self.pose.y + s * x + c * y);
+            let at = self.pose.transform_point(Point2::new(x, y));
             let Some(fit) = self.map.line_fit(at, LINE_CLEARANCE) else { continue };
             let n = fit.normal;
-            // ∂(field point)/∂θ.
-            let turn = Vector2::new(-s * x - c * y, c * x - s * y);
+            // The point seen from the robot in the field frame; turned a quarter, its
+            // derivative by the heading.
+            let seen = at - self.pose.position();
+            let turn = Vector2::new(-seen.y, seen.x);
             let h = nalgebra::RowVector3::new(n.x, n.y, n.dot(&turn));
             // The point's error along the normal: the range's along the line of sight, the
             // bearing's across it.
             let (sd, sb) = self.noise.sigma(d, None);
-            let sight = Vector2::new(c * x - s * y, s * x + c * y) / d.max(1e-6);
+            let sight = seen / d.max(1e-6);
             let along = n.dot(&sight).powi(2);
             let r = LINE_INFLATION * (sd * sd * along + (d * sb).powi(2) * (1.0 - along));
             let s_var = (h * self.cov * h.transpose())[(0, 0)] + r;
@@ -1454,26 +1455,19 @@ mod tests {
         let touch = line(truth, (7.0, 6.0), (8.3, 6.0), 8);
         let mut m = model();
         m.place(Framed::new(truth));
-        // The east net seen 3 m off where it is: rejected.
-        let wrong = frame(truth, 0.1, &[(crate::field::EAST_NET, (9.0, 3.0))]);
-        let p = Percepts {
-            time: 0.1,
-            sightings: wrong.sightings,
+        // The frame at `time` with the east net seen at `net` and the touch line's points.
+        let with_net = |time: f64, net: (f64, f64)| Percepts {
+            time,
+            sightings: frame(truth, time, &[(crate::field::EAST_NET, net)]).sightings,
             line_points: touch.clone(),
             ..Default::default()
         };
-        m.percepts(&p);
+        // The east net seen 3 m off where it is: rejected.
+        m.percepts(&with_net(0.1, (9.0, 3.0)));
         assert_eq!((m.counts().rejected, m.counts().line_corrections), (1, 0));
         m.percepts(&Percepts { time: 0.2, line_points: touch.clone(), ..Default::default() });
         assert_eq!(m.counts().line_corrections, 0, "no landmark has agreed since");
-        let right = frame(truth, 0.3, &[(crate::field::EAST_NET, (9.0, 0.0))]);
-        let p = Percepts {
-            time: 0.3,
-            sightings: right.sightings,
-            line_points: touch.clone(),
-            ..Default::default()
-        };
-        m.percepts(&p);
+        m.percepts(&with_net(0.3, (9.0, 0.0)));
         assert_eq!(m.counts().line_corrections, 8, "the net agreed");
         // Between the touch line and the goal line (the corner): no line is clear of the
         // other. 40 cm from the touch line at 0.6 m: gated (σ about 3 cm).
