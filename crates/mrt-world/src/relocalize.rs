@@ -33,6 +33,14 @@
 //!    the coarse search found no other pose far from it that explains nearly as much (on a
 //!    symmetric field, the mirrored pose).
 //!
+//!    With a single goal or post in the window but [`ONE_MARK_LINES`] line points or more
+//!    (a forward camera that sees one post and the lines before it), MUREA searches the
+//!    whole field on all of them at the fine accuracy, within [`ONE_MARK_CELLS`], and the
+//!    fix is taken on the same terms when no other pose far from it explains nearly as much
+//!    (a corner post with its two lines looks the same from its mirror image, and is
+//!    refused). A search that gave no answer makes the next wait longer, up to
+//!    [`ONE_MARK_BACKOFF`] s.
+//!
 //! 4. In ISocRob's **self mode** ([`Relocalizer::with_self_mode`], for a robot whose up
 //!    camera sees the field lines all around it, seed `003` §3.2.1), a frame with
 //!    [`SELF_POINTS`] line points or more is searched even without two goals or posts: the
@@ -126,6 +134,13 @@ pub const WINDOW_PERCEPTIONS: usize = 24;
 pub const SAME_OBJECT: f64 = 0.5;
 /// The goals and posts of the window must weigh this much together for a search.
 pub const MARKS: f64 = 1.5;
+/// With a single goal or post in the window, a search also needs this many field-line
+/// points...
+pub const ONE_MARK_LINES: usize = 10;
+/// ... and stops after this many cells.
+pub const ONE_MARK_CELLS: usize = 30_000;
+/// The longest wait after one-mark searches that gave no answer, s.
+pub const ONE_MARK_BACKOFF: f64 = 4.0;
 /// The self mode searches without such marks when a frame has this many field-line points.
 pub const SELF_POINTS: usize = 24;
 /// At most this many line points of one frame become perceptions (evenly picked).
@@ -223,12 +238,18 @@ pub struct Relocalizer {
     coarse: Murea,
     /// The refinement around the coarse fix (10 cm, 2°), on everything.
     murea: Murea,
+    /// The search on one goal or post and the lines: the refinement's accuracy over the
+    /// whole field, within [`ONE_MARK_CELLS`].
+    one_mark: Murea,
     /// Glimpses older than this are forgotten, s.
     pub window: f64,
     glimpses: VecDeque<Glimpse>,
     /// How far the robot drove (m) and turned (rad) since it started, as the odometry says.
     driven: (f64, f64),
     last_search: Option<f64>,
+    /// After a one-mark search that gave no answer: how long it waited, and when the next
+    /// may run (s).
+    one_mark_backoff: Option<(f64, f64)>,
     counts: RelocalizerCounts,
     /// The self mode (module doc, 4.): the field, and this frame's field-line points (robot
     /// frame), when on.
@@ -246,13 +267,17 @@ impl Relocalizer {
         let mut coarse = murea.clone();
         coarse.accuracy = (0.25, 4f64.to_radians());
         coarse.budget.cells = 60_000;
+        let mut one_mark = murea.clone();
+        one_mark.budget.cells = ONE_MARK_CELLS;
         Relocalizer {
             coarse,
+            one_mark,
             murea,
             window: 1.5,
             glimpses: VecDeque::new(),
             driven: (0.0, 0.0),
             last_search: None,
+            one_mark_backoff: None,
             counts: RelocalizerCounts::default(),
             self_mode: None,
         }
@@ -390,6 +415,9 @@ impl Relocalizer {
         if run >= DISAGREE && run < self.glimpses.len() {
             self.glimpses.drain(..self.glimpses.len() - run);
         }
+        if fits == Some(true) {
+            self.one_mark_backoff = None;
+        }
         if self.glimpses.len() > 1 && (fits == Some(true) || (run > 0 && run < DISAGREE)) {
             // What it sees now agrees with the tracker, or disagrees for the first time (a
             // false sighting, or the first after a carry: the next frame tells).
@@ -402,7 +430,11 @@ impl Relocalizer {
             window.iter().filter(|p| p.kind != Kind::LINE).copied().collect();
         let enough_marks = marks.len() >= 2 && marks.iter().map(|p| p.weight).sum::<f64>() >= MARKS;
         let lines_around = self.self_mode.as_ref().is_some_and(|(_, l)| l.len() >= SELF_POINTS);
-        if !enough_marks && !lines_around {
+        let lines = window.iter().filter(|p| p.kind == Kind::LINE).count();
+        let one_mark = marks.len() == 1
+            && lines >= ONE_MARK_LINES
+            && self.one_mark_backoff.is_none_or(|(_, next)| now >= next);
+        if !enough_marks && !lines_around && !one_mark {
             return None;
         }
         let tracked = self.murea.quality_at(pose, &window);
@@ -411,6 +443,9 @@ impl Relocalizer {
         }
         self.last_search = Some(now);
         self.counts.searches += 1;
+        if !enough_marks && one_mark && !lines_around {
+            return self.one_mark_search(now, &window, pose, tracked);
+        }
         if !enough_marks {
             return self.self_search(&window, pose, tracked);
         }
@@ -425,12 +460,48 @@ impl Relocalizer {
             return None;
         }
         let fix = self.murea.localize(&window, Murea::around(global.pose, 0.4, 0.15));
+        if fix.timed_out {
+            return None;
+        }
+        self.accept(fix, pose, tracked)
+    }
+
+    /// The search on one goal or post and the field lines (module doc, 3.): the whole field
+    /// at the fine accuracy within [`ONE_MARK_CELLS`]. After one that ran out of cells or
+    /// found other poses as good, the next waits twice as long as the last wait (from
+    /// [`RETRY`] up to [`ONE_MARK_BACKOFF`]): a robot that sees the same post and lines for
+    /// seconds would otherwise pay the whole budget every [`RETRY`] s.
+    fn one_mark_search(
+        &mut self,
+        now: f64,
+        window: &[Perception],
+        pose: Pose2,
+        tracked: f64,
+    ) -> Option<Fix> {
+        let fix = self.one_mark.localize(window, self.one_mark.whole_field());
+        if fix.timed_out || !fix.alternatives.is_empty() {
+            if !fix.alternatives.is_empty() {
+                self.counts.ambiguous += 1;
+            }
+            let wait =
+                self.one_mark_backoff.map_or(RETRY, |(w, _)| (2.0 * w).min(ONE_MARK_BACKOFF));
+            self.one_mark_backoff = Some((wait, now + wait));
+            return None;
+        }
+        self.accept(fix, pose, tracked)
+    }
+
+    /// `fix` when it should replace the tracker's `pose` (explaining `tracked` of the window):
+    /// it explains at least [`ACCEPT`] of the window, [`MARGIN`] more than the tracker, and
+    /// lies apart from it.
+    fn accept(&mut self, fix: Fix, pose: Pose2, tracked: f64) -> Option<Fix> {
         let apart = (fix.pose.x - pose.x).hypot(fix.pose.y - pose.y) > 0.3
             || normalize_angle(fix.pose.theta - pose.theta).abs() > 0.2;
-        if fix.timed_out || fix.quality < ACCEPT || fix.quality < tracked + MARGIN || !apart {
+        if fix.quality < ACCEPT || fix.quality < tracked + MARGIN || !apart {
             return None;
         }
         self.counts.accepted += 1;
+        self.one_mark_backoff = None;
         Some(fix)
     }
 
@@ -459,13 +530,7 @@ impl Relocalizer {
             self.counts.ambiguous += 1;
             return None;
         }
-        let apart = (fix.pose.x - pose.x).hypot(fix.pose.y - pose.y) > 0.3
-            || normalize_angle(fix.pose.theta - pose.theta).abs() > 0.2;
-        if fix.quality < ACCEPT || fix.quality < tracked + MARGIN || !apart {
-            return None;
-        }
-        self.counts.accepted += 1;
-        Some(fix)
+        self.accept(fix, pose, tracked)
     }
 }
 
@@ -545,8 +610,10 @@ mod tests {
     }
 
     /// Seed `003` §3.2.1's self mode: a robot carried to a place where it sees one net only
-    /// (no search: two goals or posts are needed) is found again from the field lines all
-    /// around it, the net telling the half-turn twins apart; without the self mode it is not.
+    /// (the search on goals and posts needs two) is found again from the field lines all
+    /// around it, the net telling the half-turn twins apart: with the self mode from the
+    /// Hough lines of one frame, without it by MUREA's search on the net and the window's
+    /// line points.
     #[test]
     fn the_self_mode_finds_a_carried_robot_from_the_lines_and_one_net() {
         let f = field();
@@ -571,16 +638,76 @@ mod tests {
                     break;
                 }
             }
-            match (self_mode, fix) {
-                (false, fix) => assert!(fix.is_none(), "{fix:?}"),
-                (true, Some(fix)) => {
-                    let err = (fix.pose.x - truth.x).hypot(fix.pose.y - truth.y);
-                    let turn = normalize_angle(fix.pose.theta - truth.theta).abs();
-                    assert!(err < 0.2 && turn < 0.05, "{fix:?}");
-                }
-                (true, None) => panic!("not found: {:?}", r.counts()),
+            let fix = fix.unwrap_or_else(|| panic!("not found: {:?}", r.counts()));
+            let err = (fix.pose.x - truth.x).hypot(fix.pose.y - truth.y);
+            let turn = normalize_angle(fix.pose.theta - truth.theta).abs();
+            assert!(err < 0.2 && turn < 0.05, "self mode {self_mode}: {fix:?}");
+        }
+    }
+
+    /// A robot whose forward camera sees one post and the lines before it, for a second, is
+    /// found again: two goals or posts are not needed when the lines say the rest.
+    #[test]
+    fn one_post_and_the_lines_in_view_find_a_carried_robot() {
+        let f = field();
+        // Looking north along the west penalty area: the north-west corner post (object 5,
+        // at (−9, 6)) 7.6 m away, 9° to the left, the area's lines ahead. (Many views are
+        // ambiguous with one post: a corner, or a post on the half-way line, looks the same
+        // from its mirror image; the search then says so and waits.)
+        let truth = Pose2::new(-6.0, -1.0, 7f64.atan2(-3.0) - 0.15);
+        let wrong = Pose2::new(2.0, -2.0, 0.5);
+        let mut one = [None; FIELD_OBJECTS];
+        one[5] = seen_from(truth)[5];
+        let bearing = one[5].map_or(1.0, |s: Sighting| s.bearing);
+        assert!(bearing.abs() < 20f64.to_radians(), "the post in view: {bearing}");
+        // The line points in a 40° field of view ahead, up to 4 m.
+        let lines: Vec<(f64, f64)> = lines_around(truth)
+            .into_iter()
+            .filter(|&(x, y)| x > 0.3 && y.atan2(x).abs() < 20f64.to_radians())
+            .collect();
+        assert!(lines.len() >= ONE_MARK_LINES, "{} line points in view", lines.len());
+        let mut r = Relocalizer::new(&f);
+        let mut found = None;
+        for k in 0..10 {
+            let p = perceptions(&f, NOISE, &one, &[None; FIELD_OBJECTS], &[], &lines);
+            if let Some(fix) = r.frame(0.1 * f64::from(k), p, wrong) {
+                found = Some(fix);
+                break;
             }
         }
+        let fix = found.unwrap_or_else(|| panic!("not found: {:?}", r.counts()));
+        let err = (fix.pose.x - truth.x).hypot(fix.pose.y - truth.y);
+        assert!(err < 0.2 && normalize_angle(fix.pose.theta - truth.theta).abs() < 0.05, "{fix:?}");
+    }
+
+    /// A one-mark search that runs out of cells is retried after 0.5, 1, 2, 4, 4 ... s, not
+    /// every 0.5 s; a fix or a tracker that fits again starts the waits over.
+    #[test]
+    fn one_mark_searches_that_give_no_answer_back_off() {
+        let f = field();
+        let truth = Pose2::new(-5.5, 3.0, 2.8);
+        let seen = seen_from(truth);
+        let mark = (1..FIELD_OBJECTS).find(|&k| seen[k].is_some()).unwrap_or(0);
+        let mut one = [None; FIELD_OBJECTS];
+        one[mark] = seen[mark];
+        let lines: Vec<(f64, f64)> =
+            lines_around(truth).into_iter().filter(|&(x, _)| x > 0.3).collect();
+        let mut r = Relocalizer::new(&f);
+        r.one_mark.budget.cells = 10; // every search runs out
+        let wrong = Pose2::new(2.0, -2.0, 0.5);
+        let mut searched = Vec::new();
+        for k in 0..100 {
+            let t = 0.1 * f64::from(k);
+            let before = r.counts().searches;
+            let p = perceptions(&f, NOISE, &one, &[None; FIELD_OBJECTS], &[], &lines);
+            assert!(r.frame(t, p, wrong).is_none());
+            if r.counts().searches > before {
+                searched.push((10.0 * t).round() / 10.0);
+            }
+        }
+        // The first frame searches at once (nothing agreed with the tracker before it).
+        assert_eq!(searched, vec![0.0, 0.5, 1.5, 3.5, 7.5], "searched at {searched:?}");
+        assert_eq!(r.one_mark_backoff.map(|b| b.0), Some(ONE_MARK_BACKOFF));
     }
 
     #[test]
