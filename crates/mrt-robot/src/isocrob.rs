@@ -47,6 +47,25 @@ const NEAR_FRONT: f64 = 0.6;
 /// Millimetres in a metre: the world snapshot's unit at the edge.
 const MM: f64 = 1000.0;
 
+/// Where a robot that is not going for the ball should look (its heading, rad, team frame):
+/// at the ball when its camera saw it within `recent` seconds, else towards where the team
+/// believes the ball is (MAP's team ball), else up the field. Not at the LPS ball's stale
+/// place: that one is dead-reckoned in the robot's frame and turns with the robot, so a robot
+/// that faced it kept whatever way it faced, and a goalkeeper looked along its goal line for
+/// seconds while the shot came (with the 40° front camera, before this).
+fn look_at_ball(w: &WorldSnapshot, recent: f64) -> f64 {
+    let me = w.my_pos.pose;
+    let ball = w.lps[lps::BALL];
+    if ball.reliability > 0.0 && ball.seen_ago <= recent {
+        me.theta + ball.theta
+    } else if w.global_ball.quality > 0.0 {
+        let b = w.global_ball.pose;
+        (b.y - me.y).atan2(b.x - me.x)
+    } else {
+        0.0
+    }
+}
+
 /// [`drive_to`] at up to 1.5 m/s.
 fn go(me: Pose2, target: (f64, f64), face: f64, c: &mut RobotCommand) {
     drive_to(me, target, face, 1500.0, c);
@@ -237,7 +256,7 @@ impl IsocrobBrain {
         match state {
             // ET_go_home(), also while another robot goes for the ball (module doc).
             AttackerState::Home | AttackerState::ShouldIGo => {
-                let face = if ball.reliability > 0.0 { towards_ball } else { 0.0 };
+                let face = look_at_ball(w, p.seen_ball);
                 c.target = Some(Target {
                     pose: Pose2::new(home.0 * MM, home.1 * MM, face),
                     avoid: true,
@@ -297,7 +316,7 @@ impl IsocrobBrain {
         });
         let (mode, y) = keeper(seen, hl, &p.keeper);
         self.post("local.var.machine.state", mode.name());
-        let face = if ball.reliability > 0.0 { me.theta + ball.theta } else { 0.0 };
+        let face = look_at_ball(w, p.seen_ball);
         RobotCommand {
             target: Some(Target {
                 pose: Pose2::new((-hl + p.keeper.axis) * MM, y * MM, face),
@@ -370,6 +389,23 @@ mod tests {
         w.lps[lps::BALL] = lpo(ball);
         w.lps[lps::NET1] = lpo((w.field.half_length, 0.0));
         w
+    }
+
+    /// A robot not going for the ball looks at it while its camera has it, then where the
+    /// team believes it is, then up the field; never at the stale, dead-reckoned LPS ball.
+    #[test]
+    fn a_robot_looks_at_the_ball_it_saw_then_the_team_ball_then_up_the_field() {
+        let me = Pose2::new(-8600.0, 0.0, 1.8);
+        let mut w = world(10.0, me, (-6600.0, 2000.0));
+        let at_ball = std::f64::consts::FRAC_PI_4; // (−6.6, 2) from (−8.6, 0): 45°
+        assert!((normalize_angle(look_at_ball(&w, 0.8)) - at_ball).abs() < 1e-9);
+        // Not seen for 5 s: the LPS ball turned with the robot and says "straight ahead".
+        w.lps[lps::BALL] = Lpo { rho: 1050.0, theta: -0.01, reliability: 0.01, seen_ago: 5.0 };
+        assert_eq!(look_at_ball(&w, 0.8), 0.0, "no team ball: up the field");
+        w.global_ball.quality = 0.5;
+        w.global_ball.pose = Pose2::new(-4600.0, -4000.0, 0.0);
+        let team = -std::f64::consts::FRAC_PI_4;
+        assert!((look_at_ball(&w, 0.8) - team).abs() < 1e-9, "towards the team ball");
     }
 
     fn board(id: u32, clock: &Arc<SimClock>) -> Blackboard {
