@@ -58,12 +58,16 @@ fn look_at_ball(w: &WorldSnapshot, recent: f64) -> f64 {
     let ball = w.lps[lps::BALL];
     if ball.reliability > 0.0 && ball.seen_ago <= recent {
         me.theta + ball.theta
-    } else if w.global_ball.quality > 0.0 {
-        let b = w.global_ball.pose;
-        (b.y - me.y).atan2(b.x - me.x)
     } else {
-        0.0
+        team_ball_heading(w).unwrap_or(0.0)
     }
+}
+
+/// The heading (rad, team frame) from the robot to where its team believes the ball is
+/// (MAP's team ball), when the team has one.
+fn team_ball_heading(w: &WorldSnapshot) -> Option<f64> {
+    let (me, ball) = (w.my_pos.pose, w.global_ball);
+    (ball.quality > 0.0).then(|| (ball.pose.y - me.y).atan2(ball.pose.x - me.x))
 }
 
 /// [`drive_to`] at up to 1.5 m/s.
@@ -289,13 +293,8 @@ impl IsocrobBrain {
             // rotate2find_ball(): the shorter way round to where the team believes the ball
             // is (the teammates' sightings, MAP's team ball), to the left when it has none.
             AttackerState::SearchBall => {
-                let team = w.global_ball;
-                let turn = if team.quality > 0.0 {
-                    let (dx, dy) = (team.pose.x - me.x, team.pose.y - me.y);
-                    normalize_angle(dy.atan2(dx) - me.theta).signum()
-                } else {
-                    1.0
-                };
+                let turn =
+                    team_ball_heading(w).map_or(1.0, |h| normalize_angle(h - me.theta).signum());
                 c.vrot = turn * p.search_speed.to_degrees();
             }
         }

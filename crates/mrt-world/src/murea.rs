@@ -666,8 +666,10 @@ impl Murea {
             x = (x.0.min(r * c), x.1.max(r * c));
             y = (y.0.min(r * s), y.1.max(r * s));
         };
+        // (sin, cos) of 0, π/2, π, 3π/2.
+        const AXES: [(f64, f64); 4] = [(0.0, 1.0), (1.0, 0.0), (0.0, -1.0), (-1.0, 0.0)];
         if a1 - a0 >= TAU {
-            for axis in [(0.0, 1.0), (0.0, -1.0), (1.0, 0.0), (-1.0, 0.0)] {
+            for axis in AXES {
                 take(axis, r1);
             }
             return (x, y);
@@ -676,9 +678,7 @@ impl Murea {
             take(sc, r0);
             take(sc, r1);
         }
-        // The axis directions within [a0, a1] reach farthest at the outer radius: (sin, cos)
-        // of 0, π/2, π, 3π/2 round the circle, by quarter turns.
-        const AXES: [(f64, f64); 4] = [(0.0, 1.0), (1.0, 0.0), (0.0, -1.0), (-1.0, 0.0)];
+        // The axis directions within [a0, a1] reach farthest at the outer radius.
         let first = (a0 / (0.5 * PI)).ceil();
         let mut axis = first * 0.5 * PI;
         let mut k = first.rem_euclid(4.0) as usize;
@@ -995,8 +995,9 @@ mod tests {
         while leaves.iter().any(|c| !murea.is_leaf(c)) {
             leaves = leaves.iter().flat_map(|c| murea.split(c)).collect();
         }
+        let prepared = Seen::new(&seen);
         let scores: Vec<f64> =
-            leaves.iter().map(|c| murea.score(c.centre(), &Seen::new(&seen), &all)).collect();
+            leaves.iter().map(|c| murea.score(c.centre(), &prepared, &all)).collect();
         let best = scores.iter().copied().fold(0.0, f64::max);
         assert_eq!(fix.evidence, best, "{fix:?}");
         assert!(fix.cells < leaves.len() / 10, "{} of {} cells", fix.cells, leaves.len());

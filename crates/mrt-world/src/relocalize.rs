@@ -609,6 +609,26 @@ mod tests {
         out
     }
 
+    /// The first fix of `r` over `frames` frames 0.1 s apart, each seeing `sightings` and the
+    /// field-line points `lines` (robot frame), while its tracker stays at `wrong`.
+    fn first_fix(
+        r: &mut Relocalizer,
+        frames: u32,
+        sightings: &[Option<Sighting>; FIELD_OBJECTS],
+        lines: &[(f64, f64)],
+        wrong: Pose2,
+    ) -> Fix {
+        let f = field();
+        for k in 0..frames {
+            r.lines(lines);
+            let p = perceptions(&f, NOISE, sightings, &[None; FIELD_OBJECTS], &[], lines);
+            if let Some(fix) = r.frame(0.1 * f64::from(k), p, wrong) {
+                return fix;
+            }
+        }
+        panic!("not found: {:?}", r.counts())
+    }
+
     /// Seed `003` §3.2.1's self mode: a robot carried to a place where it sees one net only
     /// (the search on goals and posts needs two) is found again from the field lines all
     /// around it, the net telling the half-turn twins apart: with the self mode from the
@@ -629,16 +649,7 @@ mod tests {
             if self_mode {
                 r = r.with_self_mode(&f);
             }
-            let mut fix = None;
-            for k in 0..20 {
-                r.lines(&lines);
-                let p = perceptions(&f, NOISE, &seen, &[None; FIELD_OBJECTS], &[], &lines);
-                if let Some(found) = r.frame(0.1 * f64::from(k), p, wrong) {
-                    fix = Some(found);
-                    break;
-                }
-            }
-            let fix = fix.unwrap_or_else(|| panic!("not found: {:?}", r.counts()));
+            let fix = first_fix(&mut r, 20, &seen, &lines, wrong);
             let err = (fix.pose.x - truth.x).hypot(fix.pose.y - truth.y);
             let turn = normalize_angle(fix.pose.theta - truth.theta).abs();
             assert!(err < 0.2 && turn < 0.05, "self mode {self_mode}: {fix:?}");
@@ -666,16 +677,7 @@ mod tests {
             .filter(|&(x, y)| x > 0.3 && y.atan2(x).abs() < 20f64.to_radians())
             .collect();
         assert!(lines.len() >= ONE_MARK_LINES, "{} line points in view", lines.len());
-        let mut r = Relocalizer::new(&f);
-        let mut found = None;
-        for k in 0..10 {
-            let p = perceptions(&f, NOISE, &one, &[None; FIELD_OBJECTS], &[], &lines);
-            if let Some(fix) = r.frame(0.1 * f64::from(k), p, wrong) {
-                found = Some(fix);
-                break;
-            }
-        }
-        let fix = found.unwrap_or_else(|| panic!("not found: {:?}", r.counts()));
+        let fix = first_fix(&mut Relocalizer::new(&f), 10, &one, &lines, wrong);
         let err = (fix.pose.x - truth.x).hypot(fix.pose.y - truth.y);
         assert!(err < 0.2 && normalize_angle(fix.pose.theta - truth.theta).abs() < 0.05, "{fix:?}");
     }
