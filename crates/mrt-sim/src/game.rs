@@ -203,6 +203,10 @@ pub struct Kidnap {
 /// A kidnapped robot is recovered when its position estimate is this close to the truth (m).
 pub const RECOVERED: f64 = 0.3;
 
+/// The shortest time between two kidnaps of one robot, s: the time it is given to find
+/// itself before it can be carried again.
+pub const KIDNAP_GAP: f64 = 10.0;
+
 /// The robots' cameras when they see through rendered images: the front camera's renderer,
 /// the up camera's when the robots carry one, and each camera's state (its noise stream and
 /// last frame).
@@ -365,11 +369,23 @@ impl Pitch {
 
     /// Carries the robots whose kidnap is due to random free spots: inside the field 1 m from
     /// its lines, 1 m from every other robot and the ball, 2 m from where it was.
+    ///
+    /// A robot carried less than [`KIDNAP_GAP`] ago waits until that long after its last
+    /// carry: two kidnaps due while play was stopped would otherwise carry it twice in one
+    /// cycle, and one a second after another gives it no time to find itself.
     fn kidnap_due(&mut self) {
         use rand::Rng;
         let now = self.world.time();
         while self.kidnap_plan.last().is_some_and(|&(at, _)| at <= now) {
             let Some((_, robot)) = self.kidnap_plan.pop() else { break };
+            let last = self.kidnaps.iter().rev().find(|k| k.robot == robot).map(|k| k.at);
+            if let Some(last) = last.filter(|&t| now - t < KIDNAP_GAP) {
+                let at = last + KIDNAP_GAP;
+                let i =
+                    self.kidnap_plan.partition_point(|&(t, r)| t > at || (t == at && r > robot));
+                self.kidnap_plan.insert(i, (at, robot));
+                continue;
+            }
             let Some(from) = self.world.robot(robot) else { continue };
             let (hl, hw) = (self.cfg.field.length / 2.0 - 1.0, self.cfg.field.width / 2.0 - 1.0);
             let ball = self.world.ball();

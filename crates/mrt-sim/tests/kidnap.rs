@@ -74,3 +74,26 @@ fn a_carry_is_not_told_to_the_robot() {
     assert_eq!(pitch.world().robot(2).map(|p| (p.x, p.y)), Some((3.0, 2.0)));
     assert_eq!(pitch.world().carried(2), 1);
 }
+
+/// Kidnaps that fall close together (here 6 a half in 30 s of play, and those due while play
+/// is stopped fire together when it resumes) are spread out: one robot is never carried again
+/// within [`mrt_sim::game::KIDNAP_GAP`] of its last carry, so each carry gives it time to find
+/// itself.
+#[test]
+fn a_robot_is_not_carried_again_before_the_gap() {
+    let mut cfg = config(6, Localizer::Murea);
+    cfg.rules.half_duration = 30.0;
+    let r = mrt_sim::play(&cfg, 2, (Stack::Milan, Stack::Chaos), None, false, |_| {}).unwrap();
+    let robots = 2 * cfg.rules.team_size;
+    // Without the gap each robot would be carried 12 times; with it, at most one carry in each
+    // 10 s of the 60 s match.
+    assert!(r.kidnaps.len() >= robots, "{} kidnaps", r.kidnaps.len());
+    assert!(r.kidnaps.len() <= robots * 6, "{} kidnaps", r.kidnaps.len());
+    for robot in 0..robots {
+        let times: Vec<f64> = r.kidnaps.iter().filter(|k| k.robot == robot).map(|k| k.at).collect();
+        assert!(
+            times.windows(2).all(|w| w[1] - w[0] >= mrt_sim::game::KIDNAP_GAP - 1e-9),
+            "{times:?}"
+        );
+    }
+}
