@@ -233,6 +233,11 @@ pub struct Percepts {
     /// post of that half it is (the world model tells them apart).
     #[serde(default)]
     pub posts: Vec<PostSighting>,
+    /// Goals cut by the image's side, whose net is therefore not in `sightings`: the corner
+    /// of each on the floor at its side that is in view (an upright, or a back corner seen
+    /// obliquely; which one, the world model tells). `east`: a corner of the east goal.
+    #[serde(default)]
+    pub goal_corners: Vec<PostSighting>,
     /// Where to shoot into each goal: the bearing (rad, robot frame) of its open space, the
     /// widest stretch of its mouth that no keeper hides (ISocRob seed `003` eq. 18), for the
     /// east and the west goal, when the whole goal is in view.

@@ -37,9 +37,11 @@ impl FieldConfig {
             length: self.length,
             width: self.width,
             goal_width: self.goal_width,
+            goal_depth: self.goal_depth,
             penalty_area_depth: self.penalty_area_depth,
             penalty_area_width: self.penalty_area_width,
             centre_circle_radius: self.centre_circle_radius,
+            ..mrt_world::FieldMap::default()
         }
     }
 }

@@ -618,8 +618,8 @@ fn blind_and_rim(image: &mut Image, omni: &Omni, rows: &[RowRays]) {
 
 /// The goals (east yellow, west blue) and the landmark posts.
 fn fixed_things(map: &FieldMap, cfg: &SimConfig) -> Vec<Thing> {
-    let (hl, gw, gd) = (map.half_length(), map.goal_width / 2.0, cfg.field.goal_depth);
-    let (gh, t) = (cfg.render.goal_height, 0.05);
+    let (hl, gw, gd) = (map.half_length(), map.goal_width / 2.0, map.goal_depth);
+    let (gh, t) = (cfg.render.goal_height, map.goal_wall);
     let mut things = Vec::new();
     for (side, colour) in [(1.0, palette::YELLOW), (-1.0, palette::BLUE)] {
         let x = |a: f64, b: f64| (side * a).min(side * b)..=(side * a).max(side * b);

@@ -14,7 +14,8 @@
 //!   bearing in degrees (medians and 90th percentiles).
 //!
 //! The reference points are the ball's centre (on the floor below it), the centre of each goal
-//! line (the nets of the world model), the landmark posts' axes, and the nearest point of
+//! line (the nets of the world model), the landmark posts' axes, the goals' corners on the
+//! floor (reported for a goal cut by the image's side), and the nearest point of
 //! every other robot's body (the obstacles). The whole survey is a pure function of the
 //! configuration and the seed.
 //!
@@ -43,8 +44,8 @@ use serde::Serialize;
 
 /// Objects farther than this are not counted as in view, m: the ball (a few pixels at
 /// 8 m), the nets and posts (across the whole field), the other robots.
-pub const MAX_RANGE: [(&str, f64); 4] =
-    [("ball", 8.0), ("net", 25.0), ("post", 25.0), ("obstacle", 8.0)];
+pub const MAX_RANGE: [(&str, f64); 5] =
+    [("ball", 8.0), ("net", 25.0), ("post", 25.0), ("corner", 25.0), ("obstacle", 8.0)];
 /// A percept off by more than this fraction of its distance is wrong.
 pub const WRONG_DISTANCE: f64 = 0.3;
 /// A percept off by more than this bearing is wrong, rad (10°).
@@ -53,7 +54,7 @@ pub const WRONG_BEARING: f64 = 0.1745;
 /// What the survey found for one kind of object.
 #[derive(Clone, Debug, Default, PartialEq, Serialize)]
 pub struct KindReport {
-    /// `ball`, `net`, `post` or `obstacle`.
+    /// `ball`, `net`, `post`, `corner` or `obstacle`.
     pub kind: &'static str,
     /// Objects of this kind in view (module doc).
     pub in_view: u64,
@@ -78,7 +79,7 @@ pub struct SurveyReport {
     pub scenes: usize,
     /// The seed.
     pub seed: u64,
-    /// One line per kind: ball, net, post, obstacle.
+    /// One line per kind: ball, net, post, corner, obstacle.
     pub kinds: Vec<KindReport>,
 }
 
@@ -229,8 +230,8 @@ pub fn survey(cfg: &SimConfig, seed: u64, scenes: usize) -> Result<SurveyReport,
     let r = cfg.robot.radius;
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let mut state = CameraState::new(seed);
-    let (mut ball_t, mut net_t, mut post_t, mut obstacle_t) =
-        (Tally::default(), Tally::default(), Tally::default(), Tally::default());
+    let (mut ball_t, mut net_t, mut post_t, mut corner_t, mut obstacle_t) =
+        (Tally::default(), Tally::default(), Tally::default(), Tally::default(), Tally::default());
     for scene_no in 0..scenes {
         let (robots, ball) = random_scene(&mut rng, hl, hw, r, cfg.ball.radius);
         let viewer = robots[0].0;
@@ -263,6 +264,19 @@ pub fn survey(cfg: &SimConfig, seed: u64, scenes: usize) -> Result<SurveyReport,
             .collect();
         let seen: Vec<Sighting> = p.posts.iter().map(|q| q.sighting).collect();
         post_t.add(&truth, &seen);
+        // The corners of the goals on the floor: in view when the corner is and its goal is
+        // not seen whole (then its net is reported instead).
+        for east in [true, false] {
+            let corners = map.goal_corners(east);
+            let whole = corners[..2].iter().all(|c| visible("net", c.x, c.y, 0.0));
+            let truth: Vec<(Sighting, bool)> = corners
+                .iter()
+                .map(|c| (sight(viewer, c.x, c.y), !whole && visible("corner", c.x, c.y, 0.0)))
+                .collect();
+            let seen: Vec<Sighting> =
+                p.goal_corners.iter().filter(|c| c.east == east).map(|c| c.sighting).collect();
+            corner_t.add(&truth, &seen);
+        }
         // The other robots, at their nearest point.
         let truth: Vec<(Sighting, bool)> = robots[1..]
             .iter()
@@ -282,6 +296,7 @@ pub fn survey(cfg: &SimConfig, seed: u64, scenes: usize) -> Result<SurveyReport,
             ball_t.report("ball"),
             net_t.report("net"),
             post_t.report("post"),
+            corner_t.report("corner"),
             obstacle_t.report("obstacle"),
         ],
     })

@@ -326,6 +326,62 @@ fn the_vision_agent_finds_ball_nets_and_robots_in_a_rendered_frame() {
     assert!(agent.see(&broken, 0.0, 0.0).is_err());
 }
 
+/// A goal too near to be seen whole, cut by the image's side, has no net; the corner at its
+/// other side is reported instead: from in front of the goal, the upright on that side; from
+/// beside the goal's mouth, its near back corner (the side net runs back from the upright on
+/// the floor). Within 3 % of the distance and 1°, like the posts.
+#[test]
+fn a_goal_cut_by_the_image_side_gives_the_corner_in_view() {
+    use mrt_perception::vision::agent::VisionAgent;
+    let cfg = SimConfig::default();
+    let renderer = Renderer::new(&cfg).unwrap();
+    let mut agent = VisionAgent::new(
+        *renderer.pinhole().unwrap(),
+        &mrt_perception::vision::colors::ColorTable::shipped(),
+        cfg.ball.radius,
+    );
+    let map = cfg.field.map();
+    // The outer faces of the goal's sides and back.
+    let (hl, gw, gd) =
+        (map.half_length(), map.goal_width / 2.0 + map.goal_wall, map.goal_depth + map.goal_wall);
+    let relative = |from: Pose2, x: f64, y: f64| {
+        let (dx, dy) = (x - from.x, y - from.y);
+        let (s, c) = from.theta.sin_cos();
+        let (fx, fy) = (c * dx + s * dy, -s * dx + c * dy);
+        (fx.hypot(fy), fy.atan2(fx))
+    };
+    // (viewer, the corner in view, east goal). The first is a keeper carried 2.8 m out in a
+    // match (session 39), facing its own goal: its left side is cut, its right upright in view.
+    // The third is the first turned half round the centre spot (the blue goal), the last sees
+    // the side net run back to the near back corner.
+    let cases = [
+        (Pose2::new(6.24, -0.82, 0.0), (hl, -gw), true),
+        (Pose2::new(6.5, 0.9, 0.35), (hl, gw), true),
+        (Pose2::new(-6.24, 0.82, std::f64::consts::PI), (-hl, gw), false),
+        (Pose2::new(6.0, -2.2, 0.3), (hl + gd, -gw), true),
+    ];
+    for (me, (x, y), east) in cases {
+        let image = renderer.render(&Scene::default(), me, 0.0, None, &mut CameraState::default());
+        let p = agent.see(&image, 0.0, 0.0).unwrap();
+        assert!(p.sightings[1].is_none() && p.sightings[2].is_none(), "no net from {me:?}");
+        assert_eq!(p.goal_corners.len(), 1, "from {me:?}: {:?}", p.goal_corners);
+        let c = p.goal_corners[0];
+        let (d, b) = relative(me, x, y);
+        assert_eq!(c.east, east);
+        let (dd, db) = (c.sighting.distance - d, c.sighting.bearing - b);
+        assert!(
+            dd.abs() < 0.03 * d && db.abs() < 1f64.to_radians(),
+            "from {me:?}: {c:?} vs {d} {b}"
+        );
+        assert!(c.sigma.0 > 0.0 && c.sigma.1 > 0.0 && c.pixels >= 30);
+    }
+    // A goal seen whole gives its net and no corner.
+    let me = Pose2::new(4.0, 0.3, 0.0);
+    let image = renderer.render(&Scene::default(), me, 0.0, None, &mut CameraState::default());
+    let p = agent.see(&image, 0.0, 0.0).unwrap();
+    assert!(p.sightings[1].is_some() && p.goal_corners.is_empty(), "{p:?}");
+}
+
 /// The open space (seed `003` eq. 18) on a rendered frame: an empty goal's is in its mouth;
 /// with a keeper on its left half, it lies right of the keeper. `look` reports the
 /// same goals by their nearest points.

@@ -55,6 +55,11 @@ pub struct FieldMap {
     pub width: f64,
     /// Inner width of a goal.
     pub goal_width: f64,
+    /// Depth of a goal behind its goal line, to the inner face of its back.
+    pub goal_depth: f64,
+    /// Thickness of a goal's sides and back: a goal's corners on the floor, as a camera sees
+    /// them from outside, are the outer faces' ([`FieldMap::goal_corners`]).
+    pub goal_wall: f64,
     /// Depth of the penalty area from the goal line.
     pub penalty_area_depth: f64,
     /// Width of the penalty area.
@@ -64,13 +69,15 @@ pub struct FieldMap {
 }
 
 impl Default for FieldMap {
-    /// The Middle Size League field of the seeds' time: 18 m × 12 m, goals 2 m wide, penalty
-    /// areas 2.25 m × 6.5 m, centre circle of 2 m.
+    /// The Middle Size League field of the seeds' time: 18 m × 12 m, goals 2 m wide and
+    /// 0.6 m deep with 5 cm sides, penalty areas 2.25 m × 6.5 m, centre circle of 2 m.
     fn default() -> Self {
         FieldMap {
             length: 18.0,
             width: 12.0,
             goal_width: 2.0,
+            goal_depth: 0.6,
+            goal_wall: 0.05,
             penalty_area_depth: 2.25,
             penalty_area_width: 6.5,
             centre_circle_radius: 2.0,
@@ -105,6 +112,20 @@ impl FieldMap {
             _ => return None,
         };
         Some(Point2::new(at.0, at.1))
+    }
+
+    /// The four corners on the floor of the east goal (`east`) or the west goal, at the outer
+    /// faces of its sides: the two in front (the uprights) and the two at the back. A camera
+    /// that sees a goal cut by the image's side sees one of them
+    /// (`mrt_msgs::Percepts::goal_corners`) and cannot tell which.
+    pub fn goal_corners(&self, east: bool) -> [Point2; 4] {
+        let side = if east { 1.0 } else { -1.0 };
+        let (front, back) = (
+            side * self.half_length(),
+            side * (self.half_length() + self.goal_depth + self.goal_wall),
+        );
+        let y = self.goal_width / 2.0 + self.goal_wall;
+        [Point2::new(front, y), Point2::new(front, -y), Point2::new(back, y), Point2::new(back, -y)]
     }
 
     /// Whether landmark post `k` wears the east goal's colour in its outer bands and the west

@@ -550,7 +550,7 @@ impl WorldModel {
     pub fn camera(&mut self, frame: &CameraFrame) -> WorldSnapshot {
         let none = [None; FIELD_OBJECTS];
         let perceived = self.global().then(|| {
-            relocalize::perceptions(&self.map, self.noise, &frame.sightings, &none, &[], &[])
+            relocalize::perceptions(&self.map, self.noise, &frame.sightings, &none, &[], &[], &[])
         });
         let velocity = frame.sightings[lps::BALL].map(|z| self.track_ball(frame.time, &z, None));
         let robots = &frame.robots;
@@ -742,6 +742,7 @@ impl WorldModel {
                 &p.sightings,
                 &p.sigmas,
                 &p.posts,
+                &p.goal_corners,
                 &p.line_points,
             )
         });

@@ -85,6 +85,23 @@ impl Kind {
     pub const GOAL: Kind = Kind(5);
     /// A landmark post whose pattern is not known.
     pub const POST: Kind = Kind(6);
+    /// A corner of the east goal on the floor ([`FieldMap::goal_corners`]): what a camera
+    /// sees of a goal cut by the image's side.
+    pub const EAST_CORNER: Kind = Kind(7);
+    /// A corner of the west goal.
+    pub const WEST_CORNER: Kind = Kind(8);
+    /// A goal corner whose goal is not known.
+    pub const CORNER: Kind = Kind(9);
+
+    /// The kind of a corner of the east goal (`east`) or the west goal: its goal's colour
+    /// when `coloured`.
+    pub fn goal_corner(east: bool, coloured: bool) -> Kind {
+        match (coloured, east) {
+            (false, _) => Kind::CORNER,
+            (true, true) => Kind::EAST_CORNER,
+            (true, false) => Kind::WEST_CORNER,
+        }
+    }
 
     /// The kind of field object `k` (camera sighting order, [`FieldMap::object`]): its goal
     /// colour or post pattern when `coloured`, else just goal or post; `None` for the ball and
@@ -137,8 +154,8 @@ impl Map {
         self
     }
 
-    /// The soccer field: its two goals (the centres of their goal lines), the landmark posts,
-    /// and the lines with the centre circle (as 36 chords). `coloured`: goals and posts are
+    /// The soccer field: its two goals (the centres of their goal lines) and their corners
+    /// on the floor, the landmark posts, and the lines with the centre circle (as 36 chords). `coloured`: goals and posts are
     /// told apart by colour (the ISocRob field); otherwise all goals are alike and all posts
     /// too, and the field is symmetric under a half turn.
     pub fn field(field: &FieldMap, coloured: bool) -> Map {
@@ -146,6 +163,11 @@ impl Map {
         for k in 1..FIELD_OBJECTS {
             if let (Some(at), Some(kind)) = (field.object(k), Kind::of_object(field, k, coloured)) {
                 map = map.point(kind, at);
+            }
+        }
+        for east in [true, false] {
+            for at in field.goal_corners(east) {
+                map = map.point(Kind::goal_corner(east, coloured), at);
             }
         }
         for s in field.lines() {
@@ -164,23 +186,17 @@ impl Map {
 
     /// The smallest box holding every element, `(min, max)`.
     fn bounds(&self) -> (Point2, Point2) {
-        let all = self
-            .points
-            .iter()
-            .map(|p| p.1)
-            .chain(self.segments.iter().flat_map(|s| [s.1.a, s.1.b]));
-        all.fold(
-            (
-                Point2::new(f64::INFINITY, f64::INFINITY),
-                Point2::new(f64::NEG_INFINITY, f64::NEG_INFINITY),
-            ),
-            |(lo, hi), p| {
-                (
-                    Point2::new(lo.x.min(p.x), lo.y.min(p.y)),
-                    Point2::new(hi.x.max(p.x), hi.y.max(p.y)),
-                )
-            },
-        )
+        let ends = self.segments.iter().flat_map(|s| [s.1.a, s.1.b]);
+        bounding_box(self.points.iter().map(|p| p.1).chain(ends))
+    }
+
+    /// Where a robot can stand, `(min, max)`: within the lines when the map has some (a
+    /// goal's back corners lie beyond the goal line), else the points' box.
+    fn area(&self) -> (Point2, Point2) {
+        if self.segments.is_empty() {
+            return self.bounds();
+        }
+        bounding_box(self.segments.iter().flat_map(|s| [s.1.a, s.1.b]))
     }
 
     /// Whether some element of `kind` meets the box `[x0, x1] × [y0, y1]`.
@@ -498,6 +514,17 @@ impl Ord for Entry {
     }
 }
 
+/// The smallest box holding `points`, `(min, max)` (infinite bounds when there are none).
+fn bounding_box(points: impl Iterator<Item = Point2>) -> (Point2, Point2) {
+    let none = (
+        Point2::new(f64::INFINITY, f64::INFINITY),
+        Point2::new(f64::NEG_INFINITY, f64::NEG_INFINITY),
+    );
+    points.fold(none, |(lo, hi), p| {
+        (Point2::new(lo.x.min(p.x), lo.y.min(p.y)), Point2::new(hi.x.max(p.x), hi.y.max(p.y)))
+    })
+}
+
 impl Murea {
     /// MUREA on `map`, to 5 cm and 1° within 200 000 cells, no timeout (docs/performance.md:
     /// about 3.4 ms for a global search of one frame, 9.3 ms with the ambiguity search).
@@ -514,9 +541,10 @@ impl Murea {
         }
     }
 
-    /// The whole map's area, every heading: global localization.
+    /// The whole map's area (within its lines, where it has some), every heading: global
+    /// localization.
     pub fn whole_field(&self) -> Cell {
-        let (lo, hi) = self.map.bounds();
+        let (lo, hi) = self.map.area();
         if !lo.x.is_finite() {
             return Cell { x: (0.0, 0.0), y: (0.0, 0.0), theta: (-PI, PI) };
         }
@@ -943,10 +971,13 @@ mod tests {
     use super::*;
     use proptest::prelude::*;
 
-    /// What a robot at `pose` sees of the map's points (exact range and bearing).
+    /// What a robot at `pose` sees of the map's goals and posts (exact range and bearing), all round; not the goals' corners,
+    /// which a camera reports only for a goal it cannot see whole.
     fn seen_from(map: &Map, pose: Pose2) -> Vec<Perception> {
+        let corners = [Kind::EAST_CORNER, Kind::WEST_CORNER, Kind::CORNER];
         map.points
             .iter()
+            .filter(|(kind, _)| !corners.contains(kind))
             .map(|&(kind, at)| {
                 let (dx, dy) = (at.x - pose.x, at.y - pose.y);
                 let bearing = normalize_angle(dy.atan2(dx) - pose.theta);

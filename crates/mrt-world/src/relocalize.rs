@@ -173,7 +173,8 @@ impl CameraNoise {
 
 /// The MUREA perceptions of one frame: nets and named landmarks of `sightings` (field-object
 /// order, with their standard deviations `sigmas` where known), the landmark `posts` by their
-/// colour pattern, and up to [`LINE_POINTS`] of the `line_points` (robot frame, m).
+/// colour pattern, the `goal_corners` of goals cut by the image's side by their goal's
+/// colour, and up to [`LINE_POINTS`] of the `line_points` (robot frame, m).
 /// Tolerances are three standard deviations ([`CameraNoise::sigma`]), at least 5 cm and 1°.
 pub fn perceptions(
     field: &FieldMap,
@@ -181,6 +182,7 @@ pub fn perceptions(
     sightings: &[Option<Sighting>; FIELD_OBJECTS],
     sigmas: &[Option<(f64, f64)>; FIELD_OBJECTS],
     posts: &[PostSighting],
+    goal_corners: &[PostSighting],
     line_points: &[(f64, f64)],
 ) -> Vec<Perception> {
     let point = |kind: Kind, z: &Sighting, sigma: Option<(f64, f64)>| {
@@ -197,6 +199,9 @@ pub fn perceptions(
     for post in posts {
         let kind = if post.east { Kind::EAST_POST } else { Kind::WEST_POST };
         out.push(point(kind, &post.sighting, Some(post.sigma)));
+    }
+    for corner in goal_corners {
+        out.push(point(Kind::goal_corner(corner.east, true), &corner.sighting, Some(corner.sigma)));
     }
     let step = line_points.len().div_ceil(LINE_POINTS).max(1);
     for &(x, y) in line_points.iter().step_by(step) {
@@ -581,7 +586,7 @@ mod tests {
             pixels: 40,
         }];
         let lines: Vec<(f64, f64)> = (0..40).map(|i| (1.0 + 0.1 * f64::from(i), 0.5)).collect();
-        let p = perceptions(&f, NOISE, &sightings, &[None; FIELD_OBJECTS], &posts, &lines);
+        let p = perceptions(&f, NOISE, &sightings, &[None; FIELD_OBJECTS], &posts, &[], &lines);
         assert_eq!(p[0].kind, Kind::EAST_GOAL);
         assert!((p[0].range_tolerance - 0.39).abs() < 1e-12, "3 × (3 % of 4 m + 1 cm)");
         assert_eq!(p[1].kind, Kind::WEST_POST);
@@ -614,14 +619,15 @@ mod tests {
     fn first_fix(
         r: &mut Relocalizer,
         frames: u32,
-        sightings: &[Option<Sighting>; FIELD_OBJECTS],
+        (sightings, corners): (&[Option<Sighting>; FIELD_OBJECTS], &[PostSighting]),
         lines: &[(f64, f64)],
         wrong: Pose2,
     ) -> Fix {
         let f = field();
         for k in 0..frames {
             r.lines(lines);
-            let p = perceptions(&f, NOISE, sightings, &[None; FIELD_OBJECTS], &[], lines);
+            let none = [None; FIELD_OBJECTS];
+            let p = perceptions(&f, NOISE, sightings, &none, &[], corners, lines);
             if let Some(fix) = r.frame(0.1 * f64::from(k), p, wrong) {
                 return fix;
             }
@@ -649,7 +655,7 @@ mod tests {
             if self_mode {
                 r = r.with_self_mode(&f);
             }
-            let fix = first_fix(&mut r, 20, &seen, &lines, wrong);
+            let fix = first_fix(&mut r, 20, (&seen, &[]), &lines, wrong);
             let err = (fix.pose.x - truth.x).hypot(fix.pose.y - truth.y);
             let turn = normalize_angle(fix.pose.theta - truth.theta).abs();
             assert!(err < 0.2 && turn < 0.05, "self mode {self_mode}: {fix:?}");
@@ -677,7 +683,35 @@ mod tests {
             .filter(|&(x, y)| x > 0.3 && y.atan2(x).abs() < 20f64.to_radians())
             .collect();
         assert!(lines.len() >= ONE_MARK_LINES, "{} line points in view", lines.len());
-        let fix = first_fix(&mut Relocalizer::new(&f), 10, &one, &lines, wrong);
+        let fix = first_fix(&mut Relocalizer::new(&f), 10, (&one, &[]), &lines, wrong);
+        let err = (fix.pose.x - truth.x).hypot(fix.pose.y - truth.y);
+        assert!(err < 0.2 && normalize_angle(fix.pose.theta - truth.theta).abs() < 0.05, "{fix:?}");
+    }
+
+    /// A keeper carried 2.8 m out in front of its own goal and facing it (a match of session
+    /// 39: 165 s lost) sees no net, the goal being cut by the image's side, and no post: one
+    /// corner of the goal and the lines before it find it again.
+    #[test]
+    fn a_goal_corner_and_the_lines_find_a_keeper_carried_before_its_goal() {
+        let f = field();
+        let truth = Pose2::new(6.24, -0.82, 0.0);
+        let wrong = Pose2::new(8.67, 0.0, -0.58);
+        // The east goal's south upright, at the outer face of its side.
+        let [_, upright, ..] = f.goal_corners(true);
+        let (dx, dy) = (upright.x - truth.x, upright.y - truth.y);
+        let corner = PostSighting {
+            sighting: Sighting { distance: dx.hypot(dy), bearing: dy.atan2(dx) - truth.theta },
+            sigma: (0.02, 0.004),
+            east: true,
+            pixels: 5000,
+        };
+        let lines: Vec<(f64, f64)> = lines_around(truth)
+            .into_iter()
+            .filter(|&(x, y)| x > 0.3 && y.atan2(x).abs() < 30f64.to_radians())
+            .collect();
+        assert!(lines.len() >= ONE_MARK_LINES, "{} line points in view", lines.len());
+        let none = [None; FIELD_OBJECTS];
+        let fix = first_fix(&mut Relocalizer::new(&f), 10, (&none, &[corner]), &lines, wrong);
         let err = (fix.pose.x - truth.x).hypot(fix.pose.y - truth.y);
         assert!(err < 0.2 && normalize_angle(fix.pose.theta - truth.theta).abs() < 0.05, "{fix:?}");
     }
@@ -701,7 +735,7 @@ mod tests {
         for k in 0..100 {
             let t = 0.1 * f64::from(k);
             let before = r.counts().searches;
-            let p = perceptions(&f, NOISE, &one, &[None; FIELD_OBJECTS], &[], &lines);
+            let p = perceptions(&f, NOISE, &one, &[None; FIELD_OBJECTS], &[], &[], &lines);
             assert!(r.frame(t, p, wrong).is_none());
             if r.counts().searches > before {
                 searched.push((10.0 * t).round() / 10.0);
@@ -719,7 +753,7 @@ mod tests {
         let truth = Pose2::new(2.0, 1.0, 0.3);
         for k in 0..10 {
             let seen = seen_from(truth);
-            let p = perceptions(&f, NOISE, &seen, &[None; FIELD_OBJECTS], &[], &[]);
+            let p = perceptions(&f, NOISE, &seen, &[None; FIELD_OBJECTS], &[], &[], &[]);
             assert!(r.frame(0.1 * f64::from(k), p, truth).is_none());
         }
         assert_eq!(r.counts().searches, 0, "the window fits the tracked pose");
@@ -732,7 +766,8 @@ mod tests {
         let before = Pose2::new(-3.0, 2.0, 0.0);
         let mut t = 0.0;
         for _ in 0..10 {
-            let p = perceptions(&f, NOISE, &seen_from(before), &[None; FIELD_OBJECTS], &[], &[]);
+            let p =
+                perceptions(&f, NOISE, &seen_from(before), &[None; FIELD_OBJECTS], &[], &[], &[]);
             assert!(r.frame(t, p, before).is_none());
             t += 0.1;
         }
@@ -740,7 +775,8 @@ mod tests {
         let after = Pose2::new(3.0, -2.0, 3.0);
         let mut fixed = None;
         for _ in 0..20 {
-            let p = perceptions(&f, NOISE, &seen_from(after), &[None; FIELD_OBJECTS], &[], &[]);
+            let p =
+                perceptions(&f, NOISE, &seen_from(after), &[None; FIELD_OBJECTS], &[], &[], &[]);
             if let Some(fix) = r.frame(t, p, before) {
                 fixed = Some((t, fix));
                 break;
@@ -761,7 +797,7 @@ mod tests {
         // tracker says it is at (0, 1) facing north.
         let mut sightings = [None; FIELD_OBJECTS];
         sightings[EAST_NET] = Some(Sighting { distance: 4.0, bearing: 0.0 });
-        let p = perceptions(&f, NOISE, &sightings, &[None; FIELD_OBJECTS], &[], &[]);
+        let p = perceptions(&f, NOISE, &sightings, &[None; FIELD_OBJECTS], &[], &[], &[]);
         r.frame(0.0, p, Pose2::default());
         r.moved(Pose2::new(0.0, 0.0, std::f64::consts::FRAC_PI_2));
         r.moved(Pose2::new(1.0, 0.0, 0.0));
@@ -791,7 +827,7 @@ mod tests {
         };
         let none = [None; FIELD_OBJECTS];
         for (t, d) in [(0.0, 11.5), (0.1, 10.3)] {
-            let p = perceptions(&f, NOISE, &none, &[None; FIELD_OBJECTS], &[post(d)], &[]);
+            let p = perceptions(&f, NOISE, &none, &[None; FIELD_OBJECTS], &[post(d)], &[], &[]);
             r.frame(t, p, Pose2::default());
         }
         let w = r.window_now(0.1, Pose2::default());
@@ -802,7 +838,15 @@ mod tests {
         assert!((w[0].bearing.unwrap_or(0.0) + 0.58).abs() < 1e-9);
         // Two posts of one pattern 3 m apart stay two.
         let mut r = Relocalizer::new(&f);
-        let p = perceptions(&f, NOISE, &none, &[None; FIELD_OBJECTS], &[post(4.0), post(7.0)], &[]);
+        let p = perceptions(
+            &f,
+            NOISE,
+            &none,
+            &[None; FIELD_OBJECTS],
+            &[post(4.0), post(7.0)],
+            &[],
+            &[],
+        );
         r.frame(0.0, p, Pose2::default());
         assert_eq!(r.window_now(0.0, Pose2::default()).len(), 2);
     }

@@ -19,7 +19,7 @@ use super::posts::{find_posts_in, PostPercept, PostShape};
 use super::up::UpMode;
 use crate::camera::{Camera, Omni, Pinhole, Pixel};
 use mrt_msgs::{Image, Marker, Percepts, PostSighting, RobotSighting, Sighting};
-use nalgebra::{Point2, Vector2};
+use nalgebra::{Point2, Point3, Vector2};
 
 /// Sighting index of the ball, the east and the west net (the world model's order).
 const BALL: usize = 0;
@@ -28,6 +28,9 @@ const WEST_NET: usize = 2;
 
 /// Pixels a goal must show to count.
 pub const MIN_GOAL_PIXELS: u32 = 30;
+/// Rows by which a goal's lowest pixel drops from one column to the next, at least, where a
+/// goal's side slants in the image (its floor edge drops less).
+pub const SLANT_STEP: f64 = 3.0;
 /// Obstacle scan lines: every this many columns.
 pub const OBSTACLE_STEP: usize = 4;
 /// Robot pixels in a row, up a column, that make a robot's foot.
@@ -269,11 +272,23 @@ impl VisionAgent {
                 .into_iter()
                 .enumerate()
         {
-            if let Some(net) = self.net(class, count, &posts) {
+            let count = without_posts(count, &posts, w as usize);
+            if let Some(net) = self.net(class, &count) {
                 p.sightings[k] = Some(sighting(net.at));
                 p.sigmas[k] = self.sigma(net.foot, 1.0);
                 p.pixels[k] = net.pixels;
                 p.open_space[side] = net.open_bearing;
+            } else if let Some((px, at)) = self.cut_goal_corner(class, &count) {
+                if let Some(sigma) = self.sigma(px, 1.0) {
+                    let pixels = count.iter().sum();
+                    let east = k == EAST_NET;
+                    p.goal_corners.push(PostSighting {
+                        sighting: sighting(at),
+                        sigma,
+                        east,
+                        pixels,
+                    });
+                }
             }
         }
         p.line_points = line_points(&self.classes, &self.camera, LINE_STEP, LINE_MAX_RUN)
@@ -304,37 +319,43 @@ impl VisionAgent {
         h / (h - self.posts.height / 3.0).abs().max(0.05)
     }
 
-    /// The net of the goal of `class` ([`Net`]); `posts`' columns do not count. `count` holds
-    /// the goal's column counts (eq. 16).
-    fn net(&self, class: ColorClass, mut count: Vec<u32>, posts: &[PostPercept]) -> Option<Net> {
+    /// Where the goal of `class` stands on the carpet in column `col` of the image: its lowest
+    /// pixel there has carpet (or a line) right below it. `count` holds the goal's column
+    /// counts (eq. 16). (Under a tilted camera the goal's sides slant outwards upwards; the
+    /// columns of those slants end on the wall or the hall, and a robot in front hides the
+    /// foot.) The pixel under the foot, and its floor point (robot frame, m).
+    fn goal_foot(
+        &self,
+        class: ColorClass,
+        count: &[u32],
+        col: usize,
+    ) -> Option<(Pixel, Point2<f64>)> {
         let (w, h) = self.camera.size();
         let (w, h) = (w as usize, h as usize);
-        let want = class as u8;
-        for post in posts {
-            count[post.masked_columns(w)].iter_mut().for_each(|c| *c = 0);
+        if count.get(col).is_none_or(|&c| c < 2) {
+            return None;
         }
+        let want = class as u8;
+        let row = (0..h).rev().find(|&r| self.classes[r * w + col] == want)?;
+        let below = *self.classes.get((row + 1) * w + col)?;
+        if below != ColorClass::Field as u8 && below != ColorClass::Line as u8 {
+            return None;
+        }
+        let px = Pixel::new(col as f64 + 0.5, row as f64 + 1.0);
+        Some((px, self.camera.unproject(px)?))
+    }
+
+    /// The net of the goal of `class` ([`Net`]). `count` holds the goal's column counts (eq.
+    /// 16), the posts' columns left out.
+    fn net(&self, class: ColorClass, count: &[u32]) -> Option<Net> {
+        let w = count.len();
         let pixels: u32 = count.iter().sum();
         // Too little of it, or cut by the image's side: where its far end is is unknown.
         if pixels < MIN_GOAL_PIXELS || count[0] > 0 || count[w - 1] > 0 {
             return None;
         }
-        // The outermost columns where the goal stands on the carpet: its lowest pixel there
-        // has carpet (or a line) right below it. (Under a tilted camera the goal's sides
-        // slant outwards upwards; the columns of those slants end on the wall or the hall,
-        // and a robot in front hides the foot.)
-        let (field, line) = (ColorClass::Field as u8, ColorClass::Line as u8);
-        let foot = |col: usize| {
-            if count.get(col).is_none_or(|&c| c < 2) {
-                return None;
-            }
-            let row = (0..h).rev().find(|&r| self.classes[r * w + col] == want)?;
-            let below = *self.classes.get((row + 1) * w + col)?;
-            if below != field && below != line {
-                return None;
-            }
-            let px = Pixel::new(col as f64 + 0.5, row as f64 + 1.0);
-            Some((px, self.camera.unproject(px)?))
-        };
+        // The outermost columns where the goal stands on the carpet.
+        let foot = |col: usize| self.goal_foot(class, count, col);
         let (pl, l) = (0..w).find_map(foot)?;
         let (pr, r) = (0..w).rev().find_map(foot)?;
         // The two feet are the goal's posts (or a post and a back corner): as far apart as
@@ -352,6 +373,83 @@ impl VisionAgent {
             Some(at.y.atan2(at.x))
         });
         Some(Net { at: Point2::from((l.coords + r.coords) / 2.0), foot: pl, pixels, open_bearing })
+    }
+
+    /// The goal of `class` cut by one side of the image: the outermost foot on the other side
+    /// ([`VisionAgent::goal_foot`]), one of its four corners on the floor (an upright, or a
+    /// back corner seen obliquely). Its pixel and floor point (robot frame, m). `None` when the
+    /// goal shows too little, is whole (then its net is seen) or is cut on both sides.
+    fn cut_goal_corner(&self, class: ColorClass, count: &[u32]) -> Option<(Pixel, Point2<f64>)> {
+        let w = count.len();
+        let pixels: u32 = count.iter().sum();
+        let (left, right) =
+            (count.first().is_some_and(|&c| c > 0), count.last().is_some_and(|&c| c > 0));
+        if pixels < MIN_GOAL_PIXELS || left == right {
+            return None;
+        }
+        let foot = |col: usize| self.goal_foot(class, count, col);
+        // The goal is the columns of its colour that reach the cut side without a gap;
+        // anything of its colour beyond them is something else (a post's band, a far goal).
+        let blob = if left {
+            0..(0..w).find(|&c| count[c] == 0).unwrap_or(w)
+        } else {
+            (0..w).rev().find(|&c| count[c] == 0).map_or(0, |c| c + 1)..w
+        };
+        let outermost = if left {
+            blob.rev().find(|&c| foot(c).is_some())?
+        } else {
+            blob.into_iter().find(|&c| foot(c).is_some())?
+        };
+        // Outside the corner the goal's side, slanting outwards as it rises, shows carpet
+        // below it too, each column's "foot" several rows higher than the next one in:
+        // follow those steps down to the corner.
+        let inward =
+            |c: usize| if left { c.checked_sub(1) } else { Some(c + 1).filter(|&c| c < w) };
+        let (mut col, mut here) = (outermost, foot(outermost)?);
+        while let Some((next, there)) = inward(col).and_then(|c| Some((c, foot(c)?))) {
+            if there.0.y < here.0.y + SLANT_STEP {
+                break;
+            }
+            (col, here) = (next, there);
+        }
+        let (px, at) = here;
+        // A landmark post cut by the image's side, and so not found as a post, shows its
+        // lower band like a goal: a goal stands taller than the band between the foot and
+        // the cut side.
+        let between = if left { 0..px.x as usize + 1 } else { px.x as usize..w };
+        (self.tallest_run(class, between) >= self.rows_up(at, 1.5 * self.posts.height / 3.0)?)
+            .then_some((px, at))
+    }
+
+    /// How many rows `height` (m) above the floor point `at` (robot frame) spans in the image.
+    fn rows_up(&self, at: Point2<f64>, height: f64) -> Option<f64> {
+        let floor = self.camera.project(Point3::new(at.x, at.y, 0.0))?;
+        let up = self.camera.project(Point3::new(at.x, at.y, height))?;
+        Some(floor.y - up.y)
+    }
+
+    /// The tallest run of `class` that rises from the lowest pixel of that class in one of
+    /// the `columns`, rows (a few rows of another class inside it do not end it).
+    fn tallest_run(&self, class: ColorClass, columns: std::ops::Range<usize>) -> f64 {
+        let (w, h) = self.camera.size();
+        let (w, h) = (w as usize, h as usize);
+        let want = class as u8;
+        let run = |col: usize| {
+            let is = |r: usize| self.classes[r * w + col] == want;
+            let Some(bottom) = (0..h).rev().find(|&r| is(r)) else { return 0 };
+            let (mut top, mut gap) = (bottom, 0);
+            for r in (0..bottom).rev() {
+                if is(r) {
+                    (top, gap) = (r, 0);
+                } else if gap == 2 {
+                    break;
+                } else {
+                    gap += 1;
+                }
+            }
+            bottom - top + 1
+        };
+        columns.filter(|&c| c < w).map(run).max().unwrap_or(0) as f64
     }
 
     /// Other robots: scanning every [`OBSTACLE_STEP`]-th column from the bottom up over the
@@ -476,6 +574,15 @@ impl VisionAgent {
         let d = (here.coords.norm() - below.coords.norm()).abs() * scale;
         Some((d.max(0.005), (1.0 / self.camera.intrinsics.fx).atan()))
     }
+}
+
+/// A goal's column counts (eq. 16) with the columns of the landmark `posts` cleared: their
+/// bands wear the goal colours. `w`: the image's width.
+fn without_posts(mut count: Vec<u32>, posts: &[PostPercept], w: usize) -> Vec<u32> {
+    for post in posts {
+        count[post.masked_columns(w)].iter_mut().for_each(|c| *c = 0);
+    }
+    count
 }
 
 fn sighting(at: Point2<f64>) -> Sighting {
