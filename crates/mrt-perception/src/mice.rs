@@ -210,6 +210,25 @@ impl MiceOdometry {
         )
     }
 
+    /// The robot's motion from readings that can be trusted, and whether it needed the §4.2
+    /// reduction ([`MiceOdometry::reduce`]); `None` when they cannot (then the wheels are the
+    /// better guess). A reduction that scales a reading by more than 2 is refused: a mouse
+    /// under-reads by at most half in the sensor model, and a larger factor amplifies noise in
+    /// a small `x̄`.
+    pub fn motion(&self, r: &MiceReadings) -> Option<(Displacement, bool)> {
+        match self.displacement(r) {
+            Ok(d) => Some((d, false)),
+            Err(PerceptionError::MiceInconsistent { .. }) => {
+                let fixed = self.reduce(r).ok()?;
+                let grew = |a: f64, b: f64, c: f64, d: f64| a.hypot(b) <= 2.0 * c.hypot(d);
+                let plausible = grew(fixed.x_left, fixed.y_left, r.x_left, r.y_left)
+                    && grew(fixed.x_right, fixed.y_right, r.x_right, r.y_right);
+                plausible.then(|| self.displacement(&fixed).ok().map(|d| (d, true))).flatten()
+            }
+            Err(_) => None,
+        }
+    }
+
     /// The forward model, for a simulator: what each mouse reads, in its own frame, when the
     /// robot moves by `(dx, dy, dtheta)` (robot frame at the start) along an arc in one
     /// sampling period. The robot's constant velocity `(vx, vy)` over the period follows from

@@ -43,6 +43,7 @@ pub mod devices;
 pub mod files;
 pub mod isocrob;
 pub mod members;
+pub mod mission;
 pub mod planner;
 pub mod remote;
 pub mod stacks;

@@ -122,9 +122,15 @@ impl Member for Planner {
 /// one nearest the robot that is at least [`LOOKAHEAD`] away, or the path's last pose.
 /// `None` for an empty path.
 pub fn carrot(path: &[Pose2], me: Pose2) -> Option<Pose2> {
+    carrot_at(path, me, LOOKAHEAD)
+}
+
+/// The first pose of `path` past the one nearest `me` that is at least `lookahead` away
+/// (in the path's unit), or the path's last pose; `None` for an empty path.
+pub fn carrot_at(path: &[Pose2], me: Pose2, lookahead: f64) -> Option<Pose2> {
     let d = |p: &Pose2| (p.x - me.x).hypot(p.y - me.y);
     let nearest = (0..path.len()).min_by(|&a, &b| d(&path[a]).total_cmp(&d(&path[b])))?;
-    path[nearest..].iter().find(|p| d(p) >= LOOKAHEAD).or(path.last()).copied()
+    path[nearest..].iter().find(|p| d(p) >= lookahead).or(path.last()).copied()
 }
 
 /// Whether `path` was planned for `to` ([`same_goal`]).

@@ -27,6 +27,7 @@ pub mod config;
 pub mod devices;
 pub mod drivers;
 pub mod game;
+pub mod indoor;
 pub mod metrics;
 pub mod plot;
 pub mod referee;

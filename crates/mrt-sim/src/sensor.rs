@@ -10,7 +10,7 @@
 
 use crate::config::{OdometryConfig, SensorConfig, SonarConfig};
 use crate::referee::Referee;
-use crate::world::World;
+use crate::world::{Drive, World};
 use mrt_core::frames::{Field, Framed};
 use mrt_core::{normalize_angle, Pose2};
 use mrt_msgs::robot::lps;
@@ -19,10 +19,53 @@ use mrt_plan::guidance::Sonar;
 use mrt_plan::kinematics::{integrate, Twist};
 use rand::{Rng, RngCore};
 
+/// The robots' bodies as the odometry and sonar drivers read them: the soccer [`World`] and
+/// the indoor world ([`crate::indoor::IndoorWorld`]).
+pub trait Bodies {
+    /// Robot `i`'s pose, `None` when there is no such robot.
+    fn robot(&self, i: usize) -> Option<Pose2>;
+    /// How often robot `i` was put down by hand, and where last.
+    fn placement(&self, i: usize) -> (u32, Pose2);
+    /// How often robot `i` was carried elsewhere without being told.
+    fn carried(&self, i: usize) -> u32;
+    /// Robot `i`'s velocity set-point.
+    fn drive_setpoint(&self, i: usize) -> Drive;
+    /// The robots' radius, m.
+    fn robot_radius(&self) -> f64;
+    /// Robot `i`'s sonar ring: each sonar's distance from the robot's edge ([`World::sonar`]).
+    fn sonar(&self, i: usize, count: usize, half_beam: f64, range: f64) -> Vec<f64>;
+}
+
+impl Bodies for World {
+    fn robot(&self, i: usize) -> Option<Pose2> {
+        World::robot(self, i)
+    }
+    fn placement(&self, i: usize) -> (u32, Pose2) {
+        World::placement(self, i)
+    }
+    fn carried(&self, i: usize) -> u32 {
+        World::carried(self, i)
+    }
+    fn drive_setpoint(&self, i: usize) -> Drive {
+        World::drive_setpoint(self, i)
+    }
+    fn robot_radius(&self) -> f64 {
+        self.config().robot.radius
+    }
+    fn sonar(&self, i: usize, count: usize, half_beam: f64, range: f64) -> Vec<f64> {
+        World::sonar(self, i, count, half_beam, range)
+    }
+}
+
 /// What robot `i`'s sonar ring hears (robot frame, m from the centre, ring order; no echo is
 /// an infinite range): [`World::sonar`]'s edge distances plus the radius, with noise.
-pub fn sonar_ring(world: &World, i: usize, cfg: &SonarConfig, rng: &mut dyn RngCore) -> Vec<Sonar> {
-    let radius = world.config().robot.radius;
+pub fn sonar_ring(
+    world: &dyn Bodies,
+    i: usize,
+    cfg: &SonarConfig,
+    rng: &mut dyn RngCore,
+) -> Vec<Sonar> {
+    let radius = world.robot_radius();
     world
         .sonar(i, cfg.count, cfg.half_beam, cfg.range)
         .into_iter()
@@ -169,7 +212,7 @@ impl Odometer {
     /// blocked), with noise.
     pub fn read(
         &mut self,
-        world: &World,
+        world: &dyn Bodies,
         cfg: &OdometryConfig,
         period: f64,
         rng: &mut dyn RngCore,

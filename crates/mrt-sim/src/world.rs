@@ -47,7 +47,7 @@ pub struct World {
     time: f64,
 }
 
-fn v(x: f64, y: f64) -> Vector {
+pub(crate) fn v(x: f64, y: f64) -> Vector {
     Vector::new(x as f32, y as f32)
 }
 
@@ -257,13 +257,63 @@ impl World {
         let (Some(pose), Some(robot)) = (self.robot(i), self.robots.get(i)) else {
             return Vec::new();
         };
-        let r = self.cfg.robot.radius;
-        let query = self
-            .physics
-            .query_pipeline_with_filter(QueryFilter::default().exclude_rigid_body(robot.body));
-        (0..count)
+        let ring = SonarRing { count, half_beam, range, radius: self.cfg.robot.radius };
+        ring.cast(&self.physics, robot.body, pose)
+    }
+
+    /// Advances the world by one physics step: robots accelerate towards their set-points
+    /// (within the acceleration limit), then rapier moves everything.
+    pub fn step(&mut self) {
+        let dt = self.cfg.rules.physics_step;
+        let max_dv = self.cfg.robot.max_accel * dt;
+        let max_dw = 4.0 * self.cfg.robot.max_turn_rate * dt;
+        for r in &self.robots {
+            accelerate(&mut self.physics.bodies[r.body], r.drive, max_dv, max_dw);
+        }
+        self.physics.step();
+        self.time += dt;
+    }
+}
+
+/// Changes `body`'s velocity towards the set-point `drive` (robot frame) by at most `max_dv`
+/// (m/s) and `max_dw` (rad/s): one physics step of a robot's motors.
+pub(crate) fn accelerate(body: &mut RigidBody, drive: Drive, max_dv: f64, max_dw: f64) {
+    let th = f64::from(body.rotation().angle());
+    let (c, s) = (th.cos(), th.sin());
+    let target = (drive.forward * c - drive.left * s, drive.forward * s + drive.left * c);
+    let now = body.linvel();
+    let (dvx, dvy) = (target.0 - f64::from(now.x), target.1 - f64::from(now.y));
+    let dv = dvx.hypot(dvy);
+    let k = if dv > max_dv { max_dv / dv } else { 1.0 };
+    body.set_linvel(v(f64::from(now.x) + dvx * k, f64::from(now.y) + dvy * k), true);
+    let w = f64::from(body.angvel());
+    let dw = (drive.turn - w).clamp(-max_dw, max_dw);
+    body.set_angvel((w + dw) as f32, true);
+}
+
+/// A ring of sonars round a robot of `radius` (m), as [`World::sonar`] describes it.
+pub(crate) struct SonarRing {
+    pub(crate) count: usize,
+    pub(crate) half_beam: f64,
+    pub(crate) range: f64,
+    pub(crate) radius: f64,
+}
+
+impl SonarRing {
+    /// Each sonar's distance from the robot's edge at `pose` to the nearest thing in
+    /// `physics` other than the robot's own `body` (`range` when nothing is hit).
+    pub(crate) fn cast(
+        &self,
+        physics: &PhysicsWorld,
+        body: RigidBodyHandle,
+        pose: Pose2,
+    ) -> Vec<f64> {
+        let query =
+            physics.query_pipeline_with_filter(QueryFilter::default().exclude_rigid_body(body));
+        let (r, range, half_beam) = (self.radius, self.range, self.half_beam);
+        (0..self.count)
             .map(|k| {
-                let centre = pose.theta + 2.0 * std::f64::consts::PI * k as f64 / count as f64;
+                let centre = pose.theta + 2.0 * std::f64::consts::PI * k as f64 / self.count as f64;
                 [centre - half_beam, centre, centre + half_beam]
                     .into_iter()
                     .map(|a| {
@@ -276,31 +326,6 @@ impl World {
                     .fold(range, f64::min)
             })
             .collect()
-    }
-
-    /// Advances the world by one physics step: robots accelerate towards their set-points
-    /// (within the acceleration limit), then rapier moves everything.
-    pub fn step(&mut self) {
-        let dt = self.cfg.rules.physics_step;
-        let max_dv = self.cfg.robot.max_accel * dt;
-        let max_dw = 4.0 * self.cfg.robot.max_turn_rate * dt;
-        for r in &self.robots {
-            let body = &mut self.physics.bodies[r.body];
-            let th = f64::from(body.rotation().angle());
-            let (c, s) = (th.cos(), th.sin());
-            let target =
-                (r.drive.forward * c - r.drive.left * s, r.drive.forward * s + r.drive.left * c);
-            let now = body.linvel();
-            let (dvx, dvy) = (target.0 - f64::from(now.x), target.1 - f64::from(now.y));
-            let dv = dvx.hypot(dvy);
-            let k = if dv > max_dv { max_dv / dv } else { 1.0 };
-            body.set_linvel(v(f64::from(now.x) + dvx * k, f64::from(now.y) + dvy * k), true);
-            let w = f64::from(body.angvel());
-            let dw = (r.drive.turn - w).clamp(-max_dw, max_dw);
-            body.set_angvel((w + dw) as f32, true);
-        }
-        self.physics.step();
-        self.time += dt;
     }
 }
 

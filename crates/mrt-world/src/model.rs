@@ -41,8 +41,7 @@ use mrt_msgs::{
     BallBelief, CameraFrame, GameInfo, Localization, Odometry, Percepts, PostSighting,
     RobotSighting, Sighting, Sonar, SonarScan, FIELD_OBJECTS,
 };
-use mrt_perception::mice::{Displacement, MiceOdometry, MiceReadings};
-use mrt_perception::PerceptionError;
+use mrt_perception::mice::{Displacement, MiceOdometry};
 use nalgebra::{Matrix2, Matrix2x3, Matrix3, Vector2, Vector3};
 use std::f64::consts::PI;
 
@@ -398,7 +397,7 @@ impl WorldModel {
         if let Some(p) = o.placed {
             self.place(p);
         }
-        match self.mice_motion(&o.mice) {
+        match self.mice.motion(&o.mice) {
             Some((d, reduced)) => {
                 if reduced {
                     self.counts.reduced += 1;
@@ -411,23 +410,6 @@ impl WorldModel {
                 self.counts.wheels += 1;
                 self.predict(&o.wheels, WHEEL_SIGMA);
             }
-        }
-    }
-
-    /// The mice's motion if they can be trusted, and whether it needed the §4.2 reduction.
-    /// A reduction that scales a reading by more than 2 is refused: a mouse under-reads by at
-    /// most half in the sensor model, and a larger factor amplifies noise in small `x̄`.
-    fn mice_motion(&self, r: &MiceReadings) -> Option<(Displacement, bool)> {
-        match self.mice.displacement(r) {
-            Ok(d) => Some((d, false)),
-            Err(PerceptionError::MiceInconsistent { .. }) => {
-                let fixed = self.mice.reduce(r).ok()?;
-                let grew = |a: f64, b: f64, c: f64, d: f64| a.hypot(b) <= 2.0 * c.hypot(d);
-                let plausible = grew(fixed.x_left, fixed.y_left, r.x_left, r.y_left)
-                    && grew(fixed.x_right, fixed.y_right, r.x_right, r.y_right);
-                plausible.then(|| self.mice.displacement(&fixed).ok().map(|d| (d, true))).flatten()
-            }
-            Err(_) => None,
         }
     }
 
