@@ -3,6 +3,7 @@
 
 use anyhow::{bail, Context as _, Result};
 use mrt_core::Point2;
+use mrt_plan::spike::draw::Sheet;
 use mrt_plan::spike::{Cell, CellState, Plan, PlanMap, Shape, Spike, SpikeParams};
 use std::fmt::Write as _;
 use std::path::PathBuf;
@@ -154,8 +155,7 @@ fn svg(spike: &Spike, moving: &[Shape], plan: &Plan, cells: &[Cell]) -> String {
     let (w, h) = ((map.max.x - map.min.x) * scale, (map.max.y - map.min.y) * scale);
     // A band above the map for the caption; the map below it, clipped to the area.
     let band = 44.0;
-    let x = |v: f64| (v - map.min.x) * scale;
-    let y = |v: f64| (map.max.y - v) * scale;
+    let (x, y) = (|v: f64| (v - map.min.x) * scale, |v: f64| (map.max.y - v) * scale);
     let mut out = String::new();
     let _ = writeln!(
         out,
@@ -195,51 +195,10 @@ fn svg(spike: &Spike, moving: &[Shape], plan: &Plan, cells: &[Cell]) -> String {
             c.size * scale
         );
     }
-    let shape = |out: &mut String, s: &Shape, colour: &str| match s {
-        Shape::Disc { centre, radius } => {
-            let _ = writeln!(
-                out,
-                r##"<circle cx="{:.2}" cy="{:.2}" r="{:.2}" fill="{colour}" fill-opacity="0.8"/>"##,
-                x(centre.x),
-                y(centre.y),
-                radius * scale
-            );
-        }
-        Shape::Wall { a, b } => {
-            let _ = writeln!(
-                out,
-                r##"<line x1="{:.2}" y1="{:.2}" x2="{:.2}" y2="{:.2}" stroke="{colour}" stroke-width="3"/>"##,
-                x(a.x),
-                y(a.y),
-                x(b.x),
-                y(b.y)
-            );
-        }
-        Shape::Polygon(corners) => {
-            let points: Vec<String> =
-                corners.iter().map(|p| format!("{:.2},{:.2}", x(p.x), y(p.y))).collect();
-            let _ = writeln!(
-                out,
-                r##"<polygon points="{}" fill="{colour}" fill-opacity="0.8"/>"##,
-                points.join(" ")
-            );
-        }
-    };
-    for s in &map.shapes {
-        shape(&mut out, s, "#333333");
-    }
+    let sheet = Sheet::of(map, scale);
+    sheet.map(&mut out, map);
     for s in moving {
-        shape(&mut out, s, "#c0392b");
-    }
-    for d in &map.doors {
-        let _ = writeln!(
-            out,
-            r##"<line x1="{:.2}" y1="{:.2}" x2="{:.2}" y2="{:.2}" stroke="#2e86c1" stroke-width="2" stroke-dasharray="4 3"/>"##,
-            x(d.a.x),
-            y(d.a.y),
-            x(d.b.x),
-            y(d.b.y)
-        );
+        sheet.shape(&mut out, s, "#c0392b");
     }
     let path: Vec<String> =
         plan.waypoints.iter().map(|p| format!("{:.2},{:.2}", x(p.x), y(p.y))).collect();

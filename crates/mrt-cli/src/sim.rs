@@ -92,6 +92,20 @@ pub struct SimArgs {
     /// docs/localization.md) to this JSON file, over the match or the whole series.
     #[arg(long)]
     pub metrics: Option<PathBuf>,
+    /// Which embedded world: soccer (a match) or indoor (one robot follows path points
+    /// through a building where a door closes and a person walks; the MRT manual's Roby,
+    /// docs/indoor.md).
+    #[arg(long, value_enum, default_value = "soccer")]
+    pub world: WorldKind,
+}
+
+/// `--world`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum WorldKind {
+    /// The robot-soccer match.
+    Soccer,
+    /// The building of `configs/worlds/indoor/`.
+    Indoor,
 }
 
 /// `--percepts`.
@@ -231,6 +245,9 @@ fn check_counts(args: &SimArgs) -> Result<()> {
 pub fn run(args: &SimArgs) -> Result<()> {
     check_counts(args)?;
     let cfg = config(args)?;
+    if args.world == WorldKind::Indoor {
+        return indoor(args, &cfg);
+    }
     let stacks = (
         Stack::parse(&args.home).map_err(|e| anyhow!("--home: {e}"))?,
         Stack::parse(&args.away).map_err(|e| anyhow!("--away: {e}"))?,
@@ -547,6 +564,77 @@ fn series(args: &SimArgs, cfg: &SimConfig, stacks: (Stack, Stack)) -> Result<()>
     }
     let book = book.into_inner().map_err(|_| anyhow!("a match thread failed"))?;
     write_metrics(args, &book)
+}
+
+/// `mrt sim --world indoor`: the path-point mission in the embedded building.
+fn indoor(args: &SimArgs, cfg: &SimConfig) -> Result<()> {
+    let soccer_only = [
+        (args.matches > 1, "--matches"),
+        (args.distributed, "--distributed"),
+        (args.bench, "--bench"),
+        (args.belief.is_some(), "--belief"),
+        (args.metrics.is_some(), "--metrics"),
+        (args.kidnap.is_some(), "--kidnap"),
+        (args.behaviors.is_some(), "--behaviors"),
+    ];
+    if let Some((_, flag)) = soccer_only.iter().find(|(given, _)| *given) {
+        anyhow::bail!("{flag} is for the soccer world, not --world indoor");
+    }
+    let (map, mission, events) = mrt_sim::indoor::embedded().map_err(|e| anyhow!("{e}"))?;
+    let bar = ProgressBar::new(events.duration.ceil() as u64).with_style(
+        ProgressStyle::with_template("{spinner} mission time {pos}/{len} s [{bar:40}] ({elapsed})")
+            .map_err(|e| anyhow!("{e}"))?
+            .progress_chars("=> "),
+    );
+    let started = std::time::Instant::now();
+    let realtime = args.realtime;
+    let report = mrt_sim::indoor::run_mission(cfg, args.seed, (&map, &mission, &events), |t| {
+        bar.set_position(t as u64);
+        if realtime {
+            let ahead = t - started.elapsed().as_secs_f64();
+            if ahead > 0.0 {
+                std::thread::sleep(std::time::Duration::from_secs_f64(ahead));
+            }
+        }
+    })
+    .map_err(|e| anyhow!("{e}"))?;
+    bar.finish_and_clear();
+    use mrt_robot::mission::MissionEvent;
+    outln!(
+        "indoor world, seed {}: {} of {} path points in {:.1} s{}",
+        report.seed,
+        report.reached(),
+        report.points.len(),
+        report.duration,
+        if report.finished { "" } else { " (time up)" }
+    );
+    for e in &report.events {
+        match e {
+            MissionEvent::Reached { time, point } => {
+                let at = report.points[*point];
+                outln!("  {time:6.1} s  reached point {} ({:.1}, {:.1})", point + 1, at.x, at.y);
+            }
+            MissionEvent::GaveUp { time, point } => {
+                outln!("  {time:6.1} s  gave point {} up after three time-outs", point + 1);
+            }
+            MissionEvent::NoPath { time, point } => {
+                outln!("  {time:6.1} s  no way to point {} (waits)", point + 1);
+            }
+            MissionEvent::Planned { .. } => {}
+        }
+    }
+    outln!(
+        "  re-planned {} times (the way blocked or a job timed out); the sonars corrected the dead reckoning {} times; belief {:.2} m from the truth at the end",
+        report.replans(),
+        report.fixes,
+        report.final_error
+    );
+    if let Some(path) = &args.plot {
+        std::fs::write(path, mrt_sim::plot::indoor(&map, &report))
+            .with_context(|| format!("writing {}", path.display()))?;
+        outln!("  plot: {}", path.display());
+    }
+    Ok(())
 }
 
 #[cfg(test)]

@@ -236,3 +236,28 @@ fn match_counts_and_seeds_are_range_checked() {
         "{err}"
     );
 }
+
+/// Issue 21 item 6: `mrt sim --world indoor` runs the embedded building's path-point mission
+/// to the end, reports each point reached and draws the mission; soccer-only options are
+/// refused with the reason.
+#[test]
+fn the_indoor_world_runs_its_mission_to_the_end() {
+    let dir = std::env::temp_dir().join(format!("mrt-indoor-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let svg = dir.join("indoor.svg");
+    let (ok, out, err) = run(&["--world", "indoor", "--plot", svg.to_str().unwrap()]);
+    assert!(ok, "{err}");
+    assert!(out.starts_with("indoor world, seed 1: 4 of 4 path points in "), "{out}");
+    assert_eq!(out.matches("reached point").count(), 4, "{out}");
+    assert!(!out.contains("time up"), "{out}");
+    let drawing = std::fs::read_to_string(&svg).unwrap();
+    assert!(drawing.starts_with("<svg") && drawing.trim_end().ends_with("</svg>"));
+    assert_eq!(
+        drawing.matches(r##"stroke="#27ae60""##).count(),
+        4,
+        "four points reached, in green"
+    );
+    let (ok, _, err) = run(&["--world", "indoor", "--matches", "2"]);
+    assert!(!ok && err.contains("--matches is for the soccer world"), "{err}");
+    let _ = std::fs::remove_dir_all(&dir);
+}

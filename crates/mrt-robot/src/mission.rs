@@ -10,7 +10,7 @@
 //!
 //! 1. **Where am I**: dead reckoning on the two mice (MRT manual ch. 4, with the §4.2
 //!    reduction; the wheels when the mice cannot be trusted) from the start pose, corrected
-//!    twice a second by the sonars: the pose near the dead-reckoned one (±0.2 m, ±0.1 rad)
+//!    twice a second by the sonars: the pose near the dead-reckoned one (±0.18 m, ±0.09 rad)
 //!    whose echoes lie nearest the map's walls, jambs and furniture, each echo anywhere across
 //!    its beam (a likelihood field on the map's clearance). MUREA (ch. 7) is not used here:
 //!    its evidence for a point is a disc inside the tolerance sector, and a sonar's echo is
@@ -509,7 +509,7 @@ impl Roby {
         let here = self.fit(start, &echoes);
         let mut best = (here, start, total(&here, start));
         // Coarse, then fine round the best.
-        for (step, turn, n) in [(0.04, 0.02, 5i32), (0.01, 0.005, 2)] {
+        for (step, turn, n) in [(0.05, 0.025, 3i32), (0.02, 0.01, 1), (0.01, 0.005, 1)] {
             let centre = best.1;
             for (i, j, k) in grid(n) {
                 let at = Pose2::new(

@@ -310,6 +310,111 @@ impl MatchReport {
     }
 }
 
+/// The indoor world's mission (`mrt sim --world indoor --plot`): the building, the path
+/// points (numbered, green when reached), where the robot went (blue) and where it believed
+/// it was once a second (orange dots), the doors that closed (red), the people's walks (grey),
+/// and the cells its sonars found occupied at the end (red squares).
+pub fn indoor(map: &mrt_plan::spike::PlanMap, r: &crate::indoor::IndoorReport) -> String {
+    use mrt_robot::mission::MissionEvent;
+    let scale = 50.0;
+    let sheet = mrt_plan::spike::draw::Sheet::of(map, scale);
+    let (w, h) = ((map.max.x - map.min.x) * scale, (map.max.y - map.min.y) * scale);
+    let band = 44.0;
+    let (x, y) = (|v: f64| sheet.x(v), |v: f64| sheet.y(v));
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        r##"<svg xmlns="http://www.w3.org/2000/svg" width="{w:.0}" height="{:.0}" viewBox="0 0 {w:.0} {:.0}" font-family="sans-serif">"##,
+        h + band,
+        h + band
+    );
+    let _ = writeln!(s, r##"<rect width="{w:.0}" height="{:.0}" fill="#ffffff"/>"##, h + band);
+    let _ = writeln!(
+        s,
+        r##"<text x="8" y="18" font-size="14">Roby, seed {}: {} of {} points in {:.1} s, {} re-plans, belief {:.2} m off at the end</text>"##,
+        r.seed,
+        r.reached(),
+        r.points.len(),
+        r.duration,
+        r.replans(),
+        r.final_error
+    );
+    let _ = writeln!(
+        s,
+        r##"<text x="8" y="36" font-size="11">blue: where it went · orange: where it believed it was · red: closed door, occupied cells · grey: a person's walk</text>"##
+    );
+    let _ = writeln!(s, r##"<g transform="translate(0 {band})">"##);
+    let _ = writeln!(
+        s,
+        r##"<rect width="{w:.0}" height="{h:.0}" fill="#f4f4f0" stroke="#333333" stroke-width="4"/>"##
+    );
+    sheet.map(&mut s, map);
+    for (a, b) in &r.closed_doors {
+        let _ = writeln!(
+            s,
+            r##"<line x1="{:.1}" y1="{:.1}" x2="{:.1}" y2="{:.1}" stroke="#c0392b" stroke-width="5"/>"##,
+            x(a.x),
+            y(a.y),
+            x(b.x),
+            y(b.y)
+        );
+    }
+    if let Some(last) = r.samples.last() {
+        for p in &last.occupied {
+            let side = mrt_robot::mission::ECHO_CELL * scale;
+            let _ = writeln!(
+                s,
+                r##"<rect x="{:.1}" y="{:.1}" width="{side:.1}" height="{side:.1}" fill="#c0392b" fill-opacity="0.6"/>"##,
+                x(p.x) - side / 2.0,
+                y(p.y) - side / 2.0
+            );
+        }
+    }
+    let walks: Vec<(f64, f64)> =
+        r.samples.iter().flat_map(|s| s.persons.iter().map(|(p, _)| (p.x, p.y))).collect();
+    for (px, py) in walks.iter().step_by(3) {
+        let _ = writeln!(
+            s,
+            r##"<circle cx="{:.1}" cy="{:.1}" r="3" fill="#9e9e9e"/>"##,
+            x(*px),
+            y(*py)
+        );
+    }
+    let path: Vec<String> =
+        r.trajectory.iter().map(|p| format!("{:.1},{:.1}", x(p.x), y(p.y))).collect();
+    let _ = writeln!(
+        s,
+        r##"<polyline points="{}" fill="none" stroke="#1f4e9c" stroke-width="2" stroke-linejoin="round"/>"##,
+        path.join(" ")
+    );
+    for b in &r.samples {
+        let _ = writeln!(
+            s,
+            r##"<circle cx="{:.1}" cy="{:.1}" r="2.5" fill="#e67e22"/>"##,
+            x(b.belief.x),
+            y(b.belief.y)
+        );
+    }
+    for (k, p) in r.points.iter().enumerate() {
+        let reached = r
+            .events
+            .iter()
+            .any(|e| matches!(e, MissionEvent::Reached { point, .. } if *point == k));
+        let colour = if reached { "#27ae60" } else { "#8e44ad" };
+        let _ = writeln!(
+            s,
+            r##"<circle cx="{:.1}" cy="{:.1}" r="12" fill="none" stroke="{colour}" stroke-width="3"/><text x="{:.1}" y="{:.1}" font-size="13" text-anchor="middle" fill="{colour}">{}</text>"##,
+            x(p.x),
+            y(p.y),
+            x(p.x),
+            y(p.y) + 5.0,
+            k + 1
+        );
+    }
+    s.push_str("</g>\n</svg>\n");
+    s
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -20,7 +20,7 @@ use mrt_plan::kinematics::{integrate, Twist};
 use rand::{Rng, RngCore};
 
 /// The robots' bodies as the odometry and sonar drivers read them: the soccer [`World`] and
-/// the indoor world ([`crate::indoor::IndoorWorld`]).
+/// the indoor world (`indoor::IndoorWorld`, which imports this module).
 pub trait Bodies {
     /// Robot `i`'s pose, `None` when there is no such robot.
     fn robot(&self, i: usize) -> Option<Pose2>;

@@ -53,6 +53,7 @@
 //! # Ok::<(), mrt_plan::PlanError>(())
 //! ```
 
+pub mod draw;
 mod map;
 mod tree;
 
