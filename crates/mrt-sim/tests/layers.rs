@@ -1,7 +1,7 @@
 //! The simulator's files import each other in one direction (issue 18): config → world →
-//! referee → sensor → game → metrics, sensor → indoor, drivers → devices → bus → remote, plot, soak,
-//! survey. A file
-//! that names `crate::x` depends on `x`; this test fails on any import circle, with the circle.
+//! referee → sensor → game → metrics, sensor → indoor, drivers → devices → bus → remote, plot,
+//! soak, survey. A file that names `crate::x` depends on `x`; this test fails on any import
+//! circle, with the circle.
 #![allow(missing_docs, clippy::unwrap_used, clippy::expect_used)]
 
 use std::collections::BTreeMap;
