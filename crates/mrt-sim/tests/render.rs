@@ -262,24 +262,33 @@ fn noise_lighting_and_blur_are_off_by_default_and_deterministic_when_on() {
     assert!(differ > 100, "{differ} pixels show the trail");
 }
 
+/// The default world's renderer and a vision µAgent for its camera.
+fn seeing(cfg: &SimConfig) -> (Renderer, mrt_perception::vision::agent::VisionAgent) {
+    let renderer = Renderer::new(cfg).unwrap();
+    let colors = mrt_perception::vision::colors::ColorTable::shipped();
+    let agent = mrt_perception::vision::agent::VisionAgent::new(
+        *renderer.pinhole().unwrap(),
+        &colors,
+        cfg.ball.radius,
+    );
+    (renderer, agent)
+}
+
+/// Distance and bearing of the field point `(x, y)` from `from`.
+fn relative(from: Pose2, x: f64, y: f64) -> (f64, f64) {
+    let (dx, dy) = (x - from.x, y - from.y);
+    let (s, c) = from.theta.sin_cos();
+    let (fx, fy) = (c * dx + s * dy, -s * dx + c * dy);
+    (fx.hypot(fy), fy.atan2(fx))
+}
+
 /// The vision µAgent on a rendered frame: the ball, both nets and the robots where they are
 /// (from the robot's centre; the nets are the centres of the goal lines).
 #[test]
 fn the_vision_agent_finds_ball_nets_and_robots_in_a_rendered_frame() {
-    use mrt_perception::vision::agent::VisionAgent;
     let cfg = SimConfig::default();
-    let renderer = Renderer::new(&cfg).unwrap();
-    let mut agent = VisionAgent::new(
-        *renderer.pinhole().unwrap(),
-        &mrt_perception::vision::colors::ColorTable::shipped(),
-        cfg.ball.radius,
-    );
-    let truth = |from: Pose2, x: f64, y: f64| {
-        let (dx, dy) = (x - from.x, y - from.y);
-        let (s, c) = from.theta.sin_cos();
-        let (fx, fy) = (c * dx + s * dy, -s * dx + c * dy);
-        (fx.hypot(fy), fy.atan2(fx))
-    };
+    let (renderer, mut agent) = seeing(&cfg);
+    let truth = relative;
     // Facing the yellow (east) goal from 4 m, the ball and an opponent in between.
     let me = Pose2::new(5.0, 0.4, 0.05);
     let scene = Scene { ball: Some((6.5, 0.0)), robots: vec![(Pose2::new(7.0, 1.2, 0.0), false)] };
@@ -332,24 +341,12 @@ fn the_vision_agent_finds_ball_nets_and_robots_in_a_rendered_frame() {
 /// the floor). Within 3 % of the distance and 1°, like the posts.
 #[test]
 fn a_goal_cut_by_the_image_side_gives_the_corner_in_view() {
-    use mrt_perception::vision::agent::VisionAgent;
     let cfg = SimConfig::default();
-    let renderer = Renderer::new(&cfg).unwrap();
-    let mut agent = VisionAgent::new(
-        *renderer.pinhole().unwrap(),
-        &mrt_perception::vision::colors::ColorTable::shipped(),
-        cfg.ball.radius,
-    );
+    let (renderer, mut agent) = seeing(&cfg);
     let map = cfg.field.map();
     // The outer faces of the goal's sides and back.
     let (hl, gw, gd) =
         (map.half_length(), map.goal_width / 2.0 + map.goal_wall, map.goal_depth + map.goal_wall);
-    let relative = |from: Pose2, x: f64, y: f64| {
-        let (dx, dy) = (x - from.x, y - from.y);
-        let (s, c) = from.theta.sin_cos();
-        let (fx, fy) = (c * dx + s * dy, -s * dx + c * dy);
-        (fx.hypot(fy), fy.atan2(fx))
-    };
     // (viewer, the corner in view, east goal). The first is a keeper carried 2.8 m out in a
     // match (session 39), facing its own goal: its left side is cut, its right upright in view.
     // The third is the first turned half round the centre spot (the blue goal), the last sees
@@ -391,14 +388,8 @@ fn a_goal_cut_by_the_image_side_gives_the_corner_in_view() {
 #[test]
 fn the_vision_tells_each_robot_s_team_by_its_marker() {
     use mrt_msgs::Marker;
-    use mrt_perception::vision::agent::VisionAgent;
     let cfg = SimConfig::default();
-    let renderer = Renderer::new(&cfg).unwrap();
-    let mut agent = VisionAgent::new(
-        *renderer.pinhole().unwrap(),
-        &mrt_perception::vision::colors::ColorTable::shipped(),
-        cfg.ball.radius,
-    );
+    let (renderer, mut agent) = seeing(&cfg);
     let me = Pose2::new(-4.0, 0.0, 0.0);
     let mut told = Vec::new();
     for d in [0.8, 1.5, 2.5, 3.5, 4.5, 6.0, 7.0] {
