@@ -629,6 +629,9 @@ fn indoor(args: &SimArgs, cfg: &SimConfig) -> Result<()> {
         report.fixes,
         report.final_error
     );
+    for f in &report.faults {
+        outln!("  fault: {f}");
+    }
     if let Some(path) = &args.plot {
         std::fs::write(path, mrt_sim::plot::indoor(&map, &report))
             .with_context(|| format!("writing {}", path.display()))?;

@@ -83,12 +83,12 @@ fn lock(d: &SharedDevices) -> Result<MutexGuard<'_, dyn Devices + 'static>, Memb
 /// A driver Member (MRT manual §2.1: drivers apart from processing): each cycle it reads one
 /// of the robot's devices and publishes what it read. The odometry, camera, game-controller and
 /// sonar drivers are this one Member with a different reading.
-struct Driver<M> {
+pub(crate) struct Driver<M> {
     /// `odometry`, `camera`, `sonars`: the Member is named `<kind>-<robot>`.
-    kind: &'static str,
-    robot: usize,
-    devices: SharedDevices,
-    read: fn(&mut dyn Devices) -> Result<M, String>,
+    pub(crate) kind: &'static str,
+    pub(crate) robot: usize,
+    pub(crate) devices: SharedDevices,
+    pub(crate) read: fn(&mut dyn Devices) -> Result<M, String>,
 }
 
 impl<M: Message> Member for Driver<M> {
@@ -435,10 +435,10 @@ impl Member for Guide {
 
 /// The motor and kicker driver of one robot: commands become duty cycles for its motor
 /// driver (the processing side of the AIRBoard), kick requests fire the kicker.
-struct Motor {
-    devices: SharedDevices,
-    robot: usize,
-    base: Base,
+pub(crate) struct Motor {
+    pub(crate) devices: SharedDevices,
+    pub(crate) robot: usize,
+    pub(crate) base: Base,
 }
 
 impl Member for Motor {

@@ -46,9 +46,13 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
+use crate::base::Base;
+use crate::devices::SharedDevices;
+use crate::members::{Driver, Motor};
 use crate::planner::carrot_at;
 use mrt_core::{FileError, Point2, Pose2};
-use mrt_msgs::Odometry;
+use mrt_dcdt::{Activation, Agora, Context, Member, MemberError, RequestType};
+use mrt_msgs::{MotorCommand, Odometry, RobotCommand, SonarScan};
 use mrt_perception::mice::{update_pose, MiceOdometry};
 use mrt_plan::guidance::{PositionMode, PositionParams, Sonar, VelocityGuard};
 use mrt_plan::kinematics::Twist;
@@ -57,6 +61,8 @@ use mrt_plan::PlanError;
 use mrt_team::scare::sequencer::{Progress, Sequencer, SubTask, Verdict};
 use serde::Deserialize;
 use std::collections::BTreeMap;
+use std::sync::{Arc, Mutex};
+use std::time::Duration;
 
 /// Sonar echoes farther than this are not marked, m from the robot's centre.
 pub const ECHO_RANGE: f64 = 2.0;
@@ -603,6 +609,89 @@ impl Roby {
             };
         }
     }
+}
+
+/// The indoor robot's program on the bus: Roby as a Member (`roby-<robot>`) between the
+/// robot's drivers, the same [`Devices`](crate::devices::Devices) interface the soccer robots
+/// use. Each cycle it takes the cycle's [`Odometry`] and [`SonarScan`] and publishes the
+/// velocity as a [`MotorCommand`] (the behaviors' units: mm/s and deg/s).
+pub struct RobyMember {
+    robot: usize,
+    roby: Arc<Mutex<Roby>>,
+}
+
+impl RobyMember {
+    /// The Member of robot `robot`, sharing `roby` with whoever watches it (a monitor, the
+    /// simulator's report).
+    pub fn new(robot: usize, roby: Arc<Mutex<Roby>>) -> RobyMember {
+        RobyMember { robot, roby }
+    }
+}
+
+impl Member for RobyMember {
+    fn name(&self) -> String {
+        format!("roby-{}", self.robot)
+    }
+
+    fn init(&mut self, ctx: &mut Context<'_>) -> Result<(), MemberError> {
+        ctx.subscribe_to::<Odometry>(RequestType::Local);
+        ctx.subscribe_to::<SonarScan>(RequestType::Local);
+        Ok(())
+    }
+
+    fn do_your_job(&mut self, ctx: &mut Context<'_>) -> Result<(), MemberError> {
+        let (mut odometry, mut scan) = (None, None);
+        while let Some(m) = ctx.receive_msg() {
+            if let Ok(o) = m.get::<Odometry>() {
+                odometry = Some(*o);
+            } else if let Ok(s) = m.get::<SonarScan>() {
+                scan = Some(s.clone());
+            }
+        }
+        let (Some(odometry), Some(scan)) = (odometry, scan) else { return Ok(()) };
+        let now = ctx.now().as_secs_f64();
+        let twist = self
+            .roby
+            .lock()
+            .map_err(|_| MemberError::from("Roby's lock is poisoned"))?
+            .step(now, &odometry, &scan.sonars);
+        ctx.publish(MotorCommand(RobotCommand {
+            vlin: twist.vx * 1000.0,
+            vlat: twist.vy * 1000.0,
+            vrot: twist.omega.to_degrees(),
+            ..RobotCommand::default()
+        }));
+        Ok(())
+    }
+}
+
+/// Puts robot `robot`'s indoor program into `agora`: the odometry and sonar drivers of
+/// `devices`, [`RobyMember`] on `roby`, and the motor driver for `base`, every `period`.
+pub fn add_roby(
+    agora: &mut Agora,
+    (robot, period, base): (usize, Duration, Base),
+    roby: Arc<Mutex<Roby>>,
+    devices: SharedDevices,
+) -> Result<(), String> {
+    let every = Activation::Periodic(period);
+    let odometry: Driver<Odometry> =
+        Driver { kind: "odometry", robot, devices: devices.clone(), read: |d| d.odometry() };
+    let sonars: Driver<SonarScan> = Driver {
+        kind: "sonars",
+        robot,
+        devices: devices.clone(),
+        read: |d| d.sonars().map(|sonars| SonarScan { sonars }),
+    };
+    let ids = [
+        agora.add_member(odometry, every),
+        agora.add_member(sonars, every),
+        agora.add_member(RobyMember::new(robot, roby), every),
+        agora.add_member(Motor { devices, robot, base }, Activation::OnMessage),
+    ];
+    for m in ids {
+        agora.activate_member(m).map_err(|e| e.to_string())?;
+    }
+    Ok(())
 }
 
 /// How well echoes fit the map ([`Roby::fit`]).

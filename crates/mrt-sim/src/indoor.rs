@@ -26,13 +26,20 @@
 use crate::config::SimConfig;
 use crate::sensor::{sonar_ring, Bodies, Odometer};
 use crate::world::{accelerate, v, Drive, SonarRing};
+use mrt_core::SimClock;
 use mrt_core::{FileError, Point2, Pose2};
+use mrt_dcdt::SteppedExecutor;
+use mrt_msgs::{CameraFrame, GameInfo, Odometry, Sonar};
 use mrt_plan::spike::{PlanMap, Shape};
-use mrt_robot::mission::{Mission, MissionEvent, Roby, RobyBody};
+use mrt_robot::base::Base;
+use mrt_robot::devices::{Devices, SharedDevices};
+use mrt_robot::members::member_faults;
+use mrt_robot::mission::{add_roby, Mission, MissionEvent, Roby, RobyBody};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rapier2d::prelude::*;
 use serde::Deserialize;
+use std::sync::{Arc, Mutex};
 
 /// The embedded building (`configs/worlds/indoor/map.toml`).
 pub const MAP: &str = include_str!("../../../configs/worlds/indoor/map.toml");
@@ -403,6 +410,8 @@ pub struct IndoorReport {
     pub points: Vec<Point2>,
     /// How often the sonars corrected the robot's dead reckoning.
     pub fixes: u64,
+    /// The robot program's faults: Members that failed or panicked, devices that refused.
+    pub faults: Vec<String>,
 }
 
 impl IndoorReport {
@@ -419,12 +428,76 @@ impl IndoorReport {
     }
 }
 
+/// The building's simulation and the robot's sensors, shared by its devices.
+struct Building {
+    world: IndoorWorld,
+    odometer: Odometer,
+    rng: ChaCha8Rng,
+    cfg: SimConfig,
+    base: Base,
+    faults: Vec<String>,
+}
+
+/// The indoor robot's [`Devices`]: its mice and wheels, its sonar ring and its motors in the
+/// building; no camera, game controller or kicker.
+struct IndoorDevices(Arc<Mutex<Building>>);
+
+impl IndoorDevices {
+    fn with<T>(&self, f: impl FnOnce(&mut Building) -> T) -> Result<T, String> {
+        let mut b = self.0.lock().map_err(|_| "the building's lock is poisoned".to_string())?;
+        Ok(f(&mut b))
+    }
+}
+
+impl Devices for IndoorDevices {
+    fn odometry(&mut self) -> Result<Odometry, String> {
+        self.with(|b| {
+            let period = b.cfg.rules.control_period;
+            b.odometer.read(&b.world, &b.cfg.odometry, period, &mut b.rng)
+        })
+    }
+
+    fn camera(&mut self) -> Result<CameraFrame, String> {
+        Err("the indoor robot has no camera".into())
+    }
+
+    fn game(&mut self) -> Result<GameInfo, String> {
+        Err("there is no game controller indoors".into())
+    }
+
+    fn sonars(&mut self) -> Result<Vec<Sonar>, String> {
+        self.with(|b| sonar_ring(&b.world, 0, &b.cfg.sonar, &mut b.rng))
+    }
+
+    fn set_duty(&mut self, duty: &[f64]) -> Result<(), String> {
+        self.with(|b| {
+            let twist = b.base.twist_for(duty).map_err(|e| e.to_string())?;
+            b.world.drive(Drive::from(twist));
+            Ok(())
+        })?
+    }
+
+    fn kick(&mut self) -> Result<(), String> {
+        Err("the indoor robot has no kicker".into())
+    }
+
+    fn fault(&mut self, message: &str) -> Result<(), String> {
+        self.with(|b| b.faults.push(message.to_string()))
+    }
+}
+
+fn lock<T>(m: &Mutex<T>) -> Result<std::sync::MutexGuard<'_, T>, String> {
+    m.lock().map_err(|_| "a lock is poisoned".to_string())
+}
+
 /// Runs `mission` in the building `map` with `events` until it ends or the events' duration
 /// passes; `seed` seeds the sensors' noise; `progress` hears the simulated time now and then.
+/// The robot's program runs on an Agora ([`mrt_robot::mission::add_roby`]): its drivers read
+/// the building through [`Devices`], as they would a real robot's.
 ///
 /// # Errors
-/// The robot's program refuses the configuration (a robot size SPIKE cannot plan for), or
-/// the mice configuration is invalid.
+/// The robot's program refuses the configuration (a robot size SPIKE cannot plan for), the
+/// mice or robot configuration is invalid, or the Agora cannot be built.
 pub fn run_mission(
     cfg: &SimConfig,
     seed: u64,
@@ -432,56 +505,85 @@ pub fn run_mission(
     mut progress: impl FnMut(f64),
 ) -> Result<IndoorReport, String> {
     let mice = cfg.odometry.mice()?;
+    let robot = cfg.robot()?;
     let mut body = RobyBody::new(mice);
     body.guard = mrt_plan::guidance::VelocityGuard::new(cfg.robot.radius + 0.1, 0.35)
         .map_err(|e| e.to_string())?;
     body.radius = cfg.robot.radius;
     body.position.max_speed = body.position.max_speed.min(cfg.robot.max_speed);
+    body.position.steering = robot.base.steering();
     body.half_beam = cfg.sonar.half_beam;
-    let mut roby = Roby::new(map.clone(), mission.clone(), body).map_err(|e| e.to_string())?;
-    let mut world = IndoorWorld::new(map, events, mission.start, cfg);
-    let mut odometer = Odometer::new(0, mice);
-    let mut rng = ChaCha8Rng::seed_from_u64(seed);
-    let period = cfg.rules.control_period;
-    let steps = (period / cfg.rules.physics_step).round().max(1.0) as usize;
+    let roby = Arc::new(Mutex::new(
+        Roby::new(map.clone(), mission.clone(), body).map_err(|e| e.to_string())?,
+    ));
+    let building = Arc::new(Mutex::new(Building {
+        world: IndoorWorld::new(map, events, mission.start, cfg),
+        odometer: Odometer::new(0, mice),
+        rng: ChaCha8Rng::seed_from_u64(seed),
+        cfg: cfg.clone(),
+        base: robot.base,
+        faults: Vec::new(),
+    }));
+    let period = robot.period();
+    let mut exec = SteppedExecutor::new(SimClock::new(), period);
+    let mut agora = exec.agora_builder(1u32).build().map_err(|e| e.to_string())?;
+    let devices: SharedDevices = Arc::new(Mutex::new(IndoorDevices(building.clone())));
+    add_roby(&mut agora, (0, period, robot.base), roby.clone(), devices)?;
+    exec.add_agora(agora).map_err(|e| e.to_string())?;
+    let steps = (cfg.rules.control_period / cfg.rules.physics_step).round().max(1.0) as usize;
     let (mut trajectory, mut samples) = (Vec::new(), Vec::new());
     let mut next_sample = 0.0;
-    while world.time() < events.duration && !roby.finished() {
-        let now = world.time();
-        let odometry = odometer.read(&world, &cfg.odometry, period, &mut rng);
-        let sonars = sonar_ring(&world, 0, &cfg.sonar, &mut rng);
-        let twist = roby.step(now, &odometry, &sonars);
-        world.drive(Drive::from(twist));
-        let truth = Bodies::robot(&world, 0).unwrap_or_default();
+    loop {
+        let (now, truth) = {
+            let b = lock(&building)?;
+            (b.world.time(), Bodies::robot(&b.world, 0).unwrap_or_default())
+        };
+        if now >= events.duration || lock(&roby)?.finished() {
+            break;
+        }
+        exec.run_for(period);
         trajectory.push(truth);
         if now >= next_sample {
             next_sample += 1.0;
+            let r = lock(&roby)?;
+            let persons = lock(&building)?.world.persons();
             samples.push(IndoorSample {
                 time: now,
                 truth,
-                belief: roby.pose(),
-                path: roby.path().map(|p| p.waypoints.clone()).unwrap_or_default(),
-                occupied: roby.occupied(),
-                persons: world.persons(),
+                belief: r.pose(),
+                path: r.path().map(|p| p.waypoints.clone()).unwrap_or_default(),
+                occupied: r.occupied(),
+                persons,
             });
             progress(now);
         }
+        let mut b = lock(&building)?;
         for _ in 0..steps {
-            world.step();
+            b.world.step();
         }
     }
-    let truth = Bodies::robot(&world, 0).unwrap_or_default();
-    let belief = roby.pose();
+    let reports = exec.finish();
+    let b = lock(&building)?;
+    let r = lock(&roby)?;
+    let truth = Bodies::robot(&b.world, 0).unwrap_or_default();
+    let belief = r.pose();
+    let mut faults = b.faults.clone();
+    for report in &reports {
+        faults.extend(
+            member_faults(report).iter().map(|f| format!("{} ({}×): {}", f.name, f.count, f.error)),
+        );
+    }
     Ok(IndoorReport {
         seed,
-        events: roby.events().to_vec(),
-        finished: roby.finished(),
-        duration: world.time(),
+        events: r.events().to_vec(),
+        finished: r.finished(),
+        duration: b.world.time(),
         trajectory,
         samples,
-        closed_doors: world.closed_doors(),
+        closed_doors: b.world.closed_doors(),
         final_error: (truth.x - belief.x).hypot(truth.y - belief.y),
         points: mission.points.iter().map(|p| p.at).collect(),
-        fixes: roby.fixes(),
+        fixes: r.fixes(),
+        faults,
     })
 }

@@ -26,6 +26,7 @@ fn the_robot_follows_its_path_points_through_the_building() {
         assert!(r.duration < 150.0, "seed {seed}: {} s", r.duration);
         assert!(r.final_error < 0.2, "seed {seed}: {} m", r.final_error);
         assert!(r.fixes > 20, "seed {seed}: the sonars corrected it {} times", r.fixes);
+        assert!(r.faults.is_empty(), "seed {seed}: {:?}", r.faults);
         let order: Vec<usize> = r
             .events
             .iter()
