@@ -119,6 +119,8 @@ pub struct BrianFiles {
     pub s_shape: PathBuf,
     /// Action → output shape (`s_ftoc.txt`).
     pub s_ftoc: PathBuf,
+    /// The engine's settings (`engine.txt`, [`crate::engine`]); may be absent.
+    pub engine: PathBuf,
 }
 
 impl BrianFiles {
@@ -135,6 +137,7 @@ impl BrianFiles {
             behaviors: d.join("behavior.txt"),
             s_shape: d.join("s_shape.txt"),
             s_ftoc: d.join("s_ftoc.txt"),
+            engine: d.join("engine.txt"),
         }
     }
 }
@@ -752,6 +755,11 @@ impl Brian {
             index.predicates.insert(name.clone(), predicates.len());
             predicates.push((name, e));
         }
+        let engine = if src.exists(&files.engine) {
+            crate::engine::parse_engine(&read(&files.engine)?, &files.engine)?
+        } else {
+            crate::engine::EngineSettings::default()
+        };
         let mut predicate_actions: Vec<(String, Expr)> = Vec::new();
         if src.exists(&files.predicate_actions) {
             for (name, span, raw) in parse_file(src, &files.predicate_actions, parse_definitions)? {
@@ -963,7 +971,7 @@ impl Brian {
             activity: vec![None; behaviors.len()],
             is_proposed,
             outputs: vec![None; actions.len()],
-            composer: Composer::default(),
+            composer: engine.composer.unwrap_or_default(),
             data: vec![FuzzyValue::MISSING; fuzzy_data_len],
             pred_values: vec![FuzzyValue::MISSING; predicates.len()],
             act_values: vec![FuzzyValue::MISSING; predicate_actions.len()],
@@ -974,7 +982,7 @@ impl Brian {
             predicate_actions,
             behaviors,
             actions,
-            threshold: DEFAULT_THRESHOLD,
+            threshold: engine.threshold.unwrap_or(DEFAULT_THRESHOLD),
         })
     }
 
@@ -995,9 +1003,19 @@ impl Brian {
         self.composer = c;
     }
 
-    /// Sets the CANDO threshold (`threshold_filter`, default 0.49).
+    /// Sets the CANDO threshold (`threshold_filter`, default 0.49; `engine.txt` may set it).
     pub fn set_threshold(&mut self, t: f64) {
         self.threshold = t;
+    }
+
+    /// The CANDO threshold.
+    pub fn threshold(&self) -> f64 {
+        self.threshold
+    }
+
+    /// The composer.
+    pub fn composer(&self) -> Composer {
+        self.composer
     }
 
     /// The names of the crisp inputs (`ctof.txt`).

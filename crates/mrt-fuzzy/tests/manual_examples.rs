@@ -201,6 +201,7 @@ fn load_broken(case: &str) -> (PathBuf, BrianError) {
         behaviors: pick("behavior.txt"),
         s_shape: pick("s_shape.txt"),
         s_ftoc: pick("s_ftoc.txt"),
+        engine: pick("engine.txt"),
     };
     let root = if over.join("behavior.txt").exists() || over.join("behaviors").exists() {
         over.clone()
@@ -307,4 +308,49 @@ fn error_predicate_used_before_its_definition() {
 #[test]
 fn error_behavior_listed_twice() {
     check("behavior_twice", "behavior.txt", 4, 10, "behavior `Probe` is listed twice");
+}
+
+/// `engine.txt` (optional, [`mrt_fuzzy::engine`]) sets the threshold filter of §10.3.6 and the
+/// float composer of §10.4.9 from the configuration. The harvester with a far target ahead
+/// drives FAST (above); with `threshold_filter 1` no CANDO value can be above the threshold,
+/// so no behavior runs and nothing is proposed. A mistake in the file is placed like any
+/// other file's.
+#[test]
+fn engine_txt_sets_the_threshold_and_the_composer() {
+    let dir = std::env::temp_dir().join(format!("mrt-engine-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(dir.join("behaviors")).unwrap();
+    for entry in std::fs::read_dir(harvester())
+        .unwrap()
+        .chain(std::fs::read_dir(harvester().join("behaviors")).unwrap())
+    {
+        let p = entry.unwrap().path();
+        if p.is_file() {
+            let rel = p.strip_prefix(harvester()).unwrap();
+            std::fs::copy(&p, dir.join(rel)).unwrap();
+        }
+    }
+    let drive = [
+        ("TargetDistance", 300.0, 1.0),
+        ("TargetAngle", 0.0, 1.0),
+        ("BatteryLevel", 100.0, 1.0),
+        ("GraspingObject", 0.0, 1.0),
+        ("HomeDistance", 400.0, 1.0),
+        ("HomeAngle", 180.0, 1.0),
+    ];
+    let mut brian = Brian::from_dir(&dir).unwrap();
+    assert_eq!((brian.threshold(), brian.composer()), (0.49, mrt_fuzzy::brian::Composer::Max));
+    assert!(close(brian.run(&drive)["SpeedModule"], 75.0));
+    std::fs::write(
+        dir.join("engine.txt"),
+        "# engine.txt\nthreshold_filter 1\nfloat_composer average_float_composer\n",
+    )
+    .unwrap();
+    let mut brian = Brian::from_dir(&dir).unwrap();
+    assert_eq!((brian.threshold(), brian.composer()), (1.0, mrt_fuzzy::brian::Composer::Average));
+    assert!(brian.run(&drive).is_empty(), "no behavior is above a threshold of 1");
+    std::fs::write(dir.join("engine.txt"), "threshold_filter 0.5\nfloat_composer min\n").unwrap();
+    let err = Brian::from_dir(&dir).unwrap_err().to_string();
+    assert!(err.contains("at line 2:") && err.ends_with("engine.txt:2:16"), "{err}");
+    let _ = std::fs::remove_dir_all(&dir);
 }

@@ -1,0 +1,153 @@
+//! The behavior engine's settings file, `engine.txt` (optional): what the manual sets by
+//! choosing C++ classes and calling methods (§10.3.6 `threshold_filter` and `set_threshold`,
+//! §10.4.9 the float composers), written as a file of the configuration so that a team
+//! changes them without code. One setting a line, the manual's names, `#` comments:
+//!
+//! ```text
+//! # engine.txt
+//! threshold_filter 0.5                     # a behavior runs when its CANDO is above it
+//! float_composer average_float_composer    # or max_float_composer (the default)
+//! ```
+//!
+//! Why a file of its own: the manual's nine files have fixed grammars that the original
+//! engine's tools read, and adding keys to one of them would break those tools; a missing
+//! `engine.txt` leaves the manual's defaults (threshold 0.49, the maximum).
+//!
+//! ```
+//! use mrt_fuzzy::brian::Composer;
+//! use mrt_fuzzy::engine::parse_engine;
+//!
+//! let s = parse_engine("threshold_filter 0.5\nfloat_composer average_float_composer\n", "engine.txt".as_ref())?;
+//! assert_eq!((s.threshold, s.composer), (Some(0.5), Some(Composer::Average)));
+//! # Ok::<(), mrt_fuzzy::BrianError>(())
+//! ```
+
+use crate::brian::Composer;
+use crate::lexer::Span;
+use crate::BrianError;
+use std::path::Path;
+
+/// The settings an `engine.txt` gives (`None`: the default stays).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct EngineSettings {
+    /// The CANDO threshold (`threshold_filter`), in [0, 1].
+    pub threshold: Option<f64>,
+    /// How the proposals for one output label are composed (`float_composer`).
+    pub composer: Option<Composer>,
+}
+
+/// Reads `engine.txt` (module doc); `file` names it in errors.
+///
+/// # Errors
+/// [`BrianError::At`] with the line and column of an unknown setting, a missing or extra
+/// value, a threshold that is not a number in [0, 1], an unknown composer, or a setting given
+/// twice.
+pub fn parse_engine(text: &str, file: &Path) -> Result<EngineSettings, BrianError> {
+    let mut s = EngineSettings::default();
+    for (k, line) in text.lines().enumerate() {
+        let code = line.split('#').next().unwrap_or("");
+        // Each word with its column (from 1, in characters).
+        let mut words = Vec::new();
+        let mut start = None;
+        for (col, c) in code.chars().chain(std::iter::once(' ')).enumerate() {
+            match (c.is_whitespace(), start) {
+                (false, None) => start = Some(col),
+                (true, Some(from)) => {
+                    let w: String = code.chars().skip(from).take(col - from).collect();
+                    words.push((w, from + 1));
+                    start = None;
+                }
+                _ => {}
+            }
+        }
+        let at = |column: usize, message: String| {
+            BrianError::at(file, Span { line: k + 1, column }, message)
+        };
+        let Some((key, key_col)) = words.first() else { continue };
+        let value = words.get(1);
+        if let Some((extra, col)) = words.get(2) {
+            return Err(at(*col, format!("one value after `{key}`, found `{extra}` too")));
+        }
+        let Some((value, col)) = value else {
+            return Err(at(*key_col + key.chars().count(), format!("a value after `{key}`")));
+        };
+        match key.as_str() {
+            "threshold_filter" => {
+                let t: f64 = value
+                    .parse()
+                    .ok()
+                    .filter(|t: &f64| (0.0..=1.0).contains(t))
+                    .ok_or_else(|| at(*col, format!("a threshold in [0, 1], not `{value}`")))?;
+                if s.threshold.replace(t).is_some() {
+                    return Err(at(*key_col, "threshold_filter is set twice".into()));
+                }
+            }
+            "float_composer" => {
+                let c = match value.as_str() {
+                    "max_float_composer" => Composer::Max,
+                    "average_float_composer" => Composer::Average,
+                    other => {
+                        return Err(at(
+                            *col,
+                            format!("max_float_composer or average_float_composer, not `{other}`"),
+                        ))
+                    }
+                };
+                if s.composer.replace(c).is_some() {
+                    return Err(at(*key_col, "float_composer is set twice".into()));
+                }
+            }
+            other => {
+                return Err(at(
+                    *key_col,
+                    format!("threshold_filter or float_composer, not `{other}`"),
+                ))
+            }
+        }
+    }
+    Ok(s)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    fn err(text: &str) -> String {
+        parse_engine(text, Path::new("engine.txt")).map(|_| ()).unwrap_err().to_string()
+    }
+
+    #[test]
+    fn settings_comments_and_blank_lines_are_read() {
+        let s = parse_engine(
+            "# the engine\n\n  threshold_filter   0.3  # lower\nfloat_composer max_float_composer\n",
+            Path::new("engine.txt"),
+        )
+        .unwrap();
+        assert_eq!(s, EngineSettings { threshold: Some(0.3), composer: Some(Composer::Max) });
+        assert_eq!(parse_engine("", Path::new("e")).unwrap(), EngineSettings::default());
+    }
+
+    #[test]
+    fn every_mistake_is_placed_by_line_and_column() {
+        assert!(
+            err("threshold_filter 1.5\n").ends_with("engine.txt:1:18"),
+            "{}",
+            err("threshold_filter 1.5\n")
+        );
+        assert!(err("\nthreshold_filter\n").contains("at line 2: a value after `threshold_filter`"));
+        assert!(err("\nthreshold_filter\n").ends_with("engine.txt:2:17"));
+        assert!(err("float_composer min\n").contains("not `min`"));
+        assert!(err("speed 3\n").ends_with("engine.txt:1:1"));
+        assert!(err("threshold_filter 0.2 0.3\n").ends_with("engine.txt:1:22"));
+        assert!(err("threshold_filter 0.2\nthreshold_filter 0.3\n").contains("set twice"));
+        assert!(err("threshold_filter NaN\n").contains("not `NaN`"));
+    }
+
+    proptest! {
+        #[test]
+        fn any_text_is_read_or_refused_without_panic(text in ".{0,200}") {
+            let _ = parse_engine(&text, Path::new("engine.txt"));
+        }
+    }
+}
