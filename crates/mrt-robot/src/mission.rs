@@ -576,12 +576,15 @@ impl Roby {
         for s in sonars {
             let range = if s.range.is_finite() { s.range } else { ECHO_RANGE + ECHO_CELL };
             let bearing = pose.theta + s.bearing;
-            // Free: the cells this beam saw through, short of its echo.
+            // Free: the cells this beam saw through, short of its echo (the echo is the
+            // nearest thing across the whole beam; the beam's edges are left out, a cell
+            // there may lie half outside it).
+            let half = 0.75 * self.body.half_beam;
             self.echoes.retain(|&k, _| {
                 let c = cell_centre(k);
                 let (dx, dy) = (c.x - pose.x, c.y - pose.y);
                 let off = mrt_core::normalize_angle(dy.atan2(dx) - bearing).abs();
-                !(off < 0.15 && dx.hypot(dy) < range.min(ECHO_RANGE) - ECHO_CELL)
+                !(off < half && dx.hypot(dy) < range.min(ECHO_RANGE) - ECHO_CELL)
             });
             if !(s.range.is_finite() && s.range <= ECHO_RANGE) {
                 continue;
