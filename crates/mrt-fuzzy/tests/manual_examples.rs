@@ -15,6 +15,17 @@ fn harvester() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../../configs/brian/harvester")
 }
 
+/// The harvester's inputs for a far target straight ahead with full batteries, home behind
+/// (value, reliability): it drives FAST towards NORTH.
+const FAR_TARGET_AHEAD: [(&str, f64, f64); 6] = [
+    ("TargetDistance", 300.0, 1.0),
+    ("TargetAngle", 0.0, 1.0),
+    ("BatteryLevel", 100.0, 1.0),
+    ("GraspingObject", 0.0, 1.0),
+    ("HomeDistance", 400.0, 1.0),
+    ("HomeAngle", 180.0, 1.0),
+];
+
 fn close(a: f64, b: f64) -> bool {
     (a - b).abs() < 1e-9
 }
@@ -134,14 +145,7 @@ fn harvester_loads_without_warnings_and_drives() {
     assert_eq!(speeds, want);
 
     // A far target straight ahead, full batteries: FAST (75 cm/s) towards NORTH (0°).
-    let out = brian.run(&[
-        ("TargetDistance", 300.0, 1.0),
-        ("TargetAngle", 0.0, 1.0),
-        ("BatteryLevel", 100.0, 1.0),
-        ("GraspingObject", 0.0, 1.0),
-        ("HomeDistance", 400.0, 1.0),
-        ("HomeAngle", 180.0, 1.0),
-    ]);
+    let out = brian.run(&FAR_TARGET_AHEAD);
     assert!(close(out["SpeedModule"], 75.0) && close(out["SpeedAngle"], 0.0), "{out:?}");
     // §10.4.4's CANDO: a far target with batteries half empty cannot be pursued.
     let out = brian.run(&[
@@ -330,14 +334,7 @@ fn engine_txt_sets_the_threshold_and_the_composer() {
             std::fs::copy(&p, dir.join(rel)).unwrap();
         }
     }
-    let drive = [
-        ("TargetDistance", 300.0, 1.0),
-        ("TargetAngle", 0.0, 1.0),
-        ("BatteryLevel", 100.0, 1.0),
-        ("GraspingObject", 0.0, 1.0),
-        ("HomeDistance", 400.0, 1.0),
-        ("HomeAngle", 180.0, 1.0),
-    ];
+    let drive = FAR_TARGET_AHEAD;
     let mut brian = Brian::from_dir(&dir).unwrap();
     assert_eq!((brian.threshold(), brian.composer()), (0.49, mrt_fuzzy::brian::Composer::Max));
     assert!(close(brian.run(&drive)["SpeedModule"], 75.0));
