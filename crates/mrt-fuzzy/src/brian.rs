@@ -48,43 +48,80 @@ pub const WANT_THRESHOLD: f64 = 0.49;
 /// A rule whose precondition reliability is below this proposes nothing (§10.3.7).
 pub const MIN_RELIABILITY: f64 = 0.1;
 
-/// How proposals of the same (action, label) are combined (§10.3.8, §10.4.9), after each is
-/// multiplied by its behavior's weight.
+/// How proposals of the same (action, label) are combined (§10.3.8, §10.4.9: the
+/// `float_composer`), after each is weighted by its behavior's weight ([`WeightComposer`]).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum Composer {
-    /// The maximum (formula 10.3): the default.
+    /// The maximum (formula 10.3, `max_float_composer`): the default.
     #[default]
     Max,
     /// The mean (`average_float_composer` of §10.4.9).
     Average,
+    /// The minimum (`min_float_composer` of §10.4.9).
+    Min,
 }
 
-/// One (action, label) accumulator: enough for both composers.
-#[derive(Clone, Copy, Debug, Default)]
+/// How one proposal is weighted by its behavior's weight (the WANT value; §10.4.9, the
+/// `weight_composer`). A behavior of weight 0, or a rule that does not fire, proposes nothing
+/// whichever is chosen.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum WeightComposer {
+    /// The value times the weight (`mult_weight_composer`): the default.
+    #[default]
+    Mult,
+    /// The larger of the value and the weight (`max_weight_composer`).
+    Max,
+    /// The smaller of the value and the weight (`min_weight_composer`).
+    Min,
+}
+
+impl WeightComposer {
+    /// Proposal `value` weighted by `weight`.
+    pub fn apply(self, value: f64, weight: f64) -> f64 {
+        match self {
+            WeightComposer::Mult => value * weight,
+            WeightComposer::Max => value.max(weight),
+            WeightComposer::Min => value.min(weight),
+        }
+    }
+}
+
+/// One (action, label) accumulator: enough for every composer.
+#[derive(Clone, Copy, Debug)]
 struct Acc {
     max: f64,
+    min: f64,
     sum: f64,
     n: u32,
+}
+
+impl Default for Acc {
+    fn default() -> Self {
+        Acc { max: 0.0, min: f64::INFINITY, sum: 0.0, n: 0 }
+    }
 }
 
 impl Acc {
     fn add(&mut self, v: f64) {
         self.max = self.max.max(v);
+        self.min = self.min.min(v);
         self.sum += v;
         self.n += 1;
     }
 
     fn merge(&mut self, o: &Acc) {
         self.max = self.max.max(o.max);
+        self.min = self.min.min(o.min);
         self.sum += o.sum;
         self.n += o.n;
     }
 
     fn weight(&self, c: Composer) -> f64 {
         match c {
+            _ if self.n == 0 => 0.0,
             Composer::Max => self.max,
-            Composer::Average if self.n > 0 => self.sum / f64::from(self.n),
-            Composer::Average => 0.0,
+            Composer::Average => self.sum / f64::from(self.n),
+            Composer::Min => self.min,
         }
     }
 }
@@ -416,6 +453,7 @@ pub struct Brian {
     actions: Vec<Action>,
     threshold: f64,
     composer: Composer,
+    weight_composer: WeightComposer,
     pred_values: Vec<FuzzyValue>,
     act_values: Vec<FuzzyValue>,
     lower: Vec<Acc>,
@@ -972,6 +1010,7 @@ impl Brian {
             is_proposed,
             outputs: vec![None; actions.len()],
             composer: engine.composer.unwrap_or_default(),
+            weight_composer: engine.weight_composer.unwrap_or_default(),
             data: vec![FuzzyValue::MISSING; fuzzy_data_len],
             pred_values: vec![FuzzyValue::MISSING; predicates.len()],
             act_values: vec![FuzzyValue::MISSING; predicate_actions.len()],
@@ -1016,6 +1055,16 @@ impl Brian {
     /// The composer.
     pub fn composer(&self) -> Composer {
         self.composer
+    }
+
+    /// Chooses the weight composer (default [`WeightComposer::Mult`]).
+    pub fn set_weight_composer(&mut self, c: WeightComposer) {
+        self.weight_composer = c;
+    }
+
+    /// The weight composer.
+    pub fn weight_composer(&self) -> WeightComposer {
+        self.weight_composer
     }
 
     /// The names of the crisp inputs (`ctof.txt`).
@@ -1226,7 +1275,8 @@ impl Brian {
                     // A rule that does not fire (value 0), or a behavior of weight 0, proposes
                     // nothing: it must not count in the average composer's mean.
                     RuleAction::Propose(slot) if weight * value > 0.0 => {
-                        self.level_acc[slot].add(weight * value);
+                        let weighted = self.weight_composer.apply(value, weight);
+                        self.level_acc[slot].add(weighted);
                         if self.tracing {
                             // Actions are in offset order: the last one starting at or
                             // before `slot` holds it.
@@ -1235,7 +1285,7 @@ impl Brian {
                                 .partition_point(|a| a.offset <= slot)
                                 .saturating_sub(1);
                             let label = slot - self.actions[ai].offset;
-                            self.traced.push((b, ai, Some(label), Some(weight * value)));
+                            self.traced.push((b, ai, Some(label), Some(weighted)));
                         }
                     }
                     RuleAction::Propose(_) => {}
@@ -1448,6 +1498,31 @@ mod tests {
         fn rule_definition_and_behavior_parsers_never_panic_on_token_soup(text in soup()) {
             try_all(&text);
         }
+    }
+
+    /// §10.4.9's other composers on the same proposals: GoToTarget (weight 0.67) FAST 0.56 and
+    /// 0.478, SLOW 0.968; AvoidObstacle (weight 1) SLOW 0.354. By hand:
+    /// - `max_weight_composer` (max of value and weight) with the average: FAST
+    ///   (0.67 + 0.67) / 2 = 0.67; SLOW (0.968 + 1) / 2 = 0.984.
+    /// - `min_weight_composer` (min of value and weight) with the average: FAST
+    ///   (0.56 + 0.478) / 2 = 0.519; SLOW (0.67 + 0.354) / 2 = 0.512.
+    /// - `mult_weight_composer` with `min_float_composer`: FAST min(0.3752, 0.32026) =
+    ///   0.32026; SLOW min(0.64856, 0.354) = 0.354.
+    #[test]
+    fn manual_weight_and_float_composers() {
+        let (go, avoid) = (0.67, 1.0);
+        let composed = |w: WeightComposer, f: Composer| {
+            let fast = f.combine(&[w.apply(0.56, go), w.apply(0.478, go)]);
+            let slow = f.combine(&[w.apply(0.968, go), w.apply(0.354, avoid)]);
+            (fast, slow)
+        };
+        let close =
+            |(a, b): (f64, f64), (c, d): (f64, f64)| (a - c).abs() < 1e-9 && (b - d).abs() < 1e-9;
+        assert!(close(composed(WeightComposer::Max, Composer::Average), (0.67, 0.984)));
+        assert!(close(composed(WeightComposer::Min, Composer::Average), (0.519, 0.512)));
+        assert!(close(composed(WeightComposer::Mult, Composer::Min), (0.32026, 0.354)));
+        assert!(close(composed(WeightComposer::Mult, Composer::Average), (0.34773, 0.50128)));
+        assert_eq!(Composer::Min.combine(&[]), 0.0, "no proposal: 0, not infinity");
     }
 
     /// §10.4.9 with `mult_weight_composer` and `average_float_composer`: GoToTarget (weight

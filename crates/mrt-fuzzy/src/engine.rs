@@ -1,12 +1,13 @@
 //! The behavior engine's settings file, `engine.txt` (optional): what the manual sets by
 //! choosing C++ classes and calling methods (§10.3.6 `threshold_filter` and `set_threshold`,
-//! §10.4.9 the float composers), written as a file of the configuration so that a team
+//! §10.4.9 the weight and float composers), written as a file of the configuration so that a team
 //! changes them without code. One setting a line, the manual's names, `#` comments:
 //!
 //! ```text
 //! # engine.txt
 //! threshold_filter 0.5                     # a behavior runs when its CANDO is above it
-//! float_composer average_float_composer    # or max_float_composer (the default)
+//! weight_composer mult_weight_composer     # (the default), max_ or min_weight_composer
+//! float_composer average_float_composer    # max_ (the default) or min_float_composer
 //! ```
 //!
 //! Why a file of its own: the manual's nine files have fixed grammars that the original
@@ -22,7 +23,7 @@
 //! # Ok::<(), mrt_fuzzy::BrianError>(())
 //! ```
 
-use crate::brian::Composer;
+use crate::brian::{Composer, WeightComposer};
 use crate::lexer::Span;
 use crate::BrianError;
 use std::path::Path;
@@ -34,6 +35,8 @@ pub struct EngineSettings {
     pub threshold: Option<f64>,
     /// How the proposals for one output label are composed (`float_composer`).
     pub composer: Option<Composer>,
+    /// How a proposal is weighted by its behavior's weight (`weight_composer`).
+    pub weight_composer: Option<WeightComposer>,
 }
 
 /// Reads `engine.txt` (module doc); `file` names it in errors.
@@ -86,10 +89,11 @@ pub fn parse_engine(text: &str, file: &Path) -> Result<EngineSettings, BrianErro
                 let c = match value.as_str() {
                     "max_float_composer" => Composer::Max,
                     "average_float_composer" => Composer::Average,
+                    "min_float_composer" => Composer::Min,
                     other => {
                         return Err(at(
                             *col,
-                            format!("max_float_composer or average_float_composer, not `{other}`"),
+                            format!("max_float_composer, average_float_composer or min_float_composer, not `{other}`"),
                         ))
                     }
                 };
@@ -97,10 +101,26 @@ pub fn parse_engine(text: &str, file: &Path) -> Result<EngineSettings, BrianErro
                     return Err(at(*key_col, "float_composer is set twice".into()));
                 }
             }
+            "weight_composer" => {
+                let c = match value.as_str() {
+                    "mult_weight_composer" => WeightComposer::Mult,
+                    "max_weight_composer" => WeightComposer::Max,
+                    "min_weight_composer" => WeightComposer::Min,
+                    other => {
+                        return Err(at(
+                            *col,
+                            format!("mult_weight_composer, max_weight_composer or min_weight_composer, not `{other}`"),
+                        ))
+                    }
+                };
+                if s.weight_composer.replace(c).is_some() {
+                    return Err(at(*key_col, "weight_composer is set twice".into()));
+                }
+            }
             other => {
                 return Err(at(
                     *key_col,
-                    format!("threshold_filter or float_composer, not `{other}`"),
+                    format!("threshold_filter, weight_composer or float_composer, not `{other}`"),
                 ))
             }
         }
@@ -124,7 +144,21 @@ mod tests {
             Path::new("engine.txt"),
         )
         .unwrap();
-        assert_eq!(s, EngineSettings { threshold: Some(0.3), composer: Some(Composer::Max) });
+        let want = EngineSettings {
+            threshold: Some(0.3),
+            composer: Some(Composer::Max),
+            weight_composer: None,
+        };
+        assert_eq!(s, want);
+        let s = parse_engine(
+            "weight_composer min_weight_composer\nfloat_composer min_float_composer\n",
+            Path::new("e"),
+        )
+        .unwrap();
+        assert_eq!(
+            (s.weight_composer, s.composer),
+            (Some(WeightComposer::Min), Some(Composer::Min))
+        );
         assert_eq!(parse_engine("", Path::new("e")).unwrap(), EngineSettings::default());
     }
 
@@ -138,6 +172,7 @@ mod tests {
         assert!(err("\nthreshold_filter\n").contains("at line 2: a value after `threshold_filter`"));
         assert!(err("\nthreshold_filter\n").ends_with("engine.txt:2:17"));
         assert!(err("float_composer min\n").contains("not `min`"));
+        assert!(err("weight_composer sum_weight_composer\n").ends_with("engine.txt:1:17"));
         assert!(err("speed 3\n").ends_with("engine.txt:1:1"));
         assert!(err("threshold_filter 0.2 0.3\n").ends_with("engine.txt:1:22"));
         assert!(err("threshold_filter 0.2\nthreshold_filter 0.3\n").contains("set twice"));

@@ -37,7 +37,7 @@
 //! | default (singleton) defuzzification, formula 10.6 | [`shapes::defuzzify`] |
 //! | `Predicate.ini`, `PredicateActions.ini`, `Cando.ini`, `want.txt` | [`expr`] grammar, resolved by [`brian::Brian`] |
 //! | `behavior.txt`, `*.rul` rules with `&DEL` | [`brian::Brian::from_dir`] |
-//! | `weight_composer` / `float_composer` (max, average) | [`brian::Composer`], `engine.txt` ([`engine`]) |
+//! | `weight_composer` (mult, max, min) / `float_composer` (max, average, min) | [`brian::WeightComposer`], [`brian::Composer`], `engine.txt` ([`engine`]) |
 //! | `threshold_filter` (0.49) | [`brian::Brian::set_threshold`], `engine.txt` ([`engine`]) |
 //! | Parser and Messenger (§10.3.10) on the bus | [`member::BrianMember`], [`member::BrianInputs`], [`member::BrianCommands`] (feature `member`) |
 //! | ThinkingCap HBM rules and Context-Dependent Blending (seed 001 §4.1) | [`hbm::Blender`], [`hbm::ControlVariable`], Mamdani [`hbm::centroid`] |

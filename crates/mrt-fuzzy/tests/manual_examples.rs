@@ -340,11 +340,12 @@ fn engine_txt_sets_the_threshold_and_the_composer() {
     assert!(close(brian.run(&drive)["SpeedModule"], 75.0));
     std::fs::write(
         dir.join("engine.txt"),
-        "# engine.txt\nthreshold_filter 1\nfloat_composer average_float_composer\n",
+        "# engine.txt\nthreshold_filter 1\nweight_composer min_weight_composer\nfloat_composer average_float_composer\n",
     )
     .unwrap();
     let mut brian = Brian::from_dir(&dir).unwrap();
     assert_eq!((brian.threshold(), brian.composer()), (1.0, mrt_fuzzy::brian::Composer::Average));
+    assert_eq!(brian.weight_composer(), mrt_fuzzy::brian::WeightComposer::Min);
     assert!(brian.run(&drive).is_empty(), "no behavior is above a threshold of 1");
     std::fs::write(dir.join("engine.txt"), "threshold_filter 0.5\nfloat_composer min\n").unwrap();
     let err = Brian::from_dir(&dir).unwrap_err().to_string();
