@@ -155,7 +155,8 @@ fn svg(spike: &Spike, moving: &[Shape], plan: &Plan, cells: &[Cell]) -> String {
     let (w, h) = ((map.max.x - map.min.x) * scale, (map.max.y - map.min.y) * scale);
     // A band above the map for the caption; the map below it, clipped to the area.
     let band = 44.0;
-    let (x, y) = (|v: f64| (v - map.min.x) * scale, |v: f64| (map.max.y - v) * scale);
+    let sheet = Sheet::of(map, scale);
+    let (x, y) = (|v: f64| sheet.x(v), |v: f64| sheet.y(v));
     let mut out = String::new();
     let _ = writeln!(
         out,
@@ -195,7 +196,6 @@ fn svg(spike: &Spike, moving: &[Shape], plan: &Plan, cells: &[Cell]) -> String {
             c.size * scale
         );
     }
-    let sheet = Sheet::of(map, scale);
     sheet.map(&mut out, map);
     for s in moving {
         sheet.shape(&mut out, s, "#c0392b");

@@ -39,6 +39,29 @@ pub struct EngineSettings {
     pub weight_composer: Option<WeightComposer>,
 }
 
+/// The float composers by the manual's class names.
+const FLOAT_COMPOSERS: [(&str, Composer); 3] = [
+    ("max_float_composer", Composer::Max),
+    ("average_float_composer", Composer::Average),
+    ("min_float_composer", Composer::Min),
+];
+
+/// The weight composers by the manual's class names.
+const WEIGHT_COMPOSERS: [(&str, WeightComposer); 3] = [
+    ("mult_weight_composer", WeightComposer::Mult),
+    ("max_weight_composer", WeightComposer::Max),
+    ("min_weight_composer", WeightComposer::Min),
+];
+
+/// The option named `value` among `options`, or what was expected instead.
+fn choice<T: Copy>(value: &str, options: &[(&str, T)]) -> Result<T, String> {
+    if let Some(&(_, t)) = options.iter().find(|(name, _)| *name == value) {
+        return Ok(t);
+    }
+    let names: Vec<&str> = options.iter().map(|(name, _)| *name).collect();
+    Err(format!("one of {}, not `{value}`", names.join(", ")))
+}
+
 /// Reads `engine.txt` (module doc); `file` names it in errors.
 ///
 /// # Errors
@@ -86,33 +109,13 @@ pub fn parse_engine(text: &str, file: &Path) -> Result<EngineSettings, BrianErro
                 }
             }
             "float_composer" => {
-                let c = match value.as_str() {
-                    "max_float_composer" => Composer::Max,
-                    "average_float_composer" => Composer::Average,
-                    "min_float_composer" => Composer::Min,
-                    other => {
-                        return Err(at(
-                            *col,
-                            format!("max_float_composer, average_float_composer or min_float_composer, not `{other}`"),
-                        ))
-                    }
-                };
+                let c = choice(value, &FLOAT_COMPOSERS).map_err(|m| at(*col, m))?;
                 if s.composer.replace(c).is_some() {
                     return Err(at(*key_col, "float_composer is set twice".into()));
                 }
             }
             "weight_composer" => {
-                let c = match value.as_str() {
-                    "mult_weight_composer" => WeightComposer::Mult,
-                    "max_weight_composer" => WeightComposer::Max,
-                    "min_weight_composer" => WeightComposer::Min,
-                    other => {
-                        return Err(at(
-                            *col,
-                            format!("mult_weight_composer, max_weight_composer or min_weight_composer, not `{other}`"),
-                        ))
-                    }
-                };
+                let c = choice(value, &WEIGHT_COMPOSERS).map_err(|m| at(*col, m))?;
                 if s.weight_composer.replace(c).is_some() {
                     return Err(at(*key_col, "weight_composer is set twice".into()));
                 }

@@ -276,8 +276,6 @@ pub struct Roby {
     last_fix: f64,
     /// Corrections the sonars gave.
     fixes: u64,
-    /// Cycles whose motion came from the wheels (the mice could not be trusted).
-    wheel_cycles: u64,
     mission: Mission,
     body: RobyBody,
     position: PositionMode,
@@ -314,7 +312,6 @@ impl Roby {
             spike,
             last_fix: f64::NEG_INFINITY,
             fixes: 0,
-            wheel_cycles: 0,
             pose: mission.start,
             mission,
             body,
@@ -368,13 +365,7 @@ impl Roby {
     /// One cycle at time `now` (s): this cycle's odometry and sonar ring in, the velocity to
     /// drive at out (robot frame; zero once finished).
     pub fn step(&mut self, now: f64, odometry: &Odometry, sonars: &[Sonar]) -> Twist {
-        let d = match self.body.mice.motion(&odometry.mice) {
-            Some((d, _)) => d,
-            None => {
-                self.wheel_cycles += 1;
-                odometry.wheels
-            }
-        };
+        let d = self.body.mice.motion(&odometry.mice).map_or(odometry.wheels, |(d, _)| d);
         if d.dx.is_finite() && d.dy.is_finite() && d.dtheta.is_finite() {
             self.pose = update_pose(&self.pose, &d);
         }
@@ -562,11 +553,6 @@ impl Roby {
     /// How often the sonars corrected the dead reckoning.
     pub fn fixes(&self) -> u64 {
         self.fixes
-    }
-
-    /// Cycles whose motion came from the wheels because the mice could not be trusted.
-    pub fn wheel_cycles(&self) -> u64 {
-        self.wheel_cycles
     }
 
     /// Marks the cells of the echoes the map does not explain, frees those a sonar sees

@@ -199,8 +199,8 @@ pub struct IndoorWorld {
     physics: PhysicsWorld,
     robot: RigidBodyHandle,
     drive: Drive,
-    /// The doors still open, with the wall each becomes and when.
-    doors: Vec<(f64, ColliderHandle, bool)>,
+    /// The doors that close, each with the wall it becomes and whether it is closed yet.
+    doors: Vec<(DoorCloses, ColliderHandle, bool)>,
     persons: Vec<(Person, RigidBodyHandle)>,
     cfg: SimConfig,
     time: f64,
@@ -248,7 +248,7 @@ impl IndoorWorld {
             .iter()
             .map(|d| {
                 let c = wall(d.from, d.to).enabled(false);
-                (d.at, physics.colliders.insert_with_parent(c, fixed, &mut physics.bodies), false)
+                (*d, physics.colliders.insert_with_parent(c, fixed, &mut physics.bodies), false)
             })
             .collect();
         let persons = events
@@ -303,18 +303,7 @@ impl IndoorWorld {
 
     /// The doors closed so far, as their jambs.
     pub fn closed_doors(&self) -> Vec<(Point2, Point2)> {
-        self.doors
-            .iter()
-            .filter(|d| d.2)
-            .filter_map(|d| {
-                let c = self.physics.colliders.get(d.1)?;
-                let (t, half) = (c.translation(), c.shape().as_cuboid()?.half_extents.x);
-                let a = f64::from(c.rotation().angle());
-                let (dx, dy) = (f64::from(half) * a.cos(), f64::from(half) * a.sin());
-                let (x, y) = (f64::from(t.x), f64::from(t.y));
-                Some((Point2::new(x - dx, y - dy), Point2::new(x + dx, y + dy)))
-            })
-            .collect()
+        self.doors.iter().filter(|d| d.2).map(|d| (d.0.from, d.0.to)).collect()
     }
 
     /// One physics step: doors close when due, people walk, the robot accelerates towards
@@ -322,7 +311,7 @@ impl IndoorWorld {
     pub fn step(&mut self) {
         let dt = self.cfg.rules.physics_step;
         for d in &mut self.doors {
-            if !d.2 && self.time >= d.0 {
+            if !d.2 && self.time >= d.0.at {
                 if let Some(c) = self.physics.colliders.get_mut(d.1) {
                     c.set_enabled(true);
                 }

@@ -395,18 +395,18 @@ impl VisionAgent {
         } else {
             (0..w).rev().find(|&c| count[c] == 0).map_or(0, |c| c + 1)..w
         };
-        let outermost = if left {
-            blob.rev().find(|&c| foot(c).is_some())?
+        let with_col = |c: usize| foot(c).map(|f| (c, f));
+        let (mut col, mut here) = if left {
+            blob.rev().find_map(with_col)?
         } else {
-            blob.into_iter().find(|&c| foot(c).is_some())?
+            blob.into_iter().find_map(with_col)?
         };
         // Outside the corner the goal's side, slanting outwards as it rises, shows carpet
         // below it too, each column's "foot" several rows higher than the next one in:
         // follow those steps down to the corner.
         let inward =
             |c: usize| if left { c.checked_sub(1) } else { Some(c + 1).filter(|&c| c < w) };
-        let (mut col, mut here) = (outermost, foot(outermost)?);
-        while let Some((next, there)) = inward(col).and_then(|c| Some((c, foot(c)?))) {
+        while let Some((next, there)) = inward(col).and_then(with_col) {
             if there.0.y < here.0.y + SLANT_STEP {
                 break;
             }
