@@ -54,6 +54,8 @@ pub struct RobotConfig {
     pub localizer: Localizer,
     /// The ball's rolling friction as its tracker assumes it, 1/s.
     pub ball_damping: f64,
+    /// Whether MUREA searches on goal corners too ([`LocalizationSection::goal_corners`]).
+    pub goal_corners: bool,
 }
 
 /// What the vision µAgent needs (ISocRob seed `003` §3.2.1).
@@ -81,6 +83,7 @@ impl RobotConfig {
             WorldModel::new(self.field, self.mice, self.camera.distance, self.camera.bearing)
                 .with_localizer(self.localizer)
                 .with_ball_damping(self.ball_damping)
+                .with_goal_corners(self.goal_corners)
                 .with_robot_radius(self.radius);
         // With vision the camera's view is known: a robot it should see and does not fades
         // fast. (The simulator's object sensor tells no view: its anchors fade alike.)
@@ -318,6 +321,10 @@ pub struct LocalizationSection {
     /// ball's velocity, 1/s (MAP's Kalman tracker, [`mrt_world::track`]). Measure it on your
     /// carpet: a ball rolled at `v` stops after about `v / ball_damping` metres.
     pub ball_damping: f64,
+    /// Whether MUREA also searches on the corner of a goal cut by the image's side (the
+    /// vision's `goal_corners`). Off by default: it finds some kidnapped robots sooner and
+    /// puts good trackers elsewhere more often (docs/localization.md, "Goal corners").
+    pub goal_corners: bool,
 }
 
 impl Default for LocalizationSection {
@@ -325,6 +332,7 @@ impl Default for LocalizationSection {
         LocalizationSection {
             localizer: Localizer::default(),
             ball_damping: mrt_world::model::BALL_DAMPING,
+            goal_corners: false,
         }
     }
 }
@@ -501,6 +509,7 @@ impl RobotFile {
                 "localization.ball_damping",
                 self.localization.ball_damping,
             )?,
+            goal_corners: self.localization.goal_corners,
         })
     }
 }
@@ -565,6 +574,9 @@ mod tests {
         let c = read("[localization]\nball_damping = 0.9\nlocalizer = \"gm\"\n").unwrap();
         assert_eq!(c.world_model().ball_damping(), 0.9);
         assert_eq!(c.world_model().localizer(), Localizer::Gm);
+        assert!(!c.goal_corners, "goal corners are off unless asked for");
+        let c = read("[localization]\ngoal_corners = true\n").unwrap();
+        assert!(c.goal_corners);
         let e = read("[localization]\nball_damping = -0.1\n").unwrap_err().to_string();
         assert_eq!(e, "r.toml: localization.ball_damping must be a finite number >= 0, not -0.1");
     }

@@ -103,6 +103,11 @@ impl Kind {
         }
     }
 
+    /// Whether this is the corner of a goal, of either colour or none.
+    pub fn is_goal_corner(self) -> bool {
+        matches!(self, Kind::EAST_CORNER | Kind::WEST_CORNER | Kind::CORNER)
+    }
+
     /// The kind of field object `k` (camera sighting order, [`FieldMap::object`]): its goal
     /// colour or post pattern when `coloured`, else just goal or post; `None` for the ball and
     /// past the last landmark.
