@@ -38,10 +38,7 @@ machine "Attacker" {
   },
 }
 
-local function aligned()
-  local n, b = chaos.lps_getLpo(NET1), ball()
-  return n.reliability > 0.1 and math.abs(n.theta - b.theta) < 0.2
-end
+local function aligned() return aimAligned() end
 
 machine "Score" {
   initial = "ApproachBall",

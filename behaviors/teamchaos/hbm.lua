@@ -38,19 +38,38 @@ function headedRight() return ballLeft() end
 -- Our heading points to a safe area (away from our own net).
 function freeToKick() return SAFE_HEADING(math.abs(chaos.gsGetMyPos().theta)) end
 
--- The opponent's net seen left / right of the ball (for alignment).
-function netLeftOfBall()
-  local n, b = lpo(NET1), lpo(BALL)
-  return AND(RELIABLE(n.reliability), TOR(0.05, 0.4)(n.theta - b.theta))
+-- Where to shoot: the side of the opponent's net away from its goalkeeper (the opponent MAP
+-- anchored nearest that net), 250 mm inside the post; the middle when no keeper is anchored.
+function aimPoint()
+  local f = field()
+  local keeper, best = nil, 2500
+  for _, r in ipairs(chaos.getRobots()) do
+    if r.class == "opponent" and r.reliability > 0.3 then
+      local d = math.sqrt((r.x - f.half_length) ^ 2 + r.y ^ 2)
+      if d < best then keeper, best = r, d end
+    end
+  end
+  if not keeper then return f.half_length, 0 end
+  local side = keeper.y > 0 and -1 or 1
+  return f.half_length, side * (f.goal_half_width - 250)
 end
-function netRightOfBall()
-  local n, b = lpo(NET1), lpo(BALL)
-  return AND(RELIABLE(n.reliability), TOL(-0.4, -0.05)(n.theta - b.theta))
+
+-- The bearing to shoot at (rad, left positive): the opponent's net as the camera sees it,
+-- moved from its middle to the aim point; by the global pose when the net is not in view.
+function aimBearing()
+  local ax, ay = aimPoint()
+  local n = lpo(NET1)
+  if n.reliability > 0.1 then
+    return n.theta + bearingTo(ax, ay) - bearingTo(ax, 0)
+  end
+  return bearingTo(ax, ay)
 end
-function netBehindBall()
-  local n, b = lpo(NET1), lpo(BALL)
-  return AND(RELIABLE(n.reliability), TRI(-0.2, 0, 0.2)(n.theta - b.theta))
-end
+local function aimOffBall() return aimBearing() - lpo(BALL).theta end
+-- The aim seen left / right of the ball, or behind it (for alignment).
+function netLeftOfBall() return TOR(0.05, 0.4)(aimOffBall()) end
+function netRightOfBall() return TOL(-0.4, -0.05)(aimOffBall()) end
+function netBehindBall() return TRI(-0.2, 0, 0.2)(aimOffBall()) end
+function aimAligned() return math.abs(aimOffBall()) < 0.2 end
 
 -- Localization.
 function wellLocalized() return TOR(0.4, 0.8)(chaos.gsGetMyPos().quality) end
@@ -147,8 +166,9 @@ end
 -- The unit vector from the ball to the opponent's net, and how far the robot is along it from
 -- the ball (mm; negative: behind the ball, where a push sends the ball towards the net).
 function ballToNet()
-  local b, hl = chaos.getGlobalBall(), field().half_length
-  local ux, uy = hl - b.x, -b.y
+  local b = chaos.getGlobalBall()
+  local ax, ay = aimPoint()
+  local ux, uy = ax - b.x, ay - b.y
   local n = math.max(1, math.sqrt(ux * ux + uy * uy))
   return ux / n, uy / n
 end
@@ -171,3 +191,34 @@ function behindBall(d)
   end
   return clampToField(x, y)
 end
+
+-- The control variables at a Middle Size robot's speeds (the defaults are the seed's, for a
+-- four-legged AIBO: 0.3 m/s and 90 deg/s). Same labels, so the rules read the same.
+variable {
+  name = "go", command = "vlin", min = -1200, max = 1200, mode = "centroid",
+  labels = {
+    BACK = TOL(-1200, -600),
+    SLOWBACK = TRI(-1200, -600, 0),
+    STAY = TRI(-600, 0, 600),
+    SLOW = TRI(0, 600, 1200),
+    FAST = TOR(600, 1200),
+  },
+}
+variable {
+  name = "turn", command = "vrot", min = -180, max = 180, mode = "centroid",
+  labels = {
+    HARDRIGHT = TOL(-180, -90),
+    RIGHT = TRI(-180, -90, 0),
+    NONE = TRI(-90, 0, 90),
+    LEFT = TRI(0, 90, 180),
+    HARDLEFT = TOR(90, 180),
+  },
+}
+variable {
+  name = "strafe", command = "vlat", min = -800, max = 800, mode = "centroid",
+  labels = {
+    RIGHT = TRI(-800, -400, 0),
+    NONE = TRI(-400, 0, 400),
+    LEFT = TRI(0, 400, 800),
+  },
+}

@@ -3,7 +3,7 @@
 //! goalkeeper hierarchy and the Attacker HFSM, with the expected commands worked out by hand
 //! from the predicates of `hbm.lua` and the default control variables (Mamdani centroid).
 //!
-//! Default labels used below: go STAY = TRI(−150, 0, 150), SLOW = TRI(0, 150, 300),
+//! Default labels used below (the team's are these times [`GO`], [`TURN`], [`STRAFE`]): go STAY = TRI(−150, 0, 150), SLOW = TRI(0, 150, 300),
 //! FAST = TOR(150, 300); turn RIGHT = TRI(−90, −45, 0), NONE = TRI(−45, 0, 45),
 //! LEFT = TRI(0, 45, 90); strafe RIGHT = TRI(−200, −100, 0), NONE = TRI(−100, 0, 100),
 //! LEFT = TRI(0, 100, 200). A symmetric label alone (at any degree) gives its peak: STAY 0,
@@ -16,6 +16,15 @@ use mrt_core::{Pose2, Time};
 use mrt_msgs::robot::{lps, Estimate, GameState, Lpo, WorldSnapshot};
 use mrt_script::{Cycle, Sandbox, ScriptError, ThinkingCap};
 use std::path::{Path, PathBuf};
+
+/// The team's `hbm.lua` redefines the control variables at a Middle Size robot's speeds: the
+/// same labels as the defaults (the seed's, for a four-legged robot), scaled by these factors.
+/// Every hand computation below is done with the default labels, then scaled.
+const GO: f64 = 4.0;
+/// `turn`'s scale (°/s).
+const TURN: f64 = 2.0;
+/// `strafe`'s scale (mm/s).
+const STRAFE: f64 = 4.0;
 
 fn dir() -> PathBuf {
     PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../../behaviors/teamchaos"))
@@ -153,7 +162,7 @@ fn the_shipped_directory_loads_every_behavior_and_each_runs_cleanly() {
         for w in [World(WorldSnapshot::default()), busy.clone()] {
             let c = run(&name, w);
             for v in [c.command.vlin, c.command.vrot, c.command.vlat] {
-                assert!(v.is_finite() && v.abs() <= 300.0, "{name}: {:?}", c.command);
+                assert!(v.is_finite() && v.abs() <= 300.0 * GO, "{name}: {:?}", c.command);
             }
         }
     }
@@ -184,40 +193,40 @@ fn trackbnet1_needs_the_ball_always_and_the_net_when_close() {
 fn faceball_turns_towards_the_ball() {
     // θ = 0.6: headedRight = TOR(0.05, 0.5)(0.6) = 1 → turn LEFT alone → +45 °/s.
     let c = run("faceball", World::at(0).ball(1500.0, 0.6));
-    close(c.command.vrot, 45.0);
+    close(c.command.vrot, 45.0 * TURN);
     close(c.command.vlin, 0.0);
     close(c.command.vlat, 0.0);
     assert_eq!(c.command.need(lps::BALL), 1.0);
     // θ = −0.6: turn RIGHT → −45.
-    close(run("faceball", World::at(0).ball(1500.0, -0.6)).command.vrot, -45.0);
+    close(run("faceball", World::at(0).ball(1500.0, -0.6)).command.vrot, -45.0 * TURN);
     // θ = 0: only NONE → 0.
     close(run("faceball", World::at(0).ball(1500.0, 0.0)).command.vrot, 0.0);
     // θ = 0.2: LEFT = (0.2 − 0.05) / 0.45 = 1/3 and NONE = TRI(−0.3, 0, 0.3)(0.2) = 1/3.
     // NONE clipped at 1/3 is a trapezium −45..45 with top −30..30; LEFT clipped is 0..90 with
     // top 15..75; their max is 1/3 from −30 to 75 with ramps −45..−30 and 75..90: symmetric
     // about (−45 + 90) / 2 = 22.5.
-    close(run("faceball", World::at(0).ball(1500.0, 0.2)).command.vrot, 22.5);
-    close(run("faceball", World::at(0).ball(1500.0, -0.2)).command.vrot, -22.5);
+    close(run("faceball", World::at(0).ball(1500.0, 0.2)).command.vrot, 22.5 * TURN);
+    close(run("faceball", World::at(0).ball(1500.0, -0.2)).command.vrot, -22.5 * TURN);
 }
 
 #[test]
 fn go2ball_goes_forward_when_the_ball_is_ahead_and_far_not_when_at_the_side() {
     // Ahead (θ 0) at 2 m: ballAhead 1, ballClose 0 → go FAST alone → 250; turn NONE → 0.
     let c = run("go2ball", World::at(0).ball(2000.0, 0.0));
-    close(c.command.vlin, 250.0);
+    close(c.command.vlin, 250.0 * GO);
     close(c.command.vrot, 0.0);
     close(c.command.vlat, 0.0);
     // At the side (θ 1.2): ballAhead 0 → go STAY → 0, turn LEFT → 45.
     let c = run("go2ball", World::at(0).ball(2000.0, 1.2));
     close(c.command.vlin, 0.0);
-    close(c.command.vrot, 45.0);
+    close(c.command.vrot, 45.0 * TURN);
     // Ahead at 400 mm: ballClose 0.7 → FAST 0.3, SLOW 0.7. The max of SLOW clipped at 0.7 and
     // FAST clipped at 0.3 rises 0 → 0.7 over [0, 105], stays 0.7 to 195, follows SLOW down to
     // 0.3 at 255, then FAST's 0.3 to 300: centroid 22398.75 / 143.25 = 156.36.
     let c = run("go2ball", World::at(0).ball(400.0, 0.0));
     let want = centroid(&[(0.0, 0.0), (105.0, 0.7), (195.0, 0.7), (255.0, 0.3), (300.0, 0.3)]);
     close(want, 22398.75 / 143.25);
-    close(c.command.vlin, want);
+    close(c.command.vlin, want * GO);
 }
 
 #[test]
@@ -226,18 +235,18 @@ fn dokick_kicks_when_the_ball_is_ahead_and_touching() {
     // go SLOW at NOT(0.75) = 0.25 → 150.
     let c = run("dokick", World::at(0).ball(200.0, 0.0));
     assert_eq!(c.command.kick, Some(1));
-    close(c.command.vlin, 150.0);
+    close(c.command.vlin, 150.0 * GO);
     // 1 m: not touching → no kick, SLOW 1 → 150.
     let c = run("dokick", World::at(0).ball(1000.0, 0.0));
     assert_eq!(c.command.kick, None);
-    close(c.command.vlin, 150.0);
+    close(c.command.vlin, 150.0 * GO);
     // 300 mm: touching (350 − 300) / 200 = 0.25 < 0.5 → no kick.
     assert_eq!(run("dokick", World::at(0).ball(300.0, 0.0)).command.kick, None);
     // 200 mm but off to the side (θ 1): not ahead → no kick, STAY, turn LEFT.
     let c = run("dokick", World::at(0).ball(200.0, 1.0));
     assert_eq!(c.command.kick, None);
     close(c.command.vlin, 0.0);
-    close(c.command.vrot, 45.0);
+    close(c.command.vrot, 45.0 * TURN);
 }
 
 #[test]
@@ -245,35 +254,88 @@ fn alignbnet1_strafes_to_put_the_net_behind_the_ball() {
     // Net seen 0.5 rad left of the ball: netLeftOfBall = TOR(0.05, 0.4)(0.5) = 1 → strafe
     // RIGHT → −100; ball ahead → turn NONE → 0; go STAY → 0.
     let c = run("alignbnet1", World::at(0).ball(400.0, 0.0).net1(3000.0, 0.5));
-    close(c.command.vlat, -100.0);
+    close(c.command.vlat, -100.0 * STRAFE);
     close(c.command.vrot, 0.0);
     close(c.command.vlin, 0.0);
     assert_eq!((c.command.need(lps::BALL), c.command.need(lps::NET1)), (1.0, 1.0));
     // Net right of the ball → strafe LEFT → +100; behind it → NONE → 0.
-    close(run("alignbnet1", World::at(0).ball(400.0, 0.1).net1(3000.0, -0.4)).command.vlat, 100.0);
+    close(
+        run("alignbnet1", World::at(0).ball(400.0, 0.1).net1(3000.0, -0.4)).command.vlat,
+        100.0 * STRAFE,
+    );
     close(run("alignbnet1", World::at(0).ball(400.0, 0.0).net1(3000.0, 0.0)).command.vlat, 0.0);
     // Net not seen: no strafe rule fires, vlat stays at its default 0.
     close(run("alignbnet1", World::at(0).ball(400.0, 0.0)).command.vlat, 0.0);
 }
 
+/// The aim moves away from the opponent's goalkeeper: with an opponent anchored at
+/// (8700, 500), 300 mm before the middle of the net, the aim is the far side of the net,
+/// 250 mm inside its post: (9000, −750). Seen from (0, 0) facing the net, that is
+/// atan2(−750, 9000) = −0.083 rad right of the net's middle, where the ball lies: the aim is
+/// right of the ball, netRightOfBall = TOL(−0.4, −0.05)(−0.083) = 0.095 and netBehindBall =
+/// TRI(−0.2, 0, 0.2)(−0.083) = 0.58: a small step to the left (the near ball drifts right in
+/// view faster than the far aim). Without the keeper the net's middle is behind the ball: no
+/// step.
 #[test]
-fn gkcutb_strafes_back_onto_the_ball_to_net_line_and_clears_when_safe() {
-    // Ball at (−6000, 1000), our net's centre at (−9000, 0). At the robot's x = −8500 the
-    // line is at y = 1000 + (0 − 1000)·(−8500 + 6000)/(−9000 + 6000) = 1000 − 833.3 = 166.7.
-    // The robot at y = 800 is 633.3 mm left of it (+y): posLeft = TOR(50, 300) = 1 → strafe
-    // RIGHT → −100 (towards −y, back to the line, facing +x).
-    let heading = (1000.0f64 - 800.0).atan2(2500.0); // facing the ball
-    let w = World::at(0).me(-8500.0, 800.0, heading, 0.9).global_ball(-6000.0, 1000.0);
-    let c = run("gkcutb", w.ball(2508.0, 0.0));
-    close(c.command.vlat, -100.0);
+fn alignbnet1_aims_at_the_side_of_the_net_away_from_its_keeper() {
+    use mrt_msgs::{AnchoredRobot, RobotClass};
+    let w = World::at(0).me(0.0, 0.0, 0.0, 0.9).ball(400.0, 0.0).net1(9000.0, 0.0);
+    close(run("alignbnet1", w.clone()).command.vlat, 0.0);
+    let (x, y) = (8700.0f64, 500.0f64);
+    let mut guarded = w;
+    guarded.0.robots.push(AnchoredRobot {
+        id: 5,
+        class: RobotClass::Opponent,
+        x,
+        y,
+        rho: x.hypot(y),
+        theta: y.atan2(x),
+        reliability: 0.9,
+        sigma: 80.0,
+        ..Default::default()
+    });
+    let c = run("alignbnet1", guarded);
+    // strafe NONE = TRI(−100, 0, 100) clipped at `behind`, LEFT = TRI(0, 100, 200) clipped
+    // at `right`; their union's centroid.
+    let off = (-750.0f64).atan2(9000.0);
+    let (right, behind) = ((-0.05 - off) / 0.35, 1.0 - off.abs() / 0.2);
+    let want = centroid(&[
+        (-100.0, 0.0),
+        (-100.0 + 100.0 * behind, behind),
+        (100.0 - 100.0 * behind, behind),
+        (100.0 - 100.0 * right, right),
+        (200.0 - 100.0 * right, right),
+        (200.0, 0.0),
+    ]);
+    assert!(want > 0.0 && want < 30.0, "{want}");
+    close(c.command.vlat, want * STRAFE);
+}
+
+#[test]
+fn gkcutb_holds_the_goal_line_level_with_the_ball_and_clears_when_safe() {
+    // The spot: 400 mm out of our goal line (x = −9000 + 400 = −8600), level with the ball
+    // but within the posts (|y| ≤ 1000 − 100), reached by gotopos facing the ball.
+    // Robot at (−8600, −1500) facing +x, ball at (−5000, −1000): the spot is (−8600, −900),
+    // 600 mm to the robot's left: strafe LEFT = TOR(100, 600)(600) = 1 alone → +100; 0 mm
+    // ahead: go STAY → 0. The ball is at bearing atan2(500, 3600) = 0.14 (left): turn LEFT at
+    // TRI(0, 0.6, 1.5) = 0.23 and NONE at 0.54 → between 0 and 45.
+    let theta = 500.0f64.atan2(3600.0);
+    let w = World::at(0).me(-8600.0, -1500.0, 0.0, 0.9).global_ball(-5000.0, -1000.0);
+    let c = run("gkcutb", w.ball(3635.0, theta));
+    close(c.command.vlat, 100.0 * STRAFE);
     close(c.command.vlin, 0.0);
-    // At y = −500 the robot is 666.7 mm right of the line: posRight = 1 → strafe LEFT → +100.
-    let w = World::at(0).me(-8500.0, -500.0, 0.0, 0.9).global_ball(-6000.0, 1000.0);
-    close(run("gkcutb", w.ball(2700.0, 0.6)).command.vlat, 100.0);
-    // On the line (ball and robot on y = 0): posAhead = 1 → strafe NONE → 0.
-    let w = World::at(0).me(-8500.0, 0.0, 0.0, 0.9).global_ball(-6000.0, 0.0);
-    let c = run("gkcutb", w.ball(2500.0, 0.0));
-    close(c.command.vlat, 0.0);
+    assert!(c.command.vrot > 0.0 && c.command.vrot < 45.0 * TURN, "{:?}", c.command);
+    // The ball far out on the left (y = 3000): the spot stays at the post (y = 900), where
+    // the robot already is: strafe NONE → 0.
+    let theta = 2100.0f64.atan2(3600.0);
+    let w = World::at(0).me(-8600.0, 900.0, 0.0, 0.9).global_ball(-5000.0, 3000.0);
+    close(run("gkcutb", w.ball(4168.0, theta)).command.vlat, 0.0);
+    // 1000 mm out in front of the spot, ball straight ahead: fw = −1000, go BACK =
+    // TOL(−1200, −200)(−1000) = 0.8 alone: the centroid of BACK clipped at 0.8.
+    let w = World::at(0).me(-7600.0, -900.0, 0.0, 0.9).global_ball(-5000.0, -900.0);
+    let c = run("gkcutb", w.ball(2600.0, 0.0));
+    let want = centroid(&[(-300.0, 0.8), (-270.0, 0.8), (-150.0, 0.0)]);
+    close(c.command.vlin, want * GO);
     assert_eq!(c.command.kick, None, "ball far: no kick");
     // Ball close (300 mm: ballClose = (750 − 300)/500 = 0.9) and heading 0 (freeToKick =
     // TOL(0.5, 1.2)(0) = 1): FRONTKICK 0.9 → kick 1.
@@ -311,8 +373,8 @@ fn goalkeeper_gets_out_of_its_net() {
         "goalkeeper",
         World::at(0).me(-9200.0, 0.0, 0.0, 0.9).ball(1000.0, 0.0).global_ball(-8200.0, 0.0),
     );
-    close(c.command.vlin, 150.0);
-    close(c.command.vrot, 45.0);
+    close(c.command.vlin, 150.0 * GO);
+    close(c.command.vrot, 45.0 * TURN);
     close(c.command.vlat, 0.0);
     assert!(c.command.track_landmarks);
     assert_eq!(c.command.need(lps::NET1), 1.0);
@@ -330,33 +392,34 @@ fn goalkeeper_clears_a_ball_in_the_penalty_area() {
         World::at(0).me(-7700.0, 0.0, 0.0, 0.9).ball(200.0, 0.0).global_ball(-7500.0, 0.0),
     );
     assert_eq!(c.command.kick, Some(1));
-    close(c.command.vlin, 150.0);
+    close(c.command.vlin, 150.0 * GO);
     close(c.command.vrot, 0.0);
     close(c.command.vlat, 0.0);
     assert_eq!(c.command.need(lps::BALL), 1.0);
-    // The ball 1.5 m ahead, still in the area (x = −7200): ballClose 0 → go2ball at 1 → go
-    // FAST → 250, no kick.
+    // The ball 1.5 m ahead, still in the area (x = −7200): too far to run out for
+    // (TOL(800, 1500)(1500) = 0), so gkcutb holds the spot (−8600, 0), 100 mm ahead: go STAY
+    // alone → 0, no kick. The keeper does not leave its goal for a ball it cannot reach first.
     let c = run(
         "goalkeeper",
         World::at(0).me(-8700.0, 0.0, 0.0, 0.9).ball(1500.0, 0.0).global_ball(-7200.0, 0.0),
     );
-    close(c.command.vlin, 250.0);
+    close(c.command.vlin, 0.0);
     assert_eq!(c.command.kick, None);
 }
 
 #[test]
 fn goalkeeper_cuts_the_ball_from_its_goal_area_and_localizes_when_lost() {
-    // Robot at (−8500, 500) in the goal area (TOL(−8250, −7750)(−8500) = 1, |y| = 500 ≤ 1500);
-    // ball at (−4000, 1000), outside the penalty area → gkcutb at 1. The ball-to-net line at
-    // x = −8500: y = 1000 − 1000·(−4500)/(−5000) = 100, so the robot is 400 mm left of it:
-    // strafe RIGHT → −100. The ball is at bearing atan2(500, 4500) = 0.11 (left): turn > 0.
+    // Robot at (−8500, 500); ball at (−4000, 1000), outside the penalty area → gkcutb at 1.
+    // Its spot (−8600, 900) is 400 mm to the left and 100 mm behind: strafe LEFT =
+    // TOR(100, 600)(400) = 0.6 alone → +100, go STAY → 0. The ball is at bearing
+    // atan2(500, 4500) = 0.11 (left): turn > 0.
     let theta = 500.0f64.atan2(4500.0);
     let c = run(
         "goalkeeper",
         World::at(0).me(-8500.0, 500.0, 0.0, 0.9).ball(4528.0, theta).global_ball(-4000.0, 1000.0),
     );
-    close(c.command.vlat, -100.0);
-    assert!(c.command.vrot > 0.0 && c.command.vrot < 45.0, "{:?}", c.command);
+    close(c.command.vlat, 100.0 * STRAFE);
+    assert!(c.command.vrot > 0.0 && c.command.vrot < 45.0 * TURN, "{:?}", c.command);
     close(c.command.vlin, 0.0);
     // The same with localization quality 0.2: wellLocalized = TOR(0.4, 0.8)(0.2) = 0, lost 1 →
     // gklocalize alone: stand still (STAY, NONE, NONE → 0), landmarks, both nets at 0.6.
@@ -466,35 +529,35 @@ fn the_attacker_hfsm_faces_walks_scores_and_follows_the_ball() {
     );
     let cmd = |k: usize| &cycles[k].command;
     // 0: faceball, ball left (θ 1.2) → turn LEFT 45, no forward motion.
-    close(cmd(0).vrot, 45.0);
+    close(cmd(0).vrot, 45.0 * TURN);
     close(cmd(0).vlin, 0.0);
     // 2: go2ball, ball ahead at 2 m → FAST 250; well localized → no landmark tracking.
-    close(cmd(2).vlin, 250.0);
+    close(cmd(2).vlin, 250.0 * GO);
     assert!(!cmd(2).track_landmarks);
     assert_eq!(cmd(2).need(lps::NET1), 0.0);
     // 3: quality 0.5 < 0.6 → trackLandMarks; nets unseen > 5 s → NET1 needed at 0.5.
     assert!(cmd(3).track_landmarks);
     assert_eq!(cmd(3).need(lps::NET1), 0.5);
-    close(cmd(3).vlin, 250.0);
+    close(cmd(3).vlin, 250.0 * GO);
     // 4: ApproachBall runs go2ball at 450 mm: ballClose = (750 − 450)/500 = 0.6 → SLOW 0.6,
     //    FAST 0.4: the max rises 0 → 0.6 over [0, 90], stays 0.6 to 210, follows SLOW down to
     //    0.4 at 240, then FAST's 0.4 to 300: centroid 22260 / 138 = 161.30. No landmarks.
     let want = centroid(&[(0.0, 0.0), (90.0, 0.6), (210.0, 0.6), (240.0, 0.4), (300.0, 0.4)]);
     close(want, 22260.0 / 138.0);
-    close(cmd(4).vlin, want);
+    close(cmd(4).vlin, want * GO);
     assert!(!cmd(4).track_landmarks);
     // 5: dokick at 450 mm: not touching → no kick, SLOW → 150.
     assert_eq!(cmd(5).kick, None);
-    close(cmd(5).vlin, 150.0);
+    close(cmd(5).vlin, 150.0 * GO);
     // 6: alignbnet1, net 0.5 rad left of the ball → strafe RIGHT −100, no forward motion.
-    close(cmd(6).vlat, -100.0);
+    close(cmd(6).vlat, -100.0 * STRAFE);
     close(cmd(6).vlin, 0.0);
     // 7: dokick at 200 mm → kick 1.
     assert_eq!(cmd(7).kick, Some(1));
     // 8: back in GoToBall, ball 1.2 m ahead → FAST 250.
-    close(cmd(8).vlin, 250.0);
+    close(cmd(8).vlin, 250.0 * GO);
     // 9: faceball, ball right → −45.
-    close(cmd(9).vrot, -45.0);
+    close(cmd(9).vrot, -45.0 * TURN);
 }
 
 #[test]
@@ -523,7 +586,7 @@ fn the_attacker_aligns_first_when_approaching_a_misaligned_ball() {
         ]
     );
     assert_eq!(cycles[4].taken.as_ref().map(|t| t.name.as_str()), Some("Misaligned"));
-    close(cycles[4].command.vlat, 100.0);
+    close(cycles[4].command.vlat, 100.0 * STRAFE);
 }
 
 /// Copies the shared predicates and one behavior of the shipped directory into `to`.
@@ -560,7 +623,7 @@ fn an_hfsm_naming_an_unknown_behavior_keeps_the_last_good_one_running() {
     let c = cap.cycle(World::at(0).ball(2000.0, 0.0).0);
     assert!(c.errors.is_empty(), "{:?}", c.errors);
     assert_eq!((c.path.as_str(), c.behavior.as_deref()), ("M/Go", Some("go2ball")));
-    close(c.command.vlin, 250.0);
+    close(c.command.vlin, 250.0 * GO);
     // Ball at 200 mm: the state asks for "nothere". The cycle reports it (file and line of
     // the call) and go2ball keeps running: ballClose(200) = 1 → SLOW alone → 150.
     let c = cap.cycle(World::at(100).ball(200.0, 0.0).0);
@@ -576,11 +639,11 @@ fn an_hfsm_naming_an_unknown_behavior_keeps_the_last_good_one_running() {
         other => panic!("{other:?}"),
     }
     assert_eq!((c.path.as_str(), c.behavior.as_deref()), ("M/Go", Some("go2ball")));
-    close(c.command.vlin, 150.0);
+    close(c.command.vlin, 150.0 * GO);
     // And back to normal.
     let c = cap.cycle(World::at(200).ball(2000.0, 0.0).0);
     assert!(c.errors.is_empty(), "{:?}", c.errors);
-    close(c.command.vlin, 250.0);
+    close(c.command.vlin, 250.0 * GO);
     let _ = std::fs::remove_dir_all(&tmp);
 }
 
@@ -734,14 +797,14 @@ fn field_players_share_the_roles_by_their_distance_to_the_ball() {
     assert_eq!(second[2].command.book_ball, Some(false), "a supporter gives the booking back");
     assert_eq!(second[2].behavior.as_deref(), Some("gotopos"));
     let c = &second[2].command;
-    close(c.vlin, -250.0);
-    close(c.vlat, 100.0);
+    close(c.vlin, -250.0 * GO);
+    close(c.vlat, 100.0 * STRAFE);
     close(c.vrot, 0.0);
 
     let third = run4(&|w| w.mate(2, -1000.0, 300.0, false).mate(3, -1500.0, -200.0, false));
     assert_eq!(third[2].path, "Player/Defend");
     let c = &third[2].command;
-    close(c.vlin, -250.0);
+    close(c.vlin, -250.0 * GO);
     close(c.vlat, 0.0);
 }
 

@@ -27,10 +27,10 @@ fn a_full_match_finishes_and_reproduces_its_trajectory_hash() {
     assert!(a.calls.iter().any(|(_, c)| *c == Call::HalfTime));
     assert_eq!((a.score, a.trajectory_hash), (b.score, b.trajectory_hash));
     assert_eq!(a.stats, b.stats);
-    // Both teams play: each moves to the ball and kicks it on target; Milan scores (seed 1:
-    // 3 : 0. Chaos has not scored against Milan since Milan plays with SCARE and its new
-    // goalkeeper: seeds 1 to 16 all end with Chaos at 0, docs/teams.md).
-    assert!(a.score.0 > 0, "{:?}", a.score);
+    // Both teams play: each moves to the ball and kicks it on target, and the match has goals
+    // (seed 1: 0 : 3 since Chaos plays at a Middle Size robot's speeds with its keeper on
+    // the goal line; seeds 2 to 6 go to Milan or end 0 : 0, docs/teams.md).
+    assert!(a.score.0 + a.score.1 > 0, "{:?}", a.score);
     // Every kickoff went through READY, and the robots walked to their places: the referee
     // placed few of them (one kickoff at the start, one per goal, one at half time).
     let placed: Vec<usize> = a
