@@ -390,7 +390,8 @@ impl WorldModel {
         if let Some(g) = &mut self.grid {
             g.place(pose.inner);
         }
-        // The ball's and the robots' tracks lie in the field frame of the pose that was.
+        // Moved by hand: the odometry did not feel it, so neither the ball's track (odometry
+        // frame) nor the robots' (field frame of the pose that was) holds any more.
         self.ball_track.reset();
         self.robots.reset();
     }

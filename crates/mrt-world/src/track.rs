@@ -13,7 +13,7 @@
 //! A sighting whose Mahalanobis distance from the prediction exceeds the χ² gate
 //! ([`GATE`], 99 % with two degrees of freedom) is not that object where the track expects it:
 //! once is a false sighting and is left out; [`RESTART_AFTER`] in a row is the object kicked
-//! (or the robot's pose relocalized) and the track starts again from the sighting, moving
+//! (or the robot carried) and the track starts again from the sighting, moving
 //! as the last two sightings say (not still, as a track seen for the first time: the ball's
 //! velocity error in vision matches fell from 0.34–0.37 to 0.28–0.33 m/s, seeds 1–4).
 //!
