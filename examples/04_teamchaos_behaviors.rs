@@ -4,7 +4,7 @@
 //! Lua: a hierarchical state machine (`behaviors/teamchaos/attacker.hfsm.lua`) chooses a
 //! low-level behavior each cycle with `chaos.setBehavior`, and fuzzy rules (`go2ball.lua`,
 //! `dokick.lua`, ...) blended by context give the velocities, the kick and the perceptual
-//! needs. The Attacker plays against a tiny scripted world where the ball sits 1 m away on the
+//! needs. The Attacker plays against a tiny scripted world where the ball sits 4 m away on the
 //! left: it faces the ball, walks to it, enters the `Score` meta-state, aligns the ball with
 //! the opponent's net and kicks.
 //!
@@ -123,7 +123,7 @@ pub fn run(scratch: &Path, verbose: bool) -> Result<Outcome> {
     let sandbox = Sandbox::default();
     let mut attacker = ThinkingCap::with_hfsm(scratch, scratch.join("attacker.hfsm.lua"), sandbox)
         .map_err(|e| anyhow::anyhow!("{e}"))?;
-    let mut field = Field { robot: Pose2::new(0.0, 0.0, 0.0), ball: (800.0, 600.0) };
+    let mut field = Field { robot: Pose2::new(0.0, 0.0, 0.0), ball: (3200.0, 2400.0) };
     let go2ball = scratch.join("go2ball.lua");
     let original = std::fs::read_to_string(&go2ball)?;
     let mut steps = Vec::new();
@@ -213,12 +213,13 @@ fn run_goalkeeper(dir: &Path, verbose: bool) -> Result<Vec<KeeperMove>> {
     let mut in_net = lost.clone();
     in_net.my_pos.pose = Pose2::new(-9200.0, 0.0, 0.0);
     in_net.lps[lps::BALL] = Lpo { rho: 3000.0, theta: 0.0, reliability: 0.9, seen_ago: 0.0 };
-    // The ball rolls towards the goal 3 m away, 30 cm to the goalkeeper's left of the line
-    // from the ball to the net centre: the keeper steps sideways onto it.
+    // The ball 2.9 m out at y = 300, the keeper 600 mm to its left on its line (400 mm out of
+    // the goal line): it steps sideways to stand level with the ball.
     let mut cut = lost.clone();
-    cut.lps[lps::BALL] = Lpo { rho: 3000.0, theta: 0.1, reliability: 0.9, seen_ago: 0.0 };
+    let theta = (-600.0f64).atan2(2900.0);
+    cut.lps[lps::BALL] = Lpo { rho: 2961.0, theta, reliability: 0.9, seen_ago: 0.0 };
     cut.global_ball = Estimate { pose: Pose2::new(-5700.0, 300.0, 0.0), quality: 0.9 };
-    cut.my_pos.pose = Pose2::new(-8700.0, 300.0, 0.0);
+    cut.my_pos.pose = Pose2::new(-8600.0, 900.0, 0.0);
     let mut out = Vec::new();
     if verbose {
         println!("\nGoalkeeper (goalkeeper.lua and its 11 sub-behaviors):\n");
