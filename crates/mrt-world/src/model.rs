@@ -32,7 +32,7 @@ use crate::anchor::{AnchorCounts, Anchors, Phase, RobotPercept};
 use crate::field::FieldMap;
 use crate::gm::FuzzyGrid;
 use crate::murea::{Fix, Perception};
-use crate::relocalize::{self, CameraNoise, Localizer, Relocalizer};
+use crate::relocalize::{self, CameraNoise, FrameSeen, Localizer, Relocalizer};
 use crate::track::{sighting_covariance, Track, TrackCounts, BALL_ACCEL};
 use mrt_core::frames::{Attack, Field, Framed, Team, MM_PER_M};
 use mrt_core::{normalize_angle, Point2, Pose2, Time, Vec2};
@@ -554,7 +554,7 @@ impl WorldModel {
     pub fn camera(&mut self, frame: &CameraFrame) -> WorldSnapshot {
         let none = [None; FIELD_OBJECTS];
         let perceived = self.global().then(|| {
-            relocalize::perceptions(&self.map, self.noise, &frame.sightings, &none, &[], &[], &[])
+            relocalize::perceptions(&self.map, self.noise, FrameSeen::of(&frame.sightings))
         });
         let velocity = frame.sightings[lps::BALL].map(|z| self.track_ball(frame.time, &z, None));
         let robots = &frame.robots;
@@ -739,16 +739,15 @@ impl WorldModel {
         }
         // The relocalizer takes the posts by their pattern: naming them rests on the pose.
         let perceived = self.global().then(|| {
-            let noise = self.noise;
-            relocalize::perceptions(
-                &self.map,
-                noise,
-                &p.sightings,
-                &p.sigmas,
-                &p.posts,
-                if self.goal_corners { &p.goal_corners } else { &[] },
-                &p.line_points,
-            )
+            let corners: &[PostSighting] = if self.goal_corners { &p.goal_corners } else { &[] };
+            let seen = FrameSeen {
+                sigmas: &p.sigmas,
+                posts: &p.posts,
+                goal_corners: corners,
+                line_points: &p.line_points,
+                ..FrameSeen::of(&p.sightings)
+            };
+            relocalize::perceptions(&self.map, self.noise, seen)
         });
         let mut frame = CameraFrame { time: p.time, sightings: p.sightings, ..Default::default() };
         let mut sigmas = p.sigmas;

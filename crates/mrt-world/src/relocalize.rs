@@ -171,20 +171,37 @@ impl CameraNoise {
     }
 }
 
-/// The MUREA perceptions of one frame: nets and named landmarks of `sightings` (field-object
-/// order, with their standard deviations `sigmas` where known), the landmark `posts` by their
-/// colour pattern, the `goal_corners` of goals cut by the image's side by their goal's
-/// colour, and up to [`LINE_POINTS`] of the `line_points` (robot frame, m).
-/// Tolerances are three standard deviations ([`CameraNoise::sigma`]), at least 5 cm and 1°.
-pub fn perceptions(
-    field: &FieldMap,
-    noise: CameraNoise,
-    sightings: &[Option<Sighting>; FIELD_OBJECTS],
-    sigmas: &[Option<(f64, f64)>; FIELD_OBJECTS],
-    posts: &[PostSighting],
-    goal_corners: &[PostSighting],
-    line_points: &[(f64, f64)],
-) -> Vec<Perception> {
+/// What one frame showed, as [`perceptions`] reads it: nets and named landmarks in
+/// field-object order with their standard deviations where known, the landmark posts by their
+/// colour pattern, the corners of goals cut by the image's side, and the field-line points
+/// (robot frame, m). [`FrameSeen::of`] starts from the sightings alone.
+#[derive(Clone, Copy, Debug)]
+pub struct FrameSeen<'a> {
+    /// Nets and named landmarks, field-object order.
+    pub sightings: &'a [Option<Sighting>; FIELD_OBJECTS],
+    /// Each sighting's standard deviations (distance m, bearing rad), where known.
+    pub sigmas: &'a [Option<(f64, f64)>; FIELD_OBJECTS],
+    /// Landmark posts by their colour pattern.
+    pub posts: &'a [PostSighting],
+    /// Corners of goals cut by the image's side, by their goal's colour.
+    pub goal_corners: &'a [PostSighting],
+    /// Field-line points, robot frame (m).
+    pub line_points: &'a [(f64, f64)],
+}
+
+impl<'a> FrameSeen<'a> {
+    /// The frame's `sightings`, with nothing else seen and no standard deviations known.
+    pub fn of(sightings: &'a [Option<Sighting>; FIELD_OBJECTS]) -> Self {
+        const UNKNOWN: [Option<(f64, f64)>; FIELD_OBJECTS] = [None; FIELD_OBJECTS];
+        FrameSeen { sightings, sigmas: &UNKNOWN, posts: &[], goal_corners: &[], line_points: &[] }
+    }
+}
+
+/// The MUREA perceptions of one frame ([`FrameSeen`]): its nets, landmarks, posts and goal
+/// corners, and up to [`LINE_POINTS`] of its line points. Tolerances are three standard
+/// deviations ([`CameraNoise::sigma`]), at least 5 cm and 1°.
+pub fn perceptions(field: &FieldMap, noise: CameraNoise, seen: FrameSeen<'_>) -> Vec<Perception> {
+    let FrameSeen { sightings, sigmas, posts, goal_corners, line_points } = seen;
     let point = |kind: Kind, z: &Sighting, sigma: Option<(f64, f64)>| {
         let (sd, sb) = noise.sigma(z.distance, sigma);
         Perception::point(kind, z.distance, z.bearing)
@@ -586,7 +603,11 @@ mod tests {
             pixels: 40,
         }];
         let lines: Vec<(f64, f64)> = (0..40).map(|i| (1.0 + 0.1 * f64::from(i), 0.5)).collect();
-        let p = perceptions(&f, NOISE, &sightings, &[None; FIELD_OBJECTS], &posts, &[], &lines);
+        let p = perceptions(
+            &f,
+            NOISE,
+            FrameSeen { posts: &posts, line_points: &lines, ..FrameSeen::of(&sightings) },
+        );
         assert_eq!(p[0].kind, Kind::EAST_GOAL);
         assert!((p[0].range_tolerance - 0.39).abs() < 1e-12, "3 × (3 % of 4 m + 1 cm)");
         assert_eq!(p[1].kind, Kind::WEST_POST);
@@ -626,8 +647,11 @@ mod tests {
         let f = field();
         for k in 0..frames {
             r.lines(lines);
-            let none = [None; FIELD_OBJECTS];
-            let p = perceptions(&f, NOISE, sightings, &none, &[], corners, lines);
+            let p = perceptions(
+                &f,
+                NOISE,
+                FrameSeen { goal_corners: corners, line_points: lines, ..FrameSeen::of(sightings) },
+            );
             if let Some(fix) = r.frame(0.1 * f64::from(k), p, wrong) {
                 return fix;
             }
@@ -735,7 +759,8 @@ mod tests {
         for k in 0..100 {
             let t = 0.1 * f64::from(k);
             let before = r.counts().searches;
-            let p = perceptions(&f, NOISE, &one, &[None; FIELD_OBJECTS], &[], &[], &lines);
+            let p =
+                perceptions(&f, NOISE, FrameSeen { line_points: &lines, ..FrameSeen::of(&one) });
             assert!(r.frame(t, p, wrong).is_none());
             if r.counts().searches > before {
                 searched.push((10.0 * t).round() / 10.0);
@@ -753,7 +778,7 @@ mod tests {
         let truth = Pose2::new(2.0, 1.0, 0.3);
         for k in 0..10 {
             let seen = seen_from(truth);
-            let p = perceptions(&f, NOISE, &seen, &[None; FIELD_OBJECTS], &[], &[], &[]);
+            let p = perceptions(&f, NOISE, FrameSeen::of(&seen));
             assert!(r.frame(0.1 * f64::from(k), p, truth).is_none());
         }
         assert_eq!(r.counts().searches, 0, "the window fits the tracked pose");
@@ -766,8 +791,7 @@ mod tests {
         let before = Pose2::new(-3.0, 2.0, 0.0);
         let mut t = 0.0;
         for _ in 0..10 {
-            let p =
-                perceptions(&f, NOISE, &seen_from(before), &[None; FIELD_OBJECTS], &[], &[], &[]);
+            let p = perceptions(&f, NOISE, FrameSeen::of(&seen_from(before)));
             assert!(r.frame(t, p, before).is_none());
             t += 0.1;
         }
@@ -775,8 +799,7 @@ mod tests {
         let after = Pose2::new(3.0, -2.0, 3.0);
         let mut fixed = None;
         for _ in 0..20 {
-            let p =
-                perceptions(&f, NOISE, &seen_from(after), &[None; FIELD_OBJECTS], &[], &[], &[]);
+            let p = perceptions(&f, NOISE, FrameSeen::of(&seen_from(after)));
             if let Some(fix) = r.frame(t, p, before) {
                 fixed = Some((t, fix));
                 break;
@@ -797,7 +820,7 @@ mod tests {
         // tracker says it is at (0, 1) facing north.
         let mut sightings = [None; FIELD_OBJECTS];
         sightings[EAST_NET] = Some(Sighting { distance: 4.0, bearing: 0.0 });
-        let p = perceptions(&f, NOISE, &sightings, &[None; FIELD_OBJECTS], &[], &[], &[]);
+        let p = perceptions(&f, NOISE, FrameSeen::of(&sightings));
         r.frame(0.0, p, Pose2::default());
         r.moved(Pose2::new(0.0, 0.0, std::f64::consts::FRAC_PI_2));
         r.moved(Pose2::new(1.0, 0.0, 0.0));
@@ -827,7 +850,7 @@ mod tests {
         };
         let none = [None; FIELD_OBJECTS];
         for (t, d) in [(0.0, 11.5), (0.1, 10.3)] {
-            let p = perceptions(&f, NOISE, &none, &[None; FIELD_OBJECTS], &[post(d)], &[], &[]);
+            let p = perceptions(&f, NOISE, FrameSeen { posts: &[post(d)], ..FrameSeen::of(&none) });
             r.frame(t, p, Pose2::default());
         }
         let w = r.window_now(0.1, Pose2::default());
@@ -841,11 +864,7 @@ mod tests {
         let p = perceptions(
             &f,
             NOISE,
-            &none,
-            &[None; FIELD_OBJECTS],
-            &[post(4.0), post(7.0)],
-            &[],
-            &[],
+            FrameSeen { posts: &[post(4.0), post(7.0)], ..FrameSeen::of(&none) },
         );
         r.frame(0.0, p, Pose2::default());
         assert_eq!(r.window_now(0.0, Pose2::default()).len(), 2);
