@@ -192,33 +192,9 @@ function behindBall(d)
   return clampToField(x, y)
 end
 
--- The control variables at a Middle Size robot's speeds (the defaults are the seed's, for a
--- four-legged AIBO: 0.3 m/s and 90 deg/s). Same labels, so the rules read the same.
-variable {
-  name = "go", command = "vlin", min = -1200, max = 1200, mode = "centroid",
-  labels = {
-    BACK = TOL(-1200, -600),
-    SLOWBACK = TRI(-1200, -600, 0),
-    STAY = TRI(-600, 0, 600),
-    SLOW = TRI(0, 600, 1200),
-    FAST = TOR(600, 1200),
-  },
-}
-variable {
-  name = "turn", command = "vrot", min = -180, max = 180, mode = "centroid",
-  labels = {
-    HARDRIGHT = TOL(-180, -90),
-    RIGHT = TRI(-180, -90, 0),
-    NONE = TRI(-90, 0, 90),
-    LEFT = TRI(0, 90, 180),
-    HARDLEFT = TOR(90, 180),
-  },
-}
-variable {
-  name = "strafe", command = "vlat", min = -800, max = 800, mode = "centroid",
-  labels = {
-    RIGHT = TRI(-800, -400, 0),
-    NONE = TRI(-400, 0, 400),
-    LEFT = TRI(0, 400, 800),
-  },
-}
+-- The control variables at a Middle Size robot's speeds: the defaults are the seed's, for a
+-- four-legged AIBO (go up to 0.3 m/s, turn 90 deg/s, strafe 0.2 m/s). The same labels, scaled,
+-- so the rules read the same.
+scale("go", 4)
+scale("turn", 2)
+scale("strafe", 4)

@@ -81,6 +81,25 @@ fn ramp(x: f64, from: f64, to: f64) -> f64 {
 }
 
 impl FuzzySet {
+    /// The same shape stretched by `k` (> 0) about 0: every breakpoint times `k`, so that
+    /// `scaled(k).membership(k·x) = membership(x)`. A robot with other speeds keeps a
+    /// behavior's labels and their meaning in units of its own.
+    pub fn scaled(&self, k: f64) -> FuzzySet {
+        match *self {
+            FuzzySet::Tri { a, b, c } => FuzzySet::Tri { a: a * k, b: b * k, c: c * k },
+            FuzzySet::Tol { a, b } => FuzzySet::Tol { a: a * k, b: b * k },
+            FuzzySet::Tor { a, b } => FuzzySet::Tor { a: a * k, b: b * k },
+            FuzzySet::Div { a, b, c, d } => {
+                FuzzySet::Div { a: a * k, b: b * k, c: c * k, d: d * k }
+            }
+            FuzzySet::Tra { a, b, c, d } => {
+                FuzzySet::Tra { a: a * k, b: b * k, c: c * k, d: d * k }
+            }
+            FuzzySet::Rec { b, c } => FuzzySet::Rec { b: b * k, c: c * k },
+            FuzzySet::Sng { a } => FuzzySet::Sng { a: a * k },
+        }
+    }
+
     /// The identifier used in the files (`TRI`, `TOL`, `TOR`, `DIV`, `TRA`, `REC`, `SNG`).
     pub fn identifier(&self) -> &'static str {
         match self {
@@ -243,6 +262,30 @@ mod tests {
 
     fn close(a: f64, b: f64) -> bool {
         (a - b).abs() < 1e-12
+    }
+
+    /// Every shape, stretched by k, is the same shape in the stretched units.
+    #[test]
+    fn a_scaled_set_has_the_same_membership_at_the_scaled_point() {
+        let sets = [
+            FuzzySet::Tri { a: -1.0, b: 0.5, c: 2.0 },
+            FuzzySet::Tol { a: -1.0, b: 1.0 },
+            FuzzySet::Tor { a: -1.0, b: 1.0 },
+            FuzzySet::Div { a: -3.0, b: -1.0, c: 1.0, d: 3.0 },
+            FuzzySet::Tra { a: -2.0, b: -1.0, c: 1.0, d: 2.0 },
+            FuzzySet::Rec { b: -1.0, c: 1.0 },
+            FuzzySet::Sng { a: 0.5 },
+        ];
+        for set in sets {
+            for k in [0.5, 2.0, 4.0] {
+                let big = set.scaled(k);
+                assert_eq!(big.identifier(), set.identifier());
+                for i in -40..=40 {
+                    let x = f64::from(i) * 0.1;
+                    assert!(close(big.membership(k * x), set.membership(x)), "{set:?} ×{k} at {x}");
+                }
+            }
+        }
     }
 
     #[test]

@@ -17,6 +17,7 @@
 //! | `or`, `not` | `OR(a, b, ...)`, `NOT(a)` (min / max / 1 − a) |
 //! | membership functions (figure 5) | `TRI(a, b, c)`, `TRA(a, b, c, d)`, `TOL(a, b)`, `TOR(a, b)`, `REC(a, b)`, `SNG(a)`, `DIV(a, b, c, d)`; a set is called on a value: `TOL(250, 750)(ball.rho)` |
 //! | control variables | `variable { name = "go", command = "vlin", min = -300, max = 300, mode = "centroid", labels = { STAY = TRI(-150, 0, 150), ... } }` |
+//! | a variable in other units (a faster robot) | `scale("go", 4)`: its range and every label times 4, the labels' names and rules unchanged |
 //!
 //! Truth values are numbers in `[0, 1]` (booleans count as 0 and 1). A `use`d behavior runs at
 //! activation `min(truth, activation of its user)`; what it asserts is clipped at that level
@@ -496,6 +497,28 @@ fn install(lua: &Lua, shared: &Rc<Shared>) -> mlua::Result<()> {
                 Some(slot) => *slot = declared,
                 None => all.push(declared),
             }
+            Ok(())
+        })?,
+    )?;
+
+    let s = shared.clone();
+    g.set(
+        "scale",
+        lua.create_function(move |_, (name, k): (String, f64)| {
+            if !(k.is_finite() && k > 0.0) {
+                return Err(err(format!("scale('{name}', {k}): the factor must be a number > 0")));
+            }
+            let mut all = s.declared.borrow_mut();
+            let Some((v, _)) = all.iter_mut().find(|(v, _)| v.name == name) else {
+                let names: Vec<&str> = all.iter().map(|(v, _)| v.name.as_str()).collect();
+                return Err(err(format!(
+                    "scale('{name}', {k}): no control variable '{name}' (known: {})",
+                    names.join(", ")
+                )));
+            };
+            v.min *= k;
+            v.max *= k;
+            v.labels.iter_mut().for_each(|(_, set)| *set = set.scaled(k));
             Ok(())
         })?,
     )?;

@@ -254,6 +254,35 @@ fn default_variables_use_mamdani_centroids() {
     close(c.vlin, 150.0);
 }
 
+/// `scale` stretches a default variable (its range and every label) for a robot of other
+/// speeds: FAST alone gives 250 · 4 = 1000 mm/s and turn LEFT 45 · 2 = 90 °/s. An edit of
+/// hbm.lua runs it again on fresh defaults, not on the scaled ones. A factor that is not a
+/// number > 0, or a variable that does not exist, fails the load naming hbm.lua.
+#[test]
+fn scale_stretches_a_default_variable_once_also_after_a_reload() {
+    let dir = Dir::new("scale");
+    dir.write("hbm.lua", r#"scale("go", 4) scale("turn", 2)"#);
+    dir.write("fast.lua", r#"always("go", "FAST") always("turn", "LEFT")"#);
+    let mut cap = ThinkingCap::with_behavior(dir.path(), "fast", Sandbox::default()).unwrap();
+    let c = cap.cycle(ball_at(1000.0, 0)).command;
+    close(c.vlin, 1000.0);
+    close(c.vrot, 90.0);
+    dir.edit("hbm.lua", "scale(\"go\", 4) scale(\"turn\", 2) -- edited\n");
+    let (reloaded, errors) = cap.reload_changed();
+    assert!(errors.is_empty() && reloaded.iter().any(|r| r == "hbm"), "{reloaded:?} {errors:?}");
+    close(cap.cycle(ball_at(1000.0, 100)).command.vlin, 1000.0);
+    for (k, bad) in
+        [r#"scale("go", 0)"#, r#"scale("go", -2)"#, r#"scale("speed", 2)"#].into_iter().enumerate()
+    {
+        let d = Dir::new(&format!("badscale{k}"));
+        d.write("hbm.lua", bad);
+        d.write("fast.lua", r#"always("go", "FAST")"#);
+        let e = ThinkingCap::with_behavior(d.path(), "fast", Sandbox::default()).err().unwrap();
+        let e = e.to_string();
+        assert!(e.contains("hbm.lua:1: runtime error: scale('"), "{bad}: {e}");
+    }
+}
+
 #[test]
 fn cdb_blends_sub_behaviors_by_their_activation() {
     let dir = Dir::new("cdb");

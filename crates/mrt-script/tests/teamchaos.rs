@@ -17,8 +17,9 @@ use mrt_msgs::robot::{lps, Estimate, GameState, Lpo, WorldSnapshot};
 use mrt_script::{Cycle, Sandbox, ScriptError, ThinkingCap};
 use std::path::{Path, PathBuf};
 
-/// The team's `hbm.lua` redefines the control variables at a Middle Size robot's speeds: the
-/// same labels as the defaults (the seed's, for a four-legged robot), scaled by these factors.
+/// The team's `hbm.lua` scales the control variables to a Middle Size robot's speeds
+/// (`scale("go", 4)`, ...): the same labels as the defaults (the seed's, for a four-legged
+/// robot), stretched by these factors.
 /// Every hand computation below is done with the default labels, then scaled.
 const GO: f64 = 4.0;
 /// `turn`'s scale (°/s).
