@@ -384,6 +384,18 @@ pub fn run(args: &SimArgs) -> Result<()> {
     }
     write_metrics(args, &book)?;
     let n = cfg.rules.team_size;
+    let clock = |t: f64| format!("{}:{:04.1}", (t / 60.0).floor() as u64, t % 60.0);
+    for k in report.kidnaps.iter().filter(|k| k.recovered_after.is_none()) {
+        let (team, i) = if k.robot < n { (h, k.robot) } else { (a, k.robot - n) };
+        outln!(
+            "  robot {} ({team} #{i}) carried at {} to ({:.2}, {:.2}) m facing {:.0}°: not found again",
+            k.robot,
+            clock(k.at),
+            k.to.x,
+            k.to.y,
+            k.to.theta.to_degrees()
+        );
+    }
     for f in &report.faults {
         let (team, k) = if f.robot < n { (h, f.robot) } else { (a, f.robot - n) };
         let from = f

@@ -202,6 +202,10 @@ pub struct WorldSnapshot {
     /// In `READY`: where the referee's kickoff formation wants this robot (team frame, mm,
     /// heading in radians; `getKickoffPose`). `None` in the other states.
     pub kickoff_pose: Option<Pose2>,
+    /// Whether the world model needs to localize the robot: the landmarks it sees have
+    /// disagreed with its pose for a while (ThinkingCap seed `001` §2.1: a perceptual need for
+    /// landmarks; `mrt_world::WorldModel::needs_localization`).
+    pub needs_localization: bool,
     /// The SCARE activity this robot was given, its current sub-task and the goal the
     /// sub-task sets (MRT manual ch. 11: "parametric modules ... use coordination information
     /// introduced in MAP by SCARE"); `None` when the robot runs no SCARE.
@@ -243,6 +247,7 @@ impl Default for WorldSnapshot {
             game_state: GameState::default(),
             field: Field::default(),
             kickoff_pose: None,
+            needs_localization: false,
             job: None,
         }
     }

@@ -42,6 +42,7 @@ pub mod config;
 pub mod devices;
 pub mod files;
 pub mod isocrob;
+pub mod look_around;
 pub mod members;
 pub mod mission;
 pub mod planner;

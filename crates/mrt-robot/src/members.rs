@@ -30,7 +30,8 @@
 //!    [`RobotCommand`] into a [`MotorCommand`] with [`mrt_plan::guide::Guidance`]: velocity
 //!    mode halted by the sonars, or position and potential-field modes to a target posture,
 //!    or, for a target with `plan`, position mode along the planner's path, halted by the
-//!    sonars;
+//!    sonars; on a robot whose camera cannot pan, it turns the robot in place while the world
+//!    model needs to localize ([`crate::look_around`]);
 //! 5. **`Motor`** (the motor and kicker driver, on message): turns each [`MotorCommand`] into
 //!    wheel duty cycles (the AIRBoard's processing side, [`Base::duties`]) and kicks;
 //! 6. **`FaultBook`** (on message): books the behavior Member's script errors against the
@@ -48,6 +49,7 @@ use crate::config::RobotConfig;
 use crate::devices::{Devices, SharedDevices};
 use crate::files::FilesDir;
 use crate::isocrob::IsocrobBrain;
+use crate::look_around::LookAround;
 use crate::planner::{carrot, plans_for, same_goal, Planner, REPLAN};
 use crate::stacks::{embedded_teamchaos, send_brain, Geometry, Stack, CHAOS_KEEPER, CHAOS_PLAYER};
 use mrt_blackboard::{Blackboard, Proxy};
@@ -55,8 +57,8 @@ use mrt_core::{Point2, Pose2};
 use mrt_dcdt::{Activation, Agora, Context, Member, MemberError, Message, RequestType, RunReport};
 use mrt_msgs::robot::{lps, Lpo};
 use mrt_msgs::{
-    BehaviorStatus, BookingReport, CameraFrame, GameInfo, MateReport, MemberFault, MotorCommand,
-    Odometry, Percepts, RobotCommand, Sonar, SonarScan, WorldSnapshot,
+    BehaviorStatus, BookingReport, CameraFrame, GameInfo, GameState, MateReport, MemberFault,
+    MotorCommand, Odometry, Percepts, RobotCommand, Sonar, SonarScan, WorldSnapshot,
 };
 use mrt_msgs::{PlanRequest, PlannedPath, Target};
 use mrt_perception::vision::agent::VisionAgent;
@@ -366,6 +368,9 @@ struct Guide {
     path: Option<(PlannedPath, f64)>,
     /// The goal last asked of the planner, and when.
     asked: Option<(Pose2, f64)>,
+    /// Turning to look for landmarks when the world model needs to localize, on a robot
+    /// whose camera cannot pan (`None` with a pan joint: the gaze looks instead).
+    look: Option<LookAround>,
 }
 
 impl Guide {
@@ -420,6 +425,12 @@ impl Member for Guide {
         }
         if let Some(mut cmd) = last {
             self.body.act(&mut cmd);
+            let now = self.world.time.as_secs_f64();
+            let (needs, played) =
+                (self.world.needs_localization, self.world.game_state == GameState::Playing);
+            if let Some(rate) = self.look.as_mut().and_then(|l| l.step(now, needs, played)) {
+                cmd = RobotCommand { vrot: rate.to_degrees(), ..RobotCommand::default() };
+            }
             let planned = cmd.target.is_some_and(|t| t.plan);
             self.follow(&mut cmd, ctx);
             let mut out = guide(&self.guidance, &cmd, &self.world, &self.scan.sonars);
@@ -638,6 +649,7 @@ fn add_cycle(
         scan: SonarScan::default(),
         path: None,
         asked: None,
+        look: cfg.gaze.is_none().then(LookAround::default),
     };
     let mut ids = vec![agora.add_member(odometry, every), agora.add_member(camera, every)];
     if let Some(v) = &cfg.vision {

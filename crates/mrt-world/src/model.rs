@@ -103,6 +103,9 @@ const GRID_ELSEWHERE: (f64, f64, f64) = (0.5, 0.35, 0.1);
 const GRID_PATIENCE: u32 = 3;
 /// Uncertainty added when the filter finds itself lost (m, rad).
 const LOST_SIGMA: (f64, f64) = (1.0, 0.5);
+/// The robot needs to localize ([`WorldModel::needs_localization`]) when the goals and posts
+/// it sees have disagreed with its pose, none agreeing, for this long (s).
+pub const DOUBTED: f64 = 0.5;
 
 /// LPS slot → field object (sensor order) for a team attacking west: its frame is the field
 /// turned half round, so its opponent's net is the west net, its "north-east" corner the
@@ -155,6 +158,8 @@ pub struct WorldModel {
     lines_trusted: bool,
     /// The last frame's time, s.
     now: f64,
+    /// Since when the goals and posts seen disagree with the pose, none agreeing, s.
+    doubted: Option<f64>,
     /// One standard deviation of the ball's place when it was last seen, m.
     ball_seen_sigma: f64,
     /// The ball's velocity in the field frame (m/s) when the last frame gave one.
@@ -222,6 +227,7 @@ impl WorldModel {
             grid_disagrees: 0,
             lines_trusted: false,
             now: 0.0,
+            doubted: None,
             ball_velocity: None,
             ball_seen_sigma: 0.0,
             robots: Anchors::default(),
@@ -343,6 +349,16 @@ impl WorldModel {
         )
     }
 
+    /// Whether the robot needs to localize: the goals and posts it sees (or MUREA's window)
+    /// have disagreed with its pose for [`DOUBTED`] s, none agreeing (it was carried, or its
+    /// pose went wrong), and no relocalization has settled it. This is the perceptual need that
+    /// ThinkingCap's behaviors state with `trackLandMarks` (seed `001` §2.1), stated by the
+    /// world model itself: with a pan joint the gaze looks for landmarks, without one the
+    /// robot turns ([`WorldSnapshot::needs_localization`]).
+    pub fn needs_localization(&self) -> bool {
+        self.doubted.is_some_and(|t| self.now - t >= DOUBTED)
+    }
+
     /// The pose's quality, 0 to 1 (module doc).
     pub fn quality(&self) -> f64 {
         let (xy, theta) = self.sigma();
@@ -381,6 +397,7 @@ impl WorldModel {
     /// Sets the pose, as when the robot is put down by hand.
     pub fn place(&mut self, pose: Framed<Field, Pose2>) {
         self.pose = pose.inner;
+        self.doubted = None;
         let (xy, theta) = PLACED_SIGMA;
         self.cov = Matrix3::from_diagonal(&Vector3::new(xy * xy, xy * xy, theta * theta));
         self.lines_trusted = true;
@@ -579,6 +596,7 @@ impl WorldModel {
         mut perceived: Option<Vec<Perception>>,
         line_points: &[(f64, f64)],
     ) -> WorldSnapshot {
+        let relocalized = self.counts.relocalized;
         // MUREA first checks the odometry's prediction against what the robot sees.
         let for_murea = if self.relocalizer.is_some() { perceived.take() } else { None };
         if let (Some(r), Some(perceived)) = (&mut self.relocalizer, for_murea) {
@@ -607,13 +625,14 @@ impl WorldModel {
             }
         }
         let (seen, rejected) = self.correct_all(frame, sigmas);
+        let mut disagree = rejected;
         if seen >= 3 && 2 * rejected > seen {
             // Most landmarks disagree: the estimate is wrong, not the camera. Widen the
             // uncertainty and listen to the same sightings again.
             self.counts.lost += 1;
             let (xy, theta) = LOST_SIGMA;
             self.cov += Matrix3::from_diagonal(&Vector3::new(xy * xy, xy * xy, theta * theta));
-            self.correct_all(frame, sigmas);
+            disagree = self.correct_all(frame, sigmas).1;
         }
         // The lines fit a wrong pose nearly as well as the right one (they are everywhere,
         // and alike): they refine a pose that the goals and posts confirmed, and wait after a
@@ -623,6 +642,11 @@ impl WorldModel {
             self.lines_trusted = false;
         } else if seen > 0 {
             self.lines_trusted = true;
+        }
+        if self.counts.relocalized > relocalized || (seen > disagree && !misfit) {
+            self.doubted = None;
+        } else if seen > 0 || misfit {
+            self.doubted.get_or_insert(frame.time);
         }
         if self.lines_trusted && self.sigma().0 <= LINE_CLEARANCE / 2.0 {
             self.correct_lines(line_points);
@@ -912,6 +936,7 @@ impl WorldModel {
             };
         }
         w.my_pos = Estimate { pose: mm_pose(me.to_team(attack)), quality: self.quality() };
+        w.needs_localization = self.needs_localization();
         w.kickoff_pose = self.game.kickoff_pose.map(|p| mm_pose(p.to_team(attack)));
         if let Some(Memory { at, reliability, .. }) = self.memory[lps::BALL] {
             let (x, y) = mm(at.to_team(attack));
@@ -1136,6 +1161,44 @@ mod tests {
         let k = gm.unwrap_or_else(|| panic!("GM never found it: {counts:?}"));
         assert!(k <= 8, "found after {k} frames");
         assert!(counts.relocalized >= 1, "{counts:?}");
+    }
+
+    /// Carried where it sees one net only, which its pose cannot explain and from which MUREA
+    /// cannot tell where it is: after [`DOUBTED`] s it needs to localize (and turns, on a robot
+    /// without a pan joint). A robot whose landmarks agree never does, and the need ends when
+    /// a relocalization settles it.
+    #[test]
+    fn a_robot_that_sees_what_its_pose_cannot_explain_needs_to_localize() {
+        let before = Pose2::new(-4.0, -1.0, std::f64::consts::PI);
+        let one_net = Pose2::new(3.0, 0.0, 0.0);
+        assert_eq!(narrow_frame(one_net, 0.0).sightings.iter().flatten().count(), 1);
+        let mut m = model().with_localizer(Localizer::Murea);
+        m.place(Framed::new(before));
+        let mut t = 0.0;
+        let mut step = |m: &mut WorldModel, at: Pose2, turn: f64| {
+            m.odometry(&exact_mice(Pose2::new(0.0, 0.0, turn)));
+            let w = m.camera(&narrow_frame(at, t));
+            t += 0.1;
+            w.needs_localization
+        };
+        assert!((0..10).all(|_| !step(&mut m, before, 0.0)), "its landmarks agree");
+        // Doubted from the first frame after the carry (t = 1.0 s); needed from 1.5 s.
+        let needs: Vec<bool> = (0..8).map(|_| step(&mut m, one_net, 0.0)).collect();
+        assert_eq!(needs, [false, false, false, false, false, true, true, true]);
+        assert_eq!(m.counts().relocalized, 0, "one net cannot place it");
+        // It turns in place at 2 rad/s (crate::look_around's rate in mrt-robot): MUREA finds it
+        // within one turn, and the need is met.
+        let mut at = one_net;
+        let settled = (0..32)
+            .map(|_| {
+                at.theta += 0.2;
+                step(&mut m, at, 0.2)
+            })
+            .position(|n| !n);
+        assert!(settled.is_some(), "{:?}", m.counts());
+        assert!(m.counts().relocalized >= 1);
+        let p = m.pose().inner;
+        assert!((p.x - at.x).hypot(p.y - at.y) < 0.3, "{p:?} against {at:?}");
     }
 
     /// Nobody said where it starts: from a handful of frames it knows, wherever it stands.
