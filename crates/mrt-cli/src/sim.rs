@@ -2,11 +2,12 @@
 
 use anyhow::{anyhow, Context as _, Result};
 use indicatif::{ProgressBar, ProgressStyle};
+use mrt_monitor::Recorder;
 use mrt_robot::stacks::Stack;
 use mrt_sim::config::SimConfig;
 use mrt_sim::game::{MatchReport, TeamStats};
 use mrt_sim::metrics::MetricsBook;
-use mrt_sim::play;
+use mrt_sim::play_recorded;
 use mrt_sim::referee::{Call, Team};
 use std::path::PathBuf;
 
@@ -92,6 +93,11 @@ pub struct SimArgs {
     /// docs/localization.md) to this JSON file, over the match or the whole series.
     #[arg(long)]
     pub metrics: Option<PathBuf>,
+    /// Record every robot's bus messages and the simulator's truth into this MCAP file (JSON
+    /// messages with a JSON schema per type; topics in docs/monitor.md): open it in Foxglove
+    /// or Lichtblick, or read it with any `mcap` library. One in-process match.
+    #[arg(long)]
+    pub record: Option<PathBuf>,
     /// Which embedded world: soccer (a match) or indoor (one robot follows path points
     /// through a building where a door closes and a person walks; the MRT manual's Roby,
     /// docs/indoor.md).
@@ -190,9 +196,27 @@ fn play_one(
              (cargo run --release -p mrt-cli -- sim --distributed)"
         );
     }
-    let report = play(cfg, seed, stacks, args.behaviors.as_deref(), record, progress)
+    let recorder = match &args.record {
+        Some(path) => Some(Recorder::create(path)?.shared()),
+        None => None,
+    };
+    let behaviors = args.behaviors.as_deref();
+    let report = play_recorded(cfg, seed, stacks, behaviors, record, recorder.clone(), progress)
         .map_err(|e| anyhow!("{e}"))?;
-    Ok((report, Vec::new()))
+    let mut notes = Vec::new();
+    if let (Some(rec), Some(path)) = (recorder, &args.record) {
+        let s = Recorder::finish_shared(rec)?;
+        let size = std::fs::metadata(path).map(|m| m.len()).unwrap_or(0);
+        let failed = if s.failed > 0 { format!(", {} left out", s.failed) } else { String::new() };
+        notes.push(format!(
+            "recorded {} messages on {} topics into {} ({:.1} MB{failed})",
+            s.messages,
+            s.channels,
+            path.display(),
+            size as f64 / 1e6
+        ));
+    }
+    Ok((report, notes))
 }
 
 /// How the robots were wired, for the report.
@@ -254,6 +278,11 @@ pub fn run(args: &SimArgs) -> Result<()> {
     );
     if args.bench {
         return bench(args, &cfg, stacks);
+    }
+    if args.record.is_some() && (args.matches > 1 || args.distributed || args.bench) {
+        anyhow::bail!(
+            "--record records one in-process match: leave out --matches, --distributed and --bench"
+        );
     }
     if args.matches > 1 {
         if args.distributed {

@@ -261,3 +261,23 @@ fn the_indoor_world_runs_its_mission_to_the_end() {
     assert!(!ok && err.contains("--matches is for the soccer world"), "{err}");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// Issue 22: `--record` writes one match's messages into an MCAP file and says how many; it
+/// refuses a series, and a file it cannot create is named.
+#[test]
+fn a_match_is_recorded_into_an_mcap_file() {
+    let file = std::env::temp_dir().join(format!("mrt-sim-record-{}.mcap", std::process::id()));
+    let path = file.to_str().unwrap();
+    let (ok, out, err) = run(&["--half", "2", "--percepts", "oracle", "--record", path]);
+    assert!(ok, "{err}");
+    let line = out.lines().find(|l| l.contains("recorded ")).unwrap_or_default();
+    assert!(line.contains(" topics into ") && line.contains(path), "{out}");
+    let bytes = std::fs::read(&file).unwrap();
+    std::fs::remove_file(&file).unwrap();
+    // MCAP's magic at both ends.
+    assert!(bytes.starts_with(b"\x89MCAP0\r\n") && bytes.ends_with(b"\x89MCAP0\r\n"));
+    let (ok, _, err) = run(&["--matches", "2", "--record", path]);
+    assert!(!ok && err.contains("--record records one in-process match"), "{err}");
+    let (ok, _, err) = run(&["--half", "1", "--record", "/nonexistent-mrt-dir/m.mcap"]);
+    assert!(!ok && err.contains("/nonexistent-mrt-dir/m.mcap"), "{err}");
+}

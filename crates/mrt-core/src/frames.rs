@@ -77,6 +77,22 @@ impl<'de, F, T: Deserialize<'de>> Deserialize<'de> for Framed<F, T> {
     }
 }
 
+/// A framed value's schema is its inner value's (see its `Serialize`).
+#[cfg(feature = "schema")]
+impl<F, T: schemars::JsonSchema> schemars::JsonSchema for Framed<F, T> {
+    fn schema_name() -> std::borrow::Cow<'static, str> {
+        T::schema_name()
+    }
+
+    fn json_schema(generator: &mut schemars::SchemaGenerator) -> schemars::Schema {
+        T::json_schema(generator)
+    }
+
+    fn inline_schema() -> bool {
+        T::inline_schema()
+    }
+}
+
 /// Which goal a team attacks: east (+x of the field frame) or west.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum Attack {

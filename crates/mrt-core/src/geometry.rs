@@ -53,6 +53,7 @@ pub fn angle_diff(to: f64, from: f64) -> f64 {
 }
 
 /// A posture on the plane: position `(x, y)` and heading `theta` (radians, in `(-π, π]`).
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
 pub struct Pose2 {

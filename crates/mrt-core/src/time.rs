@@ -12,6 +12,7 @@ use std::sync::Arc;
 use std::time::Duration;
 
 /// A point in time, in nanoseconds since the clock's origin (the start of the run).
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[derive(
     Clone, Copy, Debug, Default, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize,
 )]

@@ -7,12 +7,14 @@ use serde::{Deserialize, Serialize};
 
 /// What guidance asks of the motor and kicker driver: the velocities to drive (mm/s, deg/s,
 /// the units of the behaviors' [`RobotCommand`]) and the kick.
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct MotorCommand(pub RobotCommand);
 
 /// A request to the planner (SPIKE, MRT manual ch. 9): a path from where the robot is to `to`,
 /// round the robots its world model anchored. Guidance asks when a behavior's target says
 /// `plan` ([`crate::Target::plan`]); SCARE or a behavior may ask too.
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
 pub struct PlanRequest {
@@ -21,6 +23,7 @@ pub struct PlanRequest {
 }
 
 /// The planner's answer to a [`PlanRequest`]: the trajectory, or why there is none.
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
 pub struct PlannedPath {

@@ -4,6 +4,7 @@
 use serde::{Deserialize, Serialize};
 
 /// What a behavior Member did in its last cycle, for monitors.
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct BehaviorStatus {
     /// The HFSM's active path (`Attacker/Score/Align`), empty for an HBM Member.
@@ -17,5 +18,6 @@ pub struct BehaviorStatus {
 }
 
 /// Asks behavior Members to reload their changed scripts at the next cycle boundary.
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct ReloadRequest;

@@ -7,6 +7,7 @@ use crate::sensing::{CameraFrame, GameInfo, Odometry, Sonar};
 use serde::{Deserialize, Serialize};
 
 /// What robot `robot`'s devices read at the start of control cycle `cycle`.
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct DeviceFrame {
     /// The robot (0 .. 2 × team size).
@@ -27,6 +28,7 @@ pub struct DeviceFrame {
 }
 
 /// What robot `robot`'s drivers did in control cycle `cycle`.
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct DeviceAct {
     /// The robot.
@@ -45,6 +47,7 @@ pub struct DeviceAct {
 }
 
 /// The match is over: robots close their Members and answer with a [`RobotEnd`].
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct FinalWhistle {
     /// Control cycles played.
@@ -52,6 +55,7 @@ pub struct FinalWhistle {
 }
 
 /// A robot's last word: its Members that failed to start, failed jobs or panicked.
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct RobotEnd {
     /// The robot.
@@ -62,6 +66,7 @@ pub struct RobotEnd {
 
 /// A Member of a robot's Agora that failed to start, failed jobs or panicked (each time it was
 /// restarted), or whose mailbox lost messages, from its executor's report.
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct MemberFault {
     /// The Member's name.

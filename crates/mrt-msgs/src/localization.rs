@@ -7,6 +7,7 @@ use mrt_core::Pose2;
 use serde::{Deserialize, Serialize};
 
 /// What a pose filter used and refused, counted since it started.
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 pub struct FilterCounts {
     /// Cycles predicted with consistent mice readings.
@@ -38,6 +39,7 @@ pub struct FilterCounts {
 
 /// A robot's own pose estimate after a cycle, in the field frame (m, rad; not the team frame
 /// of the behaviors' snapshot), published by its world state every cycle.
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct Localization {
     /// The estimate: field frame, metres from the centre spot, heading in radians.
@@ -57,6 +59,7 @@ pub struct Localization {
 
 /// A robot's own belief about the ball, in the field frame (m, m/s): what its monitors and the
 /// simulator's scoring compare with the truth.
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct BallBelief {
     /// Where it is.

@@ -23,6 +23,7 @@ pub mod lps {
 }
 
 /// A local perceptual object (LPO): an object anchored in the robot's frame.
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
 pub struct Lpo {
@@ -37,6 +38,7 @@ pub struct Lpo {
 }
 
 /// A global estimate: a pose on the field and its quality, 0 (unknown) to 1.
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
 pub struct Estimate {
@@ -48,6 +50,7 @@ pub struct Estimate {
 }
 
 /// A teammate as this robot believes it to be.
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
 pub struct Mate {
@@ -62,6 +65,7 @@ pub struct Mate {
 /// What kind of robot an anchor is: MAP's conceptual model, Robot ▸ {Teammate, Opponent}
 /// (MRT manual ch. 8). A robot whose marker was never seen and who is where no teammate says
 /// it is stays a generic Robot.
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum RobotClass {
@@ -88,6 +92,7 @@ impl RobotClass {
 /// Another robot anchored by the world model (MAP's anchors, MRT manual ch. 8; TeamChaos'
 /// perceptual anchoring, seed `001` §2.1): a track with an identity that lasts while the robot
 /// is seen, is predicted while it is not, and fades.
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
 pub struct AnchoredRobot {
@@ -118,6 +123,7 @@ pub struct AnchoredRobot {
 
 /// The field as the world model's map knows it (`getField`), in millimetres: behaviors read
 /// their geometry from here instead of assuming one field size.
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
 pub struct Field {
@@ -144,6 +150,7 @@ impl Default for Field {
 }
 
 /// The game state set by the referee (`getCurrentState()`).
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
 pub enum GameState {
     /// Before the game.
@@ -173,6 +180,7 @@ impl GameState {
 }
 
 /// Everything a behavior may read in one cycle.
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
 pub struct WorldSnapshot {
@@ -183,6 +191,7 @@ pub struct WorldSnapshot {
     /// The robot's own global pose (`gsGetMyPos`).
     pub my_pos: Estimate,
     /// The ball's velocity in the field frame, mm/s (`getBallVel`).
+    #[cfg_attr(feature = "schema", schemars(with = "[f64; 2]"))]
     pub ball_vel: Vec2,
     /// The ball's global position (`getGlobalBall`).
     pub global_ball: Estimate,
@@ -214,6 +223,7 @@ pub struct WorldSnapshot {
 
 /// A robot's SCARE activity as its behaviors read it (MRT manual ch. 11, §2.3): names, and
 /// the goal of the current sub-task in the team frame (mm).
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
 pub struct ScareJob {
@@ -307,6 +317,7 @@ impl WorldSnapshot {
 
 /// Everything a behavior may ask for in one cycle. Fields not set keep their defaults
 /// (standing still, no kick, no needs).
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
 pub struct RobotCommand {
@@ -333,6 +344,7 @@ pub struct RobotCommand {
 /// A posture handed to guidance (ISocRob, seed `003` §3.2.3): instead of velocities, the
 /// behavior says where to be and guidance drives there, in position mode or, with `avoid`, in
 /// potential-field mode around what the sonars see.
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
 pub struct Target {

@@ -11,6 +11,7 @@ use std::f64::consts::PI;
 
 /// One sonar reading: where the sonar looks and how far the echo is (ISocRob seed `003` §2,
 /// §3.2.3).
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct Sonar {
     /// Direction of the sonar in the robot frame, rad (0 = forward, counter-clockwise).
@@ -37,6 +38,7 @@ impl Sonar {
 
 /// One reading of the sonar ring (robot frame, m from the centre, ring order; no echo is an
 /// infinite range), published by the sonar driver every cycle.
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct SonarScan {
     /// The sonars.
@@ -45,6 +47,7 @@ pub struct SonarScan {
 
 /// The four numbers the two mice give for one sampling period, metres, each in its own frame
 /// (`x̄` along the joining line, positive to the robot's right; `ȳ` forward; manual §4.1).
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct MiceReadings {
     /// `x̄_l`: left mouse, lateral.
@@ -74,6 +77,7 @@ impl MiceReadings {
 
 /// The robot's motion over one sampling period, in the robot frame at the start of the period:
 /// `(Δx, Δy)` metres, `Δθ` radians counter-clockwise (manual §4.1).
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct Displacement {
     /// `Δx`, forward, m.
@@ -98,6 +102,7 @@ impl Displacement {
 
 /// What the odometry sensors read over one control cycle, published by the odometry driver
 /// (manual ch. 4).
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct Odometry {
     /// The two optical mice, each in its own frame (MRT manual ch. 4), m.
@@ -115,6 +120,7 @@ pub const FIELD_OBJECTS: usize = lps::COUNT;
 
 /// One object detected in one frame: distance (m) and bearing (rad, counter-clockwise from
 /// the robot's heading), with the sensor's noise.
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Sighting {
     /// Distance, m.
@@ -126,6 +132,7 @@ pub struct Sighting {
 /// The colour of the marker band a robot wears round its top (RoboCup Middle Size League:
 /// magenta or cyan, one per team for a match), which tells its team: MAP's classifier reads it
 /// to make a Robot a Teammate or an Opponent (MRT manual ch. 8).
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Marker {
@@ -147,6 +154,7 @@ impl Marker {
 
 /// Another robot in one camera frame (object sensor or vision): the percept MAP anchors as a
 /// Robot, a Teammate or an Opponent (MRT manual ch. 8).
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct RobotSighting {
     /// Distance and bearing of its nearest point (its foot on the floor) from the robot's
@@ -165,6 +173,7 @@ pub struct RobotSighting {
 /// state of TeamChaos' `getCurrentState()` (seed `001` §3.3) and the robot's place in the
 /// kickoff formation. Its own message, published by the game controller's driver (a radio
 /// listening to the referee box on a real field), not part of any camera frame.
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct GameInfo {
     /// The referee's state.
@@ -181,6 +190,7 @@ pub struct GameInfo {
 
 /// One frame of the object sensor, published by the camera driver: distance and bearing of the
 /// ball, the nets and the landmarks, told apart by colour (ISocRob seed `003` §3.2.1).
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct CameraFrame {
     /// Time of the frame, s.
@@ -212,6 +222,7 @@ pub struct CameraFrame {
 /// What the vision µAgent found in one camera image (ISocRob seed `003` §3.2.1), robot frame:
 /// the objects in the object sensor's form (so the world model reads both alike), their
 /// uncertainty and pixel evidence, the field-line points and the obstacles.
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct Percepts {
     /// Time of the image, s.
@@ -252,6 +263,7 @@ pub struct Percepts {
 /// A landmark post in a camera image (ISocRob seed `003` §3.2.1: landmarks told apart by
 /// colour): its outer bands wear the colour of the goal of its half, so the image tells the
 /// half, not which of the half's posts it is.
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct PostSighting {
     /// Distance and bearing of its axis from the robot's centre.
@@ -267,6 +279,7 @@ pub struct PostSighting {
 
 /// An RGB image, 8 bits per channel, row by row from the top-left corner (`3·width` bytes a
 /// row): what a camera driver grabs or the simulator renders (ISocRob seed `003` §3.2.1).
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[derive(Clone, Default, PartialEq, Eq, Serialize, Deserialize)]
 pub struct Image {
     /// Columns.

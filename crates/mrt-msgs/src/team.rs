@@ -6,6 +6,7 @@ use serde::{Deserialize, Serialize};
 
 /// What a robot tells its teammates every cycle (team frame, mm): its own pose and its own
 /// sighting of the ball (never what it heard from others, so stale news does not circulate).
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct MateReport {
     /// The robot's player number.
@@ -39,6 +40,7 @@ pub struct MateReport {
 
 /// What a robot tells its teammates for SCARE's allocation (`mrt_team::scare`): every robot
 /// allocates from these, so all that heard the same reports agree.
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
 pub struct ScareReport {
@@ -57,6 +59,7 @@ pub struct ScareReport {
 /// What a robot tells its teammates about the ball booking (`mrt_team::booking`): whether it
 /// wants the ball, whose claim it supports, and the latest report it heard from each of them.
 /// Times are the sender's own clock, s.
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
 pub struct BookingReport {
@@ -71,6 +74,7 @@ pub struct BookingReport {
 }
 
 /// A robot a teammate anchored and sees this frame (team frame, mm).
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
 pub struct SharedRobot {

@@ -13,6 +13,7 @@ use crate::game::{MatchReport, Pitch};
 use crate::referee::Call;
 use mrt_core::SimClock;
 use mrt_dcdt::{InnerLinkManager, SteppedExecutor};
+use mrt_monitor::{SharedRecorder, Tap};
 use mrt_msgs::{Localization, MemberFault, WorldSnapshot};
 use mrt_robot::brain::Brain;
 use mrt_robot::config::RobotConfig;
@@ -87,6 +88,38 @@ pub struct BusMatch {
     links: Vec<InnerLinkManager>,
     /// The behavior files, kept while the robots may reload them.
     _files: FilesDir,
+    /// Where every robot's messages and the truth are recorded, when they are.
+    recorder: Option<SharedRecorder>,
+}
+
+/// What the simulator knows and the robots do not, recorded each cycle on the topic
+/// `/truth` beside the robots' messages (`mrt sim --record`): field frame, m, m/s, rad.
+#[derive(Clone, Debug, PartialEq, serde::Serialize, schemars::JsonSchema)]
+pub struct Truth {
+    /// The ball's place.
+    pub ball: (f64, f64),
+    /// The ball's velocity.
+    pub ball_velocity: (f64, f64),
+    /// Every robot's pose, home's then away's.
+    pub robots: Vec<mrt_core::Pose2>,
+    /// Goals, home : away.
+    pub score: (u32, u32),
+    /// The referee's state.
+    pub state: mrt_msgs::GameState,
+}
+
+impl Truth {
+    /// The truth of `pitch` now.
+    pub fn of(pitch: &Pitch) -> Truth {
+        let w = pitch.world();
+        Truth {
+            ball: w.ball(),
+            ball_velocity: w.ball_velocity(),
+            robots: (0..w.robot_count()).filter_map(|i| w.robot(i)).collect(),
+            score: pitch.referee().score(),
+            state: pitch.referee().state(),
+        }
+    }
 }
 
 impl BusMatch {
@@ -99,12 +132,26 @@ impl BusMatch {
         away: Option<Stack>,
         behaviors: Option<&Path>,
     ) -> Result<BusMatch, String> {
+        BusMatch::recorded(cfg, seed, home, away, behaviors, None)
+    }
+
+    /// [`BusMatch::new`], with every robot's messages and the truth recorded into `recorder`
+    /// (`mrt sim --record`): a [`Tap`] in each robot's Agora on the topics
+    /// `/home/<k>/<type>` and `/away/<k>/<type>`, and [`Truth`] each cycle on `/truth`.
+    pub fn recorded(
+        cfg: &SimConfig,
+        seed: u64,
+        home: Stack,
+        away: Option<Stack>,
+        behaviors: Option<&Path>,
+        recorder: Option<SharedRecorder>,
+    ) -> Result<BusMatch, String> {
         let n = cfg.rules.team_size;
         let stacks: Vec<Stack> = [Some(home), away].into_iter().flatten().collect();
         let dir = behaviors_dir(&stacks, behaviors)?;
         let files = dir.clone();
         let teams = (n, if away.is_some() { n } else { 0 });
-        BusMatch::build(cfg, seed, teams, files, |agora, robot_cfg, robot, devices| {
+        BusMatch::build(cfg, seed, teams, files, recorder, |agora, robot_cfg, robot, devices| {
             let spec = RobotSpec::of(robot, n, (home, away.unwrap_or(home)));
             add_robot(agora, robot_cfg, &spec, &dir, devices)
         })
@@ -123,7 +170,7 @@ impl BusMatch {
         let n = cfg.rules.team_size.max(1);
         let mut brains = home.into_iter().chain(away);
         let files = FilesDir::user(std::path::PathBuf::new());
-        BusMatch::build(cfg, seed, teams, files, |agora, robot_cfg, robot, devices| {
+        BusMatch::build(cfg, seed, teams, files, None, |agora, robot_cfg, robot, devices| {
             let brain = brains.next().ok_or("more robots than brains")?;
             add_robot_with_brain(agora, robot_cfg, (robot, robot % n == 0), brain, devices)
         })
@@ -136,6 +183,7 @@ impl BusMatch {
         seed: u64,
         (home, away): (usize, usize),
         files: FilesDir,
+        recorder: Option<SharedRecorder>,
         mut add: impl FnMut(
             &mut mrt_dcdt::Agora,
             &RobotConfig,
@@ -164,10 +212,17 @@ impl BusMatch {
                 let watch = EstimateWatch { pitch: pitch.clone(), robot };
                 let watch = agora.add_member(watch, mrt_dcdt::Activation::OnMessage);
                 agora.activate_member(watch).map_err(|e| e.to_string())?;
+                if let Some(rec) = &recorder {
+                    let (team, k) =
+                        if robot < home { ("home", robot) } else { ("away", robot - home) };
+                    let tap = Tap::new(format!("{team}/{k}"), rec.clone());
+                    let tap = agora.add_member(tap, mrt_dcdt::Activation::OnMessage);
+                    agora.activate_member(tap).map_err(|e| e.to_string())?;
+                }
                 exec.add_agora(agora).map_err(|e| e.to_string())?;
             }
         }
-        Ok(BusMatch { pitch, exec, period, links, _files: files })
+        Ok(BusMatch { pitch, exec, period, links, _files: files, recorder })
     }
 
     /// The pitch (the world, the referee, the book), between cycles.
@@ -197,7 +252,13 @@ impl BusMatch {
     pub fn cycle(&mut self) -> Result<Vec<Call>, String> {
         self.exec.run_for(self.period);
         let mut p = self.pitch.lock().map_err(|_| "the pitch lock is poisoned".to_string())?;
-        Ok(p.advance())
+        let calls = p.advance();
+        if let Some(rec) = &self.recorder {
+            let time = mrt_core::Time::from_secs_f64(p.world().time());
+            let mut rec = rec.lock().map_err(|_| "the recorder's lock is poisoned".to_string())?;
+            rec.record("/truth", time, &Truth::of(&p)).map_err(|e| e.to_string())?;
+        }
+        Ok(calls)
     }
 
     /// Plays until the end, calling `progress` with the simulated time after each cycle.
@@ -247,6 +308,58 @@ mod tests {
     use crate::config::short;
     use mrt_dcdt::{Activation, Context, Member, MemberError, RequestType, RunReport};
     use mrt_msgs::MateReport;
+
+    /// `mrt sim --record`: every robot's messages on `/home/<k>/<type>` and `/away/<k>/<type>`
+    /// and the truth on `/truth`, each message JSON of its channel's schema, at times of the
+    /// simulated clock; recording does not change the match.
+    #[test]
+    fn a_recorded_match_holds_every_robot_s_messages_and_the_truth() {
+        let cfg = short(3.0, 2);
+        let path = std::env::temp_dir().join(format!("mrt-sim-record-{}.mcap", std::process::id()));
+        let rec = mrt_monitor::Recorder::create(&path).unwrap().shared();
+        let m =
+            BusMatch::recorded(&cfg, 4, Stack::Chaos, Some(Stack::Milan), None, Some(rec.clone()))
+                .unwrap();
+        let recorded = m.play(|_| {}).unwrap();
+        let summary = mrt_monitor::Recorder::finish_shared(rec).unwrap();
+        let plain = BusMatch::new(&cfg, 4, Stack::Chaos, Some(Stack::Milan), None)
+            .unwrap()
+            .play(|_| {})
+            .unwrap();
+        assert_eq!(recorded.trajectory_hash, plain.trajectory_hash);
+        let bytes = std::fs::read(&path).unwrap();
+        std::fs::remove_file(&path).ok();
+        let mut topics = std::collections::BTreeMap::<String, (usize, u64)>::new();
+        for m in mcap::MessageStream::new(&bytes).unwrap() {
+            let m = m.unwrap();
+            let schema = m.channel.schema.as_ref().unwrap();
+            assert_eq!(
+                (schema.encoding.as_str(), m.channel.message_encoding.as_str()),
+                ("jsonschema", "json")
+            );
+            let value: serde_json::Value = serde_json::from_slice(&m.data).unwrap();
+            let topic = &m.channel.topic;
+            assert!(topic == "/truth" || topic.ends_with(&format!("/{}", schema.name)), "{topic}");
+            if schema.name == "WorldSnapshot" {
+                serde_json::from_value::<WorldSnapshot>(value).unwrap();
+            } else if topic == "/truth" {
+                assert_eq!(value["robots"].as_array().map(Vec::len), Some(4), "{value}");
+            }
+            let e = topics.entry(topic.clone()).or_default();
+            e.0 += 1;
+            e.1 = e.1.max(m.log_time);
+        }
+        assert_eq!(summary.messages, topics.values().map(|t| t.0 as u64).sum::<u64>());
+        // Both halves of 3 s at 10 Hz: 60 cycles, one truth and one snapshot per robot each.
+        assert_eq!(topics["/truth"].0, 60);
+        for robot in ["home/0", "home/1", "away/0", "away/1"] {
+            let snapshots = topics[&format!("/{robot}/WorldSnapshot")];
+            assert_eq!(snapshots.0, 60, "{robot}");
+            assert!(topics.contains_key(&format!("/{robot}/RobotCommand")), "{robot}");
+            // On the simulated clock: the last snapshot within a cycle of the last truth.
+            assert!(topics["/truth"].1.abs_diff(snapshots.1) <= 100_000_000, "{robot}");
+        }
+    }
 
     #[test]
     fn a_bus_match_is_deterministic_and_both_stacks_play() {

@@ -53,7 +53,21 @@ pub fn play(
     record: bool,
     mut progress: impl FnMut(f64),
 ) -> Result<game::MatchReport, String> {
-    let mut m = bus::BusMatch::new(cfg, seed, home, Some(away), behaviors)?;
+    play_recorded(cfg, seed, (home, away), behaviors, record, None, &mut progress)
+}
+
+/// [`play`], with every robot's messages and the truth written into `recorder` when given
+/// ([`bus::BusMatch::recorded`]; `mrt sim --record`).
+pub fn play_recorded(
+    cfg: &config::SimConfig,
+    seed: u64,
+    (home, away): (Stack, Stack),
+    behaviors: Option<&Path>,
+    record: bool,
+    recorder: Option<mrt_monitor::SharedRecorder>,
+    mut progress: impl FnMut(f64),
+) -> Result<game::MatchReport, String> {
+    let mut m = bus::BusMatch::recorded(cfg, seed, home, Some(away), behaviors, recorder)?;
     m.record_frames(record);
     m.play(&mut progress)
 }

@@ -1,0 +1,36 @@
+//! # mrt-monitor: seeing what the robots think
+//!
+//! The seeds' teams looked into their robots with monitors (ThinkingCap's HBM monitor, seed
+//! `001` §4.1 and §5.1; ISocRob's Monitor, seed `003` §3.2.7). This crate is MRT's: it listens
+//! on the bus like any Member and never reaches into an engine's internals.
+//!
+//! - [`record`]: a [`Recorder`] writes messages into an [MCAP](https://mcap.dev) file, one
+//!   channel per topic, each message JSON with a JSON schema per type (derived from the Rust
+//!   types with `schemars`), log times on the clock of the bus (the simulated clock in
+//!   `mrt sim`), zstd-compressed chunks. Foxglove, Lichtblick and the `mcap` libraries of
+//!   other languages read it.
+//! - [`tap`]: a [`Tap`] is a Member that records every catalogue message of its Agora
+//!   (`mrt sim --record FILE.mcap` puts one in each robot).
+//! - [`catalogue`]: the message types a tap knows, with their schemas.
+//!
+//! ```
+//! use mrt_core::Time;
+//! use mrt_monitor::Recorder;
+//! use mrt_msgs::GameInfo;
+//!
+//! let path = std::env::temp_dir().join(format!("mrt-monitor-doc-{}.mcap", std::process::id()));
+//! let mut rec = Recorder::create(&path)?;
+//! rec.record("/home/0/GameInfo", Time::from_secs_f64(0.1), &GameInfo::default())?;
+//! let summary = rec.finish()?;
+//! assert_eq!((summary.messages, summary.channels), (1, 1));
+//! # std::fs::remove_file(&path).ok();
+//! # Ok::<(), mrt_monitor::RecordError>(())
+//! ```
+#![deny(missing_docs)]
+
+pub mod catalogue;
+pub mod record;
+pub mod tap;
+
+pub use record::{RecordError, RecordSummary, Recorder, SharedRecorder};
+pub use tap::Tap;

@@ -1,0 +1,264 @@
+//! Writing an MCAP file (module doc of the crate): channels by topic, a JSON schema per
+//! message type, JSON messages, log times in nanoseconds of the bus's clock.
+
+use mcap::records::MessageHeader;
+use mcap::{Compression, WriteOptions, Writer};
+use mrt_core::Time;
+use schemars::JsonSchema;
+use serde::Serialize;
+use std::collections::BTreeMap;
+use std::fs::File;
+use std::io::{BufWriter, Seek, Write};
+use std::path::{Path, PathBuf};
+use std::sync::{Arc, Mutex};
+
+/// What can go wrong while recording.
+#[derive(Debug, thiserror::Error)]
+pub enum RecordError {
+    /// The file could not be created or written.
+    #[error("{path}: {source}")]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// Why.
+        source: std::io::Error,
+    },
+    /// The MCAP writer refused (too many channels, an I/O error underneath).
+    #[error("{path}: {source}")]
+    Mcap {
+        /// The file.
+        path: PathBuf,
+        /// Why.
+        source: mcap::McapError,
+    },
+    /// A value did not serialize as JSON.
+    #[error("a message did not serialize as JSON: {0}")]
+    Json(#[from] serde_json::Error),
+    /// Another thread panicked while it held the recorder.
+    #[error("the recorder's lock is poisoned")]
+    Poisoned,
+}
+
+/// Something an MCAP file can be written to.
+pub trait Sink: Write + Seek + Send {}
+impl<T: Write + Seek + Send> Sink for T {}
+
+/// How many messages and channels a recording holds.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct RecordSummary {
+    /// Messages written.
+    pub messages: u64,
+    /// Channels (topics) written.
+    pub channels: usize,
+    /// Messages that could not be written (a serialization error), counted and left out.
+    pub failed: u64,
+}
+
+/// A recorder shared by the [`Tap`](crate::Tap)s of several Agoras and whoever records the
+/// truth.
+pub type SharedRecorder = Arc<Mutex<Recorder>>;
+
+/// An MCAP file being written (crate doc).
+pub struct Recorder {
+    writer: Writer<Box<dyn Sink>>,
+    path: PathBuf,
+    /// Schema ids by type name.
+    schemas: BTreeMap<String, u16>,
+    /// Channel ids by topic.
+    channels: BTreeMap<String, u16>,
+    summary: RecordSummary,
+}
+
+impl std::fmt::Debug for Recorder {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Recorder")
+            .field("path", &self.path)
+            .field("summary", &self.summary)
+            .finish()
+    }
+}
+
+impl Recorder {
+    /// A recording into a new file at `path` (an existing one is replaced).
+    pub fn create(path: &Path) -> Result<Recorder, RecordError> {
+        let io = |source| RecordError::Io { path: path.to_path_buf(), source };
+        let file = File::create(path).map_err(io)?;
+        Recorder::new(Box::new(BufWriter::new(file)), path)
+    }
+
+    /// A recording into `sink`, called `path` in errors.
+    pub fn new(sink: Box<dyn Sink>, path: &Path) -> Result<Recorder, RecordError> {
+        let writer = WriteOptions::new()
+            .compression(Some(Compression::Zstd))
+            .profile("")
+            .library(concat!("mrt-monitor ", env!("CARGO_PKG_VERSION")))
+            .create(sink)
+            .map_err(|source| RecordError::Mcap { path: path.to_path_buf(), source })?;
+        Ok(Recorder {
+            writer,
+            path: path.to_path_buf(),
+            schemas: BTreeMap::new(),
+            channels: BTreeMap::new(),
+            summary: RecordSummary::default(),
+        })
+    }
+
+    /// The same recorder, shared.
+    pub fn shared(self) -> SharedRecorder {
+        Arc::new(Mutex::new(self))
+    }
+
+    fn mcap(&self) -> impl Fn(mcap::McapError) -> RecordError + '_ {
+        |source| RecordError::Mcap { path: self.path.clone(), source }
+    }
+
+    /// The channel of `topic`, whose messages are JSON of the type `schema_name` with the
+    /// JSON schema `schema` (asked only for a type not seen yet).
+    pub fn channel(
+        &mut self,
+        topic: &str,
+        schema_name: &str,
+        schema: impl FnOnce() -> serde_json::Value,
+    ) -> Result<u16, RecordError> {
+        if let Some(&id) = self.channels.get(topic) {
+            return Ok(id);
+        }
+        let schema_id = match self.schemas.get(schema_name) {
+            Some(&id) => id,
+            None => {
+                let data = serde_json::to_vec(&schema())?;
+                let id = self
+                    .writer
+                    .add_schema(schema_name, "jsonschema", &data)
+                    .map_err(|e| (self.mcap())(e))?;
+                self.schemas.insert(schema_name.to_string(), id);
+                id
+            }
+        };
+        let id = self
+            .writer
+            .add_channel(schema_id, topic, "json", &BTreeMap::new())
+            .map_err(|e| (self.mcap())(e))?;
+        self.channels.insert(topic.to_string(), id);
+        self.summary.channels = self.channels.len();
+        Ok(id)
+    }
+
+    /// Writes one JSON message on `channel` at `time`.
+    pub fn write(&mut self, channel: u16, time: Time, json: &[u8]) -> Result<(), RecordError> {
+        let header = MessageHeader {
+            channel_id: channel,
+            sequence: u32::try_from(self.summary.messages).unwrap_or(u32::MAX),
+            log_time: time.0,
+            publish_time: time.0,
+        };
+        self.writer.write_to_known_channel(&header, json).map_err(|e| (self.mcap())(e))?;
+        self.summary.messages += 1;
+        Ok(())
+    }
+
+    /// Writes `value` as JSON on `topic` at `time`, its channel's schema `T`'s.
+    pub fn record<T: Serialize + JsonSchema>(
+        &mut self,
+        topic: &str,
+        time: Time,
+        value: &T,
+    ) -> Result<(), RecordError> {
+        let name = T::schema_name();
+        let channel = self.channel(topic, &name, crate::catalogue::schema_of::<T>)?;
+        let json = serde_json::to_vec(value)?;
+        self.write(channel, time, &json)
+    }
+
+    /// Counts a message that could not be written.
+    pub fn failed(&mut self) {
+        self.summary.failed += 1;
+    }
+
+    /// What was written so far.
+    pub fn summary(&self) -> RecordSummary {
+        self.summary
+    }
+
+    /// Writes the summary and the footer and closes the file.
+    pub fn finish(mut self) -> Result<RecordSummary, RecordError> {
+        self.writer.finish().map_err(|e| (self.mcap())(e))?;
+        let mut sink = self.writer.into_inner();
+        sink.flush().map_err(|source| RecordError::Io { path: self.path.clone(), source })?;
+        Ok(self.summary)
+    }
+
+    /// [`Recorder::finish`] on a shared recorder that no one else holds any more.
+    pub fn finish_shared(shared: SharedRecorder) -> Result<RecordSummary, RecordError> {
+        let recorder = Arc::try_unwrap(shared)
+            .map_err(|_| RecordError::Poisoned)?
+            .into_inner()
+            .map_err(|_| RecordError::Poisoned)?;
+        recorder.finish()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use mrt_msgs::{GameInfo, Localization};
+
+    fn temp(name: &str) -> PathBuf {
+        std::env::temp_dir().join(format!("mrt-monitor-{name}-{}.mcap", std::process::id()))
+    }
+
+    /// What a reader of the file sees: (topic, schema name, schema encoding, message
+    /// encoding, log time, JSON) per message.
+    pub(crate) fn read_back(path: &Path) -> Vec<(String, String, String, String, u64, String)> {
+        let bytes = std::fs::read(path).unwrap_or_default();
+        mcap::MessageStream::new(&bytes)
+            .map(|s| s.filter_map(Result::ok).collect::<Vec<_>>())
+            .unwrap_or_default()
+            .into_iter()
+            .map(|m| {
+                let schema = m.channel.schema.as_ref();
+                (
+                    m.channel.topic.clone(),
+                    schema.map(|s| s.name.clone()).unwrap_or_default(),
+                    schema.map(|s| s.encoding.clone()).unwrap_or_default(),
+                    m.channel.message_encoding.clone(),
+                    m.log_time,
+                    String::from_utf8_lossy(&m.data).into_owned(),
+                )
+            })
+            .collect()
+    }
+
+    #[test]
+    fn messages_come_back_on_their_topics_with_their_schemas_and_times() {
+        let path = temp("roundtrip");
+        let mut rec = Recorder::create(&path).unwrap();
+        let game = GameInfo { attack: -1.0, ..Default::default() };
+        rec.record("/home/0/GameInfo", Time(100), &game).unwrap();
+        rec.record("/home/1/GameInfo", Time(200), &game).unwrap();
+        rec.record("/home/0/Localization", Time(300), &Localization::default()).unwrap();
+        let s = rec.finish().unwrap();
+        assert_eq!(s, RecordSummary { messages: 3, channels: 3, failed: 0 });
+        let back = read_back(&path);
+        std::fs::remove_file(&path).ok();
+        let topics: Vec<_> = back.iter().map(|m| (m.0.as_str(), m.1.as_str(), m.4)).collect();
+        assert_eq!(
+            topics,
+            [
+                ("/home/0/GameInfo", "GameInfo", 100),
+                ("/home/1/GameInfo", "GameInfo", 200),
+                ("/home/0/Localization", "Localization", 300)
+            ]
+        );
+        assert!(back.iter().all(|m| m.2 == "jsonschema" && m.3 == "json"));
+        let decoded: GameInfo = serde_json::from_str(&back[0].5).unwrap();
+        assert_eq!(decoded, game);
+    }
+
+    #[test]
+    fn a_file_that_cannot_be_created_says_which() {
+        let path = Path::new("/nonexistent-dir-of-mrt/x.mcap");
+        let e = Recorder::create(path).unwrap_err().to_string();
+        assert!(e.starts_with("/nonexistent-dir-of-mrt/x.mcap: "), "{e}");
+    }
+}
