@@ -281,3 +281,39 @@ fn a_match_is_recorded_into_an_mcap_file() {
     let (ok, _, err) = run(&["--half", "1", "--record", "/nonexistent-mrt-dir/m.mcap"]);
     assert!(!ok && err.contains("/nonexistent-mrt-dir/m.mcap"), "{err}");
 }
+
+/// Issue 22: a recording reads back in another language: Python's `mcap` package reads every
+/// message and each one validates against its channel's JSON schema
+/// (`examples/python/check_recording.py`). The interpreter is `$MRT_PYTHON` (`.ci/run` makes
+/// one with the packages), else `python3`; without it or its packages the test says it was
+/// skipped.
+#[test]
+fn python_reads_a_recording_and_every_message_matches_its_schema() {
+    let python = std::env::var("MRT_PYTHON").unwrap_or_else(|_| "python3".into());
+    let script = concat!(env!("CARGO_MANIFEST_DIR"), "/../../examples/python/check_recording.py");
+    let file = std::env::temp_dir().join(format!("mrt-sim-python-{}.mcap", std::process::id()));
+    let path = file.to_str().unwrap();
+    let (ok, _, err) = run(&["--half", "3", "--record", path]);
+    assert!(ok, "{err}");
+    let out = Command::new(&python).arg(script).arg(path).output();
+    std::fs::remove_file(&file).ok();
+    let out = match out {
+        Ok(out) if out.status.code() == Some(3) => {
+            let why = String::from_utf8_lossy(&out.stderr);
+            eprintln!("skipped: the recording's Python check ({}): {why}", python);
+            return;
+        }
+        Ok(out) => out,
+        Err(e) => {
+            eprintln!("skipped: the recording's Python check, no {python}: {e}");
+            return;
+        }
+    };
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{stdout}{}", String::from_utf8_lossy(&out.stderr));
+    let counts: serde_json::Value = serde_json::from_str(stdout.trim()).unwrap();
+    assert_eq!(counts["invalid"], 0, "{counts}");
+    // Two halves of 3 s at 10 Hz: 60 cycles of truth, and eight robots' messages.
+    assert_eq!(counts["truth"], 60, "{counts}");
+    assert!(counts["topics"].as_u64().unwrap_or(0) > 8 * 8, "{counts}");
+}

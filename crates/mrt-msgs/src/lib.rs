@@ -132,4 +132,18 @@ mod tests {
         let back: GameInfo = serde_json::from_str(&serde_json::to_string(&g).unwrap()).unwrap();
         assert_eq!(back, g);
     }
+
+    /// A sonar without an echo (an infinite range) is `null` in JSON, which has no infinity,
+    /// and reads back as no echo; the bus's binary form keeps the number.
+    #[test]
+    fn a_sonar_without_an_echo_survives_json_and_the_wire() {
+        let scan = SonarScan { sonars: vec![Sonar::new(0.0, f64::INFINITY), Sonar::new(1.0, 2.5)] };
+        let json = serde_json::to_string(&scan).unwrap();
+        assert!(json.contains(r#""range":null"#), "{json}");
+        let back: SonarScan = serde_json::from_str(&json).unwrap();
+        assert_eq!(back, scan);
+        let bytes = postcard::to_stdvec(&scan).unwrap();
+        let back: SonarScan = postcard::from_bytes(&bytes).unwrap();
+        assert_eq!(back, scan);
+    }
 }

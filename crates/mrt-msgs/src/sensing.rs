@@ -16,8 +16,21 @@ use std::f64::consts::PI;
 pub struct Sonar {
     /// Direction of the sonar in the robot frame, rad (0 = forward, counter-clockwise).
     pub bearing: f64,
-    /// Distance from the robot centre to the echo, m. NaN or infinite means no echo.
+    /// Distance from the robot centre to the echo, m. NaN or infinite means no echo (`null`
+    /// in JSON, which has neither).
+    #[serde(deserialize_with = "range_or_no_echo")]
+    #[cfg_attr(feature = "schema", schemars(with = "Option<f64>"))]
     pub range: f64,
+}
+
+/// A sonar's range as written: JSON (human-readable formats) writes a range of no echo as
+/// `null`, read back as an infinite range; binary formats carry the number itself.
+fn range_or_no_echo<'de, D: serde::Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
+    if d.is_human_readable() {
+        Ok(Option::<f64>::deserialize(d)?.unwrap_or(f64::INFINITY))
+    } else {
+        f64::deserialize(d)
+    }
 }
 
 impl Sonar {
