@@ -37,6 +37,9 @@ pub enum RecordError {
     /// Another thread panicked while it held the recorder.
     #[error("the recorder's lock is poisoned")]
     Poisoned,
+    /// The recorder was to be finished while a tap still held it.
+    #[error("the recording cannot be finished while a tap still holds it")]
+    StillShared,
 }
 
 /// Something an MCAP file can be written to.
@@ -191,7 +194,7 @@ impl Recorder {
     /// [`Recorder::finish`] on a shared recorder that no one else holds any more.
     pub fn finish_shared(shared: SharedRecorder) -> Result<RecordSummary, RecordError> {
         let recorder = Arc::try_unwrap(shared)
-            .map_err(|_| RecordError::Poisoned)?
+            .map_err(|_| RecordError::StillShared)?
             .into_inner()
             .map_err(|_| RecordError::Poisoned)?;
         recorder.finish()
@@ -253,6 +256,17 @@ mod tests {
         assert!(back.iter().all(|m| m.2 == "jsonschema" && m.3 == "json"));
         let decoded: GameInfo = serde_json::from_str(&back[0].5).unwrap();
         assert_eq!(decoded, game);
+    }
+
+    #[test]
+    fn a_recording_still_held_by_a_tap_is_not_finished() {
+        let path = temp("held");
+        let shared = Recorder::create(&path).unwrap().shared();
+        let tap = crate::Tap::new("home/0", shared.clone());
+        let e = Recorder::finish_shared(shared).unwrap_err();
+        assert!(matches!(e, RecordError::StillShared), "{e}");
+        drop(tap);
+        std::fs::remove_file(&path).ok();
     }
 
     #[test]
