@@ -27,6 +27,7 @@ mod brian;
 #[cfg(feature = "net")]
 mod distributed;
 mod plan;
+mod replay;
 mod sim;
 mod soak;
 mod vision;
@@ -71,6 +72,9 @@ enum VisionCommand {
 enum Command {
     /// Play a simulated robot-soccer match on the embedded default world (or a series).
     Sim(sim::SimArgs),
+    /// What a recording (`mrt sim --record`, an MCAP file) holds: its topics, their schemas,
+    /// message counts and time spans (docs/monitor.md).
+    Replay(replay::ReplayArgs),
     /// Run one robot: its Agora on the devices its robot file names (configs/robot/; `mrt sim
     /// --distributed` starts each of its robots with this command).
     #[cfg(feature = "net")]
@@ -251,6 +255,7 @@ fn run(command: Command) -> Result<()> {
             BrianCommand::Plot { dir, out } => brian::plot(&dir, &out)?,
         },
         Command::Sim(args) => sim::run(&args)?,
+        Command::Replay(args) => replay::run(&args)?,
         Command::Soak { command } => soak::run(&command)?,
         #[cfg(feature = "net")]
         Command::Robot(args) => distributed::robot(&args)?,

@@ -273,9 +273,20 @@ fn a_match_is_recorded_into_an_mcap_file() {
     let line = out.lines().find(|l| l.contains("recorded ")).unwrap_or_default();
     assert!(line.contains(" topics into ") && line.contains(path), "{out}");
     let bytes = std::fs::read(&file).unwrap();
-    std::fs::remove_file(&file).unwrap();
     // MCAP's magic at both ends.
     assert!(bytes.starts_with(b"\x89MCAP0\r\n") && bytes.ends_with(b"\x89MCAP0\r\n"));
+    // `mrt replay` lists what it holds: two halves of 2 s at 10 Hz.
+    let out = mrt().args(["replay", path]).output().unwrap();
+    let listing = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{listing}");
+    let truth = listing.lines().find(|l| l.trim_start().starts_with("/truth ")).unwrap_or_default();
+    assert!(truth.contains("Truth") && truth.contains(" 40 messages"), "{listing}");
+    assert!(listing.contains("/away/3/WorldSnapshot"), "{listing}");
+    std::fs::write(&file, &bytes[..bytes.len() / 3]).unwrap();
+    let out = mrt().args(["replay", path]).output().unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success() && err.contains("not a readable MCAP recording"), "{err}");
+    std::fs::remove_file(&file).unwrap();
     let (ok, _, err) = run(&["--matches", "2", "--record", path]);
     assert!(!ok && err.contains("--record records one in-process match"), "{err}");
     let (ok, _, err) = run(&["--half", "1", "--record", "/nonexistent-mrt-dir/m.mcap"]);

@@ -30,7 +30,9 @@
 
 pub mod catalogue;
 pub mod record;
+pub mod replay;
 pub mod tap;
 
 pub use record::{RecordError, RecordSummary, Recorder, SharedRecorder};
+pub use replay::{Recording, ReplayError};
 pub use tap::Tap;

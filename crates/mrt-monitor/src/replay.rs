@@ -1,0 +1,413 @@
+//! Reading a recording back (`mrt replay`): any MCAP file, ours or another tool's. Channels
+//! of JSON messages are read; any other (another encoding, no schema) is listed as skipped. A
+//! file that is not MCAP, or is cut short, is an error naming the file, never a panic.
+
+use crate::catalogue::schema_of;
+use mrt_core::Time;
+use serde::de::DeserializeOwned;
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+/// What can go wrong while reading a recording.
+#[derive(Debug, thiserror::Error)]
+pub enum ReplayError {
+    /// The file could not be read.
+    #[error("{path}: {source}")]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// Why.
+        source: std::io::Error,
+    },
+    /// The file is not MCAP, or message `index` (from 0, in file order) could not be read.
+    #[error("{path}: not a readable MCAP recording (message {index}): {source}")]
+    Mcap {
+        /// The file.
+        path: PathBuf,
+        /// The message that failed.
+        index: u64,
+        /// Why.
+        source: mcap::McapError,
+    },
+    /// The `mcap` crate's reader panicked on the file: a corrupted chunk makes version 0.24
+    /// subtract past zero (found by this module's property test). The panic is caught and
+    /// reported as this error.
+    #[error("{path}: not a readable MCAP recording (its reader failed on a corrupted chunk)")]
+    Corrupt {
+        /// The file.
+        path: PathBuf,
+    },
+    /// A chunk near message `index` could not be read.
+    #[error("{path}: not a readable MCAP recording (near message {index}): {why}")]
+    Chunk {
+        /// The file.
+        path: PathBuf,
+        /// The messages read before it.
+        index: u64,
+        /// Why.
+        why: String,
+    },
+    /// A message did not decode as the type asked for.
+    #[error("{path}: {topic} at {time:.3} s does not decode as {ty}: {source}")]
+    Json {
+        /// The file.
+        path: PathBuf,
+        /// The message's topic.
+        topic: String,
+        /// Its log time, s.
+        time: f64,
+        /// The type asked for.
+        ty: String,
+        /// Why.
+        source: serde_json::Error,
+    },
+}
+
+/// The longest record read (a decompressed chunk included), bytes: a corrupted length asks
+/// for no more memory than this. MRT's chunks are under a megabyte.
+pub const RECORD_LIMIT: usize = 64 << 20;
+
+/// One message of a recording, as read.
+#[derive(Clone, Copy, Debug)]
+pub struct Entry<'a> {
+    /// Its topic, e.g. `/home/2/WorldSnapshot`.
+    pub topic: &'a str,
+    /// Its schema's name, e.g. `WorldSnapshot`.
+    pub schema: &'a str,
+    /// Its log time.
+    pub time: Time,
+    /// The message, JSON.
+    pub json: &'a [u8],
+}
+
+/// What a scan keeps between records: schemas (name, encoding) and channels (topic,
+/// schema, encoding) by id, the topics so far, and the messages read.
+#[derive(Default)]
+struct Scan {
+    schemas: BTreeMap<u16, (String, String)>,
+    channels: BTreeMap<u16, (String, u16, String)>,
+    topics: BTreeMap<String, TopicInfo>,
+    index: u64,
+}
+
+/// The first record of a chunk's records: opcode, body and what follows; `None` when the
+/// record runs past the end.
+fn split_record(bytes: &[u8]) -> Option<(u8, &[u8], &[u8])> {
+    let (&opcode, rest) = bytes.split_first()?;
+    let len = u64::from_le_bytes(rest.get(..8)?.try_into().ok()?);
+    let len = usize::try_from(len).ok()?;
+    let body = rest.get(8..8usize.checked_add(len)?)?;
+    Some((opcode, body, &rest[8 + len..]))
+}
+
+/// One topic of a recording.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct TopicInfo {
+    /// The topic.
+    pub topic: String,
+    /// Its schema's name (empty without a schema).
+    pub schema: String,
+    /// Its messages' encoding (`json` for MRT's recordings).
+    pub encoding: String,
+    /// How many messages.
+    pub count: u64,
+    /// The first and last log times.
+    pub first: Time,
+    /// The last log time.
+    pub last: Time,
+}
+
+impl TopicInfo {
+    /// Whether `mrt replay` reads it: JSON messages with a JSON schema.
+    pub fn readable(&self) -> bool {
+        self.encoding == "json" && !self.schema.is_empty()
+    }
+}
+
+/// A recording in memory (module doc).
+#[derive(Clone, Debug)]
+pub struct Recording {
+    path: PathBuf,
+    bytes: Vec<u8>,
+}
+
+impl Recording {
+    /// Reads the file at `path`.
+    pub fn open(path: &Path) -> Result<Recording, ReplayError> {
+        let bytes = std::fs::read(path)
+            .map_err(|source| ReplayError::Io { path: path.to_path_buf(), source })?;
+        Ok(Recording::from_bytes(bytes, path))
+    }
+
+    /// A recording of `bytes`, called `path` in errors.
+    pub fn from_bytes(bytes: Vec<u8>, path: &Path) -> Recording {
+        Recording { path: path.to_path_buf(), bytes }
+    }
+
+    /// Calls `f` with every message of a readable channel ([`TopicInfo::readable`]), in file
+    /// order, and returns every topic with its counts (readable or not).
+    pub fn scan(&self, f: impl FnMut(Entry<'_>)) -> Result<Vec<TopicInfo>, ReplayError> {
+        let read = std::panic::AssertUnwindSafe(|| self.scan_unguarded(f));
+        std::panic::catch_unwind(read)
+            .unwrap_or_else(|_| Err(ReplayError::Corrupt { path: self.path.clone() }))
+    }
+
+    /// [`Recording::scan`] without the guard against the reader's panics. `mcap`'s sans-I/O
+    /// reader splits the file into records, bounded by [`RECORD_LIMIT`]; chunks come whole
+    /// and are decompressed here, into at most the size they claim (within the limit): the
+    /// crate's own chunk decompression loops forever on some corrupted chunks (found by this
+    /// module's property test).
+    fn scan_unguarded(&self, mut f: impl FnMut(Entry<'_>)) -> Result<Vec<TopicInfo>, ReplayError> {
+        use mcap::sans_io::linear_reader::{LinearReadEvent, LinearReader, LinearReaderOptions};
+        let options = LinearReaderOptions::default()
+            .with_record_length_limit(RECORD_LIMIT)
+            .with_emit_chunks(true);
+        let mut reader = LinearReader::new_with_options(options);
+        let mut rest: &[u8] = &self.bytes;
+        let mut scan = Scan::default();
+        while let Some(event) = reader.next_event() {
+            let (opcode, data) = match event.map_err(|e| self.mcap_error(scan.index, e))? {
+                LinearReadEvent::ReadRequest(n) => {
+                    let k = n.min(rest.len());
+                    reader.insert(k).copy_from_slice(&rest[..k]);
+                    reader.notify_read(k);
+                    rest = &rest[k..];
+                    continue;
+                }
+                LinearReadEvent::Record { opcode, data } => (opcode, data),
+            };
+            let record =
+                mcap::parse_record(opcode, data).map_err(|e| self.mcap_error(scan.index, e))?;
+            if let mcap::records::Record::Chunk { header, data } = record {
+                let inner = self.decompress(&header, &data, scan.index)?;
+                let mut body: &[u8] = &inner;
+                while !body.is_empty() {
+                    let (opcode, data, after) = split_record(body)
+                        .ok_or_else(|| self.corrupt(scan.index, "a record runs past its chunk"))?;
+                    let record = mcap::parse_record(opcode, data)
+                        .map_err(|e| self.mcap_error(scan.index, e))?;
+                    self.take(&mut scan, record, &mut f)?;
+                    body = after;
+                }
+            } else {
+                self.take(&mut scan, record, &mut f)?;
+            }
+        }
+        Ok(scan.topics.into_values().collect())
+    }
+
+    /// One record outside or inside a chunk: schemas and channels are kept, messages counted
+    /// and handed to `f` when readable.
+    fn take(
+        &self,
+        scan: &mut Scan,
+        record: mcap::records::Record<'_>,
+        f: &mut impl FnMut(Entry<'_>),
+    ) -> Result<(), ReplayError> {
+        use mcap::records::Record;
+        match record {
+            Record::Schema { header, .. } => {
+                scan.schemas.insert(header.id, (header.name, header.encoding));
+            }
+            Record::Channel(c) => {
+                scan.channels.insert(c.id, (c.topic, c.schema_id, c.message_encoding));
+            }
+            Record::Message { header, data } => {
+                let Some((topic, schema_id, encoding)) = scan.channels.get(&header.channel_id)
+                else {
+                    let unknown =
+                        mcap::McapError::UnknownChannel(header.sequence, header.channel_id);
+                    return Err(self.mcap_error(scan.index, unknown));
+                };
+                scan.index += 1;
+                let time = Time(header.log_time);
+                let (schema, schema_encoding) =
+                    scan.schemas.get(schema_id).map_or(("", ""), |(n, e)| (n.as_str(), e.as_str()));
+                let info = scan.topics.entry(topic.clone()).or_insert_with(|| TopicInfo {
+                    topic: topic.clone(),
+                    schema: schema.to_string(),
+                    encoding: encoding.clone(),
+                    count: 0,
+                    first: time,
+                    last: time,
+                });
+                info.count += 1;
+                info.first = info.first.min(time);
+                info.last = info.last.max(time);
+                if info.readable() && schema_encoding == "jsonschema" {
+                    f(Entry { topic, schema, time, json: &data });
+                }
+            }
+            _ => {}
+        }
+        Ok(())
+    }
+
+    /// A chunk's records, decompressed into at most the size the chunk claims.
+    fn decompress(
+        &self,
+        header: &mcap::records::ChunkHeader,
+        data: &[u8],
+        index: u64,
+    ) -> Result<Vec<u8>, ReplayError> {
+        let size = usize::try_from(header.uncompressed_size).unwrap_or(usize::MAX);
+        if size > RECORD_LIMIT {
+            return Err(self.corrupt(index, "a chunk claims more than the record limit"));
+        }
+        let inner = match header.compression.as_str() {
+            "" => data.to_vec(),
+            "zstd" => zstd::bulk::decompress(data, size).map_err(|e| {
+                self.corrupt(index, &format!("a zstd chunk does not decompress: {e}"))
+            })?,
+            other => {
+                return Err(self.corrupt(
+                    index,
+                    &format!("chunks compressed with `{other}` are not read (zstd or none)"),
+                ))
+            }
+        };
+        if inner.len() != size {
+            return Err(self.corrupt(index, "a chunk is not the size it claims"));
+        }
+        Ok(inner)
+    }
+
+    fn mcap_error(&self, index: u64, source: mcap::McapError) -> ReplayError {
+        ReplayError::Mcap { path: self.path.clone(), index, source }
+    }
+
+    fn corrupt(&self, index: u64, why: &str) -> ReplayError {
+        ReplayError::Chunk { path: self.path.clone(), index, why: why.to_string() }
+    }
+
+    /// Every topic with its counts.
+    pub fn topics(&self) -> Result<Vec<TopicInfo>, ReplayError> {
+        self.scan(|_| {})
+    }
+
+    /// The messages of `topic` decoded as `T`, in log-time order.
+    pub fn messages<T: DeserializeOwned + schemars::JsonSchema>(
+        &self,
+        topic: &str,
+    ) -> Result<Vec<(Time, T)>, ReplayError> {
+        let mut out = Vec::new();
+        let mut failed = None;
+        self.scan(|e| {
+            if e.topic != topic || failed.is_some() {
+                return;
+            }
+            match serde_json::from_slice::<T>(e.json) {
+                Ok(v) => out.push((e.time, v)),
+                Err(source) => failed = Some((e.time, source)),
+            }
+        })?;
+        if let Some((time, source)) = failed {
+            let ty = schema_of::<T>()["title"].as_str().unwrap_or("?").to_string();
+            let (path, topic) = (self.path.clone(), topic.to_string());
+            return Err(ReplayError::Json { path, topic, time: time.as_secs_f64(), ty, source });
+        }
+        out.sort_by_key(|(t, _)| *t);
+        Ok(out)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::Recorder;
+    use mrt_msgs::{GameInfo, Localization};
+    use proptest::prelude::*;
+    use std::collections::BTreeMap as Map;
+
+    fn recorded() -> (Vec<u8>, PathBuf) {
+        let path = std::env::temp_dir().join(format!(
+            "mrt-monitor-replay-{}-{:?}.mcap",
+            std::process::id(),
+            std::thread::current().id()
+        ));
+        let mut rec = Recorder::create(&path).unwrap();
+        for k in 0..5u64 {
+            let game = GameInfo { attack: k as f64, ..Default::default() };
+            rec.record("/home/0/GameInfo", Time(k * 100_000_000), &game).unwrap();
+        }
+        rec.record("/home/0/Localization", Time(7), &Localization::default()).unwrap();
+        rec.finish().unwrap();
+        let bytes = std::fs::read(&path).unwrap();
+        std::fs::remove_file(&path).ok();
+        (bytes, path)
+    }
+
+    #[test]
+    fn a_recording_lists_its_topics_and_gives_back_typed_messages() {
+        let (bytes, path) = recorded();
+        let r = Recording::from_bytes(bytes, &path);
+        let topics = r.topics().unwrap();
+        let names: Vec<_> =
+            topics.iter().map(|t| (t.topic.as_str(), t.schema.as_str(), t.count)).collect();
+        assert_eq!(
+            names,
+            [("/home/0/GameInfo", "GameInfo", 5), ("/home/0/Localization", "Localization", 1)]
+        );
+        assert_eq!((topics[0].first, topics[0].last), (Time(0), Time(400_000_000)));
+        assert!(topics.iter().all(TopicInfo::readable));
+        let games = r.messages::<GameInfo>("/home/0/GameInfo").unwrap();
+        let attacks: Vec<f64> = games.iter().map(|(_, g)| g.attack).collect();
+        assert_eq!(attacks, [0.0, 1.0, 2.0, 3.0, 4.0]);
+        // Asked for the wrong type: the error names the file, the topic, the time and the type.
+        let e = r.messages::<Localization>("/home/0/GameInfo").unwrap_err().to_string();
+        assert!(e.contains("/home/0/GameInfo at 0.000 s does not decode as Localization"), "{e}");
+    }
+
+    /// Another tool's channel (CDR, no schema) is listed but not read.
+    #[test]
+    fn channels_of_other_encodings_are_listed_and_skipped() {
+        let mut w = mcap::Writer::new(std::io::Cursor::new(Vec::new())).unwrap();
+        let c = w.add_channel(0, "/ros/odom", "cdr", &Map::new()).unwrap();
+        let header = mcap::records::MessageHeader {
+            channel_id: c,
+            sequence: 0,
+            log_time: 5,
+            publish_time: 5,
+        };
+        w.write_to_known_channel(&header, &[1, 2, 3]).unwrap();
+        w.finish().unwrap();
+        let bytes = w.into_inner().into_inner();
+        let r = Recording::from_bytes(bytes, Path::new("other.mcap"));
+        let mut read = 0;
+        let topics = r.scan(|_| read += 1).unwrap();
+        assert_eq!(read, 0);
+        assert_eq!(topics.len(), 1);
+        assert!(!topics[0].readable() && topics[0].encoding == "cdr");
+    }
+
+    #[test]
+    fn a_file_that_is_not_mcap_or_is_cut_short_is_an_error_that_names_it() {
+        let r = Recording::from_bytes(b"not an mcap file".to_vec(), Path::new("junk.mcap"));
+        let e = r.topics().unwrap_err().to_string();
+        assert!(e.starts_with("junk.mcap: not a readable MCAP recording"), "{e}");
+        let (bytes, path) = recorded();
+        let cut = Recording::from_bytes(bytes[..bytes.len() / 2].to_vec(), &path);
+        assert!(cut.topics().is_err());
+        let e = Recording::open(Path::new("/nonexistent-mrt/x.mcap")).unwrap_err().to_string();
+        assert!(e.starts_with("/nonexistent-mrt/x.mcap: "), "{e}");
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(256))]
+        /// Random bytes, and a real recording with bytes flipped: an answer or an error,
+        /// never a panic.
+        #[test]
+        fn any_bytes_read_without_panicking(noise in proptest::collection::vec(any::<u8>(), 0..2048),
+                                            flips in proptest::collection::vec((any::<usize>(), any::<u8>()), 0..8)) {
+            let _ = Recording::from_bytes(noise, Path::new("noise.mcap")).topics();
+            let (mut bytes, path) = recorded();
+            let n = bytes.len();
+            for (at, b) in flips {
+                bytes[at % n] ^= b;
+            }
+            let r = Recording::from_bytes(bytes, &path);
+            let _ = r.topics();
+            let _ = r.messages::<GameInfo>("/home/0/GameInfo");
+        }
+    }
+}
