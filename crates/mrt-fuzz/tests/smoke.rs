@@ -48,6 +48,7 @@ smoke_tests! {
     hbm => "hbm",
     hfsm => "hfsm",
     world => "world",
+    mcap => "mcap",
 }
 
 /// A harness that panics on inputs holding `!`, and allocates 300 MiB on inputs holding `@`.

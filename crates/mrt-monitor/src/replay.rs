@@ -90,6 +90,44 @@ struct Scan {
     index: u64,
 }
 
+/// MCAP's opcodes of the records read (the others are passed over).
+const OP_SCHEMA: u8 = 0x03;
+const OP_CHANNEL: u8 = 0x04;
+const OP_MESSAGE: u8 = 0x05;
+const OP_CHUNK: u8 = 0x06;
+
+/// A record's fields, little-endian, each length checked against what is left of the record.
+struct Fields<'a>(&'a [u8]);
+
+impl<'a> Fields<'a> {
+    fn take(&mut self, n: usize) -> Option<&'a [u8]> {
+        if n > self.0.len() {
+            return None;
+        }
+        let (head, tail) = self.0.split_at(n);
+        self.0 = tail;
+        Some(head)
+    }
+
+    fn u16(&mut self) -> Option<u16> {
+        Some(u16::from_le_bytes(self.take(2)?.try_into().ok()?))
+    }
+
+    fn u32(&mut self) -> Option<u32> {
+        Some(u32::from_le_bytes(self.take(4)?.try_into().ok()?))
+    }
+
+    fn u64(&mut self) -> Option<u64> {
+        Some(u64::from_le_bytes(self.take(8)?.try_into().ok()?))
+    }
+
+    /// A string prefixed by its length in bytes (u32); not UTF-8 is malformed.
+    fn string(&mut self) -> Option<String> {
+        let n = usize::try_from(self.u32()?).ok()?;
+        std::str::from_utf8(self.take(n)?).ok().map(str::to_string)
+    }
+}
+
 /// The first record of a chunk's records: opcode, body and what follows; `None` when the
 /// record runs past the end.
 fn split_record(bytes: &[u8]) -> Option<(u8, &[u8], &[u8])> {
@@ -153,10 +191,12 @@ impl Recording {
     }
 
     /// [`Recording::scan`] without the guard against the reader's panics. `mcap`'s sans-I/O
-    /// reader splits the file into records, bounded by [`RECORD_LIMIT`]; chunks come whole
-    /// and are decompressed here, into at most the size they claim (within the limit): the
-    /// crate's own chunk decompression loops forever on some corrupted chunks (found by this
-    /// module's property test).
+    /// reader splits the file into records, bounded by [`RECORD_LIMIT`]. The records read
+    /// (schema, channel, message, chunk) are parsed here, every length checked against the
+    /// record before anything is allocated, and chunks decompressed here into at most the
+    /// size they claim: the crate's own record parser allocates whatever length a string
+    /// claims, and its chunk decompression loops forever on some damaged chunks (both found
+    /// by fuzzing: this module's property test, `mrt-fuzz run mcap`).
     fn scan_unguarded(&self, mut f: impl FnMut(Entry<'_>)) -> Result<Vec<TopicInfo>, ReplayError> {
         use mcap::sans_io::linear_reader::{LinearReadEvent, LinearReader, LinearReaderOptions};
         let options = LinearReaderOptions::default()
@@ -176,51 +216,57 @@ impl Recording {
                 }
                 LinearReadEvent::Record { opcode, data } => (opcode, data),
             };
-            let record =
-                mcap::parse_record(opcode, data).map_err(|e| self.mcap_error(scan.index, e))?;
-            if let mcap::records::Record::Chunk { header, data } = record {
-                let inner = self.decompress(&header, &data, scan.index)?;
-                let mut body: &[u8] = &inner;
-                while !body.is_empty() {
-                    let (opcode, data, after) = split_record(body)
-                        .ok_or_else(|| self.corrupt(scan.index, "a record runs past its chunk"))?;
-                    let record = mcap::parse_record(opcode, data)
-                        .map_err(|e| self.mcap_error(scan.index, e))?;
-                    self.take(&mut scan, record, &mut f)?;
-                    body = after;
-                }
-            } else {
-                self.take(&mut scan, record, &mut f)?;
+            if opcode != OP_CHUNK {
+                self.take(&mut scan, opcode, data, &mut f)?;
+                continue;
+            }
+            let inner = self.chunk(data, scan.index)?;
+            let mut body: &[u8] = &inner;
+            while !body.is_empty() {
+                let (opcode, data, after) = split_record(body)
+                    .ok_or_else(|| self.corrupt(scan.index, "a record runs past its chunk"))?;
+                self.take(&mut scan, opcode, data, &mut f)?;
+                body = after;
             }
         }
         Ok(scan.topics.into_values().collect())
     }
 
     /// One record outside or inside a chunk: schemas and channels are kept, messages counted
-    /// and handed to `f` when readable.
+    /// and handed to `f` when readable; other records are passed over.
     fn take(
         &self,
         scan: &mut Scan,
-        record: mcap::records::Record<'_>,
+        opcode: u8,
+        data: &[u8],
         f: &mut impl FnMut(Entry<'_>),
     ) -> Result<(), ReplayError> {
-        use mcap::records::Record;
-        match record {
-            Record::Schema { header, .. } => {
-                scan.schemas.insert(header.id, (header.name, header.encoding));
+        let mut r = Fields(data);
+        let cut = |what: &str| self.corrupt(scan.index, &format!("a {what} record is cut short"));
+        match opcode {
+            OP_SCHEMA => {
+                let (id, name, encoding) = (|| Some((r.u16()?, r.string()?, r.string()?)))()
+                    .ok_or_else(|| cut("schema"))?;
+                scan.schemas.insert(id, (name, encoding));
             }
-            Record::Channel(c) => {
-                scan.channels.insert(c.id, (c.topic, c.schema_id, c.message_encoding));
+            OP_CHANNEL => {
+                let (id, schema, topic, encoding) =
+                    (|| Some((r.u16()?, r.u16()?, r.string()?, r.string()?)))()
+                        .ok_or_else(|| cut("channel"))?;
+                scan.channels.insert(id, (topic, schema, encoding));
             }
-            Record::Message { header, data } => {
-                let Some((topic, schema_id, encoding)) = scan.channels.get(&header.channel_id)
-                else {
-                    let unknown =
-                        mcap::McapError::UnknownChannel(header.sequence, header.channel_id);
+            OP_MESSAGE => {
+                let (channel, sequence, log_time) =
+                    (|| Some((r.u16()?, r.u32()?, r.u64()?, r.u64()?)))()
+                        .map(|(c, s, t, _)| (c, s, t))
+                        .ok_or_else(|| cut("message"))?;
+                let data = r.0;
+                let Some((topic, schema_id, encoding)) = scan.channels.get(&channel) else {
+                    let unknown = mcap::McapError::UnknownChannel(sequence, channel);
                     return Err(self.mcap_error(scan.index, unknown));
                 };
                 scan.index += 1;
-                let time = Time(header.log_time);
+                let time = Time(log_time);
                 let (schema, schema_encoding) =
                     scan.schemas.get(schema_id).map_or(("", ""), |(n, e)| (n.as_str(), e.as_str()));
                 let info = scan.topics.entry(topic.clone()).or_insert_with(|| TopicInfo {
@@ -235,7 +281,7 @@ impl Recording {
                 info.first = info.first.min(time);
                 info.last = info.last.max(time);
                 if info.readable() && schema_encoding == "jsonschema" {
-                    f(Entry { topic, schema, time, json: &data });
+                    f(Entry { topic, schema, time, json: data });
                 }
             }
             _ => {}
@@ -243,20 +289,25 @@ impl Recording {
         Ok(())
     }
 
-    /// A chunk's records, decompressed into at most the size the chunk claims.
-    fn decompress(
-        &self,
-        header: &mcap::records::ChunkHeader,
-        data: &[u8],
-        index: u64,
-    ) -> Result<Vec<u8>, ReplayError> {
-        let size = usize::try_from(header.uncompressed_size).unwrap_or(usize::MAX);
+    /// A chunk record's records, decompressed into at most the size the chunk claims (and
+    /// [`RECORD_LIMIT`]).
+    fn chunk(&self, data: &[u8], index: u64) -> Result<Vec<u8>, ReplayError> {
+        let mut r = Fields(data);
+        let header = (|| {
+            let (_start, _end, size, _crc) = (r.u64()?, r.u64()?, r.u64()?, r.u32()?);
+            let compression = r.string()?;
+            let compressed = usize::try_from(r.u64()?).ok()?;
+            Some((size, compression, r.take(compressed)?))
+        })();
+        let (size, compression, records) =
+            header.ok_or_else(|| self.corrupt(index, "a chunk record is cut short"))?;
+        let size = usize::try_from(size).unwrap_or(usize::MAX);
         if size > RECORD_LIMIT {
             return Err(self.corrupt(index, "a chunk claims more than the record limit"));
         }
-        let inner = match header.compression.as_str() {
-            "" => data.to_vec(),
-            "zstd" => zstd::bulk::decompress(data, size).map_err(|e| {
+        let inner = match compression.as_str() {
+            "" => records.to_vec(),
+            "zstd" => zstd::bulk::decompress(records, size).map_err(|e| {
                 self.corrupt(index, &format!("a zstd chunk does not decompress: {e}"))
             })?,
             other => {

@@ -6,6 +6,7 @@ use std::path::{Path, PathBuf};
 
 mod files;
 mod lua;
+mod recording;
 mod wire;
 
 /// One input of the seed corpus.
@@ -77,6 +78,7 @@ pub static TARGETS: &[Target] = &[
     lua::HBM,
     lua::HFSM,
     lua::WORLD,
+    recording::MCAP,
 ];
 
 /// The target of that name.
