@@ -37,14 +37,26 @@ fn json_of<T: Message + Serialize>(m: &Msg) -> Encoded {
     m.get::<T>().ok().map(serde_json::to_vec)
 }
 
-/// A camera frame without its image: a frame's pixels as JSON numbers would make a match's
-/// recording gigabytes (the image schema stays, its value is `null`).
+/// A camera frame without its images: a frame's pixels as JSON numbers would make a match's
+/// recording gigabytes (the images' schema stays, their values are `null`). The other fields
+/// are copied one by one, not the images (a new field must be added here, or it fails to
+/// compile).
 fn camera_frame_json(m: &Msg) -> Encoded {
     let f = m.get::<CameraFrame>().ok()?;
-    if f.image.is_none() {
+    if f.image.is_none() && f.up_image.is_none() {
         return Some(serde_json::to_vec(f));
     }
-    Some(serde_json::to_vec(&CameraFrame { image: None, ..f.clone() }))
+    let CameraFrame { time, sightings, robots, ball_velocity, image: _, pan, up_image: _ } = f;
+    let bare = CameraFrame {
+        time: *time,
+        sightings: *sightings,
+        robots: robots.clone(),
+        ball_velocity: *ball_velocity,
+        image: None,
+        pan: *pan,
+        up_image: None,
+    };
+    Some(serde_json::to_vec(&bare))
 }
 
 macro_rules! catalogue {
@@ -104,5 +116,33 @@ mod tests {
         }
         // The table's others are the engines' own (SelfDescribing, BbUpdate, the probes).
         assert_eq!(CATALOGUE.len() + 6, table.len());
+    }
+
+    /// A camera frame is recorded with everything but its images' pixels.
+    #[test]
+    fn a_camera_frame_is_recorded_without_its_images() {
+        use mrt_dcdt::{DeliveryWarranty, Msg, MsgHeader};
+        use mrt_msgs::{Image, Sighting};
+        let image = Image { width: 2, height: 1, rgb: vec![7; 6] };
+        let mut frame = CameraFrame {
+            time: 1.5,
+            pan: Some(0.25),
+            image: Some(image.clone()),
+            up_image: Some(image),
+            ..Default::default()
+        };
+        frame.sightings[0] = Some(Sighting { distance: 2.0, bearing: 0.1 });
+        let header = MsgHeader {
+            msg_type: CameraFrame::TYPE,
+            member_id: mrt_core::MemberId(1),
+            agora_id: mrt_core::AgoraId(1),
+            priority: 0,
+            warranty: DeliveryWarranty::None,
+            creation_time: mrt_core::Time(0),
+        };
+        let msg: Box<Msg> = Box::new(Msg::new(header, frame.clone()));
+        let json = (entry(CameraFrame::TYPE).unwrap().to_json)(&msg);
+        let back: CameraFrame = serde_json::from_slice(&json.unwrap().unwrap()).unwrap();
+        assert_eq!(back, CameraFrame { image: None, up_image: None, ..frame });
     }
 }

@@ -111,8 +111,8 @@ impl Recorder {
         Arc::new(Mutex::new(self))
     }
 
-    fn mcap(&self) -> impl Fn(mcap::McapError) -> RecordError + '_ {
-        |source| RecordError::Mcap { path: self.path.clone(), source }
+    fn mcap_error(&self, source: mcap::McapError) -> RecordError {
+        RecordError::Mcap { path: self.path.clone(), source }
     }
 
     /// The channel of `topic`, whose messages are JSON of the type `schema_name` with the
@@ -133,7 +133,7 @@ impl Recorder {
                 let id = self
                     .writer
                     .add_schema(schema_name, "jsonschema", &data)
-                    .map_err(|e| (self.mcap())(e))?;
+                    .map_err(|e| self.mcap_error(e))?;
                 self.schemas.insert(schema_name.to_string(), id);
                 id
             }
@@ -141,7 +141,7 @@ impl Recorder {
         let id = self
             .writer
             .add_channel(schema_id, topic, "json", &BTreeMap::new())
-            .map_err(|e| (self.mcap())(e))?;
+            .map_err(|e| self.mcap_error(e))?;
         self.channels.insert(topic.to_string(), id);
         self.summary.channels = self.channels.len();
         Ok(id)
@@ -155,7 +155,7 @@ impl Recorder {
             log_time: time.0,
             publish_time: time.0,
         };
-        self.writer.write_to_known_channel(&header, json).map_err(|e| (self.mcap())(e))?;
+        self.writer.write_to_known_channel(&header, json).map_err(|e| self.mcap_error(e))?;
         self.summary.messages += 1;
         Ok(())
     }
@@ -185,7 +185,7 @@ impl Recorder {
 
     /// Writes the summary and the footer and closes the file.
     pub fn finish(mut self) -> Result<RecordSummary, RecordError> {
-        self.writer.finish().map_err(|e| (self.mcap())(e))?;
+        self.writer.finish().map_err(|e| self.mcap_error(e))?;
         let mut sink = self.writer.into_inner();
         sink.flush().map_err(|source| RecordError::Io { path: self.path.clone(), source })?;
         Ok(self.summary)

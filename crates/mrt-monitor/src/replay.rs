@@ -2,7 +2,6 @@
 //! of JSON messages are read; any other (another encoding, no schema) is listed as skipped. A
 //! file that is not MCAP, or is cut short, is an error naming the file, never a panic.
 
-use crate::catalogue::schema_of;
 use mrt_core::Time;
 use serde::de::DeserializeOwned;
 use std::collections::BTreeMap;
@@ -29,8 +28,8 @@ pub enum ReplayError {
         /// Why.
         source: mcap::McapError,
     },
-    /// The `mcap` crate's reader panicked on the file: a corrupted chunk makes version 0.24
-    /// subtract past zero (found by this module's property test). The panic is caught and
+    /// The `mcap` crate's record framing panicked on the file (its chunk reader, no longer
+    /// used, did on damaged chunks; the guard stays for the framing). The panic is caught and
     /// reported as this error.
     #[error("{path}: not a readable MCAP recording (its reader failed on a corrupted chunk)")]
     Corrupt {
@@ -353,7 +352,7 @@ impl Recording {
             }
         })?;
         if let Some((time, source)) = failed {
-            let ty = schema_of::<T>()["title"].as_str().unwrap_or("?").to_string();
+            let ty = T::schema_name().into_owned();
             let (path, topic) = (self.path.clone(), topic.to_string());
             return Err(ReplayError::Json { path, topic, time: time.as_secs_f64(), ty, source });
         }

@@ -120,6 +120,12 @@ struct Memory {
     seen: f64,
 }
 
+/// MAP's tracker of a ball rolling with `damping` (1/s): the quiet and the manoeuvre model
+/// mixed by the IMM ([`crate::track`]).
+fn ball_track(damping: f64) -> Track {
+    Track::new(damping, BALL_ACCEL).with_maneuver(BALL_MANEUVER)
+}
+
 /// How fast the uncertainty of an unseen ball grows, m/s (it may roll away).
 pub const BALL_SPREAD: f64 = 0.5;
 
@@ -221,7 +227,7 @@ impl WorldModel {
             memory: [None; FIELD_OBJECTS],
             counts: FilterCounts::default(),
             game: GameInfo::default(),
-            ball_track: Track::new(BALL_DAMPING, BALL_ACCEL).with_maneuver(BALL_MANEUVER),
+            ball_track: ball_track(BALL_DAMPING),
             relocalizer: None,
             grid: None,
             grid_disagrees: 0,
@@ -303,7 +309,7 @@ impl WorldModel {
 
     /// The same model for a ball whose rolling friction damps its velocity by `damping` (1/s).
     pub fn with_ball_damping(mut self, damping: f64) -> Self {
-        self.ball_track = Track::new(damping, BALL_ACCEL).with_maneuver(BALL_MANEUVER);
+        self.ball_track = ball_track(damping);
         self
     }
 

@@ -51,8 +51,8 @@ use nalgebra::{Matrix2, Matrix4, Matrix4x2, Vector2, Vector4};
 pub const GATE: f64 = 9.21;
 /// The random acceleration of a rolling ball, m/s²: what its rolling friction model leaves
 /// out (bumps, spin). Pushes, kicks and collisions are the manoeuvre model's
-/// ([`BALL_MANEUVER`]) or, beyond it, the gate's, which restarts the track. A design choice, measured with `mrt sim --seed S --metrics
-/// m.json`, seeds 1 and 2: the velocity error with the object sensor is 0.39 and 0.35 m/s at
+/// ([`BALL_MANEUVER`]) or, beyond it, the gate's, which restarts the track. A design choice,
+/// measured with the quiet model alone, `mrt sim --seed S --metrics m.json`, seeds 1 and 2: the velocity error with the object sensor is 0.39 and 0.35 m/s at
 /// 0.5 m/s², 0.56 and 0.51 at 2 (the research note's value); with vision it is 0.30 and 0.33
 /// at 0.5, 0.27 and 0.30 at 2. The exact sensor's loss is the larger.
 pub const BALL_ACCEL: f64 = 0.5;
