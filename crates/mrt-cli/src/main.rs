@@ -210,6 +210,14 @@ fn write_line(args: std::fmt::Arguments<'_>) {
     }
 }
 
+/// Blocks until the process is interrupted: Ctrl-C's handler (in `main`) exits it. For
+/// commands that serve until stopped (`--serve`).
+fn wait_for_ctrl_c() -> ! {
+    loop {
+        std::thread::park();
+    }
+}
+
 /// Whether an error comes from writing to a closed pipe.
 fn is_broken_pipe(e: &anyhow::Error) -> bool {
     e.chain().any(|c| {

@@ -2,7 +2,8 @@
 
 use anyhow::{anyhow, Context as _, Result};
 use indicatif::{ProgressBar, ProgressStyle};
-use mrt_monitor::Recorder;
+use mrt_monitor::serve::Server;
+use mrt_monitor::{Recorder, SharedTimeline, Timeline};
 use mrt_robot::stacks::Stack;
 use mrt_sim::config::SimConfig;
 use mrt_sim::game::{MatchReport, TeamStats};
@@ -98,6 +99,12 @@ pub struct SimArgs {
     /// or Lichtblick, or read it with any `mcap` library. One in-process match.
     #[arg(long)]
     pub record: Option<PathBuf>,
+    /// Serve the web monitor while the match plays and after it ends (until Ctrl-C): open
+    /// the printed address in a browser to watch the field, each robot's beliefs against the
+    /// truth, and to pause, step and scrub. ADDR defaults to 127.0.0.1:8080 (loopback only);
+    /// with --realtime the match plays at wall-clock speed. One in-process match.
+    #[arg(long, value_name = "ADDR", num_args = 0..=1, default_missing_value = "127.0.0.1:8080")]
+    pub serve: Option<std::net::SocketAddr>,
     /// Which embedded world: soccer (a match) or indoor (one robot follows path points
     /// through a building where a door closes and a person walks; the MRT manual's Roby,
     /// docs/indoor.md).
@@ -153,6 +160,7 @@ fn play_one(
     stacks: (Stack, Stack),
     args: &SimArgs,
     record: bool,
+    timeline: Option<&SharedTimeline>,
     progress: impl FnMut(f64),
 ) -> Result<(MatchReport, Vec<String>)> {
     if args.distributed {
@@ -196,16 +204,32 @@ fn play_one(
              (cargo run --release -p mrt-cli -- sim --distributed)"
         );
     }
-    let recorder = match &args.record {
-        Some(path) => Some(Recorder::create(path)?.shared()),
-        None => None,
+    let recorder = match (&args.record, timeline) {
+        (None, None) => None,
+        (path, timeline) => {
+            let mut rec = match path {
+                Some(path) => Recorder::create(path)?,
+                None => Recorder::unwritten(),
+            };
+            if let Some(timeline) = timeline.cloned() {
+                rec = rec.listen(Box::new(move |topic, time, json| {
+                    if let Ok(mut t) = timeline.lock() {
+                        t.ingest(topic, time, json);
+                    }
+                }));
+            }
+            Some(rec.shared())
+        }
     };
     let behaviors = args.behaviors.as_deref();
     let report = play_recorded(cfg, seed, stacks, behaviors, record, recorder.clone(), progress)
         .map_err(|e| anyhow!("{e}"))?;
     let mut notes = Vec::new();
-    if let (Some(rec), Some(path)) = (recorder, &args.record) {
-        let s = Recorder::finish_shared(rec)?;
+    let finished = recorder.map(Recorder::finish_shared).transpose()?;
+    if let Some(t) = timeline {
+        t.lock().map_err(|_| anyhow!("the monitor's timeline lock is poisoned"))?.finish();
+    }
+    if let (Some(s), Some(path)) = (finished, &args.record) {
         let size = std::fs::metadata(path).map(|m| m.len()).unwrap_or(0);
         let failed = if s.failed > 0 { format!(", {} left out", s.failed) } else { String::new() };
         notes.push(format!(
@@ -279,10 +303,12 @@ pub fn run(args: &SimArgs) -> Result<()> {
     if args.bench {
         return bench(args, &cfg, stacks);
     }
-    if args.record.is_some() && (args.matches > 1 || args.distributed || args.bench) {
-        anyhow::bail!(
-            "--record records one in-process match: leave out --matches, --distributed and --bench"
-        );
+    for (given, name) in [(args.record.is_some(), "--record"), (args.serve.is_some(), "--serve")] {
+        if given && (args.matches > 1 || args.distributed || args.bench) {
+            anyhow::bail!(
+                "{name} takes one in-process match: leave out --matches, --distributed and --bench"
+            );
+        }
     }
     if args.matches > 1 {
         if args.distributed {
@@ -302,9 +328,20 @@ pub fn run(args: &SimArgs) -> Result<()> {
         .map_err(|e| anyhow!("{e}"))?
         .progress_chars("=> "),
     );
+    let timeline = args.serve.map(|_| Timeline::new().shared());
+    let server = match (args.serve, &timeline) {
+        (Some(addr), Some(t)) => {
+            let title = format!("{} v {}, seed {}", stacks.0.name(), stacks.1.name(), args.seed);
+            let server = Server::start(addr, t.clone(), &title)?;
+            outln!("monitor: {}", server.url());
+            Some(server)
+        }
+        _ => None,
+    };
     let started = std::time::Instant::now();
     let realtime = args.realtime;
-    let (report, notes) = play_one(&cfg, args.seed, stacks, args, args.plot.is_some(), |t| {
+    let plot = args.plot.is_some();
+    let (report, notes) = play_one(&cfg, args.seed, stacks, args, plot, timeline.as_ref(), |t| {
         bar.set_position(t as u64);
         if realtime {
             let ahead = t - started.elapsed().as_secs_f64();
@@ -459,6 +496,10 @@ pub fn run(args: &SimArgs) -> Result<()> {
         std::fs::write(p, svg).with_context(|| format!("cannot write {}", p.display()))?;
         outln!("  drawing: {}", p.display());
     }
+    if let Some(server) = server {
+        outln!("monitor: the match stays at {} to replay; Ctrl-C to stop", server.url());
+        crate::wait_for_ctrl_c();
+    }
     Ok(())
 }
 
@@ -490,7 +531,7 @@ fn bench(args: &SimArgs, cfg: &SimConfig, stacks: (Stack, Stack)) -> Result<()> 
         // check_counts: no overflow.
         let seed = args.seed.saturating_add(k);
         let started = std::time::Instant::now();
-        let (r, _) = play_one(cfg, seed, stacks, args, false, |_| {})?;
+        let (r, _) = play_one(cfg, seed, stacks, args, false, None, |_| {})?;
         let wall = started.elapsed().as_secs_f64();
         speeds.push(r.duration / wall.max(1e-9));
         bar.suspend(|| {
@@ -542,7 +583,7 @@ fn series(args: &SimArgs, cfg: &SimConfig, stacks: (Stack, Stack)) -> Result<()>
             let (bar, results, book) = (&bar, &results, &book);
             s.spawn(move || {
                 for &seed in chunk {
-                    let r = play_one(cfg, seed, stacks, args, false, |_| {}).map(|(r, _)| r);
+                    let r = play_one(cfg, seed, stacks, args, false, None, |_| {}).map(|(r, _)| r);
                     if let (Ok(r), Ok(mut book)) = (&r, book.lock()) {
                         book.add(r);
                     }

@@ -288,7 +288,7 @@ fn a_match_is_recorded_into_an_mcap_file() {
     assert!(!out.status.success() && err.contains("not a readable MCAP recording"), "{err}");
     std::fs::remove_file(&file).unwrap();
     let (ok, _, err) = run(&["--matches", "2", "--record", path]);
-    assert!(!ok && err.contains("--record records one in-process match"), "{err}");
+    assert!(!ok && err.contains("--record takes one in-process match"), "{err}");
     let (ok, _, err) = run(&["--half", "1", "--record", "/nonexistent-mrt-dir/m.mcap"]);
     assert!(!ok && err.contains("/nonexistent-mrt-dir/m.mcap"), "{err}");
 }

@@ -12,6 +12,10 @@
 //! - [`tap`]: a [`Tap`] is a Member that records every catalogue message of its Agora
 //!   (`mrt sim --record FILE.mcap` puts one in each robot).
 //! - [`catalogue`]: the message types a tap knows, with their schemas.
+//! - [`view`]: a [`Timeline`] of frames, each the simulator's truth and every robot's beliefs
+//!   in the field frame, from a recording or live from a recorder's listener.
+//! - `serve` (feature `serve`): the web monitor that draws a timeline in a browser
+//!   (`mrt sim --serve`, `mrt replay FILE --serve`).
 //!
 //! ```
 //! use mrt_core::Time;
@@ -31,8 +35,12 @@
 pub mod catalogue;
 pub mod record;
 pub mod replay;
+#[cfg(feature = "serve")]
+pub mod serve;
 pub mod tap;
+pub mod view;
 
 pub use record::{RecordError, RecordSummary, Recorder, SharedRecorder};
 pub use replay::{Recording, ReplayError};
 pub use tap::Tap;
+pub use view::{SharedTimeline, Timeline, Truth};

@@ -37,6 +37,9 @@ pub enum RecordError {
     /// Another thread panicked while it held the recorder.
     #[error("the recorder's lock is poisoned")]
     Poisoned,
+    /// More than 65 536 topics in a recording without a file.
+    #[error("more topics than a recording's 16-bit channel ids can name")]
+    TooManyTopics,
     /// The recorder was to be finished while a tap still held it.
     #[error("the recording cannot be finished while a tap still holds it")]
     StillShared,
@@ -61,14 +64,22 @@ pub struct RecordSummary {
 /// truth.
 pub type SharedRecorder = Arc<Mutex<Recorder>>;
 
-/// An MCAP file being written (crate doc).
+/// Sees every message a [`Recorder`] writes: its topic, log time and JSON (the live web
+/// monitor's [`Timeline`](crate::Timeline) of `mrt sim --serve`).
+pub type Listener = Box<dyn FnMut(&str, Time, &[u8]) + Send>;
+
+/// An MCAP file being written (crate doc), and whoever listens to what is written.
 pub struct Recorder {
-    writer: Writer<Box<dyn Sink>>,
+    /// `None` for a recorder that only feeds its listener ([`Recorder::unwritten`]).
+    writer: Option<Writer<Box<dyn Sink>>>,
     path: PathBuf,
     /// Schema ids by type name.
     schemas: BTreeMap<String, u16>,
     /// Channel ids by topic.
     channels: BTreeMap<String, u16>,
+    /// Topics by channel id.
+    topics: Vec<String>,
+    listener: Option<Listener>,
     summary: RecordSummary,
 }
 
@@ -97,22 +108,31 @@ impl Recorder {
             .library(concat!("mrt-monitor ", env!("CARGO_PKG_VERSION")))
             .create(sink)
             .map_err(|source| RecordError::Mcap { path: path.to_path_buf(), source })?;
-        Ok(Recorder {
-            writer,
-            path: path.to_path_buf(),
+        Ok(Recorder { writer: Some(writer), path: path.to_path_buf(), ..Recorder::unwritten() })
+    }
+
+    /// A recorder that writes no file: its messages go to its listener only
+    /// ([`Recorder::listen`]; `mrt sim --serve` without `--record`).
+    pub fn unwritten() -> Recorder {
+        Recorder {
+            writer: None,
+            path: PathBuf::new(),
             schemas: BTreeMap::new(),
             channels: BTreeMap::new(),
+            topics: Vec::new(),
+            listener: None,
             summary: RecordSummary::default(),
-        })
+        }
+    }
+
+    /// The same recorder, calling `listener` with every message it writes, after writing it.
+    pub fn listen(self, listener: Listener) -> Recorder {
+        Recorder { listener: Some(listener), ..self }
     }
 
     /// The same recorder, shared.
     pub fn shared(self) -> SharedRecorder {
         Arc::new(Mutex::new(self))
-    }
-
-    fn mcap_error(&self, source: mcap::McapError) -> RecordError {
-        RecordError::Mcap { path: self.path.clone(), source }
     }
 
     /// The channel of `topic`, whose messages are JSON of the type `schema_name` with the
@@ -126,22 +146,31 @@ impl Recorder {
         if let Some(&id) = self.channels.get(topic) {
             return Ok(id);
         }
-        let schema_id = match self.schemas.get(schema_name) {
-            Some(&id) => id,
-            None => {
-                let data = serde_json::to_vec(&schema())?;
-                let id = self
-                    .writer
-                    .add_schema(schema_name, "jsonschema", &data)
-                    .map_err(|e| self.mcap_error(e))?;
-                self.schemas.insert(schema_name.to_string(), id);
-                id
+        let id = match &mut self.writer {
+            Some(writer) => {
+                let schema_id = match self.schemas.get(schema_name) {
+                    Some(&id) => id,
+                    None => {
+                        let data = serde_json::to_vec(&schema())?;
+                        let id =
+                            writer.add_schema(schema_name, "jsonschema", &data).map_err(|e| {
+                                RecordError::Mcap { path: self.path.clone(), source: e }
+                            })?;
+                        self.schemas.insert(schema_name.to_string(), id);
+                        id
+                    }
+                };
+                writer
+                    .add_channel(schema_id, topic, "json", &BTreeMap::new())
+                    .map_err(|e| RecordError::Mcap { path: self.path.clone(), source: e })?
             }
+            None => u16::try_from(self.topics.len()).map_err(|_| RecordError::TooManyTopics)?,
         };
-        let id = self
-            .writer
-            .add_channel(schema_id, topic, "json", &BTreeMap::new())
-            .map_err(|e| self.mcap_error(e))?;
+        let slot = usize::from(id);
+        if self.topics.len() <= slot {
+            self.topics.resize(slot + 1, String::new());
+        }
+        self.topics[slot] = topic.to_string();
         self.channels.insert(topic.to_string(), id);
         self.summary.channels = self.channels.len();
         Ok(id)
@@ -155,8 +184,17 @@ impl Recorder {
             log_time: time.0,
             publish_time: time.0,
         };
-        self.writer.write_to_known_channel(&header, json).map_err(|e| self.mcap_error(e))?;
+        if let Some(writer) = &mut self.writer {
+            writer
+                .write_to_known_channel(&header, json)
+                .map_err(|e| RecordError::Mcap { path: self.path.clone(), source: e })?;
+        }
         self.summary.messages += 1;
+        if let (Some(listen), Some(topic)) =
+            (&mut self.listener, self.topics.get(usize::from(channel)))
+        {
+            listen(topic, time, json);
+        }
         Ok(())
     }
 
@@ -184,9 +222,10 @@ impl Recorder {
     }
 
     /// Writes the summary and the footer and closes the file.
-    pub fn finish(mut self) -> Result<RecordSummary, RecordError> {
-        self.writer.finish().map_err(|e| self.mcap_error(e))?;
-        let mut sink = self.writer.into_inner();
+    pub fn finish(self) -> Result<RecordSummary, RecordError> {
+        let Some(mut writer) = self.writer else { return Ok(self.summary) };
+        writer.finish().map_err(|source| RecordError::Mcap { path: self.path.clone(), source })?;
+        let mut sink = writer.into_inner();
         sink.flush().map_err(|source| RecordError::Io { path: self.path.clone(), source })?;
         Ok(self.summary)
     }
@@ -274,5 +313,39 @@ mod tests {
         let path = Path::new("/nonexistent-dir-of-mrt/x.mcap");
         let e = Recorder::create(path).unwrap_err().to_string();
         assert!(e.starts_with("/nonexistent-dir-of-mrt/x.mcap: "), "{e}");
+    }
+
+    /// A recorder without a file hands every message to its listener (the live monitor's
+    /// feed), with the topic it was written on; one with a file does both.
+    #[test]
+    fn a_listener_sees_every_message_written() {
+        type Seen = Arc<Mutex<Vec<(String, u64, String)>>>;
+        let seen = Seen::default();
+        let listener = |seen: &Seen| -> Listener {
+            let seen = seen.clone();
+            Box::new(move |topic, time, json| {
+                let json = String::from_utf8_lossy(json).into_owned();
+                seen.lock().unwrap().push((topic.to_string(), time.0, json));
+            })
+        };
+        let mut rec = Recorder::unwritten().listen(listener(&seen));
+        rec.record("/home/0/GameInfo", Time(5), &GameInfo::default()).unwrap();
+        rec.record("/away/1/GameInfo", Time(7), &GameInfo { attack: -1.0, ..Default::default() })
+            .unwrap();
+        assert_eq!(rec.finish().unwrap().messages, 2);
+        let seen_now = seen.lock().unwrap().clone();
+        assert_eq!(seen_now.len(), 2);
+        assert_eq!((seen_now[0].0.as_str(), seen_now[0].1), ("/home/0/GameInfo", 5));
+        assert_eq!((seen_now[1].0.as_str(), seen_now[1].1), ("/away/1/GameInfo", 7));
+        assert!(seen_now[1].2.contains("\"attack\":-1.0"), "{}", seen_now[1].2);
+
+        let path = temp("listened");
+        let mut rec = Recorder::create(&path).unwrap().listen(listener(&seen));
+        rec.record("/truth", Time(9), &GameInfo::default()).unwrap();
+        rec.finish().unwrap();
+        assert_eq!(seen.lock().unwrap().len(), 3);
+        let topics = crate::Recording::open(&path).unwrap().topics().unwrap();
+        assert_eq!(topics.len(), 1);
+        std::fs::remove_file(&path).ok();
     }
 }

@@ -15,6 +15,11 @@ pub struct BehaviorStatus {
     pub reloaded: Vec<String>,
     /// Errors of this cycle (the robot went on regardless).
     pub errors: Vec<String>,
+    /// How active each behavior was this cycle, 0 to 1, for a monitor's bars: Mr. BRIAN's
+    /// behaviors by their WANT when their CANDO let them run, 0 otherwise (MRT manual
+    /// §10.3.6). Empty when the engine reports none.
+    #[serde(default)]
+    pub activations: Vec<(String, f64)>,
 }
 
 /// Asks behavior Members to reload their changed scripts at the next cycle boundary.

@@ -15,6 +15,12 @@ pub trait Brain {
     fn take_faults(&mut self) -> Vec<String> {
         Vec::new()
     }
+
+    /// How active each of its behaviors was in the last cycle, 0 to 1, for monitors
+    /// ([`BehaviorStatus::activations`]); empty when the brain has no such notion.
+    fn activations(&self) -> Vec<(String, f64)> {
+        Vec::new()
+    }
 }
 
 /// A robot whose software could not start (a behavior file that does not load, ...): it stands
@@ -69,10 +75,11 @@ impl Member for BrainMember {
             ctx.publish(self.brain.cycle(w));
         }
         // What went wrong, for the fault book (one fault per faulty cycle, named by its first
-        // error, as a behavior Member reports).
+        // error, as a behavior Member reports), and the behaviors' activations for monitors.
         let errors = self.brain.take_faults();
-        if !errors.is_empty() {
-            ctx.publish(BehaviorStatus { errors, ..BehaviorStatus::default() });
+        let activations = self.brain.activations();
+        if !errors.is_empty() || !activations.is_empty() {
+            ctx.publish(BehaviorStatus { errors, activations, ..BehaviorStatus::default() });
         }
         Ok(())
     }

@@ -389,6 +389,16 @@ impl Brain for MilanBrain {
         c.needs.push((lps::BALL, 1.0));
         c
     }
+
+    /// Each Mr. BRIAN behavior's WANT when its CANDO let it run, 0 when it did not.
+    fn activations(&self) -> Vec<(String, f64)> {
+        let trace = self.brian.trace();
+        trace
+            .behaviors
+            .iter()
+            .map(|(name, _, activity)| (name.to_string(), activity.map_or(0.0, |(_, w)| w.value)))
+            .collect()
+    }
 }
 
 /// The brains of one team of `size` robots (robot 0 keeps goal). `behaviors` overrides the

@@ -147,8 +147,13 @@ impl Member for BehaviorMember {
         for e in &errors {
             tracing::warn!(member = %self.name, "{e}");
         }
-        let status =
-            BehaviorStatus { path: c.path, behavior: c.behavior, reloaded: c.reloaded, errors };
+        let status = BehaviorStatus {
+            path: c.path,
+            behavior: c.behavior,
+            reloaded: c.reloaded,
+            errors,
+            activations: Vec::new(),
+        };
         ctx.publish(c.command);
         ctx.publish(status);
         Ok(())

@@ -13,7 +13,7 @@ use crate::game::{MatchReport, Pitch};
 use crate::referee::Call;
 use mrt_core::SimClock;
 use mrt_dcdt::{InnerLinkManager, SteppedExecutor};
-use mrt_monitor::{SharedRecorder, Tap};
+use mrt_monitor::{SharedRecorder, Tap, Truth};
 use mrt_msgs::{Localization, MemberFault, WorldSnapshot};
 use mrt_robot::brain::Brain;
 use mrt_robot::config::RobotConfig;
@@ -92,33 +92,16 @@ pub struct BusMatch {
     recorder: Option<SharedRecorder>,
 }
 
-/// What the simulator knows and the robots do not, recorded each cycle on the topic
-/// `/truth` beside the robots' messages (`mrt sim --record`): field frame, m, m/s, rad.
-#[derive(Clone, Debug, PartialEq, serde::Serialize, schemars::JsonSchema)]
-pub struct Truth {
-    /// The ball's place.
-    pub ball: (f64, f64),
-    /// The ball's velocity.
-    pub ball_velocity: (f64, f64),
-    /// Every robot's pose, home's then away's.
-    pub robots: Vec<mrt_core::Pose2>,
-    /// Goals, home : away.
-    pub score: (u32, u32),
-    /// The referee's state.
-    pub state: mrt_msgs::GameState,
-}
-
-impl Truth {
-    /// The truth of `pitch` now.
-    pub fn of(pitch: &Pitch) -> Truth {
-        let w = pitch.world();
-        Truth {
-            ball: w.ball(),
-            ball_velocity: w.ball_velocity(),
-            robots: (0..w.robot_count()).filter_map(|i| w.robot(i)).collect(),
-            score: pitch.referee().score(),
-            state: pitch.referee().state(),
-        }
+/// The truth of `pitch` now ([`Truth`], recorded on `/truth`).
+pub fn truth_of(pitch: &Pitch) -> Truth {
+    let w = pitch.world();
+    Truth {
+        ball: w.ball(),
+        ball_velocity: w.ball_velocity(),
+        robots: (0..w.robot_count()).filter_map(|i| w.robot(i)).collect(),
+        home: pitch.config().rules.team_size,
+        score: pitch.referee().score(),
+        state: pitch.referee().state(),
     }
 }
 
@@ -249,16 +232,19 @@ impl BusMatch {
 
     /// One control cycle: every Agora runs (eyes, behaviors, motors), then the physics runs
     /// up to the next cycle. Returns the referee's calls.
+    ///
+    /// When recording, the truth is recorded first, at the time the robots' messages of this
+    /// cycle carry: what was so when they looked.
     pub fn cycle(&mut self) -> Result<Vec<Call>, String> {
-        self.exec.run_for(self.period);
-        let mut p = self.pitch.lock().map_err(|_| "the pitch lock is poisoned".to_string())?;
-        let calls = p.advance();
         if let Some(rec) = &self.recorder {
+            let p = lock_pitch(&self.pitch)?;
             let time = mrt_core::Time::from_secs_f64(p.world().time());
             let mut rec = rec.lock().map_err(|_| "the recorder's lock is poisoned".to_string())?;
-            rec.record("/truth", time, &Truth::of(&p)).map_err(|e| e.to_string())?;
+            rec.record("/truth", time, &truth_of(&p)).map_err(|e| e.to_string())?;
         }
-        Ok(calls)
+        self.exec.run_for(self.period);
+        let mut p = self.pitch.lock().map_err(|_| "the pitch lock is poisoned".to_string())?;
+        Ok(p.advance())
     }
 
     /// Plays until the end, calling `progress` with the simulated time after each cycle.
@@ -356,8 +342,8 @@ mod tests {
             let snapshots = topics[&format!("/{robot}/WorldSnapshot")];
             assert_eq!(snapshots.0, 60, "{robot}");
             assert!(topics.contains_key(&format!("/{robot}/RobotCommand")), "{robot}");
-            // On the simulated clock: the last snapshot within a cycle of the last truth.
-            assert!(topics["/truth"].1.abs_diff(snapshots.1) <= 100_000_000, "{robot}");
+            // On the simulated clock: the last snapshot at the time of the last truth.
+            assert_eq!(topics["/truth"].1, snapshots.1, "{robot}");
         }
     }
 

@@ -1,0 +1,522 @@
+//! What the web monitor shows: a [`Timeline`] of frames, one per instant of the bus's clock,
+//! each the simulator's [`Truth`] and every robot's beliefs ([`RobotView`]) at that instant,
+//! built from the same topics a recording holds (`/<robot>/<type>` and `/truth`), read back
+//! from a file ([`Timeline::of_recording`]) or fed live by a [`Recorder`](crate::Recorder)'s
+//! listener (`mrt sim --serve`).
+//!
+//! Everything in a frame is in the field frame (metres from the centre spot, x towards the
+//! east goal, radians): the robots' team-frame millimetres (`WorldSnapshot`, `PlannedPath`)
+//! are turned with the direction the robot's team attacks (`GameInfo::attack`).
+
+use crate::replay::{Recording, ReplayError};
+use mrt_core::frames::{Attack, Framed, Team, MM_PER_M};
+use mrt_core::{Point2, Pose2, Time};
+use mrt_msgs::{
+    BehaviorStatus, GameInfo, GameState, Localization, PlannedPath, RobotClass, RobotCommand,
+    WorldSnapshot,
+};
+use serde::{Deserialize, Serialize};
+use std::collections::{BTreeMap, VecDeque};
+use std::sync::{Arc, Mutex};
+
+/// What the simulator knows and the robots do not, recorded each cycle on the topic `/truth`
+/// beside the robots' messages (`mrt sim --record`): field frame, m, m/s, rad.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
+pub struct Truth {
+    /// The ball's place.
+    pub ball: (f64, f64),
+    /// The ball's velocity.
+    pub ball_velocity: (f64, f64),
+    /// Every robot's pose, home's then away's.
+    pub robots: Vec<Pose2>,
+    /// How many of `robots` are home's.
+    pub home: usize,
+    /// Goals, home : away.
+    pub score: (u32, u32),
+    /// The referee's state.
+    pub state: GameState,
+}
+
+/// The most frames a timeline keeps (two hours at the robots' 10 Hz): older ones are dropped
+/// first, so that a live monitor's memory stays bounded however long the robots run.
+pub const MAX_FRAMES: usize = 72_000;
+
+/// A robot another robot anchored (MAP), in the field frame.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct AnchorView {
+    /// Where it is, m.
+    pub at: (f64, f64),
+    /// Teammate, opponent or unknown.
+    pub class: RobotClass,
+    /// How much the anchor is trusted, 0 to 1.
+    pub reliability: f64,
+}
+
+/// What one robot believes at one instant, in the field frame (m, rad), as its messages told
+/// it: the last of each type at or before the frame's time.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct RobotView {
+    /// Its topics' prefix, e.g. `home/2`.
+    pub name: String,
+    /// Its place in the truth's robots (home's, then away's), when known.
+    pub truth_index: Option<usize>,
+    /// The direction its team attacks, +1 east, −1 west (`GameInfo`).
+    pub attack: f64,
+    /// Where it believes it is (`Localization`).
+    pub pose: Option<Pose2>,
+    /// One standard deviation of that position, m.
+    pub sigma_xy: f64,
+    /// One standard deviation of that heading, rad.
+    pub sigma_theta: f64,
+    /// The pose's quality, 0 to 1.
+    pub quality: f64,
+    /// Where it believes the ball is (its own tracker, `Localization::ball`).
+    pub ball: Option<(f64, f64)>,
+    /// How long ago it last saw the ball, s.
+    pub ball_seen_ago: f64,
+    /// The team's ball (`WorldSnapshot::global_ball`), when its quality is above 0.
+    pub team_ball: Option<(f64, f64)>,
+    /// The team ball's quality.
+    pub team_ball_quality: f64,
+    /// The robots it anchored.
+    pub anchors: Vec<AnchorView>,
+    /// Its role (`getRole`).
+    pub role: String,
+    /// Its SCARE activity, functionality and sub-task, e.g. `BringBall: ReachBall`.
+    pub job: String,
+    /// Whether it holds the ball booking.
+    pub ball_booked: bool,
+    /// Whether its world model needs landmarks to localize it.
+    pub needs_localization: bool,
+    /// The game state it believes.
+    pub game_state: GameState,
+    /// The path SPIKE planned for it, field frame, m.
+    pub path: Vec<(f64, f64)>,
+    /// Its HFSM's active path (`BehaviorStatus::path`).
+    pub hfsm: String,
+    /// The behavior that ran.
+    pub behavior: Option<String>,
+    /// Its behaviors' activations (the HBM's or Mr. BRIAN's), name and degree.
+    pub activations: Vec<(String, f64)>,
+    /// The behavior errors it reported last.
+    pub errors: Vec<String>,
+    /// Its last command: linear (m/s) and rotational (rad/s) velocity, and a kick.
+    pub command: Option<CommandView>,
+}
+
+/// A robot's command as the monitor shows it.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct CommandView {
+    /// Forward, m/s.
+    pub vlin: f64,
+    /// Sideways, m/s.
+    pub vlat: f64,
+    /// Turning, rad/s.
+    pub vrot: f64,
+    /// Whether it kicks.
+    pub kick: bool,
+}
+
+/// One instant: the truth (when recorded) and every robot's beliefs.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Frame {
+    /// The bus's clock, s.
+    pub t: f64,
+    /// The simulator's truth at `t`, when there is one.
+    pub truth: Option<Truth>,
+    /// Every robot heard so far, by name.
+    pub robots: Vec<RobotView>,
+}
+
+/// The field the robots' world models know (`WorldSnapshot::field`), in metres.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct FieldView {
+    /// From the centre spot to a goal line.
+    pub half_length: f64,
+    /// From the centre line to a side line.
+    pub half_width: f64,
+    /// From the middle of a goal to a post.
+    pub goal_half_width: f64,
+    /// From the goal line to the penalty area's line.
+    pub penalty_area_depth: f64,
+}
+
+/// Frames in time order (module doc), each kept as the JSON the web page reads.
+#[derive(Debug, Default)]
+pub struct Timeline {
+    frames: VecDeque<(f64, Arc<str>)>,
+    /// How many frames were dropped from the front ([`MAX_FRAMES`]).
+    dropped: usize,
+    /// The instant being gathered, and whether a message came for it.
+    now: Option<Time>,
+    truth: Option<Truth>,
+    robots: BTreeMap<String, RobotView>,
+    field: Option<FieldView>,
+    /// Messages of a known type that did not parse, counted and left out.
+    unreadable: u64,
+    finished: bool,
+}
+
+/// A timeline shared by its writer (a recording read back, a live match) and the web server.
+pub type SharedTimeline = Arc<Mutex<Timeline>>;
+
+impl Timeline {
+    /// An empty timeline.
+    pub fn new() -> Timeline {
+        Timeline::default()
+    }
+
+    /// The same timeline, shared.
+    pub fn shared(self) -> SharedTimeline {
+        Arc::new(Mutex::new(self))
+    }
+
+    /// Every readable message of `recording`, in file order, then [`Timeline::finish`].
+    pub fn of_recording(recording: &Recording) -> Result<Timeline, ReplayError> {
+        let mut timeline = Timeline::new();
+        recording.scan(|e| timeline.ingest(e.topic, e.time, e.json))?;
+        timeline.finish();
+        Ok(timeline)
+    }
+
+    /// Takes one message of `topic` (`/truth` or `/<robot>/<type>`) logged at `time`. A
+    /// message later than the instant being gathered closes that instant's frame first; an
+    /// earlier one (out of order) updates the beliefs of the instant being gathered. Types
+    /// the monitor does not draw are passed over; a message of a drawn type that does not
+    /// parse is counted ([`Timeline::unreadable`]) and left out.
+    pub fn ingest(&mut self, topic: &str, time: Time, json: &[u8]) {
+        match self.now {
+            Some(now) if time > now => {
+                self.close_frame(now);
+                self.now = Some(time);
+            }
+            None => self.now = Some(time),
+            _ => {}
+        }
+        let ok = if topic == "/truth" {
+            serde_json::from_slice(json).map(|t| self.truth = Some(t)).is_ok()
+        } else {
+            let Some((name, ty)) = topic.trim_start_matches('/').rsplit_once('/') else {
+                return;
+            };
+            self.robot_message(name, ty, json)
+        };
+        if !ok {
+            self.unreadable += 1;
+        }
+    }
+
+    /// Whether the message parsed (types not drawn count as parsed).
+    fn robot_message(&mut self, name: &str, ty: &str, json: &[u8]) -> bool {
+        let view = self.robots.entry(name.to_string()).or_insert_with(|| RobotView {
+            name: name.to_string(),
+            attack: 1.0,
+            ..RobotView::default()
+        });
+        match ty {
+            "GameInfo" => parse(json).map(|g: GameInfo| view.attack = g.attack).is_some(),
+            "Localization" => parse(json).map(|l: Localization| view.localization(&l)).is_some(),
+            "WorldSnapshot" => match parse::<WorldSnapshot>(json) {
+                Some(w) => {
+                    view.world(&w);
+                    let f = w.field;
+                    self.field.get_or_insert(FieldView {
+                        half_length: f.half_length / MM_PER_M,
+                        half_width: f.half_width / MM_PER_M,
+                        goal_half_width: f.goal_half_width / MM_PER_M,
+                        penalty_area_depth: f.penalty_area_depth / MM_PER_M,
+                    });
+                    true
+                }
+                None => false,
+            },
+            "PlannedPath" => parse(json).map(|p: PlannedPath| view.planned(&p)).is_some(),
+            "BehaviorStatus" => parse(json).map(|b: BehaviorStatus| view.status(b)).is_some(),
+            "RobotCommand" => parse(json).map(|c: RobotCommand| view.command(&c)).is_some(),
+            _ => true,
+        }
+    }
+
+    fn close_frame(&mut self, now: Time) {
+        let robots = self
+            .robots
+            .values()
+            .map(|r| RobotView {
+                truth_index: truth_index(&r.name, self.truth.as_ref()),
+                ..r.clone()
+            })
+            .collect();
+        let frame = Frame { t: now.as_secs_f64(), truth: self.truth.clone(), robots };
+        let Ok(json) = serde_json::to_string(&frame) else { return };
+        if self.frames.len() >= MAX_FRAMES {
+            self.frames.pop_front();
+            self.dropped += 1;
+        }
+        self.frames.push_back((frame.t, json.into()));
+    }
+
+    /// Closes the last instant's frame: nothing more will come.
+    pub fn finish(&mut self) {
+        if let Some(now) = self.now.take() {
+            self.close_frame(now);
+        }
+        self.finished = true;
+    }
+
+    /// Whether [`Timeline::finish`] was called (a recording read whole, a match over).
+    pub fn is_finished(&self) -> bool {
+        self.finished
+    }
+
+    /// The index of the first frame kept (frames before it were dropped, [`MAX_FRAMES`]).
+    pub fn first(&self) -> usize {
+        self.dropped
+    }
+
+    /// The index after the last frame.
+    pub fn end(&self) -> usize {
+        self.dropped + self.frames.len()
+    }
+
+    /// Frame `index` as JSON ([`Frame`]), when it is kept.
+    pub fn frame(&self, index: usize) -> Option<Arc<str>> {
+        let k = index.checked_sub(self.dropped)?;
+        self.frames.get(k).map(|(_, json)| json.clone())
+    }
+
+    /// The time of frame `index`, s.
+    pub fn time(&self, index: usize) -> Option<f64> {
+        let k = index.checked_sub(self.dropped)?;
+        self.frames.get(k).map(|(t, _)| *t)
+    }
+
+    /// The field, from the first world snapshot.
+    pub fn field(&self) -> Option<FieldView> {
+        self.field
+    }
+
+    /// How many messages of a drawn type did not parse.
+    pub fn unreadable(&self) -> u64 {
+        self.unreadable
+    }
+}
+
+fn parse<T: serde::de::DeserializeOwned>(json: &[u8]) -> Option<T> {
+    serde_json::from_slice(json).ok()
+}
+
+/// `home/k` is the truth's robot `k`, `away/k` its robot `home + k`.
+fn truth_index(name: &str, truth: Option<&Truth>) -> Option<usize> {
+    let truth = truth?;
+    let (team, k) = name.rsplit_once('/')?;
+    let k: usize = k.parse().ok()?;
+    let i = match team {
+        "home" => Some(k),
+        "away" => truth.home.checked_add(k),
+        _ => None,
+    }?;
+    (i < truth.robots.len()).then_some(i)
+}
+
+impl RobotView {
+    fn attack(&self) -> Attack {
+        Attack::from_direction(self.attack)
+    }
+
+    /// A team-frame point in millimetres, in the field frame in metres.
+    fn field_point(&self, x: f64, y: f64) -> (f64, f64) {
+        let p = Framed::<Team, Point2>::new(Point2::new(x, y) / MM_PER_M).to_field(self.attack());
+        (p.inner.x, p.inner.y)
+    }
+
+    fn localization(&mut self, l: &Localization) {
+        self.pose = Some(l.pose.inner);
+        self.sigma_xy = l.sigma_xy;
+        self.sigma_theta = l.sigma_theta;
+        self.quality = l.quality;
+        self.ball = l.ball.map(|b| b.at);
+        self.ball_seen_ago = l.ball.map_or(f64::INFINITY, |b| b.seen_ago);
+    }
+
+    fn world(&mut self, w: &WorldSnapshot) {
+        let b = w.global_ball;
+        self.team_ball = (b.quality > 0.0).then(|| self.field_point(b.pose.x, b.pose.y));
+        self.team_ball_quality = b.quality;
+        self.anchors = w
+            .robots
+            .iter()
+            .map(|r| AnchorView {
+                at: self.field_point(r.x, r.y),
+                class: r.class,
+                reliability: r.reliability,
+            })
+            .collect();
+        self.role = w.role.clone();
+        self.job = w.job.as_ref().map_or_else(String::new, |j| {
+            if j.functionality.is_empty() || j.functionality == j.activity {
+                format!("{}: {}", j.activity, j.subtask)
+            } else {
+                format!("{} ({}): {}", j.activity, j.functionality, j.subtask)
+            }
+        });
+        self.ball_booked = w.ball_booked;
+        self.needs_localization = w.needs_localization;
+        self.game_state = w.game_state;
+    }
+
+    fn planned(&mut self, p: &PlannedPath) {
+        self.path = p.poses.iter().map(|q| self.field_point(q.x, q.y)).collect();
+    }
+
+    fn status(&mut self, b: BehaviorStatus) {
+        self.hfsm = b.path;
+        self.behavior = b.behavior;
+        self.activations = b.activations;
+        self.errors = b.errors;
+    }
+
+    fn command(&mut self, c: &RobotCommand) {
+        self.command = Some(CommandView {
+            vlin: c.vlin / MM_PER_M,
+            vlat: c.vlat / MM_PER_M,
+            vrot: c.vrot.to_radians(),
+            kick: c.kick.is_some(),
+        });
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use mrt_msgs::{AnchoredRobot, BallBelief, Estimate};
+    use proptest::prelude::*;
+
+    fn at(t: f64) -> Time {
+        Time::from_secs_f64(t)
+    }
+
+    fn json<T: Serialize>(v: &T) -> Vec<u8> {
+        serde_json::to_vec(v).unwrap()
+    }
+
+    fn frame(t: &Timeline, i: usize) -> Frame {
+        serde_json::from_str(&t.frame(i).unwrap()).unwrap()
+    }
+
+    fn truth(score: (u32, u32)) -> Truth {
+        Truth {
+            ball: (1.0, 2.0),
+            ball_velocity: (0.0, 0.0),
+            robots: vec![Pose2::new(-3.0, 0.0, 0.0), Pose2::new(3.0, 0.0, 3.0)],
+            home: 1,
+            score,
+            state: GameState::Playing,
+        }
+    }
+
+    /// Messages of one instant make one frame; a later message closes it. An away robot that
+    /// attacks west has its team-frame millimetres turned half round into field metres: its
+    /// team ball at (1000, 500) mm is at (−1, −0.5) m on the field, the robot it anchored at
+    /// (2000, 0) mm at (−2, 0) m, its planned pose (500, −250) mm at (−0.5, 0.25) m.
+    #[test]
+    fn one_frame_per_instant_in_the_field_frame() {
+        let mut t = Timeline::new();
+        t.ingest("/truth", at(0.0), &json(&truth((0, 0))));
+        t.ingest(
+            "/away/0/GameInfo",
+            at(0.0),
+            &json(&GameInfo { attack: -1.0, ..Default::default() }),
+        );
+        let l = Localization {
+            pose: Framed::new(Pose2::new(3.0, 0.1, 3.0)),
+            sigma_xy: 0.05,
+            ball: Some(BallBelief { at: (1.1, 2.0), velocity: None, seen_ago: 0.0 }),
+            ..Default::default()
+        };
+        t.ingest("/away/0/Localization", at(0.0), &json(&l));
+        let w = WorldSnapshot {
+            global_ball: Estimate { pose: Pose2::new(1000.0, 500.0, 0.0), quality: 0.8 },
+            robots: vec![AnchoredRobot {
+                x: 2000.0,
+                class: RobotClass::Opponent,
+                reliability: 0.7,
+                ..Default::default()
+            }],
+            role: "attacker".into(),
+            ..Default::default()
+        };
+        t.ingest("/away/0/WorldSnapshot", at(0.0), &json(&w));
+        let path =
+            PlannedPath { poses: vec![Pose2::new(500.0, -250.0, 0.0)], ..Default::default() };
+        t.ingest("/away/0/PlannedPath", at(0.0), &json(&path));
+        t.ingest("/away/0/SonarScan", at(0.0), b"{}");
+        assert_eq!(t.end(), 0, "the instant is still open");
+        t.ingest("/truth", at(0.1), &json(&truth((1, 0))));
+        assert_eq!(t.end(), 1);
+        let f = frame(&t, 0);
+        assert_eq!(f.t, 0.0);
+        assert_eq!(f.truth.as_ref().unwrap().score, (0, 0));
+        let r = &f.robots[0];
+        assert_eq!(r.name, "away/0");
+        assert_eq!(r.truth_index, Some(1), "after the truth's one home robot");
+        assert_eq!(r.pose, Some(Pose2::new(3.0, 0.1, 3.0)));
+        assert_eq!(r.ball, Some((1.1, 2.0)));
+        assert_eq!(r.team_ball, Some((-1.0, -0.5)));
+        assert_eq!(r.anchors[0].at, (-2.0, -0.0));
+        assert_eq!(r.anchors[0].class, RobotClass::Opponent);
+        assert_eq!(r.path, vec![(-0.5, 0.25)]);
+        assert_eq!(r.role, "attacker");
+        assert_eq!(t.field().unwrap().half_length, w.field.half_length / 1000.0);
+        t.finish();
+        assert_eq!(t.end(), 2);
+        assert_eq!(frame(&t, 1).truth.unwrap().score, (1, 0));
+        assert_eq!(frame(&t, 1).robots[0].role, "attacker", "beliefs carry over");
+        assert!(t.is_finished() && t.frame(2).is_none());
+    }
+
+    /// A message of a drawn type that does not parse is counted and changes nothing; a topic
+    /// with no robot name is passed over.
+    #[test]
+    fn unreadable_messages_are_counted_and_left_out() {
+        let mut t = Timeline::new();
+        t.ingest("/home/1/Localization", at(0.0), b"{\"pose\": 3}");
+        t.ingest("/truth", at(0.0), b"[]");
+        t.ingest("nothing", at(0.0), b"{}");
+        t.ingest("/home/1/Odometry", at(0.0), b"not even JSON");
+        t.finish();
+        assert_eq!(t.unreadable(), 2);
+        let f = frame(&t, 0);
+        assert!(f.truth.is_none() && f.robots[0].pose.is_none());
+    }
+
+    /// The timeline keeps at most [`MAX_FRAMES`]: the oldest go first and indices stay.
+    #[test]
+    fn the_oldest_frames_are_dropped_beyond_the_limit() {
+        let mut t = Timeline::new();
+        for k in 0..=MAX_FRAMES + 1 {
+            t.ingest("/truth", Time(k as u64 * 100_000_000), &json(&truth((0, 0))));
+        }
+        t.finish();
+        assert_eq!((t.first(), t.end()), (2, MAX_FRAMES + 2));
+        assert!(t.frame(1).is_none());
+        assert!((t.time(2).unwrap() - 0.2).abs() < 1e-9);
+    }
+
+    proptest! {
+        /// Any bytes on any topic: taken or counted, never a panic.
+        #[test]
+        fn any_message_is_taken_or_counted(
+            topic in prop::sample::select(vec![
+                "/truth", "/home/0/WorldSnapshot", "/away/1/Localization", "/x/BehaviorStatus",
+                "/home/2/RobotCommand", "/home/2/PlannedPath", "/away/0/GameInfo", "//", "",
+            ]),
+            time in any::<u64>(),
+            bytes in prop::collection::vec(any::<u8>(), 0..200),
+        ) {
+            let mut t = Timeline::new();
+            t.ingest(topic, Time(time), &bytes);
+            t.finish();
+            prop_assert!(t.end() <= 1);
+        }
+    }
+}
