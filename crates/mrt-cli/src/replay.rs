@@ -1,10 +1,18 @@
-//! `mrt replay FILE.mcap`: what a recording holds, or (`--serve`) the recording in the web
-//! monitor (docs/monitor.md). Feeding it back into Members is still to come (issue 22).
+//! `mrt replay FILE.mcap`: what a recording holds; (`--serve`) the recording in the web
+//! monitor; (`--robot R [--behaviors DIR]`) one robot's behaviors re-run on the world
+//! snapshots it had, and where their commands differ from the recorded ones (docs/monitor.md).
 
-use anyhow::Result;
+use anyhow::{anyhow, bail, Context as _, Result};
+use mrt_core::Time;
 use mrt_monitor::serve::Server;
+use mrt_monitor::MatchInfo;
 use mrt_monitor::{Recording, Timeline};
+use mrt_msgs::{RobotCommand, WorldSnapshot};
+use mrt_robot::files::FilesDir;
+use mrt_robot::stacks::{embedded_teamchaos, Stack};
+use std::collections::BTreeMap;
 use std::path::PathBuf;
+use std::time::Duration;
 
 /// `mrt replay`.
 #[derive(clap::Args)]
@@ -20,6 +28,16 @@ pub struct ReplayArgs {
     /// 127.0.0.1:8080 (loopback only; port 0 takes any free port).
     #[arg(long, value_name = "ADDR", num_args = 0..=1, default_missing_value = "127.0.0.1:8080")]
     pub serve: Option<std::net::SocketAddr>,
+    /// Re-run this robot's behaviors (e.g. home/2: robot 2 of the home team, 0 keeps goal)
+    /// on the world snapshots it had in the recording, and print the cycles where their
+    /// commands differ from the recorded ones.
+    #[arg(long, value_name = "ROBOT")]
+    pub robot: Option<String>,
+    /// With --robot: the behaviors to re-run, e.g. an edited copy (TeamChaos files for a
+    /// chaos robot, a Mr. BRIAN configuration for a milan one). Default: the compiled-in
+    /// ones.
+    #[arg(long, value_name = "DIR", requires = "robot")]
+    pub behaviors: Option<PathBuf>,
 }
 
 /// Runs `mrt replay`: lists the recording's topics with their schemas, message counts and
@@ -36,6 +54,9 @@ pub fn run(args: &ReplayArgs) -> Result<()> {
         let server = Server::start(addr, timeline.shared(), &title)?;
         outln!("monitor: {} ({frames} frames); Ctrl-C to stop", server.url());
         crate::wait_for_ctrl_c();
+    }
+    if let Some(robot) = &args.robot {
+        return rerun(args, &recording, robot);
     }
     let topics = recording.topics()?;
     let secs = |t: mrt_core::Time| t.as_secs_f64();
@@ -78,4 +99,149 @@ pub fn run(args: &ReplayArgs) -> Result<()> {
         );
     }
     Ok(())
+}
+
+/// How many differing cycles `--robot` prints (`--json` gives them all).
+const SHOWN: usize = 20;
+
+/// `--robot`: the robot's behaviors re-run on its recorded snapshots (module doc).
+fn rerun(args: &ReplayArgs, recording: &Recording, robot: &str) -> Result<()> {
+    let file = args.file.display();
+    let info = recording
+        .messages::<MatchInfo>("/match")?
+        .into_iter()
+        .next()
+        .map(|(_, info)| info)
+        .with_context(|| {
+            format!(
+                "{file}: no /match topic (which stacks played): record it with mrt sim --record"
+            )
+        })?;
+    let (team, k) = robot.split_once('/').unwrap_or((robot, ""));
+    let k: usize = k.parse().map_err(|_| anyhow!("--robot {robot}: expected home/K or away/K"))?;
+    let stack = match team {
+        "home" => Some(info.home.as_str()),
+        "away" => info.away.as_deref(),
+        _ => None,
+    };
+    let stack =
+        stack.with_context(|| format!("--robot {robot}: the recording has no such team"))?;
+    if k >= info.team_size {
+        bail!("--robot {robot}: a team has robots 0 to {}", info.team_size.saturating_sub(1));
+    }
+    let stack = Stack::parse(stack).map_err(|e| anyhow!("{file}: {e}"))?;
+    if stack == Stack::Isocrob {
+        bail!("--robot {robot}: ISocRob robots play through their shared blackboard; one cannot be re-run alone");
+    }
+    let snapshots = recording.messages::<WorldSnapshot>(&format!("/{robot}/WorldSnapshot"))?;
+    if snapshots.is_empty() {
+        bail!("{file}: no world snapshots of {robot}");
+    }
+    let recorded: BTreeMap<Time, RobotCommand> = recording
+        .messages::<RobotCommand>(&format!("/{robot}/RobotCommand"))?
+        .into_iter()
+        .collect();
+    // The compiled-in TeamChaos files live while this handle does.
+    let files = match (&args.behaviors, stack) {
+        (Some(dir), _) => FilesDir::user(dir),
+        (None, Stack::Chaos) => embedded_teamchaos().map_err(|e| anyhow!("{e}"))?,
+        (None, _) => FilesDir::user(PathBuf::new()),
+    };
+    let times: Vec<Time> = snapshots.iter().map(|(t, _)| *t).collect();
+    let worlds = snapshots.into_iter().map(|(_, w)| w).collect();
+    let period = Duration::from_secs_f64(info.period);
+    let report = mrt_robot::rerun::rerun(stack, k == 0, files.path(), period, worlds)
+        .map_err(|e| anyhow!("{robot}: {e}"))?;
+    let rerun = &report.cycles;
+    let mut differing = Vec::new();
+    let mut errors = Vec::new();
+    for (time, cycle) in times.iter().zip(rerun) {
+        errors.extend(cycle.errors.iter().map(|e| (time.as_secs_f64(), e.clone())));
+        let fields = differences(recorded.get(time), cycle.command.as_ref());
+        if !fields.is_empty() {
+            differing.push((time.as_secs_f64(), fields));
+        }
+    }
+    let behaviors = args.behaviors.as_ref().map_or("the compiled-in behaviors".into(), |d| {
+        format!("the behaviors of {}", d.display())
+    });
+    let role = if k == 0 { "goalkeeper" } else { "field player" };
+    if args.json {
+        let v = serde_json::json!({
+            "robot": robot, "stack": stack.name(), "keeper": k == 0, "cycles": rerun.len(),
+            "differing": differing.len(),
+            "differences": differing.iter().map(|(t, f)| serde_json::json!({"t": t, "fields": f})).collect::<Vec<_>>(),
+            "errors": errors.iter().map(|(t, e)| serde_json::json!({"t": t, "error": e})).collect::<Vec<_>>(),
+            "fault": report.fault,
+        });
+        outln!("{}", serde_json::to_string_pretty(&v)?);
+        return Ok(());
+    }
+    outln!(
+        "{robot} ({} {role}): {} world snapshots re-run with {behaviors}; its commands differ from the recording in {} cycles",
+        stack.name(),
+        rerun.len(),
+        differing.len()
+    );
+    for (t, fields) in differing.iter().take(SHOWN) {
+        outln!("  {t:>7.1} s  {}", fields.join("; "));
+    }
+    if differing.len() > SHOWN {
+        outln!("  ... and {} more (--json lists them all)", differing.len() - SHOWN);
+    }
+    if let Some((t, first)) = errors.first() {
+        outln!("  the behaviors reported {} errors, the first at {t:.1} s: {first}", errors.len());
+    }
+    if let Some(fault) = &report.fault {
+        outln!("  the behavior Member faulted: {fault}");
+    }
+    Ok(())
+}
+
+/// What differs between the recorded command and the re-run's, field by field (units of
+/// `RobotCommand`: mm/s and degrees/s); nothing when both are absent or equal.
+fn differences(recorded: Option<&RobotCommand>, rerun: Option<&RobotCommand>) -> Vec<String> {
+    let (a, b) = match (recorded, rerun) {
+        (None, None) => return Vec::new(),
+        (Some(_), None) => return vec!["no command re-run".into()],
+        (None, Some(_)) => return vec!["no command recorded".into()],
+        (Some(a), Some(b)) => (a, b),
+    };
+    let mut out = Vec::new();
+    let close = |x: f64, y: f64| (x - y).abs() <= 1e-6 * (1.0 + x.abs().max(y.abs()));
+    for (name, x, y, unit) in [
+        ("vlin", a.vlin, b.vlin, "mm/s"),
+        ("vlat", a.vlat, b.vlat, "mm/s"),
+        ("vrot", a.vrot, b.vrot, "°/s"),
+    ] {
+        if !close(x, y) {
+            out.push(format!("{name} {x:.1} → {y:.1} {unit}"));
+        }
+    }
+    if a.kick != b.kick {
+        out.push(format!("kick {:?} → {:?}", a.kick, b.kick));
+    }
+    if a.behavior != b.behavior {
+        out.push(format!("behavior {:?} → {:?}", a.behavior, b.behavior));
+    }
+    if a.book_ball != b.book_ball {
+        out.push(format!("book_ball {:?} → {:?}", a.book_ball, b.book_ball));
+    }
+    let pose = |t: &Option<mrt_msgs::Target>| {
+        t.map(|t| (t.pose.x, t.pose.y, t.pose.theta, t.avoid, t.plan))
+    };
+    match (pose(&a.target), pose(&b.target)) {
+        (Some(p), Some(q))
+            if close(p.0, q.0)
+                && close(p.1, q.1)
+                && close(p.2, q.2)
+                && p.3 == q.3
+                && p.4 == q.4 => {}
+        (None, None) => {}
+        (p, q) => out.push(format!("target {p:?} → {q:?}")),
+    }
+    if a.needs != b.needs || a.track_landmarks != b.track_landmarks {
+        out.push(format!("needs {:?} → {:?}", a.needs, b.needs));
+    }
+    out
 }

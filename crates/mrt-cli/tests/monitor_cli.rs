@@ -215,6 +215,109 @@ fn sim_serve_shows_the_match_live_then_keeps_it() {
     assert_eq!(done["end"], 60, "two halves of 3 s at 10 Hz: {done}");
 }
 
+fn replay(args: &[&std::ffi::OsStr]) -> (bool, String, String) {
+    let out = mrt().arg("replay").args(args).output().unwrap();
+    let text = |b: &[u8]| String::from_utf8_lossy(b).into_owned();
+    (out.status.success(), text(&out.stdout), text(&out.stderr))
+}
+
+/// Issue 22, item 2: a robot's behaviors re-run on the world snapshots it had give back
+/// exactly the recorded commands (Milan's Mr. BRIAN, Chaos' HFSM player and HBM keeper); an
+/// edited behavior shows where its commands differ; a behavior that does not load is reported
+/// with its file and line.
+#[test]
+fn replay_robot_reruns_its_behaviors_on_the_recorded_snapshots() {
+    let file = std::env::temp_dir().join(format!("mrt-monitor-rerun-{}.mcap", std::process::id()));
+    let out = mrt()
+        .args(["sim", "--half", "10", "--percepts", "oracle", "--record"])
+        .arg(&file)
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let f = file.as_os_str();
+    for robot in ["home/0", "home/2", "away/0", "away/3"] {
+        let (ok, out, err) = replay(&[f, "--robot".as_ref(), robot.as_ref()]);
+        assert!(ok, "{err}");
+        assert!(out.contains("200 world snapshots re-run"), "{out}");
+        assert!(out.contains("differ from the recording in 0 cycles"), "{robot}: {out}");
+    }
+    let (_, json_out, _) = replay(&[f, "--robot".as_ref(), "home/1".as_ref(), "--json".as_ref()]);
+    let v: Value = serde_json::from_str(&json_out).unwrap();
+    assert_eq!(
+        (v["stack"].as_str(), v["cycles"].as_u64(), v["differing"].as_u64()),
+        (Some("milan"), Some(200), Some(0))
+    );
+
+    // Team Milan's fastest speed turned down from 1200 to 900 mm/s.
+    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let edited = std::env::temp_dir().join(format!("mrt-monitor-milan-{}", std::process::id()));
+    copy_dir(&root.join("configs/brian/milan"), &edited);
+    let shapes = edited.join("s_shape.txt");
+    let text = std::fs::read_to_string(&shapes).unwrap();
+    std::fs::write(&shapes, text.replace("(SNG (FAST 1200))", "(SNG (FAST 900))")).unwrap();
+    let (ok, out, err) = replay(&[
+        f,
+        "--robot".as_ref(),
+        "home/2".as_ref(),
+        "--behaviors".as_ref(),
+        edited.as_os_str(),
+    ]);
+    assert!(ok, "{err}");
+    let n: u64 = out
+        .split("differ from the recording in ")
+        .nth(1)
+        .unwrap()
+        .split(' ')
+        .next()
+        .unwrap()
+        .parse()
+        .unwrap();
+    assert!(n > 0, "{out}");
+    assert!(
+        out.contains("vlin -1200.0 → -900.0 mm/s") || out.contains("vlin 1200.0 → 900.0 mm/s"),
+        "{out}"
+    );
+
+    // A TeamChaos file that does not parse: no commands, the file and line reported.
+    let broken = std::env::temp_dir().join(format!("mrt-monitor-chaos-{}", std::process::id()));
+    copy_dir(&root.join("behaviors/teamchaos"), &broken);
+    let go2ball = broken.join("go2ball.lua");
+    let mut text = std::fs::read_to_string(&go2ball).unwrap();
+    text.push_str("\nthis is not Lua (\n");
+    std::fs::write(&go2ball, text).unwrap();
+    let (ok, out, err) = replay(&[
+        f,
+        "--robot".as_ref(),
+        "away/2".as_ref(),
+        "--behaviors".as_ref(),
+        broken.as_os_str(),
+    ]);
+    assert!(ok, "{err}");
+    assert!(out.contains("in 200 cycles") && out.contains("no command re-run"), "{out}");
+    assert!(out.contains("faulted") && out.contains("go2ball.lua:"), "{out}");
+
+    let (ok, _, err) = replay(&[f, "--robot".as_ref(), "away/7".as_ref()]);
+    assert!(!ok && err.contains("robots 0 to 3"), "{err}");
+    let (ok, _, err) = replay(&[f, "--robot".as_ref(), "east/1".as_ref()]);
+    assert!(!ok && err.contains("no such team"), "{err}");
+    for p in [&edited, &broken] {
+        std::fs::remove_dir_all(p).ok();
+    }
+    std::fs::remove_file(&file).ok();
+}
+
+fn copy_dir(from: &Path, to: &Path) {
+    std::fs::create_dir_all(to).unwrap();
+    for e in std::fs::read_dir(from).unwrap() {
+        let e = e.unwrap();
+        if e.file_type().unwrap().is_dir() {
+            copy_dir(&e.path(), &to.join(e.file_name()));
+        } else {
+            std::fs::copy(e.path(), to.join(e.file_name())).unwrap();
+        }
+    }
+}
+
 /// `--serve` takes one in-process match; a recording the monitor cannot show is an error.
 #[test]
 fn serve_refuses_what_it_cannot_show() {

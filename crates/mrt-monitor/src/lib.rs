@@ -43,4 +43,4 @@ pub mod view;
 pub use record::{RecordError, RecordSummary, Recorder, SharedRecorder};
 pub use replay::{Recording, ReplayError};
 pub use tap::Tap;
-pub use view::{SharedTimeline, Timeline, Truth};
+pub use view::{MatchInfo, SharedTimeline, Timeline, Truth};

@@ -37,6 +37,22 @@ pub struct Truth {
     pub state: GameState,
 }
 
+/// Which match a recording holds, recorded once at its start on the topic `/match`
+/// (`mrt sim --record`): what a replay needs to re-run a robot's behaviors.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize, schemars::JsonSchema)]
+pub struct MatchInfo {
+    /// The home team's stack (`milan`, `chaos`, `isocrob`, `chaser`).
+    pub home: String,
+    /// The away team's stack (`None`: home alone on the field).
+    pub away: Option<String>,
+    /// The match's seed.
+    pub seed: u64,
+    /// Robots a team; robot 0 of each keeps goal.
+    pub team_size: usize,
+    /// The robots' control period, s.
+    pub period: f64,
+}
+
 /// The most frames a timeline keeps (two hours at the robots' 10 Hz): older ones are dropped
 /// first, so that a live monitor's memory stays bounded however long the robots run.
 pub const MAX_FRAMES: usize = 72_000;

@@ -16,7 +16,8 @@
 //!   hand-written `Chaser`) behind the [`brain::Brain`] trait;
 //! - the **[`config::RobotConfig`]**: what belongs to the robot (base, sensors, field, stack),
 //!   apart from any simulator's world;
-//! - the runner of a robot whose devices are reached over the bus ([`remote::RemoteRobot`]).
+//! - the runner of a robot whose devices are reached over the bus ([`remote::RemoteRobot`]);
+//! - [`rerun`]: a robot's behaviors re-run on the world snapshots a recording kept.
 //!
 //! It depends on no simulator: `cargo tree -p mrt-robot -e normal` has no physics engine and no
 //! referee. The simulator (`mrt-sim`) is one implementation of [`devices::Devices`].
@@ -47,4 +48,5 @@ pub mod members;
 pub mod mission;
 pub mod planner;
 pub mod remote;
+pub mod rerun;
 pub mod stacks;

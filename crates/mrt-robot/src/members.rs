@@ -51,7 +51,9 @@ use crate::files::FilesDir;
 use crate::isocrob::IsocrobBrain;
 use crate::look_around::LookAround;
 use crate::planner::{carrot, plans_for, same_goal, Planner, REPLAN};
-use crate::stacks::{embedded_teamchaos, send_brain, Geometry, Stack, CHAOS_KEEPER, CHAOS_PLAYER};
+use crate::stacks::{
+    embedded_teamchaos, send_brain, Geometry, MilanBrain, Stack, CHAOS_KEEPER, CHAOS_PLAYER,
+};
 use mrt_blackboard::{Blackboard, Proxy};
 use mrt_core::{Point2, Pose2};
 use mrt_dcdt::{Activation, Agora, Context, Member, MemberError, Message, RequestType, RunReport};
@@ -571,19 +573,34 @@ pub fn add_robot(
             agora.activate_member(proxy).map_err(|e| e.to_string())?;
             (Box::new(BrainMember::new(Box::new(brain))) as Box<dyn Member>, Commander::PLAIN)
         }
-        Stack::Chaos if keeper => {
-            (Box::new(BehaviorMember::hbm(behaviors, CHAOS_KEEPER)), Commander::chaos(cfg))
-        }
-        Stack::Chaos => (
-            Box::new(BehaviorMember::hfsm(behaviors, behaviors.join(CHAOS_PLAYER))),
-            Commander::chaos(cfg),
-        ),
-        other => (Box::new(BrainMember::new(send_brain(other, keeper)?)), Commander::PLAIN),
+        Stack::Chaos => (behavior_member(stack, keeper, behaviors)?, Commander::chaos(cfg)),
+        // The directory is TeamChaos': the other stacks run their compiled-in behaviors.
+        other => (behavior_member(other, keeper, Path::new(""))?, Commander::PLAIN),
     };
     // Team Milan's parametric behaviors read SCARE's job (MRT manual ch. 11); the others
     // coordinate their own way (TeamChaos: booking and roles).
     let scare = stack == Stack::Milan;
     add_cycle(agora, cfg, (robot, keeper, scare), behavior, commander, devices)
+}
+
+/// The behavior Member of a robot of `stack` (the goalkeeper when `keeper`): for Chaos, the
+/// TeamChaos files of `behaviors` (the HBM goalkeeper or the HFSM field player); for Milan,
+/// the Mr. BRIAN configuration of `behaviors` when given (an empty path: the compiled-in
+/// one); the Chaser's hand-written player. An ISocRob robot needs its blackboard and Proxy
+/// ([`add_robot`] builds them).
+pub fn behavior_member(
+    stack: Stack,
+    keeper: bool,
+    behaviors: &Path,
+) -> Result<Box<dyn Member>, String> {
+    Ok(match stack {
+        Stack::Chaos if keeper => Box::new(BehaviorMember::hbm(behaviors, CHAOS_KEEPER)),
+        Stack::Chaos => Box::new(BehaviorMember::hfsm(behaviors, behaviors.join(CHAOS_PLAYER))),
+        Stack::Milan if !behaviors.as_os_str().is_empty() => {
+            Box::new(BrainMember::new(Box::new(MilanBrain::new(behaviors, keeper)?)))
+        }
+        other => Box::new(BrainMember::new(send_brain(other, keeper)?)),
+    })
 }
 
 /// [`add_robot`] with any `Send` [`Brain`](crate::brain::Brain) as the behaviors (a team's

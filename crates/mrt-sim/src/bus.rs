@@ -13,7 +13,7 @@ use crate::game::{MatchReport, Pitch};
 use crate::referee::Call;
 use mrt_core::SimClock;
 use mrt_dcdt::{InnerLinkManager, SteppedExecutor};
-use mrt_monitor::{SharedRecorder, Tap, Truth};
+use mrt_monitor::{MatchInfo, SharedRecorder, Tap, Truth};
 use mrt_msgs::{Localization, MemberFault, WorldSnapshot};
 use mrt_robot::brain::Brain;
 use mrt_robot::config::RobotConfig;
@@ -120,7 +120,8 @@ impl BusMatch {
 
     /// [`BusMatch::new`], with every robot's messages and the truth recorded into `recorder`
     /// (`mrt sim --record`): a [`Tap`] in each robot's Agora on the topics
-    /// `/home/<k>/<type>` and `/away/<k>/<type>`, and [`Truth`] each cycle on `/truth`.
+    /// `/home/<k>/<type>` and `/away/<k>/<type>`, [`Truth`] each cycle on `/truth`, and which
+    /// match it is ([`MatchInfo`]) on `/match` at its start.
     pub fn recorded(
         cfg: &SimConfig,
         seed: u64,
@@ -134,6 +135,17 @@ impl BusMatch {
         let dir = behaviors_dir(&stacks, behaviors)?;
         let files = dir.clone();
         let teams = (n, if away.is_some() { n } else { 0 });
+        if let Some(rec) = &recorder {
+            let info = MatchInfo {
+                home: home.name().to_string(),
+                away: away.map(|a| a.name().to_string()),
+                seed,
+                team_size: n,
+                period: cfg.robot()?.period().as_secs_f64(),
+            };
+            let mut rec = rec.lock().map_err(|_| "the recorder's lock is poisoned".to_string())?;
+            rec.record("/match", mrt_core::Time::ZERO, &info).map_err(|e| e.to_string())?;
+        }
         BusMatch::build(cfg, seed, teams, files, recorder, |agora, robot_cfg, robot, devices| {
             let spec = RobotSpec::of(robot, n, (home, away.unwrap_or(home)));
             add_robot(agora, robot_cfg, &spec, &dir, devices)
@@ -325,11 +337,16 @@ mod tests {
             );
             let value: serde_json::Value = serde_json::from_slice(&m.data).unwrap();
             let topic = &m.channel.topic;
-            assert!(topic == "/truth" || topic.ends_with(&format!("/{}", schema.name)), "{topic}");
+            let own = topic == "/truth" || topic == "/match";
+            assert!(own || topic.ends_with(&format!("/{}", schema.name)), "{topic}");
             if schema.name == "WorldSnapshot" {
                 serde_json::from_value::<WorldSnapshot>(value).unwrap();
             } else if topic == "/truth" {
                 assert_eq!(value["robots"].as_array().map(Vec::len), Some(4), "{value}");
+            } else if topic == "/match" {
+                let info: MatchInfo = serde_json::from_value(value).unwrap();
+                assert_eq!((info.home.as_str(), info.away.as_deref()), ("chaos", Some("milan")));
+                assert_eq!((info.seed, info.team_size, info.period), (4, 2, 0.1));
             }
             let e = topics.entry(topic.clone()).or_default();
             e.0 += 1;
