@@ -105,6 +105,12 @@ pub struct SimArgs {
     /// with --realtime the match plays at wall-clock speed. One in-process match.
     #[arg(long, value_name = "ADDR", num_args = 0..=1, default_missing_value = "127.0.0.1:8080")]
     pub serve: Option<std::net::SocketAddr>,
+    /// With --record or --serve: keep this many camera images a second of each robot (JPEG,
+    /// Foxglove's `foxglove.CompressedImage` on `/<robot>/camera`, about 10 KB each), for
+    /// Foxglove and the web monitor. Only cameras that render images have them (not
+    /// `--percepts oracle`). Default: none.
+    #[arg(long, value_name = "N", default_value_t = 0)]
+    pub images: u32,
     /// Which embedded world: soccer (a match) or indoor (one robot follows path points
     /// through a building where a door closes and a person walks; the MRT manual's Roby,
     /// docs/indoor.md).
@@ -211,6 +217,13 @@ fn play_one(
                 Some(path) => Recorder::create(path)?,
                 None => Recorder::unwritten(),
             };
+            if args.images > 0 {
+                // Every n-th image of a camera that renders one each control cycle.
+                let per_second =
+                    1.0 / cfg.robot().map_err(|e| anyhow!("{e}"))?.period().as_secs_f64();
+                rec =
+                    rec.with_images(((per_second / f64::from(args.images)).round() as u32).max(1));
+            }
             if let Some(timeline) = timeline.cloned() {
                 rec = rec.listen(Box::new(move |topic, time, json| {
                     if let Ok(mut t) = timeline.lock() {
@@ -302,6 +315,9 @@ pub fn run(args: &SimArgs) -> Result<()> {
     );
     if args.bench {
         return bench(args, &cfg, stacks);
+    }
+    if args.images > 0 && args.record.is_none() && args.serve.is_none() {
+        anyhow::bail!("--images keeps camera images in a recording or the monitor: add --record FILE or --serve");
     }
     for (given, name) in [(args.record.is_some(), "--record"), (args.serve.is_some(), "--serve")] {
         if given && (args.matches > 1 || args.distributed || args.bench) {

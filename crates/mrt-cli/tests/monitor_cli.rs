@@ -318,6 +318,57 @@ fn copy_dir(from: &Path, to: &Path) {
     }
 }
 
+/// `--images N`: N camera images a second of each robot, JPEG on `/<robot>/camera` with
+/// Foxglove's `foxglove.CompressedImage` schema; the monitor serves the selected robot's.
+#[test]
+fn camera_images_are_recorded_and_served() {
+    let file = std::env::temp_dir().join(format!("mrt-monitor-images-{}.mcap", std::process::id()));
+    let out = mrt()
+        .args(["sim", "--half", "2", "--images", "5", "--record"])
+        .arg(&file)
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let (ok, listing, err) = replay(&[file.as_os_str()]);
+    assert!(ok, "{err}");
+    let camera =
+        listing.lines().find(|l| l.trim_start().starts_with("/home/1/camera ")).unwrap_or_default();
+    // Two halves of 2 s, a camera frame every 0.1 s, every second one kept.
+    assert!(
+        camera.contains("foxglove.CompressedImage") && camera.contains(" 20 messages"),
+        "{listing}"
+    );
+    let (_server, url) = serve(&file);
+    let addr = host(&url);
+    let (_, frame) = http("GET", addr, "/frame/21", None);
+    let frame: Value = serde_json::from_str(&frame).unwrap();
+    let robot = frame["frame"]["robots"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|r| r["name"] == "home/1")
+        .unwrap();
+    assert_eq!(robot["image"], 20, "the image of frame 20, the last at or before 21: {robot}");
+    let mut s = TcpStream::connect(addr).unwrap();
+    write!(s, "GET /image/home/1/21 HTTP/1.1\r\nHost: {addr}\r\nConnection: close\r\n\r\n")
+        .unwrap();
+    let mut raw = Vec::new();
+    s.read_to_end(&mut raw).unwrap();
+    let head_end = raw.windows(4).position(|w| w == b"\r\n\r\n").unwrap() + 4;
+    let head = String::from_utf8_lossy(&raw[..head_end]).to_ascii_lowercase();
+    assert!(
+        head.starts_with("http/1.1 200") && head.contains("content-type: image/jpeg"),
+        "{head}"
+    );
+    assert_eq!(&raw[head_end..head_end + 2], &[0xff, 0xd8], "a JPEG");
+    let (status, _) = http("GET", addr, "/image/home/9/21", None);
+    assert_eq!(status, 404);
+    let out = mrt().args(["sim", "--images", "2"]).output().unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success() && err.contains("--images"), "{err}");
+    std::fs::remove_file(&file).ok();
+}
+
 /// `--serve` takes one in-process match; a recording the monitor cannot show is an error.
 #[test]
 fn serve_refuses_what_it_cannot_show() {

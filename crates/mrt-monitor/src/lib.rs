@@ -12,6 +12,8 @@
 //! - [`tap`]: a [`Tap`] is a Member that records every catalogue message of its Agora
 //!   (`mrt sim --record FILE.mcap` puts one in each robot).
 //! - [`catalogue`]: the message types a tap knows, with their schemas.
+//! - [`camera`]: camera images as Foxglove's `foxglove.CompressedImage` (JPEG), recorded at a
+//!   chosen rate ([`Recorder::with_images`]).
 //! - [`view`]: a [`Timeline`] of frames, each the simulator's truth and every robot's beliefs
 //!   in the field frame, from a recording or live from a recorder's listener.
 //! - `serve` (feature `serve`): the web monitor that draws a timeline in a browser
@@ -32,6 +34,7 @@
 //! ```
 #![deny(missing_docs)]
 
+pub mod camera;
 pub mod catalogue;
 pub mod record;
 pub mod replay;

@@ -80,6 +80,8 @@ pub struct Recorder {
     /// Topics by channel id.
     topics: Vec<String>,
     listener: Option<Listener>,
+    /// Record every n-th camera image of each robot (0: none).
+    images_every: u32,
     summary: RecordSummary,
 }
 
@@ -121,8 +123,21 @@ impl Recorder {
             channels: BTreeMap::new(),
             topics: Vec::new(),
             listener: None,
+            images_every: 0,
             summary: RecordSummary::default(),
         }
+    }
+
+    /// The same recorder, with every `every`-th camera image of each robot recorded as a JPEG
+    /// on `/<robot>/camera` ([`CompressedImage`](crate::camera::CompressedImage); 0: none, the
+    /// default). Images are most of what a recording with them weighs: about 10 KB each.
+    pub fn with_images(self, every: u32) -> Recorder {
+        Recorder { images_every: every, ..self }
+    }
+
+    /// Every how many camera images one is recorded (0: none).
+    pub fn images_every(&self) -> u32 {
+        self.images_every
     }
 
     /// The same recorder, calling `listener` with every message it writes, after writing it.

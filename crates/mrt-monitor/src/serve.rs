@@ -7,6 +7,8 @@
 //! - `GET /meta`: `{"title", "field", "first", "end", "finished"}`;
 //! - `GET /frame/{i}` (`i` a frame index or `latest`): `{"first", "end", "finished", "index",
 //!   "frame"}`, the frame a [`Frame`](crate::view::Frame) or `null`;
+//! - `GET /image/{team}/{k}/{i}`: robot `team/k`'s camera image (JPEG) last taken at or
+//!   before frame `i`, when the recording has images (`mrt sim --images`);
 //! - `GET /ws`: a WebSocket; each text message `{"frame": i}` (or `"latest"`) is answered
 //!   with what `/frame/{i}` answers. The page plays, pauses, steps and scrubs by asking.
 
@@ -72,6 +74,7 @@ impl Server {
             .route("/", get(page))
             .route("/meta", get(meta))
             .route("/frame/{index}", get(frame))
+            .route("/image/{team}/{k}/{index}", get(camera))
             .route("/ws", get(socket))
             .with_state(shared);
         std::thread::Builder::new()
@@ -154,6 +157,22 @@ fn envelope(s: &Shared, request: &str) -> String {
 
 async fn frame(State(s): State<Shared>, Path(index): Path<String>) -> Response {
     json(envelope(&s, &index))
+}
+
+async fn camera(
+    State(s): State<Shared>,
+    Path((team, k, index)): Path<(String, String, usize)>,
+) -> Response {
+    let Ok(t) = s.timeline.lock() else {
+        return (StatusCode::INTERNAL_SERVER_ERROR, "the timeline's lock is poisoned")
+            .into_response();
+    };
+    match t.image(&format!("{team}/{k}"), index) {
+        Some(jpeg) => ([(header::CONTENT_TYPE, "image/jpeg")], jpeg.to_vec()).into_response(),
+        None => {
+            (StatusCode::NOT_FOUND, "no camera image of that robot by that frame").into_response()
+        }
+    }
 }
 
 async fn socket(State(s): State<Shared>, ws: WebSocketUpgrade) -> Response {

@@ -1,14 +1,17 @@
 //! A Member that records its Agora's messages (crate doc).
 
+use crate::camera::CompressedImage;
 use crate::catalogue;
 use crate::record::SharedRecorder;
 use mrt_core::MsgType;
 use mrt_dcdt::{Context, Member, MemberError, RequestType};
+use mrt_msgs::CameraFrame;
 use std::collections::BTreeMap;
 
 /// Records every catalogue message published in its Agora ([`catalogue::CATALOGUE`]) on the
 /// topic `/<prefix>/<type name>` (e.g. `/home/2/WorldSnapshot`), at the message's creation
-/// time. It subscribes with [`RequestType::Local`]: each robot's own messages, once (a
+/// time, and every n-th camera image as a JPEG on `/<prefix>/camera` when the recorder
+/// asks for images ([`Recorder::with_images`](crate::Recorder::with_images)). It subscribes with [`RequestType::Local`]: each robot's own messages, once (a
 /// teammate's report is recorded on the teammate's topic). A message that does not encode is
 /// counted in the recorder's summary and left out; a recorder that fails stops the tap's
 /// Member with the error (the rest of the robot runs on).
@@ -16,12 +19,14 @@ pub struct Tap {
     prefix: String,
     recorder: SharedRecorder,
     channels: BTreeMap<MsgType, u16>,
+    /// Camera images seen, for [`Recorder::with_images`](crate::Recorder::with_images).
+    images: u64,
 }
 
 impl Tap {
     /// A tap recording under `/<prefix>/` into `recorder`.
     pub fn new(prefix: impl Into<String>, recorder: SharedRecorder) -> Tap {
-        Tap { prefix: prefix.into(), recorder, channels: BTreeMap::new() }
+        Tap { prefix: prefix.into(), recorder, channels: BTreeMap::new(), images: 0 }
     }
 }
 
@@ -58,6 +63,21 @@ impl Member for Tap {
                 }
             };
             rec.write(channel, m.creation_time(), &json).map_err(|e| e.to_string())?;
+            let every = u64::from(rec.images_every());
+            if let (true, Ok(frame)) = (every > 0, m.get::<CameraFrame>()) {
+                if let Some(image) = &frame.image {
+                    if self.images % every == 0 {
+                        let topic = format!("/{}/camera", self.prefix);
+                        match CompressedImage::jpeg(image, m.creation_time(), "camera") {
+                            Some(jpeg) => rec
+                                .record(&topic, m.creation_time(), &jpeg)
+                                .map_err(|e| e.to_string())?,
+                            None => rec.failed(),
+                        }
+                    }
+                    self.images += 1;
+                }
+            }
         }
         Ok(())
     }

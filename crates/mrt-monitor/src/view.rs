@@ -8,12 +8,13 @@
 //! east goal, radians): the robots' team-frame millimetres (`WorldSnapshot`, `PlannedPath`)
 //! are turned with the direction the robot's team attacks (`GameInfo::attack`).
 
+use crate::camera::CompressedImage;
 use crate::replay::{Recording, ReplayError};
 use mrt_core::frames::{Attack, Framed, Team, MM_PER_M};
 use mrt_core::{Point2, Pose2, Time};
 use mrt_msgs::{
-    BehaviorStatus, GameInfo, GameState, Localization, PlannedPath, RobotClass, RobotCommand,
-    WorldSnapshot,
+    BehaviorStatus, GameInfo, GameState, Localization, Percepts, PlannedPath, RobotClass,
+    RobotCommand, Sighting, WorldSnapshot,
 };
 use serde::{Deserialize, Serialize};
 use std::collections::{BTreeMap, VecDeque};
@@ -118,6 +119,41 @@ pub struct RobotView {
     pub errors: Vec<String>,
     /// Its last command: linear (m/s) and rotational (rad/s) velocity, and a kick.
     pub command: Option<CommandView>,
+    /// What its vision found in its last image (`Percepts`), in its own frame.
+    pub seen: Option<SeenView>,
+    /// The frame at which its last recorded camera image was taken ([`Timeline::image`]).
+    pub image: Option<usize>,
+}
+
+/// What a robot's vision found in one image (`Percepts`), in the robot's frame (x forward, y
+/// to the left, m): the page draws it from where the robot believes it is.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct SeenView {
+    /// The ball.
+    pub ball: Option<(f64, f64)>,
+    /// The nets and the field's landmarks.
+    pub landmarks: Vec<(f64, f64)>,
+    /// The landmark posts.
+    pub posts: Vec<(f64, f64)>,
+    /// The other robots' nearest points.
+    pub robots: Vec<(f64, f64)>,
+    /// Points of the white field lines.
+    pub lines: Vec<(f64, f64)>,
+}
+
+impl SeenView {
+    fn of(p: &Percepts) -> SeenView {
+        let at = |s: &Sighting| (s.distance * s.bearing.cos(), s.distance * s.bearing.sin());
+        let mut sightings = p.sightings.iter();
+        let ball = sightings.next().copied().flatten().map(|s| at(&s));
+        SeenView {
+            ball,
+            landmarks: sightings.flatten().map(at).collect(),
+            posts: p.posts.iter().map(|q| at(&q.sighting)).collect(),
+            robots: p.robots.iter().map(|r| at(&r.sighting)).collect(),
+            lines: p.line_points.clone(),
+        }
+    }
 }
 
 /// A robot's command as the monitor shows it.
@@ -167,11 +203,16 @@ pub struct Timeline {
     now: Option<Time>,
     truth: Option<Truth>,
     robots: BTreeMap<String, RobotView>,
+    /// Camera images by robot.
+    images: BTreeMap<String, Images>,
     field: Option<FieldView>,
     /// Messages of a known type that did not parse, counted and left out.
     unreadable: u64,
     finished: bool,
 }
+
+/// One robot's camera images (JPEG), each with the frame it was taken in, oldest first.
+type Images = VecDeque<(usize, Arc<[u8]>)>;
 
 /// A timeline shared by its writer (a recording read back, a live match) and the web server.
 pub type SharedTimeline = Arc<Mutex<Timeline>>;
@@ -215,7 +256,11 @@ impl Timeline {
             let Some((name, ty)) = topic.trim_start_matches('/').rsplit_once('/') else {
                 return;
             };
-            self.robot_message(name, ty, json)
+            if ty == "camera" {
+                self.camera_image(name, json)
+            } else {
+                self.robot_message(name, ty, json)
+            }
         };
         if !ok {
             self.unreadable += 1;
@@ -249,8 +294,32 @@ impl Timeline {
             "PlannedPath" => parse(json).map(|p: PlannedPath| view.planned(&p)).is_some(),
             "BehaviorStatus" => parse(json).map(|b: BehaviorStatus| view.status(b)).is_some(),
             "RobotCommand" => parse(json).map(|c: RobotCommand| view.command(&c)).is_some(),
+            "Percepts" => {
+                parse(json).map(|p: Percepts| view.seen = Some(SeenView::of(&p))).is_some()
+            }
             _ => true,
         }
+    }
+
+    /// Keeps a camera image (`foxglove.CompressedImage`) of robot `name` for the frame being
+    /// gathered; whether it parsed.
+    fn camera_image(&mut self, name: &str, json: &[u8]) -> bool {
+        let Some(bytes) = parse::<CompressedImage>(json).and_then(|c| c.bytes()) else {
+            return false;
+        };
+        let index = self.end();
+        self.images.entry(name.to_string()).or_default().push_back((index, bytes.into()));
+        if let Some(view) = self.robots.get_mut(name) {
+            view.image = Some(index);
+        }
+        true
+    }
+
+    /// The camera image (JPEG) of robot `name` last taken at or before frame `index`.
+    pub fn image(&self, name: &str, index: usize) -> Option<Arc<[u8]>> {
+        let images = self.images.get(name)?;
+        let k = images.partition_point(|(i, _)| *i <= index);
+        images.get(k.checked_sub(1)?).map(|(_, jpeg)| jpeg.clone())
     }
 
     fn close_frame(&mut self, now: Time) {
@@ -267,6 +336,11 @@ impl Timeline {
         if self.frames.len() >= MAX_FRAMES {
             self.frames.pop_front();
             self.dropped += 1;
+            for images in self.images.values_mut() {
+                while images.front().is_some_and(|(i, _)| *i < self.dropped) {
+                    images.pop_front();
+                }
+            }
         }
         self.frames.push_back((frame.t, json.into()));
     }
@@ -465,6 +539,9 @@ mod tests {
         let path =
             PlannedPath { poses: vec![Pose2::new(500.0, -250.0, 0.0)], ..Default::default() };
         t.ingest("/away/0/PlannedPath", at(0.0), &json(&path));
+        let mut seen = Percepts { line_points: vec![(1.0, -0.5)], ..Default::default() };
+        seen.sightings[0] = Some(Sighting { distance: 2.0, bearing: std::f64::consts::FRAC_PI_2 });
+        t.ingest("/away/0/Percepts", at(0.0), &json(&seen));
         t.ingest("/away/0/SonarScan", at(0.0), b"{}");
         assert_eq!(t.end(), 0, "the instant is still open");
         t.ingest("/truth", at(0.1), &json(&truth((1, 0))));
@@ -482,12 +559,41 @@ mod tests {
         assert_eq!(r.anchors[0].class, RobotClass::Opponent);
         assert_eq!(r.path, vec![(-0.5, 0.25)]);
         assert_eq!(r.role, "attacker");
+        let seen = r.seen.as_ref().unwrap();
+        let ball = seen.ball.unwrap();
+        assert!(ball.0.abs() < 1e-12 && (ball.1 - 2.0).abs() < 1e-12, "2 m to its left: {ball:?}");
+        assert_eq!(seen.lines, vec![(1.0, -0.5)]);
+        assert!(seen.landmarks.is_empty());
         assert_eq!(t.field().unwrap().half_length, w.field.half_length / 1000.0);
         t.finish();
         assert_eq!(t.end(), 2);
         assert_eq!(frame(&t, 1).truth.unwrap().score, (1, 0));
         assert_eq!(frame(&t, 1).robots[0].role, "attacker", "beliefs carry over");
         assert!(t.is_finished() && t.frame(2).is_none());
+    }
+
+    /// Camera images are kept by robot with the frame they came in; asking for a frame gives
+    /// the last image taken at or before it.
+    #[test]
+    fn camera_images_are_kept_by_robot_and_frame() {
+        let img = mrt_msgs::Image::new(8, 8);
+        let jpeg = |t: f64| json(&CompressedImage::jpeg(&img, at(t), "camera").unwrap());
+        let mut t = Timeline::new();
+        t.ingest("/home/1/WorldSnapshot", at(0.0), &json(&WorldSnapshot::default()));
+        t.ingest("/home/1/camera", at(0.0), &jpeg(0.0));
+        t.ingest("/home/1/WorldSnapshot", at(0.1), &json(&WorldSnapshot::default()));
+        t.ingest("/home/1/WorldSnapshot", at(0.2), &json(&WorldSnapshot::default()));
+        t.ingest("/home/1/camera", at(0.2), &jpeg(0.2));
+        t.ingest("/home/1/camera", at(0.3), b"{\"data\": 5}");
+        t.finish();
+        assert_eq!(t.unreadable(), 1);
+        assert_eq!(frame(&t, 1).robots[0].image, Some(0));
+        assert_eq!(frame(&t, 2).robots[0].image, Some(2));
+        let first = t.image("home/1", 1).unwrap();
+        assert_eq!(&first[..2], &[0xff, 0xd8]);
+        assert!(Arc::ptr_eq(&first, &t.image("home/1", 0).unwrap()));
+        assert!(!Arc::ptr_eq(&first, &t.image("home/1", 2).unwrap()));
+        assert!(t.image("home/2", 2).is_none() && t.image("home/1", 0).is_some());
     }
 
     /// A message of a drawn type that does not parse is counted and changes nothing; a topic
