@@ -3,7 +3,7 @@
 use anyhow::{anyhow, Context as _, Result};
 use indicatif::{ProgressBar, ProgressStyle};
 use mrt_monitor::serve::Server;
-use mrt_monitor::{Recorder, SharedTimeline, Timeline};
+use mrt_monitor::{Recorder, SharedRecorder, SharedTimeline, Timeline};
 use mrt_robot::stacks::Stack;
 use mrt_sim::config::SimConfig;
 use mrt_sim::game::{MatchReport, TeamStats};
@@ -106,7 +106,7 @@ pub struct SimArgs {
     #[arg(long, value_name = "ADDR", num_args = 0..=1, default_missing_value = "127.0.0.1:8080")]
     pub serve: Option<std::net::SocketAddr>,
     /// With --record or --serve: keep this many camera images a second of each robot (JPEG,
-    /// Foxglove's `foxglove.CompressedImage` on `/<robot>/camera`, about 10 KB each), for
+    /// Foxglove's `foxglove.CompressedImage` on `/<robot>/camera`, about 5 KB each), for
     /// Foxglove and the web monitor. Only cameras that render images have them (not
     /// `--percepts oracle`). Default: none.
     #[arg(long, value_name = "N", default_value_t = 0)]
@@ -210,30 +210,7 @@ fn play_one(
              (cargo run --release -p mrt-cli -- sim --distributed)"
         );
     }
-    let recorder = match (&args.record, timeline) {
-        (None, None) => None,
-        (path, timeline) => {
-            let mut rec = match path {
-                Some(path) => Recorder::create(path)?,
-                None => Recorder::unwritten(),
-            };
-            if args.images > 0 {
-                // Every n-th image of a camera that renders one each control cycle.
-                let per_second =
-                    1.0 / cfg.robot().map_err(|e| anyhow!("{e}"))?.period().as_secs_f64();
-                rec =
-                    rec.with_images(((per_second / f64::from(args.images)).round() as u32).max(1));
-            }
-            if let Some(timeline) = timeline.cloned() {
-                rec = rec.listen(Box::new(move |topic, time, json| {
-                    if let Ok(mut t) = timeline.lock() {
-                        t.ingest(topic, time, json);
-                    }
-                }));
-            }
-            Some(rec.shared())
-        }
-    };
+    let recorder = recorder(args, cfg, timeline)?;
     let behaviors = args.behaviors.as_deref();
     let report = play_recorded(cfg, seed, stacks, behaviors, record, recorder.clone(), progress)
         .map_err(|e| anyhow!("{e}"))?;
@@ -254,6 +231,35 @@ fn play_one(
         ));
     }
     Ok((report, notes))
+}
+
+/// The recorder of `--record` (into its file) and `--serve` (into the monitor's `timeline`),
+/// keeping `--images` camera images; `None` when neither was asked for.
+fn recorder(
+    args: &SimArgs,
+    cfg: &SimConfig,
+    timeline: Option<&SharedTimeline>,
+) -> Result<Option<SharedRecorder>> {
+    if args.record.is_none() && timeline.is_none() {
+        return Ok(None);
+    }
+    let mut rec = match &args.record {
+        Some(path) => Recorder::create(path)?,
+        None => Recorder::unwritten(),
+    };
+    if args.images > 0 {
+        // Every n-th image of a camera that renders one each control cycle.
+        let per_second = 1.0 / cfg.robot().map_err(|e| anyhow!("{e}"))?.period().as_secs_f64();
+        rec = rec.with_images(((per_second / f64::from(args.images)).round() as u32).max(1));
+    }
+    if let Some(timeline) = timeline.cloned() {
+        rec = rec.listen(Box::new(move |topic, time, json| {
+            if let Ok(mut t) = timeline.lock() {
+                t.ingest(topic, time, json);
+            }
+        }));
+    }
+    Ok(Some(rec.shared()))
 }
 
 /// How the robots were wired, for the report.
@@ -313,9 +319,6 @@ pub fn run(args: &SimArgs) -> Result<()> {
         Stack::parse(&args.home).map_err(|e| anyhow!("--home: {e}"))?,
         Stack::parse(&args.away).map_err(|e| anyhow!("--away: {e}"))?,
     );
-    if args.bench {
-        return bench(args, &cfg, stacks);
-    }
     if args.images > 0 && args.record.is_none() && args.serve.is_none() {
         anyhow::bail!("--images keeps camera images in a recording or the monitor: add --record FILE or --serve");
     }
@@ -325,6 +328,9 @@ pub fn run(args: &SimArgs) -> Result<()> {
                 "{name} takes one in-process match: leave out --matches, --distributed and --bench"
             );
         }
+    }
+    if args.bench {
+        return bench(args, &cfg, stacks);
     }
     if args.matches > 1 {
         if args.distributed {

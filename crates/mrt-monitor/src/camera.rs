@@ -7,8 +7,8 @@ use mrt_core::Time;
 use mrt_msgs::Image;
 use serde::{Deserialize, Serialize};
 
-/// The JPEG quality of recorded camera images (0 to 100): a 320 × 240 rendering takes about
-/// 10 KB.
+/// The JPEG quality of recorded camera images (0 to 100): a 320 × 240 rendering takes 5 to
+/// 7 KB.
 pub const JPEG_QUALITY: u8 = 75;
 
 /// A time as Foxglove's schemas write it.
