@@ -173,6 +173,20 @@ fn robot_net_file(i: usize, first: usize, discovery: u16, sim: u16, ports: &[u16
     text
 }
 
+/// The §3.3.1 file of a monitor joining a distributed match (`mrt topic`): static links from
+/// `port` to every robot's port, on a discovery port of its own (no scouting on loopback).
+fn monitor_net_file(port: u16, discovery: u16, ports: &[u16]) -> String {
+    let mut text = format!(
+        "# A monitor of a distributed match (written by mrt sim --distributed): mrt topic\n\
+         # list|echo|hz --net THIS_FILE. Static links to every robot's Agora.\n\
+         127.0.0.1 224.0.0.224 {discovery}\n"
+    );
+    for &p in ports {
+        text.push_str(&format!("ip link 0 127.0.0.1 {port} 127.0.0.1 {p}\n"));
+    }
+    text
+}
+
 /// Plays one match with every robot in a process of its own; `progress` gets the simulated
 /// time after each cycle; `restart` kills a robot's process mid-match and starts it again.
 pub fn play(
@@ -218,6 +232,10 @@ pub fn play(
             files.push(file);
         }
     }
+    // A network file for monitors (`mrt topic ... --net FILE`): static links to every robot.
+    let monitor = dir.join("monitor.cfg");
+    std::fs::write(&monitor, monitor_net_file(picker.port()?, picker.port()?, &ports))?;
+    eprintln!("network of this match: {} (mrt topic list --net FILE)", monitor.display());
     let launch = Launch { exe };
     for (i, file) in files.iter().enumerate() {
         let child = launch.robot(i, file, &procs.log(i))?;

@@ -30,6 +30,8 @@ mod plan;
 mod replay;
 mod sim;
 mod soak;
+#[cfg(feature = "net")]
+mod topic;
 mod vision;
 
 use anyhow::{Context as _, Result};
@@ -79,6 +81,14 @@ enum Command {
     /// --distributed` starts each of its robots with this command).
     #[cfg(feature = "net")]
     Robot(distributed::RobotArgs),
+    /// The messages of robots running anywhere on the network: which types and who publishes
+    /// them (`list`), one type as JSON Lines (`echo`), its rate (`hz`); `mrt sim
+    /// --distributed` prints its match's network file (docs/monitor.md).
+    #[cfg(feature = "net")]
+    Topic {
+        #[command(subcommand)]
+        command: topic::TopicCommand,
+    },
     /// Vision tools: find the ball in camera images (`detect`), tune colours (`calibrate`),
     /// save what a simulated camera sees (`render`), measure the vision on it (`survey`).
     Vision {
@@ -264,6 +274,8 @@ fn run(command: Command) -> Result<()> {
         },
         Command::Sim(args) => sim::run(&args)?,
         Command::Replay(args) => replay::run(&args)?,
+        #[cfg(feature = "net")]
+        Command::Topic { command } => topic::run(&command)?,
         Command::Soak { command } => soak::run(&command)?,
         #[cfg(feature = "net")]
         Command::Robot(args) => distributed::robot(&args)?,

@@ -576,3 +576,58 @@ fn base64_decode(s: &str) -> Vec<u8> {
     }
     out
 }
+
+/// Issue 22, item 4: `mrt topic` joins a running `mrt sim --distributed` through the network
+/// file the match prints: `list` names the types and the Agoras publishing them, `echo`
+/// prints robot 2's world snapshots (Agora 3) as JSON Lines, `hz` measures the 10 Hz cycle.
+#[test]
+fn topic_lists_echoes_and_measures_a_distributed_match() {
+    let mut child = mrt()
+        .args(["sim", "--distributed", "--half", "30", "--realtime", "--percepts", "oracle"])
+        .args(["--home", "chaser", "--away", "chaser"])
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut err = BufReader::new(child.stderr.take().unwrap());
+    let _sim = Running(child);
+    let mut line = String::new();
+    while !line.contains("network of this match: ") {
+        line.clear();
+        assert!(err.read_line(&mut line).unwrap() > 0, "the match ended before its network line");
+    }
+    // Keep reading what the match writes, so that it never blocks on a full pipe.
+    std::thread::spawn(move || std::io::copy(&mut err, &mut std::io::sink()));
+    let file = line
+        .split("network of this match: ")
+        .nth(1)
+        .unwrap()
+        .split_whitespace()
+        .next()
+        .unwrap()
+        .to_string();
+    let topic = |args: &[&str]| {
+        let out = mrt().arg("topic").args(args).args(["--net", &file]).output().unwrap();
+        let text = |b: &[u8]| String::from_utf8_lossy(b).into_owned();
+        assert!(out.status.success(), "{}", text(&out.stderr));
+        text(&out.stdout)
+    };
+    let echo = topic(&["echo", "WorldSnapshot", "--agora", "3", "--count", "3", "--seconds", "60"]);
+    let lines: Vec<Value> = echo.lines().map(|l| serde_json::from_str(l).unwrap()).collect();
+    assert_eq!(lines.len(), 3, "{echo}");
+    for l in &lines {
+        assert_eq!(l["agora"], 3);
+        let _: mrt_msgs::WorldSnapshot = serde_json::from_value(l["message"].clone()).unwrap();
+    }
+    let list = topic(&["list", "--seconds", "2"]);
+    let snapshots = list.lines().find(|l| l.starts_with("WorldSnapshot")).unwrap_or_default();
+    assert!(snapshots.contains("from Agoras 1, 2, 3, 4, 5, 6, 7, 8"), "{list}");
+    let hz = topic(&["hz", "RobotCommand", "--seconds", "3"]);
+    let one = hz.lines().find(|l| l.starts_with("RobotCommand from Agora 1: ")).unwrap_or_default();
+    let rate: f64 =
+        one.split(": ").nth(1).unwrap_or("0").split(' ').next().unwrap().parse().unwrap();
+    assert!((7.0..13.0).contains(&rate), "a 10 Hz cycle: {hz}");
+    let out = mrt().args(["topic", "echo", "Nonsense", "--net", &file]).output().unwrap();
+    let e = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success() && e.contains("WorldSnapshot"), "the types are listed: {e}");
+}
