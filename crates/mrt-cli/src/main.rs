@@ -89,6 +89,13 @@ enum Command {
         #[command(subcommand)]
         command: topic::TopicCommand,
     },
+    /// Record every bus message of the robots on a network (other processes, other machines)
+    /// into an MCAP file, for `mrt replay` and Foxglove (docs/monitor.md).
+    #[cfg(feature = "net")]
+    Record(topic::RecordArgs),
+    /// Serve the web monitor on the robots of a network, live (docs/monitor.md).
+    #[cfg(feature = "net")]
+    Monitor(topic::MonitorArgs),
     /// Vision tools: find the ball in camera images (`detect`), tune colours (`calibrate`),
     /// save what a simulated camera sees (`render`), measure the vision on it (`survey`).
     Vision {
@@ -276,6 +283,10 @@ fn run(command: Command) -> Result<()> {
         Command::Replay(args) => replay::run(&args)?,
         #[cfg(feature = "net")]
         Command::Topic { command } => topic::run(&command)?,
+        #[cfg(feature = "net")]
+        Command::Record(args) => topic::record(&args)?,
+        #[cfg(feature = "net")]
+        Command::Monitor(args) => topic::monitor(&args)?,
         Command::Soak { command } => soak::run(&command)?,
         #[cfg(feature = "net")]
         Command::Robot(args) => distributed::robot(&args)?,

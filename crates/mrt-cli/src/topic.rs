@@ -1,12 +1,15 @@
-//! `mrt topic list|echo|hz --net FILE`: the messages of robots running anywhere on the
-//! network, seen by an Agora of this process joined to their network (`mrt-net`, the same
+//! `mrt topic list|echo|hz --net FILE`, `mrt record --net FILE -o OUT.mcap` and `mrt monitor
+//! --net FILE --serve`: the messages of robots running anywhere on the network, seen by an Agora of this process joined to their network (`mrt-net`, the same
 //! discovery and links as the robots'), with a Member that subscribes to every catalogue type
 //! (`RequestType::Remote`): the robots send a type to this Agora because it wants it, like to
 //! any other (docs/monitor.md, "Topics on the network").
 
 use anyhow::{anyhow, bail, Result};
+use mrt_core::Time;
 use mrt_dcdt::{Activation, Context, Member, MemberError, RequestType};
 use mrt_monitor::catalogue::{self, Entry};
+use mrt_monitor::serve::Server;
+use mrt_monitor::{Recorder, Timeline};
 use std::collections::BTreeMap;
 use std::path::PathBuf;
 use std::sync::mpsc;
@@ -69,8 +72,15 @@ pub enum TopicCommand {
 struct Heard {
     entry: &'static Entry,
     agora: u32,
-    time: f64,
+    time: Time,
     json: Option<Vec<u8>>,
+}
+
+impl Heard {
+    /// Its topic in a recording or the monitor: `/agora/<id>/<Type>`.
+    fn topic(&self) -> String {
+        format!("/agora/{}/{}", self.agora, self.entry.name)
+    }
 }
 
 /// Subscribes to `types` from the other Agoras and hands every message to the channel.
@@ -96,8 +106,7 @@ impl Member for Listener {
         while let Some(m) = ctx.receive_msg() {
             let Some(entry) = catalogue::entry(m.msg_type()) else { continue };
             let json = if self.json { (entry.to_json)(&m).and_then(Result::ok) } else { None };
-            let heard =
-                Heard { entry, agora: m.agora_id().0, time: m.creation_time().as_secs_f64(), json };
+            let heard = Heard { entry, agora: m.agora_id().0, time: m.creation_time(), json };
             if self.out.send(heard).is_err() {
                 return Ok(()); // the command is done listening
             }
@@ -217,7 +226,8 @@ pub fn run(command: &TopicCommand) -> Result<()> {
                     return true;
                 }
                 let message = h.json.as_deref().map_or("null".into(), String::from_utf8_lossy);
-                outln!(r#"{{"agora":{},"time":{},"message":{message}}}"#, h.agora, h.time);
+                let time = h.time.as_secs_f64();
+                outln!(r#"{{"agora":{},"time":{time},"message":{message}}}"#, h.agora);
                 printed += 1;
                 count.is_none_or(|c| printed < c)
             });
@@ -250,5 +260,80 @@ pub fn run(command: &TopicCommand) -> Result<()> {
             }
         }
     }
+    Ok(())
+}
+
+/// `mrt record --net FILE -o OUT.mcap`.
+#[derive(clap::Args)]
+pub struct RecordArgs {
+    #[command(flatten)]
+    net: NetArgs,
+    /// The MCAP file to write (topics `/agora/<id>/<Type>`, docs/monitor.md).
+    #[arg(short, long, value_name = "OUT.mcap")]
+    output: PathBuf,
+    /// How long to record, s (the file is complete only when the time is up: Ctrl-C loses
+    /// its index).
+    #[arg(long, default_value_t = 60.0)]
+    seconds: f64,
+}
+
+/// Records every catalogue message of the network's Agoras for `--seconds`.
+pub fn record(args: &RecordArgs) -> Result<()> {
+    let end = deadline(args.seconds, "--seconds")?;
+    let mut rec = Recorder::create(&args.output)?;
+    let (rx, _joined) = listen(&args.net, catalogue::CATALOGUE.iter().collect(), true)?;
+    let mut failed = None;
+    until(&rx, Some(end), |h| {
+        let Some(json) = &h.json else {
+            rec.failed();
+            return true;
+        };
+        let written = rec
+            .channel(&h.topic(), h.entry.name, h.entry.schema)
+            .and_then(|c| rec.write(c, h.time, json));
+        if let Err(e) = written {
+            failed = Some(e);
+        }
+        failed.is_none()
+    });
+    if let Some(e) = failed {
+        return Err(e.into());
+    }
+    let s = rec.finish()?;
+    let size = std::fs::metadata(&args.output).map(|m| m.len()).unwrap_or(0);
+    outln!(
+        "recorded {} messages on {} topics in {} s into {} ({:.1} MB)",
+        s.messages,
+        s.channels,
+        args.seconds,
+        args.output.display(),
+        size as f64 / 1e6
+    );
+    Ok(())
+}
+
+/// `mrt monitor --net FILE --serve ADDR`.
+#[derive(clap::Args)]
+pub struct MonitorArgs {
+    #[command(flatten)]
+    net: NetArgs,
+    /// Where to serve the web monitor (loopback by default; port 0: any free port).
+    #[arg(long, value_name = "ADDR", default_value = "127.0.0.1:8080")]
+    serve: std::net::SocketAddr,
+}
+
+/// Serves the web monitor on what the network's Agoras publish, until Ctrl-C.
+pub fn monitor(args: &MonitorArgs) -> Result<()> {
+    let timeline = Timeline::new().shared();
+    let title = format!("the network of {}", args.net.net.display());
+    let server = Server::start(args.serve, timeline.clone(), &title)?;
+    let (rx, _joined) = listen(&args.net, catalogue::CATALOGUE.iter().collect(), true)?;
+    outln!("monitor: {}; Ctrl-C to stop", server.url());
+    until(&rx, None, |h| {
+        if let (Some(json), Ok(mut t)) = (&h.json, timeline.lock()) {
+            t.ingest(&h.topic(), h.time, json);
+        }
+        true
+    });
     Ok(())
 }

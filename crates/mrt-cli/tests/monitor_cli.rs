@@ -627,6 +627,49 @@ fn topic_lists_echoes_and_measures_a_distributed_match() {
     let rate: f64 =
         one.split(": ").nth(1).unwrap_or("0").split(' ').next().unwrap().parse().unwrap();
     assert!((7.0..13.0).contains(&rate), "a 10 Hz cycle: {hz}");
+    // `mrt record --net`: every robot's messages into a file that `mrt replay` reads.
+    let recorded =
+        std::env::temp_dir().join(format!("mrt-monitor-net-{}.mcap", std::process::id()));
+    let out = mrt()
+        .args(["record", "--net", &file, "--seconds", "2", "-o"])
+        .arg(&recorded)
+        .output()
+        .unwrap();
+    let said = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success() && said.starts_with("recorded "),
+        "{said}{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let (ok, listing, err) = replay(&[recorded.as_os_str()]);
+    assert!(ok, "{err}");
+    assert!(
+        listing.contains("/agora/3/WorldSnapshot") && listing.contains("/agora/8/RobotCommand"),
+        "{listing}"
+    );
+    std::fs::remove_file(&recorded).ok();
+    // `mrt monitor --net --serve`: the page's frames fill from the network.
+    let mut child = mrt()
+        .args(["monitor", "--net", &file, "--serve", "127.0.0.1:0"])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    let mut first = String::new();
+    BufReader::new(child.stdout.take().unwrap()).read_line(&mut first).unwrap();
+    let _monitor = Running(child);
+    let url = first.split_whitespace().nth(1).unwrap_or_default().trim_end_matches(';').to_string();
+    let addr = host(&url).to_string();
+    let start = Instant::now();
+    let mut frames = 0;
+    while frames < 5 && start.elapsed() < Duration::from_secs(20) {
+        std::thread::sleep(Duration::from_millis(200));
+        let meta: Value = serde_json::from_str(&http("GET", &addr, "/meta", None).1).unwrap();
+        frames = meta["end"].as_u64().unwrap();
+    }
+    assert!(frames >= 5, "{first}");
+    let (_, latest) = http("GET", &addr, "/frame/latest", None);
+    assert!(latest.contains("\"name\":\"agora/3\""), "{latest}");
     let out = mrt().args(["topic", "echo", "Nonsense", "--net", &file]).output().unwrap();
     let e = String::from_utf8_lossy(&out.stderr);
     assert!(!out.status.success() && e.contains("WorldSnapshot"), "the types are listed: {e}");
