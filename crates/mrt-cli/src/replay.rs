@@ -65,7 +65,7 @@ pub fn run(args: &ReplayArgs) -> Result<()> {
             .iter()
             .map(|t| {
                 serde_json::json!({
-                    "topic": t.topic, "schema": t.schema, "encoding": t.encoding,
+                    "topic": t.topic, "schema": t.schema, "schema_encoding": t.schema_encoding, "encoding": t.encoding,
                     "messages": t.count, "first_s": secs(t.first), "last_s": secs(t.last),
                     "readable": t.readable(),
                 })
@@ -87,7 +87,11 @@ pub fn run(args: &ReplayArgs) -> Result<()> {
         let skipped = if t.readable() {
             String::new()
         } else {
-            format!("  (skipped: {} messages, not JSON with a schema)", t.encoding)
+            format!(
+                "  (skipped: {} messages with a {} schema, not JSON with a JSON schema)",
+                t.encoding,
+                if t.schema_encoding.is_empty() { "missing" } else { &t.schema_encoding }
+            )
         };
         outln!(
             "  {:<width$}  {:<16} {:>7} messages  {:>7.1} to {:>7.1} s{skipped}",

@@ -144,6 +144,8 @@ pub struct TopicInfo {
     pub topic: String,
     /// Its schema's name (empty without a schema).
     pub schema: String,
+    /// Its schema's encoding (`jsonschema` for MRT's recordings; empty without a schema).
+    pub schema_encoding: String,
     /// Its messages' encoding (`json` for MRT's recordings).
     pub encoding: String,
     /// How many messages.
@@ -157,7 +159,7 @@ pub struct TopicInfo {
 impl TopicInfo {
     /// Whether `mrt replay` reads it: JSON messages with a JSON schema.
     pub fn readable(&self) -> bool {
-        self.encoding == "json" && !self.schema.is_empty()
+        self.encoding == "json" && !self.schema.is_empty() && self.schema_encoding == "jsonschema"
     }
 }
 
@@ -271,6 +273,7 @@ impl Recording {
                 let info = scan.topics.entry(topic.clone()).or_insert_with(|| TopicInfo {
                     topic: topic.clone(),
                     schema: schema.to_string(),
+                    schema_encoding: schema_encoding.to_string(),
                     encoding: encoding.clone(),
                     count: 0,
                     first: time,
@@ -279,7 +282,7 @@ impl Recording {
                 info.count += 1;
                 info.first = info.first.min(time);
                 info.last = info.last.max(time);
-                if info.readable() && schema_encoding == "jsonschema" {
+                if info.readable() {
                     f(Entry { topic, schema, time, json: data });
                 }
             }
@@ -408,26 +411,34 @@ mod tests {
         assert!(e.contains("/home/0/GameInfo at 0.000 s does not decode as Localization"), "{e}");
     }
 
-    /// Another tool's channel (CDR, no schema) is listed but not read.
+    /// Another tool's channels are listed but not read: CDR without a schema, and JSON
+    /// messages whose schema is not a JSON schema (a protobuf one).
     #[test]
     fn channels_of_other_encodings_are_listed_and_skipped() {
         let mut w = mcap::Writer::new(std::io::Cursor::new(Vec::new())).unwrap();
-        let c = w.add_channel(0, "/ros/odom", "cdr", &Map::new()).unwrap();
-        let header = mcap::records::MessageHeader {
-            channel_id: c,
-            sequence: 0,
-            log_time: 5,
-            publish_time: 5,
-        };
-        w.write_to_known_channel(&header, &[1, 2, 3]).unwrap();
+        let cdr = w.add_channel(0, "/ros/odom", "cdr", &Map::new()).unwrap();
+        let proto = w.add_schema("pose", "protobuf", b"\x0a\x01").unwrap();
+        let json = w.add_channel(proto, "/odd/pose", "json", &Map::new()).unwrap();
+        for channel_id in [cdr, json] {
+            let header = mcap::records::MessageHeader {
+                channel_id,
+                sequence: 0,
+                log_time: 5,
+                publish_time: 5,
+            };
+            w.write_to_known_channel(&header, b"{}").unwrap();
+        }
         w.finish().unwrap();
         let bytes = w.into_inner().into_inner();
         let r = Recording::from_bytes(bytes, Path::new("other.mcap"));
         let mut read = 0;
         let topics = r.scan(|_| read += 1).unwrap();
         assert_eq!(read, 0);
-        assert_eq!(topics.len(), 1);
-        assert!(!topics[0].readable() && topics[0].encoding == "cdr");
+        assert_eq!(topics.len(), 2);
+        let odd = topics.iter().find(|t| t.topic == "/odd/pose").unwrap();
+        assert!(!odd.readable() && odd.encoding == "json" && odd.schema_encoding == "protobuf");
+        let odom = topics.iter().find(|t| t.topic == "/ros/odom").unwrap();
+        assert!(!odom.readable() && odom.encoding == "cdr");
     }
 
     #[test]
