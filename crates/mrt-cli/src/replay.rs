@@ -111,8 +111,12 @@ const SHOWN: usize = 20;
 /// `--robot`: the robot's behaviors re-run on its recorded snapshots (module doc).
 fn rerun(args: &ReplayArgs, recording: &Recording, robot: &str) -> Result<()> {
     let file = args.file.display();
+    // One pass over the file for the three topics this needs.
+    let [snapshots, commands] = ["WorldSnapshot", "RobotCommand"].map(|t| format!("/{robot}/{t}"));
+    let mut raw = recording.raw(&["/match", &snapshots, &commands])?;
+    let mut take = |topic: &str| raw.remove(topic).unwrap_or_default();
     let info = recording
-        .messages::<MatchInfo>("/match")?
+        .decode::<MatchInfo>("/match", take("/match"))?
         .into_iter()
         .next()
         .map(|(_, info)| info)
@@ -137,25 +141,24 @@ fn rerun(args: &ReplayArgs, recording: &Recording, robot: &str) -> Result<()> {
     if stack == Stack::Isocrob {
         bail!("--robot {robot}: ISocRob robots play through their shared blackboard; one cannot be re-run alone");
     }
-    let snapshots = recording.messages::<WorldSnapshot>(&format!("/{robot}/WorldSnapshot"))?;
+    let snapshots = recording.decode::<WorldSnapshot>(&snapshots, take(&snapshots))?;
     if snapshots.is_empty() {
         bail!("{file}: no world snapshots of {robot}");
     }
-    let recorded: BTreeMap<Time, RobotCommand> = recording
-        .messages::<RobotCommand>(&format!("/{robot}/RobotCommand"))?
-        .into_iter()
-        .collect();
+    let recorded: BTreeMap<Time, RobotCommand> =
+        recording.decode::<RobotCommand>(&commands, take(&commands))?.into_iter().collect();
     // The compiled-in TeamChaos files live while this handle does.
     let files = match (&args.behaviors, stack) {
-        (Some(dir), _) => FilesDir::user(dir),
-        (None, Stack::Chaos) => embedded_teamchaos().map_err(|e| anyhow!("{e}"))?,
-        (None, _) => FilesDir::user(PathBuf::new()),
+        (Some(dir), _) => Some(FilesDir::user(dir)),
+        (None, Stack::Chaos) => Some(embedded_teamchaos().map_err(|e| anyhow!("{e}"))?),
+        (None, _) => None,
     };
     let times: Vec<Time> = snapshots.iter().map(|(t, _)| *t).collect();
     let worlds = snapshots.into_iter().map(|(_, w)| w).collect();
     let period = Duration::from_secs_f64(info.period);
-    let report = mrt_robot::rerun::rerun(stack, k == 0, files.path(), period, worlds)
-        .map_err(|e| anyhow!("{robot}: {e}"))?;
+    let report =
+        mrt_robot::rerun::rerun(stack, k == 0, files.as_ref().map(FilesDir::path), period, worlds)
+            .map_err(|e| anyhow!("{robot}: {e}"))?;
     let rerun = &report.cycles;
     let mut differing = Vec::new();
     let mut errors = Vec::new();

@@ -29,18 +29,22 @@ impl Drop for Running {
 /// A recording of the match of seed 20, Chaser v Chaos with the object sensor, two halves of
 /// 40 s: the Chaser scores at 0:36 (the match's report says so; asserted below).
 fn recording(name: &str) -> PathBuf {
-    let path = std::env::temp_dir().join(format!("mrt-monitor-{name}-{}.mcap", std::process::id()));
-    let out = mrt()
-        .args(["sim", "--half", "40", "--seed", "20", "--percepts", "oracle"])
-        .args(["--home", "chaser", "--away", "chaos", "--record"])
-        .arg(&path)
-        .output()
-        .unwrap();
-    let stdout = String::from_utf8_lossy(&out.stdout);
-    assert!(out.status.success(), "{stdout}{}", String::from_utf8_lossy(&out.stderr));
+    let args = ["--half", "40", "--seed", "20", "--percepts", "oracle"];
+    let (path, stdout) =
+        record(name, &[&args[..], &["--home", "chaser", "--away", "chaos"]].concat());
     assert!(stdout.starts_with("chaser (home) 1 : 0 chaos"), "{stdout}");
     assert!(stdout.contains("goal chaser   at   0:36"), "{stdout}");
     path
+}
+
+/// `mrt sim ARGS --record` into a file of the temporary directory named after `name`; the
+/// file and the match's report.
+fn record(name: &str, args: &[&str]) -> (PathBuf, String) {
+    let path = std::env::temp_dir().join(format!("mrt-monitor-{name}-{}.mcap", std::process::id()));
+    let out = mrt().arg("sim").args(args).arg("--record").arg(&path).output().unwrap();
+    let stdout = String::from_utf8_lossy(&out.stdout).into_owned();
+    assert!(out.status.success(), "{stdout}{}", String::from_utf8_lossy(&out.stderr));
+    (path, stdout)
 }
 
 /// Starts `mrt replay FILE --serve 127.0.0.1:0`; returns it and the page's address.
@@ -227,13 +231,7 @@ fn replay(args: &[&std::ffi::OsStr]) -> (bool, String, String) {
 /// with its file and line.
 #[test]
 fn replay_robot_reruns_its_behaviors_on_the_recorded_snapshots() {
-    let file = std::env::temp_dir().join(format!("mrt-monitor-rerun-{}.mcap", std::process::id()));
-    let out = mrt()
-        .args(["sim", "--half", "10", "--percepts", "oracle", "--record"])
-        .arg(&file)
-        .output()
-        .unwrap();
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let (file, _) = record("rerun", &["--half", "10", "--percepts", "oracle"]);
     let f = file.as_os_str();
     for robot in ["home/0", "home/2", "away/0", "away/3"] {
         let (ok, out, err) = replay(&[f, "--robot".as_ref(), robot.as_ref()]);
@@ -322,13 +320,7 @@ fn copy_dir(from: &Path, to: &Path) {
 /// Foxglove's `foxglove.CompressedImage` schema; the monitor serves the selected robot's.
 #[test]
 fn camera_images_are_recorded_and_served() {
-    let file = std::env::temp_dir().join(format!("mrt-monitor-images-{}.mcap", std::process::id()));
-    let out = mrt()
-        .args(["sim", "--half", "2", "--images", "5", "--record"])
-        .arg(&file)
-        .output()
-        .unwrap();
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let (file, _) = record("images", &["--half", "2", "--images", "5"]);
     let (ok, listing, err) = replay(&[file.as_os_str()]);
     assert!(ok, "{err}");
     let camera =

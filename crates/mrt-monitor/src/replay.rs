@@ -137,6 +137,9 @@ fn split_record(bytes: &[u8]) -> Option<(u8, &[u8], &[u8])> {
     Some((opcode, body, &rest[8 + len..]))
 }
 
+/// A topic's messages as read: log time and JSON, in file order ([`Recording::raw`]).
+pub type Raw = Vec<(Time, Vec<u8>)>;
+
 /// One topic of a recording.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct TopicInfo {
@@ -343,21 +346,40 @@ impl Recording {
         &self,
         topic: &str,
     ) -> Result<Vec<(Time, T)>, ReplayError> {
-        let mut out = Vec::new();
-        let mut failed = None;
+        let mut raw = self.raw(&[topic])?;
+        self.decode(topic, raw.remove(topic).unwrap_or_default())
+    }
+
+    /// The JSON messages of each of `topics`, in file order, read in one pass over the file
+    /// (topics without messages are absent).
+    pub fn raw(&self, topics: &[&str]) -> Result<BTreeMap<String, Raw>, ReplayError> {
+        let mut out: BTreeMap<String, Raw> = BTreeMap::new();
         self.scan(|e| {
-            if e.topic != topic || failed.is_some() {
-                return;
-            }
-            match serde_json::from_slice::<T>(e.json) {
-                Ok(v) => out.push((e.time, v)),
-                Err(source) => failed = Some((e.time, source)),
+            if topics.contains(&e.topic) {
+                out.entry(e.topic.to_string()).or_default().push((e.time, e.json.to_vec()));
             }
         })?;
-        if let Some((time, source)) = failed {
-            let ty = T::schema_name().into_owned();
-            let (path, topic) = (self.path.clone(), topic.to_string());
-            return Err(ReplayError::Json { path, topic, time: time.as_secs_f64(), ty, source });
+        Ok(out)
+    }
+
+    /// `raw` messages of `topic` ([`Recording::raw`]) decoded as `T`, in log-time order; the
+    /// first that does not decode is an error naming the file, the topic, the time and `T`.
+    pub fn decode<T: DeserializeOwned + schemars::JsonSchema>(
+        &self,
+        topic: &str,
+        raw: Raw,
+    ) -> Result<Vec<(Time, T)>, ReplayError> {
+        let mut out = Vec::with_capacity(raw.len());
+        for (time, json) in raw {
+            match serde_json::from_slice::<T>(&json) {
+                Ok(v) => out.push((time, v)),
+                Err(source) => {
+                    let ty = T::schema_name().into_owned();
+                    let (path, topic) = (self.path.clone(), topic.to_string());
+                    let time = time.as_secs_f64();
+                    return Err(ReplayError::Json { path, topic, time, ty, source });
+                }
+            }
         }
         out.sort_by_key(|(t, _)| *t);
         Ok(out)

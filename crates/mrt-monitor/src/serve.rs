@@ -168,7 +168,10 @@ async fn camera(
             .into_response();
     };
     match t.image(&format!("{team}/{k}"), index) {
-        Some(jpeg) => ([(header::CONTENT_TYPE, "image/jpeg")], jpeg.to_vec()).into_response(),
+        Some(jpeg) => {
+            let body = axum::body::Bytes::from_owner(jpeg);
+            ([(header::CONTENT_TYPE, "image/jpeg")], body).into_response()
+        }
         None => {
             (StatusCode::NOT_FOUND, "no camera image of that robot by that frame").into_response()
         }

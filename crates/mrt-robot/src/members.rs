@@ -573,9 +573,9 @@ pub fn add_robot(
             agora.activate_member(proxy).map_err(|e| e.to_string())?;
             (Box::new(BrainMember::new(Box::new(brain))) as Box<dyn Member>, Commander::PLAIN)
         }
-        Stack::Chaos => (behavior_member(stack, keeper, behaviors)?, Commander::chaos(cfg)),
+        Stack::Chaos => (behavior_member(stack, keeper, Some(behaviors))?, Commander::chaos(cfg)),
         // The directory is TeamChaos': the other stacks run their compiled-in behaviors.
-        other => (behavior_member(other, keeper, Path::new(""))?, Commander::PLAIN),
+        other => (behavior_member(other, keeper, None)?, Commander::PLAIN),
     };
     // Team Milan's parametric behaviors read SCARE's job (MRT manual ch. 11); the others
     // coordinate their own way (TeamChaos: booking and roles).
@@ -584,22 +584,23 @@ pub fn add_robot(
 }
 
 /// The behavior Member of a robot of `stack` (the goalkeeper when `keeper`): for Chaos, the
-/// TeamChaos files of `behaviors` (the HBM goalkeeper or the HFSM field player); for Milan,
-/// the Mr. BRIAN configuration of `behaviors` when given (an empty path: the compiled-in
-/// one); the Chaser's hand-written player. An ISocRob robot needs its blackboard and Proxy
+/// TeamChaos files of `behaviors` (the HBM goalkeeper or the HFSM field player; they are
+/// required); for Milan, the Mr. BRIAN configuration of `behaviors`, or the compiled-in one
+/// without; the Chaser's hand-written player. An ISocRob robot needs its blackboard and Proxy
 /// ([`add_robot`] builds them).
 pub fn behavior_member(
     stack: Stack,
     keeper: bool,
-    behaviors: &Path,
+    behaviors: Option<&Path>,
 ) -> Result<Box<dyn Member>, String> {
-    Ok(match stack {
-        Stack::Chaos if keeper => Box::new(BehaviorMember::hbm(behaviors, CHAOS_KEEPER)),
-        Stack::Chaos => Box::new(BehaviorMember::hfsm(behaviors, behaviors.join(CHAOS_PLAYER))),
-        Stack::Milan if !behaviors.as_os_str().is_empty() => {
-            Box::new(BrainMember::new(Box::new(MilanBrain::new(behaviors, keeper)?)))
+    Ok(match (stack, behaviors) {
+        (Stack::Chaos, Some(dir)) if keeper => Box::new(BehaviorMember::hbm(dir, CHAOS_KEEPER)),
+        (Stack::Chaos, Some(dir)) => Box::new(BehaviorMember::hfsm(dir, dir.join(CHAOS_PLAYER))),
+        (Stack::Chaos, None) => return Err("a Chaos robot needs its TeamChaos files".into()),
+        (Stack::Milan, Some(dir)) => {
+            Box::new(BrainMember::new(Box::new(MilanBrain::new(dir, keeper)?)))
         }
-        other => Box::new(BrainMember::new(send_brain(other, keeper)?)),
+        (other, _) => Box::new(BrainMember::new(send_brain(other, keeper)?)),
     })
 }
 

@@ -84,7 +84,7 @@ pub struct RerunReport {
 pub fn rerun(
     stack: Stack,
     keeper: bool,
-    behaviors: &Path,
+    behaviors: Option<&Path>,
     period: Duration,
     snapshots: Vec<WorldSnapshot>,
 ) -> Result<RerunReport, String> {
@@ -137,8 +137,7 @@ mod tests {
             .collect();
         let mut direct = Chaser { keeper: false };
         let expected: Vec<RobotCommand> = worlds.iter().map(|w| direct.cycle(w)).collect();
-        let report =
-            rerun(Stack::Chaser, false, Path::new(""), Duration::from_millis(100), worlds).unwrap();
+        let report = rerun(Stack::Chaser, false, None, Duration::from_millis(100), worlds).unwrap();
         assert_eq!(report.fault, None);
         assert_eq!(report.cycles.len(), 6);
         for (k, (cycle, want)) in report.cycles.iter().zip(&expected).enumerate() {
@@ -151,8 +150,7 @@ mod tests {
     /// An ISocRob robot needs its blackboard: it cannot be re-run alone, and says so.
     #[test]
     fn an_isocrob_robot_is_refused() {
-        let e = rerun(Stack::Isocrob, false, Path::new(""), Duration::from_millis(100), vec![])
-            .unwrap_err();
+        let e = rerun(Stack::Isocrob, false, None, Duration::from_millis(100), vec![]).unwrap_err();
         assert!(e.contains("blackboard"), "{e}");
     }
 }
