@@ -5,6 +5,7 @@
 //! - `mrt bb serve|get|set|watch|list` serves a blackboard with its relay, or talks to one;
 //! - `mrt demo [hello-agora|two-agoras]` runs a numbered example and prints what happens;
 //! - `mrt behave FILE [--world world.json] [--cycles N]` runs a Lua behavior or HFSM offline;
+//!   `mrt behave push FILE --robot ID --net CONFIG` sends an edited one to a running robot;
 //! - `mrt hfsm dot FILE [--dot out.dot] [--svg out.svg]` draws an HFSM;
 //! - `mrt plan path --from X,Y --to X,Y [--obstacles ...] [--json] [--svg out.svg]` plans a
 //!   path with SPIKE;
@@ -27,6 +28,7 @@ mod brian;
 #[cfg(feature = "net")]
 mod distributed;
 mod plan;
+mod push;
 mod replay;
 mod sim;
 mod soak;
@@ -120,22 +122,9 @@ enum Command {
         command: BrianCommand,
     },
     /// Run a Lua behavior or HFSM (`*.hfsm.lua`) against world snapshots and print each
-    /// cycle's commands as JSON Lines (behaviors are looked up beside FILE).
-    Behave {
-        /// The behavior or HFSM file.
-        file: PathBuf,
-        /// World snapshots as JSON: one object (used every cycle) or an array (one per cycle).
-        /// Without it the world is empty: nothing seen.
-        #[arg(long)]
-        world: Option<PathBuf>,
-        /// Cycles to run, 1 to 1 000 000 000 (default: 1, or the array's length). Cycles
-        /// are run as they come: a long run needs no more memory than a short one.
-        #[arg(long)]
-        cycles: Option<u64>,
-        /// Simulated time between cycles, for worlds without a time, 1 to 3 600 000 ms.
-        #[arg(long, default_value_t = 100)]
-        period_ms: u64,
-    },
+    /// cycle's commands as JSON Lines (behaviors are looked up beside FILE); or send an
+    /// edited behavior to a running robot (`mrt behave push FILE --robot ID --net CONFIG`).
+    Behave(BehaveArgs),
     /// SPIKE, the path planner (MRT manual ch. 9): plan a path on the soccer field or a map
     /// file.
     Plan {
@@ -188,6 +177,36 @@ enum BrianCommand {
         #[arg(long, default_value = "shapes.svg")]
         out: PathBuf,
     },
+}
+
+#[derive(clap::Args)]
+#[command(args_conflicts_with_subcommands = true, subcommand_negates_reqs = true)]
+struct BehaveArgs {
+    #[command(subcommand)]
+    command: Option<BehaveCommand>,
+    /// The behavior or HFSM file.
+    #[arg(required = true)]
+    file: Option<PathBuf>,
+    /// World snapshots as JSON: one object (used every cycle) or an array (one per cycle).
+    /// Without it the world is empty: nothing seen.
+    #[arg(long)]
+    world: Option<PathBuf>,
+    /// Cycles to run, 1 to 1 000 000 000 (default: 1, or the array's length). Cycles
+    /// are run as they come: a long run needs no more memory than a short one.
+    #[arg(long)]
+    cycles: Option<u64>,
+    /// Simulated time between cycles, for worlds without a time, 1 to 3 600 000 ms.
+    #[arg(long, default_value_t = 100)]
+    period_ms: u64,
+}
+
+#[derive(Subcommand)]
+enum BehaveCommand {
+    /// Send an edited behavior file to a running robot (seed 001 §3.2): checked for syntax
+    /// errors here first, then compiled by the robot off its control path and swapped in at
+    /// a cycle boundary, or refused with the error and its line while the old version keeps
+    /// running (docs/behaviors.md, "Sending a behavior to a running robot").
+    Push(push::PushArgs),
 }
 
 #[derive(Subcommand)]
@@ -296,7 +315,11 @@ fn run(command: Command) -> Result<()> {
         Command::Vision { command: VisionCommand::Calibrate(args) } => vision::calibrate(&args)?,
         Command::Vision { command: VisionCommand::Survey(args) } => vision::survey(&args)?,
         Command::Plan { command: PlanCommand::Path(args) } => plan::path(&args)?,
-        Command::Behave { file, world, cycles, period_ms } => {
+        Command::Behave(BehaveArgs { command: Some(BehaveCommand::Push(args)), .. }) => {
+            push::push(&args)?
+        }
+        Command::Behave(BehaveArgs { command: None, file, world, cycles, period_ms }) => {
+            let file = file.context("mrt behave needs a FILE")?;
             behave::behave(&file, world.as_deref(), cycles, period_ms)?
         }
         Command::Hfsm { command: HfsmCommand::Dot { file, dot, svg } } => {

@@ -4,9 +4,9 @@
 use mrt_core::{Message, MsgType};
 use mrt_dcdt::Msg;
 use mrt_msgs::{
-    BehaviorStatus, CameraFrame, DeviceAct, DeviceFrame, FinalWhistle, GameInfo, Localization,
-    MateReport, MotorCommand, Odometry, Percepts, PlanRequest, PlannedPath, ReloadRequest,
-    RobotCommand, RobotEnd, SonarScan, WorldSnapshot,
+    BehaviorPush, BehaviorPushReply, BehaviorStatus, CameraFrame, DeviceAct, DeviceFrame,
+    FinalWhistle, GameInfo, Localization, MateReport, MotorCommand, Odometry, Percepts,
+    PlanRequest, PlannedPath, ReloadRequest, RobotCommand, RobotEnd, SonarScan, WorldSnapshot,
 };
 use schemars::JsonSchema;
 use serde::Serialize;
@@ -78,6 +78,8 @@ catalogue! {
     RobotCommand,
     BehaviorStatus,
     ReloadRequest,
+    BehaviorPush,
+    BehaviorPushReply,
     MateReport,
     SonarScan,
     MotorCommand,

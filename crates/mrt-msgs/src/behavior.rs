@@ -26,3 +26,43 @@ pub struct BehaviorStatus {
 #[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct ReloadRequest;
+
+/// An edited behavior file sent to a running robot (seed `001` §3.2: a behavior with no syntax
+/// errors "can be sent to the robot at any time, without the need of stopping or rebooting
+/// it"). The robot whose Agora is `robot` compiles it off its control path, writes it into its
+/// behavior directory and swaps it in at a cycle boundary, or keeps its running version, and
+/// answers with a [`BehaviorPushReply`] either way (`mrt behave push`).
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct BehaviorPush {
+    /// The Agora of the robot it is for (the others ignore it).
+    pub robot: u32,
+    /// The sender's number for this request, repeated in the reply.
+    pub request: u64,
+    /// The file's name in the robot's behavior directory (`attacker.lua`,
+    /// `player.hfsm.lua`, `hbm.lua`): a bare name ending in `.lua`, no directories.
+    pub file: String,
+    /// The file's new text.
+    pub source: String,
+}
+
+/// A robot's answer to a [`BehaviorPush`].
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct BehaviorPushReply {
+    /// The robot's Agora.
+    pub robot: u32,
+    /// The request answered.
+    pub request: u64,
+    /// The file, as the request named it.
+    pub file: String,
+    /// Whether the new version runs from the next cycle on. When not, the robot keeps its
+    /// running version and `error` says why.
+    pub installed: bool,
+    /// What was swapped in (behavior names, `hbm`, the HFSM file).
+    pub reloaded: Vec<String>,
+    /// Why the file was refused, as a local hot reload reports it (`file:line: message`).
+    pub error: Option<String>,
+    /// The line of the error, when it has one.
+    pub line: Option<u32>,
+}

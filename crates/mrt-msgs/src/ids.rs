@@ -22,6 +22,10 @@ pub const ROBOT_COMMAND: MsgType = reserved(0x21);
 pub const BEHAVIOR_STATUS: MsgType = reserved(0x30);
 /// [`crate::ReloadRequest`]: reload the edited behaviors at the next cycle boundary.
 pub const RELOAD_REQUEST: MsgType = reserved(0x31);
+/// [`crate::BehaviorPush`]: an edited behavior file for a running robot.
+pub const BEHAVIOR_PUSH: MsgType = reserved(0x32);
+/// [`crate::BehaviorPushReply`]: the robot's answer to a behavior push.
+pub const BEHAVIOR_PUSH_REPLY: MsgType = reserved(0x33);
 /// [`crate::MateReport`]: a robot's pose and ball, told to its teammates.
 pub const MATE_REPORT: MsgType = reserved(0x40);
 /// [`crate::SonarScan`]: one reading of the sonar ring.
@@ -68,6 +72,8 @@ pub const TABLE: &[(MsgType, &str)] = &[
     (ROBOT_COMMAND, "RobotCommand"),
     (BEHAVIOR_STATUS, "BehaviorStatus"),
     (RELOAD_REQUEST, "ReloadRequest"),
+    (BEHAVIOR_PUSH, "BehaviorPush"),
+    (BEHAVIOR_PUSH_REPLY, "BehaviorPushReply"),
     (MATE_REPORT, "MateReport"),
     (SONAR_SCAN, "SonarScan"),
     (MOTOR_COMMAND, "MotorCommand"),
@@ -117,6 +123,8 @@ mod tests {
             (0xFFFF_0021, "RobotCommand"),
             (0xFFFF_0030, "BehaviorStatus"),
             (0xFFFF_0031, "ReloadRequest"),
+            (0xFFFF_0032, "BehaviorPush"),
+            (0xFFFF_0033, "BehaviorPushReply"),
             (0xFFFF_0040, "MateReport"),
             (0xFFFF_0041, "SonarScan"),
             (0xFFFF_0042, "MotorCommand"),

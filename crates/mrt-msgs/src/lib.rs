@@ -19,7 +19,7 @@
 //! | [`RobotCommand`] | behaviors → guidance | TeamChaos `001` §3.3 |
 //! | [`MotorCommand`] | guidance → motor and kicker driver | ISocRob `003` §3.2.3 |
 //! | [`PlanRequest`], [`PlannedPath`] | guidance (or SCARE) ↔ planner | manual ch. 9 (SPIKE) |
-//! | [`BehaviorStatus`], [`ReloadRequest`] | behavior Member ↔ monitors, editors | TeamChaos `001` §3.2 |
+//! | [`BehaviorStatus`], [`ReloadRequest`], [`BehaviorPush`], [`BehaviorPushReply`] | behavior Member ↔ monitors, editors | TeamChaos `001` §3.2 |
 //! | [`DeviceFrame`], [`DeviceAct`], [`FinalWhistle`], [`RobotEnd`] | distributed simulator ↔ robot | MRT's own |
 //!
 //! Three standard messages live with their engine and take their id from [`ids`] too: the
@@ -47,7 +47,7 @@ mod sensing;
 mod team;
 
 pub use acting::{MotorCommand, PlanRequest, PlannedPath};
-pub use behavior::{BehaviorStatus, ReloadRequest};
+pub use behavior::{BehaviorPush, BehaviorPushReply, BehaviorStatus, ReloadRequest};
 pub use device::{DeviceAct, DeviceFrame, FinalWhistle, MemberFault, RobotEnd};
 pub use localization::{BallBelief, FilterCounts, Localization};
 pub use mrt_core::{Message, MsgType};
@@ -81,6 +81,8 @@ messages! {
     RobotCommand => ROBOT_COMMAND,
     BehaviorStatus => BEHAVIOR_STATUS,
     ReloadRequest => RELOAD_REQUEST,
+    BehaviorPush => BEHAVIOR_PUSH,
+    BehaviorPushReply => BEHAVIOR_PUSH_REPLY,
     MateReport => MATE_REPORT,
     SonarScan => SONAR_SCAN,
     MotorCommand => MOTOR_COMMAND,

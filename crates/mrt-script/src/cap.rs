@@ -202,6 +202,18 @@ impl ThinkingCap {
         self.reload_hfsm(&machine, done, errors)
     }
 
+    /// Installs one script compiled off the control path (a behavior sent to the robot,
+    /// `mrt behave push`), already written at `change.path` in the behavior directory: what
+    /// was swapped in, or why nothing was (the running version stays). Call it at a cycle
+    /// boundary.
+    pub fn install(&mut self, change: crate::watch::Change) -> Result<Vec<String>, ScriptError> {
+        let (done, mut errors) = self.apply(vec![change]);
+        match errors.is_empty() {
+            true => Ok(done),
+            false => Err(errors.swap_remove(0)),
+        }
+    }
+
     /// Applies what the watcher compiled off the control path (see [`Hbm::apply`]).
     fn apply(&mut self, changes: Vec<crate::watch::Change>) -> (Vec<String>, Vec<ScriptError>) {
         let touched: Vec<PathBuf> = changes.iter().map(|c| c.path.clone()).collect();

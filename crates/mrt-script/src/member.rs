@@ -4,8 +4,11 @@
 //! HFSM (the "HFSM Member") or of one HBM behavior (the "HBM Member") per activation (every
 //! 100 ms by default, as in the seed: [`DEFAULT_PERIOD`]), and publishes the [`RobotCommand`](mrt_msgs::robot::RobotCommand)
 //! and a [`BehaviorStatus`] (active path, behavior, errors) for monitors. A
-//! [`ReloadRequest`] on the bus reloads the edited scripts at the next cycle boundary, like the
-//! seed's editor sending a behavior to a running robot.
+//! [`ReloadRequest`] on the bus reloads the edited scripts at the next cycle boundary; a
+//! [`BehaviorPush`] for this robot's Agora brings the edited file itself, like the seed's
+//! editor sending a behavior to a running robot ([`crate::push`]): it is compiled off the
+//! control path, written into the behavior directory and swapped in at a cycle boundary, and
+//! a [`BehaviorPushReply`] says whether it runs or why the old version stays.
 //!
 //! A Lua state belongs to one thread, and Members may move between threads, so the scripts run
 //! on a worker thread owned by the Member, under the [`Watchdog`]: each cycle is one
@@ -13,6 +16,7 @@
 //! and a cycle that does not end within the deadline stops the behavior, not the robot.
 
 use crate::cap::ThinkingCap;
+use crate::push::Pusher;
 use crate::runtime::Sandbox;
 use crate::watchdog::{Watchdog, DEFAULT_DEADLINE};
 use mrt_dcdt::{Context, Member, MemberError, Message, RequestType};
@@ -24,7 +28,7 @@ use std::time::Duration;
 /// 100 ms" (§3.2).
 pub const DEFAULT_PERIOD: Duration = Duration::from_millis(100);
 
-pub use mrt_msgs::{BehaviorStatus, ReloadRequest};
+pub use mrt_msgs::{BehaviorPush, BehaviorPushReply, BehaviorStatus, ReloadRequest};
 
 /// What the Member runs.
 #[derive(Clone, Debug)]
@@ -44,6 +48,7 @@ pub struct BehaviorMember {
     worker: Option<Watchdog>,
     world: WorldSnapshot,
     blackboard: Option<mrt_blackboard::Blackboard>,
+    pusher: Option<Pusher>,
 }
 
 impl BehaviorMember {
@@ -72,6 +77,7 @@ impl BehaviorMember {
             worker: None,
             world: WorldSnapshot::default(),
             blackboard: None,
+            pusher: None,
         }
     }
 
@@ -125,13 +131,17 @@ impl Member for BehaviorMember {
         // Only this robot's own world (an Agora may share a link with teammates).
         ctx.subscribe_to::<WorldSnapshot>(RequestType::Local);
         ctx.subscribe_to::<ReloadRequest>(RequestType::All);
+        ctx.subscribe_to::<BehaviorPush>(RequestType::All);
+        self.pusher = Some(Pusher::new(ctx.agora_id().0, self.dir.clone()));
         self.worker = Some(self.spawn()?);
         Ok(())
     }
 
     fn do_your_job(&mut self, ctx: &mut Context<'_>) -> Result<(), MemberError> {
-        let Some(worker) = &mut self.worker else { return Err("not initialized".into()) };
-        let mut early = Vec::new();
+        let (Some(worker), Some(pusher)) = (&mut self.worker, &mut self.pusher) else {
+            return Err("not initialized".into());
+        };
+        let (mut early, mut replies) = (Vec::new(), Vec::new());
         while let Some(m) = ctx.receive_msg() {
             if m.msg_type() == WorldSnapshot::TYPE {
                 self.world = m.get::<WorldSnapshot>()?.clone();
@@ -139,7 +149,26 @@ impl Member for BehaviorMember {
                 if let Err(e) = worker.reload_requested() {
                     early.push(e.to_string());
                 }
+            } else if m.msg_type() == BehaviorPush::TYPE {
+                match m.get::<BehaviorPush>() {
+                    Ok(push) => replies.extend(pusher.receive(push)),
+                    Err(e) => tracing::warn!(member = %self.name, "dropped a malformed push: {e}"),
+                }
             }
+        }
+        // Pushes compiled since the last cycle are swapped in at this boundary.
+        for ready in pusher.ready() {
+            let reply = pusher.settle(ready, |change| worker.install(change));
+            match &reply.error {
+                None => {
+                    tracing::info!(member = %self.name, file = %reply.file, "pushed behavior installed")
+                }
+                Some(e) => tracing::warn!(member = %self.name, "pushed behavior refused: {e}"),
+            }
+            replies.push(reply);
+        }
+        for reply in replies {
+            ctx.publish_with(reply, mrt_dcdt::DeliveryWarranty::Reliable, 0);
         }
         let c = worker.cycle(self.world.clone());
         let errors: Vec<String> =

@@ -101,6 +101,17 @@ pub enum ScriptError {
 }
 
 impl ScriptError {
+    /// The line the error names, when it names one.
+    pub fn line(&self) -> Option<usize> {
+        match self {
+            ScriptError::Syntax { line, .. }
+            | ScriptError::Runtime { line, .. }
+            | ScriptError::Budget { line, .. }
+            | ScriptError::Invalid { line, .. } => Some(*line).filter(|&l| l > 0),
+            _ => None,
+        }
+    }
+
     pub(crate) fn setup(e: mlua::Error) -> ScriptError {
         ScriptError::Setup(e.to_string())
     }

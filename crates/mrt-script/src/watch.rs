@@ -120,7 +120,14 @@ pub(crate) fn compile_file(path: &Path, name: &str) -> Option<Result<Compiled, S
         Ok(s) => s,
         Err(source) => return Some(Err(ScriptError::Io { file: name.to_string(), source })),
     };
-    Some(COMPILER.with(|lua| {
+    Some(compile_source(name, source))
+}
+
+/// Compiles a script's text the way [`Script`](crate::Script) names it (`name` appears in
+/// errors), with this thread's private compiler: call it off the control path. Text chunks
+/// only: bytecode is refused, so only MRT's own compiler's output is ever loaded.
+pub fn compile_source(name: &str, source: String) -> Result<Compiled, ScriptError> {
+    COMPILER.with(|lua| {
         let f = lua
             .load(&source)
             .set_name(format!("@{name}"))
@@ -128,7 +135,7 @@ pub(crate) fn compile_file(path: &Path, name: &str) -> Option<Result<Compiled, S
             .into_function()
             .map_err(|e| ScriptError::syntax(name, &e))?;
         Ok(Compiled { bytecode: f.dump(false), source })
-    }))
+    })
 }
 
 fn on_event(list: &Mutex<WatchList>, tx: &Sender<Change>, ev: notify::Result<Event>) {

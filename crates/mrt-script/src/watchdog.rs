@@ -30,6 +30,7 @@
 use crate::cap::{Cycle, ThinkingCap};
 use crate::runtime::Interrupt;
 use crate::script::ScriptError;
+use crate::watch::Change;
 use mrt_msgs::robot::{RobotCommand, WorldSnapshot};
 use std::sync::mpsc::{channel, Receiver, RecvTimeoutError, Sender};
 use std::sync::Arc;
@@ -51,12 +52,20 @@ type Factory = Arc<dyn Fn() -> Result<ThinkingCap, ScriptError> + Send + Sync>;
 enum Job {
     Cycle(u64, Box<WorldSnapshot>),
     Reload,
+    Install(u64, Box<Change>),
 }
 
-/// A cycle's result and the reload report that came before it.
+/// What the worker did for a job.
+enum Done {
+    /// A cycle's result and the reload report that came before it.
+    Cycle(Box<Cycle>),
+    /// What an install swapped in, or why it did not.
+    Installed(Result<Vec<String>, ScriptError>),
+}
+
 struct Reply {
     seq: u64,
-    cycle: Cycle,
+    done: Done,
 }
 
 struct Worker {
@@ -121,27 +130,63 @@ impl Watchdog {
         Ok(())
     }
 
+    /// Installs a script compiled off the control path and already written into the
+    /// behavior directory (a behavior sent to the robot, `mrt behave push`), now, between two
+    /// cycles, within the deadline: what was swapped in, or why nothing was (the running
+    /// version stays, exactly as with a local hot reload). A stopped robot gets a fresh
+    /// worker loaded from the files instead, as with [`Watchdog::reload_requested`].
+    pub fn install(&mut self, change: Change) -> Result<Vec<String>, ScriptError> {
+        if self.worker.is_none() {
+            let name = change.name.clone();
+            self.reload_requested()?;
+            return Ok(vec![name]);
+        }
+        match self.round_trip(|seq| Job::Install(seq, Box::new(change))) {
+            Ok(Done::Installed(r)) => r,
+            Ok(Done::Cycle(_)) => {
+                Err(ScriptError::Setup(format!("{}: a cycle's reply to an install", self.name)))
+            }
+            Err(errors) => Err(errors.into_iter().next().unwrap_or_else(|| {
+                ScriptError::Setup(format!("{}: the behavior's thread stopped", self.name))
+            })),
+        }
+    }
+
     /// Runs one cycle on `world` within the deadline.
     pub fn cycle(&mut self, world: WorldSnapshot) -> Cycle {
-        let Some(worker) = &self.worker else { return safe(Vec::new()) };
+        if self.worker.is_none() {
+            return safe(Vec::new());
+        }
+        match self.round_trip(|seq| Job::Cycle(seq, Box::new(world))) {
+            Ok(Done::Cycle(c)) => *c,
+            Ok(Done::Installed(_)) => safe(Vec::new()),
+            Err(errors) => safe(errors),
+        }
+    }
+
+    /// Sends one job to the worker and waits for its reply within the deadline; a job that
+    /// overruns it stops the robot, a worker that panicked is restarted (module docs). The
+    /// errors say which.
+    fn round_trip(&mut self, job: impl FnOnce(u64) -> Job) -> Result<Done, Vec<ScriptError>> {
+        let Some(worker) = &self.worker else { return Err(Vec::new()) };
         self.seq += 1;
         let seq = self.seq;
-        let sent = worker.jobs.send(Job::Cycle(seq, Box::new(world))).is_ok();
+        let sent = worker.jobs.send(job(seq)).is_ok();
         let until = Instant::now() + self.deadline;
         let outcome = loop {
             if !sent {
                 break Err(RecvTimeoutError::Disconnected);
             }
             match worker.replies.recv_timeout(until.saturating_duration_since(Instant::now())) {
-                Ok(r) if r.seq == seq => break Ok(r.cycle),
-                Ok(_) => continue, // A reply to an earlier cycle: not ours.
+                Ok(r) if r.seq == seq => break Ok(r.done),
+                Ok(_) => continue, // A reply to an earlier job: not ours.
                 Err(e) => break Err(e),
             }
         };
         match outcome {
-            Ok(c) => {
+            Ok(done) => {
                 self.restarts = 0;
-                c
+                Ok(done)
             }
             Err(RecvTimeoutError::Timeout) => {
                 // Abort what runs (at its next budget check) and leave the worker behind: it
@@ -150,7 +195,7 @@ impl Watchdog {
                 self.worker = None;
                 let deadline_ms = u64::try_from(self.deadline.as_millis()).unwrap_or(u64::MAX);
                 tracing::error!(behavior = %self.name, deadline_ms, "stopped by the watchdog");
-                safe(vec![ScriptError::Watchdog { file: self.name.clone(), deadline_ms }])
+                Err(vec![ScriptError::Watchdog { file: self.name.clone(), deadline_ms }])
             }
             Err(RecvTimeoutError::Disconnected) => {
                 // The worker panicked: isolated (its thread is gone), reported, restarted.
@@ -166,7 +211,7 @@ impl Watchdog {
                         Err(e) => errors.push(e),
                     }
                 }
-                safe(errors)
+                Err(errors)
             }
         }
     }
@@ -216,7 +261,14 @@ fn spawn(name: &str, make: &Factory) -> Result<Worker, ScriptError> {
                         reloaded.append(&mut cycle.reloaded);
                         errors.append(&mut cycle.errors);
                         (cycle.reloaded, cycle.errors) = (reloaded, errors);
-                        if reply_tx.send(Reply { seq, cycle }).is_err() {
+                        if reply_tx.send(Reply { seq, done: Done::Cycle(Box::new(cycle)) }).is_err()
+                        {
+                            return;
+                        }
+                    }
+                    Job::Install(seq, change) => {
+                        let done = Done::Installed(cap.install(*change));
+                        if reply_tx.send(Reply { seq, done }).is_err() {
                             return;
                         }
                     }

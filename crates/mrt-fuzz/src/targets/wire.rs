@@ -39,6 +39,13 @@ macro_rules! message_types {
         $f!(mrt_msgs::DeviceAct);
         $f!(mrt_msgs::FinalWhistle);
         $f!(mrt_msgs::RobotEnd);
+        $f!(mrt_msgs::GameInfo);
+        $f!(mrt_msgs::Localization);
+        $f!(mrt_msgs::Percepts);
+        $f!(mrt_msgs::PlanRequest);
+        $f!(mrt_msgs::PlannedPath);
+        $f!(mrt_msgs::BehaviorPush);
+        $f!(mrt_msgs::BehaviorPushReply);
     };
 }
 
@@ -88,6 +95,14 @@ fn wire_seeds(_root: &Path) -> Result<Vec<Seed>, FuzzError> {
     default_frame!(mrt_msgs::DeviceFrame);
     default_frame!(mrt_msgs::DeviceAct);
     default_frame!(mrt_msgs::RobotEnd);
+    default_frame!(mrt_msgs::BehaviorPushReply);
+    let pushed = mrt_msgs::BehaviorPush {
+        robot: 3,
+        request: 17,
+        file: "attacker.lua".to_string(),
+        source: "-- an edited behavior\nfunction go() end\n".to_string(),
+    };
+    push("BehaviorPush", Msg::new(header(mrt_msgs::BehaviorPush::TYPE), pushed).into_ref())?;
     push("SelfDescribing", Msg::new(header(SelfDescribing::TYPE), sample_describing()).into_ref())?;
     let update = mrt_blackboard::BbUpdate(mrt_blackboard::Update {
         from: 2,
