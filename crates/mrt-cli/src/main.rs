@@ -27,6 +27,8 @@ mod behave;
 mod brian;
 #[cfg(feature = "net")]
 mod distributed;
+#[cfg(feature = "net")]
+mod edge;
 mod plan;
 mod push;
 mod replay;
@@ -98,6 +100,11 @@ enum Command {
     /// Serve the web monitor on the robots of a network, live (docs/monitor.md).
     #[cfg(feature = "net")]
     Monitor(topic::MonitorArgs),
+    /// The robots' messages for programs in other languages: JSON and the manual's XML
+    /// self-describing form on plain zenoh keys, and JSON from them onto the robots' bus
+    /// (docs/network.md, "Programs in other languages").
+    #[cfg(feature = "net")]
+    Edge(edge::EdgeArgs),
     /// Vision tools: find the ball in camera images (`detect`), tune colours (`calibrate`),
     /// save what a simulated camera sees (`render`), measure the vision on it (`survey`).
     Vision {
@@ -306,6 +313,8 @@ fn run(command: Command) -> Result<()> {
         Command::Record(args) => topic::record(&args)?,
         #[cfg(feature = "net")]
         Command::Monitor(args) => topic::monitor(&args)?,
+        #[cfg(feature = "net")]
+        Command::Edge(args) => edge::run(&args)?,
         Command::Soak { command } => soak::run(&command)?,
         #[cfg(feature = "net")]
         Command::Robot(args) => distributed::robot(&args)?,

@@ -116,7 +116,7 @@ impl Member for Listener {
 }
 
 /// The catalogue entry named `name` (case-insensitive), or an error listing them all.
-fn entry_named(name: &str) -> Result<&'static Entry> {
+pub(crate) fn entry_named(name: &str) -> Result<&'static Entry> {
     catalogue::CATALOGUE.iter().find(|e| e.name.eq_ignore_ascii_case(name)).ok_or_else(|| {
         let names: Vec<&str> = catalogue::CATALOGUE.iter().map(|e| e.name).collect();
         anyhow!("no message type {name:?}: the types are {}", names.join(", "))

@@ -2,13 +2,14 @@
 //! its bus id, its name, its JSON schema and how a bus message of it becomes JSON.
 
 use mrt_core::{Message, MsgType};
-use mrt_dcdt::Msg;
+use mrt_dcdt::{DeliveryWarranty, Endpoint, Msg};
 use mrt_msgs::{
     BehaviorPush, BehaviorPushReply, BehaviorStatus, CameraFrame, DeviceAct, DeviceFrame,
     FinalWhistle, GameInfo, Localization, MateReport, MotorCommand, Odometry, Percepts,
     PlanRequest, PlannedPath, ReloadRequest, RobotCommand, RobotEnd, SonarScan, WorldSnapshot,
 };
 use schemars::JsonSchema;
+use serde::de::DeserializeOwned;
 use serde::Serialize;
 
 /// A bus message as JSON: `None` when the message is of another type or its payload does not
@@ -26,6 +27,9 @@ pub struct Entry {
     pub schema: fn() -> serde_json::Value,
     /// A bus message of this type as JSON.
     pub to_json: fn(&Msg) -> Encoded,
+    /// A message of this type read from JSON and published on `ep`'s bus (what a program in
+    /// another language sends through `mrt edge`).
+    pub publish_json: fn(&Endpoint, &[u8], DeliveryWarranty) -> Result<(), serde_json::Error>,
 }
 
 /// The JSON schema of `T`.
@@ -35,6 +39,15 @@ pub fn schema_of<T: JsonSchema>() -> serde_json::Value {
 
 fn json_of<T: Message + Serialize>(m: &Msg) -> Encoded {
     m.get::<T>().ok().map(serde_json::to_vec)
+}
+
+fn publish_json<T: Message + DeserializeOwned>(
+    ep: &Endpoint,
+    json: &[u8],
+    warranty: DeliveryWarranty,
+) -> Result<(), serde_json::Error> {
+    ep.publish_with(serde_json::from_slice::<T>(json)?, warranty, 0);
+    Ok(())
 }
 
 /// A camera frame without its images: a frame's pixels as JSON numbers would make a match's
@@ -67,6 +80,7 @@ macro_rules! catalogue {
             name: <$ty as Message>::NAME,
             schema: schema_of::<$ty>,
             to_json: catalogue!(@json $ty $(, $json)?),
+            publish_json: publish_json::<$ty>,
         }),*];
     };
     (@json $ty:ty) => { json_of::<$ty> };

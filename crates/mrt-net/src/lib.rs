@@ -40,7 +40,7 @@ mod link;
 pub mod probe;
 
 pub use config::{NetConfig, NetError};
-pub use link::{envelope, NetLink, NetPresence, NetStats, ENVELOPE};
+pub use link::{envelope, NetLink, NetPresence, NetStats, RawPort, RawSubscription, ENVELOPE};
 
 /// Joins a NETWORK Agora (built by `Agora::from_config(file, id)`) to the network its
 /// configuration file describes.

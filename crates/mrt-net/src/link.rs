@@ -430,6 +430,57 @@ impl NetLink {
     pub fn session(&self) -> &zenoh::Session {
         &self.shared.session
     }
+
+    /// A handle for plain zenoh payloads beside DCDT's frames, for programs that are not
+    /// Agoras (`mrt edge`: messages as JSON for other languages).
+    pub fn raw(&self) -> RawPort {
+        RawPort(self.shared.session.clone())
+    }
+}
+
+/// Plain zenoh puts and subscriptions on an Agora's session, outside DCDT's framing
+/// ([`NetLink::raw`]). Keys under `mrt/m/` are DCDT's and refused here.
+#[derive(Clone)]
+pub struct RawPort(zenoh::Session);
+
+/// A subscription of a [`RawPort`]: it lasts while this lives.
+pub struct RawSubscription(#[allow(dead_code)] Subscriber<()>);
+
+impl RawPort {
+    fn check(key: &str) -> Result<(), NetError> {
+        if key.starts_with(&format!("{ROOT}/m/")) || key == format!("{ROOT}/m") {
+            return Err(NetError::Zenoh(format!("{key}: keys under {ROOT}/m/ carry DCDT frames")));
+        }
+        Ok(())
+    }
+
+    /// Puts `bytes` on `key` (reliably: blocks when the link is congested).
+    pub fn put(&self, key: &str, bytes: Vec<u8>) -> Result<(), NetError> {
+        Self::check(key)?;
+        self.0
+            .put(key, bytes)
+            .congestion_control(CongestionControl::Block)
+            .wait()
+            .map_err(|e| NetError::Zenoh(e.to_string()))
+    }
+
+    /// Calls `f` with the key and the payload of everything put on keys matching `key_expr`
+    /// (a zenoh key expression, e.g. `mrt/json-in/*`), on zenoh's receiving thread.
+    pub fn subscribe(
+        &self,
+        key_expr: &str,
+        f: impl Fn(&str, Vec<u8>) + Send + Sync + 'static,
+    ) -> Result<RawSubscription, NetError> {
+        Self::check(key_expr)?;
+        self.0
+            .declare_subscriber(key_expr.to_string())
+            .callback(move |s: Sample| {
+                f(s.key_expr().as_str(), s.payload().to_bytes().into_owned())
+            })
+            .wait()
+            .map(RawSubscription)
+            .map_err(|e| NetError::Zenoh(e.to_string()))
+    }
 }
 
 impl Drop for NetLink {
