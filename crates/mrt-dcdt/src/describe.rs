@@ -57,7 +57,8 @@
 //! - **Sequences.** Elements of a sequence, tuple or array are indexed: `lps[0]`,
 //!   `needs[0][1]`; an empty sequence leaves nothing. A sequence of bytes (`Vec<u8>`, `&[u8]`,
 //!   `serde_bytes`) is a single attribute whose symbol is its size, e.g. `<921600 bytes>`: a
-//!   camera image's content is left out. Tuples and arrays of `u8` stay numbers.
+//!   camera image's content is left out. Tuples and arrays of `u8`, and sequences of
+//!   `Option<u8>` or of newtypes of `u8`, stay numbers.
 //! - **Enums with data, newtypes, maps.** A variant with data is an object whose class is the
 //!   variant's name, with the variant's fields, or `0`, `1`, ... for a tuple or newtype
 //!   variant. A newtype struct is its value (a struct in it takes the newtype's name as
@@ -923,6 +924,14 @@ impl TreeSerializer {
     }
 }
 
+/// `node`, a number if it is a byte.
+fn not_byte(node: Node) -> Node {
+    match node {
+        Node::Byte(b) => Node::Number(f64::from(b)),
+        other => other,
+    }
+}
+
 /// The elements of a sequence or a tuple; a sequence of `u8` is kept as bytes.
 struct SeqBuilder {
     inner: TreeSerializer,
@@ -1063,7 +1072,8 @@ impl serde::Serializer for TreeSerializer {
         Ok(Node::Absent)
     }
     fn serialize_some<T: Serialize + ?Sized>(self, value: &T) -> Result<Node, DescribeError> {
-        value.serialize(self.deeper()?)
+        // Only a bare `u8` is a byte: `Vec<Option<u8>>` is a sequence of numbers.
+        Ok(not_byte(value.serialize(self.deeper()?)?))
     }
     fn serialize_unit(self) -> Result<Node, DescribeError> {
         Ok(Node::Absent)
@@ -1087,7 +1097,7 @@ impl serde::Serializer for TreeSerializer {
         // A newtype is its value; a struct wrapped in it takes the newtype's name.
         match value.serialize(self.deeper()?)? {
             Node::Struct { fields, .. } => Ok(Node::Struct { class: name.to_owned(), fields }),
-            other => Ok(other),
+            other => Ok(not_byte(other)),
         }
     }
     fn serialize_newtype_variant<T: Serialize + ?Sized>(
@@ -2310,6 +2320,14 @@ mod generated {
                 row("mixed[1]", "3", 0.0, 1.0),
             ]
         );
+        // Optional bytes and newtypes of bytes are numbers.
+        #[derive(Serialize)]
+        struct Level(u8);
+        assert_eq!(
+            attrs(&form("v", &vec![Some(1), Some(2)]), "v"),
+            [row("[0]", "1", 0.0, 1.0), row("[1]", "2", 0.0, 1.0)]
+        );
+        assert_eq!(attrs(&form("v", &vec![Level(3)]), "v"), [row("[0]", "3", 0.0, 1.0)]);
         // Bytes followed by something else are numbers after all.
         assert_eq!(attrs(&form("v", &vec![Some(4), None]), "v"), [row("[0]", "4", 0.0, 1.0)]);
     }
