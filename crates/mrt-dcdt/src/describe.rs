@@ -47,7 +47,9 @@
 //! - **Objects.** The value is the first object, named by the caller ([`Message::NAME`] for
 //!   `of_message`), of class its type's name. Each struct in it (a unit or tuple struct too)
 //!   is an object of its own, after the objects before it depth first, named by its path from
-//!   the message and of class its type's name: `ball`, `mates[2]`, `mates[2].at.pose`.
+//!   the message and of class its type's name: `ball`, `mates[2]`, `mates[2].at.pose`. A
+//!   value that is not a struct (a number, a sequence, a map) is a first object of class
+//!   `name`, a lone number or symbol being its attribute `value`.
 //! - **Attributes.** The other fields are attributes of the nearest enclosing object, named by
 //!   their path from it. A number (any integer or float, as an `f64`: integers beyond 2⁵³ are
 //!   rounded) has a `value`; a bool (`true`, `false`), a string, a char and a unit enum
