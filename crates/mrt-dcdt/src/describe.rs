@@ -36,6 +36,104 @@
 //! assert_eq!(SelfDescribing::from_xml(&xml)?, msg);
 //! # Ok::<(), mrt_dcdt::describe::XmlError>(())
 //! ```
+//!
+//! # The form of a typed message
+//!
+//! Every typed message has a self-describing form, generated from its type: [`describe`] (and
+//! [`SelfDescribing::of_message`], which names the form after the message type) takes any value
+//! that implements `Serialize`, so the standard catalogue (`mrt-msgs`) needs no per-message
+//! code. The rules:
+//!
+//! - **Objects.** The value is the first object, named by the caller ([`Message::NAME`] for
+//!   `of_message`), of class its type's name. Each struct in it (a unit or tuple struct too)
+//!   is an object of its own, after the objects before it depth first, named by its path from
+//!   the message and of class its type's name: `ball`, `mates[2]`, `mates[2].at.pose`. A
+//!   value that is not a struct (a number, a sequence, a map) is a first object of class
+//!   `name`, a lone number or symbol being its attribute `value`.
+//! - **Attributes.** The other fields are attributes of the nearest enclosing object, named by
+//!   their path from it. A number (any integer or float, as an `f64`: integers beyond 2⁵³ are
+//!   rounded) has a `value`; a bool (`true`, `false`), a string, a char and a unit enum
+//!   variant (its serde name) have a `symbol`. `NaN`, `inf` and `-inf` are written as such and
+//!   read back.
+//! - **Absent values.** `None` and `()` are left out; `Some(v)` is `v`.
+//! - **Sequences.** Elements of a sequence, tuple or array are indexed: `lps[0]`,
+//!   `needs[0][1]`; an empty sequence leaves nothing. A sequence of bytes (`Vec<u8>`, `&[u8]`,
+//!   `serde_bytes`) is a single attribute whose symbol is its size, e.g. `<921600 bytes>`: a
+//!   camera image's content is left out. Tuples and arrays of `u8`, and sequences of
+//!   `Option<u8>` or of newtypes of `u8`, stay numbers.
+//! - **Enums with data, newtypes, maps.** A variant with data is an object whose class is the
+//!   variant's name, with the variant's fields, or `0`, `1`, ... for a tuple or newtype
+//!   variant. A newtype struct is its value (a struct in it takes the newtype's name as
+//!   class). A map entry is named by its key, `f.key`, the key being a number or a symbol
+//!   (any other key is a [`DescribeError::MapKey`]).
+//! - **Variability and reliability.** By default an attribute has variability 0 and
+//!   reliability 1. Numeric fields of a struct with the names of the shared ontology below set
+//!   them for the struct's other attributes and for those of the objects nested in it (the
+//!   nearest struct's field wins; the fields themselves keep 0 and 1):
+//!
+//!   | field | gives | to |
+//!   |---|---|---|
+//!   | `reliability`, `quality` | the reliability | every attribute |
+//!   | `variability` | the variability | every numeric attribute |
+//!   | `sigma` | the variability | the numeric attributes `x` and `y` (one standard deviation of a place) |
+//!   | `f_sigma`, `sigma_f` | the variability | the numeric attributes of field `f`; with no field `f`, those named `f` (`sigma_xy`: `x` and `y`) |
+//!
+//!   Within one struct, a `f_sigma` rule wins over `sigma`, which wins over `variability`. A
+//!   reliability is clamped to [0, 1] (NaN: 0), a variability made non-negative (NaN:
+//!   infinite), so that the form always reads back. Symbols have variability 0. A `sigma`
+//!   that is not a number (a pair such as `RobotSighting::sigma`) is an ordinary attribute.
+//!
+//! ```
+//! use mrt_core::Time;
+//! use mrt_dcdt::describe::{describe, SelfDescribing};
+//! use serde::Serialize;
+//!
+//! #[derive(Serialize)]
+//! enum Colour { Green, White }
+//!
+//! #[derive(Serialize)]
+//! struct Anchor { distance: f64, bearing: f64, distance_sigma: f64, reliability: f64 }
+//!
+//! #[derive(Serialize)]
+//! struct Percept {
+//!     robot: u32,
+//!     floor: Colour,
+//!     wall: Anchor,
+//!     ball: Option<Anchor>,
+//!     landmarks: Vec<(f64, f64)>,
+//!     image: Vec<u8>,
+//! }
+//!
+//! let percept = Percept {
+//!     robot: 2,
+//!     floor: Colour::Green,
+//!     wall: Anchor { distance: 2.4, bearing: 0.0, distance_sigma: 0.1, reliability: 0.9 },
+//!     ball: None,
+//!     landmarks: vec![(4.5, -0.25)],
+//!     image: vec![0; 12],
+//! };
+//! let form = describe("percept", &percept, Time(12_500_000_000))?;
+//! assert_eq!(
+//!     form.to_xml(),
+//!     r#"<message timestamp="12.500000000">
+//!   <object name="percept" class="Percept">
+//!     <attribute name="robot" value="2" variability="0" reliability="1"/>
+//!     <attribute name="floor" symbol="Green" variability="0" reliability="1"/>
+//!     <attribute name="landmarks[0][0]" value="4.5" variability="0" reliability="1"/>
+//!     <attribute name="landmarks[0][1]" value="-0.25" variability="0" reliability="1"/>
+//!     <attribute name="image" symbol="&lt;12 bytes&gt;" variability="0" reliability="1"/>
+//!   </object>
+//!   <object name="wall" class="Anchor">
+//!     <attribute name="distance" value="2.4" variability="0.1" reliability="0.9"/>
+//!     <attribute name="bearing" value="0" variability="0" reliability="0.9"/>
+//!     <attribute name="distance_sigma" value="0.1" variability="0" reliability="1"/>
+//!     <attribute name="reliability" value="0.9" variability="0" reliability="1"/>
+//!   </object>
+//! </message>"#
+//! );
+//! assert_eq!(SelfDescribing::from_xml(&form.to_xml())?, form);
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
 
 use crate::msg::{Message, RESERVED_TYPES_START};
 use mrt_core::{MsgType, Time};
@@ -713,6 +811,661 @@ impl<'a> Parser<'a> {
     }
 }
 
+// ---------------------------------------------------------------------------------------------
+// Generating the form of a typed message
+
+/// Why [`describe`] could not give the self-describing form of a value.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum DescribeError {
+    /// A map key that is not a number or a symbol (a struct, a sequence, `None`): it cannot
+    /// name an attribute.
+    #[error("a map key must be a number or a symbol, found {found}")]
+    MapKey {
+        /// What the key is, e.g. `a struct`.
+        found: &'static str,
+    },
+    /// The value nests deeper than [`MAX_DEPTH`] levels.
+    #[error("the value nests deeper than {MAX_DEPTH} levels")]
+    TooDeep,
+    /// The value's `Serialize` implementation failed.
+    #[error("the value could not be serialized: {0}")]
+    Serialize(String),
+}
+
+impl serde::ser::Error for DescribeError {
+    fn custom<M: std::fmt::Display>(msg: M) -> Self {
+        DescribeError::Serialize(msg.to_string())
+    }
+}
+
+/// How deeply a described value may nest (structs, sequences, maps, enums and options
+/// together): deeper values are refused with [`DescribeError::TooDeep`] rather than risking the
+/// stack.
+pub const MAX_DEPTH: usize = 128;
+
+/// The self-describing form of `value`, stamped `timestamp`, its first object named `name`.
+///
+/// The form is generated from the value's `Serialize` implementation, by the rules of the
+/// [module documentation](self#the-form-of-a-typed-message); any value that serializes gives a
+/// form that [`SelfDescribing::to_xml`] writes and [`SelfDescribing::from_xml`] reads back.
+/// Errors: a map key that is not a number or a symbol, a value nested deeper than
+/// [`MAX_DEPTH`], or a `Serialize` implementation that fails.
+pub fn describe<T: Serialize + ?Sized>(
+    name: &str,
+    value: &T,
+    timestamp: Time,
+) -> Result<SelfDescribing, DescribeError> {
+    let node = value.serialize(TreeSerializer { depth: 0 })?;
+    let mut flat = Flattener { objects: Vec::new() };
+    let root = Uncertainty { reliability: 1.0, rules: Vec::new() };
+    match node {
+        Node::Struct { class, fields } => flat.object(name, "", class, fields, &root)?,
+        other => {
+            flat.objects.push(Object::new(name, name));
+            flat.walk(0, "", String::new(), "", other, &root, false)?;
+        }
+    }
+    Ok(SelfDescribing { timestamp, objects: flat.objects })
+}
+
+impl SelfDescribing {
+    /// The self-describing form of the bus message `msg` ([`describe`]), its first object
+    /// named after the message type ([`Message::NAME`]).
+    pub fn of_message<M: Message>(msg: &M, timestamp: Time) -> Result<Self, DescribeError> {
+        describe(M::NAME, msg, timestamp)
+    }
+}
+
+/// A serialized value before it is flattened into objects.
+#[derive(Debug)]
+enum Node {
+    /// Any number (integers included).
+    Number(f64),
+    /// A `u8`: a number, unless it is an element of a byte sequence.
+    Byte(u8),
+    /// A bool, a string, a char or a unit enum variant.
+    Symbol(String),
+    /// A byte array, of this many bytes.
+    Bytes(usize),
+    /// `None` or `()`: left out.
+    Absent,
+    /// A struct, a unit or tuple struct, or an enum variant with data (`class`: the variant).
+    Struct { class: String, fields: Vec<(String, Node)> },
+    /// A sequence or a tuple.
+    Seq(Vec<Node>),
+    /// A map, its keys already turned into names.
+    Map(Vec<(String, Node)>),
+}
+
+impl Node {
+    fn kind(&self) -> &'static str {
+        match self {
+            Node::Number(_) | Node::Byte(_) => "a number",
+            Node::Symbol(_) => "a symbol",
+            Node::Bytes(_) => "bytes",
+            Node::Absent => "nothing",
+            Node::Struct { .. } => "a struct",
+            Node::Seq(_) => "a sequence",
+            Node::Map(_) => "a map",
+        }
+    }
+}
+
+/// Builds the [`Node`] tree of a value.
+struct TreeSerializer {
+    depth: usize,
+}
+
+impl TreeSerializer {
+    fn deeper(&self) -> Result<TreeSerializer, DescribeError> {
+        if self.depth >= MAX_DEPTH {
+            return Err(DescribeError::TooDeep);
+        }
+        Ok(TreeSerializer { depth: self.depth + 1 })
+    }
+}
+
+/// `node`, a number if it is a byte.
+fn not_byte(node: Node) -> Node {
+    match node {
+        Node::Byte(b) => Node::Number(f64::from(b)),
+        other => other,
+    }
+}
+
+/// The elements of a sequence or a tuple; a sequence of `u8` is kept as bytes.
+struct SeqBuilder {
+    inner: TreeSerializer,
+    items: Vec<Node>,
+    bytes: Vec<u8>,
+    /// Whether `u8` elements are kept as bytes (sequences, not tuples).
+    byte_seq: bool,
+}
+
+impl SeqBuilder {
+    fn new(inner: TreeSerializer, byte_seq: bool, len: Option<usize>) -> Self {
+        let items = Vec::with_capacity(len.unwrap_or(0).min(64));
+        SeqBuilder { inner, items, bytes: Vec::new(), byte_seq }
+    }
+
+    fn push<T: Serialize + ?Sized>(&mut self, value: &T) -> Result<(), DescribeError> {
+        let node = value.serialize(TreeSerializer { depth: self.inner.depth })?;
+        match node {
+            Node::Byte(b) if self.byte_seq && self.items.is_empty() => self.bytes.push(b),
+            node => {
+                // Not bytes after all: the bytes seen so far are numbers.
+                self.items.extend(self.bytes.drain(..).map(|b| Node::Number(f64::from(b))));
+                self.items.push(node);
+            }
+        }
+        Ok(())
+    }
+
+    fn finish(self) -> Node {
+        if self.items.is_empty() && !self.bytes.is_empty() {
+            Node::Bytes(self.bytes.len())
+        } else {
+            Node::Seq(self.items)
+        }
+    }
+}
+
+/// The fields of a struct or of an enum variant with data.
+struct StructBuilder {
+    inner: TreeSerializer,
+    class: String,
+    fields: Vec<(String, Node)>,
+}
+
+impl StructBuilder {
+    fn push<T: Serialize + ?Sized>(&mut self, key: String, value: &T) -> Result<(), DescribeError> {
+        let node = value.serialize(TreeSerializer { depth: self.inner.depth })?;
+        self.fields.push((key, node));
+        Ok(())
+    }
+
+    fn finish(self) -> Node {
+        Node::Struct { class: self.class, fields: self.fields }
+    }
+}
+
+/// The entries of a map.
+struct MapBuilder {
+    inner: TreeSerializer,
+    entries: Vec<(String, Node)>,
+    key: Option<String>,
+}
+
+/// A map key as a name: a symbol as is, a number as written in the form.
+fn key_name(node: Node) -> Result<String, DescribeError> {
+    match node {
+        Node::Symbol(s) => Ok(s),
+        Node::Number(v) => Ok(v.to_string()),
+        Node::Byte(b) => Ok(b.to_string()),
+        other => Err(DescribeError::MapKey { found: other.kind() }),
+    }
+}
+
+impl serde::Serializer for TreeSerializer {
+    type Ok = Node;
+    type Error = DescribeError;
+    type SerializeSeq = SeqBuilder;
+    type SerializeTuple = SeqBuilder;
+    type SerializeTupleStruct = StructBuilder;
+    type SerializeTupleVariant = StructBuilder;
+    type SerializeMap = MapBuilder;
+    type SerializeStruct = StructBuilder;
+    type SerializeStructVariant = StructBuilder;
+
+    fn serialize_bool(self, v: bool) -> Result<Node, DescribeError> {
+        Ok(Node::Symbol(v.to_string()))
+    }
+    fn serialize_i8(self, v: i8) -> Result<Node, DescribeError> {
+        Ok(Node::Number(f64::from(v)))
+    }
+    fn serialize_i16(self, v: i16) -> Result<Node, DescribeError> {
+        Ok(Node::Number(f64::from(v)))
+    }
+    fn serialize_i32(self, v: i32) -> Result<Node, DescribeError> {
+        Ok(Node::Number(f64::from(v)))
+    }
+    #[allow(clippy::cast_precision_loss)]
+    fn serialize_i64(self, v: i64) -> Result<Node, DescribeError> {
+        Ok(Node::Number(v as f64))
+    }
+    #[allow(clippy::cast_precision_loss)]
+    fn serialize_i128(self, v: i128) -> Result<Node, DescribeError> {
+        Ok(Node::Number(v as f64))
+    }
+    fn serialize_u8(self, v: u8) -> Result<Node, DescribeError> {
+        Ok(Node::Byte(v))
+    }
+    fn serialize_u16(self, v: u16) -> Result<Node, DescribeError> {
+        Ok(Node::Number(f64::from(v)))
+    }
+    fn serialize_u32(self, v: u32) -> Result<Node, DescribeError> {
+        Ok(Node::Number(f64::from(v)))
+    }
+    #[allow(clippy::cast_precision_loss)]
+    fn serialize_u64(self, v: u64) -> Result<Node, DescribeError> {
+        Ok(Node::Number(v as f64))
+    }
+    #[allow(clippy::cast_precision_loss)]
+    fn serialize_u128(self, v: u128) -> Result<Node, DescribeError> {
+        Ok(Node::Number(v as f64))
+    }
+    fn serialize_f32(self, v: f32) -> Result<Node, DescribeError> {
+        Ok(Node::Number(f64::from(v)))
+    }
+    fn serialize_f64(self, v: f64) -> Result<Node, DescribeError> {
+        Ok(Node::Number(v))
+    }
+    fn serialize_char(self, v: char) -> Result<Node, DescribeError> {
+        Ok(Node::Symbol(v.to_string()))
+    }
+    fn serialize_str(self, v: &str) -> Result<Node, DescribeError> {
+        Ok(Node::Symbol(v.to_owned()))
+    }
+    fn serialize_bytes(self, v: &[u8]) -> Result<Node, DescribeError> {
+        Ok(Node::Bytes(v.len()))
+    }
+    fn serialize_none(self) -> Result<Node, DescribeError> {
+        Ok(Node::Absent)
+    }
+    fn serialize_some<T: Serialize + ?Sized>(self, value: &T) -> Result<Node, DescribeError> {
+        // Only a bare `u8` is a byte: `Vec<Option<u8>>` is a sequence of numbers.
+        Ok(not_byte(value.serialize(self.deeper()?)?))
+    }
+    fn serialize_unit(self) -> Result<Node, DescribeError> {
+        Ok(Node::Absent)
+    }
+    fn serialize_unit_struct(self, name: &'static str) -> Result<Node, DescribeError> {
+        Ok(Node::Struct { class: name.to_owned(), fields: Vec::new() })
+    }
+    fn serialize_unit_variant(
+        self,
+        _name: &'static str,
+        _index: u32,
+        variant: &'static str,
+    ) -> Result<Node, DescribeError> {
+        Ok(Node::Symbol(variant.to_owned()))
+    }
+    fn serialize_newtype_struct<T: Serialize + ?Sized>(
+        self,
+        name: &'static str,
+        value: &T,
+    ) -> Result<Node, DescribeError> {
+        // A newtype is its value; a struct wrapped in it takes the newtype's name.
+        match value.serialize(self.deeper()?)? {
+            Node::Struct { fields, .. } => Ok(Node::Struct { class: name.to_owned(), fields }),
+            other => Ok(not_byte(other)),
+        }
+    }
+    fn serialize_newtype_variant<T: Serialize + ?Sized>(
+        self,
+        _name: &'static str,
+        _index: u32,
+        variant: &'static str,
+        value: &T,
+    ) -> Result<Node, DescribeError> {
+        let node = value.serialize(self.deeper()?)?;
+        Ok(Node::Struct { class: variant.to_owned(), fields: vec![("0".to_owned(), node)] })
+    }
+    fn serialize_seq(self, len: Option<usize>) -> Result<SeqBuilder, DescribeError> {
+        Ok(SeqBuilder::new(self.deeper()?, true, len))
+    }
+    fn serialize_tuple(self, len: usize) -> Result<SeqBuilder, DescribeError> {
+        Ok(SeqBuilder::new(self.deeper()?, false, Some(len)))
+    }
+    fn serialize_tuple_struct(
+        self,
+        name: &'static str,
+        len: usize,
+    ) -> Result<StructBuilder, DescribeError> {
+        let fields = Vec::with_capacity(len.min(64));
+        Ok(StructBuilder { inner: self.deeper()?, class: name.to_owned(), fields })
+    }
+    fn serialize_tuple_variant(
+        self,
+        _name: &'static str,
+        _index: u32,
+        variant: &'static str,
+        len: usize,
+    ) -> Result<StructBuilder, DescribeError> {
+        let fields = Vec::with_capacity(len.min(64));
+        Ok(StructBuilder { inner: self.deeper()?, class: variant.to_owned(), fields })
+    }
+    fn serialize_map(self, _len: Option<usize>) -> Result<MapBuilder, DescribeError> {
+        Ok(MapBuilder { inner: self.deeper()?, entries: Vec::new(), key: None })
+    }
+    fn serialize_struct(
+        self,
+        name: &'static str,
+        len: usize,
+    ) -> Result<StructBuilder, DescribeError> {
+        let fields = Vec::with_capacity(len.min(64));
+        Ok(StructBuilder { inner: self.deeper()?, class: name.to_owned(), fields })
+    }
+    fn serialize_struct_variant(
+        self,
+        _name: &'static str,
+        _index: u32,
+        variant: &'static str,
+        len: usize,
+    ) -> Result<StructBuilder, DescribeError> {
+        let fields = Vec::with_capacity(len.min(64));
+        Ok(StructBuilder { inner: self.deeper()?, class: variant.to_owned(), fields })
+    }
+}
+
+impl serde::ser::SerializeSeq for SeqBuilder {
+    type Ok = Node;
+    type Error = DescribeError;
+    fn serialize_element<T: Serialize + ?Sized>(&mut self, value: &T) -> Result<(), Self::Error> {
+        self.push(value)
+    }
+    fn end(self) -> Result<Node, DescribeError> {
+        Ok(self.finish())
+    }
+}
+
+impl serde::ser::SerializeTuple for SeqBuilder {
+    type Ok = Node;
+    type Error = DescribeError;
+    fn serialize_element<T: Serialize + ?Sized>(&mut self, value: &T) -> Result<(), Self::Error> {
+        self.push(value)
+    }
+    fn end(self) -> Result<Node, DescribeError> {
+        Ok(self.finish())
+    }
+}
+
+impl serde::ser::SerializeTupleStruct for StructBuilder {
+    type Ok = Node;
+    type Error = DescribeError;
+    fn serialize_field<T: Serialize + ?Sized>(&mut self, value: &T) -> Result<(), Self::Error> {
+        self.push(self.fields.len().to_string(), value)
+    }
+    fn end(self) -> Result<Node, DescribeError> {
+        Ok(self.finish())
+    }
+}
+
+impl serde::ser::SerializeTupleVariant for StructBuilder {
+    type Ok = Node;
+    type Error = DescribeError;
+    fn serialize_field<T: Serialize + ?Sized>(&mut self, value: &T) -> Result<(), Self::Error> {
+        self.push(self.fields.len().to_string(), value)
+    }
+    fn end(self) -> Result<Node, DescribeError> {
+        Ok(self.finish())
+    }
+}
+
+impl serde::ser::SerializeStruct for StructBuilder {
+    type Ok = Node;
+    type Error = DescribeError;
+    fn serialize_field<T: Serialize + ?Sized>(
+        &mut self,
+        key: &'static str,
+        value: &T,
+    ) -> Result<(), Self::Error> {
+        self.push(key.to_owned(), value)
+    }
+    fn end(self) -> Result<Node, DescribeError> {
+        Ok(self.finish())
+    }
+}
+
+impl serde::ser::SerializeStructVariant for StructBuilder {
+    type Ok = Node;
+    type Error = DescribeError;
+    fn serialize_field<T: Serialize + ?Sized>(
+        &mut self,
+        key: &'static str,
+        value: &T,
+    ) -> Result<(), Self::Error> {
+        self.push(key.to_owned(), value)
+    }
+    fn end(self) -> Result<Node, DescribeError> {
+        Ok(self.finish())
+    }
+}
+
+impl serde::ser::SerializeMap for MapBuilder {
+    type Ok = Node;
+    type Error = DescribeError;
+    fn serialize_key<T: Serialize + ?Sized>(&mut self, key: &T) -> Result<(), Self::Error> {
+        let node = key.serialize(TreeSerializer { depth: self.inner.depth })?;
+        self.key = Some(key_name(node)?);
+        Ok(())
+    }
+    fn serialize_value<T: Serialize + ?Sized>(&mut self, value: &T) -> Result<(), Self::Error> {
+        let node = value.serialize(TreeSerializer { depth: self.inner.depth })?;
+        let key = self.key.take().unwrap_or_default();
+        self.entries.push((key, node));
+        Ok(())
+    }
+    fn end(self) -> Result<Node, DescribeError> {
+        Ok(Node::Map(self.entries))
+    }
+}
+
+/// A rule giving a variability to numeric attributes, from a field of an enclosing object.
+#[derive(Clone, Debug)]
+enum VarRule {
+    /// Every numeric attribute (`variability`; `<f>_sigma` below field `f`).
+    All(f64),
+    /// The attributes of field `.0` of the object that holds the rule and the objects below it
+    /// (`<f>_sigma`, `sigma_<f>`).
+    Field(String, f64),
+    /// The attributes named one of `.0` (`sigma_<f>` when `f` is no field; `sigma`: `x` and
+    /// `y`).
+    Named(Vec<String>, f64),
+}
+
+/// What an object's attributes inherit: the reliability and the variability rules, nearest
+/// first.
+#[derive(Clone, Debug)]
+struct Uncertainty {
+    reliability: f64,
+    rules: Vec<VarRule>,
+}
+
+impl Uncertainty {
+    /// The variability of a numeric attribute of field `field`, whose last name is `leaf`.
+    fn variability(&self, field: &str, leaf: &str) -> f64 {
+        for rule in &self.rules {
+            match rule {
+                VarRule::All(v) => return *v,
+                VarRule::Field(f, v) if f == field => return *v,
+                VarRule::Named(names, v) if names.iter().any(|n| n == leaf) => return *v,
+                _ => {}
+            }
+        }
+        0.0
+    }
+
+    /// What the objects below field `field` inherit.
+    fn below(&self, field: &str) -> Uncertainty {
+        let rules = self
+            .rules
+            .iter()
+            .filter_map(|rule| match rule {
+                VarRule::Field(f, v) if f == field => Some(VarRule::All(*v)),
+                VarRule::Field(..) => None,
+                other => Some(other.clone()),
+            })
+            .collect();
+        Uncertainty { reliability: self.reliability, rules }
+    }
+}
+
+/// A reliability as the form allows it: in [0, 1], NaN (unknown) as 0.
+fn sane_reliability(v: f64) -> f64 {
+    if v.is_nan() {
+        0.0
+    } else {
+        v.clamp(0.0, 1.0)
+    }
+}
+
+/// A variability as the form allows it: non-negative, NaN (unknown) as infinite.
+fn sane_variability(v: f64) -> f64 {
+    if v.is_nan() {
+        f64::INFINITY
+    } else {
+        v.abs()
+    }
+}
+
+/// What a numeric field of a struct says about the uncertainty of the others, if anything.
+enum Source {
+    Reliability(f64),
+    Variability(VarRule),
+}
+
+fn source(field: &str, value: f64, fields: &[(String, Node)]) -> Option<Source> {
+    let var = sane_variability(value);
+    let names = |list: &[&str]| list.iter().map(|&n| n.to_owned()).collect();
+    let target = |f: &str| {
+        if fields.iter().any(|(name, _)| name == f) {
+            VarRule::Field(f.to_owned(), var)
+        } else if f == "xy" {
+            VarRule::Named(names(&["x", "y"]), var)
+        } else {
+            VarRule::Named(names(&[f]), var)
+        }
+    };
+    match field {
+        "reliability" | "quality" => Some(Source::Reliability(sane_reliability(value))),
+        "variability" => Some(Source::Variability(VarRule::All(var))),
+        "sigma" => Some(Source::Variability(VarRule::Named(names(&["x", "y"]), var))),
+        _ => {
+            let f = field.strip_prefix("sigma_").or_else(|| field.strip_suffix("_sigma"))?;
+            (!f.is_empty()).then(|| Source::Variability(target(f)))
+        }
+    }
+}
+
+/// The name of an attribute without its indices and the path above it: `pose` for
+/// `mates[2].pose[0]`.
+fn leaf_name(path: &str) -> &str {
+    let last = path.rsplit('.').next().unwrap_or(path);
+    last.split('[').next().unwrap_or(last)
+}
+
+/// `path` followed by field or key `name`.
+fn join(path: &str, name: &str) -> String {
+    if path.is_empty() {
+        name.to_owned()
+    } else {
+        format!("{path}.{name}")
+    }
+}
+
+/// Flattens a [`Node`] tree into the objects of a form.
+struct Flattener {
+    objects: Vec<Object>,
+}
+
+impl Flattener {
+    /// Appends the object `name` of class `class` and, after it, the objects nested in it,
+    /// named from `path` (`""` for the message itself, `name` otherwise).
+    fn object(
+        &mut self,
+        name: &str,
+        path: &str,
+        class: String,
+        fields: Vec<(String, Node)>,
+        inherited: &Uncertainty,
+    ) -> Result<(), DescribeError> {
+        let mut own = Uncertainty { reliability: inherited.reliability, rules: Vec::new() };
+        let mut sources = Vec::new();
+        for (name, node) in &fields {
+            let value = match node {
+                Node::Number(v) => *v,
+                Node::Byte(b) => f64::from(*b),
+                _ => continue,
+            };
+            match source(name, value, &fields) {
+                Some(Source::Reliability(r)) => own.reliability = r,
+                Some(Source::Variability(rule)) => own.rules.push(rule),
+                None => continue,
+            }
+            sources.push(name.clone());
+        }
+        // The object's own rules first, the most specific first; then the inherited ones.
+        own.rules.sort_by_key(|rule| match rule {
+            VarRule::Field(..) => 0,
+            VarRule::Named(..) => 1,
+            VarRule::All(_) => 2,
+        });
+        own.rules.extend(inherited.rules.iter().cloned());
+        let index = self.objects.len();
+        self.objects.push(Object::new(name, class));
+        for (field, node) in fields {
+            let is_source = sources.contains(&field);
+            self.walk(index, path, field.clone(), &field, node, &own, is_source)?;
+        }
+        Ok(())
+    }
+
+    /// Adds what `node` holds, reached by `rel` from object `index` (named `path`) through its
+    /// field `field`: attributes to the object, objects after it.
+    #[allow(clippy::too_many_arguments)]
+    fn walk(
+        &mut self,
+        index: usize,
+        path: &str,
+        rel: String,
+        field: &str,
+        node: Node,
+        unc: &Uncertainty,
+        is_source: bool,
+    ) -> Result<(), DescribeError> {
+        let name = if rel.is_empty() { "value".to_owned() } else { rel.clone() };
+        let attribute = match node {
+            Node::Absent => return Ok(()),
+            Node::Number(v) => number(name, v, field, unc, is_source),
+            Node::Byte(b) => number(name, f64::from(b), field, unc, is_source),
+            Node::Symbol(s) => Attribute::symbol(name, s, 0.0, unc.reliability),
+            Node::Bytes(n) => Attribute::symbol(name, format!("<{n} bytes>"), 0.0, unc.reliability),
+            Node::Seq(items) => {
+                for (i, item) in items.into_iter().enumerate() {
+                    self.walk(index, path, format!("{rel}[{i}]"), field, item, unc, false)?;
+                }
+                return Ok(());
+            }
+            Node::Map(entries) => {
+                for (key, item) in entries {
+                    self.walk(index, path, join(&rel, &key), field, item, unc, false)?;
+                }
+                return Ok(());
+            }
+            Node::Struct { class, fields } => {
+                let below = unc.below(field);
+                let name = join(path, &rel);
+                return self.object(&name, &name, class, fields, &below);
+            }
+        };
+        if let Some(object) = self.objects.get_mut(index) {
+            object.attributes.push(attribute);
+        }
+        Ok(())
+    }
+}
+
+/// A numeric attribute with its variability and reliability.
+fn number(name: String, v: f64, field: &str, unc: &Uncertainty, is_source: bool) -> Attribute {
+    if is_source {
+        return Attribute::number(name, v, 0.0, 1.0);
+    }
+    let variability = unc.variability(field, leaf_name(&name));
+    Attribute::number(name, v, variability, unc.reliability)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -1238,6 +1991,468 @@ mod tests {
             damaged.push_str(&insert);
             damaged.extend(&chars[at..]);
             let _ = SelfDescribing::from_xml(&damaged);
+        }
+    }
+}
+
+/// The forms generated from types ([`describe`]).
+#[cfg(test)]
+mod generated {
+    use super::*;
+    use proptest::prelude::*;
+    use std::collections::BTreeMap;
+
+    /// Whether two forms are equal, a NaN equal to a NaN.
+    fn same(a: &SelfDescribing, b: &SelfDescribing) -> bool {
+        let number = |x: f64, y: f64| x == y || (x.is_nan() && y.is_nan());
+        a.timestamp == b.timestamp
+            && a.objects.len() == b.objects.len()
+            && a.objects.iter().zip(&b.objects).all(|(o, p)| {
+                o.name == p.name
+                    && o.class == p.class
+                    && o.attributes.len() == p.attributes.len()
+                    && o.attributes.iter().zip(&p.attributes).all(|(x, y)| {
+                        x.name == y.name
+                            && number(x.variability, y.variability)
+                            && number(x.reliability, y.reliability)
+                            && match (&x.value, &y.value) {
+                                (AttrValue::Number(u), AttrValue::Number(v)) => number(*u, *v),
+                                (u, v) => u == v,
+                            }
+                    })
+            })
+    }
+
+    /// The form of `value` as `name`, checked to read back from its XML.
+    fn form<T: Serialize + ?Sized>(name: &str, value: &T) -> SelfDescribing {
+        let form = match describe(name, value, Time(7)) {
+            Ok(form) => form,
+            Err(e) => panic!("{e}"),
+        };
+        let xml = form.to_xml();
+        match SelfDescribing::from_xml(&xml) {
+            Ok(back) => assert!(same(&back, &form), "{xml}"),
+            Err(e) => panic!("{e}\n{xml}"),
+        }
+        form
+    }
+
+    /// `(name, value or symbol, variability, reliability)` of each attribute of object `name`.
+    fn attrs(form: &SelfDescribing, name: &str) -> Vec<(String, String, f64, f64)> {
+        let Some(object) = form.object(name) else { panic!("no object {name}") };
+        object
+            .attributes
+            .iter()
+            .map(|a| {
+                let value = match &a.value {
+                    AttrValue::Number(v) => v.to_string(),
+                    AttrValue::Symbol(s) => format!("'{s}'"),
+                };
+                (a.name.clone(), value, a.variability, a.reliability)
+            })
+            .collect()
+    }
+
+    fn row(
+        name: &str,
+        value: &str,
+        variability: f64,
+        reliability: f64,
+    ) -> (String, String, f64, f64) {
+        (name.to_owned(), value.to_owned(), variability, reliability)
+    }
+
+    fn objects(form: &SelfDescribing) -> Vec<(&str, &str)> {
+        form.objects.iter().map(|o| (o.name.as_str(), o.class.as_str())).collect()
+    }
+
+    #[derive(Serialize, Clone, Debug, Default)]
+    struct Pose {
+        x: f64,
+        y: f64,
+        theta: f64,
+    }
+
+    #[derive(Serialize, Clone, Debug)]
+    enum Kind {
+        Ball,
+        Robot(u32),
+        Post { east: bool, at: Pose },
+        Pair(f32, i64),
+    }
+
+    #[derive(Serialize, Clone, Debug)]
+    struct Thing {
+        name: String,
+        kind: Kind,
+        pose: Pose,
+        sigma: f64,
+        quality: f64,
+        tags: Vec<char>,
+    }
+
+    #[derive(Serialize, Clone, Debug)]
+    struct Scene {
+        time: u64,
+        things: Vec<Thing>,
+        grid: [u8; 3],
+        image: Vec<u8>,
+        table: BTreeMap<String, f64>,
+        by_id: BTreeMap<u16, Pose>,
+        pair: (i8, Option<bool>),
+        unit: (),
+        variability: f64,
+        pose_sigma: f64,
+        pose: Option<Pose>,
+    }
+
+    #[test]
+    fn nested_structs_are_objects_named_by_path() {
+        let thing = |name: &str, kind| Thing {
+            name: name.to_owned(),
+            kind,
+            pose: Pose { x: 1.0, y: 2.0, theta: 0.5 },
+            sigma: 0.25,
+            quality: 0.75,
+            tags: vec!['a', '<'],
+        };
+        let scene = Scene {
+            time: 3,
+            things: vec![
+                thing("ball", Kind::Ball),
+                thing("mate", Kind::Robot(4)),
+                thing("post", Kind::Post { east: true, at: Pose::default() }),
+                thing("pair", Kind::Pair(1.5, -2)),
+            ],
+            grid: [1, 2, 3],
+            image: vec![9; 1_000_000],
+            table: BTreeMap::from([("b".to_owned(), 2.0), ("a".to_owned(), 1.0)]),
+            by_id: BTreeMap::from([(7, Pose::default())]),
+            pair: (-1, None),
+            unit: (),
+            variability: 0.5,
+            pose_sigma: 0.125,
+            pose: Some(Pose { x: 3.0, y: 4.0, theta: -1.0 }),
+        };
+        let form = form("scene", &scene);
+        assert_eq!(
+            objects(&form),
+            [
+                ("scene", "Scene"),
+                ("things[0]", "Thing"),
+                ("things[0].pose", "Pose"),
+                ("things[1]", "Thing"),
+                ("things[1].kind", "Robot"),
+                ("things[1].pose", "Pose"),
+                ("things[2]", "Thing"),
+                ("things[2].kind", "Post"),
+                ("things[2].kind.at", "Pose"),
+                ("things[2].pose", "Pose"),
+                ("things[3]", "Thing"),
+                ("things[3].kind", "Pair"),
+                ("things[3].pose", "Pose"),
+                ("by_id.7", "Pose"),
+                ("pose", "Pose"),
+            ]
+        );
+        // `variability` gives every other number of the scene 0.5 and reaches nested
+        // objects; `pose_sigma` gives the field `pose` 0.125 instead.
+        assert_eq!(
+            attrs(&form, "scene"),
+            [
+                row("time", "3", 0.5, 1.0),
+                row("grid[0]", "1", 0.5, 1.0),
+                row("grid[1]", "2", 0.5, 1.0),
+                row("grid[2]", "3", 0.5, 1.0),
+                row("image", "'<1000000 bytes>'", 0.0, 1.0),
+                row("table.a", "1", 0.5, 1.0),
+                row("table.b", "2", 0.5, 1.0),
+                row("pair[0]", "-1", 0.5, 1.0),
+                row("variability", "0.5", 0.0, 1.0),
+                row("pose_sigma", "0.125", 0.0, 1.0),
+            ]
+        );
+        assert_eq!(
+            attrs(&form, "pose"),
+            [row("x", "3", 0.125, 1.0), row("y", "4", 0.125, 1.0), row("theta", "-1", 0.125, 1.0)]
+        );
+        assert_eq!(attrs(&form, "by_id.7")[0], row("x", "0", 0.5, 1.0));
+        // `quality` is the reliability of a thing's attributes and of its pose's; `sigma` the
+        // variability of the pose's x and y, the scene's `variability` that of the rest.
+        assert_eq!(
+            attrs(&form, "things[0]"),
+            [
+                row("name", "'ball'", 0.0, 0.75),
+                row("kind", "'Ball'", 0.0, 0.75),
+                row("sigma", "0.25", 0.0, 1.0),
+                row("quality", "0.75", 0.0, 1.0),
+                row("tags[0]", "'a'", 0.0, 0.75),
+                row("tags[1]", "'<'", 0.0, 0.75),
+            ]
+        );
+        assert_eq!(
+            attrs(&form, "things[0].pose"),
+            [row("x", "1", 0.25, 0.75), row("y", "2", 0.25, 0.75), row("theta", "0.5", 0.5, 0.75)]
+        );
+        // Variants with data.
+        assert_eq!(attrs(&form, "things[1].kind"), [row("0", "4", 0.5, 0.75)]);
+        assert_eq!(attrs(&form, "things[2].kind"), [row("east", "'true'", 0.0, 0.75)]);
+        assert_eq!(
+            attrs(&form, "things[3].kind"),
+            [row("0", "1.5", 0.5, 0.75), row("1", "-2", 0.5, 0.75)]
+        );
+    }
+
+    #[test]
+    fn named_sigmas_reach_nested_attributes() {
+        #[derive(Serialize)]
+        struct Estimate {
+            pose: Pose,
+            sigma_xy: f64,
+            sigma_theta: f64,
+            quality: f64,
+        }
+        let form = form(
+            "Estimate",
+            &Estimate { pose: Pose::default(), sigma_xy: 0.1, sigma_theta: 0.05, quality: 0.5 },
+        );
+        assert_eq!(
+            attrs(&form, "pose"),
+            [row("x", "0", 0.1, 0.5), row("y", "0", 0.1, 0.5), row("theta", "0", 0.05, 0.5)]
+        );
+    }
+
+    #[test]
+    fn uncertainty_is_made_valid() {
+        #[derive(Serialize)]
+        struct Odd {
+            v: f64,
+            reliability: f64,
+            variability: f64,
+        }
+        for (reliability, variability, r, v) in [
+            (f64::NAN, f64::NAN, 0.0, f64::INFINITY),
+            (2.0, -3.0, 1.0, 3.0),
+            (-1.0, f64::NEG_INFINITY, 0.0, f64::INFINITY),
+            (0.5, -0.0, 0.5, 0.0),
+        ] {
+            let form = form("odd", &Odd { v: f64::NAN, reliability, variability });
+            let v_attr = &form.objects[0].attributes[0];
+            assert_eq!((v_attr.variability, v_attr.reliability), (v, r));
+            assert!(matches!(v_attr.value, AttrValue::Number(x) if x.is_nan()));
+        }
+        // Non-finite numbers as values read back.
+        let form = form("numbers", &[f64::INFINITY, f64::NEG_INFINITY, f64::NAN, -0.0, 5e-324]);
+        assert!(form.to_xml().contains(r#"name="[0]" value="inf""#), "{}", form.to_xml());
+        assert!(form.to_xml().contains(r#"name="[1]" value="-inf""#));
+        assert!(form.to_xml().contains(r#"name="[2]" value="NaN""#));
+    }
+
+    #[test]
+    fn values_that_are_not_structs() {
+        assert_eq!(attrs(&form("n", &2.5), "n"), [row("value", "2.5", 0.0, 1.0)]);
+        assert_eq!(objects(&form("n", &2.5)), [("n", "n")]);
+        assert_eq!(attrs(&form("s", "hi"), "s"), [row("value", "'hi'", 0.0, 1.0)]);
+        assert!(attrs(&form("none", &None::<f64>), "none").is_empty());
+        assert!(attrs(&form("empty", &Vec::<f64>::new()), "empty").is_empty());
+        let seq = form("poses", &vec![Pose::default(); 2]);
+        assert_eq!(objects(&seq), [("poses", "poses"), ("[0]", "Pose"), ("[1]", "Pose")]);
+        let map = form("m", &BTreeMap::from([('k', Pose::default())]));
+        assert_eq!(objects(&map), [("m", "m"), ("k", "Pose")]);
+        assert_eq!(objects(&form("k", &Kind::Robot(1))), [("k", "Robot")]);
+        #[derive(Serialize)]
+        struct Unit;
+        #[derive(Serialize)]
+        struct Wrapper(Pose);
+        #[derive(Serialize)]
+        struct Meters(f64);
+        #[derive(Serialize)]
+        struct Pair(f64, Unit);
+        assert_eq!(objects(&form("u", &Unit)), [("u", "Unit")]);
+        assert_eq!(objects(&form("w", &Wrapper(Pose::default()))), [("w", "Wrapper")]);
+        assert_eq!(attrs(&form("w", &Wrapper(Pose::default())), "w").len(), 3);
+        assert_eq!(attrs(&form("m", &Meters(2.0)), "m"), [row("value", "2", 0.0, 1.0)]);
+        assert_eq!(objects(&form("p", &Pair(1.0, Unit))), [("p", "Pair"), ("1", "Unit")]);
+        // u128, i128, chars, bools.
+        assert_eq!(
+            attrs(&form("t", &(u128::MAX, i128::MIN, 'x', false)), "t"),
+            [
+                row("[0]", &(u128::MAX as f64).to_string(), 0.0, 1.0),
+                row("[1]", &(i128::MIN as f64).to_string(), 0.0, 1.0),
+                row("[2]", "'x'", 0.0, 1.0),
+                row("[3]", "'false'", 0.0, 1.0),
+            ]
+        );
+    }
+
+    /// `serialize_bytes` (what `serde_bytes` calls) gives one attribute.
+    struct Bytes(Vec<u8>);
+
+    impl Serialize for Bytes {
+        fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+            s.serialize_bytes(&self.0)
+        }
+    }
+
+    #[test]
+    fn byte_arrays_are_one_attribute() {
+        #[derive(Serialize)]
+        struct Image {
+            raw: Bytes,
+            rgb: Vec<u8>,
+            empty: Bytes,
+            small: [u8; 2],
+            mixed: Vec<Option<u8>>,
+        }
+        let image = Image {
+            raw: Bytes(vec![1; 5]),
+            rgb: vec![0; 921_600],
+            empty: Bytes(Vec::new()),
+            small: [7, 8],
+            mixed: vec![None, Some(3)],
+        };
+        assert_eq!(
+            attrs(&form("image", &image), "image"),
+            [
+                row("raw", "'<5 bytes>'", 0.0, 1.0),
+                row("rgb", "'<921600 bytes>'", 0.0, 1.0),
+                row("empty", "'<0 bytes>'", 0.0, 1.0),
+                row("small[0]", "7", 0.0, 1.0),
+                row("small[1]", "8", 0.0, 1.0),
+                row("mixed[1]", "3", 0.0, 1.0),
+            ]
+        );
+        // Optional bytes and newtypes of bytes are numbers.
+        #[derive(Serialize)]
+        struct Level(u8);
+        assert_eq!(
+            attrs(&form("v", &vec![Some(1), Some(2)]), "v"),
+            [row("[0]", "1", 0.0, 1.0), row("[1]", "2", 0.0, 1.0)]
+        );
+        assert_eq!(attrs(&form("v", &vec![Level(3)]), "v"), [row("[0]", "3", 0.0, 1.0)]);
+        // Bytes followed by something else are numbers after all.
+        assert_eq!(attrs(&form("v", &vec![Some(4), None]), "v"), [row("[0]", "4", 0.0, 1.0)]);
+    }
+
+    #[test]
+    fn errors_are_typed() {
+        let bad_key = BTreeMap::from([((1, 2), 3.0)]);
+        assert!(matches!(
+            describe("m", &bad_key, Time(0)),
+            Err(DescribeError::MapKey { found: "a sequence" })
+        ));
+        struct Failing;
+        impl Serialize for Failing {
+            fn serialize<S: serde::Serializer>(&self, _: S) -> Result<S::Ok, S::Error> {
+                Err(serde::ser::Error::custom("no camera"))
+            }
+        }
+        let err = describe("f", &vec![Failing], Time(0)).err().map(|e| e.to_string());
+        assert_eq!(err.as_deref(), Some("the value could not be serialized: no camera"));
+        #[derive(Serialize)]
+        struct Chain(Option<Box<Chain>>);
+        let mut chain = Chain(None);
+        for _ in 0..MAX_DEPTH {
+            chain = Chain(Some(Box::new(chain)));
+        }
+        assert!(matches!(describe("c", &chain, Time(0)), Err(DescribeError::TooDeep)));
+        let mut shallow = Chain(None);
+        for _ in 0..MAX_DEPTH / 3 {
+            shallow = Chain(Some(Box::new(shallow)));
+        }
+        assert!(describe("c", &shallow, Time(0)).is_ok());
+    }
+
+    fn number() -> impl Strategy<Value = f64> {
+        prop_oneof![
+            any::<f64>(),
+            -1e4..1e4f64,
+            prop::sample::select(vec![0.0, -0.0, 1.0, f64::NAN, f64::INFINITY, f64::NEG_INFINITY]),
+        ]
+    }
+
+    fn pose() -> impl Strategy<Value = Pose> {
+        (number(), number(), number()).prop_map(|(x, y, theta)| Pose { x, y, theta })
+    }
+
+    fn kind() -> impl Strategy<Value = Kind> {
+        prop_oneof![
+            Just(Kind::Ball),
+            any::<u32>().prop_map(Kind::Robot),
+            (any::<bool>(), pose()).prop_map(|(east, at)| Kind::Post { east, at }),
+            (any::<f32>(), any::<i64>()).prop_map(|(a, b)| Kind::Pair(a, b)),
+        ]
+    }
+
+    fn thing() -> impl Strategy<Value = Thing> {
+        (
+            any::<String>(),
+            kind(),
+            pose(),
+            number(),
+            number(),
+            prop::collection::vec(any::<char>(), 0..3),
+        )
+            .prop_map(|(name, kind, pose, sigma, quality, tags)| Thing {
+                name,
+                kind,
+                pose,
+                sigma,
+                quality,
+                tags,
+            })
+    }
+
+    fn scene() -> impl Strategy<Value = Scene> {
+        (
+            (any::<u64>(), prop::collection::vec(thing(), 0..3), any::<[u8; 3]>()),
+            prop::collection::vec(any::<u8>(), 0..40),
+            prop::collection::btree_map(any::<String>(), number(), 0..3),
+            prop::collection::btree_map(any::<u16>(), pose(), 0..3),
+            (any::<i8>(), any::<Option<bool>>()),
+            (number(), number(), prop::option::of(pose())),
+        )
+            .prop_map(|((time, things, grid), image, table, by_id, pair, rest)| Scene {
+                time,
+                things,
+                grid,
+                image,
+                table,
+                by_id,
+                pair,
+                unit: (),
+                variability: rest.0,
+                pose_sigma: rest.1,
+                pose: rest.2,
+            })
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(256))]
+
+        /// Any value gives a form, whose XML reads back as the form.
+        #[test]
+        fn any_value_reads_back(scene in scene(), nanos in any::<u64>()) {
+            let form = describe("scene", &scene, Time(nanos))
+                .map_err(|e| TestCaseError::fail(e.to_string()))?;
+            let xml = form.to_xml();
+            let back = SelfDescribing::from_xml(&xml)
+                .map_err(|e| TestCaseError::fail(format!("{e}\n{xml}")))?;
+            prop_assert!(same(&back, &form), "{}", xml);
+            prop_assert_eq!(form.objects.len(), 1 + scene.things.iter().map(|t| match t.kind {
+                Kind::Ball => 2,
+                Kind::Post { .. } => 4,
+                _ => 3,
+            }).sum::<usize>() + scene.by_id.len() + usize::from(scene.pose.is_some()));
+        }
+
+        #[test]
+        fn any_thing_reads_back(things in prop::collection::vec(thing(), 0..4)) {
+            let form = describe("things", &things, Time(1))
+                .map_err(|e| TestCaseError::fail(e.to_string()))?;
+            let back = SelfDescribing::from_xml(&form.to_xml())
+                .map_err(|e| TestCaseError::fail(e.to_string()))?;
+            prop_assert!(same(&back, &form));
         }
     }
 }

@@ -79,7 +79,7 @@
 //! | PostOffice policies `SLWB`, `SLWDWCV`, `SLWSM` | [`PolicyKind`] (plus the default `PMQ`) |
 //! | InnerLinkManager | [`InnerLinkManager`] |
 //! | Agora configuration file (§3.3.1) | [`config::AgoraConfig`] |
-//! | XML self-describing message (§3.2) | `describe::SelfDescribing` (feature `describe`) |
+//! | XML self-describing message (§3.2) | `describe::SelfDescribing`, any message's form generated from its type by `describe::describe` (feature `describe`) |
 //!
 //! Start with [`Agora`], [`Member`] and [`Context`]; for simulation, [`SteppedExecutor`].
 #![deny(missing_docs)]

@@ -46,6 +46,9 @@ pub mod robot;
 mod sensing;
 mod team;
 
+#[cfg(test)]
+mod describe_tests;
+
 pub use acting::{MotorCommand, PlanRequest, PlannedPath};
 pub use behavior::{BehaviorPush, BehaviorPushReply, BehaviorStatus, ReloadRequest};
 pub use device::{DeviceAct, DeviceFrame, FinalWhistle, MemberFault, RobotEnd};
@@ -73,6 +76,13 @@ macro_rules! messages {
         /// The catalogue's types as `(id, name)`, for the table test.
         #[cfg(test)]
         const CATALOGUE: &[(MsgType, &str)] = &[$((ids::$id, stringify!($ty))),*];
+
+        /// Visits every type of the catalogue, for the tests that must cover them all: a type
+        /// added here without samples ([`describe_tests::Samples`]) fails to compile.
+        #[cfg(test)]
+        fn visit_catalogue(visitor: &mut impl describe_tests::Visitor) {
+            $(visitor.visit::<$ty>();)*
+        }
     };
 }
 
