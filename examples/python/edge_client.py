@@ -1,19 +1,20 @@
 #!/usr/bin/env python3
 """A program in another language on MRT's robots' network, through `mrt edge`: reads a robot's
-world snapshots (JSON; the manual's XML self-describing form is beside it on mrt/xml/...) and
-sends that robot a command, a new behavior file (`BehaviorPush`), then waits for its answer.
+world snapshots (as JSON, and in the MRT manual's XML self-describing form) and sends that
+robot a command, a new behavior file (`BehaviorPush`), then waits for its answer.
 
     pip install eclipse-zenoh==1.10.2
     mrt sim --distributed --home chaos        # prints: network of this match: .../monitor.cfg
     mrt edge --net .../monitor.cfg            # prints: edge ready: listening on tcp/127.0.0.1:P ...
     python3 examples/python/edge_client.py --connect tcp/127.0.0.1:P --robot 2
 
-Prints one JSON line {"snapshots": N, "time": S, "pose": [x, y, theta], "installed": true,
-"reloaded": [...]} and exits 0 when the robot took the behavior, 1 when it did not or was
+Prints one JSON line {"snapshots": N, "time": S, "pose": [x, y, theta], "xml_objects": K,
+"ball_reliability": R, "installed": true, "reloaded": [...]} and exits 0 when the robot took the behavior, 1 when it did not or was
 silent, 3 when the zenoh package is missing.
 """
 import argparse
 import json
+import xml.etree.ElementTree as ET
 import sys
 import threading
 import time
@@ -49,12 +50,19 @@ def main():
     conf.insert_json5("scouting/gossip/enabled", "false")
     session = zenoh.open(conf)
 
-    snapshots, replies = [], []
+    snapshots, replies, described = [], [], []
     got = threading.Condition()
 
     def on_snapshot(sample):
         with got:
             snapshots.append(json.loads(sample.payload.to_bytes()))
+            got.notify_all()
+
+    def on_xml(sample):
+        # The manual's self-describing form: objects with a class, attributes with a value
+        # (or a symbol), a variability and a reliability.
+        with got:
+            described.append(ET.fromstring(sample.payload.to_bytes()))
             got.notify_all()
 
     def on_reply(sample):
@@ -66,13 +74,20 @@ def main():
     subs = [
         session.declare_subscriber(f"mrt/json/{robot}/WorldSnapshot", on_snapshot),
         session.declare_subscriber(f"mrt/json/{robot}/BehaviorPushReply", on_reply),
+        session.declare_subscriber(f"mrt/xml/{robot}/WorldSnapshot", on_xml),
     ]
 
     with got:
-        if not got.wait_for(lambda: len(snapshots) >= args.snapshots, args.timeout):
+        if not got.wait_for(lambda: len(snapshots) >= args.snapshots and described, args.timeout):
             print(f"robot {robot}: {len(snapshots)} world snapshots in {args.timeout} s", file=sys.stderr)
             return 1
         last = snapshots[-1]
+        form = described[-1]
+    ball = form.find("object[@name='global_ball.pose']")
+    reliability = None
+    if ball is not None:
+        x = ball.find("attribute[@name='x']")
+        reliability = None if x is None else float(x.get("reliability"))
     # Time in nanoseconds of the robot's clock; the pose in the robot's team frame, mm and rad.
     pose = (last.get("my_pos") or {}).get("pose") or {}
 
@@ -89,6 +104,8 @@ def main():
         "snapshots": len(snapshots),
         "time": (last.get("time") or 0) / 1e9,
         "pose": [pose.get("x"), pose.get("y"), pose.get("theta")],
+        "xml_objects": len(form.findall("object")),
+        "ball_reliability": reliability,
         "installed": reply.get("installed"),
         "reloaded": reply.get("reloaded"),
         "error": reply.get("error"),

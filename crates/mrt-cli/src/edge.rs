@@ -99,6 +99,10 @@ impl Member for Edge {
             if let Some(Ok(json)) = (entry.to_json)(&m) {
                 sent = self.raw.put(&format!("mrt/json/{agora}/{}", entry.name), json).is_ok();
             }
+            if let Some(Ok(xml)) = (entry.to_xml)(&m) {
+                let key = format!("mrt/xml/{agora}/{}", entry.name);
+                sent &= self.raw.put(&key, xml.into_bytes()).is_ok();
+            }
             let count = if sent { &self.counts.out } else { &self.counts.dropped_out };
             count.fetch_add(1, Ordering::Relaxed);
         }

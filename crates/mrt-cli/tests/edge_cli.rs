@@ -88,9 +88,20 @@ fn programs_outside_read_the_robots_and_send_them_a_behavior_through_the_edge() 
             let _ = tx2.send((k.to_string(), serde_json::from_slice(&b).unwrap()));
         })
         .unwrap();
+    let (xml_tx, xml_rx) = mpsc::channel::<String>();
+    let _xml = raw
+        .subscribe("mrt/xml/6/WorldSnapshot", move |_, b| {
+            let _ = xml_tx.send(String::from_utf8(b).unwrap());
+        })
+        .unwrap();
     let (key, snapshot) = rx.recv_timeout(Duration::from_secs(30)).expect("no world snapshot");
     assert_eq!(key, "mrt/json/6/WorldSnapshot");
     let _: mrt_msgs::WorldSnapshot = serde_json::from_value(snapshot).unwrap();
+    // The same snapshots in the manual's XML self-describing form (§3.2).
+    let xml = xml_rx.recv_timeout(Duration::from_secs(10)).expect("no XML world snapshot");
+    let described = mrt_dcdt::describe::SelfDescribing::from_xml(&xml).unwrap();
+    assert_eq!(described.objects[0].name, "WorldSnapshot", "{xml}");
+    assert!(described.object("my_pos.pose").and_then(|o| o.attribute("x")).is_some(), "{xml}");
     // DCDT's own keys are not for plain payloads.
     assert!(raw.put("mrt/m/1", b"x".to_vec()).is_err());
 
@@ -133,6 +144,8 @@ fn programs_outside_read_the_robots_and_send_them_a_behavior_through_the_edge() 
     let result: Value = serde_json::from_str(said.trim()).unwrap();
     assert!(result["snapshots"].as_u64().unwrap() >= 3, "{result}");
     assert!(result["pose"][0].is_f64() && result["time"].as_f64().unwrap() > 0.0, "{result}");
+    assert!(result["xml_objects"].as_u64().unwrap() > 5, "{result}");
+    assert!(result["ball_reliability"].is_f64(), "{result}");
     assert_eq!(result["installed"], true, "{result}");
     drop(link);
 }

@@ -2,6 +2,7 @@
 //! its bus id, its name, its JSON schema and how a bus message of it becomes JSON.
 
 use mrt_core::{Message, MsgType};
+use mrt_dcdt::describe::{DescribeError, SelfDescribing};
 use mrt_dcdt::{DeliveryWarranty, Endpoint, Msg};
 use mrt_msgs::{
     BehaviorPush, BehaviorPushReply, BehaviorStatus, CameraFrame, DeviceAct, DeviceFrame,
@@ -27,6 +28,10 @@ pub struct Entry {
     pub schema: fn() -> serde_json::Value,
     /// A bus message of this type as JSON.
     pub to_json: fn(&Msg) -> Encoded,
+    /// A bus message of this type as the MRT manual's XML self-describing form (§3.2),
+    /// generated from its type (`mrt_dcdt::describe`); `None` when the message is of another
+    /// type or its payload does not decode.
+    pub to_xml: fn(&Msg) -> Option<Result<String, DescribeError>>,
     /// A message of this type read from JSON and published on `ep`'s bus (what a program in
     /// another language sends through `mrt edge`).
     pub publish_json: fn(&Endpoint, &[u8], DeliveryWarranty) -> Result<(), serde_json::Error>,
@@ -39,6 +44,11 @@ pub fn schema_of<T: JsonSchema>() -> serde_json::Value {
 
 fn json_of<T: Message + Serialize>(m: &Msg) -> Encoded {
     m.get::<T>().ok().map(serde_json::to_vec)
+}
+
+fn xml_of<T: Message + Serialize>(m: &Msg) -> Option<Result<String, DescribeError>> {
+    let value = m.get::<T>().ok()?;
+    Some(SelfDescribing::of_message(value, m.creation_time()).map(|d| d.to_xml()))
 }
 
 fn publish_json<T: Message + DeserializeOwned>(
@@ -80,6 +90,7 @@ macro_rules! catalogue {
             name: <$ty as Message>::NAME,
             schema: schema_of::<$ty>,
             to_json: catalogue!(@json $ty $(, $json)?),
+            to_xml: xml_of::<$ty>,
             publish_json: publish_json::<$ty>,
         }),*];
     };
@@ -160,5 +171,29 @@ mod tests {
         let json = (entry(CameraFrame::TYPE).unwrap().to_json)(&msg);
         let back: CameraFrame = serde_json::from_slice(&json.unwrap().unwrap()).unwrap();
         assert_eq!(back, CameraFrame { image: None, up_image: None, ..frame });
+        // The XML form keeps the image as its size only.
+        let xml = (entry(CameraFrame::TYPE).unwrap().to_xml)(&msg).unwrap().unwrap();
+        assert!(xml.contains("symbol=\"&lt;") || xml.contains("bytes"), "{xml}");
+    }
+
+    #[test]
+    fn every_type_has_its_xml_form_and_no_other_types() {
+        let header = |ty| mrt_dcdt::MsgHeader {
+            msg_type: ty,
+            member_id: mrt_core::MemberId(1),
+            agora_id: mrt_core::AgoraId(2),
+            priority: 0,
+            warranty: DeliveryWarranty::None,
+            creation_time: mrt_core::Time(1_500_000_000),
+        };
+        let snapshot = Msg::new(header(WorldSnapshot::TYPE), WorldSnapshot::default());
+        for e in CATALOGUE {
+            let xml = (e.to_xml)(&snapshot);
+            assert_eq!(xml.is_some(), e.ty == WorldSnapshot::TYPE, "{}", e.name);
+        }
+        let xml = (entry(WorldSnapshot::TYPE).unwrap().to_xml)(&snapshot).unwrap().unwrap();
+        let back = SelfDescribing::from_xml(&xml).unwrap();
+        assert_eq!(back.timestamp, mrt_core::Time(1_500_000_000));
+        assert_eq!(back.objects[0].name, "WorldSnapshot");
     }
 }
