@@ -9,6 +9,8 @@
 //! - `mrt plan path --from X,Y --to X,Y [--obstacles ...] [--json] [--svg out.svg]` plans a
 //!   path with SPIKE;
 //! - `mrt soak matches|hour` runs the soak campaigns of `docs/reliability.md`;
+//! - `mrt mice calibrate LOG [--json]` calibrates the two-mice odometry (MRT manual §4.2) from
+//!   the log of its readings (`docs/mice.md`; `mrt sim --calibrate-mice` on a simulated robot);
 //! - `mrt check FILE...` checks DCDT Agora configuration files (MRT manual §3.3.1) and
 //!   prints each in canonical form, or the first error with file, line and column.
 //!
@@ -26,6 +28,7 @@ mod behave;
 mod brian;
 #[cfg(feature = "net")]
 mod distributed;
+mod mice;
 mod plan;
 mod replay;
 mod sim;
@@ -159,6 +162,12 @@ enum Command {
         #[command(subcommand)]
         command: soak::SoakCommand,
     },
+    /// The two-mice odometry sensor (MRT manual ch. 4): calibrate it from the log of its
+    /// readings (docs/mice.md).
+    Mice {
+        #[command(subcommand)]
+        command: mice::MiceCommand,
+    },
 }
 
 #[derive(Subcommand)]
@@ -288,6 +297,7 @@ fn run(command: Command) -> Result<()> {
         #[cfg(feature = "net")]
         Command::Monitor(args) => topic::monitor(&args)?,
         Command::Soak { command } => soak::run(&command)?,
+        Command::Mice { command } => mice::run(&command)?,
         #[cfg(feature = "net")]
         Command::Robot(args) => distributed::robot(&args)?,
         Command::Bb { command } => bb::run(command)?,
