@@ -52,7 +52,8 @@
 pub mod log;
 
 use crate::error::{positive, PerceptionError};
-use mrt_core::{arc_velocity, normalize_angle};
+use mrt_core::{arc_velocity, normalize_angle, sinc};
+use mrt_msgs::Displacement;
 use serde::{Deserialize, Serialize};
 use std::f64::consts::TAU;
 
@@ -227,6 +228,35 @@ impl MiceMounting {
     /// (the joining line from the left mouse to the right one turned by +90°), rad.
     pub fn delta(&self) -> f64 {
         (self.right.x - self.left.x).atan2(self.left.y - self.right.y)
+    }
+
+    /// The robot's motion over one sampling period from both mice's counts, for this mounting
+    /// (the manual's §4.1 in its general form, research notes `MODULES.md` §1.1), and the
+    /// residual `ε` of the §4.1 constraint: the two mice's motions along their joining line,
+    /// which a rigid body makes equal, differ by `ε` metres (0 for consistent counts).
+    ///
+    /// Each mouse's motion in the robot frame is `m_i = v + Δθ J p_i` (`v` the motion of the
+    /// reference point over the arc, in the turning frame), so with `b = p_r − p_l`:
+    /// `Δθ = (m_r − m_l) · J b / |b|²` (least squares: the cosine rule of eq. 4.2 when `ε = 0`),
+    /// `v = (m_l + m_r)/2 − Δθ J (p_l + p_r)/2`, and the chord `sinc(Δθ/2) R(Δθ/2) v`. `None`
+    /// when the mice sit at the same place (no rotation can be seen).
+    pub fn displacement(&self, run: &Run) -> Option<(Displacement, f64)> {
+        let (lx, ly) = self.left.to_robot(run.left);
+        let (rx, ry) = self.right.to_robot(run.right);
+        let (bx, by) = (self.right.x - self.left.x, self.right.y - self.left.y);
+        let b2 = bx * bx + by * by;
+        if b2 == 0.0 || !b2.is_finite() {
+            return None;
+        }
+        let (dx, dy) = (rx - lx, ry - ly);
+        // J b = (−b_y, b_x).
+        let dtheta = (-dx * by + dy * bx) / b2;
+        let epsilon = (dx * bx + dy * by) / b2.sqrt();
+        let (cx, cy) = (0.5 * (self.left.x + self.right.x), 0.5 * (self.left.y + self.right.y));
+        let (vx, vy) = (0.5 * (lx + rx) + dtheta * cy, 0.5 * (ly + ry) - dtheta * cx);
+        let (s, c) = (0.5 * dtheta).sin_cos();
+        let k = sinc(0.5 * dtheta);
+        Some((Displacement::new(k * (c * vx - s * vy), k * (s * vx + c * vy), dtheta), epsilon))
     }
 
     /// Both mice's counts for a motion over one sampling period
@@ -630,6 +660,29 @@ mod tests {
         assert!(MouseMounting::new(0.0, 0.0, 0.0, -1.0).is_err());
     }
 
+    /// Odometry through a general mounting: the manual's own mounting gives what
+    /// `MiceOdometry` gives; inconsistent counts show in `ε`.
+    #[test]
+    fn displacement_through_a_mounting() {
+        let m = MiceMounting::parallel(0.2, 1000.0).unwrap();
+        let mice = crate::mice::MiceOdometry::new(0.2, 1e-3).unwrap();
+        let r = mice.readings_for(0.02, 0.005, 0.03);
+        let counts = |x: f64, y: f64| Counts::new(1000.0 * x, 1000.0 * y);
+        let run = Run { left: counts(r.x_left, r.y_left), right: counts(r.x_right, r.y_right) };
+        let (d, eps) = m.displacement(&run).unwrap();
+        let e = mice.displacement(&r).unwrap();
+        assert!(close(d.dx, e.dx, 1e-15) && close(d.dy, e.dy, 1e-15), "{d:?} {e:?}");
+        assert!(close(d.dtheta, 0.03, 1e-15) && close(eps, 0.0, 1e-15));
+        // The right mouse (at y = −0.1, its x̄ along the joining line) reads 1 mm more to its
+        // right: ε = (m_r − m_l)·b/|b| = (0, −0.001)·(0, −1) = +1 mm.
+        let mut off = run;
+        off.right.x += 1.0;
+        let (_, eps) = m.displacement(&off).unwrap();
+        assert!(close(eps, 0.001, 1e-12), "{eps}");
+        let same = MiceMounting { left: m.left, right: m.left };
+        assert_eq!(same.displacement(&run), None);
+    }
+
     /// A random mounting within a robot of radius 0.25 m.
     fn mounting(rng: &mut impl Rng) -> MouseMounting {
         MouseMounting {
@@ -728,6 +781,19 @@ mod tests {
             }
             prop_assert!(close(normalize_angle(c.delta.value - truth.delta()), 0.0, 1e-9));
             prop_assert!(close(c.distance.value, truth.distance(), 1e-9));
+        }
+
+        /// Any mounting's counts of any motion give the motion back (the forward model
+        /// inverted), consistent (`ε = 0`).
+        #[test]
+        fn displacement_inverts_the_forward_model(seed in any::<u64>(), dx in -0.2f64..0.2,
+                                                  dy in -0.2f64..0.2, dth in -1.5f64..1.5) {
+            let mut rng = ChaCha8Rng::seed_from_u64(seed);
+            let m = MiceMounting { left: mounting(&mut rng), right: mounting(&mut rng) };
+            prop_assume!(m.distance() > 0.01);
+            let (d, eps) = m.displacement(&m.run_for(dx, dy, dth)).unwrap();
+            prop_assert!(close(d.dx, dx, 1e-9) && close(d.dy, dy, 1e-9), "{:?}", d);
+            prop_assert!(close(d.dtheta, dth, 1e-9) && close(eps, 0.0, 1e-9), "{:?} {}", d, eps);
         }
 
         /// With the manual's ten straight runs and five turns and noisy mice (0.5 % per axis and
