@@ -291,6 +291,16 @@ mod tests {
         }
     }
 
+    /// The manual's own mounting (§4.1: parallel mice 0.2 m apart across the robot, σ = 0,
+    /// δ = 0) is one case among others.
+    #[test]
+    fn the_manual_mounting_too() {
+        let truth = MiceMounting::parallel(0.2, 400.0 * CPI).unwrap();
+        let report = run(&SimConfig::default(), &truth, 7).unwrap();
+        assert_eq!(report.check(&Tolerances::default()), Ok(()), "{report:#?}");
+        assert!(report.calibration.delta.value.abs() < 0.5f64.to_radians());
+    }
+
     /// Noise-free mice: the estimates are as good as the rig's stopping and the counts'
     /// rounding allow (well under a tenth of the tolerances).
     #[test]
