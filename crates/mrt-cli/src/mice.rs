@@ -81,6 +81,13 @@ pub fn sim(cfg: &SimConfig, seed: u64, json: bool, log: Option<&Path>) -> Result
             "within_tolerances": check.is_ok(),
             "outside": check.as_ref().err(),
             "simulated_seconds": report.seconds,
+            "validation": {
+                "path": report.validation.path,
+                "error_calibrated": report.validation.error_calibrated,
+                "error_true_mounting": report.validation.error_true_mounting,
+                "heading_error_calibrated": report.validation.heading_error_calibrated,
+                "heading_error_true_mounting": report.validation.heading_error_true_mounting,
+            },
         });
         outln!("{}", serde_json::to_string_pretty(&value)?);
     } else {
@@ -106,6 +113,16 @@ pub fn sim(cfg: &SimConfig, seed: u64, json: bool, log: Option<&Path>) -> Result
             tol.position * 1000.0,
             tol.distance * 1000.0,
             if check.is_ok() { "all within" } else { "NOT all within" }
+        );
+        let v = &report.validation;
+        outln!(
+            "put to use: dead reckoning on a {:.2} m test drive ends {:.1} mm and {:.2}° off through \
+             the calibrated mounting, {:.1} mm and {:.2}° through the simulated one",
+            v.path,
+            v.error_calibrated * 1000.0,
+            v.heading_error_calibrated.to_degrees(),
+            v.error_true_mounting * 1000.0,
+            v.heading_error_true_mounting.to_degrees()
         );
     }
     check.map_err(|bad| anyhow!("estimates outside the tolerances: {}", bad.join("; ")))
