@@ -259,6 +259,49 @@ impl MiceMounting {
         Some((Displacement::new(k * (c * vx - s * vy), k * (s * vx + c * vy), dtheta), epsilon))
     }
 
+    /// The error reduction of the manual's §4.2 for this mounting: a mouse never counts more
+    /// than it moved and a miss keeps its direction, so when the two mice's motions along their
+    /// joining line differ by more than `tolerance` metres, the one that moved less along it
+    /// under-read and its counts are scaled up until they agree (exact if the other mouse was
+    /// right, a reduction of the error otherwise). Consistent counts come back unchanged;
+    /// `None` when the counts cannot be repaired: the two motions along the line have opposite
+    /// signs or one is zero, the mice sit at the same place, or the repair would more than
+    /// double a reading (a mouse under-reads by at most half in the simulator's model, and a
+    /// larger factor amplifies noise).
+    ///
+    /// Blind spot: motion across the joining line shows no difference; this is why IANUS3's
+    /// mice sit on the body's diagonal (manual §12.7).
+    pub fn reduce(&self, run: &Run, tolerance: f64) -> Option<Run> {
+        let (bx, by) = (self.right.x - self.left.x, self.right.y - self.left.y);
+        let len = bx.hypot(by);
+        if len == 0.0 || !len.is_finite() {
+            return None;
+        }
+        let along = |m: &MouseMounting, c: Counts| {
+            let (x, y) = m.to_robot(c);
+            (x * bx + y * by) / len
+        };
+        let (a_l, a_r) = (along(&self.left, run.left), along(&self.right, run.right));
+        if (a_r - a_l).abs() <= tolerance {
+            return Some(*run);
+        }
+        if a_l * a_r <= 0.0 {
+            return None;
+        }
+        let mut out = *run;
+        let (short, kappa) = if a_l.abs() < a_r.abs() {
+            (&mut out.left, a_r / a_l)
+        } else {
+            (&mut out.right, a_l / a_r)
+        };
+        if !(1.0..=2.0).contains(&kappa) {
+            return None;
+        }
+        short.x *= kappa;
+        short.y *= kappa;
+        Some(out)
+    }
+
     /// Both mice's counts for a motion over one sampling period
     /// ([`MouseMounting::counts_for`]).
     pub fn run_for(&self, dx: f64, dy: f64, dtheta: f64) -> Run {
@@ -681,6 +724,34 @@ mod tests {
         assert!(close(eps, 0.001, 1e-12), "{eps}");
         let same = MiceMounting { left: m.left, right: m.left };
         assert_eq!(same.displacement(&run), None);
+    }
+
+    /// §4.2's reduction for a general mounting: a mouse that read 70 % of its motion is
+    /// restored; consistent counts are unchanged; opposite signs cannot be repaired.
+    #[test]
+    fn reduction_through_a_mounting() {
+        let m = MiceMounting {
+            left: MouseMounting::new(0.09, 0.11, 0.35, 15_748.0).unwrap(),
+            right: MouseMounting::new(-0.07, -0.12, -0.61, 14_961.0).unwrap(),
+        };
+        let good = m.run_for(0.03, 0.004, 0.05);
+        assert_eq!(m.reduce(&good, 1e-6), Some(good));
+        for which in [Mouse::Left, Mouse::Right] {
+            let mut bad = good;
+            let c = if which == Mouse::Left { &mut bad.left } else { &mut bad.right };
+            c.x *= 0.7;
+            c.y *= 0.7;
+            let (_, eps) = m.displacement(&bad).unwrap();
+            assert!(eps.abs() > 1e-3, "{which:?}: ε = {eps}");
+            let fixed = m.reduce(&bad, 1e-6).unwrap();
+            for (f, g) in [(fixed.left, good.left), (fixed.right, good.right)] {
+                assert!(close(f.x, g.x, 1e-9) && close(f.y, g.y, 1e-9), "{which:?}");
+            }
+        }
+        // A sideways motion along the joining line read backwards by one mouse: irreparable.
+        let mut opposite = m.run_for(-0.016, -0.023, 0.0);
+        opposite.left = Counts::new(-opposite.left.x, -opposite.left.y);
+        assert_eq!(m.reduce(&opposite, 1e-6), None);
     }
 
     /// A random mounting within a robot of radius 0.25 m.
