@@ -10,6 +10,8 @@
 //! - `mrt plan path --from X,Y --to X,Y [--obstacles ...] [--json] [--svg out.svg]` plans a
 //!   path with SPIKE;
 //! - `mrt soak matches|hour` runs the soak campaigns of `docs/reliability.md`;
+//! - `mrt mice calibrate LOG [--json]` calibrates the two-mice odometry (MRT manual §4.2) from
+//!   the log of its readings (`docs/mice.md`; `mrt sim --calibrate-mice` on a simulated robot);
 //! - `mrt check FILE...` checks DCDT Agora configuration files (MRT manual §3.3.1) and
 //!   prints each in canonical form, or the first error with file, line and column.
 //!
@@ -29,6 +31,7 @@ mod brian;
 mod distributed;
 #[cfg(feature = "net")]
 mod edge;
+mod mice;
 mod plan;
 mod push;
 mod replay;
@@ -154,6 +157,12 @@ enum Command {
     Soak {
         #[command(subcommand)]
         command: soak::SoakCommand,
+    },
+    /// The two-mice odometry sensor (MRT manual ch. 4): calibrate it from the log of its
+    /// readings (docs/mice.md).
+    Mice {
+        #[command(subcommand)]
+        command: mice::MiceCommand,
     },
 }
 
@@ -316,6 +325,7 @@ fn run(command: Command) -> Result<()> {
         #[cfg(feature = "net")]
         Command::Edge(args) => edge::run(&args)?,
         Command::Soak { command } => soak::run(&command)?,
+        Command::Mice { command } => mice::run(&command)?,
         #[cfg(feature = "net")]
         Command::Robot(args) => distributed::robot(&args)?,
         Command::Bb { command } => bb::run(command)?,

@@ -116,6 +116,19 @@ pub struct SimArgs {
     /// docs/indoor.md).
     #[arg(long, value_enum, default_value = "soccer")]
     pub world: WorldKind,
+    /// Instead of a match: drive one robot through the two-mice calibration procedure (MRT
+    /// manual §4.2: ten straight runs of 500 mm, five turns of 360° in place), its mice
+    /// mounted anywhere and as noisy as the configuration says, calibrate them from their
+    /// counts and print the estimates beside the simulated mounting (docs/mice.md).
+    #[arg(long)]
+    pub calibrate_mice: bool,
+    /// With --calibrate-mice: write the readings' log (CSV, docs/mice.md) to this file, for
+    /// `mrt mice calibrate`.
+    #[arg(long, value_name = "FILE", requires = "calibrate_mice")]
+    pub mice_log: Option<PathBuf>,
+    /// With --calibrate-mice: print JSON (SI units).
+    #[arg(long, requires = "calibrate_mice")]
+    pub json: bool,
 }
 
 /// `--world`.
@@ -312,6 +325,9 @@ fn check_counts(args: &SimArgs) -> Result<()> {
 pub fn run(args: &SimArgs) -> Result<()> {
     check_counts(args)?;
     let cfg = config(args)?;
+    if args.calibrate_mice {
+        return crate::mice::sim(&cfg, args.seed, args.json, args.mice_log.as_deref());
+    }
     if args.world == WorldKind::Indoor {
         return indoor(args, &cfg);
     }

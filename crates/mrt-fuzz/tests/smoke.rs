@@ -42,6 +42,7 @@ smoke_tests! {
     robot_file => "robot-file",
     vision_files => "vision-files",
     plan_map => "plan-map",
+    mice_log => "mice-log",
     bb_config => "bb-config",
     relay_line => "relay-line",
     lua_script => "lua-script",

@@ -32,6 +32,7 @@
 //! | eq. (4.1), (4.2) and the mid-point of the mice | [`mice::MiceOdometry::displacement`], [`mice::MiceArcs`] |
 //! | eq. (4.3)–(4.5) | [`mice::update_pose`] |
 //! | `x̄_r = x̄_l` error detection, error reduction (manual §4.2) | [`mice::MiceOdometry::check`], [`mice::MiceOdometry::reduce`] |
+//! | calibration: `D`, `σ_r`, `σ_l`, `δ`, resolutions, positions (manual §4.2), general mounting | [`mice_calibration::calibrate`], [`mice_calibration::MiceMounting`], its log [`mice_calibration::log`] |
 //! | front camera, inverse projection eqs (7)–(9) (ISocRob `003` §3.2.1) | [`camera::Pinhole`] (with a pan joint) |
 //! | "up" camera, mirror (ISocRob `003` §2.2) | [`camera::Omni`], its file [`camera::OmniFile`]; either model's file [`camera::CameraModel`] |
 //! | the µAgent's "up" mode: the ball all around (ISocRob `003` §3.2.1) | [`vision::up::find_ball_up`] |
@@ -46,6 +47,7 @@
 pub mod camera;
 mod error;
 pub mod mice;
+pub mod mice_calibration;
 pub mod source;
 #[cfg(all(feature = "v4l2", target_os = "linux"))]
 pub mod v4l2;

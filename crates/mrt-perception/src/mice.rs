@@ -18,7 +18,9 @@
 //! ([`MiceOdometry::reduce`], §4.2).
 //!
 //! Mice mounted otherwise (IANUS3 has them "on the opposite side of the robot diagonal", ch. 12.7,
-//! with the calibration angles `σ_r`, `σ_l`, `δ` of §4.2) are not modelled here.
+//! with the calibration angles `σ_r`, `σ_l`, `δ` of §4.2) are not modelled here: their
+//! calibration and their odometry are in [`crate::mice_calibration`]
+//! ([`crate::mice_calibration::MiceMounting::displacement`]).
 //!
 //! # The manual's formulas, with their typos fixed
 //!

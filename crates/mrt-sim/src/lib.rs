@@ -29,6 +29,7 @@ pub mod drivers;
 pub mod game;
 pub mod indoor;
 pub mod metrics;
+pub mod mice_calibration;
 pub mod plot;
 pub mod referee;
 pub mod remote;

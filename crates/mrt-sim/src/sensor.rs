@@ -190,6 +190,21 @@ pub fn look(
 
 pub use mrt_msgs::Odometry;
 
+/// What a simulated mouse gets wrong in one reading `(x, y)` (any unit: the errors are
+/// relative): with probability `mice_miss_probability` it under-reads, 50–100 % of the motion
+/// in the true direction (MRT manual §4.2), then each axis is off by `mice_noise` times the
+/// motion's length (Gaussian).
+pub fn mouse_errors(x: &mut f64, y: &mut f64, cfg: &OdometryConfig, rng: &mut dyn RngCore) {
+    let length = x.hypot(*y);
+    if rng.random_bool(cfg.mice_miss_probability.clamp(0.0, 1.0)) {
+        let read = rng.random_range(0.5..1.0);
+        *x *= read;
+        *y *= read;
+    }
+    *x += cfg.mice_noise * length * gauss(rng);
+    *y += cfg.mice_noise * length * gauss(rng);
+}
+
 /// The odometry driver of one simulated robot: mice and wheels since its last reading.
 #[derive(Clone, Debug)]
 pub struct Odometer {
@@ -235,18 +250,8 @@ impl Odometer {
         self.last = Some(now);
         let d = now.relative_to(&from);
         let mut mice = self.mice.readings_for(d.x, d.y, normalize_angle(d.theta));
-        let mut mouse = |x: &mut f64, y: &mut f64| {
-            let length = x.hypot(*y);
-            if rng.random_bool(cfg.mice_miss_probability.clamp(0.0, 1.0)) {
-                let read = rng.random_range(0.5..1.0);
-                *x *= read;
-                *y *= read;
-            }
-            *x += cfg.mice_noise * length * gauss(rng);
-            *y += cfg.mice_noise * length * gauss(rng);
-        };
-        mouse(&mut mice.x_left, &mut mice.y_left);
-        mouse(&mut mice.x_right, &mut mice.y_right);
+        mouse_errors(&mut mice.x_left, &mut mice.y_left, cfg, rng);
+        mouse_errors(&mut mice.x_right, &mut mice.y_right, cfg, rng);
         let drive = world.drive_setpoint(self.robot);
         let twist = Twist::new(drive.forward, drive.left, drive.turn);
         let moved = integrate(Pose2::default(), &twist, period);

@@ -208,6 +208,29 @@ impl Harness for PlanToml {
     }
 }
 
+/// The two-mice calibration's readings log (`mrt mice calibrate LOG`, docs/mice.md).
+pub(super) const MICE_LOG: Target = Target {
+    name: "mice-log",
+    about: "a two-mice calibration log (CalibrationLog::parse); a log that reads is calibrated (manual §4.2), every estimate a number or NaN, never a panic",
+    keywords: &["kind,run,mouse,x,y", "straight", "turn", "left", "right", "l", "r", ",", "#", "\r\n", "0", "-1", "1000000", "1000001", "9223372036854775807", "-9223372036854775808"],
+    structured: None,
+    seeds: |root| files_under(&root.join("configs/mice"), |s| s.ends_with(".csv")),
+    harness: |_| Ok(Box::new(MiceLog)),
+};
+
+struct MiceLog;
+
+impl Harness for MiceLog {
+    fn exec(&mut self, _seed: &Seed, input: &[u8]) -> bool {
+        use mrt_perception::mice_calibration::{log::CalibrationLog, Procedure};
+        let Ok(log) = CalibrationLog::parse("fuzz.csv", input) else { return false };
+        // Documented: every run has both mice; a log that reads calibrates or says why.
+        let _ = log.calibrate(&Procedure::default());
+        let _ = log.to_text(&Procedure::default());
+        true
+    }
+}
+
 /// A robot's file (`mrt robot --config`).
 pub(super) const ROBOT_FILE: Target = Target {
     name: "robot-file",

@@ -72,6 +72,7 @@ pub static TARGETS: &[Target] = &[
     files::ROBOT_FILE,
     files::VISION_FILES,
     files::PLAN_MAP,
+    files::MICE_LOG,
     files::BB_CONFIG,
     files::RELAY_LINE,
     lua::LUA_SCRIPT,
