@@ -36,7 +36,7 @@ use crate::error::BrianError;
 use crate::expr::{parse_definitions, parse_expr, Expr, RawExpr};
 use crate::lexer::{tokenize, Cursor, Span, Tok};
 use crate::set::{FuzzySet, FuzzyValue};
-use crate::shapes::{defuzzify, parse_associations, parse_shapes, resolve, Shape};
+use crate::shapes::{barycenter, defuzzify, parse_associations, parse_shapes, resolve, Shape};
 use std::collections::{BTreeMap, HashMap, HashSet};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -403,7 +403,12 @@ struct Input {
 #[derive(Clone, Debug)]
 struct Action {
     name: String,
+    /// Each label with its singleton (for a polygon shape, its set's barycenter at height 1).
     labels: Vec<(String, f64)>,
+    /// Each label's set, in label order.
+    sets: Vec<(String, FuzzySet)>,
+    /// Defuzzified by barycenter (polygon sets, formula 10.7) rather than by singletons (10.6).
+    barycenter: bool,
     circular: bool,
     /// The input slot `Proposed<name>` that re-fuzzifies this action for higher levels.
     proposed: Option<usize>,
@@ -823,27 +828,26 @@ impl Brian {
         let mut actions = Vec::new();
         let mut offset = 0;
         for (a, i) in s_assocs.iter().zip(s_idx) {
-            let mut labels = Vec::new();
-            for (label, set) in &s_shapes[i].sets {
-                match set {
-                    FuzzySet::Sng { a } => labels.push((label.clone(), *a)),
-                    other => {
-                        return Err(BrianError::at(
-                            &files.s_shape,
-                            s_shapes[i].span,
-                            format!("output shape `{}` set `{label}` is {}: defuzzification uses singletons (SNG) only", s_shapes[i].name, other.identifier()),
-                        ))
-                    }
-                }
-            }
-            // Formula 10.6 sums weight × singleton (weights at most 1): the sum must stay a
-            // number, or the command would be infinite or NaN.
-            if !labels.iter().map(|(_, v)| v.abs()).sum::<f64>().is_finite() {
+            let shape = &s_shapes[i];
+            let circular = a.name.contains("Angle");
+            let (labels, barycenter) = output_labels(shape, circular, &files.s_shape)?;
+            // Formula 10.6 sums weight × singleton (weights at most 1), formula 10.7 area ×
+            // centroid: the sum must stay a number, or the command would be infinite or NaN.
+            let sum: f64 = if barycenter {
+                let moments = shape.sets.iter().flat_map(|(_, set)| {
+                    crate::shapes::clipped_areas(set, 1.0).map(|(x, area)| area + (x * area).abs())
+                });
+                moments.sum()
+            } else {
+                labels.iter().map(|(_, v)| v.abs()).sum()
+            };
+            if !sum.is_finite() {
                 return Err(BrianError::at(
                     &files.s_shape,
                     s_shapes[i].span,
                     format!(
-                        "the singletons of output shape `{}` are too large: their sum is not a finite number",
+                        "the {} of output shape `{}` are too large: their sum is not a finite number",
+                        if barycenter { "sets" } else { "singletons" },
                         s_shapes[i].name
                     ),
                 ));
@@ -853,7 +857,9 @@ impl Brian {
             actions.push(Action {
                 name: a.name.clone(),
                 labels,
-                circular: a.name.contains("Angle"),
+                sets: shape.sets.clone(),
+                barycenter,
+                circular,
                 proposed,
                 offset,
             });
@@ -1114,7 +1120,14 @@ impl Brian {
         self.inputs.iter().map(|i| (i.name.as_str(), &i.shape))
     }
 
-    /// The output actions with their singletons `(label, value)`.
+    /// The output actions with their sets `(label, set)`: SNG for singleton defuzzification,
+    /// TRI, DIV, TRA or REC for barycenter defuzzification (§10.4.6, formula 10.7).
+    pub fn output_sets(&self) -> impl Iterator<Item = (&str, &[(String, FuzzySet)])> {
+        self.actions.iter().map(|a| (a.name.as_str(), a.sets.as_slice()))
+    }
+
+    /// The output actions with their singletons `(label, value)`; for a shape of polygons
+    /// (barycenter defuzzification), each set's barycenter at full height.
     pub fn output_singletons(&self) -> impl Iterator<Item = (&str, &[(String, f64)])> {
         self.actions.iter().map(|a| (a.name.as_str(), a.labels.as_slice()))
     }
@@ -1233,7 +1246,11 @@ impl Brian {
     /// Defuzzifies one action from the accumulated proposals.
     fn crisp(&self, a: &Action, c: Composer) -> Option<f64> {
         let w = &self.lower[a.offset..a.offset + a.labels.len()];
-        defuzzify(a.labels.iter().zip(w).map(|((_, s), w)| (*s, w.weight(c))), a.circular)
+        if a.barycenter {
+            barycenter(a.sets.iter().zip(w).map(|((_, s), w)| (s, w.weight(c))), a.circular)
+        } else {
+            defuzzify(a.labels.iter().zip(w).map(|((_, s), w)| (*s, w.weight(c))), a.circular)
+        }
     }
 
     /// Defuzzifies what the lower levels propose into `Proposed<Action>` data and fuzzifies it.
@@ -1310,6 +1327,61 @@ impl Brian {
             }
         }
     }
+}
+
+/// The labels of an output shape with their singletons, and whether the shape is defuzzified
+/// by barycenter (§10.3.9, §10.4.6): a shape of singletons only (SNG) by formula 10.6, a shape
+/// of polygons only (TRI, DIV, TRA, REC) by formula 10.7, each label's singleton then being
+/// its set's barycenter at full height. A shape that mixes them, or that holds TOL or TOR
+/// (their area is infinite), is refused at the shape's name.
+fn output_labels(
+    shape: &Shape,
+    circular: bool,
+    file: &Path,
+) -> Result<(Vec<(String, f64)>, bool), BrianError> {
+    let polygon = |set: &FuzzySet| crate::shapes::is_polygon(set);
+    let barycenter = shape.sets.first().is_some_and(|(_, set)| polygon(set));
+    let mut labels = Vec::with_capacity(shape.sets.len());
+    for (label, set) in &shape.sets {
+        let err = |what: String| BrianError::at(file, shape.span, what);
+        let id = set.identifier();
+        match (set, barycenter) {
+            (FuzzySet::Sng { a }, false) => labels.push((label.clone(), *a)),
+            (FuzzySet::Tol { .. } | FuzzySet::Tor { .. }, _) => {
+                return Err(err(format!(
+                    "output shape `{}` set `{label}` is {id}, open on one side: defuzzification \
+                     uses singletons (SNG, formula 10.6) or polygons of finite area (TRI, DIV, \
+                     TRA, REC: barycenter, formula 10.7)",
+                    shape.name
+                )))
+            }
+            (_, true) if polygon(set) => {
+                let Some(centroid) = crate::shapes::barycenter([(set, 1.0)], circular) else {
+                    return Err(err(format!(
+                        "output shape `{}` set `{label}` ({id} {:?}) has no barycenter: \
+                         barycenter defuzzification needs polygons of some width and of finite \
+                         size (or use SNG)",
+                        shape.name,
+                        set.params()
+                    )));
+                };
+                labels.push((label.clone(), centroid));
+            }
+            _ => {
+                let (first, kind) = if barycenter {
+                    ("polygons (TRI, DIV, TRA, REC: barycenter, formula 10.7)", id)
+                } else {
+                    ("singletons (SNG, formula 10.6)", id)
+                };
+                return Err(err(format!(
+                    "output shape `{}` mixes {first} with set `{label}` ({kind}): one shape is \
+                     defuzzified one way, all SNG or all polygons",
+                    shape.name
+                )));
+            }
+        }
+    }
+    Ok((labels, barycenter))
 }
 
 fn warning(file: &Path, span: Span, what: &str) -> String {
@@ -1479,6 +1551,8 @@ mod tests {
         let actions = [Action {
             name: "Out".into(),
             labels: vec![("HIGH".into(), 1.0)],
+            sets: vec![("HIGH".into(), FuzzySet::Sng { a: 1.0 })],
+            barycenter: false,
             circular: false,
             proposed: None,
             offset: 0,
