@@ -17,7 +17,11 @@
 //! `max_float_composer` gives FAST 0.64, SLOW 0.49.
 #![allow(clippy::unwrap_used)]
 
-use mrt_fuzzy::brian::{Brian, BrianSources};
+use mrt_fuzzy::brian::{
+    Brian, BrianSources, CandoFilter, CodeBehavior, Composition, Proposals, Semantics, Situation,
+    ThresholdFilter,
+};
+use mrt_fuzzy::{BrianError, FuzzyValue};
 
 /// The configuration of the module doc, with `s_shape` as the output shape of Speed.
 fn base(s_shape: &str) -> BrianSources {
@@ -101,4 +105,183 @@ fn output_shapes_that_cannot_be_defuzzified_are_refused_where_they_are() {
         let line = if shape.starts_with('\n') { 2 } else { 1 };
         assert!(e.ends_with(&format!("s_shape.txt:{line}:2")), "{shape}: {e}");
     }
+}
+
+/// §10.2.4, formula 10.5: for each output, only the actions of the behavior of largest
+/// μC · μW. Singletons SLOW 20, FAST 80.
+///
+/// - Dist 80, Obst 30: Go scores 0.8 × 0.8 = 0.64, Avoid 0.7 × 0.7 = 0.49. Go alone: FAST
+///   0.64, SLOW 0.16, so (0.16 × 20 + 0.64 × 80) / 0.8 = 54.4 / 0.8 = 68. The weighted
+///   composition (formula 10.3) gives 61 / 1.13 = 53.982301 (module doc).
+/// - Dist 80, Obst 10: Blocked 0.9, Avoid scores 0.81 > 0.64. Avoid alone: SLOW 0.81, so 20.
+///   Weighted: SLOW max(0.16, 0.81) = 0.81, FAST 0.64, so (16.2 + 51.2) / 1.45 = 46.482759.
+#[test]
+fn argmax_composition_of_formula_10_5() {
+    let mut brian = Brian::from_sources(&base(SINGLETONS)).unwrap();
+    assert_eq!(brian.composition(), Composition::Weighted, "the default");
+    assert_close(speed(&mut brian, (80.0, 1.0), (30.0, 1.0)), 61.0 / 1.13);
+    assert_close(speed(&mut brian, (80.0, 1.0), (10.0, 1.0)), 67.4 / 1.45);
+    brian.set_composition(Composition::Argmax);
+    assert_close(speed(&mut brian, (80.0, 1.0), (30.0, 1.0)), 68.0);
+    assert_close(speed(&mut brian, (80.0, 1.0), (10.0, 1.0)), 20.0);
+
+    // Chosen in engine.txt.
+    let mut files = base(SINGLETONS);
+    files.insert("engine.txt", "composition argmax   # formula 10.5\n");
+    let mut brian = Brian::from_sources(&files).unwrap();
+    assert_eq!(brian.composition(), Composition::Argmax);
+    assert_close(speed(&mut brian, (80.0, 1.0), (30.0, 1.0)), 68.0);
+
+    // A mistake is placed.
+    files.insert("engine.txt", "\ncomposition vectorial\n");
+    let e = Brian::from_sources(&files).unwrap_err().to_string();
+    assert!(e.contains("at line 2: one of weighted, argmax, not `vectorial`"), "{e}");
+    assert!(e.ends_with("engine.txt:2:13"), "{e}");
+}
+
+/// `semantics original`: CANDO and WANT gated on reliability, rules blind to it.
+/// Singletons SLOW 20, FAST 80; Obst 30 (Blocked 0.7, reliability 1): Avoid proposes SLOW 0.49
+/// in both semantics.
+///
+/// Dist (80, 0.4): Far (0.8, 0.4), Near (0.2, 0.4).
+/// - Manual: Go runs (0.8 > 0.49), weight 0.8; its rules propose 0.8 × 0.4 = 0.32 and
+///   0.2 × 0.4 = 0.08, weighted FAST 0.256 and SLOW 0.064. SLOW max(0.064, 0.49) = 0.49:
+///   (0.49 × 20 + 0.256 × 80) / 0.746 = 30.28 / 0.746 = 40.589812.
+/// - Original: Go's CANDO reliability 0.4 is not above 0.49: Go does not run. 20.
+///
+/// Dist (80, 0.6):
+/// - Manual: FAST 0.8 × 0.6 × 0.8 = 0.384, SLOW 0.49: (9.8 + 30.72) / 0.874 = 46.361556.
+/// - Original: Go runs (0.6 > 0.49) with weight 0.8 (WANT reliability 0.6 > 0.49), its rules
+///   propose 0.8 and 0.2 whatever the reliability: FAST 0.64, SLOW 0.49: 61 / 1.13 =
+///   53.982301, as with reliability 1.
+///
+/// With the threshold at 0.3 and Dist (80, 0.4), Go runs in both; in the original its WANT
+/// reliability 0.4 is not above 0.49, so its weight is 0 and it proposes nothing: 20; the
+/// manual gives 40.589812 as above.
+#[test]
+fn original_semantics_gate_cando_and_want_on_reliability() {
+    let mut files = base(SINGLETONS);
+    let mut manual = Brian::from_sources(&files).unwrap();
+    assert_eq!(manual.semantics(), Semantics::Manual, "the default");
+    files.insert("engine.txt", "semantics original\n");
+    let mut original = Brian::from_sources(&files).unwrap();
+    assert_eq!(original.semantics(), Semantics::Original);
+
+    assert_close(speed(&mut manual, (80.0, 0.4), (30.0, 1.0)), 30.28 / 0.746);
+    assert_close(speed(&mut original, (80.0, 0.4), (30.0, 1.0)), 20.0);
+    assert_close(speed(&mut manual, (80.0, 0.6), (30.0, 1.0)), 40.52 / 0.874);
+    assert_close(speed(&mut original, (80.0, 0.6), (30.0, 1.0)), 61.0 / 1.13);
+    // Reliability 1: both agree.
+    assert_close(speed(&mut manual, (80.0, 1.0), (30.0, 1.0)), 61.0 / 1.13);
+    assert_close(speed(&mut original, (80.0, 1.0), (30.0, 1.0)), 61.0 / 1.13);
+
+    for brian in [&mut manual, &mut original] {
+        brian.set_threshold(0.3);
+    }
+    assert_close(speed(&mut manual, (80.0, 0.4), (30.0, 1.0)), 30.28 / 0.746);
+    assert_close(speed(&mut original, (80.0, 0.4), (30.0, 1.0)), 20.0);
+    let go = original.trace().behaviors.iter().find(|b| b.0 == "Go").unwrap().2;
+    assert!(go.is_some(), "Go runs, with weight 0");
+
+    // Settable through the API too.
+    original.set_semantics(Semantics::Manual);
+    assert_close(speed(&mut original, (80.0, 0.4), (30.0, 1.0)), 30.28 / 0.746);
+}
+
+/// Avoid's rule `(Blocked) => (Speed SLOW);` written in Rust: SLOW with the rule's value,
+/// Blocked's value × reliability.
+struct AvoidInCode;
+
+impl CodeBehavior for AvoidInCode {
+    fn run(&self, situation: &Situation<'_>, out: &mut Proposals<'_>) {
+        assert_eq!(situation.behavior(), "Avoid");
+        if let Some(blocked) = situation.predicate("Blocked") {
+            let same = situation.datum("Obst", "NEAR");
+            assert_eq!(same, Some(blocked));
+            let _ = out.propose("Speed", "SLOW", blocked.value * blocked.reliability);
+        }
+    }
+}
+
+/// A level-2 behavior in code: deletes every Speed proposal of level 1 (`&DEL.Speed ANY`) and
+/// proposes SLOW with value 1.
+struct Brake;
+
+impl CodeBehavior for Brake {
+    fn run(&self, _situation: &Situation<'_>, out: &mut Proposals<'_>) {
+        let _ = out.delete("Speed", None);
+        let _ = out.propose("Speed", "SLOW", 1.0);
+        assert!(out.propose("Speed", "REVERSE", 1.0).is_err());
+        assert!(out.propose("Steer", "LEFT", 1.0).is_err());
+    }
+}
+
+/// Code behaviors (§10.3.6–10.3.7), listed as `code:<name>` in `behavior.txt`.
+///
+/// - Avoid in code proposes what its rule file proposed: Dist 80, Obst 30 give 61 / 1.13 =
+///   53.982301 as in the module doc.
+/// - Not registered, it proposes nothing (the loader warns): Go alone, FAST 0.64, SLOW 0.16:
+///   (3.2 + 51.2) / 0.8 = 68.
+/// - Brake (level 2, CANDO = WANT = Blocked 0.7) deletes level 1's Speed and proposes SLOW
+///   1 × 0.7: Speed 20, whatever level 1 wished.
+#[test]
+fn behaviors_written_in_code() {
+    let mut files = base(SINGLETONS);
+    files.insert("behavior.txt", "(level 1 Go behaviors/Go.rul)\n(level 1 Avoid code:Avoid)");
+    let mut brian = Brian::from_sources(&files).unwrap();
+    assert!(brian.warnings().iter().any(|w| w.contains("behavior `Avoid` is written in code")));
+    assert_close(speed(&mut brian, (80.0, 1.0), (30.0, 1.0)), 68.0);
+    assert_eq!(brian.register_behavior("Avoid", AvoidInCode).unwrap(), 1);
+    assert_close(speed(&mut brian, (80.0, 1.0), (30.0, 1.0)), 61.0 / 1.13);
+    let e = brian.register_behavior("Kick", Brake).unwrap_err();
+    assert!(matches!(e, BrianError::NoCodeBehavior { ref name } if name == "Kick"), "{e}");
+
+    files.insert(
+        "behavior.txt",
+        "(level 1 Go behaviors/Go.rul)\n(level 1 Avoid behaviors/Avoid.rul)\n\
+         (level 2 Brake code:Brake)",
+    );
+    files.insert("Cando.ini", "Go = (P Far);\nAvoid = (P Blocked);\nBrake = (P Blocked);");
+    files.insert("want.txt", "Go = (P Far);\nAvoid = (P Blocked);\nBrake = (P Blocked);");
+    let mut brian = Brian::from_sources(&files).unwrap();
+    brian.register_behavior("Brake", Brake).unwrap();
+    brian.set_tracing(true);
+    assert_close(speed(&mut brian, (80.0, 1.0), (30.0, 1.0)), 20.0);
+    let trace = brian.trace();
+    let brake: Vec<_> = trace.proposals.iter().filter(|p| p.behavior == "Brake").collect();
+    assert_eq!(brake.len(), 2, "{brake:?}");
+    assert_eq!((brake[0].label, brake[0].value), (None, None), "the deletion");
+    assert_close(brake[1].value.unwrap(), 0.7);
+
+    // A code name that is missing is an error at its place.
+    files.insert("behavior.txt", "(level 1 Go behaviors/Go.rul)\n(level 1  Avoid code:)");
+    let e = Brian::from_sources(&files).unwrap_err().to_string();
+    assert!(e.contains("the name of the code behavior of `Avoid` after `code:`"), "{e}");
+    assert!(e.ends_with("behavior.txt:2:17"), "{e}");
+}
+
+/// A CANDO filter of the program's (§10.3.6, `can_do_filter`): a behavior runs when its CANDO
+/// value is at least 0.75. Dist 80, Obst 30: Go (0.8) runs, Avoid (0.7) does not: Go alone,
+/// (3.2 + 51.2) / 0.8 = 68. `set_threshold` brings the threshold filter back: 53.982301.
+#[test]
+fn a_pluggable_cando_filter() {
+    struct AtLeast(f64);
+    impl CandoFilter for AtLeast {
+        fn can_do(&self, _behavior: &str, cando: FuzzyValue) -> bool {
+            cando.value >= self.0
+        }
+    }
+    let mut brian = Brian::from_sources(&base(SINGLETONS)).unwrap();
+    assert!(!brian.has_cando_filter());
+    brian.set_cando_filter(AtLeast(0.75));
+    assert!(brian.has_cando_filter());
+    assert_close(speed(&mut brian, (80.0, 1.0), (30.0, 1.0)), 68.0);
+    let avoid = brian.trace().behaviors.iter().find(|b| b.0 == "Avoid").unwrap().2;
+    assert_eq!(avoid, None, "Avoid did not run");
+    brian.set_threshold(0.49);
+    assert!(!brian.has_cando_filter());
+    assert_close(speed(&mut brian, (80.0, 1.0), (30.0, 1.0)), 61.0 / 1.13);
+    // The threshold filter as a plugged filter gives the same.
+    brian.set_cando_filter(ThresholdFilter { threshold: 0.49 });
+    assert_close(speed(&mut brian, (80.0, 1.0), (30.0, 1.0)), 61.0 / 1.13);
 }
