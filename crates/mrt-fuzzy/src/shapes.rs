@@ -546,6 +546,35 @@ mod tests {
             let _ = parse_associations(&text, Path::new("x"));
         }
 
+        /// The barycenter lies within the supports of the sets it weighs, and weights out of
+        /// [0, 1] (or NaN) neither panic nor leave that range.
+        #[test]
+        fn barycenter_stays_within_the_sets(
+            params in proptest::collection::vec((-1e3f64..1e3, 0.0f64..50.0, 0.0f64..50.0, 0.0f64..50.0, 0u8..4), 1..6),
+            weights in proptest::collection::vec(prop_oneof![-1.0f64..2.0, Just(f64::NAN)], 6),
+        ) {
+            let sets: Vec<FuzzySet> = params
+                .iter()
+                .map(|&(a, w1, w2, w3, kind)| match kind {
+                    0 => FuzzySet::Tri { a, b: a + w1, c: a + w1 + w2 + 1.0 },
+                    1 => FuzzySet::Tra { a, b: a + w1, c: a + w1 + w2, d: a + w1 + w2 + w3 + 1.0 },
+                    2 => FuzzySet::Rec { b: a, c: a + w1 + 1.0 },
+                    _ => FuzzySet::Div { a, b: a + w1 + 1.0, c: a + w1 + 1.0 + w2, d: a + w1 + w2 + w3 + 2.0 },
+                })
+                .collect();
+            let out = barycenter(sets.iter().zip(weights.iter().copied()), false);
+            let used: Vec<&FuzzySet> =
+                sets.iter().zip(&weights).filter(|(_, w)| **w > 0.0).map(|(s, _)| s).collect();
+            match out {
+                None => prop_assert!(used.is_empty()),
+                Some(x) => {
+                    let lo = used.iter().map(|s| s.params()[0]).fold(f64::INFINITY, f64::min);
+                    let hi = used.iter().map(|s| *s.params().last().unwrap_or(&0.0)).fold(f64::NEG_INFINITY, f64::max);
+                    prop_assert!(lo - 1e-6 <= x && x <= hi + 1e-6, "{x} not in [{lo}, {hi}]");
+                }
+            }
+        }
+
         #[test]
         fn token_soup_never_panics(parts in proptest::collection::vec(prop_oneof![
             Just("("), Just(")"), Just("TRI"), Just("SNG"), Just("TRA"), Just("DIV"), Just("A"),
