@@ -1,7 +1,7 @@
 //! `mrt brian check|eval|plot`: Mr. BRIAN's checker (MRT manual §10.4.7), a JSON Lines
 //! evaluator, and a drawing of every shape.
 
-use anyhow::{bail, Context as _, Result};
+use anyhow::{anyhow, bail, Context as _, Result};
 use mrt_fuzzy::brian::Brian;
 use mrt_fuzzy::FuzzySet;
 use serde_json::{json, Map, Value};
@@ -52,9 +52,15 @@ fn fv(v: mrt_fuzzy::FuzzyValue) -> Value {
     json!([v.value, v.reliability])
 }
 
-/// `mrt brian eval DIR [--input FILE] [--trace]`: one JSON object of commands per input line.
-pub fn eval(dir: &Path, input: Option<&Path>, trace: bool) -> Result<()> {
+/// `mrt brian eval DIR [--input FILE] [--trace] [--semantics manual|original]`: one JSON
+/// object of commands per input line.
+pub fn eval(dir: &Path, input: Option<&Path>, trace: bool, semantics: Option<&str>) -> Result<()> {
     let mut brian = Brian::from_dir(dir)?;
+    if let Some(name) = semantics {
+        let s =
+            mrt_fuzzy::engine::semantics_by_name(name).map_err(|e| anyhow!("--semantics: {e}"))?;
+        brian.set_semantics(s);
+    }
     brian.set_tracing(trace);
     let reader: Box<dyn BufRead> = match input {
         Some(p) => Box::new(std::io::BufReader::new(
@@ -215,10 +221,13 @@ pub fn plot(dir: &Path, out: &Path) -> Result<()> {
         panel(&mut body, y0, &format!("input {name} — shape {}", shape.name), &shape.sets);
         y0 += 200.0;
     }
-    for (name, labels) in brian.output_singletons() {
-        let sets: Vec<(String, FuzzySet)> =
-            labels.iter().map(|(l, v)| (l.clone(), FuzzySet::Sng { a: *v })).collect();
-        panel(&mut body, y0, &format!("output {name} (singletons)"), &sets);
+    for (name, sets) in brian.output_sets() {
+        let how = if sets.iter().all(|(_, s)| matches!(s, FuzzySet::Sng { .. })) {
+            "singletons"
+        } else {
+            "barycenter"
+        };
+        panel(&mut body, y0, &format!("output {name} ({how})"), sets);
         y0 += 200.0;
     }
     let svg = format!(

@@ -184,6 +184,11 @@ enum BrianCommand {
         /// Add every predicate, predicate action, CANDO and WANT under `_trace`.
         #[arg(long)]
         trace: bool,
+        /// How reliability counts: `manual` (the MRT manual's) or `original` (the original
+        /// C++ engine's: CANDO/WANT gated on reliability, rules blind to it). Default: the
+        /// configuration's `engine.txt`, else `manual`.
+        #[arg(long, value_parser = ["manual", "original"])]
+        semantics: Option<String>,
     },
     /// Draw every input and output shape as SVG.
     Plot {
@@ -311,7 +316,9 @@ fn run(command: Command) -> Result<()> {
         }
         Command::Brian { command } => match command {
             BrianCommand::Check { dir } => brian::check(&dir)?,
-            BrianCommand::Eval { dir, input, trace } => brian::eval(&dir, input.as_deref(), trace)?,
+            BrianCommand::Eval { dir, input, trace, semantics } => {
+                brian::eval(&dir, input.as_deref(), trace, semantics.as_deref())?
+            }
             BrianCommand::Plot { dir, out } => brian::plot(&dir, &out)?,
         },
         Command::Sim(args) => sim::run(&args)?,

@@ -225,3 +225,50 @@ fn check_reports_bad_utf8_at_its_place_and_refuses_foreign_rule_files() {
     std::fs::remove_file(&secret).unwrap();
     std::fs::remove_dir_all(&broken).unwrap();
 }
+
+/// `mrt brian eval --semantics original|manual` (issue 23): the worked example of
+/// `crates/mrt-fuzzy/tests/composition.rs`. Dist (80, reliability 0.4), Obst 30: the manual's
+/// semantics give (0.49 × 20 + 0.256 × 80) / 0.746 = 40.589812; the original engine's do not
+/// run Go (its CANDO reliability 0.4 is not above 0.49), leaving Avoid's SLOW: 20.
+#[test]
+fn eval_semantics_original_and_manual() {
+    let dir = std::env::temp_dir().join(format!("mrt-brian-semantics-{}", std::process::id()));
+    std::fs::create_dir_all(dir.join("behaviors")).unwrap();
+    for (name, text) in [
+        ("shape_ctof.txt", "(DIST (TOL (NEAR 0 100)) (TOR (FAR 0 100)))"),
+        ("ctof.txt", "(Dist DIST)\n(Obst DIST)"),
+        ("Predicate.ini", "Far = (D Dist FAR);\nNear = (D Dist NEAR);\nBlocked = (D Obst NEAR);"),
+        ("Cando.ini", "Go = (P Far);\nAvoid = (P Blocked);"),
+        ("want.txt", "Go = (P Far);\nAvoid = (P Blocked);"),
+        ("behavior.txt", "(level 1 Go behaviors/Go.rul)\n(level 1 Avoid behaviors/Avoid.rul)"),
+        ("behaviors/Go.rul", "(Far) => (Speed FAST);\n(Near) => (Speed SLOW);"),
+        ("behaviors/Avoid.rul", "(Blocked) => (Speed SLOW);"),
+        ("s_shape.txt", "(SPEED (SNG (SLOW 20)) (SNG (FAST 80)))"),
+        ("s_ftoc.txt", "(Speed SPEED)"),
+    ] {
+        std::fs::write(dir.join(name), text).unwrap();
+    }
+    let speed = |semantics: Option<&str>| {
+        let mut cmd = mrt();
+        cmd.args(["brian", "eval"]).arg(&dir);
+        if let Some(s) = semantics {
+            cmd.args(["--semantics", s]);
+        }
+        let mut child = cmd.stdin(Stdio::piped()).stdout(Stdio::piped()).spawn().unwrap();
+        child.stdin.take().unwrap().write_all(b"{\"Dist\": [80, 0.4], \"Obst\": 30}\n").unwrap();
+        let out = child.wait_with_output().unwrap();
+        assert!(out.status.success());
+        let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        v["Speed"].as_f64().unwrap()
+    };
+    assert!((speed(None) - 30.28 / 0.746).abs() < 1e-6);
+    assert!((speed(Some("manual")) - 30.28 / 0.746).abs() < 1e-6);
+    assert!((speed(Some("original")) - 20.0).abs() < 1e-6);
+    // engine.txt may choose it; the command line wins.
+    std::fs::write(dir.join("engine.txt"), "semantics original\n").unwrap();
+    assert!((speed(None) - 20.0).abs() < 1e-6);
+    assert!((speed(Some("manual")) - 30.28 / 0.746).abs() < 1e-6);
+    let bad = mrt().args(["brian", "eval"]).arg(&dir).args(["--semantics", "c++"]).output();
+    assert!(!bad.unwrap().status.success());
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -3,10 +3,16 @@
 //!
 //! One cycle: fuzzify the inputs (`ctof.txt`) → predicates (`Predicate.ini`) → for each level in
 //! increasing order: re-fuzzify what lower levels proposed as `Proposed<Action>` data and
-//! evaluate `PredicateActions.ini`, then run the level's behaviors (alphabetically) whose CANDO
-//! is above the threshold, each rule proposing its actions with value = precondition value ×
-//! reliability, weighted once by the behavior's WANT; compose by max per (action, label); apply
-//! `&DEL` to lower levels → defuzzify each action (`s_ftoc.txt`, formula 10.6).
+//! evaluate `PredicateActions.ini`, then run the level's behaviors (alphabetically) that the
+//! CANDO filter lets run (by default: CANDO above the threshold, [`ThresholdFilter`]; or a
+//! [`CandoFilter`] of the program's), each rule proposing its actions with value =
+//! precondition value × reliability (a [`CodeBehavior`] proposes its own), weighted once by the
+//! behavior's WANT ([`WeightComposer`]); compose per (action, label) ([`Composer`], by default
+//! the maximum); apply `&DEL` to lower levels → defuzzify each action (`s_ftoc.txt`): by
+//! singletons (formula 10.6) or, for a shape of polygons, by barycenter (formula 10.7,
+//! [`crate::shapes::barycenter`]). [`Composition::Argmax`] keeps, for each output, only the
+//! best behavior's proposals (formula 10.5); [`Semantics::Original`] reads reliability as the
+//! original C++ engine did.
 //!
 //! # Opposite proposals
 //!
@@ -27,8 +33,10 @@
 //!   gives the stronger wish's heading when the weights differ and, when they cancel exactly
 //!   (the mean direction is undefined), 0°. Levels do not change this: a higher level
 //!   overrides a lower one only through `&DEL`; otherwise all levels' proposals are composed
-//!   together. Formula 10.5 is not implemented: design the WANTs so that opposite behaviors
-//!   do not run at once, or let the higher one `&DEL` the other's action.
+//!   together. To avoid the mean: design the WANTs so that opposite behaviors do not run at
+//!   once, let the higher one `&DEL` the other's action, or choose formula 10.5
+//!   (`composition argmax` in `engine.txt`, [`Composition::Argmax`]): only the behavior of
+//!   larger μC · μW acts (−30 with weights 0.64 against 0.36).
 //!
 //! `tests/opposite_proposals.rs` checks both cases against a hand computation.
 
@@ -36,7 +44,7 @@ use crate::error::BrianError;
 use crate::expr::{parse_definitions, parse_expr, Expr, RawExpr};
 use crate::lexer::{tokenize, Cursor, Span, Tok};
 use crate::set::{FuzzySet, FuzzyValue};
-use crate::shapes::{defuzzify, parse_associations, parse_shapes, resolve, Shape};
+use crate::shapes::{barycenter, defuzzify, parse_associations, parse_shapes, resolve, Shape};
 use std::collections::{BTreeMap, HashMap, HashSet};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -86,22 +94,98 @@ impl WeightComposer {
     }
 }
 
-/// One (action, label) accumulator: enough for every composer.
-#[derive(Clone, Copy, Debug)]
+/// How the proposals of the running behaviors become the outputs (§10.2.4): "Both the
+/// approaches are implemented in Mr. BRIAN and it is possible to select the best one for the
+/// application". `engine.txt`: `composition weighted` or `composition argmax`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Composition {
+    /// Formula 10.3: every running behavior's proposals, each weighted by its behavior's
+    /// weight ([`WeightComposer`]) and combined per label ([`Composer`]): the default, as in
+    /// RoboCup.
+    #[default]
+    Weighted,
+    /// Formula 10.5: for each output, only the proposals of the behavior with the largest
+    /// μC · μW (CANDO value × weight) among the behaviors that propose a label of it (after
+    /// `&DEL`); ties go to the behavior that runs first (lower level, then name). Opposite
+    /// wishes are never averaged, at the price of pursuing one goal at a time.
+    Argmax,
+}
+
+/// Which reading of reliability the engine follows: the manual's (the default) or the
+/// original C++ engine's, for configurations tuned on it (`engine.txt`: `semantics manual` or
+/// `semantics original`; `mrt brian eval --semantics`).
+///
+/// | | [`Semantics::Manual`] | [`Semantics::Original`] |
+/// |---|---|---|
+/// | a behavior runs when | CANDO value above the threshold (§10.3.6) | and CANDO reliability above the threshold |
+/// | its weight is its WANT value when | the value is above 0.49 | and the reliability is above 0.49 |
+/// | a rule proposes | precondition value × reliability, nothing under reliability 0.1 (§10.3.7) | the precondition value, whatever its reliability |
+///
+/// The original program filters CANDO and WANT with a filter of membership *and*
+/// reliability, and its rules propose the precondition's membership: reliability decides
+/// whether a behavior counts, not how much. The manual (§10.3.7) makes it scale each proposal.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Semantics {
+    /// As the manual describes (§10.3.6, §10.3.7): the default.
+    #[default]
+    Manual,
+    /// As the original C++ engine measured: CANDO and WANT gated on reliability, rules blind
+    /// to it.
+    Original,
+}
+
+/// One (action, label) accumulator: enough for every composer and both compositions: the
+/// sums of every proposal, and those of the best behavior proposing here (formula 10.5).
+#[derive(Clone, Copy, Debug, Default)]
 struct Acc {
+    all: Sums,
+    best: Sums,
+    /// The best behavior's μC · μW.
+    score: f64,
+    /// The best behavior (its index in run order).
+    by: usize,
+}
+
+impl Acc {
+    fn add(&mut self, v: f64, score: f64, by: usize) {
+        self.all.add(v);
+        if self.best.n == 0 || score > self.score {
+            self.best = Sums::default();
+            self.score = score;
+            self.by = by;
+        }
+        if self.by == by {
+            self.best.add(v);
+        }
+    }
+
+    /// Adds what a higher level proposed: ties keep the lower level's behavior.
+    fn merge(&mut self, o: &Acc) {
+        self.all.merge(&o.all);
+        if o.best.n > 0 && (self.best.n == 0 || o.score > self.score) {
+            self.best = o.best;
+            self.score = o.score;
+            self.by = o.by;
+        }
+    }
+}
+
+/// Sums of the weighted proposals of one (action, label).
+#[derive(Clone, Copy, Debug)]
+struct Sums {
     max: f64,
     min: f64,
     sum: f64,
     n: u32,
 }
 
-impl Default for Acc {
+impl Default for Sums {
     fn default() -> Self {
-        Acc { max: 0.0, min: f64::INFINITY, sum: 0.0, n: 0 }
+        Sums { max: 0.0, min: f64::INFINITY, sum: 0.0, n: 0 }
     }
 }
 
-impl Acc {
+impl Sums {
     fn add(&mut self, v: f64) {
         self.max = self.max.max(v);
         self.min = self.min.min(v);
@@ -109,7 +193,7 @@ impl Acc {
         self.n += 1;
     }
 
-    fn merge(&mut self, o: &Acc) {
+    fn merge(&mut self, o: &Sums) {
         self.max = self.max.max(o.max);
         self.min = self.min.min(o.min);
         self.sum += o.sum;
@@ -129,7 +213,7 @@ impl Acc {
 impl Composer {
     /// Combines weighted proposals of one (action, label); 0 when there are none.
     pub fn combine(self, weighted: &[f64]) -> f64 {
-        let mut acc = Acc::default();
+        let mut acc = Sums::default();
         weighted.iter().for_each(|v| acc.add(*v));
         acc.weight(self)
     }
@@ -403,7 +487,12 @@ struct Input {
 #[derive(Clone, Debug)]
 struct Action {
     name: String,
+    /// Each label with its singleton (for a polygon shape, its set's barycenter at height 1).
     labels: Vec<(String, f64)>,
+    /// Each label's set, in label order.
+    sets: Vec<(String, FuzzySet)>,
+    /// Defuzzified by barycenter (polygon sets, formula 10.7) rather than by singletons (10.6).
+    barycenter: bool,
     circular: bool,
     /// The input slot `Proposed<name>` that re-fuzzifies this action for higher levels.
     proposed: Option<usize>,
@@ -411,7 +500,7 @@ struct Action {
     offset: usize,
 }
 
-#[derive(Clone, Debug)]
+#[derive(Clone, Copy, Debug)]
 enum RuleAction {
     Propose(usize),
     Delete { action: usize, label: Option<usize> },
@@ -432,6 +521,201 @@ struct Behavior {
     cando: Option<Expr>,
     want: Option<Expr>,
     rules: Vec<Rule>,
+    /// For a behavior written in Rust (`code:<name>` in `behavior.txt`): its name and, once
+    /// registered, its code.
+    code: Option<CodeSlot>,
+}
+
+/// A code behavior's place in the engine.
+#[derive(Clone, Debug)]
+struct CodeSlot {
+    name: String,
+    behavior: Option<Plugged<dyn CodeBehavior>>,
+}
+
+/// Code plugged into the engine, shared by clones of it.
+struct Plugged<T: ?Sized>(Arc<T>);
+
+impl<T: ?Sized> Clone for Plugged<T> {
+    fn clone(&self) -> Self {
+        Plugged(self.0.clone())
+    }
+}
+
+impl<T: ?Sized> std::fmt::Debug for Plugged<T> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("<code>")
+    }
+}
+
+/// The prefix that marks a behavior written in Rust in `behavior.txt`:
+/// `(level 1 KeepClear code:KeepClear)` instead of the path of a `.rul` file.
+pub const CODE_PREFIX: &str = "code:";
+
+/// A behavior written in Rust instead of a `.rul` file (MRT manual §10.3.6–10.3.7: "the user
+/// can also write his own behaviors and then put them into Mr. BRIAN with very little effort";
+/// the original engine's abstract `behavior` class, of which `rules_behavior` is one kind).
+///
+/// `behavior.txt` lists it as `(level <n> <name> code:<code name>)`; its CANDO and WANT come
+/// from `Cando.ini` and `want.txt` like any behavior's, and
+/// [`Brian::register_behavior`]`(<code name>, ...)` gives its code. Whenever the CANDO filter
+/// lets it run, [`run`](CodeBehavior::run) reads the cycle's predicates, predicate actions and
+/// fuzzy data from the [`Situation`] and proposes actions (or `&DEL`s) through the
+/// [`Proposals`]; the engine weighs and composes them as a rule's.
+///
+/// ```
+/// use mrt_fuzzy::brian::{Brian, BrianSources, CodeBehavior, Proposals, Situation};
+///
+/// /// SLOW as much as an obstacle is near.
+/// struct Avoid;
+/// impl CodeBehavior for Avoid {
+///     fn run(&self, situation: &Situation<'_>, out: &mut Proposals<'_>) {
+///         if let Some(blocked) = situation.predicate("Blocked") {
+///             let _ = out.propose("Speed", "SLOW", blocked.value);
+///         }
+///     }
+/// }
+///
+/// let mut files = BrianSources::new();
+/// files.insert("shape_ctof.txt", "(DIST (TOL (NEAR 0 100)))");
+/// files.insert("ctof.txt", "(Obst DIST)");
+/// files.insert("Predicate.ini", "Blocked = (D Obst NEAR);");
+/// files.insert("Cando.ini", "Avoid = (P Blocked);");
+/// files.insert("want.txt", "Avoid = (P Blocked);");
+/// files.insert("behavior.txt", "(level 1 Avoid code:Avoid)");
+/// files.insert("s_shape.txt", "(SPEED (SNG (SLOW 20)) (SNG (FAST 80)))");
+/// files.insert("s_ftoc.txt", "(Speed SPEED)");
+/// let mut brian = Brian::from_sources(&files)?;
+/// brian.register_behavior("Avoid", Avoid)?;
+/// assert_eq!(brian.run(&[("Obst", 30.0, 1.0)])["Speed"], 20.0);
+/// # Ok::<(), mrt_fuzzy::BrianError>(())
+/// ```
+pub trait CodeBehavior: Send + Sync {
+    /// One cycle of the behavior: read the situation, propose actions.
+    fn run(&self, situation: &Situation<'_>, out: &mut Proposals<'_>);
+}
+
+/// The CANDO filter (§10.3.6, the original engine's abstract `can_do_filter`): which behaviors
+/// run, from their activation conditions. The default is the threshold filter
+/// ([`ThresholdFilter`], `threshold_filter` in `engine.txt`); [`Brian::set_cando_filter`]
+/// plugs another.
+pub trait CandoFilter: Send + Sync {
+    /// Whether `behavior`, whose CANDO is `cando`, runs this cycle.
+    fn can_do(&self, behavior: &str, cando: FuzzyValue) -> bool;
+}
+
+/// The threshold filter (§10.3.6, `threshold_filter`): a behavior runs when its CANDO value is
+/// above the threshold (default [`DEFAULT_THRESHOLD`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ThresholdFilter {
+    /// The threshold.
+    pub threshold: f64,
+}
+
+impl CandoFilter for ThresholdFilter {
+    fn can_do(&self, _behavior: &str, cando: FuzzyValue) -> bool {
+        cando.value > self.threshold
+    }
+}
+
+/// What a [`CodeBehavior`] sees of the cycle: the predicates of `Predicate.ini`, the predicate
+/// actions of `PredicateActions.ini` as evaluated for its level (what lower levels propose),
+/// the fuzzy data, and its own CANDO and WANT.
+pub struct Situation<'a> {
+    brian: &'a Brian,
+    behavior: usize,
+}
+
+impl Situation<'_> {
+    /// The behavior's name in `behavior.txt`.
+    pub fn behavior(&self) -> &str {
+        &self.brian.behaviors[self.behavior].name
+    }
+
+    /// The behavior's level.
+    pub fn level(&self) -> i64 {
+        self.brian.behaviors[self.behavior].level
+    }
+
+    /// A predicate of `Predicate.ini` or a predicate action of `PredicateActions.ini`, by name.
+    pub fn predicate(&self, name: &str) -> Option<FuzzyValue> {
+        let b = self.brian;
+        match b.names.predicates.get(name) {
+            Some(&i) => b.pred_values.get(i).copied(),
+            None => b.act_values.get(*b.names.predicate_actions.get(name)?).copied(),
+        }
+    }
+
+    /// The fuzzy datum `(D <input> <label>)`.
+    pub fn datum(&self, input: &str, label: &str) -> Option<FuzzyValue> {
+        let b = self.brian;
+        let i = *b.names.inputs.get(input)?;
+        let k = *b.names.labels.get(i)?.get(label)?;
+        b.data.get(b.inputs.get(i)?.offset + k).copied()
+    }
+
+    /// The behavior's (CANDO, WANT) this cycle.
+    pub fn activity(&self) -> Option<Activity> {
+        self.brian.activity.get(self.behavior).copied().flatten()
+    }
+}
+
+/// Where a [`CodeBehavior`] puts its actions: proposals `(action, label, value)` as a rule's
+/// `(<action> <label>)` with the rule's value, and deletions as `&DEL.<action> <label|ANY>`.
+pub struct Proposals<'a> {
+    brian: &'a Brian,
+    out: &'a mut Vec<(RuleAction, f64)>,
+}
+
+/// A name a [`CodeBehavior`] used that the configuration does not have.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct UnknownName(pub String);
+
+impl std::fmt::Display for UnknownName {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{}", self.0)
+    }
+}
+
+impl std::error::Error for UnknownName {}
+
+impl Proposals<'_> {
+    fn action(&self, action: &str) -> Result<usize, UnknownName> {
+        let names = &self.brian.sorted_names;
+        names
+            .binary_search_by(|(n, _)| (**n).cmp(action))
+            .ok()
+            .and_then(|i| names.get(i))
+            .map(|(_, ai)| *ai)
+            .ok_or_else(|| UnknownName(format!("unknown action `{action}` (not in s_ftoc.txt)")))
+    }
+
+    fn label(&self, ai: usize, label: &str) -> Result<usize, UnknownName> {
+        let a = &self.brian.actions[ai];
+        a.labels
+            .iter()
+            .position(|(l, _)| l == label)
+            .ok_or_else(|| UnknownName(format!("action `{}` has no label `{label}`", a.name)))
+    }
+
+    /// Proposes `label` of `action` with `value` (clamped to [0, 1]; NaN counts as 0, which
+    /// proposes nothing), as a rule whose precondition has that value.
+    pub fn propose(&mut self, action: &str, label: &str, value: f64) -> Result<(), UnknownName> {
+        let ai = self.action(action)?;
+        let k = self.label(ai, label)?;
+        let value = if value.is_nan() { 0.0 } else { value.clamp(0.0, 1.0) };
+        self.out.push((RuleAction::Propose(self.brian.actions[ai].offset + k), value));
+        Ok(())
+    }
+
+    /// Deletes what lower levels proposed for `label` of `action`, or for every label with
+    /// `None` (`&DEL.<action> ANY`).
+    pub fn delete(&mut self, action: &str, label: Option<&str>) -> Result<(), UnknownName> {
+        let ai = self.action(action)?;
+        let label = label.map(|l| self.label(ai, l)).transpose()?;
+        self.out.push((RuleAction::Delete { action: ai, label }, 1.0));
+        Ok(())
+    }
 }
 
 /// A loaded Mr. BRIAN configuration, ready to run cycles.
@@ -452,8 +736,14 @@ pub struct Brian {
     behaviors: Vec<Behavior>,
     actions: Vec<Action>,
     threshold: f64,
+    /// A CANDO filter plugged in place of the threshold filter.
+    cando_filter: Option<Plugged<dyn CandoFilter>>,
     composer: Composer,
     weight_composer: WeightComposer,
+    composition: Composition,
+    semantics: Semantics,
+    /// What a code behavior proposed, reused every cycle.
+    code_out: Vec<(RuleAction, f64)>,
     pred_values: Vec<FuzzyValue>,
     act_values: Vec<FuzzyValue>,
     lower: Vec<Acc>,
@@ -474,8 +764,8 @@ pub struct Brian {
     feedback: Vec<Option<usize>>,
     /// Inputs that carry `Proposed<Action>` data (set by the engine, not by callers).
     is_proposed: Vec<bool>,
-    /// Input name → slot.
-    input_index: HashMap<String, usize>,
+    /// Names of inputs (slots), labels, predicates and predicate actions.
+    names: Index,
     outputs: Vec<Option<f64>>,
 }
 
@@ -574,7 +864,7 @@ impl std::fmt::Debug for Commands {
 /// Name → index tables of what is defined so far, so that every reference resolves in
 /// constant time: loading is linear in the size of the configuration (issue 17: it was
 /// quadratic, 200 000 definitions never finished).
-#[derive(Default)]
+#[derive(Clone, Debug, Default)]
 struct Index {
     /// Crisp input name → its index in the inputs.
     inputs: HashMap<String, usize>,
@@ -823,27 +1113,26 @@ impl Brian {
         let mut actions = Vec::new();
         let mut offset = 0;
         for (a, i) in s_assocs.iter().zip(s_idx) {
-            let mut labels = Vec::new();
-            for (label, set) in &s_shapes[i].sets {
-                match set {
-                    FuzzySet::Sng { a } => labels.push((label.clone(), *a)),
-                    other => {
-                        return Err(BrianError::at(
-                            &files.s_shape,
-                            s_shapes[i].span,
-                            format!("output shape `{}` set `{label}` is {}: defuzzification uses singletons (SNG) only", s_shapes[i].name, other.identifier()),
-                        ))
-                    }
-                }
-            }
-            // Formula 10.6 sums weight × singleton (weights at most 1): the sum must stay a
-            // number, or the command would be infinite or NaN.
-            if !labels.iter().map(|(_, v)| v.abs()).sum::<f64>().is_finite() {
+            let shape = &s_shapes[i];
+            let circular = a.name.contains("Angle");
+            let (labels, barycenter) = output_labels(shape, circular, &files.s_shape)?;
+            // Formula 10.6 sums weight × singleton (weights at most 1), formula 10.7 area ×
+            // centroid: the sum must stay a number, or the command would be infinite or NaN.
+            let sum: f64 = if barycenter {
+                let moments = shape.sets.iter().flat_map(|(_, set)| {
+                    crate::shapes::clipped_areas(set, 1.0).map(|(x, area)| area + (x * area).abs())
+                });
+                moments.sum()
+            } else {
+                labels.iter().map(|(_, v)| v.abs()).sum()
+            };
+            if !sum.is_finite() {
                 return Err(BrianError::at(
                     &files.s_shape,
                     s_shapes[i].span,
                     format!(
-                        "the singletons of output shape `{}` are too large: their sum is not a finite number",
+                        "the {} of output shape `{}` are too large: their sum is not a finite number",
+                        if barycenter { "sets" } else { "singletons" },
                         s_shapes[i].name
                     ),
                 ));
@@ -853,7 +1142,9 @@ impl Brian {
             actions.push(Action {
                 name: a.name.clone(),
                 labels,
-                circular: a.name.contains("Angle"),
+                sets: shape.sets.clone(),
+                barycenter,
+                circular,
                 proposed,
                 offset,
             });
@@ -885,32 +1176,52 @@ impl Brian {
                     format!("behavior `{}` is listed twice", b.name),
                 ));
             }
-            let canon = match checked.get(b.path.as_str()) {
-                Some(canon) => canon.clone(),
-                None => {
-                    let canon = src.rule_file(&root, base, &files.behaviors, b)?;
-                    checked.insert(b.path.as_str(), canon.clone());
-                    canon
+            let code = match b.path.strip_prefix(CODE_PREFIX) {
+                Some("") => {
+                    return Err(BrianError::at(
+                        &files.behaviors,
+                        b.path_span,
+                        format!(
+                            "the name of the code behavior of `{}` after `{CODE_PREFIX}` \
+                             (`{CODE_PREFIX}<name>`, registered with Brian::register_behavior)",
+                            b.name
+                        ),
+                    ))
                 }
+                Some(name) => Some(CodeSlot { name: name.to_string(), behavior: None }),
+                None => None,
             };
-            let rules = match rule_files.get(&canon) {
-                Some(rules) => rules.clone(),
-                None => {
-                    // Read the checked file; report places under the path as written.
-                    let rul = base.join(&b.path);
-                    let text = read(&canon).map_err(|e| match e {
-                        BrianError::Io { source, .. } => {
-                            BrianError::Io { file: rul.clone(), source }
-                        }
-                        BrianError::At { line, column, message, .. } => {
-                            BrianError::At { file: rul.clone(), line, column, message }
-                        }
-                    })?;
-                    let rules = parse_text(&text, &rul, |c| {
-                        parse_rules(c, &Names { file: &rul, ..names }, &outputs)
-                    })?;
-                    rule_files.insert(canon, rules.clone());
-                    rules
+            let rules = if code.is_some() {
+                Vec::new()
+            } else {
+                let canon = match checked.get(b.path.as_str()) {
+                    Some(canon) => canon.clone(),
+                    None => {
+                        let canon = src.rule_file(&root, base, &files.behaviors, b)?;
+                        checked.insert(b.path.as_str(), canon.clone());
+                        canon
+                    }
+                };
+                match rule_files.get(&canon) {
+                    Some(rules) => rules.clone(),
+                    None => {
+                        // Read the checked file; report places under the path as written.
+                        let rul = base.join(&b.path);
+                        let text = read(&canon).map_err(|e| match e {
+                            BrianError::Io { source, .. } => {
+                                BrianError::Io { file: rul.clone(), source }
+                            }
+                            BrianError::At { line, column, message, .. } => {
+                                BrianError::At { file: rul.clone(), line, column, message }
+                            }
+                            other => other,
+                        })?;
+                        let rules = parse_text(&text, &rul, |c| {
+                            parse_rules(c, &Names { file: &rul, ..names }, &outputs)
+                        })?;
+                        rule_files.insert(canon, rules.clone());
+                        rules
+                    }
                 }
             };
             let cando = match cando_of.get(b.name.as_str()) {
@@ -928,6 +1239,7 @@ impl Brian {
                 cando,
                 want,
                 rules,
+                code,
             });
         }
         for (file, defs) in [(&files.cando, &cando), (&files.want, &want)] {
@@ -985,6 +1297,17 @@ impl Brian {
             warnings.push(warning(&files.behaviors, b.span, &what));
         }
 
+        for b in &behaviors {
+            if let Some(code) = &b.code {
+                let what = format!(
+                    "behavior `{}` is written in code (`{CODE_PREFIX}{}`): it proposes nothing \
+                     until a program registers it (Brian::register_behavior(\"{}\", ...))",
+                    b.name, code.name, code.name
+                );
+                warnings.push(warning(&files.behaviors, b.span, &what));
+            }
+        }
+
         let slots = actions.iter().map(|a| a.labels.len()).sum();
         let mut is_proposed = vec![false; inputs.len()];
         for p in actions.iter().filter_map(|a| a.proposed) {
@@ -1005,7 +1328,11 @@ impl Brian {
             shared_outputs: Arc::new(vec![None; actions.len()]),
             feedback,
             warnings,
-            input_index: index.inputs,
+            names: index,
+            cando_filter: None,
+            composition: engine.composition.unwrap_or_default(),
+            semantics: engine.semantics.unwrap_or_default(),
+            code_out: Vec::new(),
             activity: vec![None; behaviors.len()],
             is_proposed,
             outputs: vec![None; actions.len()],
@@ -1042,9 +1369,70 @@ impl Brian {
         self.composer = c;
     }
 
-    /// Sets the CANDO threshold (`threshold_filter`, default 0.49; `engine.txt` may set it).
+    /// Sets the CANDO threshold (`threshold_filter`, default 0.49; `engine.txt` may set it),
+    /// and brings the threshold filter back if another CANDO filter was plugged in.
     pub fn set_threshold(&mut self, t: f64) {
         self.threshold = t;
+        self.cando_filter = None;
+    }
+
+    /// Plugs a CANDO filter in place of the threshold filter (§10.3.6, `can_do_filter`).
+    /// Under [`Semantics::Original`] a behavior must still have a CANDO reliability above
+    /// the threshold.
+    pub fn set_cando_filter(&mut self, filter: impl CandoFilter + 'static) {
+        self.cando_filter = Some(Plugged(Arc::new(filter)));
+    }
+
+    /// Whether a CANDO filter of the program's replaces the threshold filter.
+    pub fn has_cando_filter(&self) -> bool {
+        self.cando_filter.is_some()
+    }
+
+    /// Chooses how proposals become outputs (default [`Composition::Weighted`], formula
+    /// 10.3; `engine.txt` may set it).
+    pub fn set_composition(&mut self, c: Composition) {
+        self.composition = c;
+    }
+
+    /// The composition.
+    pub fn composition(&self) -> Composition {
+        self.composition
+    }
+
+    /// Chooses the semantics of reliability (default [`Semantics::Manual`]; `engine.txt`
+    /// may set it).
+    pub fn set_semantics(&mut self, s: Semantics) {
+        self.semantics = s;
+    }
+
+    /// The semantics of reliability.
+    pub fn semantics(&self) -> Semantics {
+        self.semantics
+    }
+
+    /// Gives the code of the behaviors that `behavior.txt` lists as `code:<name>` (see
+    /// [`CodeBehavior`]); returns how many behaviors use it. A code behavior nobody registered
+    /// proposes nothing; registering again replaces the code.
+    ///
+    /// # Errors
+    /// [`BrianError::NoCodeBehavior`] when no behavior of `behavior.txt` is `code:<name>`.
+    pub fn register_behavior(
+        &mut self,
+        name: &str,
+        behavior: impl CodeBehavior + 'static,
+    ) -> Result<usize, BrianError> {
+        let code: Arc<dyn CodeBehavior> = Arc::new(behavior);
+        let mut n = 0;
+        for slot in self.behaviors.iter_mut().filter_map(|b| b.code.as_mut()) {
+            if slot.name == name {
+                slot.behavior = Some(Plugged(code.clone()));
+                n += 1;
+            }
+        }
+        if n == 0 {
+            return Err(BrianError::NoCodeBehavior { name: name.to_string() });
+        }
+        Ok(n)
     }
 
     /// The CANDO threshold.
@@ -1114,14 +1502,21 @@ impl Brian {
         self.inputs.iter().map(|i| (i.name.as_str(), &i.shape))
     }
 
-    /// The output actions with their singletons `(label, value)`.
+    /// The output actions with their sets `(label, set)`: SNG for singleton defuzzification,
+    /// TRI, DIV, TRA or REC for barycenter defuzzification (§10.4.6, formula 10.7).
+    pub fn output_sets(&self) -> impl Iterator<Item = (&str, &[(String, FuzzySet)])> {
+        self.actions.iter().map(|a| (a.name.as_str(), a.sets.as_slice()))
+    }
+
+    /// The output actions with their singletons `(label, value)`; for a shape of polygons
+    /// (barycenter defuzzification), each set's barycenter at full height.
     pub fn output_singletons(&self) -> impl Iterator<Item = (&str, &[(String, f64)])> {
         self.actions.iter().map(|a| (a.name.as_str(), a.labels.as_slice()))
     }
 
     /// The slot of a crisp input, for [`set_input`](Self::set_input).
     pub fn input_slot(&self, name: &str) -> Option<usize> {
-        self.input_index.get(name).copied()
+        self.names.inputs.get(name).copied()
     }
 
     /// Sets an input for the next [`step`](Self::step). Reliability is clamped to `[0, 1]`; a
@@ -1222,7 +1617,7 @@ impl Brian {
             }
         }
         for (ai, a) in self.actions.iter().enumerate() {
-            self.outputs[ai] = self.crisp(a, self.composer);
+            self.outputs[ai] = self.crisp(a, self.composer, self.composition);
         }
         // The previous cycle's outputs come back as inputs of the same name (§10.5).
         for (input, fb) in self.inputs.iter_mut().zip(&self.feedback) {
@@ -1231,9 +1626,28 @@ impl Brian {
     }
 
     /// Defuzzifies one action from the accumulated proposals.
-    fn crisp(&self, a: &Action, c: Composer) -> Option<f64> {
+    fn crisp(&self, a: &Action, c: Composer, composition: Composition) -> Option<f64> {
         let w = &self.lower[a.offset..a.offset + a.labels.len()];
-        defuzzify(a.labels.iter().zip(w).map(|((_, s), w)| (*s, w.weight(c))), a.circular)
+        // Formula 10.5: the behavior of largest μC · μW among those proposing for this action
+        // (ties: the first to run).
+        let mut best: Option<(f64, usize)> = None;
+        if composition == Composition::Argmax {
+            for acc in w.iter().filter(|acc| acc.best.n > 0) {
+                if best.is_none_or(|(s, by)| acc.score > s || (acc.score == s && acc.by < by)) {
+                    best = Some((acc.score, acc.by));
+                }
+            }
+        }
+        let weight = |acc: &Acc| match best {
+            None => acc.all.weight(c),
+            Some((_, by)) if acc.best.n > 0 && acc.by == by => acc.best.weight(c),
+            Some(_) => 0.0,
+        };
+        if a.barycenter {
+            barycenter(a.sets.iter().zip(w).map(|((_, s), w)| (s, weight(w))), a.circular)
+        } else {
+            defuzzify(a.labels.iter().zip(w).map(|((_, s), w)| (*s, weight(w))), a.circular)
+        }
     }
 
     /// Defuzzifies what the lower levels propose into `Proposed<Action>` data and fuzzifies it.
@@ -1242,8 +1656,8 @@ impl Brian {
             let a = &self.actions[ai];
             let Some(slot) = a.proposed else { continue };
             // What lower levels propose is composed by max per label (issue 4), whatever
-            // composer the outputs use.
-            let crisp = self.crisp(a, Composer::Max);
+            // composer and composition the outputs use.
+            let crisp = self.crisp(a, Composer::Max, Composition::Weighted);
             self.inputs[slot].now = crisp.map(|v| (v, 1.0));
             self.fuzzify(slot);
         }
@@ -1255,7 +1669,13 @@ impl Brian {
         let cando = beh.cando.as_ref().map_or(FuzzyValue::MISSING, |e| {
             e.eval(&self.data, &self.pred_values, &self.act_values)
         });
-        if cando.value <= self.threshold {
+        let passes = match &self.cando_filter {
+            Some(filter) => filter.0.can_do(&beh.name, cando),
+            None => ThresholdFilter { threshold: self.threshold }.can_do(&beh.name, cando),
+        };
+        // The original engine also gates CANDO and WANT on their reliability (Semantics).
+        let original = self.semantics == Semantics::Original;
+        if !passes || (original && cando.reliability <= self.threshold) {
             self.activity[b] = None;
             return;
         }
@@ -1263,53 +1683,137 @@ impl Brian {
             e.eval(&self.data, &self.pred_values, &self.act_values)
         });
         self.activity[b] = Some((cando, want));
-        let weight = if want.value > WANT_THRESHOLD { want.value } else { 0.0 };
-        for rule in &beh.rules {
+        let reliable = !original || want.reliability > WANT_THRESHOLD;
+        let weight = if want.value > WANT_THRESHOLD && reliable { want.value } else { 0.0 };
+        // μC · μW, by which formula 10.5 chooses.
+        let score = cando.value * weight;
+        if self.behaviors[b].code.is_some() {
+            self.run_code(b, weight, score);
+            return;
+        }
+        for r in 0..self.behaviors[b].rules.len() {
+            let rule = &self.behaviors[b].rules[r];
             let p = rule.precondition.eval(&self.data, &self.pred_values, &self.act_values);
-            if p.reliability < MIN_RELIABILITY {
-                continue;
-            }
-            let value = p.value * p.reliability;
-            for act in &rule.actions {
-                match *act {
-                    // A rule that does not fire (value 0), or a behavior of weight 0, proposes
-                    // nothing: it must not count in the average composer's mean.
-                    RuleAction::Propose(slot) if weight * value > 0.0 => {
-                        let weighted = self.weight_composer.apply(value, weight);
-                        self.level_acc[slot].add(weighted);
-                        if self.tracing {
-                            // Actions are in offset order: the last one starting at or
-                            // before `slot` holds it.
-                            let ai = self
-                                .actions
-                                .partition_point(|a| a.offset <= slot)
-                                .saturating_sub(1);
-                            let label = slot - self.actions[ai].offset;
-                            self.traced.push((b, ai, Some(label), Some(weighted)));
-                        }
-                    }
-                    RuleAction::Propose(_) => {}
-                    // `&DEL` applies when the rule fires (value > 0), whatever the behavior's
-                    // weight: a running behavior (CANDO above the threshold) may suppress lower
-                    // levels even while its WANT gives its own proposals no weight. This is
-                    // what the shared conformance data (brian40-hier) require.
-                    RuleAction::Delete { action, label } if value > 0.0 => {
-                        if self.tracing {
-                            self.traced.push((b, action, label, None));
-                        }
-                        let a = &self.actions[action];
-                        match label {
-                            Some(k) => self.lower[a.offset + k] = Acc::default(),
-                            None => self.lower[a.offset..a.offset + a.labels.len()]
-                                .iter_mut()
-                                .for_each(|v| *v = Acc::default()),
-                        }
-                    }
-                    RuleAction::Delete { .. } => {}
-                }
+            let value = match self.semantics {
+                Semantics::Manual if p.reliability < MIN_RELIABILITY => continue,
+                Semantics::Manual => p.value * p.reliability,
+                Semantics::Original => p.value,
+            };
+            for k in 0..rule.actions.len() {
+                let act = self.behaviors[b].rules[r].actions[k];
+                self.apply(b, act, value, weight, score);
             }
         }
     }
+
+    /// Runs a code behavior: its proposals are applied as a rule's.
+    fn run_code(&mut self, b: usize, weight: f64, score: f64) {
+        let code = self.behaviors[b].code.as_ref().and_then(|c| c.behavior.clone());
+        let Some(code) = code else { return };
+        let mut out = std::mem::take(&mut self.code_out);
+        out.clear();
+        code.0.run(
+            &Situation { brian: self, behavior: b },
+            &mut Proposals { brian: self, out: &mut out },
+        );
+        for &(act, value) in &out {
+            self.apply(b, act, value, weight, score);
+        }
+        self.code_out = out;
+    }
+
+    /// One action of behavior `b`, from a rule of value `value` (or a code behavior), the
+    /// behavior weighing `weight` with μC · μW = `score`.
+    fn apply(&mut self, b: usize, act: RuleAction, value: f64, weight: f64, score: f64) {
+        match act {
+            // A rule that does not fire (value 0), or a behavior of weight 0, proposes
+            // nothing: it must not count in the average composer's mean.
+            RuleAction::Propose(slot) if weight * value > 0.0 => {
+                let weighted = self.weight_composer.apply(value, weight);
+                self.level_acc[slot].add(weighted, score, b);
+                if self.tracing {
+                    // Actions are in offset order: the last one starting at or before `slot`
+                    // holds it.
+                    let ai = self.actions.partition_point(|a| a.offset <= slot).saturating_sub(1);
+                    let label = slot - self.actions[ai].offset;
+                    self.traced.push((b, ai, Some(label), Some(weighted)));
+                }
+            }
+            RuleAction::Propose(_) => {}
+            // `&DEL` applies when the rule fires (value > 0), whatever the behavior's weight:
+            // a running behavior (CANDO above the threshold) may suppress lower levels even
+            // while its WANT gives its own proposals no weight. This is what the shared
+            // conformance data (brian40-hier) require.
+            RuleAction::Delete { action, label } if value > 0.0 => {
+                if self.tracing {
+                    self.traced.push((b, action, label, None));
+                }
+                let a = &self.actions[action];
+                match label {
+                    Some(k) => self.lower[a.offset + k] = Acc::default(),
+                    None => self.lower[a.offset..a.offset + a.labels.len()]
+                        .iter_mut()
+                        .for_each(|v| *v = Acc::default()),
+                }
+            }
+            RuleAction::Delete { .. } => {}
+        }
+    }
+}
+
+/// The labels of an output shape with their singletons, and whether the shape is defuzzified
+/// by barycenter (§10.3.9, §10.4.6): a shape of singletons only (SNG) by formula 10.6, a shape
+/// of polygons only (TRI, DIV, TRA, REC) by formula 10.7, each label's singleton then being
+/// its set's barycenter at full height. A shape that mixes them, or that holds TOL or TOR
+/// (their area is infinite), is refused at the shape's name.
+fn output_labels(
+    shape: &Shape,
+    circular: bool,
+    file: &Path,
+) -> Result<(Vec<(String, f64)>, bool), BrianError> {
+    let polygon = |set: &FuzzySet| crate::shapes::is_polygon(set);
+    let barycenter = shape.sets.first().is_some_and(|(_, set)| polygon(set));
+    let mut labels = Vec::with_capacity(shape.sets.len());
+    for (label, set) in &shape.sets {
+        let err = |what: String| BrianError::at(file, shape.span, what);
+        let id = set.identifier();
+        match (set, barycenter) {
+            (FuzzySet::Sng { a }, false) => labels.push((label.clone(), *a)),
+            (FuzzySet::Tol { .. } | FuzzySet::Tor { .. }, _) => {
+                return Err(err(format!(
+                    "output shape `{}` set `{label}` is {id}, open on one side: defuzzification \
+                     uses singletons (SNG, formula 10.6) or polygons of finite area (TRI, DIV, \
+                     TRA, REC: barycenter, formula 10.7)",
+                    shape.name
+                )))
+            }
+            (_, true) if polygon(set) => {
+                let Some(centroid) = crate::shapes::barycenter([(set, 1.0)], circular) else {
+                    return Err(err(format!(
+                        "output shape `{}` set `{label}` ({id} {:?}) has no barycenter: \
+                         barycenter defuzzification needs polygons of some width and of finite \
+                         size (or use SNG)",
+                        shape.name,
+                        set.params()
+                    )));
+                };
+                labels.push((label.clone(), centroid));
+            }
+            _ => {
+                let (first, kind) = if barycenter {
+                    ("polygons (TRI, DIV, TRA, REC: barycenter, formula 10.7)", id)
+                } else {
+                    ("singletons (SNG, formula 10.6)", id)
+                };
+                return Err(err(format!(
+                    "output shape `{}` mixes {first} with set `{label}` ({kind}): one shape is \
+                     defuzzified one way, all SNG or all polygons",
+                    shape.name
+                )));
+            }
+        }
+    }
+    Ok((labels, barycenter))
 }
 
 fn warning(file: &Path, span: Span, what: &str) -> String {
@@ -1479,6 +1983,8 @@ mod tests {
         let actions = [Action {
             name: "Out".into(),
             labels: vec![("HIGH".into(), 1.0)],
+            sets: vec![("HIGH".into(), FuzzySet::Sng { a: 1.0 })],
+            barycenter: false,
             circular: false,
             proposed: None,
             offset: 0,

@@ -8,7 +8,17 @@
 //! threshold_filter 0.5                     # a behavior runs when its CANDO is above it
 //! weight_composer mult_weight_composer     # (the default), max_ or min_weight_composer
 //! float_composer average_float_composer    # max_ (the default) or min_float_composer
+//! composition argmax                       # weighted (the default, formula 10.3) or argmax (10.5)
+//! semantics original                       # manual (the default) or original (the C++ engine's)
 //! ```
+//!
+//! `composition` chooses between the two ways of §10.2.4 ("both the approaches are
+//! implemented in Mr. BRIAN and it is possible to select the best one for the application"):
+//! the weighted composition of formula 10.3 or the best behavior's actions of formula 10.5
+//! ([`Composition`]). `semantics` chooses how reliability counts ([`Semantics`]): as the
+//! manual says, or as the original C++ engine did, for configurations tuned on it. Both are
+//! properties of a configuration (its rules and WANTs were written for one of them), hence
+//! settings of its directory rather than of a program.
 //!
 //! Why a file of its own: the manual's nine files have fixed grammars that the original
 //! engine's tools read, and adding keys to one of them would break those tools; a missing
@@ -23,7 +33,7 @@
 //! # Ok::<(), mrt_fuzzy::BrianError>(())
 //! ```
 
-use crate::brian::{Composer, WeightComposer};
+use crate::brian::{Composer, Composition, Semantics, WeightComposer};
 use crate::lexer::Span;
 use crate::BrianError;
 use std::path::Path;
@@ -37,6 +47,23 @@ pub struct EngineSettings {
     pub composer: Option<Composer>,
     /// How a proposal is weighted by its behavior's weight (`weight_composer`).
     pub weight_composer: Option<WeightComposer>,
+    /// How proposals become outputs (`composition`: formula 10.3 or 10.5).
+    pub composition: Option<Composition>,
+    /// How reliability counts (`semantics`: the manual's or the original engine's).
+    pub semantics: Option<Semantics>,
+}
+
+/// The compositions by name.
+const COMPOSITIONS: [(&str, Composition); 2] =
+    [("weighted", Composition::Weighted), ("argmax", Composition::Argmax)];
+
+/// The semantics by name.
+const SEMANTICS: [(&str, Semantics); 2] =
+    [("manual", Semantics::Manual), ("original", Semantics::Original)];
+
+/// The semantics named `value` (`manual` or `original`), for command lines.
+pub fn semantics_by_name(value: &str) -> Result<Semantics, String> {
+    choice(value, &SEMANTICS)
 }
 
 /// The float composers by the manual's class names.
@@ -72,15 +99,17 @@ pub fn parse_engine(text: &str, file: &Path) -> Result<EngineSettings, BrianErro
     let mut s = EngineSettings::default();
     for (k, line) in text.lines().enumerate() {
         let code = line.split('#').next().unwrap_or("");
-        // Each word with its column (from 1, in characters).
+        // Each word with its column (from 1, in characters). One pass over the line: a
+        // 64 KiB line of words took seconds when each word was cut from the line's start.
         let mut words = Vec::new();
         let mut start = None;
-        for (col, c) in code.chars().chain(std::iter::once(' ')).enumerate() {
+        let ends = code.char_indices().chain(std::iter::once((code.len(), ' ')));
+        for (col, (byte, c)) in ends.enumerate() {
             match (c.is_whitespace(), start) {
-                (false, None) => start = Some(col),
-                (true, Some(from)) => {
-                    let w: String = code.chars().skip(from).take(col - from).collect();
-                    words.push((w, from + 1));
+                (false, None) => start = Some((byte, col)),
+                (true, Some((from, from_col))) => {
+                    words
+                        .push((code.get(from..byte).unwrap_or_default().to_string(), from_col + 1));
                     start = None;
                 }
                 _ => {}
@@ -120,10 +149,25 @@ pub fn parse_engine(text: &str, file: &Path) -> Result<EngineSettings, BrianErro
                     return Err(at(*key_col, "weight_composer is set twice".into()));
                 }
             }
+            "composition" => {
+                let c = choice(value, &COMPOSITIONS).map_err(|m| at(*col, m))?;
+                if s.composition.replace(c).is_some() {
+                    return Err(at(*key_col, "composition is set twice".into()));
+                }
+            }
+            "semantics" => {
+                let c = choice(value, &SEMANTICS).map_err(|m| at(*col, m))?;
+                if s.semantics.replace(c).is_some() {
+                    return Err(at(*key_col, "semantics is set twice".into()));
+                }
+            }
             other => {
                 return Err(at(
                     *key_col,
-                    format!("threshold_filter, weight_composer or float_composer, not `{other}`"),
+                    format!(
+                        "threshold_filter, weight_composer, float_composer, composition or \
+                         semantics, not `{other}`"
+                    ),
                 ))
             }
         }
@@ -150,7 +194,7 @@ mod tests {
         let want = EngineSettings {
             threshold: Some(0.3),
             composer: Some(Composer::Max),
-            weight_composer: None,
+            ..EngineSettings::default()
         };
         assert_eq!(s, want);
         let s = parse_engine(
@@ -163,6 +207,17 @@ mod tests {
             (Some(WeightComposer::Min), Some(Composer::Min))
         );
         assert_eq!(parse_engine("", Path::new("e")).unwrap(), EngineSettings::default());
+        let s =
+            parse_engine("composition argmax\nsemantics original # C++\n", Path::new("e")).unwrap();
+        assert_eq!(
+            (s.composition, s.semantics),
+            (Some(Composition::Argmax), Some(Semantics::Original))
+        );
+        let s = parse_engine("composition weighted\nsemantics manual\n", Path::new("e")).unwrap();
+        assert_eq!(
+            (s.composition, s.semantics),
+            (Some(Composition::Weighted), Some(Semantics::Manual))
+        );
     }
 
     #[test]
@@ -180,6 +235,30 @@ mod tests {
         assert!(err("threshold_filter 0.2 0.3\n").ends_with("engine.txt:1:22"));
         assert!(err("threshold_filter 0.2\nthreshold_filter 0.3\n").contains("set twice"));
         assert!(err("threshold_filter NaN\n").contains("not `NaN`"));
+        assert!(
+            err("\ncomposition  best\n").contains("at line 2: one of weighted, argmax, not `best`"),
+            "{}",
+            err("\ncomposition  best\n")
+        );
+        assert!(err("\ncomposition  best\n").ends_with("engine.txt:2:14"));
+        assert!(err("semantics C++\n").ends_with("engine.txt:1:11"));
+        assert!(err("semantics manual\nsemantics original\n").ends_with("engine.txt:2:1"));
+        assert!(err("semantics\n").contains("a value after `semantics`"));
+    }
+
+    /// Found by the fuzzer (target `brian`, seed 23, input 14162): a 64 KiB mutant of the
+    /// harvester's `engine.txt` took 9 s, each word being cut from the start of its line. A
+    /// line of 20 000 words is now refused at once, at the second value's column.
+    #[test]
+    fn a_long_line_is_read_in_linear_time() {
+        let line = format!("threshold_filter {}\n", "0.5 ".repeat(20_000));
+        let start = std::time::Instant::now();
+        assert!(err(&line).ends_with("engine.txt:1:22"), "{}", err(&line));
+        assert!(start.elapsed() < std::time::Duration::from_secs(1), "{:?}", start.elapsed());
+        // Columns count characters: two no-break spaces (blanks), then a word of three é.
+        let wide = format!("# é\nsemantics{}ééé\n", "\u{a0}".repeat(2));
+        assert!(err(&wide).contains("not `ééé`"), "{}", err(&wide));
+        assert!(err(&wide).ends_with("engine.txt:2:12"), "{}", err(&wide));
     }
 
     proptest! {

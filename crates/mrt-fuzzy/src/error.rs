@@ -21,6 +21,13 @@ pub enum BrianError {
         /// What was expected, or what is wrong.
         message: String,
     },
+    /// [`crate::brian::Brian::register_behavior`] was given a name that no behavior of
+    /// `behavior.txt` is written as (`code:<name>`).
+    #[error("no behavior of behavior.txt is `code:{name}`: list one as `(level <n> <behavior> code:{name})`")]
+    NoCodeBehavior {
+        /// The name given.
+        name: String,
+    },
     /// A file could not be read.
     #[error("error in file {}: {source}", file.display())]
     Io {

@@ -35,6 +35,10 @@
 //! | `shape_ctof.txt`, `s_shape.txt` | [`shapes::parse_shapes`], [`shapes::Shape`] |
 //! | `ctof.txt`, `s_ftoc.txt` | [`shapes::parse_associations`] |
 //! | default (singleton) defuzzification, formula 10.6 | [`shapes::defuzzify`] |
+//! | barycenter defuzzification (TRI, DIV, TRA, REC outputs), formula 10.7 | [`shapes::barycenter`] |
+//! | weighted composition (10.3) or the best behavior's actions (10.5) | [`brian::Composition`], `composition` in `engine.txt` |
+//! | `behavior` written in code / `can_do_filter` | [`brian::CodeBehavior`] (`code:<name>` in `behavior.txt`), [`brian::CandoFilter`] |
+//! | the original C++ engine's reading of reliability | [`brian::Semantics`], `semantics` in `engine.txt` |
 //! | `Predicate.ini`, `PredicateActions.ini`, `Cando.ini`, `want.txt` | [`expr`] grammar, resolved by [`brian::Brian`] |
 //! | `behavior.txt`, `*.rul` rules with `&DEL` | [`brian::Brian::from_dir`] |
 //! | `weight_composer` (mult, max, min) / `float_composer` (max, average, min) | [`brian::WeightComposer`], [`brian::Composer`], `engine.txt` ([`engine`]) |

@@ -172,7 +172,7 @@ fn harvester_files_say_what_they_are() {
         .filter(|p| p.is_file() && p.extension().is_some_and(|e| e != "md"))
         .collect();
     files.sort();
-    assert_eq!(files.len(), 12, "{files:?}");
+    assert_eq!(files.len(), 13, "{files:?}");
     for f in files {
         let text = std::fs::read_to_string(&f).unwrap();
         let header: Vec<&str> = text.lines().take_while(|l| l.starts_with('#')).collect();

@@ -99,3 +99,23 @@ fn levels_do_not_change_the_result_without_del() {
     assert_eq!(run((1, 2), 0.8, 0.6), run((1, 1), 0.8, 0.6));
     assert_eq!(run((2, 1), 0.8, 0.6), run((1, 1), 0.8, 0.6));
 }
+
+/// Formula 10.5 (`composition argmax`) on the same wishes: only the behavior of larger
+/// μC · μW acts. L = 0.8, R = 0.6: FromLeft scores 0.8 × 0.8 = 0.64 against 0.6 × 0.6 = 0.36,
+/// so Turn is RIGHT, −30 (the weighted mean gives (0.64 × −30 + 0.36 × 30) / 1 = −8.4), and the
+/// heading EAST, 90°. Equal wishes (0.7 each) tie: the first behavior to run, FromLeft (same
+/// level, name order), acts alone: −30 and 90°, not the cancelled 0 of the mean.
+#[test]
+fn argmax_composition_takes_one_side() {
+    for (l, r, weighted_turn) in [(0.8, 0.6, -8.4), (0.7, 0.7, 0.0)] {
+        let dir = config((1, 1));
+        let mut b = Brian::from_dir(&dir).unwrap();
+        let c = b.run(&[("L", l, 1.0), ("R", r, 1.0)]);
+        assert!((c["Turn"] - weighted_turn).abs() < 1e-6, "{c:?}");
+        b.set_composition(mrt_fuzzy::brian::Composition::Argmax);
+        let c = b.run(&[("L", l, 1.0), ("R", r, 1.0)]);
+        std::fs::remove_dir_all(&dir).unwrap();
+        assert!((c["Turn"] + 30.0).abs() < 1e-6, "{c:?}");
+        assert!((c["SpeedAngle"] - 90.0).abs() < 1e-6, "{c:?}");
+    }
+}

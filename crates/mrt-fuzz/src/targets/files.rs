@@ -45,7 +45,7 @@ impl Harness for DcdtConfig {
 pub(super) const BRIAN: Target = Target {
     name: "brian",
     about: "Mr. BRIAN configurations (every file of configs/brian/*, one mutated at a time): Brian::from_sources, then cycles on extreme inputs",
-    keywords: &["TRI", "TOL", "TOR", "DIV", "TRA", "REC", "SNG", "AND", "OR", "NOT", "P", "D", "&DEL", "level", "=>", "=", ";", "(", ")"],
+    keywords: &["TRI", "TOL", "TOR", "DIV", "TRA", "REC", "SNG", "AND", "OR", "NOT", "P", "D", "&DEL", "level", "=>", "=", ";", "(", ")", "code:", "threshold_filter", "weight_composer", "float_composer", "composition", "argmax", "weighted", "semantics", "original", "manual"],
     structured: None,
     seeds: |root| {
         files_under(&root.join("configs/brian"), |slot| !slot.ends_with(".md") && slot.contains('/'))
