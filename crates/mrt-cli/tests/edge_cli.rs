@@ -60,13 +60,25 @@ fn start(args: &[&str], marker: &str, on_stdout: bool) -> (Running, String) {
 #[test]
 fn programs_outside_read_the_robots_and_send_them_a_behavior_through_the_edge() {
     let (_sim, line) = start(
-        &["sim", "--distributed", "--half", "40", "--realtime", "--percepts", "oracle"],
+        &[
+            "sim",
+            "--distributed",
+            "--half",
+            "40",
+            "--realtime",
+            "--percepts",
+            "oracle",
+            "--home",
+            "chaos",
+            "--away",
+            "chaser",
+        ],
         "network of this match: ",
         false,
     );
     let net = line.split("network of this match: ").nth(1).unwrap().split_whitespace().next();
     let net = net.unwrap().to_string();
-    // The default match: home Milan (Agoras 1-4), away Chaos (Agoras 5-8, Lua behaviors).
+    // Home Chaos (Agoras 1-4, Lua behaviors that take pushes), away the Chaser (5-8).
     let (_edge, ready) = start(&["edge", "--net", &net, "--seconds", "60"], "edge ready", true);
     let endpoint = ready.split_whitespace().find(|w| w.starts_with("tcp/")).unwrap();
     let endpoint = endpoint.trim_end_matches([';', ',']).to_string();
@@ -79,23 +91,23 @@ fn programs_outside_read_the_robots_and_send_them_a_behavior_through_the_edge() 
     let (tx, rx) = mpsc::channel::<(String, Value)>();
     let tx2 = tx.clone();
     let _snapshots = raw
-        .subscribe("mrt/json/6/WorldSnapshot", move |k, b| {
+        .subscribe("mrt/json/3/WorldSnapshot", move |k, b| {
             let _ = tx.send((k.to_string(), serde_json::from_slice(&b).unwrap()));
         })
         .unwrap();
     let _replies = raw
-        .subscribe("mrt/json/6/BehaviorPushReply", move |k, b| {
+        .subscribe("mrt/json/3/BehaviorPushReply", move |k, b| {
             let _ = tx2.send((k.to_string(), serde_json::from_slice(&b).unwrap()));
         })
         .unwrap();
     let (xml_tx, xml_rx) = mpsc::channel::<String>();
     let _xml = raw
-        .subscribe("mrt/xml/6/WorldSnapshot", move |_, b| {
+        .subscribe("mrt/xml/3/WorldSnapshot", move |_, b| {
             let _ = xml_tx.send(String::from_utf8(b).unwrap());
         })
         .unwrap();
     let (key, snapshot) = rx.recv_timeout(Duration::from_secs(30)).expect("no world snapshot");
-    assert_eq!(key, "mrt/json/6/WorldSnapshot");
+    assert_eq!(key, "mrt/json/3/WorldSnapshot");
     let _: mrt_msgs::WorldSnapshot = serde_json::from_value(snapshot).unwrap();
     // The same snapshots in the manual's XML self-describing form (§3.2).
     let xml = xml_rx.recv_timeout(Duration::from_secs(10)).expect("no XML world snapshot");
@@ -105,11 +117,11 @@ fn programs_outside_read_the_robots_and_send_them_a_behavior_through_the_edge() 
     // DCDT's own keys are not for plain payloads.
     assert!(raw.put("mrt/m/1", b"x".to_vec()).is_err());
 
-    // Garbage is dropped; a push in JSON reaches robot 6's behavior Member, which answers.
+    // Garbage is dropped; a push in JSON reaches robot 3's behavior Member, which answers.
     raw.put("mrt/json-in/BehaviorPush", b"{not json".to_vec()).unwrap();
     raw.put("mrt/json-in/NoSuchType", b"{}".to_vec()).unwrap();
     let push = serde_json::json!({
-        "robot": 6, "request": 4242, "file": "stand.lua",
+        "robot": 3, "request": 4242, "file": "stand.lua",
         "source": "-- pushed through the edge\nalways(\"go\", \"STAY\")\nalways(\"turn\", \"NONE\")\nalways(\"strafe\", \"NONE\")\nneed(1, BALL)\n",
     });
     raw.put("mrt/json-in/BehaviorPush", serde_json::to_vec(&push).unwrap()).unwrap();
@@ -136,7 +148,7 @@ fn programs_outside_read_the_robots_and_send_them_a_behavior_through_the_edge() 
         .join("../../examples/python/edge_client.py");
     let out = Command::new(&python)
         .arg(script)
-        .args(["--connect", &endpoint, "--robot", "7", "--timeout", "20"])
+        .args(["--connect", &endpoint, "--robot", "2", "--timeout", "20"])
         .output()
         .unwrap();
     let said = String::from_utf8_lossy(&out.stdout);
