@@ -31,6 +31,7 @@ mod brian;
 mod distributed;
 #[cfg(feature = "net")]
 mod edge;
+mod interrupt;
 mod mice;
 mod plan;
 mod push;
@@ -291,14 +292,7 @@ fn main() -> Result<()> {
         )
         .with_writer(std::io::stderr)
         .init();
-    // An interrupted run leaves no files behind: the handles that would remove the compiled-in
-    // behaviors' directory are not dropped when the process is killed by the signal.
-    if let Err(e) = ctrlc::set_handler(|| {
-        mrt_robot::files::remove_embedded_dirs();
-        std::process::exit(130);
-    }) {
-        eprintln!("warning: cannot install the Ctrl-C handler: {e}");
-    }
+    interrupt::install();
     match run(Cli::parse().command) {
         Err(e) if is_broken_pipe(&e) => Ok(()),
         other => other,

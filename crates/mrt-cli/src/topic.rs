@@ -4,6 +4,7 @@
 //! (`RequestType::Remote`): the robots send a type to this Agora because it wants it, like to
 //! any other (docs/monitor.md, "Topics on the network").
 
+use crate::interrupt;
 use anyhow::{anyhow, bail, Result};
 use mrt_core::Time;
 use mrt_dcdt::{Activation, Context, Member, MemberError, RequestType};
@@ -54,8 +55,9 @@ pub enum TopicCommand {
         #[arg(long)]
         seconds: Option<f64>,
     },
-    /// Measure the rate of one type, per publishing Agora: messages a second and the mean,
-    /// smallest and largest gap between two.
+    /// Measure the rate of one type, per publishing Agora: messages a second, the mean,
+    /// smallest and largest gap between two, and the delay (docs/monitor.md, "Topics on the
+    /// network"). Ctrl-C ends it early with what was heard so far.
     Hz {
         /// The message type.
         r#type: String,
@@ -163,22 +165,23 @@ impl Drop for Joined {
     }
 }
 
-/// Messages heard until `deadline` (or the channel ends), each handed to `f`; `f` returns
+/// Messages heard until `deadline`, Ctrl-C in a command that finishes itself
+/// ([`interrupt::finish_on_ctrl_c`]) or the channel's end, each handed to `f`; `f` returns
 /// false to stop.
 fn until(rx: &mpsc::Receiver<Heard>, deadline: Option<Instant>, mut f: impl FnMut(Heard) -> bool) {
-    loop {
-        let wait = deadline
-            .map_or(Duration::from_secs(3600), |d| d.saturating_duration_since(Instant::now()));
+    /// How long a wait lasts at most before Ctrl-C is looked at again.
+    const POLL: Duration = Duration::from_millis(100);
+    while !interrupt::interrupted() {
+        let wait = deadline.map_or(POLL, |d| d.saturating_duration_since(Instant::now()));
         if wait.is_zero() {
             return;
         }
-        match rx.recv_timeout(wait) {
+        match rx.recv_timeout(wait.min(POLL)) {
             Ok(h) => {
                 if !f(h) {
                     return;
                 }
             }
-            Err(mpsc::RecvTimeoutError::Timeout) if deadline.is_some() => return,
             Err(mpsc::RecvTimeoutError::Timeout) => {}
             Err(mpsc::RecvTimeoutError::Disconnected) => return,
         }
@@ -235,28 +238,20 @@ pub fn run(command: &TopicCommand) -> Result<()> {
         TopicCommand::Hz { r#type, net, seconds } => {
             let entry = entry_named(r#type)?;
             let end = deadline(*seconds, "--seconds")?;
+            interrupt::finish_on_ctrl_c();
             let (rx, _joined) = listen(net, vec![entry], false)?;
-            let mut arrivals: BTreeMap<u32, Vec<Instant>> = BTreeMap::new();
+            let start = Instant::now();
+            let mut heard: BTreeMap<u32, Vec<(f64, f64)>> = BTreeMap::new();
             until(&rx, Some(end), |h| {
-                arrivals.entry(h.agora).or_default().push(Instant::now());
+                let arrival = start.elapsed().as_secs_f64();
+                heard.entry(h.agora).or_default().push((arrival, h.time.as_secs_f64()));
                 true
             });
-            if arrivals.is_empty() {
-                outln!("no {} heard in {seconds} s", entry.name);
+            if heard.is_empty() {
+                outln!("no {} heard in {:.1} s", entry.name, start.elapsed().as_secs_f64());
             }
-            for (agora, times) in &arrivals {
-                let gaps: Vec<f64> =
-                    times.windows(2).map(|w| (w[1] - w[0]).as_secs_f64() * 1000.0).collect();
-                let mean = gaps.iter().sum::<f64>() / gaps.len().max(1) as f64;
-                let min = gaps.iter().copied().fold(f64::INFINITY, f64::min);
-                let max = gaps.iter().copied().fold(0.0, f64::max);
-                let rate = if mean > 0.0 { 1000.0 / mean } else { 0.0 };
-                outln!(
-                    "{} from Agora {agora}: {rate:.1} msg/s over {} messages; gap mean {mean:.1} ms, min {:.1} ms, max {max:.1} ms",
-                    entry.name,
-                    times.len(),
-                    if min.is_finite() { min } else { 0.0 }
-                );
+            for (agora, times) in &heard {
+                outln!("{} from Agora {agora}: {}", entry.name, Rate::of(times));
             }
         }
     }
@@ -271,17 +266,19 @@ pub struct RecordArgs {
     /// The MCAP file to write (topics `/agora/<id>/<Type>`, docs/monitor.md).
     #[arg(short, long, value_name = "OUT.mcap")]
     output: PathBuf,
-    /// How long to record, s (the file is complete only when the time is up: Ctrl-C loses
-    /// its index).
+    /// How long to record at most, s. Ctrl-C ends the recording earlier, with a complete file
+    /// (its summary and index written); a second Ctrl-C quits at once.
     #[arg(long, default_value_t = 60.0)]
     seconds: f64,
 }
 
-/// Records every catalogue message of the network's Agoras for `--seconds`.
+/// Records every catalogue message of the network's Agoras for `--seconds` or until Ctrl-C.
 pub fn record(args: &RecordArgs) -> Result<()> {
     let end = deadline(args.seconds, "--seconds")?;
     let mut rec = Recorder::create(&args.output)?;
+    interrupt::finish_on_ctrl_c();
     let (rx, _joined) = listen(&args.net, catalogue::CATALOGUE.iter().collect(), true)?;
+    let start = Instant::now();
     let mut failed = None;
     until(&rx, Some(end), |h| {
         let Some(json) = &h.json else {
@@ -302,10 +299,10 @@ pub fn record(args: &RecordArgs) -> Result<()> {
     let s = rec.finish()?;
     let size = std::fs::metadata(&args.output).map(|m| m.len()).unwrap_or(0);
     outln!(
-        "recorded {} messages on {} topics in {} s into {} ({:.1} MB)",
+        "recorded {} messages on {} topics in {:.1} s into {} ({:.1} MB)",
         s.messages,
         s.channels,
-        args.seconds,
+        start.elapsed().as_secs_f64(),
         args.output.display(),
         size as f64 / 1e6
     );
@@ -336,4 +333,131 @@ pub fn monitor(args: &MonitorArgs) -> Result<()> {
         true
     });
     Ok(())
+}
+
+/// What `mrt topic hz` says of one Agora's messages of a type, from each message's arrival
+/// (s since listening began, this process's clock) and creation time (s, the publisher's
+/// clock).
+///
+/// Every Agora's clock has an origin of its own (`WallClock` starts with its Agora), so a
+/// message's delay cannot be read off its two times directly. The difference of the two,
+/// arrival minus creation, is the delay plus an unknown constant offset between the clocks;
+/// the quickest message's difference is taken as the offset, and each message's delay is
+/// given **beyond the quickest one's**: the delay's spread, which is what grows when a link
+/// or a subscriber falls behind. When the publisher's clock does not run at real time (a
+/// simulated clock, e.g. `mrt sim --distributed` stepping faster than real time), the offset
+/// is not constant and no delay is given.
+#[derive(Clone, Debug, PartialEq)]
+struct Rate {
+    messages: usize,
+    /// Messages a second, from the mean gap.
+    rate: f64,
+    /// Mean, smallest and largest gap between two arrivals, ms.
+    gaps: (f64, f64, f64),
+    /// Delay beyond the quickest message's, ms: mean, 95th percentile, largest.
+    delay: Option<(f64, f64, f64)>,
+    /// How fast the publisher's clock ran against this process's, when it was measured.
+    clock_rate: Option<f64>,
+}
+
+impl Rate {
+    /// How far the publisher's clock may run from real time for delays to be given.
+    const REAL_TIME: f64 = 0.05;
+
+    fn of(times: &[(f64, f64)]) -> Rate {
+        let gaps: Vec<f64> = times.windows(2).map(|w| (w[1].0 - w[0].0) * 1000.0).collect();
+        let mean = gaps.iter().sum::<f64>() / gaps.len().max(1) as f64;
+        let min = gaps.iter().copied().fold(f64::INFINITY, f64::min);
+        let max = gaps.iter().copied().fold(0.0, f64::max);
+        let rate = if mean > 0.0 { 1000.0 / mean } else { 0.0 };
+        let (first, last) = (times.first(), times.last());
+        let clock_rate = match (first, last) {
+            (Some(a), Some(b)) if b.0 - a.0 > 0.0 && times.len() >= 3 => {
+                Some((b.1 - a.1) / (b.0 - a.0))
+            }
+            _ => None,
+        };
+        let delay = clock_rate.filter(|r| (r - 1.0).abs() <= Rate::REAL_TIME).map(|_| {
+            let offsets: Vec<f64> =
+                times.iter().map(|(arrival, created)| arrival - created).collect();
+            let quickest = offsets.iter().copied().fold(f64::INFINITY, f64::min);
+            let mut delays: Vec<f64> = offsets.iter().map(|o| (o - quickest) * 1000.0).collect();
+            delays.sort_by(f64::total_cmp);
+            let mean = delays.iter().sum::<f64>() / delays.len() as f64;
+            let p95 = delays[((delays.len() - 1) as f64 * 0.95).round() as usize];
+            (mean, p95, delays.last().copied().unwrap_or(0.0))
+        });
+        Rate {
+            messages: times.len(),
+            rate,
+            gaps: (mean, if min.is_finite() { min } else { 0.0 }, max),
+            delay,
+            clock_rate,
+        }
+    }
+}
+
+impl std::fmt::Display for Rate {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let (mean, min, max) = self.gaps;
+        write!(
+            f,
+            "{:.1} msg/s over {} messages; gap mean {mean:.1} ms, min {min:.1} ms, max {max:.1} ms",
+            self.rate, self.messages
+        )?;
+        match (self.delay, self.clock_rate) {
+            (Some((mean, p95, max)), _) => write!(
+                f,
+                "; delay beyond the quickest message mean {mean:.2} ms, 95% {p95:.2} ms, max {max:.2} ms"
+            ),
+            (None, Some(r)) => {
+                write!(f, "; no delay: the publisher's clock runs at {r:.2}× real time")
+            }
+            (None, None) => Ok(()),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Messages created every 100 ms on a clock 7 s ahead of ours, arriving 1 ms after
+    /// creation except the third, 4 ms: the delay beyond the quickest is 0, 0, 3, 0, 0 ms.
+    #[test]
+    fn hz_gives_the_rate_the_gaps_and_the_delay_beyond_the_quickest_message() {
+        let times: Vec<(f64, f64)> = (0..5)
+            .map(|i| {
+                let created = 7.0 + 0.1 * i as f64;
+                let late = if i == 2 { 0.004 } else { 0.001 };
+                (created - 7.0 + late, created)
+            })
+            .collect();
+        let r = Rate::of(&times);
+        assert_eq!(r.messages, 5);
+        assert!((r.rate - 10.0).abs() < 1e-9, "{r:?}");
+        let (mean, min, max) = r.gaps;
+        assert!(
+            (mean - 100.0).abs() < 1e-9 && (min - 97.0).abs() < 1e-9 && (max - 103.0).abs() < 1e-9
+        );
+        let (mean, p95, max) = r.delay.unwrap();
+        assert!((mean - 0.6).abs() < 1e-9 && (p95 - 3.0).abs() < 1e-9 && (max - 3.0).abs() < 1e-9);
+        let line = r.to_string();
+        assert!(
+            line.contains("10.0 msg/s over 5 messages") && line.contains("max 3.00 ms"),
+            "{line}"
+        );
+    }
+
+    /// A publisher whose clock runs twice as fast as ours (a simulation ahead of real time):
+    /// the rate is measured, the delay is not.
+    #[test]
+    fn hz_gives_no_delay_when_the_publisher_s_clock_is_not_real_time() {
+        let times: Vec<(f64, f64)> = (0..10).map(|i| (0.1 * i as f64, 0.2 * i as f64)).collect();
+        let r = Rate::of(&times);
+        assert_eq!(r.delay, None);
+        assert!((r.clock_rate.unwrap() - 2.0).abs() < 1e-9);
+        assert!(r.to_string().contains("runs at 2.00× real time"), "{r}");
+        assert_eq!(Rate::of(&[(0.5, 3.0)]).delay, None, "one message has no delay");
+    }
 }

@@ -619,20 +619,40 @@ fn topic_lists_echoes_and_measures_a_distributed_match() {
     let rate: f64 =
         one.split(": ").nth(1).unwrap_or("0").split(' ').next().unwrap().parse().unwrap();
     assert!((7.0..13.0).contains(&rate), "a 10 Hz cycle: {hz}");
-    // `mrt record --net`: every robot's messages into a file that `mrt replay` reads.
+    assert!(one.contains("delay beyond the quickest message") || one.contains("real time"), "{hz}");
+    // `mrt record --net`: every robot's messages into a file that `mrt replay` reads; Ctrl-C
+    // (SIGINT) ends it long before its --seconds with the file complete.
     let recorded =
         std::env::temp_dir().join(format!("mrt-monitor-net-{}.mcap", std::process::id()));
-    let out = mrt()
-        .args(["record", "--net", &file, "--seconds", "2", "-o"])
+    let child = mrt()
+        .args(["record", "--net", &file, "--seconds", "600", "-o"])
         .arg(&recorded)
-        .output()
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
         .unwrap();
+    std::thread::sleep(Duration::from_secs(3));
+    let interrupted = std::process::Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(interrupted.success());
+    let out = child.wait_with_output().unwrap();
     let said = String::from_utf8_lossy(&out.stdout);
     assert!(
         out.status.success() && said.starts_with("recorded "),
         "{said}{}",
         String::from_utf8_lossy(&out.stderr)
     );
+    // A finished MCAP file ends with its footer (opcode 0x02, 20 bytes: where the summary
+    // with the index starts, 0 when there is none) and the magic.
+    let bytes = std::fs::read(&recorded).unwrap();
+    let (footer, magic) = bytes.split_at(bytes.len() - 8);
+    assert_eq!(magic, b"\x89MCAP0\r\n", "the file is finished");
+    let footer = &footer[footer.len() - 29..];
+    assert_eq!(footer[0], 0x02, "a footer record");
+    let summary_start = u64::from_le_bytes(footer[9..17].try_into().unwrap());
+    assert!(summary_start > 0, "the file has its summary and index");
     let (ok, listing, err) = replay(&[recorded.as_os_str()]);
     assert!(ok, "{err}");
     assert!(
