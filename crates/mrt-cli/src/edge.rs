@@ -11,7 +11,7 @@
 //! published it (for instance a `BehaviorPush` for a robot); what does not read is counted
 //! and dropped, with one warning a type.
 
-use crate::topic::{entry_named, NetArgs};
+use crate::topic::{deadline, entry_named, NetArgs};
 use anyhow::{anyhow, bail, Result};
 use mrt_dcdt::{Activation, Context, DeliveryWarranty, Member, MemberError, RequestType};
 use mrt_monitor::catalogue::{self, Entry};
@@ -123,13 +123,7 @@ impl Member for Edge {
 
 /// Runs `mrt edge`.
 pub fn run(args: &EdgeArgs) -> Result<()> {
-    let end = match args.seconds {
-        Some(s) if !(s.is_finite() && s > 0.0 && s <= 86_400.0) => {
-            bail!("--seconds must be more than 0 and at most 86400 s, not {s}")
-        }
-        Some(s) => Some(Instant::now() + Duration::from_secs_f64(s)),
-        None => None,
-    };
+    let end = args.seconds.map(|s| deadline(s, "--seconds")).transpose()?;
     let names: Vec<String> = if args.types.is_empty() {
         DEFAULT_TYPES.iter().map(|s| s.to_string()).collect()
     } else {
@@ -171,8 +165,9 @@ pub fn run(args: &EdgeArgs) -> Result<()> {
         fixed.iter().map(|s| s.as_str()).collect::<Vec<_>>().join(", "),
         names.join(", ")
     );
-    // Ctrl-C's handler ends the process.
-    while end.is_none_or(|e| Instant::now() < e) {
+    // Ctrl-C ends the edge with its counts said.
+    crate::interrupt::finish_on_ctrl_c();
+    while end.is_none_or(|e| Instant::now() < e) && !crate::interrupt::interrupted() {
         if worker.is_finished() {
             break;
         }

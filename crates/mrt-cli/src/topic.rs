@@ -188,7 +188,8 @@ fn until(rx: &mpsc::Receiver<Heard>, deadline: Option<Instant>, mut f: impl FnMu
     }
 }
 
-fn deadline(seconds: f64, option: &str) -> Result<Instant> {
+/// The instant `seconds` from now, for an `option` that must be in (0, 86400] s.
+pub(crate) fn deadline(seconds: f64, option: &str) -> Result<Instant> {
     if !(seconds.is_finite() && seconds > 0.0 && seconds <= 86_400.0) {
         bail!("{option} must be more than 0 and at most 86400 s, not {seconds}");
     }
