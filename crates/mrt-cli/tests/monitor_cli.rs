@@ -360,14 +360,22 @@ fn camera_images_are_recorded_and_served() {
     assert_eq!(status, 200, "{seen}");
     let seen: Value = serde_json::from_str(&seen).unwrap();
     assert!((seen["time"].as_f64().unwrap() - frame["frame"]["t"].as_f64().unwrap()).abs() < 0.15);
-    let (w, h) = (seen["detections"]["width"].as_f64().unwrap(), seen["detections"]["height"].as_f64().unwrap());
+    let (w, h) = (
+        seen["detections"]["width"].as_f64().unwrap(),
+        seen["detections"]["height"].as_f64().unwrap(),
+    );
     assert!(w >= 160.0 && h >= 120.0, "{seen}");
     for item in seen["detections"]["items"].as_array().unwrap() {
         let (x, y) = (item["x"].as_f64().unwrap(), item["y"].as_f64().unwrap());
         assert!((0.0..=w).contains(&x) && (0.0..=h).contains(&y), "{item}");
     }
     // The away team's TeamChaos robots run an HFSM: its shape, once, named by each frame.
-    let away = frame["frame"]["robots"].as_array().unwrap().iter().find(|r| r["name"] == "away/1").unwrap();
+    let away = frame["frame"]["robots"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|r| r["name"] == "away/1")
+        .unwrap();
     let told = away["hfsm_structure"].as_u64().unwrap();
     let (status, shape) = http("GET", addr, &format!("/hfsm/away/1/{told}"), None);
     assert_eq!(status, 200, "{shape}");
@@ -629,7 +637,8 @@ fn the_page_draws_the_camera_detections_and_the_hfsm_in_headless_chromium() {
     // The graph follows the replay: the active path is the frame's.
     browser.eval("window.monitor.seek(55)");
     browser.wait("return document.body.dataset.frame === '55'", "frame 55");
-    let path = browser.eval("return window.monitor.state().frame.robots.find((r) => r.name === 'away/1').hfsm");
+    let path = browser
+        .eval("return window.monitor.state().frame.robots.find((r) => r.name === 'away/1').hfsm");
     assert!(browser.text("hfsm-file").ends_with(path.as_str().unwrap()), "{path}");
     // Home's Mr. BRIAN robots have no HFSM: no graph.
     browser.eval("window.monitor.select('home/1')");
@@ -646,6 +655,12 @@ fn the_page_draws_the_camera_detections_and_the_hfsm_in_headless_chromium() {
     assert_eq!(&png[1..4], b"PNG");
     let shot = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("monitor-overlay.png");
     std::fs::write(&shot, png).unwrap();
+    eprintln!("screenshot: {}", shot.display());
+    // And the HFSM graph, below the field.
+    browser.eval("document.getElementById('hfsm-view').scrollIntoView()");
+    let png = browser.command("GET", "screenshot", None);
+    let shot = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("monitor-hfsm.png");
+    std::fs::write(&shot, base64_decode(png.as_str().unwrap())).unwrap();
     eprintln!("screenshot: {}", shot.display());
     drop(browser);
     std::fs::remove_file(&file).ok();
