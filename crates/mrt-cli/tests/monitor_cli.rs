@@ -355,6 +355,35 @@ fn camera_images_are_recorded_and_served() {
     assert_eq!(&raw[head_end..head_end + 2], &[0xff, 0xd8], "a JPEG");
     let (status, _) = http("GET", addr, "/image/home/9/21", None);
     assert_eq!(status, 404);
+    // What the vision found in that same image, where in it (`Percepts::detections`).
+    let (status, seen) = http("GET", addr, "/seen/home/1/21", None);
+    assert_eq!(status, 200, "{seen}");
+    let seen: Value = serde_json::from_str(&seen).unwrap();
+    assert!((seen["time"].as_f64().unwrap() - frame["frame"]["t"].as_f64().unwrap()).abs() < 0.15);
+    let (w, h) = (
+        seen["detections"]["width"].as_f64().unwrap(),
+        seen["detections"]["height"].as_f64().unwrap(),
+    );
+    assert!(w >= 160.0 && h >= 120.0, "{seen}");
+    for item in seen["detections"]["items"].as_array().unwrap() {
+        let (x, y) = (item["x"].as_f64().unwrap(), item["y"].as_f64().unwrap());
+        assert!((0.0..=w).contains(&x) && (0.0..=h).contains(&y), "{item}");
+    }
+    // The away team's TeamChaos robots run an HFSM: its shape, once, named by each frame.
+    let away = frame["frame"]["robots"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|r| r["name"] == "away/1")
+        .unwrap();
+    let told = away["hfsm_structure"].as_u64().unwrap();
+    let (status, shape) = http("GET", addr, &format!("/hfsm/away/1/{told}"), None);
+    assert_eq!(status, 200, "{shape}");
+    let shape: Value = serde_json::from_str(&shape).unwrap();
+    let root = shape["root"].as_str().unwrap();
+    assert!(away["hfsm"].as_str().unwrap().starts_with(root), "{away}\n{shape}");
+    assert!(!shape["machines"][0]["states"].as_array().unwrap().is_empty(), "{shape}");
+    assert_eq!(http("GET", addr, "/hfsm/home/1/21", None).0, 404, "Mr. BRIAN has no HFSM");
     let out = mrt().args(["sim", "--images", "2"]).output().unwrap();
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(!out.status.success() && err.contains("--images"), "{err}");
@@ -543,6 +572,95 @@ fn the_page_draws_the_field_and_follows_the_replay_in_headless_chromium() {
     assert_eq!(&png[1..4], b"PNG");
     let shot = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("monitor.png");
     std::fs::write(&shot, png).unwrap();
+    eprintln!("screenshot: {}", shot.display());
+    drop(browser);
+    std::fs::remove_file(&file).ok();
+    std::fs::remove_dir_all(&profile).ok();
+}
+
+/// Counts the pixels drawn on canvas `id` (not transparent), and those of the HFSM's amber.
+const COUNT_DRAWN: &str = "
+    const c = document.getElementById(arguments[0]);
+    const d = c.getContext('2d').getImageData(0, 0, c.width, c.height).data;
+    let drawn = 0, amber = 0;
+    for (let i = 0; i < d.length; i += 4) {
+      if (d[i + 3] > 0) drawn++;
+      if (d[i + 3] > 0 && d[i] > 200 && d[i + 1] > 140 && d[i + 1] < 220 && d[i + 2] < 90) amber++;
+    }
+    return { drawn, amber, width: c.width, height: c.height };";
+
+/// Issue 22, item 3: over the selected robot's camera image the page draws where its vision
+/// found things (a canvas over the picture, fed by `/seen` for that same image), and below the
+/// field its HFSM as a graph with the active path highlighted (fed by `/hfsm`), following the
+/// replay; a screenshot is kept in the test's target directory.
+#[test]
+fn the_page_draws_the_camera_detections_and_the_hfsm_in_headless_chromium() {
+    let Some((_driver, driver)) = chromedriver() else {
+        eprintln!("skipped: no chromedriver (see the test above)");
+        return;
+    };
+    let (file, _) = record("overlay", &["--half", "3", "--images", "5", "--percepts", "vision"]);
+    let (_server, url) = serve(&file);
+    let addr = host(&url).to_string();
+    // A frame whose image of away/1 shows something to its vision.
+    let frame = (1..60)
+        .find(|i| {
+            let (status, seen) = http("GET", &addr, &format!("/seen/away/1/{i}"), None);
+            status == 200
+                && serde_json::from_str::<Value>(&seen).unwrap()["detections"]["items"]
+                    .as_array()
+                    .is_some_and(|a| !a.is_empty())
+        })
+        .expect("away/1's vision finds something in 6 s");
+    let profile =
+        std::env::temp_dir().join(format!("mrt-monitor-chromium-overlay-{}", std::process::id()));
+    let browser = Browser::open(&driver, &profile);
+    browser.go(&format!("{url}?frame={frame}&paused=1&robot=away/1"));
+    browser.wait(&format!("return document.body.dataset.frame === '{frame}'"), "the frame");
+    browser.wait(
+        "return Number(document.getElementById('camera-overlay').dataset.drawn) > 0",
+        "the camera overlay",
+    );
+    let count = |id: &str| {
+        browser.command("POST", "execute/sync", Some(&json!({"script": COUNT_DRAWN, "args": [id]})))
+    };
+    let overlay = count("camera-overlay");
+    assert!(overlay["drawn"].as_u64().unwrap() > 10, "{overlay}");
+    browser.wait(
+        "const h = document.getElementById('hfsm').dataset; return Number(h.states) > 2 && Number(h.active) >= 2",
+        "the HFSM graph with its active path",
+    );
+    let graph = count("hfsm");
+    assert!(graph["drawn"].as_u64().unwrap() > 5_000, "{graph}");
+    assert!(graph["amber"].as_u64().unwrap() > 50, "the active path: {graph}");
+    assert!(browser.text("hfsm-file").contains(".hfsm.lua"), "{}", browser.text("hfsm-file"));
+    // The graph follows the replay: the active path is the frame's.
+    browser.eval("window.monitor.seek(55)");
+    browser.wait("return document.body.dataset.frame === '55'", "frame 55");
+    let path = browser
+        .eval("return window.monitor.state().frame.robots.find((r) => r.name === 'away/1').hfsm");
+    assert!(browser.text("hfsm-file").ends_with(path.as_str().unwrap()), "{path}");
+    // Home's Mr. BRIAN robots have no HFSM: no graph.
+    browser.eval("window.monitor.select('home/1')");
+    assert_eq!(browser.eval("return document.getElementById('hfsm-view').hidden"), json!(true));
+    browser.eval("window.monitor.select('away/1')");
+    browser.eval(&format!("window.monitor.seek({frame})"));
+    browser.wait(
+        "return Number(document.getElementById('camera-overlay').dataset.drawn) > 0",
+        "the camera overlay again",
+    );
+
+    let png = browser.command("GET", "screenshot", None);
+    let png = base64_decode(png.as_str().unwrap());
+    assert_eq!(&png[1..4], b"PNG");
+    let shot = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("monitor-overlay.png");
+    std::fs::write(&shot, png).unwrap();
+    eprintln!("screenshot: {}", shot.display());
+    // And the HFSM graph, below the field.
+    browser.eval("document.getElementById('hfsm-view').scrollIntoView()");
+    let png = browser.command("GET", "screenshot", None);
+    let shot = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("monitor-hfsm.png");
+    std::fs::write(&shot, base64_decode(png.as_str().unwrap())).unwrap();
     eprintln!("screenshot: {}", shot.display());
     drop(browser);
     std::fs::remove_file(&file).ok();

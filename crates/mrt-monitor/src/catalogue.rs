@@ -6,8 +6,9 @@ use mrt_dcdt::describe::{DescribeError, SelfDescribing};
 use mrt_dcdt::{DeliveryWarranty, Endpoint, Msg};
 use mrt_msgs::{
     BehaviorPush, BehaviorPushReply, BehaviorStatus, CameraFrame, DeviceAct, DeviceFrame,
-    FinalWhistle, GameInfo, Localization, MateReport, MotorCommand, Odometry, Percepts,
-    PlanRequest, PlannedPath, ReloadRequest, RobotCommand, RobotEnd, SonarScan, WorldSnapshot,
+    FinalWhistle, GameInfo, HfsmStructure, Localization, MateReport, MotorCommand, Odometry,
+    Percepts, PlanRequest, PlannedPath, ReloadRequest, RobotCommand, RobotEnd, SonarScan,
+    WorldSnapshot,
 };
 use schemars::JsonSchema;
 use serde::de::DeserializeOwned;
@@ -105,6 +106,7 @@ catalogue! {
     ReloadRequest,
     BehaviorPush,
     BehaviorPushReply,
+    HfsmStructure,
     MateReport,
     SonarScan,
     MotorCommand,

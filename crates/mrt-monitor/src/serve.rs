@@ -9,6 +9,12 @@
 //!   "frame"}`, the frame a [`Frame`](crate::view::Frame) or `null`;
 //! - `GET /image/{team}/{k}/{i}`: robot `team/k`'s camera image (JPEG) last taken at or
 //!   before frame `i`, when the recording has images (`mrt sim --images`);
+//! - `GET /seen/{team}/{k}/{i}`: what robot `team/k`'s vision found in that same image, where
+//!   in it (a [`SeenImage`](crate::view::SeenImage): time, image size, boxes in pixels), when
+//!   its percepts said (ISocRob seed `003` §3.2.7);
+//! - `GET /hfsm/{team}/{k}/{i}`: the shape of robot `team/k`'s HFSM in force at frame `i` (an
+//!   `HfsmStructure`: machines, states, transitions), when its behavior Member told it
+//!   (ThinkingCap seed `001` §4.1, §5.1);
 //! - `GET /ws`: a WebSocket; each text message `{"frame": i}` (or `"latest"`) is answered
 //!   with what `/frame/{i}` answers. The page plays, pauses, steps and scrubs by asking.
 
@@ -75,6 +81,8 @@ impl Server {
             .route("/meta", get(meta))
             .route("/frame/{index}", get(frame))
             .route("/image/{team}/{k}/{index}", get(camera))
+            .route("/seen/{team}/{k}/{index}", get(seen))
+            .route("/hfsm/{team}/{k}/{index}", get(hfsm))
             .route("/ws", get(socket))
             .with_state(shared);
         std::thread::Builder::new()
@@ -175,6 +183,35 @@ async fn camera(
         None => {
             (StatusCode::NOT_FOUND, "no camera image of that robot by that frame").into_response()
         }
+    }
+}
+
+async fn seen(
+    State(s): State<Shared>,
+    Path((team, k, index)): Path<(String, String, usize)>,
+) -> Response {
+    let Ok(t) = s.timeline.lock() else {
+        return (StatusCode::INTERNAL_SERVER_ERROR, "the timeline's lock is poisoned")
+            .into_response();
+    };
+    match t.image_seen(&format!("{team}/{k}"), index) {
+        Some(seen) => json(seen.to_string()),
+        None => (StatusCode::NOT_FOUND, "no detections for that robot's image by that frame")
+            .into_response(),
+    }
+}
+
+async fn hfsm(
+    State(s): State<Shared>,
+    Path((team, k, index)): Path<(String, String, usize)>,
+) -> Response {
+    let Ok(t) = s.timeline.lock() else {
+        return (StatusCode::INTERNAL_SERVER_ERROR, "the timeline's lock is poisoned")
+            .into_response();
+    };
+    match t.hfsm(&format!("{team}/{k}"), index) {
+        Some(shape) => json(shape.to_string()),
+        None => (StatusCode::NOT_FOUND, "no HFSM told by that robot by that frame").into_response(),
     }
 }
 

@@ -13,8 +13,8 @@ use crate::replay::{Recording, ReplayError};
 use mrt_core::frames::{Attack, Framed, Team, MM_PER_M};
 use mrt_core::{Point2, Pose2, Time};
 use mrt_msgs::{
-    BehaviorStatus, GameInfo, GameState, Localization, Percepts, PlannedPath, RobotClass,
-    RobotCommand, Sighting, WorldSnapshot,
+    BehaviorStatus, GameInfo, GameState, HfsmStructure, ImageDetections, Localization, Percepts,
+    PlannedPath, RobotClass, RobotCommand, Sighting, WorldSnapshot,
 };
 use serde::{Deserialize, Serialize};
 use std::collections::{BTreeMap, VecDeque};
@@ -121,8 +121,13 @@ pub struct RobotView {
     pub command: Option<CommandView>,
     /// What its vision found in its last image (`Percepts`), in its own frame.
     pub seen: Option<SeenView>,
-    /// The frame at which its last recorded camera image was taken ([`Timeline::image`]).
+    /// The frame at which its last recorded camera image was taken ([`Timeline::image`];
+    /// what its vision found in that image: [`Timeline::image_seen`]).
     pub image: Option<usize>,
+    /// The frame at which the shape of its HFSM now in force was first told
+    /// ([`Timeline::hfsm`]; the shape is kept once, not in every frame).
+    #[serde(default)]
+    pub hfsm_structure: Option<usize>,
 }
 
 /// What a robot's vision found in one image (`Percepts`), in the robot's frame (x forward, y
@@ -205,14 +210,50 @@ pub struct Timeline {
     robots: BTreeMap<String, RobotView>,
     /// Camera images by robot.
     images: BTreeMap<String, Images>,
+    /// The last image detections by robot, waiting for their image (`time`, [`SeenImage`] as
+    /// JSON).
+    seen_pending: BTreeMap<String, (f64, Arc<str>)>,
+    /// HFSM shapes by robot.
+    structures: BTreeMap<String, Structures>,
     field: Option<FieldView>,
     /// Messages of a known type that did not parse, counted and left out.
     unreadable: u64,
     finished: bool,
 }
 
-/// One robot's camera images (JPEG), each with the frame it was taken in, oldest first.
-type Images = VecDeque<(usize, Arc<[u8]>)>;
+/// One robot's camera images, oldest first.
+type Images = VecDeque<Shot>;
+
+/// One camera image of a robot.
+#[derive(Debug)]
+struct Shot {
+    /// The frame it came in.
+    index: usize,
+    /// When it was taken, s (its timestamp).
+    time: f64,
+    /// The JPEG.
+    jpeg: Arc<[u8]>,
+    /// What the robot's vision found in it ([`SeenImage`] as JSON), once its percepts came.
+    seen: Option<Arc<str>>,
+}
+
+/// What a robot's vision found in one camera image, where in the image
+/// (`Percepts::detections`): what the page draws over the picture (ISocRob seed `003` §3.2.7,
+/// the Monitor's window per vision channel).
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct SeenImage {
+    /// The image's time, s (the same as the picture's).
+    pub time: f64,
+    /// The objects, pixels.
+    pub detections: ImageDetections,
+}
+
+/// Percepts and images are paired by the image's time, to within this, s.
+const SAME_IMAGE: f64 = 5e-4;
+
+/// The shapes of one robot's HFSM ([`HfsmStructure`] as JSON), each with the frame it was
+/// first told in, oldest first; one entry per change, not per message.
+type Structures = VecDeque<(usize, Arc<str>)>;
 
 /// A timeline shared by its writer (a recording read back, a live match) and the web server.
 pub type SharedTimeline = Arc<Mutex<Timeline>>;
@@ -269,6 +310,7 @@ impl Timeline {
 
     /// Whether the message parsed (types not drawn count as parsed).
     fn robot_message(&mut self, name: &str, ty: &str, json: &[u8]) -> bool {
+        let index = self.end();
         let view = self.robots.entry(name.to_string()).or_insert_with(|| RobotView {
             name: name.to_string(),
             attack: 1.0,
@@ -294,21 +336,61 @@ impl Timeline {
             "PlannedPath" => parse(json).map(|p: PlannedPath| view.planned(&p)).is_some(),
             "BehaviorStatus" => parse(json).map(|b: BehaviorStatus| view.status(b)).is_some(),
             "RobotCommand" => parse(json).map(|c: RobotCommand| view.command(&c)).is_some(),
-            "Percepts" => {
-                parse(json).map(|p: Percepts| view.seen = Some(SeenView::of(&p))).is_some()
-            }
+            "Percepts" => match parse::<Percepts>(json) {
+                Some(p) => {
+                    view.seen = Some(SeenView::of(&p));
+                    if let Some(detections) = p.detections {
+                        self.image_detections(name, SeenImage { time: p.time, detections });
+                    }
+                    true
+                }
+                None => false,
+            },
+            "HfsmStructure" => match parse::<HfsmStructure>(json) {
+                Some(h) => {
+                    let known = self.structures.entry(name.to_string()).or_default();
+                    let Ok(json) = serde_json::to_string(&h) else { return false };
+                    // Told again unchanged (for monitors that join late): kept once.
+                    if known.back().is_none_or(|(_, last)| **last != *json) {
+                        known.push_back((index, json.into()));
+                        view.hfsm_structure = Some(index);
+                    }
+                    true
+                }
+                None => false,
+            },
             _ => true,
+        }
+    }
+
+    /// Pairs what the vision of robot `name` found with its image of the same time: the
+    /// last image kept, or the next one to come.
+    fn image_detections(&mut self, name: &str, seen: SeenImage) {
+        let Ok(json) = serde_json::to_string(&seen) else { return };
+        let shot = self.images.get_mut(name).and_then(|i| i.back_mut());
+        match shot {
+            Some(shot) if (shot.time - seen.time).abs() <= SAME_IMAGE => {
+                shot.seen = Some(json.into());
+            }
+            _ => {
+                self.seen_pending.insert(name.to_string(), (seen.time, json.into()));
+            }
         }
     }
 
     /// Keeps a camera image (`foxglove.CompressedImage`) of robot `name` for the frame being
     /// gathered; whether it parsed.
     fn camera_image(&mut self, name: &str, json: &[u8]) -> bool {
-        let Some(bytes) = parse::<CompressedImage>(json).and_then(|c| c.bytes()) else {
-            return false;
-        };
+        let Some(image) = parse::<CompressedImage>(json) else { return false };
+        let Some(bytes) = image.bytes() else { return false };
         let index = self.end();
-        self.images.entry(name.to_string()).or_default().push_back((index, bytes.into()));
+        let time = f64::from(image.timestamp.sec) + f64::from(image.timestamp.nsec) * 1e-9;
+        let seen = match self.seen_pending.get(name) {
+            Some((t, seen)) if (t - time).abs() <= SAME_IMAGE => Some(seen.clone()),
+            _ => None,
+        };
+        let shot = Shot { index, time, jpeg: bytes.into(), seen };
+        self.images.entry(name.to_string()).or_default().push_back(shot);
         if let Some(view) = self.robots.get_mut(name) {
             view.image = Some(index);
         }
@@ -317,9 +399,28 @@ impl Timeline {
 
     /// The camera image (JPEG) of robot `name` last taken at or before frame `index`.
     pub fn image(&self, name: &str, index: usize) -> Option<Arc<[u8]>> {
+        self.shot(name, index).map(|s| s.jpeg.clone())
+    }
+
+    /// What the vision of robot `name` found in the image [`Timeline::image`] gives for frame
+    /// `index` ([`SeenImage`] as JSON): the same image, paired by its time; `None` when its
+    /// percepts said nothing of the image.
+    pub fn image_seen(&self, name: &str, index: usize) -> Option<Arc<str>> {
+        self.shot(name, index).and_then(|s| s.seen.clone())
+    }
+
+    fn shot(&self, name: &str, index: usize) -> Option<&Shot> {
         let images = self.images.get(name)?;
-        let k = images.partition_point(|(i, _)| *i <= index);
-        images.get(k.checked_sub(1)?).map(|(_, jpeg)| jpeg.clone())
+        let k = images.partition_point(|s| s.index <= index);
+        images.get(k.checked_sub(1)?)
+    }
+
+    /// The shape of robot `name`'s HFSM in force at frame `index` ([`HfsmStructure`] as
+    /// JSON): the last told at or before it (ThinkingCap seed `001` §4.1, §5.1).
+    pub fn hfsm(&self, name: &str, index: usize) -> Option<Arc<str>> {
+        let known = self.structures.get(name)?;
+        let k = known.partition_point(|(i, _)| *i <= index);
+        known.get(k.checked_sub(1)?).map(|(_, json)| json.clone())
     }
 
     fn close_frame(&mut self, now: Time) {
@@ -337,8 +438,14 @@ impl Timeline {
             self.frames.pop_front();
             self.dropped += 1;
             for images in self.images.values_mut() {
-                while images.front().is_some_and(|(i, _)| *i < self.dropped) {
+                while images.front().is_some_and(|s| s.index < self.dropped) {
                     images.pop_front();
+                }
+            }
+            // The shape in force at the first frame kept stays.
+            for known in self.structures.values_mut() {
+                while known.get(1).is_some_and(|(i, _)| *i <= self.dropped) {
+                    known.pop_front();
                 }
             }
         }
@@ -594,6 +701,82 @@ mod tests {
         assert!(Arc::ptr_eq(&first, &t.image("home/1", 0).unwrap()));
         assert!(!Arc::ptr_eq(&first, &t.image("home/1", 2).unwrap()));
         assert!(t.image("home/2", 2).is_none() && t.image("home/1", 0).is_some());
+    }
+
+    /// What the vision found in an image is served with that image, paired by the image's
+    /// time whichever comes first: the percepts of a later image go with the later image,
+    /// and percepts of an image not recorded go with none.
+    #[test]
+    fn image_detections_go_with_their_image() {
+        use mrt_msgs::{DetectionKind, ImageDetection, ImageDetections};
+        let img = mrt_msgs::Image::new(8, 8);
+        let jpeg = |t: f64| json(&CompressedImage::jpeg(&img, at(t), "camera").unwrap());
+        let percepts = |t: f64, x: f32| {
+            let item = ImageDetection { kind: DetectionKind::Ball, x, y: 4.0, w: 2.0, h: 2.0 };
+            let detections = ImageDetections { width: 8, height: 8, items: vec![item] };
+            json(&Percepts { time: t, detections: Some(detections), ..Default::default() })
+        };
+        let seen = |t: &Timeline, i: usize| -> Option<SeenImage> {
+            t.image_seen("home/1", i).map(|j| serde_json::from_str(&j).unwrap())
+        };
+        let mut t = Timeline::new();
+        // The image first, then its percepts.
+        t.ingest("/home/1/camera", at(0.0), &jpeg(0.0));
+        t.ingest("/home/1/Percepts", at(0.0), &percepts(0.0, 1.0));
+        // Percepts of an image that was not recorded.
+        t.ingest("/home/1/Percepts", at(0.1), &percepts(0.1, 2.0));
+        // Percepts first (a listener's order), then their image.
+        t.ingest("/home/1/Percepts", at(0.2), &percepts(0.2, 3.0));
+        t.ingest("/home/1/camera", at(0.2), &jpeg(0.2));
+        // An image whose percepts never came.
+        t.ingest("/home/1/camera", at(0.3), &jpeg(0.3));
+        t.finish();
+        let first = seen(&t, 0).unwrap();
+        assert_eq!((first.time, first.detections.items[0].x), (0.0, 1.0));
+        assert_eq!(seen(&t, 1).unwrap().detections.items[0].x, 1.0, "frame 1 shows image 0");
+        assert_eq!(seen(&t, 2).unwrap().detections.items[0].x, 3.0);
+        assert!(seen(&t, 3).is_none() && t.image("home/1", 3).is_some());
+        assert_eq!(frame(&t, 2).robots[0].image, Some(2));
+    }
+
+    /// The HFSM's shape is kept once per change, not per message nor per frame; each frame
+    /// names the shape in force, and the active path stays in the frame.
+    #[test]
+    fn the_hfsm_shape_is_kept_once_per_change() {
+        use mrt_msgs::{HfsmMachine, HfsmState};
+        let shape = |states: &[&str]| HfsmStructure {
+            file: "p.hfsm.lua".into(),
+            root: "P".into(),
+            machines: vec![HfsmMachine {
+                name: "P".into(),
+                initial: states[0].into(),
+                states: states
+                    .iter()
+                    .map(|s| HfsmState { name: (*s).into(), runs: None })
+                    .collect(),
+                transitions: Vec::new(),
+            }],
+        };
+        let status = |path: &str| BehaviorStatus { path: path.into(), ..Default::default() };
+        let mut t = Timeline::new();
+        t.ingest("/home/0/HfsmStructure", at(0.0), &json(&shape(&["A", "B"])));
+        t.ingest("/home/0/BehaviorStatus", at(0.0), &json(&status("P/A")));
+        t.ingest("/home/0/HfsmStructure", at(0.1), &json(&shape(&["A", "B"])));
+        t.ingest("/home/0/BehaviorStatus", at(0.1), &json(&status("P/B")));
+        t.ingest("/home/0/HfsmStructure", at(0.2), &json(&shape(&["A", "C"])));
+        t.ingest("/home/0/HfsmStructure", at(0.3), b"{\"root\": 7}");
+        t.finish();
+        assert_eq!(t.unreadable(), 1);
+        assert_eq!(t.structures["home/0"].len(), 2, "told again unchanged: kept once");
+        let f1 = frame(&t, 1);
+        assert_eq!((f1.robots[0].hfsm.as_str(), f1.robots[0].hfsm_structure), ("P/B", Some(0)));
+        assert_eq!(frame(&t, 3).robots[0].hfsm_structure, Some(2));
+        let back: HfsmStructure = serde_json::from_str(&t.hfsm("home/0", 1).unwrap()).unwrap();
+        assert_eq!(back, shape(&["A", "B"]));
+        let later: HfsmStructure = serde_json::from_str(&t.hfsm("home/0", 3).unwrap()).unwrap();
+        assert_eq!(later.machines[0].states[1].name, "C");
+        assert!(t.hfsm("home/1", 3).is_none());
+        assert!(!t.frame(1).unwrap().contains("\"machines\""), "not copied into frames");
     }
 
     /// A message of a drawn type that does not parse is counted and changes nothing; a topic

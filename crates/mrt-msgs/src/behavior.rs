@@ -66,3 +66,60 @@ pub struct BehaviorPushReply {
     /// The line of the error, when it has one.
     pub line: Option<u32>,
 }
+
+/// The shape of a behavior Member's HFSM, for monitors that draw it (ThinkingCap seed `001`
+/// §4.1 and §5.1: the HFSM editor's and monitor's view of the machines): its machines, each
+/// with its states and labelled transitions. Published when the machine is loaded or
+/// reloaded, and again now and then for monitors that join late; never each cycle. Together
+/// with [`BehaviorStatus::path`] (`Root/State/Inner`) it says where in the drawing the robot
+/// is.
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct HfsmStructure {
+    /// The file it was loaded from.
+    pub file: String,
+    /// The root machine's name (the first element of every active path).
+    pub root: String,
+    /// Every machine of the file, the root first.
+    pub machines: Vec<HfsmMachine>,
+}
+
+/// One machine of an [`HfsmStructure`].
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct HfsmMachine {
+    /// Its name.
+    pub name: String,
+    /// The state it starts in.
+    pub initial: String,
+    /// Its states, in file order.
+    pub states: Vec<HfsmState>,
+    /// Its transitions, in the order they are checked.
+    pub transitions: Vec<HfsmTransition>,
+}
+
+/// One state of an [`HfsmMachine`].
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct HfsmState {
+    /// Its name (an element of the active path).
+    pub name: String,
+    /// For a meta-state, the machine it runs (whose states are its children).
+    pub runs: Option<String>,
+}
+
+/// One transition of an [`HfsmMachine`].
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct HfsmTransition {
+    /// Its name (`from->to` when the file gave none).
+    pub name: String,
+    /// The state it leaves.
+    pub from: String,
+    /// The state it enters.
+    pub to: String,
+    /// Its priority (smaller is checked first).
+    pub priority: f64,
+    /// Its test as drawings show it: the predicate's text, or `function (line N)`.
+    pub test: String,
+}

@@ -490,7 +490,51 @@ impl Samples for Percepts {
         filled.goal_corners = vec![post];
         filled.open_space = [Some(0.1), None];
         filled.pan = Some(0.0);
+        let at = |kind, x, y, w, h| ImageDetection { kind, x, y, w, h };
+        filled.detections = Some(ImageDetections {
+            width: 320,
+            height: 240,
+            items: vec![
+                at(DetectionKind::Ball, 160.5, 200.0, 12.0, 12.0),
+                at(DetectionKind::Post, 40.0, 100.0, 6.0, 30.0),
+                at(DetectionKind::Line, 8.5, 230.0, 0.0, 0.0),
+            ],
+        });
         vec![Percepts::default(), filled]
+    }
+}
+
+impl Samples for HfsmStructure {
+    fn samples() -> Vec<Self> {
+        let state = |name: &str, runs: Option<&str>| HfsmState {
+            name: name.to_owned(),
+            runs: runs.map(str::to_owned),
+        };
+        let filled = HfsmStructure {
+            file: "player.hfsm.lua".to_owned(),
+            root: "Player".to_owned(),
+            machines: vec![
+                HfsmMachine {
+                    name: "Player".to_owned(),
+                    initial: "Wait".to_owned(),
+                    states: vec![state("Wait", None), state("Attack", Some("Attack"))],
+                    transitions: vec![HfsmTransition {
+                        name: "Go".to_owned(),
+                        from: "Wait".to_owned(),
+                        to: "Attack".to_owned(),
+                        priority: 0.0,
+                        test: "chaos.getCurrentState() == PLAYING".to_owned(),
+                    }],
+                },
+                HfsmMachine {
+                    name: "Attack".to_owned(),
+                    initial: "GoToBall".to_owned(),
+                    states: vec![state("GoToBall", None)],
+                    transitions: Vec::new(),
+                },
+            ],
+        };
+        vec![HfsmStructure::default(), filled]
     }
 }
 

@@ -26,6 +26,8 @@ pub const RELOAD_REQUEST: MsgType = reserved(0x31);
 pub const BEHAVIOR_PUSH: MsgType = reserved(0x32);
 /// [`crate::BehaviorPushReply`]: the robot's answer to a behavior push.
 pub const BEHAVIOR_PUSH_REPLY: MsgType = reserved(0x33);
+/// [`crate::HfsmStructure`]: the states and transitions of a behavior Member's HFSM.
+pub const HFSM_STRUCTURE: MsgType = reserved(0x34);
 /// [`crate::MateReport`]: a robot's pose and ball, told to its teammates.
 pub const MATE_REPORT: MsgType = reserved(0x40);
 /// [`crate::SonarScan`]: one reading of the sonar ring.
@@ -74,6 +76,7 @@ pub const TABLE: &[(MsgType, &str)] = &[
     (RELOAD_REQUEST, "ReloadRequest"),
     (BEHAVIOR_PUSH, "BehaviorPush"),
     (BEHAVIOR_PUSH_REPLY, "BehaviorPushReply"),
+    (HFSM_STRUCTURE, "HfsmStructure"),
     (MATE_REPORT, "MateReport"),
     (SONAR_SCAN, "SonarScan"),
     (MOTOR_COMMAND, "MotorCommand"),
@@ -125,6 +128,7 @@ mod tests {
             (0xFFFF_0031, "ReloadRequest"),
             (0xFFFF_0032, "BehaviorPush"),
             (0xFFFF_0033, "BehaviorPushReply"),
+            (0xFFFF_0034, "HfsmStructure"),
             (0xFFFF_0040, "MateReport"),
             (0xFFFF_0041, "SonarScan"),
             (0xFFFF_0042, "MotorCommand"),

@@ -20,6 +20,7 @@
 //! | [`MotorCommand`] | guidance → motor and kicker driver | ISocRob `003` §3.2.3 |
 //! | [`PlanRequest`], [`PlannedPath`] | guidance (or SCARE) ↔ planner | manual ch. 9 (SPIKE) |
 //! | [`BehaviorStatus`], [`ReloadRequest`], [`BehaviorPush`], [`BehaviorPushReply`] | behavior Member ↔ monitors, editors | TeamChaos `001` §3.2 |
+//! | [`HfsmStructure`] (the machine's states and transitions) | HFSM Member → monitors | ThinkingCap `001` §4.1, §5.1 |
 //! | [`DeviceFrame`], [`DeviceAct`], [`FinalWhistle`], [`RobotEnd`] | distributed simulator ↔ robot | MRT's own |
 //!
 //! Three standard messages live with their engine and take their id from [`ids`] too: the
@@ -50,7 +51,10 @@ mod team;
 mod describe_tests;
 
 pub use acting::{MotorCommand, PlanRequest, PlannedPath};
-pub use behavior::{BehaviorPush, BehaviorPushReply, BehaviorStatus, ReloadRequest};
+pub use behavior::{
+    BehaviorPush, BehaviorPushReply, BehaviorStatus, HfsmMachine, HfsmState, HfsmStructure,
+    HfsmTransition, ReloadRequest,
+};
 pub use device::{DeviceAct, DeviceFrame, FinalWhistle, MemberFault, RobotEnd};
 pub use localization::{BallBelief, FilterCounts, Localization};
 pub use mrt_core::{Message, MsgType};
@@ -59,8 +63,9 @@ pub use robot::{
     Target, WorldSnapshot,
 };
 pub use sensing::{
-    CameraFrame, Displacement, GameInfo, Image, Marker, MiceReadings, Odometry, Percepts,
-    PostSighting, RobotSighting, Sighting, Sonar, SonarScan, FIELD_OBJECTS,
+    CameraFrame, DetectionKind, Displacement, GameInfo, Image, ImageDetection, ImageDetections,
+    Marker, MiceReadings, Odometry, Percepts, PostSighting, RobotSighting, Sighting, Sonar,
+    SonarScan, FIELD_OBJECTS,
 };
 pub use team::{BookingReport, MateReport, ScareReport, SharedRobot};
 
@@ -93,6 +98,7 @@ messages! {
     ReloadRequest => RELOAD_REQUEST,
     BehaviorPush => BEHAVIOR_PUSH,
     BehaviorPushReply => BEHAVIOR_PUSH_REPLY,
+    HfsmStructure => HFSM_STRUCTURE,
     MateReport => MATE_REPORT,
     SonarScan => SONAR_SCAN,
     MotorCommand => MOTOR_COMMAND,

@@ -271,6 +271,65 @@ pub struct Percepts {
     /// camera looked, so that the world model knows what it should have seen.
     #[serde(default)]
     pub pan: Option<f64>,
+    /// Where in the image the objects above were found (pixels), for monitors that draw them
+    /// over the camera's picture (ISocRob seed `003` §3.2.7, the Monitor's vision window).
+    /// `None` from a vision that does not say; nothing reads it to decide anything.
+    #[serde(default)]
+    pub detections: Option<ImageDetections>,
+}
+
+/// What the vision found where in one camera image (pixels from the image's top-left corner,
+/// x to the right, y down): what a monitor draws over the picture (ISocRob seed `003` §3.2.7).
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct ImageDetections {
+    /// The image's width, pixels (to scale the boxes to the picture shown).
+    pub width: u32,
+    /// The image's height, pixels.
+    pub height: u32,
+    /// Each object found, ball first; field-line points last and at most
+    /// [`ImageDetections::MAX_LINE_POINTS`] of them (spread over all found).
+    pub items: Vec<ImageDetection>,
+}
+
+impl ImageDetections {
+    /// The most field-line points a message carries.
+    pub const MAX_LINE_POINTS: usize = 24;
+}
+
+/// One object in an image ([`ImageDetections`]): a box round its centre, pixels.
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ImageDetection {
+    /// What it is.
+    pub kind: DetectionKind,
+    /// The centre's column.
+    pub x: f32,
+    /// The centre's row.
+    pub y: f32,
+    /// The box's width (a ball's diameter; 0 for a point).
+    pub w: f32,
+    /// The box's height (a ball's diameter; 0 for a point).
+    pub h: f32,
+}
+
+/// What an [`ImageDetection`] is.
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum DetectionKind {
+    /// The ball (a circle: its blob's centre of mass and apparent diameter).
+    Ball,
+    /// A goal seen whole (its net in [`Percepts::sightings`]).
+    Net,
+    /// The corner of a goal cut by the image's side ([`Percepts::goal_corners`]): a point.
+    GoalCorner,
+    /// A landmark post ([`Percepts::posts`]).
+    Post,
+    /// Another robot ([`Percepts::robots`]), its box resting on its foot.
+    Robot,
+    /// A point of a white field line ([`Percepts::line_points`]): a point.
+    Line,
 }
 
 /// A landmark post in a camera image (ISocRob seed `003` §3.2.1: landmarks told apart by

@@ -1,12 +1,16 @@
 //! Colour vision's hot path on the synthetic 640×480 frame: green field, 3 px white
 //! lines and centre circle, a yellow and a blue goal, an orange ball of radius 10 px, five black
 //! robots of radius 22 px, Gaussian noise σ = 8 per channel. Measured: building the lookup table
-//! (once per colour file), classifying the frame through it, and that plus the ball's blob.
+//! (once per colour file), classifying the frame through it, and that plus the ball's blob;
+//! and the whole vision µAgent on it (`VisionAgent::see`: classes, ball, goals, posts, lines,
+//! robots, and where in the image each was found for monitors).
 //!
 //! Run: `cargo bench -p mrt-perception --bench vision`. Results go to `docs/performance.md`.
 #![allow(missing_docs, clippy::unwrap_used)]
 
 use criterion::{black_box, criterion_group, criterion_main, Criterion, Throughput};
+use mrt_perception::camera::{Intrinsics, Pinhole};
+use mrt_perception::vision::agent::VisionAgent;
 use mrt_perception::vision::blobs::blobs;
 use mrt_perception::vision::colors::{ColorClass, ColorTable, Lut};
 use rand::{Rng, SeedableRng};
@@ -78,6 +82,10 @@ fn bench(c: &mut Criterion) {
             blobs(&out, W as u32, H as u32, ColorClass::Ball, 3)
         })
     });
+    let image = mrt_msgs::Image { width: W as u32, height: H as u32, rgb: img.clone() };
+    let camera = Pinhole::new(Intrinsics::centred(W as u32, H as u32, 520.0), 0.45, 0.35);
+    let mut agent = VisionAgent::new(camera, &colors, 0.11);
+    g.bench_function("agent_see", |b| b.iter(|| agent.see(black_box(&image), 1.0, 0.0).unwrap()));
     g.finish();
 }
 

@@ -50,7 +50,15 @@ pub struct Cycle {
     pub reloaded: Vec<String>,
     /// What went wrong (the robot went on regardless).
     pub errors: Vec<ScriptError>,
+    /// The HFSM's shape, for monitors (ThinkingCap seed `001` §4.1, §5.1): in the first
+    /// cycle, after the machine was reloaded, and every [`STRUCTURE_EVERY`] cycles for
+    /// monitors that join late; `None` otherwise and without an HFSM.
+    pub structure: Option<mrt_msgs::HfsmStructure>,
 }
+
+/// Cycles between two [`Cycle::structure`]s of an unchanged machine (10 s of the seed's
+/// 100 ms cycle).
+pub const STRUCTURE_EVERY: u32 = 100;
 
 /// Where the behavior to run comes from.
 enum Top {
@@ -70,6 +78,8 @@ pub struct ThinkingCap {
     runaways: u32,
     /// Failing cycles in a row (runaways included).
     failing: u32,
+    /// Cycles until the HFSM's shape is told again (0: this cycle).
+    structure_in: u32,
 }
 
 impl ThinkingCap {
@@ -128,7 +138,7 @@ impl ThinkingCap {
     /// A cap that has run nothing yet.
     fn assemble(rt: LuaRuntime, io: Rc<RefCell<RobotIo>>, hbm: Hbm, top: Top) -> ThinkingCap {
         let (last_good, watcher, runaways, failing) = (None, None, 0, 0);
-        ThinkingCap { rt, io, hbm, top, last_good, watcher, runaways, failing }
+        ThinkingCap { rt, io, hbm, top, last_good, watcher, runaways, failing, structure_in: 0 }
     }
 
     fn base(
@@ -270,7 +280,10 @@ impl ThinkingCap {
                 h.reload_if_changed(&self.rt)
             };
             match attempt {
-                Ok(true) => done.push(h.file().to_string()),
+                Ok(true) => {
+                    done.push(h.file().to_string());
+                    self.structure_in = 0;
+                }
                 Ok(false) => {}
                 Err(e) => errors.push(e),
             }
@@ -291,10 +304,12 @@ impl ThinkingCap {
         }
         let rejected = errors.len();
         self.io.borrow_mut().new_cycle(world);
+        let structure = self.structure();
         if self.stopped() {
             let command = RobotCommand::default();
             let path = self.hfsm().map(Hfsm::path).unwrap_or_default();
-            return Cycle { command, path, behavior: None, taken: None, reloaded, errors };
+            let behavior = None;
+            return Cycle { command, path, behavior, taken: None, reloaded, errors, structure };
         }
         let mut taken = None;
         let (chosen, path) = match &mut self.top {
@@ -351,6 +366,14 @@ impl ThinkingCap {
             };
             errors.push(ScriptError::Stopped { file: self.top_name(), cycles, why });
         }
-        Cycle { command, path, behavior, taken, reloaded, errors }
+        Cycle { command, path, behavior, taken, reloaded, errors, structure }
+    }
+
+    /// The HFSM's shape when it is due ([`Cycle::structure`]).
+    fn structure(&mut self) -> Option<mrt_msgs::HfsmStructure> {
+        let Top::Hfsm(h, _) = &self.top else { return None };
+        let due = self.structure_in == 0;
+        self.structure_in = if due { STRUCTURE_EVERY - 1 } else { self.structure_in - 1 };
+        due.then(|| h.structure())
     }
 }

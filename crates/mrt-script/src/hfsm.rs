@@ -462,6 +462,52 @@ impl Hfsm {
         out
     }
 
+    /// The machines' shape for monitors (ThinkingCap seed `001` §4.1, §5.1: the HFSM view),
+    /// the root first: what [`Hfsm::to_dot`] and [`Hfsm::to_svg`] draw, as a bus message. A
+    /// meta-state `runs` the machine whose states are its children; the active path
+    /// ([`Hfsm::path`]) is the root's name, then one state name per level.
+    pub fn structure(&self) -> mrt_msgs::HfsmStructure {
+        let order =
+            std::iter::once(self.root).chain((0..self.machines.len()).filter(|&m| m != self.root));
+        let machines = order
+            .map(|mi| {
+                let m = &self.machines[mi];
+                let name = |s: usize| m.states[s].name.clone();
+                mrt_msgs::HfsmMachine {
+                    name: m.name.clone(),
+                    initial: name(m.initial),
+                    states: m
+                        .states
+                        .iter()
+                        .map(|s| mrt_msgs::HfsmState {
+                            name: s.name.clone(),
+                            runs: match s.kind {
+                                StateKind::Meta(inner) => Some(self.machines[inner].name.clone()),
+                                StateKind::Code(_) => None,
+                            },
+                        })
+                        .collect(),
+                    transitions: m
+                        .transitions
+                        .iter()
+                        .map(|t| mrt_msgs::HfsmTransition {
+                            name: t.name.clone(),
+                            from: name(t.from),
+                            to: name(t.to),
+                            priority: t.priority,
+                            test: t.shown.clone(),
+                        })
+                        .collect(),
+                }
+            })
+            .collect();
+        mrt_msgs::HfsmStructure {
+            file: self.file.clone(),
+            root: self.machines[self.root].name.clone(),
+            machines,
+        }
+    }
+
     /// Names of the machines, root first.
     pub fn machine_names(&self) -> Vec<String> {
         let root = &self.machines[self.root].name;

@@ -226,6 +226,7 @@ fn safe(errors: Vec<ScriptError>) -> Cycle {
         taken: None,
         reloaded: Vec::new(),
         errors,
+        structure: None,
     }
 }
 

@@ -685,6 +685,44 @@ fn to_dot_draws_every_state_and_transition() {
     }
 }
 
+/// The machine's shape as a bus message (`HfsmStructure`, for monitors): the root first, the
+/// same states, meta-states and labelled transitions the dot drawing has.
+#[test]
+fn the_structure_has_what_the_drawing_has() {
+    let src = r#"
+      machine "Score" { initial = "Approach", states = { Approach = true, Kick = true },
+        transitions = { { from = "Approach", to = "Kick", test = "true" } } }
+      machine "Attacker" { initial = "FaceBall",
+        states = { FaceBall = true, Score = meta "Score" },
+        transitions = {
+          { name = "NearBall", from = "FaceBall", to = "Score", priority = 1, test = "false" },
+        } }"#;
+    let (_rt, _io, h) = load(src);
+    let s = h.structure();
+    assert_eq!(s.root, "Attacker");
+    let names: Vec<&str> = s.machines.iter().map(|m| m.name.as_str()).collect();
+    assert_eq!(names, ["Attacker", "Score"], "the root first");
+    let attacker = &s.machines[0];
+    assert_eq!(attacker.initial, "FaceBall");
+    let score = attacker.states.iter().find(|st| st.name == "Score").unwrap();
+    assert_eq!(score.runs.as_deref(), Some("Score"));
+    let t = &attacker.transitions[0];
+    assert_eq!(
+        (t.name.as_str(), t.from.as_str(), t.to.as_str()),
+        ("NearBall", "FaceBall", "Score")
+    );
+    assert_eq!((t.priority, t.test.as_str()), (1.0, "false"));
+    let inner = &s.machines[1];
+    assert_eq!(inner.transitions[0].name, "Approach->Kick");
+    assert!(inner.states.iter().all(|st| st.runs.is_none()));
+    let dot = h.to_dot(true);
+    for m in &s.machines {
+        for st in &m.states {
+            assert!(dot.contains(&format!("\"{}/{}\"", m.name, st.name)), "{}", st.name);
+        }
+    }
+}
+
 /// A runtime error in a string test is attributed to the machine file, at the line of the
 /// machine's definition (string tests have no lines of their own), not to the internal
 /// dispatcher that runs the tests.

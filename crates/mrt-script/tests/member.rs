@@ -97,3 +97,52 @@ fn a_member_whose_files_do_not_load_fails_init_without_stopping_the_others() {
     assert!(!log.lock().unwrap().is_empty(), "faceball kept running");
     assert!(format!("{report:?}").contains("no-such-behavior"), "{report:?}");
 }
+
+/// Collects the HFSM shapes published (`HfsmStructure`), with their time.
+struct Shapes(Arc<Mutex<Vec<(f64, mrt_msgs::HfsmStructure)>>>);
+impl Member for Shapes {
+    fn init(&mut self, ctx: &mut Context<'_>) -> Result<(), MemberError> {
+        ctx.subscribe_to::<mrt_msgs::HfsmStructure>(RequestType::All);
+        Ok(())
+    }
+    fn do_your_job(&mut self, ctx: &mut Context<'_>) -> Result<(), MemberError> {
+        while let Some(m) = ctx.receive_msg() {
+            let s = m.get::<mrt_msgs::HfsmStructure>()?.clone();
+            self.0.lock().map_err(|_| "poisoned")?.push((m.creation_time().as_secs_f64(), s));
+        }
+        Ok(())
+    }
+}
+
+/// The HFSM Member tells its machine's shape for monitors (seed 001 §4.1, §5.1) in its first
+/// cycle and then every `STRUCTURE_EVERY` cycles, not every cycle.
+#[test]
+fn the_hfsm_member_tells_its_shape_rarely() {
+    let shapes = Arc::default();
+    let mut exec = SteppedExecutor::new(SimClock::new(), Duration::from_millis(10));
+    let mut robot = exec.agora_builder(1).build().unwrap();
+    let attacker = BehaviorMember::hfsm(DIR, format!("{DIR}/attacker.hfsm.lua"));
+    let ids = [
+        robot.add_member(World, Activation::Periodic(Duration::from_millis(50))),
+        robot.add_member(attacker, Activation::Periodic(DEFAULT_PERIOD)),
+        robot.add_member(Shapes(Arc::clone(&shapes)), Activation::OnMessage),
+    ];
+    for id in ids {
+        robot.activate_member(id).unwrap();
+    }
+    exec.add_agora(robot).unwrap();
+    exec.run_for(Duration::from_millis(12_000));
+    exec.finish();
+    let shapes = shapes.lock().unwrap();
+    assert_eq!(
+        shapes.len(),
+        2,
+        "at the start and 10 s later: {:?}",
+        shapes.iter().map(|s| s.0).collect::<Vec<_>>()
+    );
+    let s = &shapes[0].1;
+    assert_eq!(s.root, "Attacker");
+    let states: Vec<&str> = s.machines[0].states.iter().map(|st| st.name.as_str()).collect();
+    assert!(states.contains(&"GoToBall") && states.contains(&"FaceBall"), "{states:?}");
+    assert_eq!(shapes[1].1, *s);
+}

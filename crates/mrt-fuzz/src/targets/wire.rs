@@ -46,6 +46,7 @@ macro_rules! message_types {
         $f!(mrt_msgs::PlannedPath);
         $f!(mrt_msgs::BehaviorPush);
         $f!(mrt_msgs::BehaviorPushReply);
+        $f!(mrt_msgs::HfsmStructure);
     };
 }
 
@@ -96,6 +97,7 @@ fn wire_seeds(_root: &Path) -> Result<Vec<Seed>, FuzzError> {
     default_frame!(mrt_msgs::DeviceAct);
     default_frame!(mrt_msgs::RobotEnd);
     default_frame!(mrt_msgs::BehaviorPushReply);
+    default_frame!(mrt_msgs::HfsmStructure);
     let pushed = mrt_msgs::BehaviorPush {
         robot: 3,
         request: 17,

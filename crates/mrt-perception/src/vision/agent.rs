@@ -18,7 +18,10 @@ use super::lines::line_points;
 use super::posts::{find_posts_in, PostPercept, PostShape};
 use super::up::UpMode;
 use crate::camera::{Camera, Omni, Pinhole, Pixel};
-use mrt_msgs::{Image, Marker, Percepts, PostSighting, RobotSighting, Sighting};
+use mrt_msgs::{
+    DetectionKind, Image, ImageDetection, ImageDetections, Marker, Percepts, PostSighting,
+    RobotSighting, Sighting,
+};
 use nalgebra::{Point2, Point3, Vector2};
 
 /// Sighting index of the ball, the east and the west net (the world model's order).
@@ -76,6 +79,9 @@ struct Net {
     pixels: u32,
     /// The bearing of its open space (eq. 18), rad.
     open_bearing: Option<f64>,
+    /// Its box in the image: from its first to its last column, from its feet up by its
+    /// columns' mean height.
+    shown: ImageDetection,
 }
 
 /// Everything the µAgent found in one image ([`VisionAgent::look`]): the percepts, and the
@@ -251,11 +257,15 @@ impl VisionAgent {
         self.classes.resize(w as usize * h as usize, 0);
         self.lut.classify(&image.rgb, &mut self.classes);
         let mut p = Percepts { time, pan: Some(pan), ..Default::default() };
+        // Where in the image each object was found, for monitors (ISocRob seed `003` §3.2.7).
+        let mut shown = Vec::with_capacity(8 + ImageDetections::MAX_LINE_POINTS);
         let ball = find_ball(&self.classes, &self.camera, self.ball_radius);
         if let Some(ball) = ball {
             p.sightings[BALL] = Some(sighting(ball.at));
             p.sigmas[BALL] = self.sigma(ball.pixel, 1.0 - self.ball_radius / self.camera.height);
             p.pixels[BALL] = ball.pixels;
+            let d = 2.0 * ball.radius_px;
+            shown.push(detection(DetectionKind::Ball, ball.pixel, d, d));
         }
         let west = if self.east_goal == ColorClass::GoalYellow {
             ColorClass::GoalBlue
@@ -278,8 +288,10 @@ impl VisionAgent {
                 p.sigmas[k] = self.sigma(net.foot, 1.0);
                 p.pixels[k] = net.pixels;
                 p.open_space[side] = net.open_bearing;
+                shown.push(net.shown);
             } else if let Some((px, at)) = self.cut_goal_corner(class, &count) {
                 if let Some(sigma) = self.sigma(px, 1.0) {
+                    shown.push(detection(DetectionKind::GoalCorner, px, 0.0, 0.0));
                     let pixels = count.iter().sum();
                     let east = k == EAST_NET;
                     p.goal_corners.push(PostSighting {
@@ -291,24 +303,45 @@ impl VisionAgent {
                 }
             }
         }
-        p.line_points = line_points(&self.classes, &self.camera, LINE_STEP, LINE_MAX_RUN)
-            .into_iter()
-            .map(|l| (l.at.x, l.at.y))
-            .collect();
-        p.robots = self.robots();
+        let lines = line_points(&self.classes, &self.camera, LINE_STEP, LINE_MAX_RUN);
+        p.line_points = lines.iter().map(|l| (l.at.x, l.at.y)).collect();
+        p.robots = self.robots(&mut shown);
         p.posts = posts
             .iter()
             .filter_map(|post| {
-                Some(PostSighting {
+                let s = PostSighting {
                     sighting: sighting(post.at),
                     sigma: self
                         .sigma(post.pixel, if post.foot { 1.0 } else { self.boundary_scale() })?,
                     east: post.outer == self.east_goal,
                     pixels: post.pixels,
-                })
+                };
+                shown.push(self.post_box(post));
+                Some(s)
             })
             .collect();
+        // At most so many line points, spread over all of them.
+        let every = lines.len().div_ceil(ImageDetections::MAX_LINE_POINTS).max(1);
+        shown.extend(
+            lines.iter().step_by(every).map(|l| detection(DetectionKind::Line, l.pixel, 0.0, 0.0)),
+        );
+        p.detections = Some(ImageDetections { width: w, height: h, items: shown });
         Ok((p, ball, posts))
+    }
+
+    /// The box of a landmark post in the image: its columns, from its foot up to its top as
+    /// the camera projects them (its measured pixel when a projection fails).
+    fn post_box(&self, post: &PostPercept) -> ImageDetection {
+        let (c0, c1) = (post.columns.0 as f64, post.columns.1 as f64 + 1.0);
+        let row = |z: f64| self.camera.project(Point3::new(post.at.x, post.at.y, z)).map(|p| p.y);
+        let bottom = row(0.0).unwrap_or(post.pixel.y);
+        let top = row(self.posts.height).unwrap_or(post.pixel.y).min(bottom);
+        detection(
+            DetectionKind::Post,
+            Pixel::new(0.5 * (c0 + c1), 0.5 * (top + bottom)),
+            c1 - c0,
+            bottom - top,
+        )
     }
 
     /// A distance measured at the posts' lower band boundary is this many times as uncertain
@@ -372,7 +405,17 @@ impl VisionAgent {
             let at = self.camera.unproject(px)?;
             Some(at.y.atan2(at.x))
         });
-        Some(Net { at: Point2::from((l.coords + r.coords) / 2.0), foot: pl, pixels, open_bearing })
+        // Its box: its first to last column, up from its lower foot by its mean column height.
+        let first = count.iter().position(|&c| c > 0).unwrap_or(0);
+        let last = count.iter().rposition(|&c| c > 0).unwrap_or(w - 1);
+        let columns = count[first..=last].iter().filter(|&&c| c > 0).count().max(1);
+        let tall = f64::from(pixels) / columns as f64;
+        let bottom = pl.y.max(pr.y);
+        let width = (last + 1 - first) as f64;
+        let centre = Pixel::new(first as f64 + 0.5 * width, bottom - 0.5 * tall);
+        let shown = detection(DetectionKind::Net, centre, width, tall);
+        let at = Point2::from((l.coords + r.coords) / 2.0);
+        Some(Net { at, foot: pl, pixels, open_bearing, shown })
     }
 
     /// The goal of `class` cut by one side of the image: the outermost foot on the other side
@@ -458,7 +501,9 @@ impl VisionAgent {
     /// lowest foot, with the colour of the marker band its columns show above the foot
     /// ([`VisionAgent::marker`]).
     /// (Cheaper than labelling the dark blobs, which are large, and it gives the foot.)
-    fn robots(&self) -> Vec<RobotSighting> {
+    /// Each robot's box in the image (its columns, from its foot up to the top the marker
+    /// scan reached) goes into `shown`.
+    fn robots(&self, shown: &mut Vec<ImageDetection>) -> Vec<RobotSighting> {
         let (w, h) = self.camera.size();
         let (w, h) = (w as usize, h as usize);
         let (robot, field, line) =
@@ -519,11 +564,16 @@ impl VisionAgent {
             }
             let px = Pixel::new((g.0 + g.1) as f64 / 2.0 + 0.5, g.2 as f64 + 1.0);
             if let Some(at) = self.camera.unproject(px) {
+                let (marker, top) = self.marker((g.0..=g.1).step_by(OBSTACLE_STEP), g.2);
                 out.push(RobotSighting {
                     sighting: sighting(at),
                     sigma: self.sigma(px, 1.0),
-                    marker: self.marker((g.0..=g.1).step_by(OBSTACLE_STEP), g.2),
+                    marker,
                 });
+                let (left, right) = (g.0 as f64, (g.1 + OBSTACLE_STEP).min(w) as f64);
+                let (top, bottom) = (top as f64, g.2 as f64 + 1.0);
+                let centre = Pixel::new(0.5 * (left + right), 0.5 * (top + bottom));
+                shown.push(detection(DetectionKind::Robot, centre, right - left, bottom - top));
             }
         }
         out
@@ -533,22 +583,23 @@ impl VisionAgent {
     /// going up each column from the foot through the robot's body (robot and marker pixels,
     /// gaps of at most [`MARKER_GAP`] others), the marker colour with at least
     /// [`MARKER_MIN_PIXELS`] pixels and twice the other's; `None` when the band is out of the
-    /// image, too small, or both colours show alike (two robots one behind the other).
-    fn marker(&self, columns: impl Iterator<Item = usize>, foot: usize) -> Option<Marker> {
+    /// image, too small, or both colours show alike (two robots one behind the other). With
+    /// it, the highest row of the robot the scan reached.
+    fn marker(&self, columns: impl Iterator<Item = usize>, foot: usize) -> (Option<Marker>, usize) {
         let w = self.camera.size().0 as usize;
         let (robot, magenta, cyan) = (
             ColorClass::Robot as u8,
             ColorClass::MarkerMagenta as u8,
             ColorClass::MarkerCyan as u8,
         );
-        let (mut m, mut c) = (0u32, 0u32);
+        let (mut m, mut c, mut top) = (0u32, 0u32, foot);
         for col in columns {
             let mut gap = 0;
             for row in (0..=foot).rev() {
                 match self.classes.get(row * w + col).copied() {
-                    Some(k) if k == robot => gap = 0,
-                    Some(k) if k == magenta => (m, gap) = (m + 1, 0),
-                    Some(k) if k == cyan => (c, gap) = (c + 1, 0),
+                    Some(k) if k == robot => (gap, top) = (0, top.min(row)),
+                    Some(k) if k == magenta => (m, gap, top) = (m + 1, 0, top.min(row)),
+                    Some(k) if k == cyan => (c, gap, top) = (c + 1, 0, top.min(row)),
                     _ => {
                         gap += 1;
                         if gap > MARKER_GAP {
@@ -558,11 +609,12 @@ impl VisionAgent {
                 }
             }
         }
-        match (m, c) {
+        let marker = match (m, c) {
             (m, c) if m >= MARKER_MIN_PIXELS && m >= 2 * c => Some(Marker::Magenta),
             (m, c) if c >= MARKER_MIN_PIXELS && c >= 2 * m => Some(Marker::Cyan),
             _ => None,
-        }
+        };
+        (marker, top)
     }
 
     /// One pixel's worth of error at `px`, whose floor point is `scale` times as far as the
@@ -585,6 +637,11 @@ fn without_posts(mut count: Vec<u32>, posts: &[PostPercept], w: usize) -> Vec<u3
     count
 }
 
+/// An object of `kind` in the image, its box `w` × `h` round `centre` (pixels).
+fn detection(kind: DetectionKind, centre: Pixel, w: f64, h: f64) -> ImageDetection {
+    ImageDetection { kind, x: centre.x as f32, y: centre.y as f32, w: w as f32, h: h as f32 }
+}
+
 fn sighting(at: Point2<f64>) -> Sighting {
     Sighting { distance: at.coords.norm(), bearing: at.y.atan2(at.x) }
 }
@@ -598,6 +655,62 @@ mod tests {
     fn agent() -> VisionAgent {
         let cam = Pinhole::new(Intrinsics::centred(32, 24, 26.0), 0.45, 0.35);
         VisionAgent::new(cam, &ColorTable::shipped(), 0.11)
+    }
+
+    /// A 160 × 120 image of carpet with a ball of radius 0.11 m painted where the camera sees
+    /// one 1.5 m ahead and 0.3 m to the left (each pixel whose ray meets the ball's sphere),
+    /// and a white line across the carpet at 1 m: the ball's detection is in the image, at
+    /// the painted blob, about its size; the line points are in the image, capped.
+    #[test]
+    fn detections_are_in_the_image_at_the_rendered_ball() {
+        let cam = Pinhole::new(Intrinsics::centred(160, 120, 130.0), 0.45, 0.35);
+        let mut agent = VisionAgent::new(cam, &ColorTable::shipped(), 0.11);
+        let (w, h) = (160usize, 120usize);
+        let centre = Point3::new(1.5, 0.3, 0.11);
+        let mut image = Image::new(w as u32, h as u32);
+        let (mut sum, mut n) = ((0.0, 0.0), 0.0);
+        for row in 0..h {
+            for col in 0..w {
+                let px = Pixel::new(col as f64 + 0.5, row as f64 + 0.5);
+                let floor = cam.unproject(px);
+                // The ray from the camera's centre through the pixel, near the ball's sphere.
+                let hits = cam.project(centre).is_some_and(|c| {
+                    let r = 0.11 * 130.0 / (centre - cam.centre()).norm();
+                    (c - px).norm() <= r
+                });
+                let rgb = if hits {
+                    (sum.0, sum.1, n) = (sum.0 + px.x, sum.1 + px.y, n + 1.0);
+                    [255, 120, 0]
+                } else if floor.is_some_and(|f| (f.x - 1.0).abs() < 0.03) {
+                    [245, 245, 245]
+                } else {
+                    [30, 140, 40]
+                };
+                image.rgb[(row * w + col) * 3..][..3].copy_from_slice(&rgb);
+            }
+        }
+        assert!(n > 20.0, "the ball shows: {n} pixels");
+        let p = agent.see(&image, 2.0, 0.0).unwrap();
+        assert!(p.sightings[BALL].is_some(), "the vision finds the painted ball");
+        let d = p.detections.expect("the vision says where it found things");
+        assert_eq!((d.width, d.height), (160, 120));
+        let ball = d.items[0];
+        assert_eq!(ball.kind, DetectionKind::Ball, "the ball first");
+        let (cx, cy) = (sum.0 / n, sum.1 / n);
+        assert!((f64::from(ball.x) - cx).abs() < 0.5 && (f64::from(ball.y) - cy).abs() < 0.5);
+        let diameter = 2.0 * (n / std::f64::consts::PI).sqrt();
+        assert!((f64::from(ball.w) - diameter).abs() < 1.0, "{} against {diameter}", ball.w);
+        let lines = d.items.iter().filter(|i| i.kind == DetectionKind::Line).count();
+        assert!(lines > 0 && lines <= ImageDetections::MAX_LINE_POINTS, "{lines}");
+        for i in &d.items {
+            let inside = |v: f32, size: f32, len: u32| {
+                v - size / 2.0 >= -0.5 && v + size / 2.0 <= len as f32 + 0.5
+            };
+            assert!(
+                inside(i.x, i.w, d.width) && inside(i.y, i.h, d.height),
+                "{i:?} out of the image"
+            );
+        }
     }
 
     proptest! {
@@ -619,6 +732,12 @@ mod tests {
         fn random_frames_give_finite_percepts(bytes in proptest::collection::vec(any::<u8>(), 2304)) {
             let image = Image { width: 32, height: 24, rgb: bytes };
             let p = agent().see(&image, 1.0, 0.2).unwrap();
+            let d = p.detections.as_ref().unwrap();
+            prop_assert!(d.items.iter().filter(|i| i.kind == DetectionKind::Line).count()
+                <= ImageDetections::MAX_LINE_POINTS);
+            for i in &d.items {
+                prop_assert!(i.x.is_finite() && i.y.is_finite() && i.w >= 0.0 && i.h >= 0.0);
+            }
             for s in p.sightings.iter().flatten().chain(p.robots.iter().map(|r| &r.sighting)) {
                 prop_assert!(s.distance.is_finite() && s.bearing.is_finite());
             }
