@@ -125,6 +125,14 @@ fn rerun(args: &ReplayArgs, recording: &Recording, robot: &str) -> Result<()> {
                 "{file}: no /match topic (which stacks played): record it with mrt sim --record"
             )
         })?;
+    if info.profile == mrt_monitor::RecordProfile::Compact {
+        bail!(
+            "{file} is a compact recording (mrt sim --record --compact): it keeps {robot}'s \
+             world snapshots at 2 Hz with rounded floats, not the ones its behaviors ran on each \
+             cycle, so a re-run cannot reproduce its commands and every difference would \
+             mislead. Record the match without --compact to re-run behaviors."
+        );
+    }
     let (team, k) = robot.split_once('/').unwrap_or((robot, ""));
     let k: usize = k.parse().map_err(|_| anyhow!("--robot {robot}: expected home/K or away/K"))?;
     let stack = match team {

@@ -304,6 +304,93 @@ fn replay_robot_reruns_its_behaviors_on_the_recorded_snapshots() {
     std::fs::remove_file(&file).ok();
 }
 
+/// `--compact`: the same match in a smaller file that keeps every topic (the world snapshots
+/// at 2 Hz, 4 decimals), that the monitor still shows with each robot's beliefs, that
+/// Python's `mcap` reads and validates against the schemas (when `$MRT_PYTHON` has the
+/// packages), and on which `mrt replay --robot` says it cannot re-run behaviors exactly
+/// instead of listing differences. Both files hold Foxglove's views: `/field`, `/scene`
+/// (`foxglove.SceneUpdate`) and `/<robot>/pose` (`foxglove.FrameTransform`).
+#[test]
+fn a_compact_recording_is_smaller_and_still_shows_the_match() {
+    let args = ["--half", "5", "--percepts", "oracle"];
+    let (full, _) = record("full", &args);
+    let (compact, said) = record("compact", &[&args[..], &["--compact"]].concat());
+    assert!(said.contains("left out by --compact"), "{said}");
+    let size = |p: &Path| std::fs::metadata(p).unwrap().len();
+    assert!(size(&compact) * 2 < size(&full), "{} against {}", size(&compact), size(&full));
+    let topics = |file: &Path| -> Vec<(String, String, u64)> {
+        let (ok, listing, err) = replay(&[file.as_os_str(), "--json".as_ref()]);
+        assert!(ok, "{err}");
+        let list: Vec<Value> = serde_json::from_str(&listing).unwrap();
+        list.iter()
+            .map(|t| {
+                let s = |k: &str| t[k].as_str().unwrap_or_default().to_string();
+                (s("topic"), s("schema"), t["messages"].as_u64().unwrap_or(0))
+            })
+            .collect()
+    };
+    let (full_topics, compact_topics) = (topics(&full), topics(&compact));
+    let names = |t: &[(String, String, u64)]| t.iter().map(|t| t.0.clone()).collect::<Vec<_>>();
+    assert_eq!(names(&full_topics), names(&compact_topics), "every topic kept");
+    let count = |t: &[(String, String, u64)], topic: &str| {
+        t.iter().find(|t| t.0 == topic).map(|t| (t.1.clone(), t.2)).unwrap_or_default()
+    };
+    // Two halves of 5 s: 100 cycles; the snapshots at 2 Hz, the commands and the truth at 10.
+    assert_eq!(count(&full_topics, "/home/2/WorldSnapshot").1, 100);
+    assert_eq!(count(&compact_topics, "/home/2/WorldSnapshot").1, 20);
+    assert_eq!(count(&compact_topics, "/home/2/RobotCommand").1, 100);
+    assert_eq!(count(&compact_topics, "/truth").1, 100);
+    assert_eq!(count(&full_topics, "/scene"), ("foxglove.SceneUpdate".into(), 100));
+    assert_eq!(count(&compact_topics, "/scene").1, 50, "5 Hz");
+    assert_eq!(count(&compact_topics, "/field"), ("foxglove.SceneUpdate".into(), 1));
+    assert_eq!(count(&full_topics, "/away/1/pose"), ("foxglove.FrameTransform".into(), 100));
+    assert_eq!(count(&compact_topics, "/away/1/pose").1, 20);
+
+    // The monitor shows it: a frame at every cycle, each robot with a believed pose.
+    let (server, url) = serve(&compact);
+    let (_, meta) = http("GET", host(&url), "/meta", None);
+    let meta: Value = serde_json::from_str(&meta).unwrap();
+    assert_eq!(meta["end"], 100, "{meta}");
+    let (_, frame) = http("GET", host(&url), "/frame/60", None);
+    let frame: Value = serde_json::from_str(&frame).unwrap();
+    let robots = frame["frame"]["robots"].as_array().unwrap();
+    assert_eq!(robots.len(), 8, "{frame}");
+    assert!(robots.iter().all(|r| r["pose"].is_array() || r["pose"].is_object()), "{frame}");
+    drop(server);
+
+    // No misleading differences from a compact recording.
+    let (ok, out, err) = replay(&[compact.as_os_str(), "--robot".as_ref(), "home/2".as_ref()]);
+    assert!(!ok && out.is_empty(), "{out}");
+    assert!(err.contains("compact recording") && err.contains("without --compact"), "{err}");
+    let (ok, out, err) = replay(&[full.as_os_str(), "--robot".as_ref(), "home/2".as_ref()]);
+    assert!(ok && out.contains("in 0 cycles"), "{out}{err}");
+
+    let python = std::env::var("MRT_PYTHON").unwrap_or_else(|_| "python3".into());
+    let script = concat!(env!("CARGO_MANIFEST_DIR"), "/../../examples/python/check_recording.py");
+    for file in [&compact, &full] {
+        match Command::new(&python).arg(script).arg(file).output() {
+            Ok(out) if out.status.code() == Some(3) => {
+                eprintln!(
+                    "skipped: the Python check ({python}): {}",
+                    String::from_utf8_lossy(&out.stderr)
+                );
+            }
+            Ok(out) => {
+                let stdout = String::from_utf8_lossy(&out.stdout);
+                assert!(out.status.success(), "{stdout}{}", String::from_utf8_lossy(&out.stderr));
+                let counts: Value = serde_json::from_str(stdout.trim()).unwrap();
+                assert_eq!(
+                    (counts["invalid"].as_u64(), counts["truth"].as_u64()),
+                    (Some(0), Some(100))
+                );
+            }
+            Err(e) => eprintln!("skipped: the Python check, no {python}: {e}"),
+        }
+    }
+    std::fs::remove_file(&full).ok();
+    std::fs::remove_file(&compact).ok();
+}
+
 fn copy_dir(from: &Path, to: &Path) {
     std::fs::create_dir_all(to).unwrap();
     for e in std::fs::read_dir(from).unwrap() {

@@ -46,12 +46,8 @@ impl CompressedImage {
         image::codecs::jpeg::JpegEncoder::new_with_quality(&mut jpeg, JPEG_QUALITY)
             .encode_image(&rgb)
             .ok()?;
-        let nanos = time.0;
         Some(CompressedImage {
-            timestamp: Timestamp {
-                sec: u32::try_from(nanos / 1_000_000_000).unwrap_or(u32::MAX),
-                nsec: u32::try_from(nanos % 1_000_000_000).unwrap_or(0),
-            },
+            timestamp: Timestamp::of(time),
             frame_id: frame_id.to_string(),
             data: base64::engine::general_purpose::STANDARD.encode(jpeg),
             format: "jpeg".into(),

@@ -12,6 +12,12 @@
 //! - [`tap`]: a [`Tap`] is a Member that records every catalogue message of its Agora
 //!   (`mrt sim --record FILE.mcap` puts one in each robot).
 //! - [`catalogue`]: the message types a tap knows, with their schemas.
+//! - [`profile`]: a [`RecordProfile`]: every message with every digit (the default), or a
+//!   compact file a user can mail (`mrt sim --record FILE --compact`: the bulky high-rate types
+//!   at 2 Hz of the simulated clock, floats with 4 decimals).
+//! - [`foxglove`]: Foxglove's well-known schemas beside MRT's own: the field and the truth as
+//!   `foxglove.SceneUpdate` (`/field`, `/scene`), each robot's believed pose as a
+//!   `foxglove.FrameTransform` (`/<robot>/pose`), errors and faults as `foxglove.Log` (`/log`).
 //! - [`camera`]: camera images as Foxglove's `foxglove.CompressedImage` (JPEG), recorded at a
 //!   chosen rate ([`Recorder::with_images`]).
 //! - [`view`]: a [`Timeline`] of frames, each the simulator's truth and every robot's beliefs
@@ -36,6 +42,8 @@
 
 pub mod camera;
 pub mod catalogue;
+pub mod foxglove;
+pub mod profile;
 pub mod record;
 pub mod replay;
 #[cfg(feature = "serve")]
@@ -43,6 +51,7 @@ pub mod serve;
 pub mod tap;
 pub mod view;
 
+pub use profile::RecordProfile;
 pub use record::{RecordError, RecordSummary, Recorder, SharedRecorder};
 pub use replay::{Recording, ReplayError};
 pub use tap::Tap;

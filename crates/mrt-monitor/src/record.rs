@@ -1,6 +1,8 @@
 //! Writing an MCAP file (module doc of the crate): channels by topic, a JSON schema per
-//! message type, JSON messages, log times in nanoseconds of the bus's clock.
+//! message type, JSON messages, log times in nanoseconds of the bus's clock; with a
+//! [`RecordProfile`], every message or a compact file (`mrt sim --record FILE --compact`).
 
+use crate::profile::RecordProfile;
 use mcap::records::MessageHeader;
 use mcap::{Compression, WriteOptions, Writer};
 use mrt_core::Time;
@@ -58,6 +60,8 @@ pub struct RecordSummary {
     pub channels: usize,
     /// Messages that could not be written (a serialization error), counted and left out.
     pub failed: u64,
+    /// Messages a compact profile left out ([`RecordProfile::interval`]).
+    pub decimated: u64,
 }
 
 /// A recorder shared by the [`Tap`](crate::Tap)s of several Agoras and whoever records the
@@ -79,6 +83,12 @@ pub struct Recorder {
     channels: BTreeMap<String, u16>,
     /// Topics by channel id.
     topics: Vec<String>,
+    /// By channel id: the least time between two kept messages (ns; 0 keeps all), and the
+    /// window (log time / interval) of the last one kept.
+    decimation: Vec<(u64, Option<u64>)>,
+    profile: RecordProfile,
+    /// A message rounded by the profile's precision, reused.
+    rounded: Vec<u8>,
     listener: Option<Listener>,
     /// Record every n-th camera image of each robot (0: none).
     images_every: u32,
@@ -95,22 +105,45 @@ impl std::fmt::Debug for Recorder {
 }
 
 impl Recorder {
-    /// A recording into a new file at `path` (an existing one is replaced).
+    /// A recording of every message into a new file at `path` (an existing one is
+    /// replaced).
     pub fn create(path: &Path) -> Result<Recorder, RecordError> {
-        let io = |source| RecordError::Io { path: path.to_path_buf(), source };
-        let file = File::create(path).map_err(io)?;
-        Recorder::new(Box::new(BufWriter::new(file)), path)
+        Recorder::create_with(path, RecordProfile::Full)
     }
 
-    /// A recording into `sink`, called `path` in errors.
+    /// A recording into a new file at `path` that keeps what `profile` says
+    /// ([`RecordProfile::Compact`]: `mrt sim --record FILE --compact`).
+    pub fn create_with(path: &Path, profile: RecordProfile) -> Result<Recorder, RecordError> {
+        let io = |source| RecordError::Io { path: path.to_path_buf(), source };
+        let file = File::create(path).map_err(io)?;
+        Recorder::new_with(Box::new(BufWriter::new(file)), path, profile)
+    }
+
+    /// A recording of every message into `sink`, called `path` in errors.
     pub fn new(sink: Box<dyn Sink>, path: &Path) -> Result<Recorder, RecordError> {
+        Recorder::new_with(sink, path, RecordProfile::Full)
+    }
+
+    /// A recording into `sink`, called `path` in errors, that keeps what `profile` says.
+    pub fn new_with(
+        sink: Box<dyn Sink>,
+        path: &Path,
+        profile: RecordProfile,
+    ) -> Result<Recorder, RecordError> {
         let writer = WriteOptions::new()
             .compression(Some(Compression::Zstd))
+            .compression_level(profile.zstd_level())
+            .chunk_size(profile.chunk_size())
             .profile("")
             .library(concat!("mrt-monitor ", env!("CARGO_PKG_VERSION")))
             .create(sink)
             .map_err(|source| RecordError::Mcap { path: path.to_path_buf(), source })?;
-        Ok(Recorder { writer: Some(writer), path: path.to_path_buf(), ..Recorder::unwritten() })
+        Ok(Recorder {
+            writer: Some(writer),
+            path: path.to_path_buf(),
+            profile,
+            ..Recorder::unwritten()
+        })
     }
 
     /// A recorder that writes no file: its messages go to its listener only
@@ -122,6 +155,9 @@ impl Recorder {
             schemas: BTreeMap::new(),
             channels: BTreeMap::new(),
             topics: Vec::new(),
+            decimation: Vec::new(),
+            profile: RecordProfile::Full,
+            rounded: Vec::new(),
             listener: None,
             images_every: 0,
             summary: RecordSummary::default(),
@@ -133,6 +169,11 @@ impl Recorder {
     /// default). JPEG does not compress further: each image adds its 5 to 7 KB to the file.
     pub fn with_images(self, every: u32) -> Recorder {
         Recorder { images_every: every, ..self }
+    }
+
+    /// What this recording keeps.
+    pub fn profile(&self) -> RecordProfile {
+        self.profile
     }
 
     /// Every how many camera images one is recorded (0: none).
@@ -184,15 +225,54 @@ impl Recorder {
         let slot = usize::from(id);
         if self.topics.len() <= slot {
             self.topics.resize(slot + 1, String::new());
+            self.decimation.resize(slot + 1, (0, None));
         }
         self.topics[slot] = topic.to_string();
+        self.decimation[slot] = (self.profile.interval(schema_name).unwrap_or(0), None);
         self.channels.insert(topic.to_string(), id);
         self.summary.channels = self.channels.len();
         Ok(id)
     }
 
-    /// Writes one JSON message on `channel` at `time`.
+    /// Whether a message on `channel` at `time` is kept, by the profile's interval for the
+    /// channel's schema ([`RecordProfile::interval`]): the first message of each window of
+    /// that length on the bus's (simulated) clock, counted from 0. A message not kept is
+    /// counted in [`RecordSummary::decimated`]; a kept one starts its window.
+    pub fn due(&mut self, channel: u16, time: Time) -> bool {
+        let Some((interval, last)) = self.decimation.get_mut(usize::from(channel)) else {
+            return true;
+        };
+        if *interval == 0 {
+            return true;
+        }
+        let window = time.0 / *interval;
+        if *last == Some(window) {
+            self.summary.decimated += 1;
+            return false;
+        }
+        *last = Some(window);
+        true
+    }
+
+    /// Writes one JSON message on `channel` at `time`, its floats rounded when the profile
+    /// says so ([`RecordProfile::precision`]). It is written whether [`Recorder::due`] or
+    /// not: ask first.
     pub fn write(&mut self, channel: u16, time: Time, json: &[u8]) -> Result<(), RecordError> {
+        match self.profile.precision() {
+            Some(p) => {
+                let mut rounded = std::mem::take(&mut self.rounded);
+                rounded.clear();
+                p.round_json(json, &mut rounded);
+                let done = self.write_exact(channel, time, &rounded);
+                self.rounded = rounded;
+                done
+            }
+            None => self.write_exact(channel, time, json),
+        }
+    }
+
+    /// Writes `json` as it is.
+    fn write_exact(&mut self, channel: u16, time: Time, json: &[u8]) -> Result<(), RecordError> {
         let header = MessageHeader {
             channel_id: channel,
             sequence: u32::try_from(self.summary.messages).unwrap_or(u32::MAX),
@@ -213,7 +293,8 @@ impl Recorder {
         Ok(())
     }
 
-    /// Writes `value` as JSON on `topic` at `time`, its channel's schema `T`'s.
+    /// Writes `value` as JSON on `topic` at `time`, its channel's schema `T`'s, when the
+    /// profile keeps it ([`Recorder::due`]).
     pub fn record<T: Serialize + JsonSchema>(
         &mut self,
         topic: &str,
@@ -222,8 +303,31 @@ impl Recorder {
     ) -> Result<(), RecordError> {
         let name = T::schema_name();
         let channel = self.channel(topic, &name, crate::catalogue::schema_of::<T>)?;
+        if !self.due(channel, time) {
+            return Ok(());
+        }
         let json = serde_json::to_vec(value)?;
         self.write(channel, time, &json)
+    }
+
+    /// [`Recorder::record`] with the floats rounded to `precision` whatever the profile
+    /// (the Foxglove views drawn from other messages: `/scene`, `/<robot>/pose`).
+    pub fn record_rounded<T: Serialize + JsonSchema>(
+        &mut self,
+        topic: &str,
+        time: Time,
+        value: &T,
+        precision: crate::profile::Precision,
+    ) -> Result<(), RecordError> {
+        let name = T::schema_name();
+        let channel = self.channel(topic, &name, crate::catalogue::schema_of::<T>)?;
+        if !self.due(channel, time) {
+            return Ok(());
+        }
+        let json = serde_json::to_vec(value)?;
+        let mut rounded = Vec::with_capacity(json.len());
+        precision.round_json(&json, &mut rounded);
+        self.write_exact(channel, time, &rounded)
     }
 
     /// Counts a message that could not be written.
@@ -237,8 +341,16 @@ impl Recorder {
     }
 
     /// Writes the summary and the footer and closes the file.
+    /// The file's metadata record `mrt` holds the profile (`profile`: `full` or `compact`).
     pub fn finish(self) -> Result<RecordSummary, RecordError> {
         let Some(mut writer) = self.writer else { return Ok(self.summary) };
+        let metadata = mcap::records::Metadata {
+            name: "mrt".into(),
+            metadata: BTreeMap::from([("profile".to_string(), self.profile.name().to_string())]),
+        };
+        writer
+            .write_metadata(&metadata)
+            .map_err(|source| RecordError::Mcap { path: self.path.clone(), source })?;
         writer.finish().map_err(|source| RecordError::Mcap { path: self.path.clone(), source })?;
         let mut sink = writer.into_inner();
         sink.flush().map_err(|source| RecordError::Io { path: self.path.clone(), source })?;
@@ -295,7 +407,7 @@ mod tests {
         rec.record("/home/1/GameInfo", Time(200), &game).unwrap();
         rec.record("/home/0/Localization", Time(300), &Localization::default()).unwrap();
         let s = rec.finish().unwrap();
-        assert_eq!(s, RecordSummary { messages: 3, channels: 3, failed: 0 });
+        assert_eq!(s, RecordSummary { messages: 3, channels: 3, failed: 0, decimated: 0 });
         let back = read_back(&path);
         std::fs::remove_file(&path).ok();
         let topics: Vec<_> = back.iter().map(|m| (m.0.as_str(), m.1.as_str(), m.4)).collect();
@@ -310,6 +422,45 @@ mod tests {
         assert!(back.iter().all(|m| m.2 == "jsonschema" && m.3 == "json"));
         let decoded: GameInfo = serde_json::from_str(&back[0].5).unwrap();
         assert_eq!(decoded, game);
+    }
+
+    /// A compact recording keeps a `Localization` topic at 2 Hz of the simulated clock (the
+    /// first message of each half second: 0, 0.5, 1.0 and 1.5 s of 20 messages at 10 Hz),
+    /// every `GameInfo`, and writes floats with 4 decimals; the file's metadata names the
+    /// profile. The full one keeps all 40 with every digit.
+    #[test]
+    fn compact_decimates_by_simulated_time_and_rounds() {
+        let record = |profile: RecordProfile, name: &str| {
+            let path = temp(name);
+            let mut rec = Recorder::create_with(&path, profile).unwrap();
+            for k in 0..20u64 {
+                let t = Time(k * 100_000_000);
+                let l = Localization { sigma_xy: 0.0123456789, ..Default::default() };
+                rec.record("/home/0/Localization", t, &l).unwrap();
+                rec.record("/home/0/GameInfo", t, &GameInfo { attack: -1.0, ..Default::default() })
+                    .unwrap();
+            }
+            let summary = rec.finish().unwrap();
+            let bytes = std::fs::read(&path).unwrap();
+            let back = read_back(&path);
+            std::fs::remove_file(&path).ok();
+            (summary, back, bytes)
+        };
+        let (s, back, bytes) = record(RecordProfile::Compact, "compact");
+        assert_eq!(s, RecordSummary { messages: 24, channels: 2, failed: 0, decimated: 16 });
+        let times: Vec<u64> =
+            back.iter().filter(|m| m.0 == "/home/0/Localization").map(|m| m.4).collect();
+        assert_eq!(times, [0, 500_000_000, 1_000_000_000, 1_500_000_000]);
+        let l = back.iter().find(|m| m.0 == "/home/0/Localization").unwrap();
+        assert!(l.5.contains("\"sigma_xy\":0.0123,"), "{}", l.5);
+        let decoded: Localization = serde_json::from_str(&l.5).unwrap();
+        assert_eq!(decoded.sigma_xy, 0.0123);
+        let has = |needle: &[u8]| bytes.windows(needle.len()).any(|w| w == needle);
+        assert!(has(b"profile") && has(b"compact"));
+        let (s, back, bytes) = record(RecordProfile::Full, "full");
+        assert_eq!(s, RecordSummary { messages: 40, channels: 2, failed: 0, decimated: 0 });
+        assert!(back[0].5.contains("\"sigma_xy\":0.0123456789,"), "{}", back[0].5);
+        assert!(bytes.windows(4).any(|w| w == b"full"));
     }
 
     #[test]

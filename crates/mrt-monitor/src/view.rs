@@ -52,6 +52,11 @@ pub struct MatchInfo {
     pub team_size: usize,
     /// The robots' control period, s.
     pub period: f64,
+    /// What the recording keeps ([`RecordProfile`](crate::RecordProfile)): a compact one
+    /// cannot re-run a robot's behaviors exactly (`mrt replay --robot` says so). Absent in
+    /// recordings made before it was recorded: full.
+    #[serde(default)]
+    pub profile: crate::RecordProfile,
 }
 
 /// The most frames a timeline keeps (two hours at the robots' 10 Hz): older ones are dropped

@@ -13,7 +13,9 @@ use crate::game::{MatchReport, Pitch};
 use crate::referee::Call;
 use mrt_core::SimClock;
 use mrt_dcdt::{InnerLinkManager, SteppedExecutor};
-use mrt_monitor::{MatchInfo, SharedRecorder, Tap, Truth};
+use mrt_monitor::foxglove::{Bodies, FieldLines, SceneUpdate};
+use mrt_monitor::profile::VIEW_PRECISION;
+use mrt_monitor::{MatchInfo, RecordProfile, SharedRecorder, Tap, Truth};
 use mrt_msgs::{Localization, MemberFault, WorldSnapshot};
 use mrt_robot::brain::Brain;
 use mrt_robot::config::RobotConfig;
@@ -120,8 +122,10 @@ impl BusMatch {
 
     /// [`BusMatch::new`], with every robot's messages and the truth recorded into `recorder`
     /// (`mrt sim --record`): a [`Tap`] in each robot's Agora on the topics
-    /// `/home/<k>/<type>` and `/away/<k>/<type>`, [`Truth`] each cycle on `/truth`, and which
-    /// match it is ([`MatchInfo`]) on `/match` at its start.
+    /// `/home/<k>/<type>` and `/away/<k>/<type>`, [`Truth`] each cycle on `/truth` and drawn
+    /// for Foxglove on `/scene` (`foxglove.SceneUpdate`), and at its start which match it is
+    /// ([`MatchInfo`], with the recorder's profile) on `/match` and the field's lines on
+    /// `/field` (issue 22).
     pub fn recorded(
         cfg: &SimConfig,
         seed: u64,
@@ -142,9 +146,24 @@ impl BusMatch {
                 seed,
                 team_size: n,
                 period: cfg.robot()?.period().as_secs_f64(),
+                profile: RecordProfile::Full,
             };
             let mut rec = rec.lock().map_err(|_| "the recorder's lock is poisoned".to_string())?;
+            let info = MatchInfo { profile: rec.profile(), ..info };
             rec.record("/match", mrt_core::Time::ZERO, &info).map_err(|e| e.to_string())?;
+            let f = &cfg.field;
+            let lines = FieldLines {
+                half_length: f.length / 2.0,
+                half_width: f.width / 2.0,
+                goal_half_width: f.goal_width / 2.0,
+                goal_depth: f.goal_depth,
+                penalty_area_depth: f.penalty_area_depth,
+                penalty_area_half_width: f.penalty_area_width / 2.0,
+                centre_circle_radius: f.centre_circle_radius,
+            };
+            let field = SceneUpdate::field(&lines, mrt_core::Time::ZERO);
+            rec.record_rounded("/field", mrt_core::Time::ZERO, &field, VIEW_PRECISION)
+                .map_err(|e| e.to_string())?;
         }
         BusMatch::build(cfg, seed, teams, files, recorder, |agora, robot_cfg, robot, devices| {
             let spec = RobotSpec::of(robot, n, (home, away.unwrap_or(home)));
@@ -252,7 +271,13 @@ impl BusMatch {
             let p = lock_pitch(&self.pitch)?;
             let time = mrt_core::Time::from_secs_f64(p.world().time());
             let mut rec = rec.lock().map_err(|_| "the recorder's lock is poisoned".to_string())?;
-            rec.record("/truth", time, &truth_of(&p)).map_err(|e| e.to_string())?;
+            let truth = truth_of(&p);
+            rec.record("/truth", time, &truth).map_err(|e| e.to_string())?;
+            let c = p.config();
+            let bodies = Bodies { robot_radius: c.robot.radius, ball_radius: c.ball.radius };
+            let scene = SceneUpdate::of_truth(&truth, &bodies, time);
+            rec.record_rounded("/scene", time, &scene, VIEW_PRECISION)
+                .map_err(|e| e.to_string())?;
         }
         self.exec.run_for(self.period);
         let mut p = self.pitch.lock().map_err(|_| "the pitch lock is poisoned".to_string())?;
@@ -337,7 +362,8 @@ mod tests {
             );
             let value: serde_json::Value = serde_json::from_slice(&m.data).unwrap();
             let topic = &m.channel.topic;
-            let own = topic == "/truth" || topic == "/match";
+            let own = ["/truth", "/match", "/scene", "/field", "/log"].contains(&topic.as_str())
+                || (topic.ends_with("/pose") && schema.name == "foxglove.FrameTransform");
             assert!(own || topic.ends_with(&format!("/{}", schema.name)), "{topic}");
             if schema.name == "WorldSnapshot" {
                 serde_json::from_value::<WorldSnapshot>(value).unwrap();
@@ -355,6 +381,9 @@ mod tests {
         assert_eq!(summary.messages, topics.values().map(|t| t.0 as u64).sum::<u64>());
         // Both halves of 3 s at 10 Hz: 60 cycles, one truth and one snapshot per robot each.
         assert_eq!(topics["/truth"].0, 60);
+        // Foxglove's views: the truth drawn each cycle, the field once, each believed pose.
+        assert_eq!((topics["/scene"].0, topics["/field"].0), (60, 1));
+        assert!(topics.contains_key("/away/1/pose"), "{:?}", topics.keys());
         for robot in ["home/0", "home/1", "away/0", "away/1"] {
             let snapshots = topics[&format!("/{robot}/WorldSnapshot")];
             assert_eq!(snapshots.0, 60, "{robot}");
