@@ -208,7 +208,7 @@ mod tests {
     fn floats_are_rounded_to_four_decimals_and_six_digits() {
         let p = COMPACT_PRECISION;
         assert_eq!(p.round(1.23456789), 1.2346);
-        assert_eq!(p.round(-0.785398163), -0.7854);
+        assert_eq!(p.round(-0.612345678), -0.6123);
         assert_eq!(p.round(4500.123456), 4500.12);
         assert_eq!(p.round(123456789.0), 123457000.0);
         assert_eq!(p.round(0.00004999), 0.0);
