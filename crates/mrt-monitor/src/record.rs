@@ -258,7 +258,18 @@ impl Recorder {
     /// says so ([`RecordProfile::precision`]). It is written whether [`Recorder::due`] or
     /// not: ask first.
     pub fn write(&mut self, channel: u16, time: Time, json: &[u8]) -> Result<(), RecordError> {
-        match self.profile.precision() {
+        self.write_with(channel, time, json, self.profile.precision())
+    }
+
+    /// [`Recorder::write`] with the floats rounded to `precision` (`None`: as they are).
+    fn write_with(
+        &mut self,
+        channel: u16,
+        time: Time,
+        json: &[u8],
+        precision: Option<crate::profile::Precision>,
+    ) -> Result<(), RecordError> {
+        match precision {
             Some(p) => {
                 let mut rounded = std::mem::take(&mut self.rounded);
                 rounded.clear();
@@ -301,13 +312,7 @@ impl Recorder {
         time: Time,
         value: &T,
     ) -> Result<(), RecordError> {
-        let name = T::schema_name();
-        let channel = self.channel(topic, &name, crate::catalogue::schema_of::<T>)?;
-        if !self.due(channel, time) {
-            return Ok(());
-        }
-        let json = serde_json::to_vec(value)?;
-        self.write(channel, time, &json)
+        self.record_with(topic, time, value, self.profile.precision())
     }
 
     /// [`Recorder::record`] with the floats rounded to `precision` whatever the profile
@@ -319,15 +324,23 @@ impl Recorder {
         value: &T,
         precision: crate::profile::Precision,
     ) -> Result<(), RecordError> {
+        self.record_with(topic, time, value, Some(precision))
+    }
+
+    fn record_with<T: Serialize + JsonSchema>(
+        &mut self,
+        topic: &str,
+        time: Time,
+        value: &T,
+        precision: Option<crate::profile::Precision>,
+    ) -> Result<(), RecordError> {
         let name = T::schema_name();
         let channel = self.channel(topic, &name, crate::catalogue::schema_of::<T>)?;
         if !self.due(channel, time) {
             return Ok(());
         }
         let json = serde_json::to_vec(value)?;
-        let mut rounded = Vec::with_capacity(json.len());
-        precision.round_json(&json, &mut rounded);
-        self.write_exact(channel, time, &rounded)
+        self.write_with(channel, time, &json, precision)
     }
 
     /// Counts a message that could not be written.

@@ -15,7 +15,7 @@ use std::collections::BTreeMap;
 /// time (those the recorder's profile keeps: [`Recorder::due`](crate::Recorder::due)), and
 /// every n-th camera image as a JPEG on `/<prefix>/camera` when the recorder asks for images
 /// ([`Recorder::with_images`](crate::Recorder::with_images)). Foxglove's views
-/// ([`foxglove`](crate::foxglove)): the believed pose of each `Localization` as a
+/// ([`foxglove`]): the believed pose of each `Localization` as a
 /// `foxglove.FrameTransform` on `/<prefix>/pose`, and the errors and faults the robot reports
 /// as `foxglove.Log` lines on `/log`. It subscribes with [`RequestType::Local`]: each robot's own messages, once (a
 /// teammate's report is recorded on the teammate's topic). A message that does not encode is

@@ -51,7 +51,7 @@ pub struct Cycle {
     /// What went wrong (the robot went on regardless).
     pub errors: Vec<ScriptError>,
     /// The HFSM's shape, for monitors (ThinkingCap seed `001` §4.1, §5.1): in the first
-    /// cycle, after the machine was reloaded, and every [`STRUCTURE_EVERY`] cycles for
+    /// cycle, after the machine was reloaded, and every `STRUCTURE_EVERY` (100) cycles for
     /// monitors that join late; `None` otherwise and without an HFSM.
     pub structure: Option<mrt_msgs::HfsmStructure>,
 }
