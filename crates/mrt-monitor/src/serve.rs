@@ -167,52 +167,40 @@ async fn frame(State(s): State<Shared>, Path(index): Path<String>) -> Response {
     json(envelope(&s, &index))
 }
 
-async fn camera(
-    State(s): State<Shared>,
-    Path((team, k, index)): Path<(String, String, usize)>,
+/// What the timeline holds of robot `team/k` by frame `index`, as `answer` makes it into a
+/// response; 404 with `missing` when it holds nothing.
+fn of_robot(
+    s: &Shared,
+    (team, k, index): (String, String, usize),
+    missing: &'static str,
+    answer: impl FnOnce(&crate::Timeline, &str, usize) -> Option<Response>,
 ) -> Response {
     let Ok(t) = s.timeline.lock() else {
         return (StatusCode::INTERNAL_SERVER_ERROR, "the timeline's lock is poisoned")
             .into_response();
     };
-    match t.image(&format!("{team}/{k}"), index) {
-        Some(jpeg) => {
-            let body = axum::body::Bytes::from_owner(jpeg);
-            ([(header::CONTENT_TYPE, "image/jpeg")], body).into_response()
-        }
-        None => {
-            (StatusCode::NOT_FOUND, "no camera image of that robot by that frame").into_response()
-        }
-    }
+    answer(&t, &format!("{team}/{k}"), index)
+        .unwrap_or_else(|| (StatusCode::NOT_FOUND, missing).into_response())
 }
 
-async fn seen(
-    State(s): State<Shared>,
-    Path((team, k, index)): Path<(String, String, usize)>,
-) -> Response {
-    let Ok(t) = s.timeline.lock() else {
-        return (StatusCode::INTERNAL_SERVER_ERROR, "the timeline's lock is poisoned")
-            .into_response();
-    };
-    match t.image_seen(&format!("{team}/{k}"), index) {
-        Some(seen) => json(seen.to_string()),
-        None => (StatusCode::NOT_FOUND, "no detections for that robot's image by that frame")
-            .into_response(),
-    }
+async fn camera(State(s): State<Shared>, Path(at): Path<(String, String, usize)>) -> Response {
+    of_robot(&s, at, "no camera image of that robot by that frame", |t, robot, i| {
+        let jpeg = t.image(robot, i)?;
+        let body = axum::body::Bytes::from_owner(jpeg);
+        Some(([(header::CONTENT_TYPE, "image/jpeg")], body).into_response())
+    })
 }
 
-async fn hfsm(
-    State(s): State<Shared>,
-    Path((team, k, index)): Path<(String, String, usize)>,
-) -> Response {
-    let Ok(t) = s.timeline.lock() else {
-        return (StatusCode::INTERNAL_SERVER_ERROR, "the timeline's lock is poisoned")
-            .into_response();
-    };
-    match t.hfsm(&format!("{team}/{k}"), index) {
-        Some(shape) => json(shape.to_string()),
-        None => (StatusCode::NOT_FOUND, "no HFSM told by that robot by that frame").into_response(),
-    }
+async fn seen(State(s): State<Shared>, Path(at): Path<(String, String, usize)>) -> Response {
+    of_robot(&s, at, "no detections for that robot's image by that frame", |t, robot, i| {
+        t.image_seen(robot, i).map(|seen| json(seen.to_string()))
+    })
+}
+
+async fn hfsm(State(s): State<Shared>, Path(at): Path<(String, String, usize)>) -> Response {
+    of_robot(&s, at, "no HFSM told by that robot by that frame", |t, robot, i| {
+        t.hfsm(robot, i).map(|shape| json(shape.to_string()))
+    })
 }
 
 async fn socket(State(s): State<Shared>, ws: WebSocketUpgrade) -> Response {
