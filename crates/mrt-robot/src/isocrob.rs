@@ -104,7 +104,9 @@ struct Params {
     facing: f64,
     seen_ball: f64,
     kick_distance: f64,
+    kick_reach: f64,
     behind: f64,
+    orbit: f64,
     heard: f64,
     home_x: f64,
     home_spread: f64,
@@ -153,7 +155,9 @@ impl IsocrobBrain {
             facing: self.float("facing", 0.25),
             seen_ball: self.float("seen-ball", 0.3),
             kick_distance: self.float("kick-distance", 5.0),
+            kick_reach: self.float("kick-reach", 0.45),
             behind: self.float("behind", 0.35),
+            orbit: self.float("orbit", 0.6),
             heard: self.float("heard", 1.0),
             home_x: self.float(home, -1.0),
             home_spread: self.float("home-spread", 2.5),
@@ -270,8 +274,17 @@ impl IsocrobBrain {
             // move_close2ball(): straight at the ball, turning to it.
             AttackerState::ApproachBall => go(me, ball_at, towards_ball, &mut c),
             // The arc round the ball until the robot faces the goal with the ball before it:
-            // to the posture behind the ball on the line from the goal, stepping round the
-            // ball when on its wrong side (a robot with no dribbler cannot turn holding it).
+            // round the ball at `orbit` from it to the posture behind it on the line from the
+            // goal, facing the ball all the way (a robot with no dribbler cannot turn holding
+            // it, and a front camera that looks away from the ball loses it). Behind the ball,
+            // facing it is facing the goal.
+            AttackerState::FaceGoal if p.orbit > 0.0 => {
+                let behind = field.behind_ball(ball_at, p.behind * MM);
+                let to = Geometry::orbit(me, ball_at, behind, p.orbit * MM);
+                go(me, to, towards_ball, &mut c);
+            }
+            // `orbit` 0: straight to the posture, facing the goal, stepping round the ball
+            // when on its wrong side.
             AttackerState::FaceGoal => {
                 let behind = field.behind_ball(ball_at, p.behind * MM);
                 go(me, Geometry::step_round(me, ball_at, behind), behind.theta, &mut c);
@@ -286,7 +299,10 @@ impl IsocrobBrain {
                 let lined_up = normalize_angle(me.theta - shot).abs() < p.facing;
                 // One request a kick: none while the valve is open.
                 let idle = self.pulse_from.is_none();
-                if idle && goal <= p.kick_distance && ball.theta.abs() < 0.3 && lined_up {
+                // The kicker reaches the ball only when it touches the robot's front: a pulse
+                // fired at a ball farther away misses it, and the solenoid then recharges.
+                let reach = ball.rho / MM <= p.kick_reach;
+                if idle && goal <= p.kick_distance && reach && ball.theta.abs() < 0.3 && lined_up {
                     self.post("local.var.kicker.kick", true);
                 }
             }
@@ -484,6 +500,53 @@ mod tests {
         let c = r.cycle(&w);
         assert_eq!(c.kick, Some(1), "{c:?}");
         assert!(c.vlin > 0.0);
+    }
+
+    /// In RUN_AND_KICK with the ball 0.7 m ahead (near, but beyond the kicker's reach of
+    /// 0.45 m) the attacker pushes on without firing: a pulse then would miss the ball and
+    /// leave the solenoid recharging when the ball does reach the kicker.
+    #[test]
+    fn an_attacker_kicks_only_a_ball_within_the_kickers_reach() {
+        let clock = Arc::new(SimClock::new());
+        let mut r = IsocrobBrain::new(2, Role::Attacker, 1, board(2, &clock)).unwrap();
+        let me = Pose2::new(7000.0, 0.0, 0.0);
+        let far = world(0.0, me, (7700.0, 0.0));
+        r.cycle(&far); // APPROACH_BALL → FACE_GOAL (near, before it)
+        r.cycle(&far); // FACE_GOAL → RUN_AND_KICK (facing the goal)
+        assert_eq!(r.state(), AttackerState::RunAndKick);
+        let c = r.cycle(&far);
+        assert_eq!((c.kick, r.state()), (None, AttackerState::RunAndKick), "{c:?}");
+        assert!(c.vlin > 0.0, "pushes on: {c:?}");
+        let c = r.cycle(&world(0.1, me, (7400.0, 0.0)));
+        assert_eq!(c.kick, Some(1), "within reach: {c:?}");
+    }
+
+    /// FACE_GOAL goes round the ball facing it: a robot beside the ball heads for a point
+    /// on the circle round it (not straight for the posture behind it) and turns to the
+    /// ball, which stays before its camera.
+    #[test]
+    fn face_goal_goes_round_the_ball_facing_it() {
+        let clock = Arc::new(SimClock::new());
+        let mut r = IsocrobBrain::new(2, Role::Attacker, 1, board(2, &clock)).unwrap();
+        // The ball 0.6 m to the robot's left; the robot faces up the field, the goal ahead.
+        let me = Pose2::new(0.0, 0.0, 0.0);
+        let w = world(0.0, me, (0.0, 600.0));
+        r.cycle(&w); // APPROACH_BALL: not yet before it, so no FACE_GOAL
+        let mut w = w;
+        w.my_pos.pose.theta = std::f64::consts::FRAC_PI_2;
+        w.lps[lps::BALL].theta = 0.0;
+        w.lps[lps::NET1].theta -= std::f64::consts::FRAC_PI_2;
+        r.cycle(&w); // facing the ball: FACE_GOAL
+        assert_eq!(r.state(), AttackerState::FaceGoal);
+        let c = r.cycle(&w);
+        assert_eq!(r.state(), AttackerState::FaceGoal);
+        assert!(c.vrot.abs() < 1e-9, "keeps facing the ball: {c:?}");
+        // By hand: the posture is 350 mm behind the ball, at about (−349, 623) mm; the robot
+        // is at −90° about the ball and the posture at about 176°, the shorter way clockwise.
+        // The waypoint is 0.6 rad on, at −124° on the 600 mm circle: (−339, 105) mm, in the
+        // robot's frame (facing +y) 105 mm ahead and 339 mm to its left.
+        assert!(c.vlat > 0.0 && c.vlin > 0.0, "{c:?}");
+        assert!((c.vlin / c.vlat - 105.0 / 339.0).abs() < 0.02, "{c:?}");
     }
 
     /// The goalkeeper stands on its axis (0.4 m before its goal line) in front of the ball,

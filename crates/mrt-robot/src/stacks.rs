@@ -114,6 +114,11 @@ const MILAN: &[(&str, &str)] = &[
     ("want.txt", include_str!("../../../configs/brian/milan/want.txt")),
 ];
 
+/// How far round the ball [`Geometry::orbit`] aims ahead of the robot, rad: small enough that
+/// the chord to the waypoint stays well outside the ball's circle (at 0.6 rad it passes at
+/// 96 % of the radius).
+pub const ORBIT_STEP: f64 = 0.6;
+
 /// The field as the teams need it, in the team frame (mm), from the snapshot's field.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Geometry {
@@ -164,6 +169,23 @@ impl Geometry {
             py -= side * 600.0 * ux;
         }
         (px, py)
+    }
+
+    /// Where to go to reach `behind` (a posture from [`Geometry::behind_ball`]) round the
+    /// ball, `radius` mm from it: along that circle the shorter way, at most [`ORBIT_STEP`]
+    /// ahead of the robot's own angle about the ball, and straight to the posture once the
+    /// robot is within [`ORBIT_STEP`] of it. A robot that faces the ball on the way keeps it
+    /// before its camera and never sweeps it along with its front (ISocRob's FACE_GOAL with a
+    /// 63° front camera: docs/teams.md).
+    pub fn orbit(me: Pose2, ball: (f64, f64), behind: Pose2, radius: f64) -> (f64, f64) {
+        let mine = (me.y - ball.1).atan2(me.x - ball.0);
+        let goal = (behind.y - ball.1).atan2(behind.x - ball.0);
+        let turn = mrt_core::normalize_angle(goal - mine);
+        if turn.abs() <= ORBIT_STEP {
+            return (behind.x, behind.y);
+        }
+        let a = mine + ORBIT_STEP.copysign(turn);
+        (ball.0 + radius * a.cos(), ball.1 + radius * a.sin())
     }
 
     /// Where along the opponent's goal line to shoot (mm from its centre): the open side,
@@ -539,6 +561,48 @@ mod tests {
 
     /// The Parser gives Mr. BRIAN the robots MAP anchored: the nearest opponent (a teammate
     /// nearer is skipped) and the free direction towards the opponent's net.
+    #[test]
+    fn orbit_goes_round_the_ball_the_shorter_way_and_never_through_it() {
+        use std::f64::consts::PI;
+        let g = Geometry { half_length: 9000.0, goal_half_width: 1000.0 };
+        let ball = (0.0, 0.0);
+        let behind = g.behind_ball(ball, 350.0);
+        assert!((behind.x + 350.0).abs() < 1e-9 && behind.y.abs() < 1e-9);
+        // In front of the ball (between it and the opponent's net), a little to its left:
+        // round by the left, 0.6 rad further about the ball, on the 600 mm circle.
+        let me = Pose2::new(600.0 * 0.1f64.cos(), 600.0 * 0.1f64.sin(), PI);
+        let (x, y) = Geometry::orbit(me, ball, behind, 600.0);
+        assert!((x.hypot(y) - 600.0).abs() < 1e-9);
+        assert!((y.atan2(x) - 0.7).abs() < 1e-9, "{x} {y}");
+        // Mirrored: round by the right.
+        let me = Pose2::new(me.x, -me.y, PI);
+        let (_, y) = Geometry::orbit(me, ball, behind, 600.0);
+        assert!(y < 0.0);
+        // Close to the posture's side of the ball: straight to the posture.
+        let me = Pose2::new(-700.0, 200.0, 0.0);
+        assert_eq!(Geometry::orbit(me, ball, behind, 600.0), (behind.x, behind.y));
+        // Followed step by step from anywhere round the ball, the path reaches the posture
+        // and never comes nearer the ball than 90 % of the radius.
+        for k in 0..36 {
+            let a = f64::from(k) * PI / 18.0;
+            let mut me = Pose2::new(1500.0 * a.cos(), 1500.0 * a.sin(), 0.0);
+            let mut nearest = f64::INFINITY;
+            for _ in 0..2000 {
+                let (tx, ty) = Geometry::orbit(me, ball, behind, 600.0);
+                let (dx, dy) = (tx - me.x, ty - me.y);
+                let d = dx.hypot(dy);
+                if d < 1.0 {
+                    break;
+                }
+                let step = d.min(10.0);
+                me = Pose2::new(me.x + dx / d * step, me.y + dy / d * step, 0.0);
+                nearest = nearest.min(me.x.hypot(me.y));
+            }
+            assert!((me.x - behind.x).hypot(me.y - behind.y) < 1.0, "from {a} rad: {me:?}");
+            assert!(nearest > 0.9 * 350.0, "from {a} rad: {nearest} mm from the ball");
+        }
+    }
+
     #[test]
     fn milan_reads_the_nearest_opponent_and_the_free_direction() {
         let dir = embedded_milan().unwrap();
