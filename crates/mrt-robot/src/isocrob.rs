@@ -155,9 +155,9 @@ impl IsocrobBrain {
             facing: self.float("facing", 0.25),
             seen_ball: self.float("seen-ball", 0.3),
             kick_distance: self.float("kick-distance", 5.0),
-            kick_reach: self.float("kick-reach", 0.45),
+            kick_reach: self.float("kick-reach", 0.7),
             behind: self.float("behind", 0.35),
-            orbit: self.float("orbit", 0.6),
+            orbit: self.float("orbit", 0.0),
             heard: self.float("heard", 1.0),
             home_x: self.float(home, -1.0),
             home_spread: self.float("home-spread", 2.5),
@@ -502,15 +502,17 @@ mod tests {
         assert!(c.vlin > 0.0);
     }
 
-    /// In RUN_AND_KICK with the ball 0.7 m ahead (near, but beyond the kicker's reach of
-    /// 0.45 m) the attacker pushes on without firing: a pulse then would miss the ball and
+    /// With `kick-reach` at the kicker's reach (0.45 m), in RUN_AND_KICK with the ball
+    /// 0.65 m ahead (near, but beyond that reach) the attacker pushes on without firing: a pulse then would miss the ball and
     /// leave the solenoid recharging when the ball does reach the kicker.
     #[test]
     fn an_attacker_kicks_only_a_ball_within_the_kickers_reach() {
         let clock = Arc::new(SimClock::new());
-        let mut r = IsocrobBrain::new(2, Role::Attacker, 1, board(2, &clock)).unwrap();
+        let bb = board(2, &clock);
+        let mut r = IsocrobBrain::new(2, Role::Attacker, 1, bb.clone()).unwrap();
+        bb.set("local.var.machine.config.kick-reach", 0.45).unwrap();
         let me = Pose2::new(7000.0, 0.0, 0.0);
-        let far = world(0.0, me, (7700.0, 0.0));
+        let far = world(0.0, me, (7650.0, 0.0));
         r.cycle(&far); // APPROACH_BALL → FACE_GOAL (near, before it)
         r.cycle(&far); // FACE_GOAL → RUN_AND_KICK (facing the goal)
         assert_eq!(r.state(), AttackerState::RunAndKick);
@@ -521,13 +523,15 @@ mod tests {
         assert_eq!(c.kick, Some(1), "within reach: {c:?}");
     }
 
-    /// FACE_GOAL goes round the ball facing it: a robot beside the ball heads for a point
+    /// With `orbit` 0.6 m, FACE_GOAL goes round the ball facing it: a robot beside the ball heads for a point
     /// on the circle round it (not straight for the posture behind it) and turns to the
     /// ball, which stays before its camera.
     #[test]
     fn face_goal_goes_round_the_ball_facing_it() {
         let clock = Arc::new(SimClock::new());
-        let mut r = IsocrobBrain::new(2, Role::Attacker, 1, board(2, &clock)).unwrap();
+        let bb = board(2, &clock);
+        let mut r = IsocrobBrain::new(2, Role::Attacker, 1, bb.clone()).unwrap();
+        bb.set("local.var.machine.config.orbit", 0.6).unwrap();
         // The ball 0.6 m to the robot's left; the robot faces up the field, the goal ahead.
         let me = Pose2::new(0.0, 0.0, 0.0);
         let w = world(0.0, me, (0.0, 600.0));
