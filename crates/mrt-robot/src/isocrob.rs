@@ -502,9 +502,10 @@ mod tests {
         assert!(c.vlin > 0.0);
     }
 
-    /// With `kick-reach` at the kicker's reach (0.45 m), in RUN_AND_KICK with the ball
-    /// 0.65 m ahead (near, but beyond that reach) the attacker pushes on without firing: a pulse then would miss the ball and
-    /// leave the solenoid recharging when the ball does reach the kicker.
+    /// With `kick-reach` at the kicker's reach (0.45 m), in RUN_AND_KICK with the ball 0.65 m
+    /// ahead (near, but beyond that reach) the attacker pushes on without firing: a pulse
+    /// then would miss the ball and leave the solenoid recharging when the ball does reach
+    /// the kicker.
     #[test]
     fn an_attacker_kicks_only_a_ball_within_the_kickers_reach() {
         let clock = Arc::new(SimClock::new());
@@ -523,9 +524,9 @@ mod tests {
         assert_eq!(c.kick, Some(1), "within reach: {c:?}");
     }
 
-    /// With `orbit` 0.6 m, FACE_GOAL goes round the ball facing it: a robot beside the ball heads for a point
-    /// on the circle round it (not straight for the posture behind it) and turns to the
-    /// ball, which stays before its camera.
+    /// With `orbit` 0.6 m, FACE_GOAL goes round the ball facing it: a robot beside the ball
+    /// heads for a point on the circle round it (not straight for the posture behind it)
+    /// and turns to the ball, which stays before its camera.
     #[test]
     fn face_goal_goes_round_the_ball_facing_it() {
         let clock = Arc::new(SimClock::new());
