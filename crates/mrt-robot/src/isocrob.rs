@@ -278,16 +278,16 @@ impl IsocrobBrain {
             // goal, facing the ball all the way (a robot with no dribbler cannot turn holding
             // it, and a front camera that looks away from the ball loses it). Behind the ball,
             // facing it is facing the goal.
-            AttackerState::FaceGoal if p.orbit > 0.0 => {
-                let behind = field.behind_ball(ball_at, p.behind * MM);
-                let to = Geometry::orbit(me, ball_at, behind, p.orbit * MM);
-                go(me, to, towards_ball, &mut c);
-            }
-            // `orbit` 0: straight to the posture, facing the goal, stepping round the ball
-            // when on its wrong side.
+            // With `orbit` 0: straight to the posture, facing the goal, stepping round the
+            // ball when on its wrong side.
             AttackerState::FaceGoal => {
                 let behind = field.behind_ball(ball_at, p.behind * MM);
-                go(me, Geometry::step_round(me, ball_at, behind), behind.theta, &mut c);
+                let (to, face) = if p.orbit > 0.0 {
+                    (Geometry::orbit(me, ball_at, behind, p.orbit * MM), towards_ball)
+                } else {
+                    (Geometry::step_round(me, ball_at, behind), behind.theta)
+                };
+                go(me, to, face, &mut c);
             }
             // push_ball(): through the ball towards the goal; kick_ball() when the goal is
             // near enough and the ball lies before the kicker.
@@ -502,16 +502,22 @@ mod tests {
         assert!(c.vlin > 0.0);
     }
 
+    /// Attacker 2 of its team with the Machine's parameter `name` set to `value` on its
+    /// blackboard (over `config.dat`'s).
+    fn attacker_with(name: &str, value: f64) -> IsocrobBrain {
+        let bb = board(2, &Arc::new(SimClock::new()));
+        let r = IsocrobBrain::new(2, Role::Attacker, 1, bb.clone()).unwrap();
+        bb.set(&format!("local.var.machine.config.{name}"), value).unwrap();
+        r
+    }
+
     /// With `kick-reach` at the kicker's reach (0.45 m), in RUN_AND_KICK with the ball 0.65 m
     /// ahead (near, but beyond that reach) the attacker pushes on without firing: a pulse
     /// then would miss the ball and leave the solenoid recharging when the ball does reach
     /// the kicker.
     #[test]
     fn an_attacker_kicks_only_a_ball_within_the_kickers_reach() {
-        let clock = Arc::new(SimClock::new());
-        let bb = board(2, &clock);
-        let mut r = IsocrobBrain::new(2, Role::Attacker, 1, bb.clone()).unwrap();
-        bb.set("local.var.machine.config.kick-reach", 0.45).unwrap();
+        let mut r = attacker_with("kick-reach", 0.45);
         let me = Pose2::new(7000.0, 0.0, 0.0);
         let far = world(0.0, me, (7650.0, 0.0));
         r.cycle(&far); // APPROACH_BALL → FACE_GOAL (near, before it)
@@ -529,10 +535,7 @@ mod tests {
     /// and turns to the ball, which stays before its camera.
     #[test]
     fn face_goal_goes_round_the_ball_facing_it() {
-        let clock = Arc::new(SimClock::new());
-        let bb = board(2, &clock);
-        let mut r = IsocrobBrain::new(2, Role::Attacker, 1, bb.clone()).unwrap();
-        bb.set("local.var.machine.config.orbit", 0.6).unwrap();
+        let mut r = attacker_with("orbit", 0.6);
         // The ball 0.6 m to the robot's left; the robot faces up the field, the goal ahead.
         let me = Pose2::new(0.0, 0.0, 0.0);
         let w = world(0.0, me, (0.0, 600.0));
