@@ -11,7 +11,9 @@
 //! The predicates come from the robot's world snapshot, never from the simulator:
 //! - `ffb()`: the ball was seen within `seen-ball` seconds (the front camera's LPS ball);
 //! - `ffog()`: the opponent's goal centre lies within `facing` of straight ahead (the world
-//!   model's LPS net, placed by the pose estimate when not in sight);
+//!   model's LPS net, placed by the pose estimate when not in sight); in FACE_GOAL, with the
+//!   ball also within `ahead` of the kicker (a robot facing the goal with the ball beside it
+//!   goes on round: RUN_AND_KICK would push the ball off sideways);
 //! - `fnb()`: the ball is seen, nearer than `att.near-ball` and before the kicker (in
 //!   FACE_GOAL, which goes round the ball, near is enough);
 //! - `r(360)`: the search turned the robot round once (its estimated heading, unwrapped);
@@ -20,7 +22,9 @@
 //! - `slg()`: [`should_i_go`] on the heuristics heard within `heard` seconds.
 //!
 //! The seed's robots "stand still" in SHOULD_I_GO; these walk to their home posture meanwhile,
-//! facing the ball, so that a robot that is not going for the ball stays in the game.
+//! facing the ball, so that a robot that is not going for the ball stays in the game. The
+//! home postures follow the team's ball: the attackers `att.support` ahead of it in their
+//! lanes, the defender `def.guard` of the way out from its goal towards it.
 
 use crate::brain::Brain;
 use crate::stacks::{drive_to, walk_to_kickoff, Geometry};
@@ -107,6 +111,9 @@ struct Params {
     kick_reach: f64,
     behind: f64,
     orbit: f64,
+    ahead: f64,
+    guard: f64,
+    support: f64,
     heard: f64,
     home_x: f64,
     home_spread: f64,
@@ -158,6 +165,9 @@ impl IsocrobBrain {
             kick_reach: self.float("kick-reach", 0.7),
             behind: self.float("behind", 0.35),
             orbit: self.float("orbit", 0.0),
+            ahead: self.float("ahead", 0.0),
+            guard: self.float("def.guard", 0.0),
+            support: self.float("att.support", 0.0),
             heard: self.float("heard", 1.0),
             home_x: self.float(home, -1.0),
             home_spread: self.float("home-spread", 2.5),
@@ -238,7 +248,29 @@ impl IsocrobBrain {
         // The home posture: attackers spread across the field, the defender back.
         let side = if self.index % 2 == 0 { 1.0 } else { -1.0 };
         let lane = side * p.home_spread * (self.index / 2 + 1) as f64 / 2.0;
-        let home = (p.home_x, lane);
+        let mut home = (p.home_x, lane);
+        // Home postures that follow the ball the team believes in (MAP's team ball):
+        let hl = w.field.half_length / MM;
+        let ball_m = w.global_ball.pose;
+        let ball_m = (w.global_ball.quality > 0.0).then_some((ball_m.x / MM, ball_m.y / MM));
+        match (self.role, ball_m) {
+            // an attacker with `att.support`: that far ahead of the ball (behind it when
+            // negative), in its lane, to take up what comes loose;
+            (Role::Attacker, Some((bx, _))) if p.support != 0.0 => {
+                home.0 = (bx + p.support).clamp(1.0 - hl, hl - 1.0);
+            }
+            // the defender with `def.guard`: between the ball and its own goal, on the line
+            // from the goal's centre to the ball, that fraction of the way out (≥ 1.5 m).
+            (Role::Defender, Some((bx, by))) if p.guard > 0.0 => {
+                let (dx, dy) = (bx + hl, by);
+                let d = dx.hypot(dy);
+                if d > 1.5 {
+                    let out = (p.guard * d).max(1.5) / d;
+                    home = (out * dx - hl, out * dy);
+                }
+            }
+            _ => {}
+        }
         let rp = (me_m.x - home.0).hypot(me_m.y - home.1) <= p.reached;
         // r(360): the heading turned since the search began.
         let rotated = match (self.attacker.state(), &mut self.search) {
@@ -249,6 +281,11 @@ impl IsocrobBrain {
             }
             _ => false,
         };
+        // FACE_GOAL ends facing the goal with the ball before the kicker, not beside it.
+        let ffog = ffog
+            && (p.ahead <= 0.0
+                || self.attacker.state() != AttackerState::FaceGoal
+                || ball.theta.abs() < p.ahead);
         let pred = Predicates { ffb, ffog, fnb, rotated, rp, kb: kicked, slg };
         let state = self.attacker.step(&pred);
         self.search = match (state, self.search) {
@@ -555,6 +592,64 @@ mod tests {
         // robot's frame (facing +y) 105 mm ahead and 339 mm to its left.
         assert!(c.vlat > 0.0 && c.vlin > 0.0, "{c:?}");
         assert!((c.vlin / c.vlat - 105.0 / 339.0).abs() < 0.02, "{c:?}");
+    }
+
+    /// With `ahead` 0.3 rad, FACE_GOAL hands over to RUN_AND_KICK only when the robot faces
+    /// the goal with the ball before its kicker: facing the goal with the ball 0.5 rad to the
+    /// side it goes on round; without `ahead` it would run with the ball beside it and push
+    /// it off sideways.
+    #[test]
+    fn face_goal_runs_only_with_the_ball_before_the_kicker() {
+        let me = Pose2::new(0.0, 0.0, 0.0);
+        let beside = (400.0 * 0.5f64.cos(), 400.0 * 0.5f64.sin());
+        let mut plain = attacker_with("ahead", 0.0);
+        plain.cycle(&world(0.0, me, beside)); // APPROACH_BALL → FACE_GOAL (near, within 0.6)
+        plain.cycle(&world(0.1, me, beside));
+        assert_eq!(plain.state(), AttackerState::RunAndKick, "the seed's ffog alone");
+        let mut r = attacker_with("ahead", 0.3);
+        r.cycle(&world(0.0, me, beside));
+        r.cycle(&world(0.1, me, beside));
+        assert_eq!(r.state(), AttackerState::FaceGoal, "the ball beside the kicker");
+        r.cycle(&world(0.2, me, (400.0, 40.0)));
+        assert_eq!(r.state(), AttackerState::RunAndKick, "the ball before it");
+    }
+
+    /// A robot of the team that waits in SHOULD_I_GO (a teammate posted a better heuristic)
+    /// while the team believes the ball is at (−3, 3) m, and where it heads.
+    fn waiting_at(role: Role, index: usize, name: &str, value: f64) -> Pose2 {
+        let bb = board(2, &Arc::new(SimClock::new()));
+        let mut r = IsocrobBrain::new(2, role, index, bb.clone()).unwrap();
+        bb.set(&format!("local.var.machine.config.{name}"), value).unwrap();
+        bb.set(&format!("{HEURISTIC}9"), -10.0).unwrap();
+        let mut w = world(0.0, Pose2::new(-1000.0, -3000.0, 0.0), (-3000.0, 3000.0));
+        w.global_ball.pose = Pose2::new(-3000.0, 3000.0, 0.0);
+        w.global_ball.quality = 0.5;
+        r.cycle(&w);
+        let c = r.cycle(&w);
+        assert_eq!(r.state(), AttackerState::ShouldIGo);
+        c.target.unwrap().pose
+    }
+
+    /// With `def.guard` 0.33, the defender waits on the line from the centre of its own goal
+    /// (−9, 0) m to the ball, a third of the way out: by hand, (−9, 0) + 0.33·(6, 3) =
+    /// (−7.02, 0.99) m. Without it, at its fixed home (−5 m, in its lane).
+    #[test]
+    fn the_defender_guards_the_line_from_its_goal_to_the_ball() {
+        let t = waiting_at(Role::Defender, 0, "def.guard", 0.33);
+        assert!((t.x + 7020.0).abs() < 1e-6 && (t.y - 990.0).abs() < 1e-6, "{t:?}");
+        let t = waiting_at(Role::Defender, 0, "def.guard", 0.0);
+        assert!((t.x + 5000.0).abs() < 1e-6 && (t.y - 1250.0).abs() < 1e-6, "{t:?}");
+    }
+
+    /// With `att.support` 2 m, an attacker not going for the ball waits 2 m ahead of where
+    /// the team believes it is (x = −3 + 2 = −1 m), in its lane (index 1: 1.25 m to the right);
+    /// with −1.5 m, 1.5 m behind it.
+    #[test]
+    fn an_attacker_waits_ahead_of_the_ball_to_support() {
+        let t = waiting_at(Role::Attacker, 1, "att.support", 2.0);
+        assert!((t.x + 1000.0).abs() < 1e-6 && (t.y + 1250.0).abs() < 1e-6, "{t:?}");
+        let t = waiting_at(Role::Attacker, 1, "att.support", -1.5);
+        assert!((t.x + 4500.0).abs() < 1e-6 && (t.y + 1250.0).abs() < 1e-6, "{t:?}");
     }
 
     /// The goalkeeper stands on its axis (0.4 m before its goal line) in front of the ball,
