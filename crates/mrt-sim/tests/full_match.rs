@@ -71,8 +71,8 @@ fn a_full_match_finishes_and_reproduces_its_trajectory_hash() {
 
 /// Team ISocRob (seed `003` §3.2.2) plays a whole match against the baseline: its robots talk
 /// only through their blackboards (the heuristics of `should_I_go` carried by the Proxy), no
-/// Member of theirs fails, they shoot on target and score (seed 5, oracle: 4 : 0; 100 seeds:
-/// 179 : 60, docs/teams.md), and the same seed gives the same match.
+/// Member of theirs fails, they shoot on target and score (seed 5, oracle: 4 : 0; the series
+/// are in docs/teams.md), and the same seed gives the same match.
 #[test]
 fn team_isocrob_plays_a_match_on_its_blackboards() {
     let cfg = SimConfig::oracle();
