@@ -251,8 +251,9 @@ impl IsocrobBrain {
         let mut home = (p.home_x, lane);
         // Home postures that follow the ball the team believes in (MAP's team ball):
         let hl = w.field.half_length / MM;
-        let ball_m = w.global_ball.pose;
-        let ball_m = (w.global_ball.quality > 0.0).then_some((ball_m.x / MM, ball_m.y / MM));
+        let team_ball = w.global_ball;
+        let ball_m =
+            (team_ball.quality > 0.0).then_some((team_ball.pose.x / MM, team_ball.pose.y / MM));
         match (self.role, ball_m) {
             // an attacker with `att.support`: that far ahead of the ball (behind it when
             // negative), in its lane, to take up what comes loose;
@@ -542,10 +543,16 @@ mod tests {
     /// Attacker 2 of its team with the Machine's parameter `name` set to `value` on its
     /// blackboard (over `config.dat`'s).
     fn attacker_with(name: &str, value: f64) -> IsocrobBrain {
+        robot_with(Role::Attacker, 1, name, value).0
+    }
+
+    /// Robot 2 of its team playing `role` as field player `index`, with the Machine's
+    /// parameter `name` set to `value`, and its blackboard.
+    fn robot_with(role: Role, index: usize, name: &str, value: f64) -> (IsocrobBrain, Blackboard) {
         let bb = board(2, &Arc::new(SimClock::new()));
-        let r = IsocrobBrain::new(2, Role::Attacker, 1, bb.clone()).unwrap();
+        let r = IsocrobBrain::new(2, role, index, bb.clone()).unwrap();
         bb.set(&format!("local.var.machine.config.{name}"), value).unwrap();
-        r
+        (r, bb)
     }
 
     /// With `kick-reach` at the kicker's reach (0.45 m), in RUN_AND_KICK with the ball 0.65 m
@@ -617,9 +624,7 @@ mod tests {
     /// A robot of the team that waits in SHOULD_I_GO (a teammate posted a better heuristic)
     /// while the team believes the ball is at (−3, 3) m, and where it heads.
     fn waiting_at(role: Role, index: usize, name: &str, value: f64) -> Pose2 {
-        let bb = board(2, &Arc::new(SimClock::new()));
-        let mut r = IsocrobBrain::new(2, role, index, bb.clone()).unwrap();
-        bb.set(&format!("local.var.machine.config.{name}"), value).unwrap();
+        let (mut r, bb) = robot_with(role, index, name, value);
         bb.set(&format!("{HEURISTIC}9"), -10.0).unwrap();
         let mut w = world(0.0, Pose2::new(-1000.0, -3000.0, 0.0), (-3000.0, 3000.0));
         w.global_ball.pose = Pose2::new(-3000.0, 3000.0, 0.0);
