@@ -809,6 +809,54 @@ fn field_players_share_the_roles_by_their_distance_to_the_ball() {
     close(c.vlat, 0.0);
 }
 
+/// The Supporter and the Defender keep their roles while a teammate is within `HOLD` (400
+/// mm) of their own distance to the ball, and swap once it is clearly nearer or farther. The
+/// robot stands 800 mm from the ball, as in the test above; teammate A at (−1000, 300) is 361
+/// mm from the ball (clearly nearer), teammate B moves:
+/// - B 1000 mm from the ball (200 mm farther than the robot): rank 2, Support, cycle after
+///   cycle. With the hold margins the wrong way round (Support → Defend when B is nearer
+///   than the robot's distance + 400; Defend → Support when only A is nearer than its
+///   distance − 400) both swaps held here and the robot changed roles at every cycle,
+///   turning its spot back and forth (a trace of a vision match: 600 swaps a match);
+/// - B 100 mm from the ball: rank 3, Defend;
+/// - B back at 1000 mm: still within the hold, the robot stays Defend;
+/// - B 1300 mm from the ball (500 mm farther): Support again.
+#[test]
+fn supporter_and_defender_hold_their_roles_within_the_margin() {
+    let mut cap =
+        ThinkingCap::with_hfsm(dir(), dir().join("player.hfsm.lua"), Sandbox::default()).unwrap();
+    let world = |t: u64, b_from_ball: f64| {
+        World::at(t)
+            .playing()
+            .me(-2000.0, 0.0, 0.0, 0.9)
+            .ball(800.0, 0.0)
+            .global_ball(-1200.0, 0.0)
+            .net1(7800.0, 0.0)
+            .mate(0, -8500.0, 0.0, true)
+            .mate(2, -1000.0, 300.0, false)
+            .mate(3, -1200.0, -b_from_ball, false)
+    };
+    let mut t = 0;
+    let mut play = |b_from_ball: f64, cycles: usize| {
+        (0..cycles)
+            .map(|_| {
+                t += 100;
+                let c = cap.cycle(world(t, b_from_ball).0);
+                assert!(c.errors.is_empty(), "{:?}", c.errors);
+                c.path
+            })
+            .collect::<Vec<_>>()
+    };
+    let start = play(1000.0, 8);
+    assert_eq!(start[..2], ["Player/Wait", "Player/Search"]);
+    assert!(start[2..].iter().all(|p| p == "Player/Support"), "{start:?}");
+    assert!(play(100.0, 3).iter().all(|p| p == "Player/Defend"));
+    let held = play(1000.0, 6);
+    assert!(held.iter().all(|p| p == "Player/Defend"), "{held:?}");
+    let back = play(1300.0, 2);
+    assert_eq!(back.last().map(String::as_str), Some("Player/Support"), "{back:?}");
+}
+
 /// The behaviors read the field from the world model (`getField`): on a 12 m field the
 /// goalkeeper's own net is at x = −6000, so a keeper standing at x = −6050 is in it
 /// (inOwnNet = TOL(−6100, −5850)(−6050) = 0.8 ≥ every other meta-rule's NOT(inOwnNet) = 0.2;
