@@ -54,12 +54,18 @@ function aimPoint()
   return f.half_length, side * (f.goal_half_width - 250)
 end
 
--- The bearing to shoot at (rad, left positive): the opponent's net as the camera sees it,
--- moved from its middle to the aim point; by the global pose when the net is not in view.
+-- The bearing to shoot at (rad, left positive). A robot localized well (quality at least
+-- AIM_BY_POSE) aims by its global pose. The others aim by the opponent's net as the camera
+-- sees it, moved from its middle to the aim point (the seed's alignment, for an AIBO that was
+-- often lost), or by the pose when the net is not in view. With the cameras, a net cut by the
+-- image's border is seen off its middle: in a vision match the camera's bearing was more than
+-- 0.2 rad off the pose's in one Align cycle in five, the pose's heading 0.2 deg off the truth
+-- (median). The Attacker then went back and forth between Align and DoKick.
+AIM_BY_POSE = 0.6
 function aimBearing()
   local ax, ay = aimPoint()
   local n = lpo(NET1)
-  if n.reliability > 0.1 then
+  if n.reliability > 0.1 and chaos.gsGetMyPos().quality < AIM_BY_POSE then
     return n.theta + bearingTo(ax, ay) - bearingTo(ax, 0)
   end
   return bearingTo(ax, ay)

@@ -61,6 +61,13 @@ impl World {
         self
     }
 
+    /// Localized too poorly to aim by its pose (quality 0.5, under hbm.lua's `AIM_BY_POSE`
+    /// 0.6): the robot aims by the net as its camera sees it, the seed's way.
+    fn aims_by_camera(mut self) -> World {
+        self.0.my_pos.quality = 0.5;
+        self
+    }
+
     /// No net seen for `s` seconds.
     fn nets_unseen(mut self, s: f64) -> World {
         for i in [lps::NET1, lps::NET2] {
@@ -254,19 +261,53 @@ fn dokick_kicks_when_the_ball_is_ahead_and_touching() {
 fn alignbnet1_strafes_to_put_the_net_behind_the_ball() {
     // Net seen 0.5 rad left of the ball: netLeftOfBall = TOR(0.05, 0.4)(0.5) = 1 → strafe
     // RIGHT → −100; ball ahead → turn NONE → 0; go STAY → 0.
-    let c = run("alignbnet1", World::at(0).ball(400.0, 0.0).net1(3000.0, 0.5));
+    let c = run("alignbnet1", World::at(0).aims_by_camera().ball(400.0, 0.0).net1(3000.0, 0.5));
     close(c.command.vlat, -100.0 * STRAFE);
     close(c.command.vrot, 0.0);
     close(c.command.vlin, 0.0);
     assert_eq!((c.command.need(lps::BALL), c.command.need(lps::NET1)), (1.0, 1.0));
     // Net right of the ball → strafe LEFT → +100; behind it → NONE → 0.
     close(
-        run("alignbnet1", World::at(0).ball(400.0, 0.1).net1(3000.0, -0.4)).command.vlat,
+        run("alignbnet1", World::at(0).aims_by_camera().ball(400.0, 0.1).net1(3000.0, -0.4))
+            .command
+            .vlat,
         100.0 * STRAFE,
     );
-    close(run("alignbnet1", World::at(0).ball(400.0, 0.0).net1(3000.0, 0.0)).command.vlat, 0.0);
+    close(
+        run("alignbnet1", World::at(0).aims_by_camera().ball(400.0, 0.0).net1(3000.0, 0.0))
+            .command
+            .vlat,
+        0.0,
+    );
     // Net not seen: no strafe rule fires, vlat stays at its default 0.
-    close(run("alignbnet1", World::at(0).ball(400.0, 0.0)).command.vlat, 0.0);
+    close(run("alignbnet1", World::at(0).aims_by_camera().ball(400.0, 0.0)).command.vlat, 0.0);
+}
+
+/// A robot localized well (quality 0.9 ≥ `AIM_BY_POSE`) aims by its pose, not by a net its
+/// camera sees off its middle (a net cut by the image's border). At (0, 1000) facing the net,
+/// the net's middle (9000, 0) lies atan2(−1000, 9000) = −0.110 rad right, and so right of the
+/// ball straight ahead: netRightOfBall = TOL(−0.4, −0.05)(−0.110) = 0.171 and netBehindBall =
+/// TRI(−0.2, 0, 0.2)(−0.110) = 0.448, a small step to the left, whatever the camera says of
+/// the net (0.5 rad left here, which alone would call for a step to the right, −100).
+#[test]
+fn a_well_localized_robot_aims_by_its_pose_not_by_a_net_seen_off_its_middle() {
+    let w = World::at(0).me(0.0, 1000.0, 0.0, 0.9).ball(400.0, 0.0).net1(9000.0, 0.5);
+    let c = run("alignbnet1", w.clone());
+    let off = (-1000.0f64).atan2(9000.0);
+    let (right, behind) = ((-0.05 - off) / 0.35, 1.0 - off.abs() / 0.2);
+    let want = centroid(&[
+        (-100.0, 0.0),
+        (-100.0 + 100.0 * behind, behind),
+        (100.0 - 100.0 * behind, behind),
+        (100.0 - 100.0 * right, right),
+        (200.0 - 100.0 * right, right),
+        (200.0, 0.0),
+    ]);
+    assert!(want > 0.0 && want < 40.0, "{want}");
+    close(c.command.vlat, want * STRAFE);
+    // The same robot lost (quality 0.5) follows its camera: the net left of the ball, a step
+    // to the right.
+    close(run("alignbnet1", w.aims_by_camera()).command.vlat, -100.0 * STRAFE);
 }
 
 /// The aim moves away from the opponent's goalkeeper: with an opponent anchored at
@@ -454,18 +495,18 @@ fn the_attacker_hfsm_faces_walks_scores_and_follows_the_ball() {
         //    needs NET1 at 0.5.
         World::at(300).ball(2000.0, 0.0).me(0.0, 0.0, 0.0, 0.5).nets_unseen(6.0),
         // 4: 450 mm (< 500): NearBall → Score, entered at ApproachBall.
-        World::at(400).ball(450.0, 0.0).net1(4000.0, 0.6),
+        World::at(400).ball(450.0, 0.0).net1(4000.0, 0.6).aims_by_camera(),
         // 5: 450 mm (< 600) and aligned: Kickable → DoKick.
-        World::at(500).ball(450.0, 0.0).net1(4000.0, aligned),
+        World::at(500).ball(450.0, 0.0).net1(4000.0, aligned).aims_by_camera(),
         // 6: alignment lost: LostAlignment → Align.
-        World::at(600).ball(450.0, 0.0).net1(4000.0, 0.5),
+        World::at(600).ball(450.0, 0.0).net1(4000.0, 0.5).aims_by_camera(),
         // 7: aligned again, ball at 200 mm: Aligned → DoKick, which kicks.
-        World::at(700).ball(200.0, 0.0).net1(4000.0, aligned),
+        World::at(700).ball(200.0, 0.0).net1(4000.0, aligned).aims_by_camera(),
         // 8: the ball rolled to 1.2 m and the net is off: Score's BallAway (> 900) and DoKick's
         //    LostAlignment both pass; the enclosing meta-state's transition wins.
-        World::at(800).ball(1200.0, 0.0).net1(4000.0, 0.5),
+        World::at(800).ball(1200.0, 0.0).net1(4000.0, 0.5).aims_by_camera(),
         // 9: the ball far on the right (|θ| > 0.8): BallAside → FaceBall.
-        World::at(900).ball(1200.0, -1.0).net1(4000.0, 0.5),
+        World::at(900).ball(1200.0, -1.0).net1(4000.0, 0.5).aims_by_camera(),
     ];
     let cycles: Vec<Cycle> = worlds.iter().map(|w| cap.cycle(w.0.clone())).collect();
     for (k, c) in cycles.iter().enumerate() {
@@ -566,13 +607,13 @@ fn the_attacker_aligns_first_when_approaching_a_misaligned_ball() {
     let mut cap =
         ThinkingCap::with_hfsm(dir(), dir().join("attacker.hfsm.lua"), Sandbox::default()).unwrap();
     let worlds = [
-        World::at(0).ball(2000.0, 0.0).net1(5000.0, 0.0),
-        World::at(100).ball(2000.0, 0.0).net1(5000.0, 0.0),
-        World::at(200).ball(480.0, 0.0).net1(5000.0, -0.5),
+        World::at(0).ball(2000.0, 0.0).net1(5000.0, 0.0).aims_by_camera(),
+        World::at(100).ball(2000.0, 0.0).net1(5000.0, 0.0).aims_by_camera(),
+        World::at(200).ball(480.0, 0.0).net1(5000.0, -0.5).aims_by_camera(),
         // 650 mm: the seed's Kickable needs < 600: stay in ApproachBall.
-        World::at(300).ball(650.0, 0.0).net1(5000.0, -0.5),
+        World::at(300).ball(650.0, 0.0).net1(5000.0, -0.5).aims_by_camera(),
         // 550 mm, net 0.5 rad right of the ball: Misaligned → Align; strafe LEFT +100.
-        World::at(400).ball(550.0, 0.0).net1(5000.0, -0.5),
+        World::at(400).ball(550.0, 0.0).net1(5000.0, -0.5).aims_by_camera(),
     ];
     let cycles: Vec<Cycle> = worlds.iter().map(|w| cap.cycle(w.0.clone())).collect();
     let paths: Vec<&str> = cycles.iter().map(|c| c.path.as_str()).collect();
