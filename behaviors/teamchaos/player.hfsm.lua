@@ -53,7 +53,7 @@ machine "Player" {
     { name = "Defend", from = "Search", to = "Defend", priority = 2, test = function() return ballKnown() and ballRank(0) > 2 end },
     { name = "BallLost", from = "Attack", to = "Search", test = "chaos.lps_getLpo(BALL).reliability < 0.2" },
     { name = "WrongSide", from = "Attack", to = "GetBehind", priority = 2, test = function() return aheadOfBall() > -150 or chaos.lps_getLpo(BALL).rho > 2000 end },
-    { name = "Behind", from = "GetBehind", to = "Attack", test = function() return aheadOfBall() < -400 and chaos.lps_getLpo(BALL).rho < 1000 and ballSeenNow() and booked() end },
+    { name = "Behind", from = "GetBehind", to = "Attack", test = function() return aheadOfBall() < -250 and chaos.lps_getLpo(BALL).rho < 1500 and ballSeenNow() and booked() end },
     { name = "Stop", from = "GetBehind", to = "Wait", priority = -1, test = function() return not playing() end },
     { name = "GiveWay", from = "GetBehind", to = "Support", priority = 1, test = function() return ballRank(HOLD) > 1 end },
     { name = "BallLost", from = "GetBehind", to = "Search", priority = 2, test = function() return not ballKnown() end },

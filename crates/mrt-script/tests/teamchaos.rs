@@ -122,6 +122,17 @@ fn close(got: f64, want: f64) {
 /// Mamdani centroid of a piecewise linear membership given by its breakpoints `(x, μ)`:
 /// `∫xμ / ∫μ`, each linear piece contributing area h·(ya + yb)/2 and moment
 /// h/6·(ya·(2a + b) + yb·(a + 2b)). Used to spell out the hand computations.
+/// The cycle asked guidance for the posture `(x, y, theta)` (mm, mm, rad), straight there
+/// (position mode: no obstacle avoidance, no planning).
+#[track_caller]
+fn assert_target(c: &Cycle, (x, y, theta): (f64, f64, f64)) {
+    let t = c.command.target.unwrap_or_else(|| panic!("no target: {:?}", c.command));
+    close(t.pose.x, x);
+    close(t.pose.y, y);
+    close(t.pose.theta, theta);
+    assert!(!t.avoid && !t.plan, "{t:?}");
+}
+
 fn centroid(points: &[(f64, f64)]) -> f64 {
     let (mut area, mut moment) = (0.0, 0.0);
     for w in points.windows(2) {
@@ -356,28 +367,22 @@ fn alignbnet1_aims_at_the_side_of_the_net_away_from_its_keeper() {
 #[test]
 fn gkcutb_holds_the_goal_line_level_with_the_ball_and_clears_when_safe() {
     // The spot: 400 mm out of our goal line (x = −9000 + 400 = −8600), level with the ball
-    // but within the posts (|y| ≤ 1000 − 100), reached by gotopos facing the ball.
+    // but within the posts (|y| ≤ 1000 − 100), facing the ball: a posture for guidance in
+    // position mode (straight there, `avoid` false), not fuzzy velocities.
     // Robot at (−8600, −1500) facing +x, ball at (−5000, −1000): the spot is (−8600, −900),
-    // 600 mm to the robot's left: strafe LEFT = TOR(100, 600)(600) = 1 alone → +100; 0 mm
-    // ahead: go STAY → 0. The ball is at bearing atan2(500, 3600) = 0.14 (left): turn LEFT at
-    // TRI(0, 0.6, 1.5) = 0.23 and NONE at 0.54 → between 0 and 45.
-    let theta = 500.0f64.atan2(3600.0);
+    // facing atan2(−1000 + 1500, −5000 + 8600) = atan2(500, 3600).
     let w = World::at(0).me(-8600.0, -1500.0, 0.0, 0.9).global_ball(-5000.0, -1000.0);
-    let c = run("gkcutb", w.ball(3635.0, theta));
-    close(c.command.vlat, 100.0 * STRAFE);
-    close(c.command.vlin, 0.0);
-    assert!(c.command.vrot > 0.0 && c.command.vrot < 45.0 * TURN, "{:?}", c.command);
-    // The ball far out on the left (y = 3000): the spot stays at the post (y = 900), where
-    // the robot already is: strafe NONE → 0.
-    let theta = 2100.0f64.atan2(3600.0);
+    let c = run("gkcutb", w.ball(3635.0, 500.0f64.atan2(3600.0)));
+    assert_target(&c, (-8600.0, -900.0, 500.0f64.atan2(3600.0)));
+    assert_eq!(c.command.need(lps::BALL), 1.0);
+    // The ball far out on the left (y = 3000): the spot stays at the post (y = 900).
     let w = World::at(0).me(-8600.0, 900.0, 0.0, 0.9).global_ball(-5000.0, 3000.0);
-    close(run("gkcutb", w.ball(4168.0, theta)).command.vlat, 0.0);
-    // 1000 mm out in front of the spot, ball straight ahead: fw = −1000, go BACK =
-    // TOL(−1200, −200)(−1000) = 0.8 alone: the centroid of BACK clipped at 0.8.
+    let c = run("gkcutb", w.ball(4168.0, 2100.0f64.atan2(3600.0)));
+    assert_target(&c, (-8600.0, 900.0, 2100.0f64.atan2(3600.0)));
+    // 1000 mm out in front of the spot, ball straight ahead: back to (−8600, −900), facing 0.
     let w = World::at(0).me(-7600.0, -900.0, 0.0, 0.9).global_ball(-5000.0, -900.0);
     let c = run("gkcutb", w.ball(2600.0, 0.0));
-    let want = centroid(&[(-300.0, 0.8), (-270.0, 0.8), (-150.0, 0.0)]);
-    close(c.command.vlin, want * GO);
+    assert_target(&c, (-8600.0, -900.0, 0.0));
     assert_eq!(c.command.kick, None, "ball far: no kick");
     // Ball close (300 mm: ballClose = (750 − 300)/500 = 0.9) and heading 0 (freeToKick =
     // TOL(0.5, 1.2)(0) = 1): FRONTKICK 0.9 → kick 1.
@@ -418,6 +423,7 @@ fn goalkeeper_gets_out_of_its_net() {
     close(c.command.vlin, 150.0 * GO);
     close(c.command.vrot, 45.0 * TURN);
     close(c.command.vlat, 0.0);
+    assert_eq!(c.command.target, None);
     assert!(c.command.track_landmarks);
     assert_eq!(c.command.need(lps::NET1), 1.0);
     assert_eq!(c.command.kick, None);
@@ -439,32 +445,29 @@ fn goalkeeper_clears_a_ball_in_the_penalty_area() {
     close(c.command.vlat, 0.0);
     assert_eq!(c.command.need(lps::BALL), 1.0);
     // The ball 1.5 m ahead, still in the area (x = −7200): too far to run out for
-    // (TOL(800, 1500)(1500) = 0), so gkcutb holds the spot (−8600, 0), 100 mm ahead: go STAY
-    // alone → 0, no kick. The keeper does not leave its goal for a ball it cannot reach first.
+    // (TOL(800, 1500)(1500) = 0), so gkcutb holds the spot (−8600, 0), 100 mm ahead, facing
+    // the ball; no kick. The keeper does not leave its goal for a ball it cannot reach first.
     let c = run(
         "goalkeeper",
         World::at(0).me(-8700.0, 0.0, 0.0, 0.9).ball(1500.0, 0.0).global_ball(-7200.0, 0.0),
     );
-    close(c.command.vlin, 0.0);
+    assert_target(&c, (-8600.0, 0.0, 0.0));
     assert_eq!(c.command.kick, None);
 }
 
 #[test]
 fn goalkeeper_cuts_the_ball_from_its_goal_area_and_localizes_when_lost() {
-    // Robot at (−8500, 500); ball at (−4000, 1000), outside the penalty area → gkcutb at 1.
-    // Its spot (−8600, 900) is 400 mm to the left and 100 mm behind: strafe LEFT =
-    // TOR(100, 600)(400) = 0.6 alone → +100, go STAY → 0. The ball is at bearing
-    // atan2(500, 4500) = 0.11 (left): turn > 0.
+    // Robot at (−8500, 500); ball at (−4000, 1000), outside the penalty area → gkcutb at 1:
+    // its spot (−8600, 900), facing the ball, atan2(500, 4500) = 0.11 (left).
     let theta = 500.0f64.atan2(4500.0);
     let c = run(
         "goalkeeper",
         World::at(0).me(-8500.0, 500.0, 0.0, 0.9).ball(4528.0, theta).global_ball(-4000.0, 1000.0),
     );
-    close(c.command.vlat, 100.0 * STRAFE);
-    assert!(c.command.vrot > 0.0 && c.command.vrot < 45.0 * TURN, "{:?}", c.command);
-    close(c.command.vlin, 0.0);
+    assert_target(&c, (-8600.0, 900.0, theta));
     // The same with localization quality 0.2: wellLocalized = TOR(0.4, 0.8)(0.2) = 0, lost 1 →
-    // gklocalize alone: stand still (STAY, NONE, NONE → 0), landmarks, both nets at 0.6.
+    // gklocalize alone: stand still (STAY, NONE, NONE → 0, no posture), landmarks, both nets
+    // at 0.6.
     let c = run(
         "goalkeeper",
         World::at(0).me(-8500.0, 500.0, 0.0, 0.2).ball(4528.0, theta).global_ball(-4000.0, 1000.0),
@@ -784,7 +787,7 @@ fn editing_an_included_machine_file_reloads_the_machine() {
 /// is always left out of the ranking. The first cycle enters Wait, the second starts the game
 /// (Search); from the third the role is played, and `gotopos` drives towards its spot:
 /// - alone near the ball: rank 1 → GetBehind, then (800 mm ahead, 800 mm behind the ball on
-///   its line to the net: aheadOfBall = −800 < −400) Behind → the seed's Attacker;
+///   its line to the net: aheadOfBall = −800 < −250) Behind → the seed's Attacker;
 /// - a teammate at (−1000, 300), 361 mm from the ball: rank 2 → Support. The spot is 2 m
 ///   behind the ball and 1.5 m towards the middle (the ball is at y = 0, so +y): (−3200, 1500),
 ///   in the robot's frame 1200 mm back and 1500 mm left: go BACK alone (centroid of
@@ -848,6 +851,39 @@ fn field_players_share_the_roles_by_their_distance_to_the_ball() {
     let c = &third[2].command;
     close(c.vlin, -250.0 * GO);
     close(c.vlat, 0.0);
+}
+
+/// The attacker-to-be hands over to the seed's Attacker once it is behind the ball (more than
+/// 250 mm back along the ball's line to the net) and within 1.5 m of it. The ball is at
+/// (−1200, 0), the net's middle straight ahead along +x; the robot 1200 mm from the ball:
+/// - 300 mm back and 1162 mm aside, at (−1500, −1162): Behind → Attack/FaceBall;
+/// - 200 mm back, at (−1400, −1183): still GetBehind;
+/// - 1600 mm straight back, at (−2800, 0): too far, still GetBehind.
+#[test]
+fn the_attacker_takes_over_behind_the_ball_within_reach() {
+    let path_at = |x: f64, y: f64| {
+        let mut cap =
+            ThinkingCap::with_hfsm(dir(), dir().join("player.hfsm.lua"), Sandbox::default())
+                .unwrap();
+        let (dx, dy) = (-1200.0 - x, -y);
+        let mut last = String::new();
+        for k in 0..4 {
+            let mut w = World::at(k * 100)
+                .playing()
+                .me(x, y, 0.0, 0.9)
+                .ball(dx.hypot(dy), dy.atan2(dx))
+                .global_ball(-1200.0, 0.0)
+                .mate(0, -8500.0, 0.0, true);
+            w.0.ball_booked = true;
+            let c = cap.cycle(w.0);
+            assert!(c.errors.is_empty(), "{:?}", c.errors);
+            last = c.path;
+        }
+        last
+    };
+    assert_eq!(path_at(-1500.0, -1162.0), "Player/Attack/FaceBall");
+    assert_eq!(path_at(-1400.0, -1183.0), "Player/GetBehind");
+    assert_eq!(path_at(-2800.0, 0.0), "Player/GetBehind");
 }
 
 /// The Supporter and the Defender keep their roles while a teammate is within `HOLD` (400
