@@ -122,6 +122,22 @@ fn close(got: f64, want: f64) {
 /// Mamdani centroid of a piecewise linear membership given by its breakpoints `(x, μ)`:
 /// `∫xμ / ∫μ`, each linear piece contributing area h·(ya + yb)/2 and moment
 /// h/6·(ya·(2a + b) + yb·(a + 2b)). Used to spell out the hand computations.
+/// alignbnet1's strafe (default labels) with the aim `off` rad right of the ball, −0.2 <
+/// `off` < −0.05: NONE = TRI(−100, 0, 100) clipped at netBehindBall = TRI(−0.2, 0, 0.2)(off),
+/// LEFT = TRI(0, 100, 200) clipped at netRightOfBall = TOL(−0.4, −0.05)(off); their union's
+/// centroid.
+fn small_step_left(off: f64) -> f64 {
+    let (right, behind) = ((-0.05 - off) / 0.35, 1.0 - off.abs() / 0.2);
+    centroid(&[
+        (-100.0, 0.0),
+        (-100.0 + 100.0 * behind, behind),
+        (100.0 - 100.0 * behind, behind),
+        (100.0 - 100.0 * right, right),
+        (200.0 - 100.0 * right, right),
+        (200.0, 0.0),
+    ])
+}
+
 /// The cycle asked guidance for the posture `(x, y, theta)` (mm, mm, rad), straight there
 /// (position mode: no obstacle avoidance, no planning).
 #[track_caller]
@@ -304,16 +320,7 @@ fn alignbnet1_strafes_to_put_the_net_behind_the_ball() {
 fn a_well_localized_robot_aims_by_its_pose_not_by_a_net_seen_off_its_middle() {
     let w = World::at(0).me(0.0, 1000.0, 0.0, 0.9).ball(400.0, 0.0).net1(9000.0, 0.5);
     let c = run("alignbnet1", w.clone());
-    let off = (-1000.0f64).atan2(9000.0);
-    let (right, behind) = ((-0.05 - off) / 0.35, 1.0 - off.abs() / 0.2);
-    let want = centroid(&[
-        (-100.0, 0.0),
-        (-100.0 + 100.0 * behind, behind),
-        (100.0 - 100.0 * behind, behind),
-        (100.0 - 100.0 * right, right),
-        (200.0 - 100.0 * right, right),
-        (200.0, 0.0),
-    ]);
+    let want = small_step_left((-1000.0f64).atan2(9000.0));
     assert!(want > 0.0 && want < 40.0, "{want}");
     close(c.command.vlat, want * STRAFE);
     // The same robot lost (quality 0.5) follows its camera: the net left of the ball, a step
@@ -348,18 +355,7 @@ fn alignbnet1_aims_at_the_side_of_the_net_away_from_its_keeper() {
         ..Default::default()
     });
     let c = run("alignbnet1", guarded);
-    // strafe NONE = TRI(−100, 0, 100) clipped at `behind`, LEFT = TRI(0, 100, 200) clipped
-    // at `right`; their union's centroid.
-    let off = (-750.0f64).atan2(9000.0);
-    let (right, behind) = ((-0.05 - off) / 0.35, 1.0 - off.abs() / 0.2);
-    let want = centroid(&[
-        (-100.0, 0.0),
-        (-100.0 + 100.0 * behind, behind),
-        (100.0 - 100.0 * behind, behind),
-        (100.0 - 100.0 * right, right),
-        (200.0 - 100.0 * right, right),
-        (200.0, 0.0),
-    ]);
+    let want = small_step_left((-750.0f64).atan2(9000.0));
     assert!(want > 0.0 && want < 30.0, "{want}");
     close(c.command.vlat, want * STRAFE);
 }
