@@ -68,6 +68,8 @@ pub struct KeeperMove {
     pub vlat: f64,
     /// Whether it looks for landmarks.
     pub track_landmarks: bool,
+    /// The posture it asked guidance for, if any (team frame: mm, mm, rad).
+    pub target: Option<Pose2>,
 }
 
 /// The scripted world: the robot at the origin facing +x, the ball at `ball`, the opponent's
@@ -214,7 +216,7 @@ fn run_goalkeeper(dir: &Path, verbose: bool) -> Result<Vec<KeeperMove>> {
     in_net.my_pos.pose = Pose2::new(-9200.0, 0.0, 0.0);
     in_net.lps[lps::BALL] = Lpo { rho: 3000.0, theta: 0.0, reliability: 0.9, seen_ago: 0.0 };
     // The ball 2.9 m out at y = 300, the keeper 600 mm to its left on its line (400 mm out of
-    // the goal line): it steps sideways to stand level with the ball.
+    // the goal line): it asks guidance for the spot level with the ball, (−8600, 300).
     let mut cut = lost.clone();
     let theta = (-600.0f64).atan2(2900.0);
     cut.lps[lps::BALL] = Lpo { rho: 2961.0, theta, reliability: 0.9, seen_ago: 0.0 };
@@ -235,8 +237,11 @@ fn run_goalkeeper(dir: &Path, verbose: bool) -> Result<Vec<KeeperMove>> {
         }
         let m = &c.command;
         if verbose {
+            let to = m.target.map_or(String::new(), |t| {
+                format!("  to ({:.0}, {:.0}) facing {:.2} rad", t.pose.x, t.pose.y, t.pose.theta)
+            });
             println!(
-                "  {name:<34} vlin {:>6.1}  vrot {:>6.1}  vlat {:>6.1}  landmarks {}",
+                "  {name:<34} vlin {:>6.1}  vrot {:>6.1}  vlat {:>6.1}  landmarks {}{to}",
                 m.vlin, m.vrot, m.vlat, m.track_landmarks
             );
         }
@@ -246,6 +251,7 @@ fn run_goalkeeper(dir: &Path, verbose: bool) -> Result<Vec<KeeperMove>> {
             vrot: m.vrot,
             vlat: m.vlat,
             track_landmarks: m.track_landmarks,
+            target: m.target.map(|t| t.pose),
         });
     }
     Ok(out)

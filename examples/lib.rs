@@ -174,7 +174,8 @@ mod tests {
         let gk = &out.goalkeeper;
         assert!(gk[0].vrot != 0.0 && gk[0].track_landmarks, "ball lost: turns to look for it");
         assert!(gk[1].vlin > 0.0, "inside its net: moves out");
-        assert!(gk[2].vlat < 0.0, "left of the ball: strafes right");
+        let spot = gk[2].target.expect("off the line: it asks guidance for its spot");
+        assert!((spot.x + 8600.0).abs() < 1e-9 && (spot.y - 300.0).abs() < 1e-9, "{spot:?}");
     }
 
     #[test]
