@@ -778,6 +778,23 @@ fn editing_an_included_machine_file_reloads_the_machine() {
     std::fs::remove_dir_all(&scratch).unwrap();
 }
 
+/// The shipped field player's machine (`player.hfsm.lua`).
+fn player() -> ThinkingCap {
+    ThinkingCap::with_hfsm(dir(), dir().join("player.hfsm.lua"), Sandbox::default()).unwrap()
+}
+
+/// The roles' scene at `t_ms`: playing, the robot at (−2000, 0) facing the opponent's net,
+/// the ball 800 mm ahead at (−1200, 0), the goalkeeper teammate at (−8500, 0).
+fn role_scene(t_ms: u64) -> World {
+    World::at(t_ms)
+        .playing()
+        .me(-2000.0, 0.0, 0.0, 0.9)
+        .ball(800.0, 0.0)
+        .global_ball(-1200.0, 0.0)
+        .net1(7800.0, 0.0)
+        .mate(0, -8500.0, 0.0, true)
+}
+
 /// The field player's roles (seed 001 §5.1, figure 8). The robot stands at (−2000, 0) facing
 /// the opponent's net; the ball is 800 mm ahead, at (−1200, 0). The goalkeeper at (−8500, 0)
 /// is always left out of the ranking. The first cycle enters Wait, the second starts the game
@@ -794,18 +811,7 @@ fn editing_an_included_machine_file_reloads_the_machine() {
 ///   mm behind the robot: go BACK (−250), strafe NONE (0).
 #[test]
 fn field_players_share_the_roles_by_their_distance_to_the_ball() {
-    let player = || {
-        ThinkingCap::with_hfsm(dir(), dir().join("player.hfsm.lua"), Sandbox::default()).unwrap()
-    };
-    let base = |t| {
-        World::at(t)
-            .playing()
-            .me(-2000.0, 0.0, 0.0, 0.9)
-            .ball(800.0, 0.0)
-            .global_ball(-1200.0, 0.0)
-            .net1(7800.0, 0.0)
-            .mate(0, -8500.0, 0.0, true)
-    };
+    let base = role_scene;
     let run4 = |extra: &dyn Fn(World) -> World| {
         let mut cap = player();
         (0..4)
@@ -858,9 +864,7 @@ fn field_players_share_the_roles_by_their_distance_to_the_ball() {
 #[test]
 fn the_attacker_takes_over_behind_the_ball_within_reach() {
     let path_at = |x: f64, y: f64| {
-        let mut cap =
-            ThinkingCap::with_hfsm(dir(), dir().join("player.hfsm.lua"), Sandbox::default())
-                .unwrap();
+        let mut cap = player();
         let (dx, dy) = (-1200.0 - x, -y);
         let mut last = String::new();
         for k in 0..4 {
@@ -896,18 +900,9 @@ fn the_attacker_takes_over_behind_the_ball_within_reach() {
 /// - B 1300 mm from the ball (500 mm farther): Support again.
 #[test]
 fn supporter_and_defender_hold_their_roles_within_the_margin() {
-    let mut cap =
-        ThinkingCap::with_hfsm(dir(), dir().join("player.hfsm.lua"), Sandbox::default()).unwrap();
+    let mut cap = player();
     let world = |t: u64, b_from_ball: f64| {
-        World::at(t)
-            .playing()
-            .me(-2000.0, 0.0, 0.0, 0.9)
-            .ball(800.0, 0.0)
-            .global_ball(-1200.0, 0.0)
-            .net1(7800.0, 0.0)
-            .mate(0, -8500.0, 0.0, true)
-            .mate(2, -1000.0, 300.0, false)
-            .mate(3, -1200.0, -b_from_ball, false)
+        role_scene(t).mate(2, -1000.0, 300.0, false).mate(3, -1200.0, -b_from_ball, false)
     };
     let mut t = 0;
     let mut play = |b_from_ball: f64, cycles: usize| {
