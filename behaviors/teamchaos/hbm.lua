@@ -62,7 +62,30 @@ end
 -- 0.2 rad off the pose's in one Align cycle in five, the pose's heading 0.2 deg off the truth
 -- (median). The Attacker then went back and forth between Align and DoKick.
 AIM_BY_POSE = 0.6
+-- Within CLEAR_ZONE mm of the centre of our net the attacker does not go round the ball to
+-- shoot at the far net: the spot behind the ball on that line is then in our goal or beside
+-- it, out of reach, and in vision matches the attacker-to-be stood on our goal line while
+-- the Chaser poked the ball in. It clears the ball straight away from our net instead: the
+-- spot behind the ball is then between it and our net. clearingPoint is the point 5 m out
+-- along that way, nil outside the zone.
+CLEAR_ZONE = 3000
+function clearingPoint()
+  local b, hl = chaos.getGlobalBall(), field().half_length
+  local dx, dy = b.x + hl, b.y
+  local d = math.sqrt(dx * dx + dy * dy)
+  if d > CLEAR_ZONE then return nil end
+  if d < 1 then dx, dy, d = 1, 0, 1 end
+  return b.x + dx / d * 5000, b.y + dy / d * 5000
+end
+-- Where the attacker sends the ball: the clearing point near our net, else the aim point.
+function targetPoint()
+  local cx, cy = clearingPoint()
+  if cx then return cx, cy end
+  return aimPoint()
+end
 function aimBearing()
+  local cx, cy = clearingPoint()
+  if cx then return bearingTo(cx, cy) end
   local ax, ay = aimPoint()
   local n = lpo(NET1)
   if n.reliability > 0.1 and chaos.gsGetMyPos().quality < AIM_BY_POSE then
@@ -137,11 +160,15 @@ local function clampToField(x, y)
 end
 
 -- Where the supporter waits: 2 m behind the ball and 1.5 m towards the middle of the field,
--- ready for a rebound or a loose ball.
+-- ready for a rebound or a loose ball; never closer than SUPPORT_FLOOR mm to our goal line,
+-- where it would crowd the keeper (vision matches: all three field players on our goal line
+-- while the Chaser poked the ball in).
+SUPPORT_FLOOR = 3000
 function supportSpot()
   local b = chaos.getGlobalBall()
   local side = b.y > 0 and -1 or 1
-  return clampToField(b.x - 2000, b.y + side * 1500)
+  local x = math.max(b.x - 2000, -field().half_length + SUPPORT_FLOOR)
+  return clampToField(x, b.y + side * 1500)
 end
 
 -- Where the defender stands: on the line from the centre of our net to the ball, 40 % of the
@@ -169,11 +196,12 @@ function inRobotFrame(x, y)
   return dx * c + dy * s, -dx * s + dy * c
 end
 
--- The unit vector from the ball to the opponent's net, and how far the robot is along it from
--- the ball (mm; negative: behind the ball, where a push sends the ball towards the net).
+-- The unit vector from the ball to where the attacker sends it (targetPoint: the opponent's
+-- net, or away from ours near it), and how far the robot is along it from the ball (mm;
+-- negative: behind the ball, where a push sends the ball that way).
 function ballToNet()
   local b = chaos.getGlobalBall()
-  local ax, ay = aimPoint()
+  local ax, ay = targetPoint()
   local ux, uy = ax - b.x, ay - b.y
   local n = math.max(1, math.sqrt(ux * ux + uy * uy))
   return ux / n, uy / n

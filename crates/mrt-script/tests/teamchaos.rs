@@ -360,6 +360,31 @@ fn alignbnet1_aims_at_the_side_of_the_net_away_from_its_keeper() {
     close(c.command.vlat, want * STRAFE);
 }
 
+/// Near our net (within `CLEAR_ZONE`, 3 m of its centre) the attacker clears the ball straight
+/// away from our net instead of lining it up with the far net, whose spot behind the ball would
+/// be in our goal. The ball at (−7500, 1500) is 2121 mm from our net's centre (−9000, 0); the
+/// robot at (−8400, 600) is on the line from that centre through the ball, facing along it
+/// (π/4), the ball 1273 mm straight ahead: the clearing direction passes behind the ball
+/// (aimOffBall = 0, netBehindBall = 1): no step aside. The same scene 6 m up the field (ball
+/// at (−1500, 1500), 7648 mm from our net) lines the ball up with the far net's middle
+/// (9000, 0), atan2(−600, 11400) − π/4 = −0.838 rad: right of the ball, netRightOfBall = 1, a
+/// step to the LEFT (+100).
+#[test]
+fn alignbnet1_clears_a_ball_near_our_net_straight_away_from_it() {
+    use std::f64::consts::FRAC_PI_4;
+    let scene = |dx: f64| {
+        World::at(0)
+            .me(-8400.0 + dx, 600.0, FRAC_PI_4, 0.9)
+            .ball(900.0 * 2f64.sqrt(), 0.0)
+            .global_ball(-7500.0 + dx, 1500.0)
+            .net1(9000.0, 0.3)
+    };
+    let near = run("alignbnet1", scene(0.0)).command;
+    close(near.vlat, 0.0);
+    close(near.vrot, 0.0);
+    close(run("alignbnet1", scene(6000.0)).command.vlat, 100.0 * STRAFE);
+}
+
 #[test]
 fn gkcutb_holds_the_goal_line_level_with_the_ball_and_clears_when_safe() {
     // The spot: 400 mm out of our goal line (x = −9000 + 400 = −8600), level with the ball
@@ -923,6 +948,39 @@ fn supporter_and_defender_hold_their_roles_within_the_margin() {
     assert!(held.iter().all(|p| p == "Player/Defend"), "{held:?}");
     let back = play(1300.0, 2);
     assert_eq!(back.last().map(String::as_str), Some("Player/Support"), "{back:?}");
+}
+
+/// The supporter keeps `SUPPORT_FLOOR` (3 m) from our goal line: with the ball deep in our
+/// half at (−7000, 1000), 2 m behind it would be x = −9000, on our goal line beside the keeper.
+/// A teammate 300 mm from the ball is the attacker-to-be; the robot, 1803 mm from the ball, is
+/// the Supporter, and its spot is (−6000, −500): 3 m out, 1.5 m towards the middle. Standing
+/// there facing the ball (atan2(1500, −1000)), it stays: go STAY, strafe NONE, turn NONE, all
+/// 0. Without the floor the spot would be (−8500, −500) (clamped into the field), 1387 mm
+/// ahead along its heading: go FAST.
+#[test]
+fn the_supporter_stays_out_of_our_goal_mouth() {
+    let mut cap = player();
+    let path = (0..4)
+        .map(|k| {
+            let mut w = World::at(k * 100)
+                .playing()
+                .me(-6000.0, -500.0, 1500.0f64.atan2(-1000.0), 0.9)
+                .ball(1000.0f64.hypot(1500.0), 0.0)
+                .global_ball(-7000.0, 1000.0)
+                .mate(0, -8500.0, 0.0, true)
+                .mate(2, -7000.0, 1300.0, false);
+            w.0.ball_booked = false;
+            let c = cap.cycle(w.0);
+            assert!(c.errors.is_empty(), "{:?}", c.errors);
+            if k == 3 {
+                close(c.command.vlin, 0.0);
+                close(c.command.vlat, 0.0);
+                close(c.command.vrot, 0.0);
+            }
+            c.path
+        })
+        .collect::<Vec<_>>();
+    assert_eq!(path[2..], ["Player/Support", "Player/Support"], "{path:?}");
 }
 
 /// The behaviors read the field from the world model (`getField`): on a 12 m field the
