@@ -199,7 +199,7 @@ end
 -- The unit vector from the ball to where the attacker sends it (targetPoint: the opponent's
 -- net, or away from ours near it), and how far the robot is along it from the ball (mm;
 -- negative: behind the ball, where a push sends the ball that way).
-function ballToNet()
+function ballToTarget()
   local b = chaos.getGlobalBall()
   local ax, ay = targetPoint()
   local ux, uy = ax - b.x, ay - b.y
@@ -208,7 +208,7 @@ function ballToNet()
 end
 function aheadOfBall()
   local b, p = chaos.getGlobalBall(), chaos.gsGetMyPos()
-  local ux, uy = ballToNet()
+  local ux, uy = ballToTarget()
   return (p.x - b.x) * ux + (p.y - b.y) * uy
 end
 
@@ -217,7 +217,7 @@ end
 -- towards its own net.
 function behindBall(d)
   local b, p = chaos.getGlobalBall(), chaos.gsGetMyPos()
-  local ux, uy = ballToNet()
+  local ux, uy = ballToTarget()
   local x, y = b.x - ux * d, b.y - uy * d
   if aheadOfBall() > -d / 2 then
     local side = ((p.x - b.x) * uy - (p.y - b.y) * ux) > 0 and 1 or -1

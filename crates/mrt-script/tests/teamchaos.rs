@@ -960,27 +960,26 @@ fn supporter_and_defender_hold_their_roles_within_the_margin() {
 #[test]
 fn the_supporter_stays_out_of_our_goal_mouth() {
     let mut cap = player();
-    let path = (0..4)
+    let cycles = (0..4)
         .map(|k| {
-            let mut w = World::at(k * 100)
+            let w = World::at(k * 100)
                 .playing()
                 .me(-6000.0, -500.0, 1500.0f64.atan2(-1000.0), 0.9)
                 .ball(1000.0f64.hypot(1500.0), 0.0)
                 .global_ball(-7000.0, 1000.0)
                 .mate(0, -8500.0, 0.0, true)
                 .mate(2, -7000.0, 1300.0, false);
-            w.0.ball_booked = false;
             let c = cap.cycle(w.0);
             assert!(c.errors.is_empty(), "{:?}", c.errors);
-            if k == 3 {
-                close(c.command.vlin, 0.0);
-                close(c.command.vlat, 0.0);
-                close(c.command.vrot, 0.0);
-            }
-            c.path
+            c
         })
         .collect::<Vec<_>>();
-    assert_eq!(path[2..], ["Player/Support", "Player/Support"], "{path:?}");
+    let paths: Vec<&str> = cycles.iter().map(|c| c.path.as_str()).collect();
+    assert_eq!(paths[2..], ["Player/Support", "Player/Support"], "{paths:?}");
+    let c = &cycles[3].command;
+    close(c.vlin, 0.0);
+    close(c.vlat, 0.0);
+    close(c.vrot, 0.0);
 }
 
 /// The behaviors read the field from the world model (`getField`): on a 12 m field the
