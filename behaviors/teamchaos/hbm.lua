@@ -69,13 +69,20 @@ AIM_BY_POSE = 0.6
 -- spot behind the ball is then between it and our net. clearingPoint is the point 5 m out
 -- along that way, nil outside the zone.
 CLEAR_ZONE = 3000
-function clearingPoint()
-  local b, hl = chaos.getGlobalBall(), field().half_length
-  local dx, dy = b.x + hl, b.y
+-- The ball seen from the centre of our net: its distance (mm) and the unit vector towards it
+-- (straight up the field for a ball on that centre).
+local function ballFromOurNet()
+  local b = chaos.getGlobalBall()
+  local dx, dy = b.x + field().half_length, b.y
   local d = math.sqrt(dx * dx + dy * dy)
+  if d < 1 then return 0, 1, 0 end
+  return d, dx / d, dy / d
+end
+function clearingPoint()
+  local d, ux, uy = ballFromOurNet()
   if d > CLEAR_ZONE then return nil end
-  if d < 1 then dx, dy, d = 1, 0, 1 end
-  return b.x + dx / d * 5000, b.y + dy / d * 5000
+  local b = chaos.getGlobalBall()
+  return b.x + ux * 5000, b.y + uy * 5000
 end
 -- Where the attacker sends the ball: the clearing point near our net, else the aim point.
 function targetPoint()
@@ -174,12 +181,9 @@ end
 -- Where the defender stands: on the line from the centre of our net to the ball, 40 % of the
 -- way out (between 2.5 m and 4.5 m from the net), cutting the ball's way to the goal.
 function defendSpot()
-  local b, hl = chaos.getGlobalBall(), field().half_length
-  local dx, dy = b.x + hl, b.y
-  local d = math.max(1, math.sqrt(dx * dx + dy * dy))
-  local r = math.max(2500, math.min(4500, 0.4 * d))
-  if r > d then r = d end
-  return clampToField(-hl + dx / d * r, dy / d * r)
+  local d, ux, uy = ballFromOurNet()
+  local r = math.min(d, math.max(2500, math.min(4500, 0.4 * d)))
+  return clampToField(-field().half_length + ux * r, uy * r)
 end
 
 -- The bearing (rad, left positive) from the robot to a field point, and the point in the
@@ -219,7 +223,7 @@ function behindBall(d)
   local b, p = chaos.getGlobalBall(), chaos.gsGetMyPos()
   local ux, uy = ballToTarget()
   local x, y = b.x - ux * d, b.y - uy * d
-  if aheadOfBall() > -d / 2 then
+  if (p.x - b.x) * ux + (p.y - b.y) * uy > -d / 2 then -- aheadOfBall(), its vector at hand
     local side = ((p.x - b.x) * uy - (p.y - b.y) * ux) > 0 and 1 or -1
     x, y = x + side * 700 * uy, y - side * 700 * ux
   end
