@@ -68,6 +68,7 @@ fn paint(c: ColorClass) -> Rgb<u8> {
         ColorClass::Field => [0, 130, 0],
         ColorClass::MarkerMagenta => [255, 0, 255],
         ColorClass::MarkerCyan => [0, 255, 255],
+        ColorClass::BallShade => [150, 70, 0],
     })
 }
 

@@ -76,6 +76,10 @@ fn bench(c: &mut Criterion) {
     let mut g = c.benchmark_group("frame_640x480");
     g.throughput(Throughput::Elements((W * H) as u64));
     g.bench_function("lut_classify", |b| b.iter(|| lut.classify(black_box(&img), &mut out)));
+    // The frame's carpet (30, 140, 40) is not the colour file's (30, 130, 50): corrected.
+    g.bench_function("lut_classify_balanced", |b| {
+        b.iter(|| lut.classify_balanced(black_box(&img), W, &mut out))
+    });
     g.bench_function("lut_classify_and_ball_blob", |b| {
         b.iter(|| {
             lut.classify(black_box(&img), &mut out);
@@ -86,6 +90,25 @@ fn bench(c: &mut Criterion) {
     let camera = Pinhole::new(Intrinsics::centred(W as u32, H as u32, 520.0), 0.45, 0.35);
     let mut agent = VisionAgent::new(camera, &colors, 0.11);
     g.bench_function("agent_see", |b| b.iter(|| agent.see(black_box(&image), 1.0, 0.0).unwrap()));
+    g.finish();
+    lit_frames(c, &colors);
+}
+
+/// The whole µAgent on MuJoCo's 320×240 frames of the shipped camera under each of the four
+/// lights of `tests/frames/mujoco` (each frame white-balanced before it is classified).
+fn lit_frames(c: &mut Criterion, colors: &ColorTable) {
+    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/frames/mujoco");
+    let mut g = c.benchmark_group("mujoco_320x240");
+    g.throughput(Throughput::Elements(320 * 240));
+    for light in ["bright", "half", "warm", "side"] {
+        let path = std::path::Path::new(dir).join(light).join("frame_0001.png");
+        let image = mrt_perception::source::load_image(&path).unwrap();
+        let camera = Pinhole::new(Intrinsics::centred(320, 240, 260.0), 0.45, 20f64.to_radians());
+        let mut agent = VisionAgent::new(camera, colors, 0.11);
+        g.bench_function(format!("agent_see_{light}"), |b| {
+            b.iter(|| agent.see(black_box(&image), 1.0, 0.0).unwrap())
+        });
+    }
     g.finish();
 }
 

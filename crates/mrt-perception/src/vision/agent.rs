@@ -255,7 +255,7 @@ impl VisionAgent {
         check_size(image, (w, h))?;
         self.camera.pan = pan;
         self.classes.resize(w as usize * h as usize, 0);
-        self.lut.classify(&image.rgb, &mut self.classes);
+        self.lut.classify_balanced(&image.rgb, w as usize, &mut self.classes);
         let mut p = Percepts { time, pan: Some(pan), ..Default::default() };
         // Where in the image each object was found, for monitors (ISocRob seed `003` §3.2.7).
         let mut shown = Vec::with_capacity(8 + ImageDetections::MAX_LINE_POINTS);

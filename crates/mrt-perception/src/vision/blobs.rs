@@ -24,6 +24,8 @@ pub struct Blob {
     pub centroid: Pixel,
     /// Its bounding box: first and last column, first and last row.
     pub bbox: BoundingBox,
+    /// Its pixels of the core class ([`blobs_joined`]; all of them for [`blobs`]).
+    pub core: u32,
 }
 
 /// First and last column, first and last row.
@@ -48,18 +50,32 @@ pub fn blobs(
     class: ColorClass,
     min_pixels: u32,
 ) -> Vec<Blob> {
+    blobs_joined(classes, width, height, class, class, min_pixels)
+}
+
+/// [`blobs`] of the pixels of `core` and of `joins` together: a blob is a connected region of
+/// either class, and [`Blob::core`] counts its pixels of `core` (the ball's lit and shaded
+/// sides, [`find_ball`]).
+pub fn blobs_joined(
+    classes: &[u8],
+    width: u32,
+    height: u32,
+    core: ColorClass,
+    joins: ColorClass,
+    min_pixels: u32,
+) -> Vec<Blob> {
     let n = (width as usize).saturating_mul(height as usize);
     if width == 0 || height == 0 || width > MAX_SIDE || height > MAX_SIDE || classes.len() < n {
         return Vec::new();
     }
-    let want = class as u8;
+    let (a, b) = (core as u8, joins as u8);
     let (cw, ch) = (width.div_ceil(CELL), height.div_ceil(CELL));
     let mut cells = vec![0u8; (cw * ch) as usize];
     for (y, row) in classes[..n].chunks_exact(width as usize).enumerate() {
         let cy = y / CELL as usize;
         for (cx, chunk) in row.chunks(CELL as usize).enumerate() {
             // Without a branch a pixel (`contains` calls memchr for 8 bytes).
-            if chunk.iter().fold(false, |any, &c| any | (c == want)) {
+            if chunk.iter().fold(false, |any, &c| any | (c == a) | (c == b)) {
                 cells[cy * cw as usize + cx] = 255;
             }
         }
@@ -91,36 +107,43 @@ pub fn blobs(
             let row = ((py0 + y) * width + px0) as usize;
             for x in 0..ww {
                 let (gx, gy) = (px0 + x, py0 + y);
-                if classes[row + x as usize] == want
-                    && regions.get_pixel(gx / CELL, gy / CELL).0[0] == label
-                {
+                let c = classes[row + x as usize];
+                if (c == a || c == b) && regions.get_pixel(gx / CELL, gy / CELL).0[0] == label {
                     mask[(y * ww + x) as usize] = 255;
                 }
             }
         }
         let Some(mask) = GrayImage::from_raw(ww, wh, mask) else { continue };
-        out.extend(label_blobs(&mask, (px0, py0), min_pixels));
+        let is_core = |x: u32, y: u32| classes[(y * width + x) as usize] == a;
+        out.extend(label_blobs(&mask, (px0, py0), min_pixels, is_core));
     }
     out.sort_by(|a, b| b.pixels.cmp(&a.pixels).then(a.bbox.cmp(&b.bbox)));
     out
 }
 
-/// The blobs of a mask (255: the class), offset by the window's origin.
-fn label_blobs(mask: &GrayImage, (ox, oy): (u32, u32), min_pixels: u32) -> Vec<Blob> {
+/// The blobs of a mask (255: the class), offset by the window's origin; `is_core` tells a
+/// pixel of the core class (image coordinates).
+fn label_blobs(
+    mask: &GrayImage,
+    (ox, oy): (u32, u32),
+    min_pixels: u32,
+    is_core: impl Fn(u32, u32) -> bool,
+) -> Vec<Blob> {
     let labels = connected_components(mask, Connectivity::Eight, Luma([0u8]));
-    // Per label: count, sums of columns and rows, bounding box.
-    let mut stats: Vec<(u32, f64, f64, BoundingBox)> = Vec::new();
+    // Per label: count, sums of columns and rows, bounding box, core pixels.
+    let mut stats: Vec<(u32, f64, f64, BoundingBox, u32)> = Vec::new();
     for (x, y, l) in labels.enumerate_pixels() {
         let l = l.0[0] as usize;
         if l == 0 {
             continue;
         }
         if stats.len() < l {
-            stats.resize(l, (0, 0.0, 0.0, (u32::MAX, 0, u32::MAX, 0)));
+            stats.resize(l, (0, 0.0, 0.0, (u32::MAX, 0, u32::MAX, 0), 0));
         }
         let (x, y) = (x + ox, y + oy);
         let s = &mut stats[l - 1];
         s.0 += 1;
+        s.4 += u32::from(is_core(x, y));
         s.1 += f64::from(x);
         s.2 += f64::from(y);
         s.3 = (s.3 .0.min(x), s.3 .1.max(x), s.3 .2.min(y), s.3 .3.max(y));
@@ -128,11 +151,12 @@ fn label_blobs(mask: &GrayImage, (ox, oy): (u32, u32), min_pixels: u32) -> Vec<B
     stats
         .into_iter()
         .filter(|s| s.0 >= min_pixels.max(1))
-        .map(|(count, sx, sy, bbox)| Blob {
+        .map(|(count, sx, sy, bbox, core)| Blob {
             pixels: count,
             // Pixel centres: a pixel (x, y) covers [x, x + 1).
             centroid: Pixel::new(sx / f64::from(count) + 0.5, sy / f64::from(count) + 0.5),
             bbox,
+            core,
         })
         .collect()
 }
@@ -160,24 +184,144 @@ pub struct BallPercept {
 /// high side).
 pub const BALL_AREA_RANGE: (f64, f64) = (0.3, 3.0);
 
-/// The ball in a class map seen by `camera`: the largest ball blob whose area fits the size a
+/// Of a ball blob, this share of its pixels at least must be of the ball's own class (its lit
+/// side): a blob of the shade's darker orange alone is not a ball.
+pub const BALL_CORE_SHARE: f64 = 0.2;
+
+/// The ball in a class map seen by `camera`: the largest blob of the ball's class and its
+/// shade ([`ColorClass::BallShade`], joined where it touches) whose silhouette fits the size a
 /// ball of `radius` (m) would have where its centre's ray says it is, corrected from the floor
 /// point of that ray to the point under the ball (both coordinates).
+///
+/// The centre is the centre of the circle fitted to the blob's outline ([`Silhouette`]): a
+/// ball half in shade, cut by the image's border or partly behind a robot still has its
+/// centre where the circle's is, where a centre of mass would move towards the part seen.
 pub fn find_ball(classes: &[u8], camera: &Pinhole, radius: f64) -> Option<BallPercept> {
     let (w, h) = camera.size();
-    for blob in blobs(classes, w, h, ColorClass::Ball, 3) {
-        let Some(hit) = camera.unproject(blob.centroid) else { continue };
+    for blob in blobs_joined(classes, w, h, ColorClass::Ball, ColorClass::BallShade, 3) {
+        if f64::from(blob.core) < BALL_CORE_SHARE * f64::from(blob.pixels) {
+            continue;
+        }
+        let outline = Silhouette::of(classes, (w, h), &blob);
+        let centre = outline.circle().map_or(outline.centroid, |c| c.0);
+        let Some(hit) = camera.unproject(centre) else { continue };
         let foot = camera.mount;
         let at = ball_floor_point(foot, camera.height, hit, radius);
-        let centre = Point3::new(at.x, at.y, radius);
-        let range = (centre - camera.centre()).norm();
+        let centre_3d = Point3::new(at.x, at.y, radius);
+        let range = (centre_3d - camera.centre()).norm();
         let expected = ball_diameter_px(radius, camera.intrinsics.fx, range) / 2.0;
         let area = std::f64::consts::PI * expected * expected;
-        if let Some(ball) = BallPercept::sized(&blob, area, at, foot) {
+        let filled = Blob { pixels: outline.area, centroid: centre, ..blob };
+        if let Some(ball) = BallPercept::sized(&filled, area, at, foot) {
             return Some(ball);
         }
     }
     None
+}
+
+/// A ball blob's outline: each row's span from its first to its last pixel of the ball or its
+/// shade (a highlight or a hole inside is filled), and the ends of those spans and of each
+/// column's, the points a circle is fitted to. Ends on the image's border are left out: there
+/// the ball goes on beyond the image.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Silhouette {
+    /// Pixels inside the spans.
+    pub area: u32,
+    /// The spans' centre of mass.
+    pub centroid: Pixel,
+    /// The outline's points, on the outer sides of the spans' end pixels.
+    pub edge: Vec<Pixel>,
+}
+
+/// Outline points fewer than this: no circle is fitted.
+const MIN_EDGE_POINTS: usize = 8;
+
+impl Silhouette {
+    /// The outline of `blob` in a class map of `(width, height)`.
+    pub fn of(classes: &[u8], (width, height): (u32, u32), blob: &Blob) -> Silhouette {
+        let (x0, x1, y0, y1) = blob.bbox;
+        let is_ball = |x: u32, y: u32| {
+            let c = classes.get((y * width + x) as usize).copied().unwrap_or(0);
+            c == ColorClass::Ball as u8 || c == ColorClass::BallShade as u8
+        };
+        let (mut area, mut sx, mut sy) = (0u32, 0.0, 0.0);
+        let mut edge = Vec::new();
+        for y in y0..=y1 {
+            let Some(first) = (x0..=x1).find(|&x| is_ball(x, y)) else { continue };
+            let last = (first..=x1).rev().find(|&x| is_ball(x, y)).unwrap_or(first);
+            let n = last - first + 1;
+            area += n;
+            sx += f64::from(n) * (f64::from(first) + f64::from(last) + 1.0) / 2.0;
+            sy += f64::from(n) * (f64::from(y) + 0.5);
+            let cy = f64::from(y) + 0.5;
+            if first > 0 {
+                edge.push(Pixel::new(f64::from(first), cy));
+            }
+            if last + 1 < width {
+                edge.push(Pixel::new(f64::from(last) + 1.0, cy));
+            }
+        }
+        for x in x0..=x1 {
+            let Some(first) = (y0..=y1).find(|&y| is_ball(x, y)) else { continue };
+            let last = (first..=y1).rev().find(|&y| is_ball(x, y)).unwrap_or(first);
+            let cx = f64::from(x) + 0.5;
+            if first > 0 {
+                edge.push(Pixel::new(cx, f64::from(first)));
+            }
+            if last + 1 < height {
+                edge.push(Pixel::new(cx, f64::from(last) + 1.0));
+            }
+        }
+        let centroid = if area > 0 {
+            Pixel::new(sx / f64::from(area), sy / f64::from(area))
+        } else {
+            blob.centroid
+        };
+        Silhouette { area, centroid, edge }
+    }
+
+    /// The circle through the outline (centre, radius in pixels): a least-squares fit, then
+    /// fitted again without the points well inside it (where the ball's edge is not seen: a
+    /// shade too dark for its class, a robot in front), twice. `None` for too few points or a
+    /// degenerate outline.
+    pub fn circle(&self) -> Option<(Pixel, f64)> {
+        let mut points: Vec<Pixel> = self.edge.clone();
+        let mut fit = fit_circle(&points)?;
+        for _ in 0..2 {
+            let (c, r) = fit;
+            points.retain(|p| (p - c).norm() - r > -1.0);
+            if points.len() < MIN_EDGE_POINTS {
+                break;
+            }
+            fit = fit_circle(&points)?;
+        }
+        Some(fit)
+    }
+}
+
+/// The least-squares circle through `points` (Kåsa's algebraic fit: `x² + y² + Dx + Ey + F =
+/// 0`), centred on their mean for conditioning.
+fn fit_circle(points: &[Pixel]) -> Option<(Pixel, f64)> {
+    if points.len() < MIN_EDGE_POINTS {
+        return None;
+    }
+    let n = points.len() as f64;
+    let mean = points.iter().fold(nalgebra::Vector2::zeros(), |s, p| s + p.coords) / n;
+    let mut a = nalgebra::Matrix3::<f64>::zeros();
+    let mut b = nalgebra::Vector3::<f64>::zeros();
+    for p in points {
+        let (x, y) = (p.x - mean.x, p.y - mean.y);
+        let row = nalgebra::Vector3::new(x, y, 1.0);
+        a += row * row.transpose();
+        b -= row * (x * x + y * y);
+    }
+    let s = a.lu().solve(&b)?;
+    let (cx, cy) = (-s.x / 2.0, -s.y / 2.0);
+    let r2 = cx * cx + cy * cy - s.z;
+    if !(r2.is_finite() && r2 > 0.0) {
+        return None;
+    }
+    Some((Pixel::new(cx + mean.x, cy + mean.y), r2.sqrt()))
 }
 
 impl BallPercept {
@@ -263,7 +407,7 @@ mod tests {
                 m.iter().map(|&c| if c == 1 { 255 } else { 0 }).collect(),
             )
             .unwrap();
-            let mut slow = label_blobs(&full, (0, 0), 1);
+            let mut slow = label_blobs(&full, (0, 0), 1, |_, _| true);
             for v in [&mut fast, &mut slow] {
                 v.sort_by(|a, b| a.bbox.cmp(&b.bbox).then(a.pixels.cmp(&b.pixels)));
             }
@@ -293,6 +437,67 @@ mod tests {
             assert!((ball.distance - d).abs() <= 0.05 * d, "({x}, {y}): {ball:?}");
             assert!((ball.bearing - b).abs() <= 1.5f64.to_radians(), "({x}, {y}): {ball:?}");
         }
+    }
+
+    /// Which pixels (column, row) of a ball a case takes away.
+    type Cut = dyn Fn(usize, usize) -> bool;
+
+    /// A ball whose lower half is in shade too dark for either ball class, or whose shade is
+    /// of the shade's class, or that a robot hides in part: still found where it is (its
+    /// outline's circle, not its centre of mass).
+    #[test]
+    fn a_ball_half_in_shade_or_half_hidden_is_found_at_its_centre() {
+        let cam = Pinhole::new(Intrinsics::centred(320, 240, 260.0), 0.45, 0.35);
+        let radius = 0.11;
+        for (x, y) in [(1.0, 0.2), (2.0, -0.4), (3.5, 0.5)] {
+            let centre = Point3::new(x, y, radius);
+            let px = cam.project(centre).unwrap();
+            let r_px = ball_diameter_px(radius, 260.0, (centre - cam.centre()).norm()) / 2.0;
+            let whole = map(320, 240, &[(ColorClass::Ball, px.x, px.y, r_px)]);
+            let (d, b) = (x.hypot(y), y.atan2(x));
+            let below = move |_: usize, row: usize| (row as f64 + 0.5) > px.y + 0.2 * r_px;
+            let left = move |col: usize, _: usize| (col as f64 + 0.5) < px.x - 0.3 * r_px;
+            // Shade of no class below the middle; the shade's class; a robot on the left.
+            let cases: [(&str, &Cut, ColorClass); 3] = [
+                ("dark lower part", &below, ColorClass::Unknown),
+                ("shaded lower part", &below, ColorClass::BallShade),
+                ("a robot in front", &left, ColorClass::Robot),
+            ];
+            for (name, cut, fill) in cases {
+                let mut m = whole.clone();
+                for (k, class) in m.iter_mut().enumerate() {
+                    if *class == ColorClass::Ball as u8 && cut(k % 320, k / 320) {
+                        *class = fill as u8;
+                    }
+                }
+                let ball = find_ball(&m, &cam, radius).unwrap_or_else(|| panic!("{name}"));
+                assert!((ball.distance - d).abs() <= 0.05 * d, "{name} ({x}, {y}): {ball:?}");
+                assert!((ball.bearing - b).abs() <= 1.5f64.to_radians(), "{name}: {ball:?}");
+            }
+        }
+    }
+
+    #[test]
+    fn a_blob_of_the_shade_alone_is_no_ball() {
+        let cam = Pinhole::new(Intrinsics::centred(320, 240, 260.0), 0.45, 0.35);
+        let px = cam.project(Point3::new(2.0, 0.0, 0.11)).unwrap();
+        let m = map(320, 240, &[(ColorClass::BallShade, px.x, px.y, 14.0)]);
+        assert!(find_ball(&m, &cam, 0.11).is_none());
+    }
+
+    #[test]
+    fn a_circle_is_fitted_to_a_discs_outline_and_not_to_too_few_points() {
+        let m = map(80, 60, &[(ColorClass::Ball, 30.3, 25.6, 9.0)]);
+        let blob = blobs(&m, 80, 60, ColorClass::Ball, 1)[0];
+        let outline = Silhouette::of(&m, (80, 60), &blob);
+        assert_eq!(outline.area, blob.pixels, "a disc has no holes to fill");
+        let (c, r) = outline.circle().unwrap();
+        assert!((c.x - 30.3).abs() < 0.3 && (c.y - 25.6).abs() < 0.3, "{c}");
+        assert!((r - 9.0).abs() < 0.5, "{r}");
+        assert!(fit_circle(&outline.edge[..MIN_EDGE_POINTS - 1]).is_none());
+        // Points on a line: no circle.
+        let line: Vec<Pixel> = (0..20).map(|k| Pixel::new(f64::from(k), 3.0)).collect();
+        assert!(fit_circle(&line).is_none_or(|(_, r)| r > 1e3), "{:?}", fit_circle(&line));
     }
 
     #[test]

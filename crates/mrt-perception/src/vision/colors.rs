@@ -16,7 +16,11 @@
 //! one table per class, `[ball]`, `[goal_yellow]`, `[goal_blue]`, `[line]`, `[field]`,
 //! `[robot]`, each with `hue_min`, `hue_max` (degrees, 0 to 360), `sat_min`, `val_min` and
 //! optionally `sat_max`, `val_max` (0 to 1). A pixel that fits several classes takes the first
-//! in that order of precedence: ball, goal_yellow, goal_blue, robot, line, field.
+//! in that order of precedence: ball, ball_shade, goal_yellow, goal_blue, marker_magenta,
+//! marker_cyan, robot, line, field. **MRT adds** `[ball_shade]`, the ball's side in shade (of
+//! the ball's hue, too dark for its class: it joins a ball it touches and is never a ball
+//! alone), and `[white_balance] carpet`, the carpet's colour under the light the classes were
+//! set for, to which each image is corrected first ([`super::balance`]).
 
 use mrt_core::FileError;
 use serde::{Deserialize, Serialize};
@@ -44,15 +48,20 @@ pub enum ColorClass {
     MarkerMagenta = 7,
     /// A cyan robot marker (the other team's).
     MarkerCyan = 8,
+    /// The ball's shaded side (MRT's addition): too dark for the ball's class but of its hue;
+    /// it joins a ball blob it touches and never makes a ball on its own
+    /// ([`super::blobs::find_ball`]).
+    BallShade = 9,
 }
 
 impl ColorClass {
     /// How many byte values name a class, `Unknown` included (`class as usize` is below it).
-    pub const COUNT: usize = 9;
+    pub const COUNT: usize = 10;
 
     /// The classes in their order of precedence.
-    pub const ALL: [ColorClass; 8] = [
+    pub const ALL: [ColorClass; 9] = [
         ColorClass::Ball,
+        ColorClass::BallShade,
         ColorClass::GoalYellow,
         ColorClass::GoalBlue,
         ColorClass::MarkerMagenta,
@@ -73,6 +82,7 @@ impl ColorClass {
             6 => ColorClass::Field,
             7 => ColorClass::MarkerMagenta,
             8 => ColorClass::MarkerCyan,
+            9 => ColorClass::BallShade,
             _ => ColorClass::Unknown,
         }
     }
@@ -89,6 +99,7 @@ impl ColorClass {
             ColorClass::Field => "field",
             ColorClass::MarkerMagenta => "marker_magenta",
             ColorClass::MarkerCyan => "marker_cyan",
+            ColorClass::BallShade => "ball_shade",
         }
     }
 }
@@ -173,6 +184,22 @@ pub struct ColorTable {
     /// Cyan robot markers.
     #[serde(default)]
     pub marker_cyan: Option<Thresholds>,
+    /// The ball's shaded side, second in precedence (MRT's addition; module doc).
+    #[serde(default)]
+    pub ball_shade: Option<Thresholds>,
+    /// The carpet's colour under the light the classes were set for (MRT's addition): each
+    /// image is corrected so that its carpet shows this colour before it is classified
+    /// ([`super::balance`]). Without it images are classified as they come.
+    #[serde(default)]
+    pub white_balance: Option<WhiteBalance>,
+}
+
+/// What an image's colours are corrected to before classification ([`super::balance`]).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct WhiteBalance {
+    /// The carpet's red, green and blue (0–255) under the light the classes were set for.
+    pub carpet: [f64; 3],
 }
 
 impl ColorTable {
@@ -190,6 +217,17 @@ impl ColorTable {
         for class in ColorClass::ALL {
             if let Some(th) = self.get(class) {
                 th.check(class.name())?;
+            }
+        }
+        if let Some(wb) = &self.white_balance {
+            if !wb.carpet.iter().all(|c| (1.0..=255.0).contains(c)) {
+                return Err(format!(
+                    "white_balance.carpet must be three levels of 1 to 255, not {:?}",
+                    wb.carpet
+                ));
+            }
+            if self.field.is_none() {
+                return Err("white_balance needs a [field] class to find the carpet".into());
             }
         }
         Ok(())
@@ -221,6 +259,7 @@ impl ColorTable {
             ColorClass::Field => self.field.as_ref(),
             ColorClass::MarkerMagenta => self.marker_magenta.as_ref(),
             ColorClass::MarkerCyan => self.marker_cyan.as_ref(),
+            ColorClass::BallShade => self.ball_shade.as_ref(),
         }
     }
 
@@ -270,11 +309,19 @@ pub fn hsv_of_rgb15(c: u16) -> (f64, f64, f64) {
     (hue, sat, max / 31.0)
 }
 
-/// The colour lookup table: RGB15 → class, 32 768 entries (module doc).
+/// The colour lookup table: RGB15 → class, 32 768 entries (module doc), with what the white
+/// balance needs ([`super::balance`]).
 #[derive(Clone)]
 pub struct Lut {
     table: Box<[u8; 1 << 15]>,
+    /// Of the field's hue and saturation, at any value from [`CARPET_MIN_VALUE`] up.
+    carpet: Box<[bool; 1 << 15]>,
+    white_balance: Option<[f64; 3]>,
 }
+
+/// The darkest value a pixel of the carpet's hue and saturation is measured at by the white
+/// balance (two levels of 31).
+pub const CARPET_MIN_VALUE: f64 = 2.0 / 31.0;
 
 impl std::fmt::Debug for Lut {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
@@ -286,11 +333,27 @@ impl Lut {
     /// The table of `colors`, every RGB15 value classified once.
     pub fn new(colors: &ColorTable) -> Lut {
         let mut table = Box::new([0u8; 1 << 15]);
-        for (c, slot) in table.iter_mut().enumerate() {
+        let mut carpet = Box::new([false; 1 << 15]);
+        let field =
+            colors.field.map(|f| Thresholds { val_min: CARPET_MIN_VALUE, val_max: 1.0, ..f });
+        for (c, (slot, carpet)) in table.iter_mut().zip(carpet.iter_mut()).enumerate() {
             let (h, s, v) = hsv_of_rgb15(c as u16);
             *slot = colors.classify_hsv(h, s, v) as u8;
+            *carpet = field.is_some_and(|f| f.contains(h, s, v));
         }
-        Lut { table }
+        Lut { table, carpet, white_balance: colors.white_balance.map(|w| w.carpet) }
+    }
+
+    /// The carpet's colour the images are balanced to, if the colour file gives one.
+    pub fn white_balance(&self) -> Option<[f64; 3]> {
+        self.white_balance
+    }
+
+    /// Whether an RGB15 value has the field's hue and saturation (at any value from
+    /// [`CARPET_MIN_VALUE`] up).
+    #[inline]
+    pub fn is_carpet15(&self, c: u16) -> bool {
+        self.carpet[usize::from(c & 0x7FFF)]
     }
 
     /// The class of an RGB15 value.

@@ -1,0 +1,205 @@
+//! White balance: each image's colours corrected so that its carpet shows the colour the colour
+//! classes were set for, before the lookup table classifies them (MRT's addition to ISocRob's
+//! vision, seed `003` §3.2.1, whose thresholds hold for one light only).
+//!
+//! A light half as bright, a warm lamp or a camera's own gain moves every colour of the image
+//! the same way, channel by channel. The carpet, most of what a field camera sees, is a
+//! reference that is always there: its mean colour is measured on a sparse grid of the image
+//! (every [`SAMPLE_STEP`]th pixel of every [`SAMPLE_STEP`]th row, the pixels of the field's
+//! hue and saturation whatever their brightness), and each channel gets the gain that brings
+//! that mean to the colour file's `[white_balance] carpet` (a von Kries correction). Gains
+//! within [`DEAD_BAND`] of one are left at one, so that images under the light the classes
+//! were set for are classified exactly as they come; an image with too little carpet
+//! ([`MIN_CARPET_SHARE`]) is left as it is too.
+//!
+//! ```
+//! use mrt_perception::vision::balance::Gains;
+//!
+//! // An image under a light half as bright as the colour file's: twice the level.
+//! let gains = Gains::new([2.0, 2.0, 2.0]);
+//! assert_eq!(gains.apply([15, 65, 25]), [30, 130, 50]);
+//! assert!(Gains::new([1.01, 0.99, 1.0]).is_unity(), "within the dead band");
+//! ```
+
+use super::colors::{rgb15_of, Lut};
+
+/// The carpet is measured on every this many pixels of every this many rows.
+pub const SAMPLE_STEP: usize = 4;
+/// The share of the sampled pixels that must be carpet for an image to be balanced.
+pub const MIN_CARPET_SHARE: f64 = 0.05;
+/// Gains within this of one are one.
+pub const DEAD_BAND: f64 = 0.03;
+/// The largest gain (and the inverse of the smallest): darker or brighter images than that
+/// are corrected that far only.
+pub const MAX_GAIN: f64 = 4.0;
+
+/// One gain a channel, as three tables of the 256 levels.
+#[derive(Clone)]
+pub struct Gains {
+    factors: [f64; 3],
+    maps: [[u8; 256]; 3],
+}
+
+impl std::fmt::Debug for Gains {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Gains").field("factors", &self.factors).finish_non_exhaustive()
+    }
+}
+
+impl Default for Gains {
+    fn default() -> Self {
+        Gains::new([1.0; 3])
+    }
+}
+
+impl Gains {
+    /// The gains `factors` (red, green, blue), each kept within `1 / MAX_GAIN ..= MAX_GAIN`
+    /// and snapped to one within [`DEAD_BAND`] when all three are (a factor that is not a
+    /// number is one).
+    pub fn new(factors: [f64; 3]) -> Gains {
+        let mut factors =
+            factors.map(|f| if f.is_finite() { f.clamp(1.0 / MAX_GAIN, MAX_GAIN) } else { 1.0 });
+        if factors.iter().all(|f| (f - 1.0).abs() <= DEAD_BAND) {
+            factors = [1.0; 3];
+        }
+        let maps = factors.map(|f| {
+            let mut map = [0u8; 256];
+            for (v, m) in map.iter_mut().enumerate() {
+                *m = (v as f64 * f).round().min(255.0) as u8;
+            }
+            map
+        });
+        Gains { factors, maps }
+    }
+
+    /// The gains, red, green, blue.
+    pub fn factors(&self) -> [f64; 3] {
+        self.factors
+    }
+
+    /// Whether every gain is one (the image is classified as it comes).
+    pub fn is_unity(&self) -> bool {
+        self.factors == [1.0; 3]
+    }
+
+    /// A pixel, corrected.
+    #[inline]
+    pub fn apply(&self, [r, g, b]: [u8; 3]) -> [u8; 3] {
+        [self.maps[0][usize::from(r)], self.maps[1][usize::from(g)], self.maps[2][usize::from(b)]]
+    }
+
+    /// The gains that bring the mean colour of the carpet in `rgb` (an RGB888 image
+    /// `width` pixels wide) to `carpet`; one where the image shows too little carpet.
+    /// `is_carpet` tells a pixel of the carpet's hue and saturation by its RGB15 value.
+    pub fn to_carpet(
+        rgb: &[u8],
+        width: usize,
+        carpet: [f64; 3],
+        is_carpet: impl Fn(u16) -> bool,
+    ) -> Gains {
+        if width == 0 {
+            return Gains::default();
+        }
+        let (mut sum, mut count, mut sampled) = ([0u64; 3], 0u64, 0u64);
+        for row in rgb.chunks_exact(3 * width).step_by(SAMPLE_STEP) {
+            for px in row.chunks_exact(3).step_by(SAMPLE_STEP) {
+                sampled += 1;
+                if is_carpet(rgb15_of(px[0], px[1], px[2])) {
+                    count += 1;
+                    for (s, &v) in sum.iter_mut().zip(px) {
+                        *s += u64::from(v);
+                    }
+                }
+            }
+        }
+        if count == 0 || (count as f64) < MIN_CARPET_SHARE * sampled as f64 {
+            return Gains::default();
+        }
+        let mean = sum.map(|s| (s as f64 / count as f64).max(0.5));
+        Gains::new([carpet[0] / mean[0], carpet[1] / mean[1], carpet[2] / mean[2]])
+    }
+}
+
+impl Lut {
+    /// Classifies an RGB888 image `width` pixels wide into `out` as [`Lut::classify`] does,
+    /// after correcting its colours by the gains that bring its carpet to the colour file's
+    /// `[white_balance]` (none without one), and returns those gains.
+    pub fn classify_balanced(&self, rgb: &[u8], width: usize, out: &mut [u8]) -> Gains {
+        let gains = match self.white_balance() {
+            Some(carpet) => Gains::to_carpet(rgb, width, carpet, |c| self.is_carpet15(c)),
+            None => Gains::default(),
+        };
+        if gains.is_unity() {
+            self.classify(rgb, out);
+        } else {
+            for (px, o) in rgb.chunks_exact(3).zip(out.iter_mut()) {
+                let [r, g, b] = gains.apply([px[0], px[1], px[2]]);
+                *o = self.class15(rgb15_of(r, g, b)) as u8;
+            }
+        }
+        gains
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::vision::colors::{ColorClass, ColorTable};
+
+    /// A frame of carpet with an orange disc, every level scaled by `light` per channel.
+    fn frame(light: [f64; 3]) -> Vec<u8> {
+        let (w, h) = (64usize, 48usize);
+        let mut rgb = Vec::with_capacity(w * h * 3);
+        for y in 0..h {
+            for x in 0..w {
+                let ball = (x as f64 - 32.0).hypot(y as f64 - 24.0) < 6.0;
+                let c: [f64; 3] = if ball { [250.0, 110.0, 15.0] } else { [30.0, 130.0, 50.0] };
+                for (v, l) in c.iter().zip(light) {
+                    rgb.push((v * l).round().min(255.0) as u8);
+                }
+            }
+        }
+        rgb
+    }
+
+    fn classes(lut: &Lut, rgb: &[u8]) -> (Vec<u8>, Gains) {
+        let mut out = vec![0u8; rgb.len() / 3];
+        let gains = lut.classify_balanced(rgb, 64, &mut out);
+        (out, gains)
+    }
+
+    #[test]
+    fn a_dim_or_tinted_image_is_classified_as_under_the_files_light() {
+        let lut = Lut::new(&ColorTable::shipped());
+        let (reference, gains) = classes(&lut, &frame([1.0; 3]));
+        assert!(gains.is_unity(), "the file's own light: no correction ({gains:?})");
+        for light in [[0.35, 0.35, 0.35], [1.0, 0.8, 0.55], [0.6, 0.7, 1.0]] {
+            let (seen, gains) = classes(&lut, &frame(light));
+            let same = seen.iter().zip(&reference).filter(|(a, b)| a == b).count();
+            assert!(same as f64 > 0.99 * reference.len() as f64, "{light:?}: {gains:?}");
+            for (g, l) in gains.factors().iter().zip(light) {
+                assert!((g * l - 1.0).abs() < 0.05, "{light:?}: {gains:?}");
+            }
+        }
+    }
+
+    #[test]
+    fn without_carpet_or_a_white_balance_nothing_is_corrected() {
+        let lut = Lut::new(&ColorTable::shipped());
+        let orange = [250u8, 110, 15].repeat(64 * 48);
+        assert!(classes(&lut, &orange).1.is_unity(), "no carpet in view");
+        let plain = ColorTable { white_balance: None, ..ColorTable::shipped() };
+        let lut = Lut::new(&plain);
+        let (seen, gains) = classes(&lut, &frame([0.35; 3]));
+        assert!(gains.is_unity());
+        assert!(!seen.contains(&(ColorClass::Field as u8)), "too dark for the field's class");
+    }
+
+    #[test]
+    fn gains_are_bounded_and_numbers() {
+        assert_eq!(Gains::new([f64::NAN, f64::INFINITY, 1e9]).factors(), [1.0, 1.0, MAX_GAIN]);
+        assert_eq!(Gains::new([0.0; 3]).factors(), [1.0 / MAX_GAIN; 3]);
+        assert_eq!(Gains::new([3.0; 3]).apply([100, 0, 255]), [255, 0, 255], "clipped");
+        assert!(Gains::to_carpet(&[], 0, [30.0, 130.0, 50.0], |_| true).is_unity());
+    }
+}
