@@ -188,35 +188,70 @@ pub const BALL_AREA_RANGE: (f64, f64) = (0.3, 3.0);
 /// side): a blob of the shade's darker orange alone is not a ball.
 pub const BALL_CORE_SHARE: f64 = 0.2;
 
-/// The ball in a class map seen by `camera`: the largest blob of the ball's class and its
-/// shade ([`ColorClass::BallShade`], joined where it touches) whose silhouette fits the size a
-/// ball of `radius` (m) would have where its centre's ray says it is, corrected from the floor
-/// point of that ray to the point under the ball (both coordinates).
+/// The farthest a ball is looked for, m (floor distance): a blob whose ray meets the floor
+/// farther away is a few pixels of something else of the ball's colour, or so small that its
+/// position would mean little.
+pub const MAX_BALL_RANGE: f64 = 12.0;
+
+/// The ball in a class map seen by `camera`: of the blobs of the ball's class and its shade
+/// ([`ColorClass::BallShade`], joined where it touches), the largest whose silhouette fits the
+/// size a ball of `radius` (m) would have where its centre's ray says it is, within
+/// [`MAX_BALL_RANGE`], corrected from the floor point of that ray to the point under the ball
+/// (both coordinates). Where the shade runs on into something else of its colour (a wall
+/// under a warm light) and the joined blob is too big, the lit side alone is tried.
 ///
 /// The centre is the centre of the circle fitted to the blob's outline ([`Silhouette`]): a
 /// ball half in shade, cut by the image's border or partly behind a robot still has its
 /// centre where the circle's is, where a centre of mass would move towards the part seen.
 pub fn find_ball(classes: &[u8], camera: &Pinhole, radius: f64) -> Option<BallPercept> {
     let (w, h) = camera.size();
+    let mut lit: Option<Vec<Blob>> = None;
+    let mut best: Option<BallPercept> = None;
     for blob in blobs_joined(classes, w, h, ColorClass::Ball, ColorClass::BallShade, 3) {
-        if f64::from(blob.core) < BALL_CORE_SHARE * f64::from(blob.pixels) {
-            continue;
-        }
-        let outline = Silhouette::of(classes, (w, h), &blob);
-        let centre = outline.circle().map_or(outline.centroid, |c| c.0);
-        let Some(hit) = camera.unproject(centre) else { continue };
-        let foot = camera.mount;
-        let at = ball_floor_point(foot, camera.height, hit, radius);
-        let centre_3d = Point3::new(at.x, at.y, radius);
-        let range = (centre_3d - camera.centre()).norm();
-        let expected = ball_diameter_px(radius, camera.intrinsics.fx, range) / 2.0;
-        let area = std::f64::consts::PI * expected * expected;
-        let filled = Blob { pixels: outline.area, centroid: centre, ..blob };
-        if let Some(ball) = BallPercept::sized(&filled, area, at, foot) {
-            return Some(ball);
+        let lit_enough = f64::from(blob.core) >= BALL_CORE_SHARE * f64::from(blob.pixels);
+        let with_shade = lit_enough.then(|| sized_ball(classes, camera, radius, &blob, true));
+        let found = with_shade.flatten().or_else(|| {
+            if blob.core == 0 || blob.core == blob.pixels {
+                return None;
+            }
+            let lit = lit.get_or_insert_with(|| blobs(classes, w, h, ColorClass::Ball, 3));
+            let (x0, x1, y0, y1) = blob.bbox;
+            lit.iter()
+                .filter(|b| b.bbox.0 >= x0 && b.bbox.1 <= x1 && b.bbox.2 >= y0 && b.bbox.3 <= y1)
+                .find_map(|b| sized_ball(classes, camera, radius, b, false))
+        });
+        if let Some(ball) = found {
+            if best.is_none_or(|b| ball.pixels > b.pixels) {
+                best = Some(ball);
+            }
         }
     }
-    None
+    best
+}
+
+/// The ball `blob` shows, if its silhouette (with the shade's pixels or without) has a
+/// ball's size where it stands.
+fn sized_ball(
+    classes: &[u8],
+    camera: &Pinhole,
+    radius: f64,
+    blob: &Blob,
+    with_shade: bool,
+) -> Option<BallPercept> {
+    let outline = Silhouette::of(classes, camera.size(), blob, with_shade);
+    let centre = outline.circle().map_or(outline.centroid, |c| c.0);
+    let hit = camera.unproject(centre)?;
+    let foot = camera.mount;
+    let at = ball_floor_point(foot, camera.height, hit, radius);
+    if (at - foot).norm() > MAX_BALL_RANGE {
+        return None;
+    }
+    let centre_3d = Point3::new(at.x, at.y, radius);
+    let range = (centre_3d - camera.centre()).norm();
+    let expected = ball_diameter_px(radius, camera.intrinsics.fx, range) / 2.0;
+    let area = std::f64::consts::PI * expected * expected;
+    let filled = Blob { pixels: outline.area, centroid: centre, ..*blob };
+    BallPercept::sized(&filled, area, at, foot)
 }
 
 /// A ball blob's outline: each row's span from its first to its last pixel of the ball or its
@@ -237,12 +272,19 @@ pub struct Silhouette {
 const MIN_EDGE_POINTS: usize = 8;
 
 impl Silhouette {
-    /// The outline of `blob` in a class map of `(width, height)`.
-    pub fn of(classes: &[u8], (width, height): (u32, u32), blob: &Blob) -> Silhouette {
+    /// The outline of `blob` in a class map of `(width, height)`, of the ball's pixels and,
+    /// `with_shade`, its shade's.
+    pub fn of(
+        classes: &[u8],
+        (width, height): (u32, u32),
+        blob: &Blob,
+        with_shade: bool,
+    ) -> Silhouette {
         let (x0, x1, y0, y1) = blob.bbox;
+        let shade = if with_shade { ColorClass::BallShade } else { ColorClass::Ball } as u8;
         let is_ball = |x: u32, y: u32| {
             let c = classes.get((y * width + x) as usize).copied().unwrap_or(0);
-            c == ColorClass::Ball as u8 || c == ColorClass::BallShade as u8
+            c == ColorClass::Ball as u8 || c == shade
         };
         let (mut area, mut sx, mut sy) = (0u32, 0.0, 0.0);
         let mut edge = Vec::new();
@@ -477,6 +519,42 @@ mod tests {
         }
     }
 
+    /// A wall of the shade's colour (grey under a warm lamp) touching the ball: the joined
+    /// blob is too big, the ball's lit side alone is the ball.
+    #[test]
+    fn a_ball_against_a_wall_of_its_shades_colour_is_found_by_its_lit_side() {
+        let cam = Pinhole::new(Intrinsics::centred(320, 240, 260.0), 0.45, 0.35);
+        let (x, y, radius) = (3.0, 0.3, 0.11);
+        let centre = Point3::new(x, y, radius);
+        let px = cam.project(centre).unwrap();
+        let r_px = ball_diameter_px(radius, 260.0, (centre - cam.centre()).norm()) / 2.0;
+        let mut m = map(320, 240, &[(ColorClass::Ball, px.x, px.y, r_px)]);
+        let wall_top = px.y - r_px - 10.0;
+        for (k, c) in m.iter_mut().enumerate() {
+            let row = (k / 320) as f64 + 0.5;
+            if *c != ColorClass::Ball as u8 && row > wall_top && row < px.y {
+                *c = ColorClass::BallShade as u8;
+            }
+        }
+        let ball = find_ball(&m, &cam, radius).unwrap();
+        let d = x.hypot(y);
+        assert!((ball.distance - d).abs() <= 0.05 * d, "{ball:?}");
+    }
+
+    /// A few pixels of the ball's colour high in the image (a post's band under an orange
+    /// light) would be a ball far beyond the field: not a ball.
+    #[test]
+    fn no_ball_beyond_the_farthest_range() {
+        let cam = Pinhole::new(Intrinsics::centred(320, 240, 260.0), 0.45, 0.35);
+        for d in [MAX_BALL_RANGE + 1.0, 2.0 * MAX_BALL_RANGE] {
+            let centre = Point3::new(d, 0.0, 0.11);
+            let px = cam.project(centre).unwrap();
+            let r_px = ball_diameter_px(0.11, 260.0, (centre - cam.centre()).norm()) / 2.0;
+            let m = map(320, 240, &[(ColorClass::Ball, px.x, px.y, r_px.max(1.5))]);
+            assert!(find_ball(&m, &cam, 0.11).is_none(), "{d} m");
+        }
+    }
+
     #[test]
     fn a_blob_of_the_shade_alone_is_no_ball() {
         let cam = Pinhole::new(Intrinsics::centred(320, 240, 260.0), 0.45, 0.35);
@@ -489,7 +567,7 @@ mod tests {
     fn a_circle_is_fitted_to_a_discs_outline_and_not_to_too_few_points() {
         let m = map(80, 60, &[(ColorClass::Ball, 30.3, 25.6, 9.0)]);
         let blob = blobs(&m, 80, 60, ColorClass::Ball, 1)[0];
-        let outline = Silhouette::of(&m, (80, 60), &blob);
+        let outline = Silhouette::of(&m, (80, 60), &blob, true);
         assert_eq!(outline.area, blob.pixels, "a disc has no holes to fill");
         let (c, r) = outline.circle().unwrap();
         assert!((c.x - 30.3).abs() < 0.3 && (c.y - 25.6).abs() < 0.3, "{c}");
