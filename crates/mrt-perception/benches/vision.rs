@@ -11,6 +11,7 @@
 use criterion::{black_box, criterion_group, criterion_main, Criterion, Throughput};
 use mrt_perception::camera::{Intrinsics, Pinhole};
 use mrt_perception::vision::agent::VisionAgent;
+use mrt_perception::vision::balance::BalancedLut;
 use mrt_perception::vision::blobs::blobs;
 use mrt_perception::vision::colors::{ColorClass, ColorTable, Lut};
 use rand::{Rng, SeedableRng};
@@ -77,8 +78,9 @@ fn bench(c: &mut Criterion) {
     g.throughput(Throughput::Elements((W * H) as u64));
     g.bench_function("lut_classify", |b| b.iter(|| lut.classify(black_box(&img), &mut out)));
     // The frame's carpet (30, 140, 40) is not the colour file's (30, 130, 50): corrected.
+    let mut balanced = BalancedLut::default();
     g.bench_function("lut_classify_balanced", |b| {
-        b.iter(|| lut.classify_balanced(black_box(&img), W, &mut out))
+        b.iter(|| balanced.classify(&lut, black_box(&img), W, &mut out))
     });
     g.bench_function("lut_classify_and_ball_blob", |b| {
         b.iter(|| {

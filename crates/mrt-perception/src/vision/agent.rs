@@ -11,6 +11,7 @@
 //! (where its far end stands is unknown), and the columns of the landmark posts
 //! ([`super::posts`]), whose bands wear the goal colours, do not count as goal.
 
+use super::balance::BalancedLut;
 use super::blobs::{find_ball, BallPercept};
 use super::colors::{ColorClass, ColorTable, Lut};
 use super::goals::{find_goal, goal_columns, open_space, GoalPercept};
@@ -105,6 +106,8 @@ pub struct Sight {
 pub struct VisionAgent {
     camera: Pinhole,
     lut: Lut,
+    /// The lookup table under the last image's light.
+    balanced: BalancedLut,
     ball_radius: f64,
     east_goal: ColorClass,
     posts: PostShape,
@@ -135,6 +138,7 @@ impl VisionAgent {
         VisionAgent {
             camera,
             lut: Lut::new(colors),
+            balanced: BalancedLut::default(),
             ball_radius,
             east_goal: ColorClass::GoalYellow,
             posts: PostShape::default(),
@@ -255,7 +259,7 @@ impl VisionAgent {
         check_size(image, (w, h))?;
         self.camera.pan = pan;
         self.classes.resize(w as usize * h as usize, 0);
-        self.lut.classify_balanced(&image.rgb, w as usize, &mut self.classes);
+        self.balanced.classify(&self.lut, &image.rgb, w as usize, &mut self.classes);
         let mut p = Percepts { time, pan: Some(pan), ..Default::default() };
         // Where in the image each object was found, for monitors (ISocRob seed `003` §3.2.7).
         let mut shown = Vec::with_capacity(8 + ImageDetections::MAX_LINE_POINTS);

@@ -1,10 +1,13 @@
 //! Blobs of one colour class and the ball percept (ISocRob seed `003` §3.2.1: the windowed
-//! centre of mass of the ball's pixels, its distance-dependent size test and its centre
-//! correction, eqs 10–11 as fixed in the research notes §3).
+//! blob of the ball's pixels, its distance-dependent size test and its centre correction, eqs
+//! 10–11 as fixed in the research notes §3).
 //!
 //! Connected components are `imageproc`'s (8-connected); this module only gathers each
 //! component's pixel count, centre of mass and bounding box, and turns the best ball blob into
-//! a floor position through the camera model.
+//! a floor position through the camera model. **MRT's addition**, for real light: the ball's
+//! shade joins its blob ([`blobs_joined`]), and the ball's centre is the centre of the circle
+//! fitted to the blob's outline ([`Silhouette`]) rather than its centre of mass, which moves
+//! towards the part in view when shade, a robot or the image's border hides the rest.
 
 use super::colors::ColorClass;
 use crate::camera::{ball_diameter_px, ball_floor_point, Camera, Pinhole, Pixel};
@@ -164,9 +167,10 @@ fn label_blobs(
 /// The ball as the camera saw it.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct BallPercept {
-    /// Its blob's centre of mass.
+    /// Its centre in the image: the centre of the circle fitted to its outline (its
+    /// silhouette's centre of mass where no circle fits).
     pub pixel: Pixel,
-    /// Its apparent radius, pixels (from the blob's area).
+    /// Its apparent radius, pixels (from its silhouette's area).
     pub radius_px: f64,
     /// The ball's floor point (robot frame, m): under its centre.
     pub at: Point2<f64>,
@@ -188,29 +192,27 @@ pub const BALL_AREA_RANGE: (f64, f64) = (0.3, 3.0);
 /// side): a blob of the shade's darker orange alone is not a ball.
 pub const BALL_CORE_SHARE: f64 = 0.2;
 
-/// The farthest a ball is looked for, m (floor distance): a blob whose ray meets the floor
-/// farther away is a few pixels of something else of the ball's colour, or so small that its
-/// position would mean little.
+/// The farthest a ball is looked for, m (floor distance from the point under the camera): a
+/// blob farther away is a few pixels of something else of the ball's colour, or so small that
+/// its position would mean little.
 pub const MAX_BALL_RANGE: f64 = 12.0;
 
 /// The ball in a class map seen by `camera`: of the blobs of the ball's class and its shade
 /// ([`ColorClass::BallShade`], joined where it touches), the largest whose silhouette fits the
 /// size a ball of `radius` (m) would have where its centre's ray says it is, within
 /// [`MAX_BALL_RANGE`], corrected from the floor point of that ray to the point under the ball
-/// (both coordinates). Where the shade runs on into something else of its colour (a wall
-/// under a warm light) and the joined blob is too big, the lit side alone is tried.
-///
-/// The centre is the centre of the circle fitted to the blob's outline ([`Silhouette`]): a
-/// ball half in shade, cut by the image's border or partly behind a robot still has its
-/// centre where the circle's is, where a centre of mass would move towards the part seen.
+/// (both coordinates). A joined blob that is mostly shade, or that does not fit (the shade ran
+/// on into something else of its colour, such as a wall under a warm light), is tried by its
+/// lit side alone: the blobs of the ball's class within it.
 pub fn find_ball(classes: &[u8], camera: &Pinhole, radius: f64) -> Option<BallPercept> {
     let (w, h) = camera.size();
     let mut lit: Option<Vec<Blob>> = None;
     let mut best: Option<BallPercept> = None;
     for blob in blobs_joined(classes, w, h, ColorClass::Ball, ColorClass::BallShade, 3) {
         let lit_enough = f64::from(blob.core) >= BALL_CORE_SHARE * f64::from(blob.pixels);
-        let with_shade = lit_enough.then(|| sized_ball(classes, camera, radius, &blob, true));
-        let found = with_shade.flatten().or_else(|| {
+        let joined =
+            if lit_enough { sized_ball(classes, camera, radius, &blob, true) } else { None };
+        let found = joined.or_else(|| {
             if blob.core == 0 || blob.core == blob.pixels {
                 return None;
             }
@@ -229,8 +231,8 @@ pub fn find_ball(classes: &[u8], camera: &Pinhole, radius: f64) -> Option<BallPe
     best
 }
 
-/// The ball `blob` shows, if its silhouette (with the shade's pixels or without) has a
-/// ball's size where it stands.
+/// The ball `blob` shows, if its silhouette (of the ball's pixels and, `with_shade`, its
+/// shade's) has a ball's size where it stands.
 fn sized_ball(
     classes: &[u8],
     camera: &Pinhole,
@@ -238,7 +240,8 @@ fn sized_ball(
     blob: &Blob,
     with_shade: bool,
 ) -> Option<BallPercept> {
-    let outline = Silhouette::of(classes, camera.size(), blob, with_shade);
+    let shade = if with_shade { ColorClass::BallShade } else { ColorClass::Ball };
+    let outline = Silhouette::of(classes, camera.size(), blob.bbox, [ColorClass::Ball, shade]);
     let centre = outline.circle().map_or(outline.centroid, |c| c.0);
     let hit = camera.unproject(centre)?;
     let foot = camera.mount;
@@ -250,12 +253,11 @@ fn sized_ball(
     let range = (centre_3d - camera.centre()).norm();
     let expected = ball_diameter_px(radius, camera.intrinsics.fx, range) / 2.0;
     let area = std::f64::consts::PI * expected * expected;
-    let filled = Blob { pixels: outline.area, centroid: centre, ..*blob };
-    BallPercept::sized(&filled, area, at, foot)
+    BallPercept::sized(outline.area, centre, area, at, foot)
 }
 
-/// A ball blob's outline: each row's span from its first to its last pixel of the ball or its
-/// shade (a highlight or a hole inside is filled), and the ends of those spans and of each
+/// A ball blob's outline: each row's span from its first to its last pixel of the ball's
+/// classes (a highlight or a hole inside is filled), and the ends of those spans and of each
 /// column's, the points a circle is fitted to. Ends on the image's border are left out: there
 /// the ball goes on beyond the image.
 #[derive(Clone, Debug, PartialEq)]
@@ -272,72 +274,90 @@ pub struct Silhouette {
 const MIN_EDGE_POINTS: usize = 8;
 
 impl Silhouette {
-    /// The outline of `blob` in a class map of `(width, height)`, of the ball's pixels and,
-    /// `with_shade`, its shade's.
+    /// The outline of the pixels of `of` within `bbox` (first and last column, first and last
+    /// row, clipped to the map) of a class map of `(width, height)`.
     pub fn of(
         classes: &[u8],
         (width, height): (u32, u32),
-        blob: &Blob,
-        with_shade: bool,
+        bbox: BoundingBox,
+        of: [ColorClass; 2],
     ) -> Silhouette {
-        let (x0, x1, y0, y1) = blob.bbox;
-        let shade = if with_shade { ColorClass::BallShade } else { ColorClass::Ball } as u8;
-        let is_ball = |x: u32, y: u32| {
-            let c = classes.get((y * width + x) as usize).copied().unwrap_or(0);
-            c == ColorClass::Ball as u8 || c == shade
+        let (w, h) = (width as usize, height as usize);
+        let (x0, y0) = (bbox.0 as usize, bbox.2 as usize);
+        let (x1, y1) = ((bbox.1 as usize).min(w.max(1) - 1), (bbox.3 as usize).min(h.max(1) - 1));
+        let of = of.map(|c| c as u8);
+        let at = |x: usize, y: usize| classes.get(y * w + x).is_some_and(|c| of.contains(c));
+        // The first and last pixel of the ball's classes along one line, if any.
+        let ends = |mut line: std::ops::RangeInclusive<usize>, at: &dyn Fn(usize) -> bool| {
+            let first = line.find(|&k| at(k))?;
+            Some((first, line.rev().find(|&k| at(k)).unwrap_or(first)))
         };
         let (mut area, mut sx, mut sy) = (0u32, 0.0, 0.0);
         let mut edge = Vec::new();
         for y in y0..=y1 {
-            let Some(first) = (x0..=x1).find(|&x| is_ball(x, y)) else { continue };
-            let last = (first..=x1).rev().find(|&x| is_ball(x, y)).unwrap_or(first);
-            let n = last - first + 1;
+            let Some((first, last)) = ends(x0..=x1, &|x| at(x, y)) else { continue };
+            let n = (last - first + 1) as u32;
             area += n;
-            sx += f64::from(n) * (f64::from(first) + f64::from(last) + 1.0) / 2.0;
-            sy += f64::from(n) * (f64::from(y) + 0.5);
-            let cy = f64::from(y) + 0.5;
-            if first > 0 {
-                edge.push(Pixel::new(f64::from(first), cy));
-            }
-            if last + 1 < width {
-                edge.push(Pixel::new(f64::from(last) + 1.0, cy));
-            }
+            sx += f64::from(n) * (first + last + 1) as f64 / 2.0;
+            sy += f64::from(n) * (y as f64 + 0.5);
+            push_ends(&mut edge, (first, last), w, |along| Pixel::new(along, y as f64 + 0.5));
         }
         for x in x0..=x1 {
-            let Some(first) = (y0..=y1).find(|&y| is_ball(x, y)) else { continue };
-            let last = (first..=y1).rev().find(|&y| is_ball(x, y)).unwrap_or(first);
-            let cx = f64::from(x) + 0.5;
-            if first > 0 {
-                edge.push(Pixel::new(cx, f64::from(first)));
-            }
-            if last + 1 < height {
-                edge.push(Pixel::new(cx, f64::from(last) + 1.0));
-            }
+            let Some(span) = ends(y0..=y1, &|y| at(x, y)) else { continue };
+            push_ends(&mut edge, span, h, |along| Pixel::new(x as f64 + 0.5, along));
         }
         let centroid = if area > 0 {
             Pixel::new(sx / f64::from(area), sy / f64::from(area))
         } else {
-            blob.centroid
+            Pixel::new((x0 + x1 + 1) as f64 / 2.0, (y0 + y1 + 1) as f64 / 2.0)
         };
         Silhouette { area, centroid, edge }
     }
 
     /// The circle through the outline (centre, radius in pixels): a least-squares fit, then
-    /// fitted again without the points well inside it (where the ball's edge is not seen: a
-    /// shade too dark for its class, a robot in front), twice. `None` for too few points or a
-    /// degenerate outline.
+    /// fitted again, twice, without the points well inside it (where the ball's edge is not
+    /// seen: a shade too dark for its class, a robot in front) or half a radius outside
+    /// (another blob in the corner of its box). `None` for too few points, or a circle that could not be
+    /// the outline's: its centre farther than its radius from the outline's box, or a radius
+    /// larger than the box's longer side.
     pub fn circle(&self) -> Option<(Pixel, f64)> {
-        let mut points: Vec<Pixel> = self.edge.clone();
+        let mut points = self.edge.clone();
         let mut fit = fit_circle(&points)?;
         for _ in 0..2 {
             let (c, r) = fit;
-            points.retain(|p| (p - c).norm() - r > -1.0);
-            if points.len() < MIN_EDGE_POINTS {
-                break;
+            points.retain(|p| (-1.0..=0.5 * r).contains(&((p - c).norm() - r)));
+            match fit_circle(&points) {
+                Some(refit) => fit = refit,
+                None => break,
             }
-            fit = fit_circle(&points)?;
         }
-        Some(fit)
+        let (lo, hi) = self.edge.iter().fold(
+            (
+                Pixel::new(f64::INFINITY, f64::INFINITY),
+                Pixel::new(f64::NEG_INFINITY, f64::NEG_INFINITY),
+            ),
+            |(lo, hi), p| (lo.inf(p), hi.sup(p)),
+        );
+        let (c, r) = fit;
+        let side = (hi.x - lo.x).max(hi.y - lo.y);
+        let inside = c.x >= lo.x - r && c.x <= hi.x + r && c.y >= lo.y - r && c.y <= hi.y + r;
+        (inside && r <= side).then_some(fit)
+    }
+}
+
+/// The ends of a span `(first, last)` on a line of `len` pixels as outline points, `point`
+/// placing a position along the line; an end on the image's border is left out.
+fn push_ends(
+    edge: &mut Vec<Pixel>,
+    (first, last): (usize, usize),
+    len: usize,
+    point: impl Fn(f64) -> Pixel,
+) {
+    if first > 0 {
+        edge.push(point(first as f64));
+    }
+    if last + 1 < len {
+        edge.push(point((last + 1) as f64));
     }
 }
 
@@ -367,27 +387,28 @@ fn fit_circle(points: &[Pixel]) -> Option<(Pixel, f64)> {
 }
 
 impl BallPercept {
-    /// The ball `blob` shows, standing at `at` and seen from `foot` (robot frame), when its
-    /// pixels fit the `expected` area ([`BALL_AREA_RANGE`]).
+    /// The ball of `pixels` pixels centred at `pixel`, standing at `at` and seen from `foot`
+    /// (robot frame), when its pixels fit the `expected` area ([`BALL_AREA_RANGE`]).
     pub(crate) fn sized(
-        blob: &Blob,
+        pixels: u32,
+        pixel: Pixel,
         expected: f64,
         at: Point2<f64>,
         foot: Point2<f64>,
     ) -> Option<BallPercept> {
         let (lo, hi) = BALL_AREA_RANGE;
-        let n = f64::from(blob.pixels);
+        let n = f64::from(pixels);
         if n < lo * expected || n > hi * expected {
             return None;
         }
         let d = at - foot;
         Some(BallPercept {
-            pixel: blob.centroid,
+            pixel,
             radius_px: (n / std::f64::consts::PI).sqrt(),
             at,
             distance: d.norm(),
             bearing: d.y.atan2(d.x),
-            pixels: blob.pixels,
+            pixels,
         })
     }
 }
@@ -422,6 +443,7 @@ mod tests {
         );
         let b = blobs(&m, 80, 60, ColorClass::Ball, 1);
         assert_eq!(b.len(), 2);
+        assert!(b.iter().all(|b| b.core == b.pixels), "one class: every pixel is core");
         assert!(b[0].pixels > b[1].pixels);
         assert!((b[0].centroid.x - 20.0).abs() < 0.05 && (b[0].centroid.y - 20.0).abs() < 0.05);
         assert_eq!(b[0].bbox, (15, 24, 15, 24));
@@ -539,6 +561,7 @@ mod tests {
         let ball = find_ball(&m, &cam, radius).unwrap();
         let d = x.hypot(y);
         assert!((ball.distance - d).abs() <= 0.05 * d, "{ball:?}");
+        assert!((ball.bearing - y.atan2(x)).abs() <= 1.5f64.to_radians(), "{ball:?}");
     }
 
     /// A few pixels of the ball's colour high in the image (a post's band under an orange
@@ -546,13 +569,29 @@ mod tests {
     #[test]
     fn no_ball_beyond_the_farthest_range() {
         let cam = Pinhole::new(Intrinsics::centred(320, 240, 260.0), 0.45, 0.35);
-        for d in [MAX_BALL_RANGE + 1.0, 2.0 * MAX_BALL_RANGE] {
+        for d in [MAX_BALL_RANGE - 1.0, MAX_BALL_RANGE + 1.0, 2.0 * MAX_BALL_RANGE] {
             let centre = Point3::new(d, 0.0, 0.11);
             let px = cam.project(centre).unwrap();
             let r_px = ball_diameter_px(0.11, 260.0, (centre - cam.centre()).norm()) / 2.0;
             let m = map(320, 240, &[(ColorClass::Ball, px.x, px.y, r_px.max(1.5))]);
-            assert!(find_ball(&m, &cam, 0.11).is_none(), "{d} m");
+            let found = find_ball(&m, &cam, 0.11);
+            assert_eq!(found.is_some(), d < MAX_BALL_RANGE, "{d} m: {found:?}");
         }
+    }
+
+    #[test]
+    fn a_joined_blob_counts_its_core() {
+        let mut m = map(80, 60, &[(ColorClass::Ball, 30.0, 30.0, 8.0)]);
+        let lit = m.iter().filter(|&&c| c == ColorClass::Ball as u8).count() as u32;
+        for c in m.iter_mut().skip(31 * 80).take(80) {
+            if *c == ColorClass::Field as u8 {
+                *c = ColorClass::BallShade as u8;
+            }
+        }
+        let b = blobs_joined(&m, 80, 60, ColorClass::Ball, ColorClass::BallShade, 1);
+        assert_eq!(b.len(), 1, "the shade's row runs through the ball: one blob");
+        assert_eq!(b[0].core, lit);
+        assert_eq!(b[0].pixels, lit + 80 - 16, "the row's shade beside the ball joins it");
     }
 
     #[test]
@@ -567,7 +606,7 @@ mod tests {
     fn a_circle_is_fitted_to_a_discs_outline_and_not_to_too_few_points() {
         let m = map(80, 60, &[(ColorClass::Ball, 30.3, 25.6, 9.0)]);
         let blob = blobs(&m, 80, 60, ColorClass::Ball, 1)[0];
-        let outline = Silhouette::of(&m, (80, 60), &blob, true);
+        let outline = Silhouette::of(&m, (80, 60), blob.bbox, [ColorClass::Ball; 2]);
         assert_eq!(outline.area, blob.pixels, "a disc has no holes to fill");
         let (c, r) = outline.circle().unwrap();
         assert!((c.x - 30.3).abs() < 0.3 && (c.y - 25.6).abs() < 0.3, "{c}");

@@ -13,13 +13,13 @@
 //! frame is one table read per pixel ([`Lut::classify`]).
 //!
 //! The classes come from a COLORS.toml file ([`ColorTable::from_toml`], `configs/vision/`):
-//! one table per class, `[ball]`, `[goal_yellow]`, `[goal_blue]`, `[line]`, `[field]`,
-//! `[robot]`, each with `hue_min`, `hue_max` (degrees, 0 to 360), `sat_min`, `val_min` and
+//! one table per class, `[ball]`, `[ball_shade]`, `[goal_yellow]`, `[goal_blue]`,
+//! `[marker_magenta]`, `[marker_cyan]`, `[robot]`, `[line]`, `[field]`, each with `hue_min`, `hue_max` (degrees, 0 to 360), `sat_min`, `val_min` and
 //! optionally `sat_max`, `val_max` (0 to 1). A pixel that fits several classes takes the first
 //! in that order of precedence: ball, ball_shade, goal_yellow, goal_blue, marker_magenta,
 //! marker_cyan, robot, line, field. **MRT adds** `[ball_shade]`, the ball's side in shade (of
-//! the ball's hue, too dark for its class: it joins a ball it touches and is never a ball
-//! alone), and `[white_balance] carpet`, the carpet's colour under the light the classes were
+//! the ball's hue, what the ball's class does not take, darker or a little less saturated: it
+//! joins a ball it touches and is never a ball alone), and `[white_balance] carpet`, the carpet's colour under the light the classes were
 //! set for, to which each image is corrected first ([`super::balance`]).
 
 use mrt_core::FileError;
@@ -48,8 +48,9 @@ pub enum ColorClass {
     MarkerMagenta = 7,
     /// A cyan robot marker (the other team's).
     MarkerCyan = 8,
-    /// The ball's shaded side (MRT's addition): too dark for the ball's class but of its hue;
-    /// it joins a ball blob it touches and never makes a ball on its own
+    /// The ball's shaded side (MRT's addition): of the ball's hue, what the ball's class does
+    /// not take (darker, or a little less saturated); it joins a ball blob it touches and never
+    /// makes a ball on its own
     /// ([`super::blobs::find_ball`]).
     BallShade = 9,
 }

@@ -37,6 +37,7 @@
 //! ```
 
 use super::agent::{check_size, VisionError};
+use super::balance::BalancedLut;
 use super::blobs::{blobs, BallPercept};
 use super::colors::{ColorClass, Lut};
 use crate::camera::{Camera, Omni, Pixel};
@@ -59,12 +60,13 @@ pub const UP_LINE_MAX_RUN: usize = 12;
 pub struct UpMode {
     omni: Omni,
     classes: Vec<u8>,
+    balanced: BalancedLut,
 }
 
 impl UpMode {
     /// The up mode of `omni`.
     pub fn new(omni: Omni) -> UpMode {
-        UpMode { omni, classes: Vec::new() }
+        UpMode { omni, classes: Vec::new(), balanced: BalancedLut::default() }
     }
 
     /// Its camera.
@@ -77,13 +79,14 @@ impl UpMode {
         &self.classes
     }
 
-    /// Classifies an image of its camera through `lut`; an image of another size (or whose
-    /// buffer does not hold its pixels) is refused.
+    /// Classifies an image of its camera through `lut`, white-balanced to its carpet first
+    /// ([`super::balance`]); an image of another size (or whose buffer does not hold its
+    /// pixels) is refused.
     pub fn classify(&mut self, lut: &Lut, image: &Image) -> Result<(), VisionError> {
         let (w, h) = self.omni.size();
         check_size(image, (w, h))?;
         self.classes.resize(w as usize * h as usize, 0);
-        lut.classify(&image.rgb, &mut self.classes);
+        self.balanced.classify(lut, &image.rgb, w as usize, &mut self.classes);
         Ok(())
     }
 
@@ -210,7 +213,9 @@ pub fn find_ball_up(classes: &[u8], omni: &Omni, radius: f64) -> Option<BallPerc
         if !omni.images(at) {
             continue;
         }
-        if let Some(ball) = BallPercept::sized(&blob, area, at, Point2::origin()) {
+        if let Some(ball) =
+            BallPercept::sized(blob.pixels, blob.centroid, area, at, Point2::origin())
+        {
             return Some(ball);
         }
     }
