@@ -102,15 +102,27 @@ fn lit_frames(c: &mut Criterion, colors: &ColorTable) {
     let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/frames/mujoco");
     let mut g = c.benchmark_group("mujoco_320x240");
     g.throughput(Throughput::Elements(320 * 240));
-    for light in ["bright", "half", "warm", "side"] {
+    let camera = Pinhole::new(Intrinsics::centred(320, 240, 260.0), 0.45, 20f64.to_radians());
+    let frame = |light: &str| {
         let path = std::path::Path::new(dir).join(light).join("frame_0001.png");
-        let image = mrt_perception::source::load_image(&path).unwrap();
-        let camera = Pinhole::new(Intrinsics::centred(320, 240, 260.0), 0.45, 20f64.to_radians());
+        mrt_perception::source::load_image(&path).unwrap()
+    };
+    for light in ["bright", "half", "warm", "side"] {
+        let image = frame(light);
         let mut agent = VisionAgent::new(camera, colors, 0.11);
         g.bench_function(format!("agent_see_{light}"), |b| {
             b.iter(|| agent.see(black_box(&image), 1.0, 0.0).unwrap())
         });
     }
+    // Every image under another light than the last: the balanced table is built each time.
+    let (half, warm) = (frame("half"), frame("warm"));
+    let mut agent = VisionAgent::new(camera, colors, 0.11);
+    g.bench_function("agent_see_light_changes", |b| {
+        b.iter(|| {
+            agent.see(black_box(&half), 1.0, 0.0).unwrap();
+            agent.see(black_box(&warm), 1.0, 0.0).unwrap()
+        })
+    });
     g.finish();
 }
 

@@ -357,6 +357,11 @@ impl Lut {
         self.carpet[usize::from(c & 0x7FFF)]
     }
 
+    /// The whole table: the class byte of every RGB15 value.
+    pub(crate) fn raw(&self) -> &[u8; 1 << 15] {
+        &self.table
+    }
+
     /// The class of an RGB15 value.
     #[inline]
     pub fn class15(&self, c: u16) -> ColorClass {
