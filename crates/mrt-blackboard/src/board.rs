@@ -805,7 +805,7 @@ mod tests {
         Blackboard::with_limits(1, Arc::new(SimClock::new()), limits)
     }
 
-    /// Issue 17: a million `SETV`s of new names took 343 MB. Now the symbols are capped, and
+    /// A million `SETV`s of new names took 343 MB. Now the symbols are capped, and
     /// guests (relay, other robots) stop earlier, leaving room for the robot's own Members.
     #[test]
     fn symbols_are_capped_and_guests_leave_room_for_the_robot() {

@@ -112,7 +112,7 @@ fn malformed_updates_are_counted_and_dropped() {
     }
 }
 
-/// Issue 17: the limits of the relay hold for updates from the network too. A teammate (or
+/// The limits of the relay hold for updates from the network too. A teammate (or
 /// a forged frame) sending a string past `max_string` or more new symbols than a guest may
 /// create has them counted and dropped; the robot's own sets still work.
 #[test]

@@ -1,4 +1,4 @@
-//! Issue 17 item 3, "a relay that serves under abuse": a hostile tester locked every client
+//! A relay that serves under abuse: a hostile tester locked every client
 //! out with 32 clients trickling one byte every 2 s, grew the blackboard to 343 MB with a
 //! million `SETV`s of new names and got a 192 MB `LSTV` reply, drove the relay to 2 cores and
 //! 1 GB with 31 clients watching at `REFR 10`, authenticated with an empty token, could not

@@ -17,7 +17,7 @@ pub const MAX_CYCLES: u64 = 1_000_000_000;
 pub const MAX_PERIOD_MS: u64 = 3_600_000;
 
 /// The worlds to run, one per cycle, produced as the cycles go: nothing is allocated per cycle
-/// up front (issue 17: `--cycles 100000000` allocated every world first, 23 GB).
+/// up front.
 struct Worlds {
     /// The snapshots of the file: one (used every cycle) or one per cycle, the last one
     /// repeated when `--cycles` asks for more.

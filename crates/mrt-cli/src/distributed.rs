@@ -490,7 +490,7 @@ mod tests {
         let net = NetConfig::from_agora_config(&cfg).unwrap();
         assert_eq!(net.connect, ["tcp/127.0.0.1:7100", "tcp/127.0.0.1:7002"]);
         assert!(net.listen.contains(&"tcp/127.0.0.1:7003".to_string()));
-        // Loopback only: no multicast scouting, whose sockets bind 0.0.0.0 (issue 17).
+        // Loopback only: no multicast scouting, whose sockets bind 0.0.0.0.
         assert_eq!(net.multicast, None);
         assert!(net.listen.iter().chain(&net.connect).all(|e| e.starts_with("tcp/127.0.0.1:")));
     }

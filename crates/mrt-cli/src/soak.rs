@@ -1,4 +1,4 @@
-//! `mrt soak`: the soak campaigns of `docs/reliability.md` (issue 17).
+//! `mrt soak`: the soak campaigns of `docs/reliability.md`.
 //!
 //! - `mrt soak matches --count 1000`: matches on random valid configurations, stacks and
 //!   wirings (`mrt_sim::soak::SoakMatch`), several at a time; every crash is listed with the

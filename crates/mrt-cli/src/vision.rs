@@ -1,4 +1,4 @@
-//! `mrt vision`: the vision µAgent's tools for a competition (issue 19). `detect` classifies
+//! `mrt vision`: the vision µAgent's tools for a competition. `detect` classifies
 //! images with a colour file and finds the ball and the goals (their nearest point and the open
 //! space for a shot) through a camera file, one JSON line per image (or per image of a
 //! directory, `mrt_perception::source::ImageSequence`); `--png OUT` draws what it found.

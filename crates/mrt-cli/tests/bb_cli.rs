@@ -146,7 +146,7 @@ fn two_robots_share_their_blackboards_over_the_network() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
-/// Issue 17: a value with escape sequences was printed raw by `mrt bb get` (a relay, or a
+/// A value with escape sequences was printed raw by `mrt bb get` (a relay, or a
 /// client that set the value, could drive the terminal). Control characters are escaped now,
 /// in `get`, `list` and `watch` alike.
 #[test]
@@ -178,7 +178,7 @@ fn control_characters_from_the_relay_are_escaped_when_printed() {
     }
 }
 
-/// Issue 17: `mrt bb get` waited forever on a relay that never answers, buffered an endless
+/// `mrt bb get` waited forever on a relay that never answers, buffered an endless
 /// line without limit, and named the relay `0.0.0.0:0` in its errors. It gives up after
 /// `--timeout` now, refuses a line past 1 MiB, and names the real address.
 #[test]
@@ -218,7 +218,7 @@ fn a_silent_or_babbling_relay_gives_a_clear_error_in_bounded_time() {
     talker.join().unwrap();
 }
 
-/// Issue 17: `--token ""` passed the check for serving beyond loopback, and a token with a
+/// `--token ""` passed the check for serving beyond loopback, and a token with a
 /// space could never authenticate. `mrt bb serve` refuses both at startup.
 #[test]
 fn serve_refuses_unusable_tokens() {
@@ -228,7 +228,7 @@ fn serve_refuses_unusable_tokens() {
     assert!(!ok && err.contains("it has a space or a control character"), "{err}");
 }
 
-/// Issue 17: every count is range-checked before anything is contacted: `--count 0` watched
+/// Every count is range-checked before anything is contacted: `--count 0` watched
 /// nothing and `--refresh 5` was left for the relay to refuse.
 #[test]
 fn watch_counts_are_range_checked() {

@@ -113,7 +113,7 @@ fn hfsm_dot_writes_dot_and_svg() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
-/// Issue 17: `--cycles 18446744073709551615` panicked (capacity overflow) and
+/// `--cycles 18446744073709551615` panicked (capacity overflow) and
 /// `--cycles 100000000` aborted allocating 23 GB, every world being made before the first
 /// cycle. Counts are range-checked, and cycles are streamed: the largest count allowed prints
 /// its first cycles at once (the child is then stopped).

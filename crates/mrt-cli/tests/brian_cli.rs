@@ -191,7 +191,7 @@ fn check_eval_and_plot_work_on_the_shipped_harvester() {
     std::fs::remove_file(&svg).unwrap();
 }
 
-/// Issue 17: `mrt brian check` said only "stream did not contain valid UTF-8" for a file with
+/// `mrt brian check` said only "stream did not contain valid UTF-8" for a file with
 /// a bad byte, and a `behavior.txt` naming a file outside the directory printed that file's
 /// first token.
 #[test]
@@ -226,7 +226,7 @@ fn check_reports_bad_utf8_at_its_place_and_refuses_foreign_rule_files() {
     std::fs::remove_dir_all(&broken).unwrap();
 }
 
-/// `mrt brian eval --semantics original|manual` (issue 23): the worked example of
+/// `mrt brian eval --semantics original|manual`: the worked example of
 /// `crates/mrt-fuzzy/tests/composition.rs`. Dist (80, reliability 0.4), Obst 30: the manual's
 /// semantics give (0.49 × 20 + 0.256 × 80) / 0.746 = 40.589812; the original engine's do not
 /// run Go (its CANDO reliability 0.4 is not above 0.49), leaving Avoid's SLOW: 20.

@@ -1,4 +1,4 @@
-//! `mrt edge` on a running distributed match (issue 23 item 4): the robots' messages as JSON
+//! `mrt edge` on a running distributed match: the robots' messages as JSON
 //! on plain zenoh keys, and JSON from outside onto their bus; read and answered by plain
 //! zenoh (this test, through `mrt_net::RawPort`) and by Python with PyPI's `eclipse-zenoh`
 //! (`examples/python/edge_client.py`, when `$MRT_PYTHON` has the package).

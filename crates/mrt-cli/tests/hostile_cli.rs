@@ -1,4 +1,4 @@
-//! Hostile behaviors and interrupted runs (issue 17): `mrt sim --behaviors DIR` with a
+//! Hostile behaviors and interrupted runs: `mrt sim --behaviors DIR` with a
 //! behavior that tries to hang, hoard or lie finishes its match and reports the robot; no run
 //! leaves files behind, whether it ends, fails or is interrupted.
 

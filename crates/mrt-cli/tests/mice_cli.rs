@@ -1,4 +1,4 @@
-//! `mrt sim --calibrate-mice` and `mrt mice calibrate LOG` (issue 23 item 2, MRT manual §4.2):
+//! `mrt sim --calibrate-mice` and `mrt mice calibrate LOG`:
 //! the simulator's rig recovers its mounting, its log gives the same calibration through
 //! `mrt mice calibrate`, and a broken log is named by file, line and column.
 #![allow(clippy::unwrap_used, clippy::expect_used)]

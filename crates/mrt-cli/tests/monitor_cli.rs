@@ -1,4 +1,4 @@
-//! The web monitor (issue 22): `mrt replay FILE --serve` answers over HTTP, and the page,
+//! The web monitor: `mrt replay FILE --serve` answers over HTTP, and the page,
 //! loaded in a real headless Chromium driven through ChromeDriver (Debian's `chromium` and
 //! `chromium-driver`, installed by `.ci/run`), draws the field and follows the replay. Without
 //! ChromeDriver the browser test says that it was skipped.
@@ -225,7 +225,7 @@ fn replay(args: &[&std::ffi::OsStr]) -> (bool, String, String) {
     (out.status.success(), text(&out.stdout), text(&out.stderr))
 }
 
-/// Issue 22, item 2: a robot's behaviors re-run on the world snapshots it had give back
+/// A robot's behaviors re-run on the world snapshots it had give back
 /// exactly the recorded commands (Milan's Mr. BRIAN, Chaos' HFSM player and HBM keeper); an
 /// edited behavior shows where its commands differ; a behavior that does not load is reported
 /// with its file and line.
@@ -606,7 +606,7 @@ const COUNT_COLOURS: &str = "
     }
     return n;";
 
-/// Issue 22, item 5: the page loads in a real headless Chromium, its canvas draws the field,
+/// The page loads in a real headless Chromium, its canvas draws the field,
 /// the robots and the ball, and as the replay advances (played, then scrubbed to the end) the
 /// clock, the score and the selected robot's state follow the recording; a screenshot is kept
 /// in the test's target directory.
@@ -676,7 +676,7 @@ const COUNT_DRAWN: &str = "
     }
     return { drawn, amber, width: c.width, height: c.height };";
 
-/// Issue 22, item 3: over the selected robot's camera image the page draws where its vision
+/// Over the selected robot's camera image the page draws where its vision
 /// found things (a canvas over the picture, fed by `/seen` for that same image), and below the
 /// field its HFSM as a graph with the active path highlighted (fed by `/hfsm`), following the
 /// replay; a screenshot is kept in the test's target directory.
@@ -774,7 +774,7 @@ fn base64_decode(s: &str) -> Vec<u8> {
     out
 }
 
-/// Issue 22, item 4: `mrt topic` joins a running `mrt sim --distributed` through the network
+/// `mrt topic` joins a running `mrt sim --distributed` through the network
 /// file the match prints: `list` names the types and the Agoras publishing them, `echo`
 /// prints robot 2's world snapshots (Agora 3) as JSON Lines, `hz` measures the 10 Hz cycle.
 #[test]

@@ -1,4 +1,4 @@
-//! `mrt plan path` (issue 21 item 1): the JSON it promises, the SVG, a map file, and clear
+//! `mrt plan path`: the JSON it promises, the SVG, a map file, and clear
 //! errors for bad arguments.
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 

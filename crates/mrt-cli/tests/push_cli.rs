@@ -1,4 +1,4 @@
-//! `mrt behave push` over two processes (issue 23 item 5, seed `001` §3.2): this test's
+//! `mrt behave push` over two processes: this test's
 //! process is the robot (an Agora with the TeamChaos field player's HFSM Member, joined to the
 //! network on loopback), `mrt behave push` in a process of its own is the editor.
 #![cfg(feature = "net")]

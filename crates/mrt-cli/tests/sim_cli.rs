@@ -36,7 +36,7 @@ fn a_short_match_reports_score_stats_and_reproduces_from_its_seed() {
     assert_ne!(hash_of(&out), hash_of(&other));
 }
 
-/// Issue 19: `mrt sim` plays through rendered camera images and the robots' vision by
+/// `mrt sim` plays through rendered camera images and the robots' vision by
 /// default; `--percepts oracle` is the object sensor's fast mode.
 #[test]
 fn the_default_match_is_seen_through_camera_images() {
@@ -58,7 +58,7 @@ fn the_match_is_drawn_as_svg() {
     std::fs::remove_file(&svg).unwrap();
 }
 
-/// Issue 20 item 9: one robot's belief over time, in a window of the match.
+/// One robot's belief over time, in a window of the match.
 #[test]
 fn one_robots_belief_is_drawn_as_svg() {
     let svg = std::env::temp_dir().join(format!("mrt-sim-belief-{}.svg", std::process::id()));
@@ -199,7 +199,7 @@ fn a_distributed_robot_with_broken_behaviors_is_reported() {
     assert!(faulted.iter().all(|l| l.contains(&format!("go2ball.lua:{line}:"))), "{out}");
 }
 
-/// Issue 17: `--matches 0` silently played one match, and `--seed 18446744073709551615
+/// `--matches 0` silently played one match, and `--seed 18446744073709551615
 /// --matches 3` wrapped around to seeds 0 and 1. Both are errors now; the last seeds play.
 #[test]
 fn match_counts_and_seeds_are_range_checked() {
@@ -237,7 +237,7 @@ fn match_counts_and_seeds_are_range_checked() {
     );
 }
 
-/// Issue 21 item 6: `mrt sim --world indoor` runs the embedded building's path-point mission
+/// `mrt sim --world indoor` runs the embedded building's path-point mission
 /// to the end, reports each point reached and draws the mission; soccer-only options are
 /// refused with the reason.
 #[test]
@@ -262,7 +262,7 @@ fn the_indoor_world_runs_its_mission_to_the_end() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
-/// Issue 22: `--record` writes one match's messages into an MCAP file and says how many; it
+/// `--record` writes one match's messages into an MCAP file and says how many; it
 /// refuses a series, and a file it cannot create is named.
 #[test]
 fn a_match_is_recorded_into_an_mcap_file() {
@@ -293,7 +293,7 @@ fn a_match_is_recorded_into_an_mcap_file() {
     assert!(!ok && err.contains("/nonexistent-mrt-dir/m.mcap"), "{err}");
 }
 
-/// Issue 22: a recording reads back in another language: Python's `mcap` package reads every
+/// A recording reads back in another language: Python's `mcap` package reads every
 /// message and each one validates against its channel's JSON schema
 /// (`examples/python/check_recording.py`). The interpreter is `$MRT_PYTHON` (`.ci/run` makes
 /// one with the packages), else `python3`; without it or its packages the test says it was

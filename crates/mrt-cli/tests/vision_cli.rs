@@ -301,7 +301,7 @@ fn survey_prints_the_vision_against_the_truth() {
     assert!(!ok && err.contains("--scenes"), "{err}");
 }
 
-/// Issue 19 item 5: the USB camera path is built in and says clearly when there is no camera.
+/// The USB camera path is built in and says clearly when there is no camera.
 #[test]
 fn detect_from_a_missing_camera_says_so() {
     let (ok, out, err) = detect(&[], &["--device", "/dev/video-mrt-none", "--frames", "2"]);

@@ -1,4 +1,4 @@
-//! Bounded memory on the bus (issue 17, item 5): every subscription's buffer holds at most
+//! Bounded memory on the bus: every subscription's buffer holds at most
 //! `MailboxBounds::capacity` messages. A producer flooding a Member that never reads leaves at
 //! most that many messages waiting; best-effort messages beyond it drop the oldest and are
 //! counted in the `RunReport`, per Member and subscription; `Reliable` messages are not

@@ -1655,7 +1655,7 @@ impl Brian {
         for ai in 0..self.actions.len() {
             let a = &self.actions[ai];
             let Some(slot) = a.proposed else { continue };
-            // What lower levels propose is composed by max per label (issue 4), whatever
+            // What lower levels propose is composed by max per label, whatever
             // composer and composition the outputs use.
             let crisp = self.crisp(a, Composer::Max, Composition::Weighted);
             self.inputs[slot].now = crisp.map(|v| (v, 1.0));

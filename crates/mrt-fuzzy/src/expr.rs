@@ -118,7 +118,7 @@ impl Expr {
 /// Parses a definitions file: `Name = <predicate>;` lines.
 pub fn parse_definitions(c: &mut Cursor<'_>) -> Result<Vec<(String, Span, RawExpr)>, BrianError> {
     let mut out: Vec<(String, Span, RawExpr)> = Vec::new();
-    // Name → where it was defined: the duplicate check takes constant time (issue 17).
+    // Name → where it was defined: the duplicate check takes constant time.
     let mut defined: HashMap<String, Span> = HashMap::new();
     while !c.at_end() {
         let (name, span) = c.word("a name at the start of a definition")?;

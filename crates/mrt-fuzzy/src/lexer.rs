@@ -237,7 +237,7 @@ mod tests {
         assert!(e.starts_with("error in file f at line 1: `1000") && e.ends_with("f:1:12"), "{e}");
     }
 
-    /// Issue 17: invalid UTF-8 was reported without its place.
+    /// Invalid UTF-8 was reported without its place.
     #[test]
     fn invalid_utf8_names_the_line_and_column_of_the_first_bad_byte() {
         let f = Path::new("f");

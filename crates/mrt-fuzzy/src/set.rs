@@ -1,6 +1,6 @@
 //! Fuzzy sets (MRT manual §10.4.1, figure 10.4) and the (value, reliability) fuzzy datum.
 //!
-//! Membership functions follow the manual, with its open points settled as follows (issue 4):
+//! Membership functions follow the manual, with its open points settled as follows:
 //! TRA `(a b c d)` is 1 on `[b, c]` (tested first, so `a = b` gives 1 at `a`), linear on
 //! `(a, b]` and `[c, d)`, else 0; TRI `(a b c)` is TRA `(a b b c)`; REC `(b c)` is 1 on the
 //! closed `[b, c]`; TOL `(a b)` is 1 up to `a`, falling to 0 at `b`; TOR `(a b)` is 0 up to `a`,

@@ -1,4 +1,4 @@
-//! Issue 23, item 1: Mr. BRIAN's composition and defuzzification beyond the defaults, each on
+//! Mr. BRIAN's composition and defuzzification beyond the defaults, each on
 //! a worked example computed by hand in the test's comment (MRT manual §10.2.4, §10.3.6–10.3.9,
 //! §10.4.6, §10.4.9).
 //!

@@ -1,4 +1,4 @@
-//! Issue 17, item 4: what `mrt brian check` did with hostile or huge Mr. BRIAN files.
+//! What `mrt brian check` did with hostile or huge Mr. BRIAN files.
 //!
 //! - Invalid UTF-8 was reported as an OS error without a place: it is now an error at the line
 //!   and column of the first invalid byte.

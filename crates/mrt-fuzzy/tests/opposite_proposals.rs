@@ -1,4 +1,4 @@
-//! Issue 17, item 4: two behaviors propose opposite values for the same output — the manual's
+//! Two behaviors propose opposite values for the same output — the manual's
 //! *AvoidObstaclesFromLeft* / *AvoidObstaclesFromRight* case (§10.2.4). What the engine gives
 //! is checked against a hand computation of the manual's composition (formula 10.3 with the
 //! singleton defuzzification of formula 10.6), written out here independently of the engine.

@@ -1,4 +1,4 @@
-//! Foxglove's well-known schemas beside MRT's own (issue 22, item 1), so that Foxglove and
+//! Foxglove's well-known schemas beside MRT's own, so that Foxglove and
 //! Lichtblick draw a recording without a user's layout:
 //!
 //! - `/field` (once, at the start) and `/scene` (each cycle, drawn from `/truth`):

@@ -1,4 +1,4 @@
-//! How much of a match a recording keeps (issue 22: "a file a user can mail"): every message
+//! How much of a match a recording keeps: every message
 //! with every digit ([`RecordProfile::Full`], the default, what `mrt replay --robot` needs to
 //! re-run a robot's behaviors exactly), or the bulky high-rate types at a lower rate per topic
 //! on the simulated clock and every float with fewer digits ([`RecordProfile::Compact`],

@@ -229,7 +229,7 @@ mod tests {
         assert!(lan.gossip && lan.connect.is_empty(), "discovery on the LAN");
     }
 
-    /// Issue 17: the distributed simulator's robots (loopback, static links to loopback
+    /// The distributed simulator's robots (loopback, static links to loopback
     /// peers) scouted by multicast, which binds UDP sockets on 0.0.0.0. They do not scout any
     /// more; an Agora on loopback without static links still discovers its peers by scouting,
     /// and so does one whose links leave the machine.

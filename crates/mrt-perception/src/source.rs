@@ -1,4 +1,4 @@
-//! Where camera images come from (issue 19 item 5): one trait for every camera driver, and a
+//! Where camera images come from: one trait for every camera driver, and a
 //! source that plays a directory of image files, so that the vision µAgent runs on real
 //! images the same way it runs on the simulator's.
 //!

@@ -4,7 +4,7 @@
 //! The directory is removed when the last [`FilesDir`] handle on it is dropped: when the run
 //! ends, also on an error (the handles unwind with it) and, through [`remove_embedded_dirs`]
 //! from the binary's Ctrl-C handler, on an interrupt. A run no longer leaves
-//! `/tmp/mrt-teamchaos-<pid>` behind (issue 17).
+//! `/tmp/mrt-teamchaos-<pid>` behind.
 
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicU64, Ordering};

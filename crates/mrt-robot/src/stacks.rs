@@ -640,7 +640,7 @@ mod tests {
         assert!(c.vlin.is_finite());
     }
 
-    /// Shot selection (issue 21 item 5): the open side of the opponent's goal, away from its
+    /// Shot selection: the open side of the opponent's goal, away from its
     /// goalkeeper as the world model anchored it; the centre with no keeper known or with
     /// only a teammate there. Half width 1000 mm: two thirds is 666.7 mm.
     #[test]

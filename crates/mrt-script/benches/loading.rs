@@ -44,7 +44,7 @@ fn bench(c: &mut Criterion) {
     )
     .unwrap();
     c.bench_function("script_tick_minimal", |b| b.iter(|| tick.call::<i64>(&rt).unwrap()));
-    // A behavior tick with four robot-API calls (issue 5 goal: ≤ 0.5 µs).
+    // A behavior tick with four robot-API calls.
     let rt4 = LuaRuntime::new(Sandbox::default()).unwrap();
     let io = std::rc::Rc::new(std::cell::RefCell::new(mrt_script::chaos::RobotIo::default()));
     mrt_script::chaos::install(&rt4, io.clone()).unwrap();

@@ -1,6 +1,6 @@
 //! The sandboxed Lua state, its instruction budget and its memory limit.
 //!
-//! The budget cannot be slipped (issue 17): the count hook is global, so every coroutine is
+//! The budget cannot be slipped: the count hook is global, so every coroutine is
 //! metered too; once a call has spent its budget (or the watchdog has interrupted it) the
 //! overrun is sticky until the next call, and `pcall`, `xpcall` and `coroutine.resume` pass it
 //! on instead of catching it; `__gc` finalizers (which Lua runs with hooks off) are refused;

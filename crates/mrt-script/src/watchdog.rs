@@ -1,4 +1,4 @@
-//! The watchdog: a behavior's cycle under a deadline, outside Lua (issue 17).
+//! The watchdog: a behavior's cycle under a deadline, outside Lua.
 //!
 //! The instruction budget stops what runs as Lua. A C function that runs long, a Rust function
 //! added to the robot API that blocks, anything we did not think of, is the watchdog's: the

@@ -89,7 +89,7 @@ fn every_data_access_function_reads_the_snapshot() {
     );
 }
 
-/// The robots MAP anchored (issue 20 item 4): `getRobots`, `getNearestOpponent`,
+/// The robots MAP anchored: `getRobots`, `getNearestOpponent`,
 /// `getFreeDirection`, read from the snapshot's anchors.
 #[test]
 fn behaviors_read_the_anchored_robots_the_nearest_opponent_and_a_free_direction() {

@@ -1,4 +1,4 @@
-//! Hostile scripts (issue 17): every way a tester slipped the sandbox's budget, its memory
+//! Hostile scripts: every way a tester slipped the sandbox's budget, its memory
 //! limit or its output is a clear error now, and the runtime stays usable after it.
 
 #![allow(clippy::unwrap_used)]

@@ -1,4 +1,4 @@
-//! Rendering benchmark (issue 19 item 8: one 320×240 frame ≤ 0.2 ms): a robot's camera in a
+//! Rendering benchmark: a robot's camera in a
 //! busy scene (the ball, nine other robots, a goal in view), with and without the image
 //! effects; the same scene through the omnidirectional up camera, and its up mode.
 //!

@@ -125,7 +125,7 @@ impl BusMatch {
     /// `/home/<k>/<type>` and `/away/<k>/<type>`, [`Truth`] each cycle on `/truth` and drawn
     /// for Foxglove on `/scene` (`foxglove.SceneUpdate`), and at its start which match it is
     /// ([`MatchInfo`], with the recorder's profile) on `/match` and the field's lines on
-    /// `/field` (issue 22).
+    /// `/field`.
     pub fn recorded(
         cfg: &SimConfig,
         seed: u64,

@@ -198,7 +198,7 @@ pub enum PerceptSource {
     /// view, occlusion and misses. About seven times faster than vision: for long series of
     /// matches and for tests ([`SimConfig::oracle`]).
     Oracle,
-    /// The default (issue 19): every robot's camera renders an image (the `render` module)
+    /// The default: every robot's camera renders an image (the `render` module)
     /// and the robot's vision µAgent finds the ball, the goals, the posts, the field lines
     /// and the robots in it; nothing else tells the robot where they are.
     #[default]

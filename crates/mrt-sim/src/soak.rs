@@ -1,4 +1,4 @@
-//! Soak campaigns (issue 17): many matches on random valid configurations, and one robot for
+//! Soak campaigns: many matches on random valid configurations, and one robot for
 //! a long simulated time with its memory watched. `mrt soak` runs them; the results and their
 //! commands are in `docs/reliability.md`.
 //!

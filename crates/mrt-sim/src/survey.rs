@@ -1,5 +1,5 @@
 //! How well the vision µAgent sees: percepts from rendered images against the simulator's
-//! truth (issue 19: "the percept errors, vision against truth, are measured").
+//! truth.
 //!
 //! A survey draws random scenes on the field (a viewing robot, the ball, other robots; in half
 //! the scenes the ball lies ahead of the viewer, as it mostly does in play), renders the

@@ -1,4 +1,4 @@
-//! Issue 17, item 2: a simulator configuration that passes validation must not panic later.
+//! A simulator configuration that passes validation must not panic later.
 //!
 //! `[robot] radius = 0.6` passed `SimConfig::validate`, then the referee panicked at kickoff:
 //! robots enter on their side line `2 × radius + 0.05` m apart but at most 1.2 m apart, and

@@ -1,4 +1,4 @@
-//! The indoor world (issue 21 item 6; the MRT manual's Roby, §2.3): the robot follows its
+//! The indoor world: the robot follows its
 //! path points through the building on its mice and sonars, plans again when a door it
 //! meant to use is closed and when a person stands in the way, and ends its mission.
 #![allow(missing_docs, clippy::unwrap_used, clippy::expect_used)]

@@ -1,4 +1,4 @@
-//! The kidnapped robot (issue 20): robots carried elsewhere without being told find themselves
+//! The kidnapped robot: robots carried elsewhere without being told find themselves
 //! again from what they see; the carry is booked, never told to the robot.
 #![allow(missing_docs, clippy::unwrap_used, clippy::expect_used)]
 
@@ -32,7 +32,7 @@ fn kidnapped_robots_find_themselves_again_with_the_fuzzy_grid() {
 fn kidnapped_robots_find_themselves_again_with(localizer: Localizer) {
     let cfg = config(1, localizer);
     // Seed 2. Seed 3, used until session 34, changed with Milan's shots at the open side of
-    // the goal (session 35): a Chaos defender carried in front of its own goal, facing the
+    // the goal: a Chaos defender carried in front of its own goal, facing the
     // side line, saw few landmarks for 20.6 s, and Milan's keeper, carried 14 s before the
     // whistle, was not found again before it (`--kidnap 1 --half 40`, seeds 1–6: 15 or 16
     // of 16 found, slowest 0.6–2.2 s but for seed 3). Seed 1, used until session 40, changed

@@ -1,4 +1,4 @@
-//! The simulator's files import each other in one direction (issue 18): config → world →
+//! The simulator's files import each other in one direction: config → world →
 //! referee → sensor → game → metrics, sensor → indoor, drivers → devices → bus → remote, plot,
 //! soak, survey. A file that names `crate::x` depends on `x`; this test fails on any import
 //! circle, with the circle.

@@ -91,7 +91,7 @@ impl Member for Monitor {
     }
 }
 
-/// Issue 6 item 4: each robot's world state fuses its own odometry and sightings; the
+/// Each robot's world state fuses its own odometry and sightings; the
 /// simulator's truth never reaches it. Over a 4 v 4 match of two 1-minute halves (with a
 /// half-time side change, robots put down by hand at the start), every robot's own pose
 /// estimate (its `Localization` on the bus) is compared with the truth every cycle.

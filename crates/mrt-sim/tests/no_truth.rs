@@ -1,4 +1,4 @@
-//! The robot program never reads the simulator's truth (issue 20, "Done when"): what it knows,
+//! The robot program never reads the simulator's truth: what it knows,
 //! it knows from its devices. Two ways it could cheat, each tested:
 //!
 //! - by code: a robot-side crate that depends on the simulator could read its world. None

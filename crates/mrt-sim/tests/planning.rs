@@ -1,4 +1,4 @@
-//! SPIKE on the robot (issue 21 item 1): a behavior asks for a target "along a planned path";
+//! SPIKE on the robot: a behavior asks for a target "along a planned path";
 //! guidance asks the robot's planner Member, which plans round the robots the world model
 //! anchored, and follows the path in position mode. Two robots stand shoulder to shoulder on
 //! the straight line: position mode alone would run into them.

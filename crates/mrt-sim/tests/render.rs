@@ -348,7 +348,7 @@ fn a_goal_cut_by_the_image_side_gives_the_corner_in_view() {
     let (hl, gw, gd) =
         (map.half_length(), map.goal_width / 2.0 + map.goal_wall, map.goal_depth + map.goal_wall);
     // (viewer, the corner in view, east goal). The first is a keeper carried 2.8 m out in a
-    // match (session 39), facing its own goal: its left side is cut, its right upright in view.
+    // match, facing its own goal: its left side is cut, its right upright in view.
     // The third is the first turned half round the centre spot (the blue goal), the last sees
     // the side net run back to the near back corner.
     let cases = [

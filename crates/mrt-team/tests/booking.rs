@@ -1,7 +1,7 @@
 //! The ball booking (TeamChaos seed `001` §3.3) over a simulated network that loses, delays
 //! and reorders reports, with robots that fall silent: two robots that hear each other never
 //! hold the booking at once, a released or silent holder's booking passes on, and a claim
-//! that is not affirmed lapses (issue 21 item 4).
+//! that is not affirmed lapses.
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
 use mrt_msgs::BookingReport;

@@ -1,4 +1,4 @@
-//! MUREA's cost (issue 20 item 7: ≤ 10 ms per global localization of one frame on one core):
+//! MUREA's cost:
 //! one frame of a robot on the MSL field that sees 6 landmarks and 16 field-line points, with
 //! noise of a third of the tolerances, localized globally (the whole field, every heading) and
 //! in tracking mode (±0.5 m, ±0.3 rad round a prediction), under several cell budgets and
@@ -180,7 +180,7 @@ fn bench(c: &mut Criterion) {
     g.bench_function("hough_self_localize", |b| {
         b.iter(|| self_localize(&field, black_box(&points), &lines, &params))
     });
-    // The lines as MUREA perceptions (issue 20 item 3) beside the goals and posts, against the
+    // The lines as MUREA perceptions beside the goals and posts, against the
     // same goals and posts with 16 line points: one global search each.
     let landmarks: Vec<Perception> =
         frame(&field, at).into_iter().filter(|p| p.kind != Kind::LINE).collect();

@@ -463,7 +463,7 @@ mod tests {
         assert_eq!(run(), run());
     }
 
-    /// Issue 20 item 3: the Hough lines as MUREA's percept source. From the same noisy points
+    /// The Hough lines as MUREA's percept source. From the same noisy points
     /// with 30 % outliers, the lines (a handful of perceptions instead of a hundred points)
     /// put MUREA on the truth or its half-turn twin, both explaining every line; one goal
     /// sighting settles it. The lines' own numbers: each lies where a field line does.

@@ -10,7 +10,7 @@
 //! to the object the behaviors need most (seed `001` §2.1); and the team side,
 //! [`team::merge_team`]. It reads the standard messages of `mrt-msgs` only (never a
 //! simulator), so the same world model runs on a real robot. MAP and MUREA come here
-//! (issue 20).
+//!.
 //!
 //! ```
 //! use mrt_core::frames::Framed;

@@ -1,4 +1,4 @@
-//! Help for tuning a colour file (issue 19 item 6, `mrt vision calibrate`): for each class, the
+//! Help for tuning a colour file: for each class, the
 //! hue, saturation and value of the pixels it takes, so that a person sees what a threshold
 //! lets in and where it cuts. The pixels nobody takes ([`ColorClass::Unknown`]) are counted as
 //! well: a class whose colour shows up there is too narrow.

@@ -1,5 +1,5 @@
 //! An HFSM drawn as SVG, with a layout of our own that stays linear in the machine's size
-//! (issue 17: `layout-rs`' general graph layout took 91 s on a 200-state machine).
+//!.
 //!
 //! Each machine is a panel, the root first; inside it the states stand in columns by their
 //! distance (in transitions) from the initial state, read left to right as the dot drawing
