@@ -410,12 +410,15 @@ const PHASES: &str = "phases: ";
 pub fn robot(args: &RobotArgs) -> Result<()> {
     let started = Instant::now();
     let file = RobotFile::from_file(&args.config).map_err(|e| anyhow!("{e}"))?;
+    if file.devices.kind == "world" {
+        return crate::world::robot(&args.config, &file);
+    }
     let robot_cfg = file.config().map_err(|e| anyhow!("{}: {e}", args.config.display()))?;
     let spec = file.spec().map_err(|e| anyhow!("{}: {e}", args.config.display()))?;
     if file.devices.kind != "linked" {
         bail!(
-            "{}: devices.kind = \"{}\": this mrt drives linked devices only (a robot with its \
-             own hardware implements mrt_robot::devices::Devices; see ARCHITECTURE.md)",
+            "{}: devices.kind = \"{}\": this mrt drives linked devices and worlds only (a robot \
+             with its own hardware implements mrt_robot::devices::Devices; see ARCHITECTURE.md)",
             args.config.display(),
             file.devices.kind
         );

@@ -41,6 +41,8 @@ mod soak;
 #[cfg(feature = "net")]
 mod topic;
 mod vision;
+#[cfg(feature = "net")]
+mod world;
 
 use anyhow::{Context as _, Result};
 use clap::{Parser, Subcommand, ValueEnum};

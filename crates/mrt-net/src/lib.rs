@@ -40,7 +40,9 @@ mod link;
 pub mod probe;
 
 pub use config::{NetConfig, NetError};
-pub use link::{envelope, NetLink, NetPresence, NetStats, RawPort, RawSubscription, ENVELOPE};
+pub use link::{
+    envelope, NetLink, NetPresence, NetStats, RawPort, RawSubscription, RawToken, ENVELOPE,
+};
 
 /// Joins a NETWORK Agora (built by `Agora::from_config(file, id)`) to the network its
 /// configuration file describes.

@@ -446,12 +446,36 @@ pub struct RawPort(zenoh::Session);
 /// A subscription of a [`RawPort`]: it lasts while this lives.
 pub struct RawSubscription(#[allow(dead_code)] Subscriber<()>);
 
+/// A liveliness token of a [`RawPort`]: it is on the network while this lives.
+pub struct RawToken(#[allow(dead_code)] LivelinessToken);
+
 impl RawPort {
     fn check(key: &str) -> Result<(), NetError> {
         if key.starts_with(&format!("{ROOT}/m/")) || key == format!("{ROOT}/m") {
             return Err(NetError::Zenoh(format!("{key}: keys under {ROOT}/m/ carry DCDT frames")));
         }
         Ok(())
+    }
+
+    /// A session of its own, not an Agora's, joined to the network `cfg` describes (a program
+    /// that speaks plain zenoh only, such as a robot on a world's devices without teammates).
+    pub fn open(cfg: &NetConfig) -> Result<RawPort, NetError> {
+        zenoh::open(cfg.zenoh_config()?)
+            .wait()
+            .map(RawPort)
+            .map_err(|e| NetError::Zenoh(e.to_string()))
+    }
+
+    /// Declares a liveliness token on `key`: others see it while the token lives and the
+    /// session is up.
+    pub fn declare_token(&self, key: &str) -> Result<RawToken, NetError> {
+        Self::check(key)?;
+        self.0
+            .liveliness()
+            .declare_token(key.to_string())
+            .wait()
+            .map(RawToken)
+            .map_err(|e| NetError::Zenoh(e.to_string()))
     }
 
     /// Puts `bytes` on `key` (reliably: blocks when the link is congested).

@@ -7,9 +7,10 @@
 //! scaled down as a whole, keeping its direction).
 
 use mrt_core::frames::MM_PER_M;
-use mrt_msgs::RobotCommand;
+use mrt_core::Pose2;
+use mrt_msgs::{Displacement, RobotCommand};
 use mrt_plan::kinematics::{
-    duty_cycle, DiffDrive, Kinematics, Omni3, OmniWheels, Steering, Twist, WheelSpeeds,
+    duty_cycle, integrate, DiffDrive, Kinematics, Omni3, OmniWheels, Steering, Twist, WheelSpeeds,
 };
 
 /// What a motor driver refuses.
@@ -94,28 +95,43 @@ impl Base {
     /// The motors' side: duty cycles → wheel speeds → the body velocity (robot frame, m/s and
     /// rad/s): what a base does with duty cycles (a simulator's motor model).
     pub fn twist_for(&self, duty: &[f64]) -> Result<Twist, DriverError> {
+        Ok(self.forward(&self.wheel_speeds(duty)?))
+    }
+
+    /// The wheel speeds (rad/s, in wheel order) that duty cycles ask for: each duty cycle,
+    /// clamped to `[-1, 1]` (NaN: 0), times the wheels' top speed.
+    pub fn wheel_speeds(&self, duty: &[f64]) -> Result<Vec<f64>, DriverError> {
         if duty.len() != self.wheels() {
             return Err(DriverError::WheelCount { wheels: self.wheels(), got: duty.len() });
         }
-        let d = |i: usize| {
-            let x = duty[i];
-            if x.is_nan() {
-                0.0
-            } else {
-                x.clamp(-1.0, 1.0)
-            }
+        let top = match self {
+            Base::Differential(k) => k.params().max_wheel_speed,
+            Base::Omni(k) => k.params().max_wheel_speed,
         };
-        Ok(match self {
-            Base::Differential(k) => {
-                let m = k.params().max_wheel_speed;
-                k.forward(&WheelSpeeds([d(0) * m, d(1) * m]))
-            }
+        Ok(duty.iter().map(|&x| if x.is_nan() { 0.0 } else { x.clamp(-1.0, 1.0) * top }).collect())
+    }
+
+    /// The motion the wheels' encoders tell: each wheel's turn (rad, in wheel order) over one
+    /// period → the robot's displacement along the arc they drive, in the robot frame at the
+    /// start of the period.
+    pub fn motion(&self, turns: &[f64]) -> Result<Displacement, DriverError> {
+        if turns.len() != self.wheels() {
+            return Err(DriverError::WheelCount { wheels: self.wheels(), got: turns.len() });
+        }
+        let moved = integrate(Pose2::default(), &self.forward(turns), 1.0);
+        Ok(Displacement::new(moved.x, moved.y, moved.theta))
+    }
+
+    /// Wheel speeds (as many as the base has wheels) → the body velocity.
+    fn forward(&self, w: &[f64]) -> Twist {
+        let at = |i: usize| w.get(i).copied().unwrap_or(0.0);
+        match self {
+            Base::Differential(k) => k.forward(&WheelSpeeds([at(0), at(1)])),
             Base::Omni(k) => {
-                let m = k.params().max_wheel_speed;
-                let w: OmniWheels = WheelSpeeds([d(0) * m, d(1) * m, d(2) * m]);
+                let w: OmniWheels = WheelSpeeds([at(0), at(1), at(2)]);
                 k.forward(&w)
             }
-        })
+        }
     }
 }
 
@@ -152,6 +168,21 @@ mod tests {
         assert!(duty.iter().all(|x| x.abs() <= 1.0 + 1e-12));
         let d = b.twist_for(&duty).unwrap();
         assert!((d.vx - 1.2 / 60f64.to_radians().sin()).abs() < 1e-6 && d.vy.abs() < 1e-9, "{d:?}");
+    }
+
+    #[test]
+    fn encoder_turns_give_the_motion_the_wheels_drive() {
+        for b in [Base::parse("differential").unwrap(), Base::parse("omni").unwrap()] {
+            // What one second at these duty cycles turns the wheels by, moves the robot by
+            // the arc of the twist they make.
+            let duty = b.duties(&cmd(400.0, 0.0, 30.0));
+            let turns = b.wheel_speeds(&duty).unwrap();
+            let d = b.motion(&turns).unwrap();
+            let p = integrate(Pose2::default(), &b.twist_for(&duty).unwrap(), 1.0);
+            assert!((d.dx - p.x).abs() < 1e-12 && (d.dtheta - 30f64.to_radians()).abs() < 1e-9);
+            assert!(d.dx > 0.3, "{d:?}");
+            assert!(b.motion(&[0.1]).is_err());
+        }
     }
 
     #[test]

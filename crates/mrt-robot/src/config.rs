@@ -345,16 +345,35 @@ pub struct DevicesSection {
     /// simulator in another process, or a board that speaks DCDT). A team whose robot has its
     /// own hardware implements [`crate::devices::Devices`] in Rust (ARCHITECTURE.md, "Adding
     /// a real robot").
+    /// `world`: a world that speaks the device protocol over zenoh (docs/devices.md:
+    /// MuJoCo, a Python world, a real robot's bridge; [`crate::world`]).
     pub kind: String,
-    /// The robot's Agora configuration file (MRT manual §3.3.1), relative to this file.
+    /// The robot's Agora configuration file (MRT manual §3.3.1), relative to this file: for
+    /// `linked`, the network of the devices' side and the teammates; for `world`, the
+    /// teammates' network (optional: a robot without one hears no teammate).
     pub net: Option<PathBuf>,
-    /// The Agora id of the devices' side (the simulator's Agora of this robot's team).
+    /// For `linked`: the Agora id of the devices' side (the simulator's Agora of this robot's
+    /// team).
     pub agora: u32,
+    /// For `world`: the world's name, as in its keys.
+    pub world: Option<String>,
+    /// For `world`: the robot's name in that world (default `robot-<id>`).
+    pub name: Option<String>,
+    /// For `world`: zenoh endpoints that reach the world (`tcp/127.0.0.1:7470`); empty: the
+    /// world is found by multicast scouting.
+    pub connect: Vec<String>,
 }
 
 impl Default for DevicesSection {
     fn default() -> Self {
-        DevicesSection { kind: "linked".into(), net: None, agora: 201 }
+        DevicesSection {
+            kind: "linked".into(),
+            net: None,
+            agora: 201,
+            world: None,
+            name: None,
+            connect: Vec::new(),
+        }
     }
 }
 

@@ -59,6 +59,19 @@ pub struct LinkedDevices {
     faults: Vec<String>,
 }
 
+/// One cycle's readings of a robot's devices (`None`: that device gave none).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Loaded {
+    /// The mice and the wheels.
+    pub odometry: Option<Odometry>,
+    /// The camera.
+    pub camera: Option<CameraFrame>,
+    /// The game controller.
+    pub game: Option<GameInfo>,
+    /// The sonar ring.
+    pub sonars: Option<Vec<Sonar>>,
+}
+
 /// What a robot's drivers did in one cycle.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Actuation {
@@ -73,18 +86,13 @@ pub struct Actuation {
 }
 
 impl LinkedDevices {
-    /// The readings of the next cycle (each is read once).
-    pub fn load(
-        &mut self,
-        odometry: Odometry,
-        camera: CameraFrame,
-        game: GameInfo,
-        sonars: Vec<Sonar>,
-    ) {
-        self.odometry = Some(odometry);
-        self.camera = Some(camera);
-        self.game = Some(game);
-        self.sonars = Some(sonars);
+    /// The readings of the next cycle (each is read once; a device without a reading this
+    /// cycle gives its driver an error).
+    pub fn load(&mut self, readings: Loaded) {
+        self.odometry = readings.odometry;
+        self.camera = readings.camera;
+        self.game = readings.game;
+        self.sonars = readings.sonars;
     }
 
     /// What the drivers did since the last call.
@@ -99,7 +107,7 @@ impl LinkedDevices {
 }
 
 fn unread<T>(slot: &mut Option<T>, what: &str) -> Result<T, String> {
-    slot.take().ok_or_else(|| format!("no {what} reading this cycle (the simulator is silent)"))
+    slot.take().ok_or_else(|| format!("no {what} reading this cycle"))
 }
 
 impl Devices for LinkedDevices {
@@ -149,11 +157,16 @@ mod tests {
         let mut d = LinkedDevices::default();
         assert!(d.camera().is_err(), "nothing loaded yet");
         let frame = CameraFrame { time: 1.5, ..CameraFrame::default() };
-        d.load(Odometry::default(), frame.clone(), GameInfo::default(), vec![Sonar::default(); 2]);
+        d.load(Loaded {
+            odometry: Some(Odometry::default()),
+            camera: Some(frame.clone()),
+            game: Some(GameInfo::default()),
+            sonars: None,
+        });
         assert_eq!(d.game().unwrap(), GameInfo::default());
         assert_eq!(d.camera().unwrap(), frame);
         assert!(d.camera().unwrap_err().contains("no camera reading"), "read once");
-        assert_eq!(d.sonars().unwrap().len(), 2);
+        assert!(d.sonars().unwrap_err().contains("no sonar reading"), "none loaded");
         d.set_duty(&[0.1, -0.2]).unwrap();
         d.set_duty(&[0.3, 0.4]).unwrap();
         d.kick().unwrap();

@@ -50,3 +50,4 @@ pub mod planner;
 pub mod remote;
 pub mod rerun;
 pub mod stacks;
+pub mod world;

@@ -10,12 +10,12 @@
 //! `mrt_sim::remote::PitchServer`.
 
 use crate::config::RobotConfig;
-use crate::devices::LinkedDevices;
+use crate::devices::{Actuation, LinkedDevices, Loaded};
 use crate::members::{add_robot, member_faults, RobotSpec};
 use mrt_core::{SimClock, Time};
 use mrt_dcdt::config::AgoraConfig;
 use mrt_dcdt::{Agora, DeliveryWarranty, Endpoint, InnerLinkManager, RequestType, SteppedExecutor};
-use mrt_msgs::{DeviceAct, DeviceFrame, FinalWhistle, MateReport, RobotEnd};
+use mrt_msgs::{DeviceAct, DeviceFrame, FinalWhistle, MateReport, MemberFault, RobotEnd};
 use std::collections::BTreeMap;
 use std::path::Path;
 use std::sync::{Arc, Mutex};
@@ -224,29 +224,18 @@ impl RemoteRobot {
             run.first_frame.get_or_insert(last);
             // The clock of cycle k, also for a robot restarted in the middle of a match.
             let period = u64::try_from(self.period.as_nanos()).unwrap_or(u64::MAX);
-            let t = Time(frame.cycle.saturating_mul(period));
-            if t > self.exec.now() {
-                self.exec.clock().set(t);
-            }
-            let now = self.exec.now();
-            // Teammates the simulator gave up on are not waited for here either (a process
-            // killed and started again may not even be seen to leave the network).
-            for &j in &frame.not_awaited {
-                if self.mates.contains_key(&j) && !self.absent.contains(&j) {
-                    self.absent.push(j);
-                }
-            }
-            // A robot started in the middle of the match waits for no teammate in its first
-            // cycle: their reports of this cycle may have left before it subscribed.
-            let late_joiner = !self.ran && frame.cycle > 0;
-            if !late_joiner && !self.wait_for_mates(now) {
-                run.late_mates += 1;
-            }
-            if let Ok(mut d) = self.devices.lock() {
-                d.load(frame.odometry, frame.camera, frame.game, frame.sonars);
-            }
-            self.exec.run_for(self.period);
-            let act = self.devices.lock().map_err(|_| "the devices lock is poisoned")?.take();
+            let input = Cycle {
+                at: Time(frame.cycle.saturating_mul(period)),
+                first: frame.cycle == 0,
+                not_awaited: frame.not_awaited,
+                readings: Loaded {
+                    odometry: Some(frame.odometry),
+                    camera: Some(frame.camera),
+                    game: Some(frame.game),
+                    sonars: Some(frame.sonars),
+                },
+            };
+            let act = self.cycle(input, &mut run)?;
             let answer = DeviceAct {
                 robot: frame.robot,
                 cycle: frame.cycle,
@@ -257,9 +246,35 @@ impl RemoteRobot {
             };
             self.outbox.publish_with(answer, DeliveryWarranty::Reliable, 128);
             run.first_answer.get_or_insert_with(Instant::now);
-            self.ran = true;
-            run.cycles += 1;
         }
+    }
+
+    /// Runs one control cycle on `input`'s readings at its time, after the teammates'
+    /// reports due then (module doc), and says what the drivers did.
+    pub fn cycle(&mut self, input: Cycle, run: &mut RobotRun) -> Result<Actuation, String> {
+        if input.at > self.exec.now() {
+            self.exec.clock().set(input.at);
+        }
+        let now = self.exec.now();
+        // Teammates the devices' side gave up on are not waited for here either (a process
+        // killed and started again may not even be seen to leave the network).
+        for j in input.not_awaited {
+            if self.mates.contains_key(&j) && !self.absent.contains(&j) {
+                self.absent.push(j);
+            }
+        }
+        // A robot started in the middle of the match waits for no teammate in its first
+        // cycle: their reports of this cycle may have left before it subscribed.
+        let late_joiner = !self.ran && !input.first;
+        if !late_joiner && !self.wait_for_mates(now) {
+            run.late_mates += 1;
+        }
+        self.devices.lock().map_err(|_| "the devices lock is poisoned")?.load(input.readings);
+        self.exec.run_for(self.period);
+        let act = self.devices.lock().map_err(|_| "the devices lock is poisoned")?.take();
+        self.ran = true;
+        run.cycles += 1;
+        Ok(act)
     }
 
     /// Waits for the teammates' reports due at `now`; `false` if some came too late (those
@@ -302,13 +317,38 @@ impl RemoteRobot {
     }
 
     fn end(self, run: RobotRun) -> Result<RobotRun, String> {
-        let id = self.spec.agora_id()?;
-        let reports = self.exec.finish();
-        let faults = reports.iter().filter(|r| r.agora.0 == id).flat_map(member_faults).collect();
         let robot = u32::try_from(self.spec.robot).map_err(|e| e.to_string())?;
-        self.outbox.publish_with(RobotEnd { robot, faults }, DeliveryWarranty::Reliable, 128);
+        let RemoteRobot { spec, exec, outbox, .. } = self;
+        let faults = finish(&spec, exec)?;
+        outbox.publish_with(RobotEnd { robot, faults }, DeliveryWarranty::Reliable, 128);
         Ok(run)
     }
+
+    /// The match is over: the Members close; their faults (failed to start, failed jobs,
+    /// panics, lost mail).
+    pub fn finish(self) -> Result<Vec<MemberFault>, String> {
+        finish(&self.spec, self.exec)
+    }
+}
+
+fn finish(spec: &RobotSpec, exec: SteppedExecutor) -> Result<Vec<MemberFault>, String> {
+    let id = spec.agora_id()?;
+    let reports = exec.finish();
+    Ok(reports.iter().filter(|r| r.agora.0 == id).flat_map(member_faults).collect())
+}
+
+/// One control cycle's input ([`RemoteRobot::cycle`]).
+#[derive(Clone, Debug, Default)]
+pub struct Cycle {
+    /// The robot's clock in this cycle.
+    pub at: Time,
+    /// Whether it is the first cycle of the match (no teammate's report of an earlier one to
+    /// wait for).
+    pub first: bool,
+    /// Teammates (robot numbers) the devices' side is not waiting for.
+    pub not_awaited: Vec<u32>,
+    /// The devices' readings.
+    pub readings: Loaded,
 }
 
 enum Event {

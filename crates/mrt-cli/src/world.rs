@@ -1,0 +1,109 @@
+//! `mrt robot --config FILE` with `[devices] kind = "world"`: the robot program on the
+//! devices of a world that speaks the device protocol over zenoh (docs/devices.md).
+
+use anyhow::{anyhow, Context as _, Result};
+use mrt_core::AgoraId;
+use mrt_dcdt::config::AgoraConfig;
+use mrt_devices::Keys;
+use mrt_net::{NetConfig, RawPort};
+use mrt_robot::config::RobotFile;
+use mrt_robot::members::behaviors_dir;
+use mrt_robot::remote::RemoteRobot;
+use mrt_robot::world::{WorldMail, WorldPort, WorldRobot};
+use std::path::Path;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::mpsc::{sync_channel, TrySendError};
+use std::sync::Arc;
+use std::time::Duration;
+
+/// A robot that hears nothing from its world for this long gives up.
+const SILENCE: Duration = Duration::from_secs(30);
+/// Messages from the world waiting for the robot (a lock-step world has one at a time).
+const QUEUE: usize = 64;
+/// zenoh's default multicast scouting group, where a world with no `connect` is found.
+const SCOUTING: &str = "224.0.0.224:7446";
+
+struct Port(RawPort);
+
+impl WorldPort for Port {
+    fn put(&self, key: &str, bytes: Vec<u8>) -> Result<(), String> {
+        self.0.put(key, bytes).map_err(|e| e.to_string())
+    }
+}
+
+/// Runs the robot of `file` (read from `path`) on its world until the world's end. A world's
+/// camera sends images: the vision µAgent runs whatever `[vision] enabled` says.
+pub fn robot(path: &Path, file: &RobotFile) -> Result<()> {
+    let here = path.parent().unwrap_or(Path::new("."));
+    let at = |e: String| anyhow!("{}: {e}", path.display());
+    let mut file = file.clone();
+    file.vision.enabled = true;
+    let cfg = file.config().map_err(at)?;
+    let spec = file.spec().map_err(at)?;
+    let d = &file.devices;
+    let world = d.world.as_deref().ok_or_else(|| at("devices.world is missing".into()))?;
+    let name = d.name.clone().unwrap_or_else(|| format!("robot-{}", file.robot.id));
+    let keys = Keys::new(world, &name).map_err(|e| at(format!("devices: {e}")))?;
+    let net = d
+        .net
+        .as_ref()
+        .map(|p| AgoraConfig::from_file(here.join(p)).map_err(|e| anyhow!("{e}")))
+        .transpose()?;
+    let behaviors = file.robot.behaviors.as_ref().map(|p| here.join(p));
+    let dir = behaviors_dir(&[spec.stack], behaviors.as_deref()).map_err(|e| anyhow!("{e}"))?;
+    let mut remote = RemoteRobot::new(&cfg, spec, &dir, net.clone()).map_err(|e| anyhow!("{e}"))?;
+    // The team's network, when there is one; without it no teammate is waited for.
+    let _team = match (&net, remote.agora()) {
+        (Some(_), Some(agora)) => {
+            let link = mrt_net::connect(agora)?;
+            let online = link.presence();
+            remote.set_presence(move |j| online.contains(AgoraId(j + 1)));
+            Some(link)
+        }
+        _ => {
+            remote.set_presence(|_| false);
+            None
+        }
+    };
+    let session = NetConfig {
+        listen: Vec::new(),
+        connect: d.connect.clone(),
+        multicast: d.connect.is_empty().then(|| SCOUTING.to_string()),
+        gossip: false,
+        bridge: false,
+    };
+    let port = RawPort::open(&session)
+        .with_context(|| format!("cannot open a zenoh session to world {world}"))?;
+    let (tx, rx) = sync_channel(QUEUE);
+    let full = Arc::new(AtomicBool::new(false));
+    let mailer = |wrap: fn(Vec<u8>) -> WorldMail| {
+        let (tx, full) = (tx.clone(), full.clone());
+        move |_: &str, bytes: Vec<u8>| {
+            if let Err(TrySendError::Full(_)) = tx.try_send(wrap(bytes)) {
+                if !full.swap(true, Ordering::Relaxed) {
+                    eprintln!("the world sends faster than the robot runs: messages dropped");
+                }
+            }
+        }
+    };
+    let _senses = port.subscribe(&keys.sense(), mailer(WorldMail::Sense))?;
+    let _end = port.subscribe(&keys.end(), mailer(WorldMail::End))?;
+    let _alive = port.declare_token(&keys.alive())?;
+    eprintln!("robot {name}: listening to world {world} ({})", keys.sense());
+    let robot = WorldRobot::new(remote, cfg.base, keys);
+    let run =
+        robot.run(&rx, &Port(port.clone()), SILENCE).map_err(|e| anyhow!("robot {name}: {e}"))?;
+    // Let the last word leave before the session closes.
+    std::thread::sleep(Duration::from_millis(300));
+    let dropped = serde_json::to_string(&run.bye.dropped).unwrap_or_default();
+    eprintln!(
+        "robot {name}: {} steps, teammates late in {}, {} Member faults; dropped {dropped}",
+        run.robot.cycles,
+        run.robot.late_mates,
+        run.bye.faults.len(),
+    );
+    for f in &run.bye.faults {
+        eprintln!("robot {name}: {} ×{}: {}", f.name, f.count, f.error.escape_debug());
+    }
+    Ok(())
+}
