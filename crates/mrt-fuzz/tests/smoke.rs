@@ -50,6 +50,7 @@ smoke_tests! {
     hfsm => "hfsm",
     world => "world",
     mcap => "mcap",
+    devices => "devices",
 }
 
 /// A harness that panics on inputs holding `!`, and allocates 300 MiB on inputs holding `@`.

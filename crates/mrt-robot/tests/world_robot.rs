@@ -71,7 +71,10 @@ fn sense(step: u64) -> Sense {
         }),
         sonars: Some(
             (0..16)
-                .map(|i| SonarReading { bearing: f64::from(i) * std::f64::consts::FRAC_PI_8, range: Some(3.0) })
+                .map(|i| SonarReading {
+                    bearing: f64::from(i) * std::f64::consts::FRAC_PI_8,
+                    range: Some(3.0),
+                })
                 .collect(),
         ),
         camera: Some(CameraReading { time: 0.1 * step as f64, pan: None, image: image() }),

@@ -4,6 +4,7 @@
 use crate::FuzzError;
 use std::path::{Path, PathBuf};
 
+mod devices;
 mod files;
 mod lua;
 mod recording;
@@ -80,6 +81,7 @@ pub static TARGETS: &[Target] = &[
     lua::HFSM,
     lua::WORLD,
     recording::MCAP,
+    devices::DEVICES,
 ];
 
 /// The target of that name.
