@@ -134,7 +134,7 @@ fn a_world_drives_the_robot_step_by_step_and_nothing_it_sends_stops_it() {
     let runner =
         std::thread::spawn(move || robot.run(&inbox, &port, Duration::from_secs(20)).unwrap());
 
-    let top = 20.0 + 1e-9; // IANUS3: 20 rad/s a wheel
+    let top = 24.0 + 1e-9; // IANUS3: 24 rad/s a wheel
     let mut moving = 0;
     let mut hostiles = 0;
     for step in 0..100u64 {
