@@ -50,7 +50,7 @@ pub struct RobotArgs {
 /// outgoing connection of another robot or another match, before the robot it was meant for
 /// has started listening on it (the likely cause of a robot that once ended before a CI match,
 /// its log lost in a backtrace); ports below the ephemeral range are taken only by name.
-struct PortPicker {
+pub(crate) struct PortPicker {
     next: u32,
     low: u32,
     span: u32,
@@ -60,7 +60,7 @@ struct PortPicker {
 impl PortPicker {
     /// Starts at a place that differs between processes, so two matches at once rarely
     /// probe the same ports.
-    fn new() -> Self {
+    pub(crate) fn new() -> Self {
         let (low, high) = below_ephemeral();
         let span = high - low;
         let nanos = std::time::SystemTime::now()
@@ -71,7 +71,7 @@ impl PortPicker {
     }
 
     /// The next port that both TCP and UDP can bind on loopback.
-    fn port(&mut self) -> Result<u16> {
+    pub(crate) fn port(&mut self) -> Result<u16> {
         for _ in 0..self.span {
             let port = (self.low + self.next % self.span) as u16;
             self.next = self.next.wrapping_add(1);
@@ -103,19 +103,19 @@ fn below_ephemeral() -> (u32, u32) {
 }
 
 /// The robot processes and their directory; killed and removed on drop.
-struct Robots {
-    dir: PathBuf,
-    children: Vec<(usize, Child)>,
+pub(crate) struct Robots {
+    pub(crate) dir: PathBuf,
+    pub(crate) children: Vec<(usize, Child)>,
 }
 
 impl Robots {
-    fn log(&self, robot: usize) -> PathBuf {
+    pub(crate) fn log(&self, robot: usize) -> PathBuf {
         self.dir.join(format!("robot-{robot}.log"))
     }
 
     /// A robot's log for error messages: from its `Error:` line if it has one (robots run
     /// without backtraces, but an error's causes follow it), else its last lines.
-    fn tail(&self, robot: usize) -> String {
+    pub(crate) fn tail(&self, robot: usize) -> String {
         let text = std::fs::read_to_string(self.log(robot)).unwrap_or_default();
         let lines: Vec<&str> = text.lines().collect();
         let from = lines
@@ -126,14 +126,14 @@ impl Robots {
     }
 
     /// A robot process that ended already, with its status.
-    fn exited(&mut self) -> Option<(usize, std::process::ExitStatus)> {
+    pub(crate) fn exited(&mut self) -> Option<(usize, std::process::ExitStatus)> {
         self.children
             .iter_mut()
             .find_map(|(i, c)| c.try_wait().ok().flatten().map(|status| (*i, status)))
     }
 
     /// Waits up to `grace` for every robot to end by itself.
-    fn wait(&mut self, grace: Duration) {
+    pub(crate) fn wait(&mut self, grace: Duration) {
         let end = Instant::now() + grace;
         while Instant::now() < end
             && self.children.iter_mut().any(|(_, c)| matches!(c.try_wait(), Ok(None)))
@@ -337,12 +337,12 @@ pub fn play(
 
 /// How the robot processes are started (also again, mid-match): `mrt robot --config FILE`,
 /// each with the robot file this match wrote for it.
-struct Launch {
-    exe: PathBuf,
+pub(crate) struct Launch {
+    pub(crate) exe: PathBuf,
 }
 
 impl Launch {
-    fn robot(&self, i: usize, file: &Path, log: &Path) -> Result<Child> {
+    pub(crate) fn robot(&self, i: usize, file: &Path, log: &Path) -> Result<Child> {
         let log = std::fs::File::create(log)?;
         Command::new(&self.exe)
             .arg("robot")

@@ -33,6 +33,8 @@ mod distributed;
 mod edge;
 mod interrupt;
 mod mice;
+#[cfg(feature = "net")]
+mod mujoco;
 mod plan;
 mod push;
 mod replay;
@@ -80,6 +82,14 @@ enum VisionCommand {
     Survey(vision::SurveyArgs),
 }
 
+#[cfg(feature = "net")]
+#[derive(Subcommand)]
+enum WorldCommand {
+    /// A match (or the empty-goal scenario) in the MuJoCo world: prints the score, the goals
+    /// and the world's report (JSON).
+    Mujoco(mujoco::MujocoArgs),
+}
+
 #[derive(Subcommand)]
 enum Command {
     /// Play a simulated robot-soccer match on the embedded default world (or a series).
@@ -91,6 +101,13 @@ enum Command {
     /// --distributed` starts each of its robots with this command).
     #[cfg(feature = "net")]
     Robot(distributed::RobotArgs),
+    /// Play in a world nobody here wrote: `mrt world mujoco` starts the MuJoCo world
+    /// (worlds/mujoco/, Python) and one `mrt robot` per robot on its devices (docs/devices.md).
+    #[cfg(feature = "net")]
+    World {
+        #[command(subcommand)]
+        command: WorldCommand,
+    },
     /// The messages of robots running anywhere on the network: which types and who publishes
     /// them (`list`), one type as JSON Lines (`echo`), its rate (`hz`); `mrt sim
     /// --distributed` prints its match's network file (docs/monitor.md).
@@ -333,6 +350,8 @@ fn run(command: Command) -> Result<()> {
         Command::Mice { command } => mice::run(&command)?,
         #[cfg(feature = "net")]
         Command::Robot(args) => distributed::robot(&args)?,
+        #[cfg(feature = "net")]
+        Command::World { command: WorldCommand::Mujoco(args) } => mujoco::play(&args)?,
         Command::Bb { command } => bb::run(command)?,
         Command::Vision { command: VisionCommand::Detect(args) } => vision::detect(&args)?,
         Command::Vision { command: VisionCommand::Render(args) } => vision::render(&args)?,

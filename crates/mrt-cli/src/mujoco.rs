@@ -1,0 +1,214 @@
+//! `mrt world mujoco`: a match in the MuJoCo world (`worlds/mujoco/world.py`, Python), each
+//! robot the unchanged robot program in a process of its own (`mrt robot --config FILE` on a
+//! world's devices, docs/devices.md), each team on a DCDT network of its own for the
+//! teammates' reports.
+
+use crate::distributed::{Launch, PortPicker, Robots};
+use anyhow::{anyhow, bail, Context as _, Result};
+use mrt_robot::config::RobotFile;
+use mrt_robot::stacks::Stack;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+use std::time::Duration;
+
+/// The world's name in the device protocol's keys.
+const WORLD: &str = "mujoco";
+
+/// What is played.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Scenario {
+    /// Two teams, two halves, the referee's kickoffs.
+    Match,
+    /// One robot of the home team at a random pose, the ball at a random spot, no opponents:
+    /// it must score within 60 s of play.
+    EmptyGoal,
+}
+
+/// `mrt world mujoco`.
+#[derive(clap::Args)]
+pub struct MujocoArgs {
+    /// The home team's stack (chaos, milan, isocrob, chaser).
+    #[arg(long, default_value = "milan")]
+    pub home: String,
+    /// The away team's stack.
+    #[arg(long, default_value = "chaos")]
+    pub away: String,
+    /// Robots a team.
+    #[arg(long, default_value_t = 2, value_parser = clap::value_parser!(u64).range(1..=6))]
+    pub robots: u64,
+    /// The scene: lights and colours (relative to the world's directory, or a path).
+    #[arg(long, default_value = "scenes/bright.xml")]
+    pub scene: PathBuf,
+    /// The seed of the world's random choices.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Seconds of play a half.
+    #[arg(long, default_value_t = 300.0)]
+    pub half: f64,
+    /// What is played.
+    #[arg(long, value_enum, default_value_t = Scenario::Match)]
+    pub scenario: Scenario,
+    /// The MuJoCo world's directory.
+    #[arg(long, default_value = "worlds/mujoco")]
+    pub dir: PathBuf,
+    /// The Python that runs it (default: $MRT_PYTHON, else python3), with
+    /// worlds/mujoco/requirements.txt and python/requirements.txt installed.
+    #[arg(long)]
+    pub python: Option<String>,
+    /// Writes the world's truth, one JSON line a step (time, state, score, ball, robots).
+    #[arg(long)]
+    pub truth: Option<PathBuf>,
+}
+
+/// The §3.3.1 file of robot `i` of a team of the robots `first..` (at least two): the team's
+/// discovery port and static links to the lower-numbered teammates; the first robot links to
+/// the second, so that it listens on its port (a full mesh on loopback).
+fn team_net_file(i: usize, first: usize, discovery: u16, ports: &[u16]) -> String {
+    let mut text = format!(
+        "# Robot {i} of a MuJoCo match (written by mrt world mujoco): its team's network.\n\
+         127.0.0.1 224.0.0.224 {discovery}\n"
+    );
+    let peers = if i == first { &ports[first + 1..first + 2] } else { &ports[first..i] };
+    for &p in peers {
+        text.push_str(&format!("ip link 0 127.0.0.1 {} 127.0.0.1 {p}\n", ports[i]));
+    }
+    text
+}
+
+/// Robot `i`'s file: `name` in the world reached at `endpoint`, on its team's network `net`
+/// (none for a team of one).
+fn robot_file(
+    i: usize,
+    n: usize,
+    stack: Stack,
+    name: &str,
+    endpoint: &str,
+    net: Option<&Path>,
+) -> String {
+    let mut file = RobotFile::default();
+    file.robot.id = i;
+    file.robot.team_size = n;
+    file.robot.stack = stack.name().into();
+    file.body.base = "differential".into();
+    file.vision.enabled = true;
+    file.devices.kind = "world".into();
+    file.devices.world = Some(WORLD.into());
+    file.devices.name = Some(name.into());
+    file.devices.connect = vec![endpoint.into()];
+    file.devices.net = net.map(Path::to_path_buf);
+    let text = file.to_toml().unwrap_or_default();
+    format!("# Robot {i} of a MuJoCo match (written by mrt world mujoco).\n{text}")
+}
+
+/// Plays the match: the world and one robot process per robot; prints the world's report.
+pub fn play(args: &MujocoArgs) -> Result<()> {
+    let parse = |s: &str| Stack::parse(s).map_err(|e| anyhow!("{e}"));
+    let (home, away) = (parse(&args.home)?, parse(&args.away)?);
+    let script = args.dir.join("world.py");
+    if !script.is_file() {
+        bail!("{}: no MuJoCo world here (--dir names worlds/mujoco)", script.display());
+    }
+    let n = usize::try_from(args.robots)?;
+    let teams: Vec<(Stack, &str)> = match args.scenario {
+        Scenario::Match => vec![(home, "home"), (away, "away")],
+        Scenario::EmptyGoal => vec![(home, "home")],
+    };
+    let per_team = if args.scenario == Scenario::EmptyGoal { 1 } else { n };
+    let dir = std::env::temp_dir().join(format!("mrt-mujoco-{}-{}", std::process::id(), args.seed));
+    std::fs::create_dir_all(&dir).with_context(|| format!("cannot create {}", dir.display()))?;
+    let mut procs = Robots { dir: dir.clone(), children: Vec::new() };
+    let mut picker = PortPicker::new();
+    let endpoint = format!("tcp/127.0.0.1:{}", picker.port()?);
+    let count = teams.len() * per_team;
+    let ports = (0..count).map(|_| picker.port()).collect::<Result<Vec<_>>>()?;
+    let mut files = Vec::new();
+    for (t, (stack, side)) in teams.iter().enumerate() {
+        let discovery = picker.port()?;
+        for k in 0..per_team {
+            let i = t * per_team + k;
+            let net = dir.join(format!("robot-{i}.cfg"));
+            if per_team > 1 {
+                std::fs::write(&net, team_net_file(i, t * per_team, discovery, &ports))?;
+            }
+            let net = (per_team > 1).then_some(net.as_path());
+            let file = dir.join(format!("robot-{i}.toml"));
+            let name = format!("{side}-{}", k + 1);
+            std::fs::write(&file, robot_file(i, per_team, *stack, &name, &endpoint, net))?;
+            files.push(file);
+        }
+    }
+    let python = args
+        .python
+        .clone()
+        .or_else(|| std::env::var("MRT_PYTHON").ok())
+        .unwrap_or_else(|| "python3".into());
+    let mut world = Command::new(&python);
+    world
+        .arg(&script)
+        .arg("play")
+        .arg("--scene")
+        .arg(&args.scene)
+        .args(["--camera", "configs/vision/camera.toml", "--world", WORLD, "--listen", &endpoint])
+        .args(["--home", &per_team.to_string()])
+        .args(["--away", &if args.scenario == Scenario::Match { n } else { 0 }.to_string()])
+        .args(["--half", &args.half.to_string(), "--seed", &args.seed.to_string()])
+        .args(["--scenario", if args.scenario == Scenario::Match { "match" } else { "empty-goal" }])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::inherit());
+    if let Some(t) = &args.truth {
+        world.arg("--truth").arg(t);
+    }
+    if std::env::var_os("MUJOCO_GL").is_none() {
+        world.env("MUJOCO_GL", "egl");
+    }
+    let world =
+        world.spawn().with_context(|| format!("cannot start {python} {}", script.display()))?;
+    let launch = Launch { exe: std::env::current_exe().context("cannot find the mrt executable")? };
+    for (i, file) in files.iter().enumerate() {
+        let child = launch.robot(i, file, &procs.log(i))?;
+        procs.children.push((i, child));
+    }
+    let out = world.wait_with_output().context("the world did not end")?;
+    procs.wait(Duration::from_secs(5));
+    if !out.status.success() {
+        let tails: Vec<String> =
+            (0..files.len()).map(|i| format!("robot {i}:\n{}", procs.tail(i))).collect();
+        bail!("the MuJoCo world ended with {}\n{}", out.status, tails.join("\n"));
+    }
+    let report = String::from_utf8_lossy(&out.stdout);
+    let line = report.lines().last().unwrap_or("").trim();
+    let v: serde_json::Value = serde_json::from_str(line)
+        .with_context(|| format!("the world's report is not JSON: {}", line.escape_debug()))?;
+    outln!("{}", summary(&v, &teams));
+    outln!("{line}");
+    Ok(())
+}
+
+/// One line a person reads: the score and the goals, the steps and the world's speed.
+fn summary(v: &serde_json::Value, teams: &[(Stack, &str)]) -> String {
+    let score = |side: &str| v["score"][side].as_u64().unwrap_or(0);
+    let names: Vec<String> =
+        teams.iter().map(|(s, side)| format!("{side} ({}) {}", s.name(), score(side))).collect();
+    let goals: Vec<String> = v["goals"]
+        .as_array()
+        .into_iter()
+        .flatten()
+        .map(|g| {
+            format!(
+                "{} {:.1} s",
+                g["team"].as_str().unwrap_or("?"),
+                g["time"].as_f64().unwrap_or(0.0)
+            )
+        })
+        .collect();
+    format!(
+        "MuJoCo {}: {}; goals: {}; {} steps, {:.1} s of play, {:.2}x real time, {:.0} ms a frame",
+        v["scenario"].as_str().unwrap_or("match"),
+        names.join(" : "),
+        if goals.is_empty() { "none".into() } else { goals.join(", ") },
+        v["steps"].as_u64().unwrap_or(0),
+        v["play_time"].as_f64().unwrap_or(0.0),
+        v["real_time_factor"].as_f64().unwrap_or(0.0),
+        v["render_ms"].as_f64().unwrap_or(0.0),
+    )
+}
