@@ -55,6 +55,9 @@ pub struct MujocoArgs {
     /// worlds/mujoco/requirements.txt and python/requirements.txt installed.
     #[arg(long)]
     pub python: Option<String>,
+    /// Ends after this many steps whatever the game (0: when it is over).
+    #[arg(long, default_value_t = 0)]
+    pub steps: u64,
     /// Writes the world's truth, one JSON line a step (time, state, score, ball, robots).
     #[arg(long)]
     pub truth: Option<PathBuf>,
@@ -133,7 +136,10 @@ pub fn play(args: &MujocoArgs) -> Result<()> {
             let net = (per_team > 1).then_some(net.as_path());
             let file = dir.join(format!("robot-{i}.toml"));
             let name = format!("{side}-{}", k + 1);
-            std::fs::write(&file, robot_file(i, per_team, *stack, &name, &endpoint, net))?;
+            // The empty goal's one robot is a field player (robot 1 of a team of two whose
+            // keeper is not there), not a goalkeeper.
+            let (id, size) = if per_team == 1 { (1, 2) } else { (i, per_team) };
+            std::fs::write(&file, robot_file(id, size, *stack, &name, &endpoint, net))?;
             files.push(file);
         }
     }
@@ -152,6 +158,7 @@ pub fn play(args: &MujocoArgs) -> Result<()> {
         .args(["--home", &per_team.to_string()])
         .args(["--away", &if args.scenario == Scenario::Match { n } else { 0 }.to_string()])
         .args(["--half", &args.half.to_string(), "--seed", &args.seed.to_string()])
+        .args(["--steps", &args.steps.to_string()])
         .args(["--scenario", if args.scenario == Scenario::Match { "match" } else { "empty-goal" }])
         .stdout(Stdio::piped())
         .stderr(Stdio::inherit());

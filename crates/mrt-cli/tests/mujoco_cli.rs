@@ -126,3 +126,36 @@ fn the_vision_finds_the_ball_in_fresh_mujoco_frames_under_four_lights() {
     std::fs::remove_dir_all(&tmp).ok();
     assert!(failures.is_empty(), "{failures:#?}");
 }
+
+/// `mrt world mujoco`: the world and a robot process on its devices play a few seconds of the
+/// empty-goal scenario; every step is answered and the robot says goodbye.
+#[test]
+fn a_robot_process_plays_a_few_seconds_in_the_mujoco_world() {
+    if let Some(why) = unavailable() {
+        eprintln!("skipped: a robot in the MuJoCo world, MuJoCo cannot render here ({why})");
+        return;
+    }
+    let zenoh = py(&["-c", "import zenoh"]).output();
+    if !zenoh.as_ref().is_ok_and(|o| o.status.success()) {
+        eprintln!("skipped: a robot in the MuJoCo world, no zenoh for Python here");
+        return;
+    }
+    let out = Command::new(env!("CARGO_BIN_EXE_mrt"))
+        .args(["world", "mujoco", "--scenario", "empty-goal", "--seed", "5", "--steps", "40"])
+        .arg("--python")
+        .arg(python())
+        .current_dir(repo())
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(text.starts_with("MuJoCo empty-goal: home (milan)"), "{text}");
+    let report: serde_json::Value =
+        serde_json::from_str(text.lines().last().unwrap_or("")).unwrap();
+    let steps = report["steps"].as_u64().unwrap();
+    assert!(steps >= 40, "{report}");
+    assert_eq!(report["answered"]["home-1"].as_u64(), Some(steps), "{report}");
+    assert_eq!(report["missing"]["home-1"].as_u64(), Some(0), "{report}");
+    assert_eq!(report["byes"]["home-1"], true, "{report}");
+}
