@@ -44,7 +44,9 @@ import numpy as np  # noqa: E402
 
 import physics  # noqa: E402
 import render_frames as rf  # noqa: E402
-from mrt_world import World, camera, game, jpeg_image, odometry, pose, rgb8_image, sense, sonar  # noqa: E402
+from mrt_world import (  # noqa: E402
+    World, camera, game, jpeg_image, odometry, pose, rgb8_image, sense, sonar,
+)
 from referee import LENGTH, WIDTH, Referee  # noqa: E402
 
 STEP = 0.1  # s: one step, the robots' control period
@@ -277,7 +279,8 @@ def play(args) -> dict:
         "goals": [{"team": g["team"], "time": g["time"]} for g in m.referee.goals],
         "answered": answered,
         "missing": {n: world.steps - answered[n] for n in m.names},
-        "render_ms": round(1000 * float(np.mean(m.render_seconds)), 2) if m.render_seconds else None,
+        "render_ms": (round(1000 * float(np.mean(m.render_seconds)), 2)
+                      if m.render_seconds else None),
         "real_time_factor": round(m.time / wall, 3) if wall > 0 else None,
         "byes": {n: byes.get(n) is not None for n in m.names},
     }

@@ -8,7 +8,6 @@ headless) and zenoh; each skips, saying why, without them. The kinematics and re
 need nothing.
 """
 
-import argparse
 import json
 import math
 import socket
@@ -35,7 +34,8 @@ try:
     rf.mujoco_module()  # MUJOCO_GL=egl unless set or on a desktop, before MuJoCo is imported
     _NO_MUJOCO = None
 except ImportError as e:
-    _NO_MUJOCO = f"MuJoCo is not installed here ({e}): pip install -r worlds/mujoco/requirements.txt"
+    _NO_MUJOCO = (f"MuJoCo is not installed here ({e}): "
+                  "pip install -r worlds/mujoco/requirements.txt")
 
 
 def needs_mujoco(test):
