@@ -1,6 +1,6 @@
 //! # mrt-fuzz: a fuzz harness on stable Rust for every MRT parser
 //!
-//! Issue 17 item 6 ("fuzzing beyond proptest"). Every file format MRT reads from outside has a
+//! Fuzzing beyond proptest. Every file format MRT reads from outside has a
 //! [`targets::Target`] here: DCDT Agora configuration files, DCDT wire frames, the
 //! self-describing XML message, Mr. BRIAN configuration files (each file kind), the
 //! simulator's TOML, the blackboard's `config.dat`, the relay's request lines, Lua behavior

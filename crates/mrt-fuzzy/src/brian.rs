@@ -862,8 +862,8 @@ impl std::fmt::Debug for Commands {
 }
 
 /// Name → index tables of what is defined so far, so that every reference resolves in
-/// constant time: loading is linear in the size of the configuration (issue 17: it was
-/// quadratic, 200 000 definitions never finished).
+/// constant time: loading is linear in the size of the configuration (it once was
+/// quadratic: 200 000 definitions never finished).
 #[derive(Clone, Debug, Default)]
 struct Index {
     /// Crisp input name → its index in the inputs.
@@ -991,8 +991,8 @@ struct Listed {
 
 /// The rule file a `behavior.txt` line names, canonicalized, when it lies inside the
 /// configuration directory `root` (canonical). Outside, or unreadable, it is an error at the
-/// path in `behavior.txt` that never shows the file's content (issue 17: any file of the
-/// machine could be named, and its first token was printed).
+/// path in `behavior.txt` that never shows the file's content (otherwise any file of
+/// the machine could be named, and its first token printed).
 fn rule_file(root: &Path, base: &Path, list: &Path, b: &Listed) -> Result<PathBuf, BrianError> {
     let canon = base.join(&b.path).canonicalize().map_err(|e| {
         BrianError::at(

@@ -1,4 +1,4 @@
-//! The hierarchy rules of issue 4, one test each, on a tiny two-level configuration:
+//! The hierarchy rules of Mr. BRIAN, one test each, on a tiny two-level configuration:
 //! weights apply once; `&DEL` removes lower levels' proposals (one label or `ANY`), never its own
 //! level's; a level above 1 sees what the levels below propose as a crisp `Proposed<Action>`
 //! datum (reliability 1), re-fuzzified and read by `PredicateActions.ini`.

@@ -1,4 +1,4 @@
-//! SPIKE's speed (issue 21 item 1: a path on the 12 × 8 m and the 18 × 12 m fields, accurate
+//! SPIKE's speed (the goal: a path on the 12 × 8 m and the 18 × 12 m fields, accurate
 //! to 1 cm, in under 1 ms) against the `pathfinding` crate's A* on a 1 cm grid of the same
 //! map (8-connected, Euclidean heuristic, the grid's free cells precomputed outside the
 //! timing), on the same maps: each field with robots standing about as in a match, from one

@@ -1,5 +1,5 @@
-//! Re-running a robot's behaviors on the world snapshots it really had (issue 22:
-//! `mrt replay FILE --robot home/2 --behaviors DIR`): a behavior, edited or not, is fed the
+//! Re-running a robot's behaviors on the world snapshots it really had
+//! (`mrt replay FILE --robot home/2 --behaviors DIR`): a behavior, edited or not, is fed the
 //! snapshots of a recording one control cycle at a time, inside an Agora of its own on a
 //! simulated clock, exactly as the robot's world state fed it, and its commands are kept to
 //! compare with the recorded ones.

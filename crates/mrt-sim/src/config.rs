@@ -627,8 +627,8 @@ impl SimConfig {
         Ok(())
     }
 
-    /// The quantities the simulator derives from several values (issue 17: `[robot] radius =
-    /// 0.6` passed validation, then the referee panicked on a `clamp` whose minimum exceeded
+    /// The quantities the simulator derives from several values (without them `[robot]
+    /// radius = 0.6` would pass validation, then the referee panicked on a `clamp` whose minimum exceeded
     /// its maximum). Each error names the field to change.
     fn check_derived(&self) -> Result<(), String> {
         let (f, r, b) = (&self.field, self.robot.radius, self.ball.radius);

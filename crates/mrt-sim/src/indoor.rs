@@ -1,5 +1,5 @@
 //! The second embedded world: a building where one robot follows a list of path points (the
-//! MRT manual's Roby and FollowMe applications, §2.3; issue 21 item 6), started by
+//! MRT manual's Roby and FollowMe applications, §2.3), started by
 //! `mrt sim --world indoor` (docs/indoor.md).
 //!
 //! Three files in `configs/worlds/indoor/`, embedded in the binary:

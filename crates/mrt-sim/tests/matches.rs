@@ -224,7 +224,7 @@ fn wrong_team_sizes_are_refused() {
 /// the two nets to correct it (the striped posts are not recognised yet), stays within a metre.
 /// Measured (seed 1, 2 minutes): 12-15 shots, all wide of the goal (the nets' distances rest on
 /// pixel rows half a metre of floor deep at 8 m); pose error median 0.51-0.59 m. Scoring through
-/// vision is issue 19's next step, not this test's claim.
+/// vision is not this test's claim.
 #[test]
 fn a_chaser_plays_through_vision_and_roughly_knows_where_it_is() {
     let mut cfg = short(2.0, 1);

@@ -1,6 +1,6 @@
 //! Rendered camera images seen by the vision µAgent's pieces (`mrt-perception`): the simulator's
-//! palette is classified as intended, and the ball is found where it is (issue 19 item 9:
-//! error ≤ 5 % of the distance and ≤ 1.5° across the field).
+//! palette is classified as intended, and the ball is found where it is
+//! (error ≤ 5 % of the distance and ≤ 1.5° across the field).
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
 use mrt_core::Pose2;

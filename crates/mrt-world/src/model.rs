@@ -804,7 +804,7 @@ impl WorldModel {
     /// sees a landmark) would move every sighting after it and read as the ball's motion. The
     /// sighting's covariance is the camera's alone; odometry over a few frames errs far less.
     /// The place stays the sighting's in the field frame (the track lags behind kicks and a
-    /// relocalized pose: 0.33 m mean error against 0.20 m, session 22).
+    /// relocalized pose: 0.33 m mean error against 0.20 m).
     fn track_ball(&mut self, time: f64, z: &Sighting, sigma: Option<(f64, f64)>) -> (f64, f64) {
         let sd = self.noise.sigma(z.distance, sigma);
         let o = self.odom;

@@ -1092,7 +1092,7 @@ mod tests {
     }
 
     /// Two far objects with a metre of range tolerance fit a strip of poses metres long: its
-    /// ends are not two answers (stop 31: the relocalizer refused nearly every search of a
+    /// ends are not two answers (otherwise the relocalizer refuses nearly every search of a
     /// goalkeeper looking up the field as "ambiguous").
     #[test]
     fn a_long_ridge_of_poses_that_fit_is_one_answer_not_an_ambiguity() {

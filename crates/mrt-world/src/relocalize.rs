@@ -835,7 +835,7 @@ mod tests {
         assert_eq!(WEST_NET, 2);
     }
 
-    /// The gaze test's robot (stop 30's defect): a far post seen twice, 11.5 m and 10.3 m
+    /// The gaze test's robot (a defect once): a far post seen twice, 11.5 m and 10.3 m
     /// away (3σ each is about 1 m), was two posts that no pose explained together, and a
     /// search put the robot 1.7 m from where it stood.
     #[test]

@@ -28,7 +28,7 @@
 //! updates the models' probabilities; the track reads out their weighted combination. The
 //! gate leaves out only a sighting that no model expects. With the ball's 0.5 and 8 m/s²
 //! ([`BALL_ACCEL`], [`BALL_MANEUVER`]), the velocity error over 8 vision matches fell from
-//! 0.363 m/s (quiet model alone) to 0.307 (docs/performance.md, session 41).
+//! 0.363 m/s (quiet model alone) to 0.307 (docs/performance.md).
 //!
 //! ```
 //! use mrt_world::track::Track;

@@ -484,7 +484,7 @@ mod tests {
     }
 
     /// The ball across the field: painted where the camera would see it, with the apparent
-    /// size of a sphere, found at the right distance and bearing (issue 19: error ≤ 5 % of the
+    /// size of a sphere, found at the right distance and bearing (error ≤ 5 % of the
     /// distance and ≤ 1.5°).
     #[test]
     fn the_ball_is_found_at_its_distance_and_bearing_across_the_field() {
