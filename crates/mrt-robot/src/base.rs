@@ -3,8 +3,14 @@
 //! the driver side ([`MotorDriver`]) applies duty cycles to the motors. A real robot's driver
 //! talks to its board; the simulator's turns duty cycles back into the body velocity its robot
 //! follows ([`Base::twist_for`]), so wheel-speed limits shape the motion exactly as on a real
-//! base (a differential drive cannot move sideways; a command beyond a wheel's top speed is
-//! scaled down as a whole, keeping its direction).
+//! base (a command beyond a wheel's top speed is scaled down as a whole, keeping its
+//! direction).
+//!
+//! Behaviors think holonomically: a Mr. BRIAN `SpeedAngle` or a TeamChaos strafe asks for a
+//! direction of motion, which a Triskar drives as it is. A differential drive cannot move
+//! sideways, so it steers toward the asked direction instead ([`follow_on_differential`]):
+//! a sideways request turns the base while it drives the part of the request along its
+//! heading, and the behavior, which sees the robot turn, closes the loop.
 
 use mrt_core::frames::MM_PER_M;
 use mrt_core::Pose2;
@@ -12,6 +18,7 @@ use mrt_msgs::{Displacement, RobotCommand};
 use mrt_plan::kinematics::{
     duty_cycle, integrate, DiffDrive, Kinematics, Omni3, OmniWheels, Steering, Twist, WheelSpeeds,
 };
+use std::f64::consts::{FRAC_PI_2, PI};
 
 /// What a motor driver refuses.
 #[derive(Debug, thiserror::Error, PartialEq)]
@@ -71,7 +78,9 @@ impl Base {
     }
 
     /// The processing side: a command (mm/s, deg/s) → one duty cycle per wheel. A command
-    /// beyond the wheels' top speed is scaled down as a whole (direction kept).
+    /// beyond the wheels' top speed is scaled down as a whole (direction kept). On a
+    /// differential base a sideways part steers the base toward it
+    /// ([`follow_on_differential`]).
     pub fn duties(&self, cmd: &RobotCommand) -> Vec<f64> {
         let finite = |x: f64| if x.is_finite() { x } else { 0.0 };
         // The command's edge units (mm/s, deg/s: the behaviors' own) to SI.
@@ -82,7 +91,7 @@ impl Base {
         );
         match self {
             Base::Differential(k) => {
-                let w = k.inverse(&k.limit(&twist));
+                let w = k.inverse(&k.limit(&follow_on_differential(twist)));
                 w.0.iter().map(|s| duty_cycle(*s, k.params().max_wheel_speed)).collect()
             }
             Base::Omni(k) => {
@@ -135,6 +144,42 @@ impl Base {
     }
 }
 
+/// Turn rate per radian between the heading and a requested direction of motion, 1/s.
+pub const STEER_GAIN: f64 = 3.0;
+
+/// A sideways request this fast (m/s) or faster is steered toward alone; a slower one shares
+/// the turn with the behavior's own turn rate in proportion.
+pub const STEER_SPEED: f64 = 0.3;
+
+/// A holonomic request (robot frame, m/s and rad/s) as a differential drive can follow it.
+/// With no sideways part it is returned as it is (forward, backward, turning). Otherwise the
+/// base drives the request's part along its heading, `speed · cos(direction)`, and turns
+/// toward the direction at [`STEER_GAIN`] per radian, or toward its opposite when that is
+/// behind (the base then backs into it, as [`mrt_plan::guidance::PositionMode`] does). The
+/// behavior's own turn rate, which on a holonomic base would turn it while it slides (to
+/// face the ball on its way behind it), gives way to the steering as the sideways part grows
+/// to [`STEER_SPEED`]: a differential base must face where it goes, and turns to the ball
+/// once it is there and the request is small. The result has `vy = 0`.
+pub fn follow_on_differential(t: Twist) -> Twist {
+    if !t.is_finite() {
+        return Twist::ZERO;
+    }
+    if t.vy == 0.0 {
+        return t;
+    }
+    let direction = t.vy.atan2(t.vx);
+    let toward = if direction > FRAC_PI_2 {
+        direction - PI
+    } else if direction < -FRAC_PI_2 {
+        direction + PI
+    } else {
+        direction
+    };
+    let share = (t.vy.abs() / STEER_SPEED).min(1.0);
+    let omega = (1.0 - share) * t.omega + share * STEER_GAIN * toward;
+    Twist::new(t.speed() * direction.cos(), 0.0, omega)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -144,10 +189,30 @@ mod tests {
     }
 
     #[test]
-    fn a_differential_base_cannot_move_sideways() {
+    fn a_differential_base_steers_toward_a_sideways_request() {
         let b = Base::parse("differential").unwrap();
+        // Ahead and to the left: forward at the request's projection, turning left.
         let d = b.twist_for(&b.duties(&cmd(500.0, 400.0, 0.0))).unwrap();
-        assert!((d.vx - 0.5).abs() < 1e-9 && d.vy == 0.0, "{d:?}");
+        assert!(d.vy == 0.0 && d.omega > 0.5 && d.vx > 0.0, "{d:?}");
+        let straight = follow_on_differential(Twist::new(0.5, 0.4, 0.0));
+        assert!((straight.vx - 0.5).abs() < 1e-9, "{straight:?}");
+        // A pure strafe to the right turns right in place.
+        let d = b.twist_for(&b.duties(&cmd(0.0, -400.0, 0.0))).unwrap();
+        assert!(d.vx.abs() < 1e-9 && d.omega < -1.0, "{d:?}");
+        // Behind and to the left: backs up, turning its back toward it (clockwise).
+        let d = follow_on_differential(Twist::new(-0.5, 0.1, 0.0));
+        assert!(d.vx < -0.4 && d.omega < 0.0, "{d:?}");
+        // Without a sideways part nothing changes, backward included.
+        for t in [Twist::new(0.5, 0.0, 0.3), Twist::new(-0.4, 0.0, -1.0), Twist::ZERO] {
+            assert_eq!(follow_on_differential(t), t);
+        }
+        // A fast sideways request is steered toward alone; a slow one shares the turn with
+        // the behavior's, which alone turns the base when the request has no sideways part.
+        let fast = follow_on_differential(Twist::new(0.3, 0.6, -1.0));
+        assert!((fast.omega - STEER_GAIN * 2f64.atan()).abs() < 1e-12, "{fast:?}");
+        let slow = follow_on_differential(Twist::new(0.05, 0.01, -1.0));
+        assert!(slow.omega < 0.0 && slow.omega > -1.0, "{slow:?}");
+        assert_eq!(follow_on_differential(Twist::new(f64::NAN, 1.0, 0.0)), Twist::ZERO);
     }
 
     #[test]
