@@ -24,6 +24,7 @@ At the end it prints ONE JSON line on stdout (the summary); progress goes to std
 from __future__ import annotations
 
 import argparse
+import contextlib
 import copy
 import json
 import math
@@ -58,6 +59,73 @@ def log(*parts: object) -> None:
     print("world.py:", *parts, file=sys.stderr, flush=True)
 
 
+class UpView:
+    """A robot's omnidirectional camera (an MRT omni camera file, configs/vision/
+    omni-ianus3.toml): a view straight down from the mirror's viewpoint above the robot's
+    centre, which images the floor as the file's affine map and a point at height z pushed out
+    by viewpoint / (viewpoint - z), exactly the file's model. Beyond the mirror's reach the
+    image is black."""
+
+    CAMERA = "up_eye"
+    BODY = "up_viewer"
+
+    def __init__(self, cfg: dict) -> None:
+        if cfg.get("model") != "omni":
+            raise ValueError(f"an up camera file has model = \"omni\" (got {cfg.get('model')!r})")
+        if float(cfg.get("rotation_deg", 0.0)) != 0.0 or cfg.get("mirrored", False):
+            raise ValueError("the MuJoCo world renders up cameras with rotation_deg = 0 and "
+                             "mirrored = false only")
+        self.width, self.height = int(cfg["width"]), int(cfg["height"])
+        self.scale = float(cfg["scale_px_per_m"])
+        self.viewpoint = float(cfg.get("viewpoint_m", 0.8))
+        self.range = float(cfg.get("range_m", 4.5))
+        cx, cy = float(cfg["cx"]), float(cfg["cy"])
+        f = self.scale * self.viewpoint
+        self.camera = rf.Camera({"width": self.width, "height": self.height, "fx": f, "fy": f,
+                                 "cx": cx, "cy": cy, "height_m": self.viewpoint,
+                                 "tilt_deg": 90.0})
+        if not self.camera.centred():
+            raise ValueError("the MuJoCo world renders up cameras with cx = width / 2 and "
+                             "cy = height / 2 only")
+        cols, rows = np.meshgrid(np.arange(self.width) + 0.5, np.arange(self.height) + 0.5)
+        self.beyond = np.hypot(cols - cx, rows - cy) / self.scale > self.range
+        self.renderer = None
+        self.cam_id = self.mocap = -1
+
+    @staticmethod
+    def load(path) -> "UpView":
+        import tomllib
+
+        with open(path, "rb") as fh:
+            return UpView(tomllib.load(fh))
+
+    def add_to(self, spec) -> None:
+        """Adds the camera's body to the scene's MjSpec (before it is compiled)."""
+        body = spec.worldbody.add_body(name=self.BODY, mocap=True)
+        body.add_camera(name=self.CAMERA, fovy=self.camera.fovy_deg())
+
+    def attach(self, mj, model) -> None:
+        """Finds the camera in the compiled model and makes its renderer."""
+        self.cam_id = mj.mj_name2id(model, mj.mjtObj.mjOBJ_CAMERA, self.CAMERA)
+        body = mj.mj_name2id(model, mj.mjtObj.mjOBJ_BODY, self.BODY)
+        self.mocap = int(model.body_mocapid[body])
+        model.cam_resolution[self.cam_id] = (self.width, self.height)
+        model.cam_fovy[self.cam_id] = self.camera.fovy_deg()
+        model.vis.global_.offwidth = max(model.vis.global_.offwidth, self.width)
+        model.vis.global_.offheight = max(model.vis.global_.offheight, self.height)
+        self.renderer = mj.Renderer(model, self.height, self.width)
+
+    def render(self, mj, model, data, pose, option) -> np.ndarray:
+        data.mocap_pos[self.mocap] = self.camera.centre(pose)
+        data.mocap_quat[self.mocap] = self.camera.mujoco_quat(pose)
+        mj.mj_kinematics(model, data)
+        mj.mj_camlight(model, data)
+        self.renderer.update_scene(data, camera=self.cam_id, scene_option=option)
+        img = self.renderer.render().copy()
+        img[self.beyond] = 0
+        return img
+
+
 class Match:
     """The physics, the cameras and the referee of one match (no network: :func:`play` and the
     tests drive it)."""
@@ -65,7 +133,7 @@ class Match:
     def __init__(self, scene, camera_file, home: int, away: int, scenario: str = "match",
                  half: float = 300.0, seed: int = 0, image: str = "jpeg",
                  render: bool = True, placed: bool = True, shadows: bool = True,
-                 samples: int | None = None) -> None:
+                 samples: int | None = None, up_camera=None) -> None:
         if scenario not in ("match", "empty-goal"):
             raise ValueError(f"scenario must be match or empty-goal, not {scenario!r}")
         if scenario == "empty-goal":
@@ -76,16 +144,22 @@ class Match:
         self.camera = rf.Camera.load(camera_file)
         self.names = [n for n, _, _ in physics.robot_names(home, away)]
         drive = physics.edit_scene(home, away)
+        self.up = UpView.load(up_camera) if up_camera is not None and render else None
 
         def edit(spec):
             drive(spec)
+            if self.up is not None:
+                self.up.add_to(spec)
             if samples is not None:  # multisample anti-aliasing of the offscreen frames
                 spec.visual.quality.offsamples = samples
 
         if render:
             self.view = rf.World(scene, self.camera, edit=edit)
-            if not shadows:
-                self.view.renderer.scene.flags[self.view.mj.mjtRndFlag.mjRND_SHADOW] = 0
+            if self.up is not None:
+                self.up.attach(self.view.mj, self.view.model)
+            for r in [self.view.renderer] + ([self.up.renderer] if self.up else []):
+                if not shadows:
+                    r.scene.flags[self.view.mj.mjtRndFlag.mjRND_SHADOW] = 0
             model, data = self.view.model, self.view.data
         else:
             self.view = None
@@ -107,6 +181,7 @@ class Match:
         self.time = 0.0
         self.steps = 0
         self.render_seconds: list[float] = []
+        self.up_seconds: list[float] = []
         self.kicks = 0
 
     def _empty_goal_start(self, rng):
@@ -133,16 +208,32 @@ class Match:
         data.mocap_quat[view.viewer] = cam.mujoco_quat(p)
         mj.mj_kinematics(self.physics.model, data)
         mj.mj_camlight(self.physics.model, data)  # the camera follows its body
-        groups = self.physics.model.geom_group
-        for g in r.geoms:
-            groups[g] = rf.HIDDEN_GROUP
-        try:
+        with self._hidden(name):
             img = view.render()
-        finally:
-            for g in r.geoms:
-                groups[g] = 0
         self.render_seconds.append(view.render_seconds[-1])
         return img
+
+    def up_frame(self, name: str) -> np.ndarray:
+        """What robot `name`'s up camera sees now, its own body hidden."""
+        started = time.perf_counter()
+        with self._hidden(name):
+            img = self.up.render(self.physics.mj, self.physics.model, self.physics.data,
+                                 self.physics.pose(name), self.view.option)
+        self.up_seconds.append(time.perf_counter() - started)
+        return img
+
+    @contextlib.contextmanager
+    def _hidden(self, name: str):
+        """Robot `name`'s own geoms are not drawn meanwhile."""
+        groups = self.physics.model.geom_group
+        geoms = self.physics.robots[name].geoms
+        for g in geoms:
+            groups[g] = rf.HIDDEN_GROUP
+        try:
+            yield
+        finally:
+            for g in geoms:
+                groups[g] = 0
 
     def sense(self, name: str) -> dict:
         """Robot `name`'s readings now (and its odometry since the previous call)."""
@@ -150,18 +241,21 @@ class Match:
         mice, wheels = self.odometers[name].read(ph.pose(name))
         at = self.placed.pop(name, None)
         odo = odometry(mice=mice, wheels=wheels, placed=None if at is None else pose(*at))
-        cam = None
+        cam = up = None
         if self.view is not None:
-            img = self.frame(name)
-            if self.image == "rgb8":
-                data = rgb8_image(img.shape[1], img.shape[0], img)
-            else:
-                data = jpeg_image(img, quality=90)
-            cam = camera(self.time, data, pan=ph.robots[name].pan)
+            cam = camera(self.time, self._encode(self.frame(name)), pan=ph.robots[name].pan)
+        if self.up is not None:
+            up = {"image": self._encode(self.up_frame(name))}
         sonars = [sonar(b, r) for b, r in ph.sonars(name)]
         state, attack, kickoff, marker = self.referee.game(name)
         g = game(state, attack, None if kickoff is None else pose(*kickoff), marker)
-        return sense(self.steps, self.time, g, odometry=odo, camera=cam, sonars=sonars)
+        return sense(self.steps, self.time, g, odometry=odo, camera=cam, sonars=sonars,
+                     up_camera=up)
+
+    def _encode(self, img: np.ndarray) -> dict:
+        if self.image == "rgb8":
+            return rgb8_image(img.shape[1], img.shape[0], img)
+        return jpeg_image(img, quality=90)
 
     def senses(self) -> dict[str, dict]:
         return {n: self.sense(n) for n in self.names}
@@ -207,6 +301,8 @@ class Match:
     def close(self) -> None:
         if self.view is not None:
             self.view.renderer.close()
+        if self.up is not None:
+            self.up.renderer.close()
 
 
 # --- play -------------------------------------------------------------------------------------
@@ -216,7 +312,8 @@ def play(args) -> dict:
     """Plays the match `args` (main's options) with the robots over zenoh; returns the summary."""
     m = Match(rf.find(args.scene, HERE), rf.find(args.camera, REPO), args.home, args.away,
               args.scenario, args.half, args.seed, args.image, placed=not args.no_placed,
-              shadows=not args.no_shadows, samples=args.samples)
+              shadows=not args.no_shadows, samples=args.samples,
+              up_camera=rf.find(args.up_camera, REPO) if args.up_camera else None)
     truth = open(args.truth, "w") if args.truth else None
     acts_log = open(args.acts, "w") if args.acts else None
     answered = dict.fromkeys(m.names, 0)
@@ -281,6 +378,8 @@ def play(args) -> dict:
         "missing": {n: world.steps - answered[n] for n in m.names},
         "render_ms": (round(1000 * float(np.mean(m.render_seconds)), 2)
                       if m.render_seconds else None),
+        "up_render_ms": (round(1000 * float(np.mean(m.up_seconds)), 2)
+                         if m.up_seconds else None),
         "real_time_factor": round(m.time / wall, 3) if wall > 0 else None,
         "byes": {n: byes.get(n) is not None for n in m.names},
     }
@@ -305,15 +404,16 @@ def _save_frames(m: Match, senses: dict, out: Path) -> None:
     from PIL import Image
 
     for name, s in senses.items():
-        image = (s.get("camera") or {}).get("image")
-        if not image:
-            continue
-        data = base64.b64decode(image["data"])
-        if image["encoding"] == "jpeg":
-            img = Image.open(io.BytesIO(data))
-        else:
-            img = Image.frombytes("RGB", (image["width"], image["height"]), data)
-        img.save(out / f"{name}_{m.steps:05d}.png")
+        for which, suffix in (("camera", ""), ("up_camera", "_up")):
+            image = (s.get(which) or {}).get("image")
+            if not image:
+                continue
+            data = base64.b64decode(image["data"])
+            if image["encoding"] == "jpeg":
+                img = Image.open(io.BytesIO(data))
+            else:
+                img = Image.frombytes("RGB", (image["width"], image["height"]), data)
+            img.save(out / f"{name}_{m.steps:05d}{suffix}.png")
 
 
 def parser() -> argparse.ArgumentParser:
@@ -328,6 +428,9 @@ def parser() -> argparse.ArgumentParser:
     p.add_argument("--camera", default="configs/vision/camera.toml",
                    help="the robots' camera file (relative paths also tried from the "
                         "repository's root)")
+    p.add_argument("--up-camera", metavar="FILE",
+                   help="each robot's omnidirectional camera too (an omni camera file, e.g. "
+                        "configs/vision/omni-ianus3.toml); default: none")
     p.add_argument("--home", type=int, default=1, help="home robots: home-1 .. home-N")
     p.add_argument("--away", type=int, default=0, help="away robots: away-1 .. away-M")
     p.add_argument("--listen", required=True, help="zenoh endpoint, e.g. tcp/127.0.0.1:7470")

@@ -5,6 +5,7 @@
 
 use crate::distributed::{Launch, PortPicker, Robots};
 use anyhow::{anyhow, bail, Context as _, Result};
+use mrt_perception::camera::OmniFile;
 use mrt_robot::config::RobotFile;
 use mrt_robot::stacks::Stack;
 use std::path::{Path, PathBuf};
@@ -48,6 +49,13 @@ pub struct MujocoArgs {
     /// What is played.
     #[arg(long, value_enum, default_value_t = Scenario::Match)]
     pub scenario: Scenario,
+    /// Each robot's omnidirectional camera (an omni camera file), which the world renders
+    /// beside its front camera (IANUS3's omnidirectional vision, MRT manual §12.5).
+    #[arg(long, value_name = "FILE", default_value = "configs/vision/omni-ianus3.toml")]
+    pub up_camera: PathBuf,
+    /// Robots with the front camera only.
+    #[arg(long)]
+    pub no_up_camera: bool,
     /// The MuJoCo world's directory.
     #[arg(long, default_value = "worlds/mujoco")]
     pub dir: PathBuf,
@@ -61,6 +69,10 @@ pub struct MujocoArgs {
     /// Writes the world's truth, one JSON line a step (time, state, score, ball, robots).
     #[arg(long)]
     pub truth: Option<PathBuf>,
+    /// Keeps each robot process's log in this directory, as `<robot name>.log` (default:
+    /// thrown away with the match's temporary files, shown only when the world fails).
+    #[arg(long, value_name = "DIR")]
+    pub logs: Option<PathBuf>,
 }
 
 /// The §3.3.1 file of robot `i` of a team of the robots `first..` (at least two): the team's
@@ -87,6 +99,7 @@ fn robot_file(
     name: &str,
     endpoint: &str,
     net: Option<&Path>,
+    up_camera: Option<&OmniFile>,
 ) -> String {
     let mut file = RobotFile::default();
     file.robot.id = i;
@@ -94,6 +107,7 @@ fn robot_file(
     file.robot.stack = stack.name().into();
     file.body.base = "differential".into();
     file.vision.enabled = true;
+    file.vision.up_camera = up_camera.cloned();
     file.devices.kind = "world".into();
     file.devices.world = Some(WORLD.into());
     file.devices.name = Some(name.into());
@@ -117,6 +131,8 @@ pub fn play(args: &MujocoArgs) -> Result<()> {
         Scenario::EmptyGoal => vec![(home, "home")],
     };
     let per_team = if args.scenario == Scenario::EmptyGoal { 1 } else { n };
+    let up_camera =
+        if args.no_up_camera { None } else { Some(OmniFile::from_file(&args.up_camera)?) };
     let dir = std::env::temp_dir().join(format!("mrt-mujoco-{}-{}", std::process::id(), args.seed));
     std::fs::create_dir_all(&dir).with_context(|| format!("cannot create {}", dir.display()))?;
     let mut procs = Robots { dir: dir.clone(), children: Vec::new() };
@@ -125,6 +141,7 @@ pub fn play(args: &MujocoArgs) -> Result<()> {
     let count = teams.len() * per_team;
     let ports = (0..count).map(|_| picker.port()).collect::<Result<Vec<_>>>()?;
     let mut files = Vec::new();
+    let mut names = Vec::new();
     for (t, (stack, side)) in teams.iter().enumerate() {
         let discovery = picker.port()?;
         for k in 0..per_team {
@@ -139,8 +156,12 @@ pub fn play(args: &MujocoArgs) -> Result<()> {
             // The empty goal's one robot is a field player (robot 1 of a team of two whose
             // keeper is not there), not a goalkeeper.
             let (id, size) = if per_team == 1 { (1, 2) } else { (i, per_team) };
-            std::fs::write(&file, robot_file(id, size, *stack, &name, &endpoint, net))?;
+            std::fs::write(
+                &file,
+                robot_file(id, size, *stack, &name, &endpoint, net, up_camera.as_ref()),
+            )?;
             files.push(file);
+            names.push(name);
         }
     }
     let python = args
@@ -165,6 +186,9 @@ pub fn play(args: &MujocoArgs) -> Result<()> {
     if let Some(t) = &args.truth {
         world.arg("--truth").arg(t);
     }
+    if up_camera.is_some() {
+        world.arg("--up-camera").arg(&args.up_camera);
+    }
     if std::env::var_os("MUJOCO_GL").is_none() {
         world.env("MUJOCO_GL", "egl");
     }
@@ -177,6 +201,15 @@ pub fn play(args: &MujocoArgs) -> Result<()> {
     }
     let out = world.wait_with_output().context("the world did not end")?;
     procs.wait(Duration::from_secs(5));
+    if let Some(logs) = &args.logs {
+        std::fs::create_dir_all(logs)
+            .with_context(|| format!("cannot create {}", logs.display()))?;
+        for (i, name) in names.iter().enumerate() {
+            let to = logs.join(format!("{name}.log"));
+            std::fs::copy(procs.log(i), &to)
+                .with_context(|| format!("cannot keep robot {name}'s log in {}", to.display()))?;
+        }
+    }
     if !out.status.success() {
         let tails: Vec<String> =
             (0..files.len()).map(|i| format!("robot {i}:\n{}", procs.tail(i))).collect();

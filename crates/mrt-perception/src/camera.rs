@@ -561,6 +561,24 @@ impl OmniFile {
         4.5
     }
 
+    /// Parses an omnidirectional camera file; `file` names it in errors (line and column for
+    /// syntax).
+    pub fn from_toml(text: &str, file: &str) -> Result<OmniFile, mrt_core::FileError> {
+        let parsed: OmniFile = toml::from_str(text).map_err(|e| {
+            mrt_core::FileError::parse(file, text, e.span().map(|s| s.start), e.message())
+        })?;
+        parsed
+            .camera()
+            .map_err(|message| mrt_core::FileError::Invalid { file: file.to_string(), message })?;
+        Ok(parsed)
+    }
+
+    /// Reads an omnidirectional camera file.
+    pub fn from_file(path: impl AsRef<std::path::Path>) -> Result<OmniFile, mrt_core::FileError> {
+        let (text, file) = mrt_core::FileError::read(path.as_ref())?;
+        OmniFile::from_toml(&text, &file)
+    }
+
     /// The camera it describes, every value checked.
     pub fn camera(&self) -> Result<Omni, String> {
         if self.model != "omni" {
@@ -817,6 +835,14 @@ mod tests {
         assert!(e.to_string().contains("the models are \"pinhole\" and \"omni\""), "{e}");
         let e = CameraModel::from_toml("width = 3\n", "o.toml").unwrap_err();
         assert!(e.to_string().contains("no model"), "{e}");
+        // The MuJoCo world's IANUS3 camera: 32 px a metre, blind only under the body.
+        let ianus = concat!(env!("CARGO_MANIFEST_DIR"), "/../../configs/vision/omni-ianus3.toml");
+        let file = OmniFile::from_file(ianus).unwrap();
+        assert_eq!((file.width, file.scale_px_per_m, file.blind_m), (320, 32.0, 0.3));
+        let e = OmniFile::from_toml(&format!("{text}range_m = 0.5\n"), "o.toml").unwrap_err();
+        assert!(e.to_string().contains("blind_m must be"), "{e}");
+        let e = OmniFile::from_toml("model = \"omni\"\nwidth = \"wide\"\n", "o.toml").unwrap_err();
+        assert!(e.to_string().contains("o.toml:2:"), "{e}");
     }
 
     #[test]

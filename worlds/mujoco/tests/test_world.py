@@ -438,6 +438,48 @@ class MatchTest(unittest.TestCase):
             self.assertIsNone(m.sense("home-1")["odometry"]["placed"])
 
 
+class UpCameraTest(unittest.TestCase):
+    """The omnidirectional camera images the floor as its file's affine map says, a raised
+    point pushed out by viewpoint / (viewpoint - z), and nothing beyond the mirror's reach."""
+
+    def setUp(self):
+        why = rendering_unavailable()
+        if why:
+            self.skipTest(why)
+
+    def test_the_ball_is_where_the_omni_model_puts_it_all_round_the_robot(self):
+        import tomllib
+
+        import world
+
+        path = REPO / "configs" / "vision" / "omni-ianus3.toml"
+        cfg = tomllib.loads(path.read_text())
+        m = world.Match(SCENE, CAMERA_FILE, 1, 0, "empty-goal", seed=1, up_camera=path)
+        x, y, t = 1.0, -2.0, 0.7
+        m.physics.place_robot("home-1", (x, y, t))
+        vp, scale, r = cfg["viewpoint_m"], cfg["scale_px_per_m"], m.physics.ball_radius
+        for dx, dy in ((0.45, 0.0), (0.0, 1.2), (-2.0, -1.5), (3.0, 1.0)):
+            bx = x + math.cos(t) * dx - math.sin(t) * dy
+            by = y + math.sin(t) * dx + math.cos(t) * dy
+            m.physics.place_ball(bx, by)
+            img = m.up_frame("home-1").astype(int)
+            self.assertEqual(img.shape, (cfg["height"], cfg["width"], 3))
+            ball = (img[..., 0] > 120) & (img[..., 1] < 110) & (img[..., 2] < 80)
+            rows, cols = ball.nonzero()
+            self.assertGreater(len(rows), 10, (dx, dy))
+            k = vp / (vp - r)  # the ball's centre, raised by its radius
+            col = cfg["cx"] - scale * dy * k
+            row = cfg["cy"] - scale * dx * k
+            self.assertAlmostEqual(cols.mean() + 0.5, col, delta=1.5, msg=(dx, dy))
+            self.assertAlmostEqual(rows.mean() + 0.5, row, delta=1.5, msg=(dx, dy))
+        # Beyond the reach, black; the image goes to the robot with each sense.
+        self.assertEqual(int(img[0, 0].sum()), 0)
+        self.assertGreater(int(img[cfg["height"] // 2, cfg["width"] // 2 + 40].sum()), 0)
+        up = m.sense("home-1")["up_camera"]["image"]
+        self.assertEqual((up["width"], up["height"], up["encoding"]), (320, 320, "jpeg"))
+        m.close()
+
+
 # --- over zenoh -----------------------------------------------------------------------------
 
 
