@@ -158,7 +158,10 @@ def rgb8_image(width: int, height: int, data: Any) -> dict:
 
 
 def jpeg_image(image: Any, quality: int = 90) -> dict:
-    """A baseline JPEG image from a PIL image or a uint8 numpy array (height, width, 3)."""
+    """A baseline JPEG image from a PIL image or a uint8 numpy array (height, width, 3), its
+    colour at full resolution (4:4:4). The encoder's usual 4:2:0 halves the colour's
+    resolution both ways, which washes out small coloured objects: a ball 11 m away, 5
+    pixels across, is no longer orange (the images are about a third larger instead)."""
     from PIL import Image
 
     if not isinstance(image, Image.Image):
@@ -167,7 +170,7 @@ def jpeg_image(image: Any, quality: int = 90) -> dict:
     _side(image.width, "width")
     _side(image.height, "height")
     buffer = io.BytesIO()
-    image.save(buffer, format="JPEG", quality=quality)
+    image.save(buffer, format="JPEG", quality=quality, subsampling=0)
     data = base64.b64encode(buffer.getvalue()).decode("ascii")
     return {"width": image.width, "height": image.height, "encoding": "jpeg", "data": data}
 

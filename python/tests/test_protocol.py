@@ -153,6 +153,18 @@ class Builders(unittest.TestCase):
                 pixel = decoded.convert("RGB").getpixel((5, 5))
                 self.assertLess(max(abs(a - b) for a, b in zip(pixel, (30, 130, 50), strict=True)), 6)
 
+    def test_jpeg_keeps_a_small_ball_orange(self) -> None:
+        # A ball 5 pixels across on the carpet, as one 11 m away, keeps its colour (with the
+        # colour at half resolution, 4:2:0, its pixels are off by 29 a channel on average).
+        array = np.full((24, 32, 3), (30, 130, 50), np.uint8)
+        rows, cols = np.ogrid[:24, :32]
+        ball = (rows - 11.5) ** 2 + (cols - 15.5) ** 2 <= 6.25
+        array[ball] = (230, 90, 20)
+        image = jpeg_image(array, quality=90)
+        with Image.open(io.BytesIO(base64.b64decode(image["data"]))) as decoded:
+            got = np.asarray(decoded.convert("RGB")).astype(int)[ball]
+        self.assertLess(float(np.abs(got - (230, 90, 20)).mean()), 10.0)
+
     def test_encode_is_compact_and_refuses_nan(self) -> None:
         self.assertEqual(encode({"a": [1, 2]}), b'{"a":[1,2]}')
         with self.assertRaises(ValueError):
