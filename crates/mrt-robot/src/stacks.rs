@@ -301,6 +301,10 @@ impl MilanBrain {
         let field = Geometry::of(&w.field);
         let mut v = vec![("Keeper", f64::from(u8::from(self.keeper)), 1.0), ("Always", 1.0, 1.0)];
         v.push(("HeadingBearing", deg360(me.theta), q));
+        // The centre spot, from where the robot believes it is: a search goes there, from
+        // where every spot of the field is within a camera's reach.
+        v.push(("CentreDistance", me.x.hypot(me.y), q));
+        v.push(("CentreAngle", deg360((-me.y).atan2(-me.x) - me.theta), q));
         // SCARE's job (MRT manual ch. 11 and §2.3: goals for the parametric behaviors). A
         // robot without one plays the ball, as the team did before SCARE.
         let job = w.job.as_ref();
@@ -638,6 +642,30 @@ mod tests {
         // Mr. BRIAN takes every input the Parser gives (they are in ctof.txt).
         let c = brain.cycle(&w);
         assert!(c.vlin.is_finite());
+    }
+
+    /// A field player that does not see the ball turns and walks to the centre spot, from
+    /// where a camera reaches every spot of the field; there it turns on the spot.
+    #[test]
+    fn milan_searches_for_the_ball_on_its_way_to_the_centre() {
+        use std::f64::consts::{FRAC_PI_2, PI};
+        let dir = embedded_milan().unwrap();
+        let mut brain = MilanBrain::new(&dir, false).unwrap();
+        let mut w = WorldSnapshot::default();
+        w.game_state = GameState::Playing;
+        w.my_pos.quality = 0.9;
+        // 6 m east of the centre, facing north: the centre is on its left.
+        w.my_pos.pose = Pose2::new(6000.0, 0.0, FRAC_PI_2);
+        let c = brain.cycle(&w);
+        assert!(c.vlat > 500.0 && c.vlin.abs() < 100.0 && c.vrot > 100.0, "{c:?}");
+        // Facing the centre: ahead, still turning.
+        w.my_pos.pose = Pose2::new(6000.0, 0.0, PI);
+        let c = brain.cycle(&w);
+        assert!(c.vlin > 500.0 && c.vlat.abs() < 100.0 && c.vrot > 100.0, "{c:?}");
+        // On the centre spot: it turns where it stands.
+        w.my_pos.pose = Pose2::new(100.0, -100.0, 0.3);
+        let c = brain.cycle(&w);
+        assert!(c.vlin.hypot(c.vlat) < 50.0 && c.vrot > 100.0, "{c:?}");
     }
 
     /// Shot selection: the open side of the opponent's goal, away from its
