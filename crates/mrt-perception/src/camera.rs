@@ -422,16 +422,25 @@ impl Default for CameraFile {
     }
 }
 
+/// A camera file of type `F` parsed from `text` and checked by `check`; `file` names it in
+/// errors (line and column for syntax).
+fn checked_file<F: serde::de::DeserializeOwned, C>(
+    text: &str,
+    file: &str,
+    check: impl Fn(&F) -> Result<C, String>,
+) -> Result<F, mrt_core::FileError> {
+    let parsed: F = toml::from_str(text).map_err(|e| {
+        mrt_core::FileError::parse(file, text, e.span().map(|s| s.start), e.message())
+    })?;
+    check(&parsed)
+        .map_err(|message| mrt_core::FileError::Invalid { file: file.to_string(), message })?;
+    Ok(parsed)
+}
+
 impl CameraFile {
     /// Parses a camera file; `file` names it in errors (line and column for syntax).
     pub fn from_toml(text: &str, file: &str) -> Result<CameraFile, mrt_core::FileError> {
-        let parsed: CameraFile = toml::from_str(text).map_err(|e| {
-            mrt_core::FileError::parse(file, text, e.span().map(|s| s.start), e.message())
-        })?;
-        parsed
-            .camera()
-            .map_err(|message| mrt_core::FileError::Invalid { file: file.to_string(), message })?;
-        Ok(parsed)
+        checked_file(text, file, CameraFile::camera)
     }
 
     /// Reads a camera file.
@@ -564,13 +573,7 @@ impl OmniFile {
     /// Parses an omnidirectional camera file; `file` names it in errors (line and column for
     /// syntax).
     pub fn from_toml(text: &str, file: &str) -> Result<OmniFile, mrt_core::FileError> {
-        let parsed: OmniFile = toml::from_str(text).map_err(|e| {
-            mrt_core::FileError::parse(file, text, e.span().map(|s| s.start), e.message())
-        })?;
-        parsed
-            .camera()
-            .map_err(|message| mrt_core::FileError::Invalid { file: file.to_string(), message })?;
-        Ok(parsed)
+        checked_file(text, file, OmniFile::camera)
     }
 
     /// Reads an omnidirectional camera file.
