@@ -651,8 +651,7 @@ mod tests {
         use std::f64::consts::{FRAC_PI_2, PI};
         let dir = embedded_milan().unwrap();
         let mut brain = MilanBrain::new(&dir, false).unwrap();
-        let mut w = WorldSnapshot::default();
-        w.game_state = GameState::Playing;
+        let mut w = WorldSnapshot { game_state: GameState::Playing, ..Default::default() };
         w.my_pos.quality = 0.9;
         // 6 m east of the centre, facing north: the centre is on its left.
         w.my_pos.pose = Pose2::new(6000.0, 0.0, FRAC_PI_2);
