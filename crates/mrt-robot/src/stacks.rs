@@ -281,7 +281,13 @@ impl Brain for ChaosBrain {
 pub struct MilanBrain {
     brian: Brian,
     keeper: bool,
+    /// When the robot last saw the ball, or started (s of the snapshots' clock).
+    ball_seen_at: Option<f64>,
 }
+
+/// After this long (s) without the ball, more than one turn on the spot, a Milan robot that
+/// no teammate tells where the ball is counts it as lost (`BallLost`).
+pub const BALL_LOST_AFTER: f64 = 3.0;
 
 /// Degrees in [0, 360) of an angle in radians.
 fn deg360(a: f64) -> f64 {
@@ -291,7 +297,11 @@ fn deg360(a: f64) -> f64 {
 impl MilanBrain {
     /// The goalkeeper or a field player, on the configuration of `dir`.
     pub fn new(dir: &Path, keeper: bool) -> Result<MilanBrain, String> {
-        Ok(MilanBrain { brian: Brian::from_dir(dir).map_err(|e| e.to_string())?, keeper })
+        Ok(MilanBrain {
+            brian: Brian::from_dir(dir).map_err(|e| e.to_string())?,
+            keeper,
+            ball_seen_at: None,
+        })
     }
 
     /// The Parser: crisp inputs from the world snapshot (team frame, mm, degrees).
@@ -305,6 +315,10 @@ impl MilanBrain {
         // where every spot of the field is within a camera's reach.
         v.push(("CentreDistance", me.x.hypot(me.y), q));
         v.push(("CentreAngle", deg360((-me.y).atan2(-me.x) - me.theta), q));
+        let now = w.time.as_secs_f64();
+        let unseen = now - self.ball_seen_at.unwrap_or(now);
+        let lost = unseen >= BALL_LOST_AFTER && w.global_ball.quality < 0.3;
+        v.push(("BallLost", f64::from(u8::from(lost)), 1.0));
         // SCARE's job (MRT manual ch. 11 and §2.3: goals for the parametric behaviors). A
         // robot without one plays the ball, as the team did before SCARE.
         let job = w.job.as_ref();
@@ -400,6 +414,10 @@ impl Brain for MilanBrain {
         // The game state is the Messenger's: in READY, walk to the kickoff position.
         if let Some(c) = walk_to_kickoff(w) {
             return c;
+        }
+        let now = w.time.as_secs_f64();
+        if self.ball_seen_at.is_none() || w.lps[lps::BALL].reliability >= 0.1 {
+            self.ball_seen_at = Some(now);
         }
         let inputs = self.inputs(w);
         let out = self.brian.run(&inputs);
@@ -644,10 +662,12 @@ mod tests {
         assert!(c.vlin.is_finite());
     }
 
-    /// A field player that does not see the ball turns and walks to the centre spot, from
-    /// where a camera reaches every spot of the field; there it turns on the spot.
+    /// A field player that does not see the ball turns on the spot; once it has not seen it
+    /// for 3 s and no teammate knows where it is, it walks to the centre spot while it turns,
+    /// from where a camera reaches every spot of the field; there it turns on the spot again.
     #[test]
-    fn milan_searches_for_the_ball_on_its_way_to_the_centre() {
+    fn milan_searches_for_a_lost_ball_on_its_way_to_the_centre() {
+        use mrt_core::Time;
         use std::f64::consts::{FRAC_PI_2, PI};
         let dir = embedded_milan().unwrap();
         let mut brain = MilanBrain::new(&dir, false).unwrap();
@@ -655,16 +675,34 @@ mod tests {
         w.my_pos.quality = 0.9;
         // 6 m east of the centre, facing north: the centre is on its left.
         w.my_pos.pose = Pose2::new(6000.0, 0.0, FRAC_PI_2);
+        let at = |w: &mut WorldSnapshot, t: f64| w.time = Time::from_secs_f64(t);
+        let c = brain.cycle(&w);
+        assert!(c.vlin.hypot(c.vlat) < 50.0 && c.vrot > 100.0, "just lost: turns {c:?}");
+        at(&mut w, 3.5);
         let c = brain.cycle(&w);
         assert!(c.vlat > 500.0 && c.vlin.abs() < 100.0 && c.vrot > 100.0, "{c:?}");
         // Facing the centre: ahead, still turning.
         w.my_pos.pose = Pose2::new(6000.0, 0.0, PI);
         let c = brain.cycle(&w);
         assert!(c.vlin > 500.0 && c.vlat.abs() < 100.0 && c.vrot > 100.0, "{c:?}");
+        // A teammate knows where the ball is: no walk.
+        w.global_ball.quality = 0.8;
+        let c = brain.cycle(&w);
+        assert!(c.vlin.hypot(c.vlat) < 50.0, "{c:?}");
+        w.global_ball.quality = 0.0;
         // On the centre spot: it turns where it stands.
         w.my_pos.pose = Pose2::new(100.0, -100.0, 0.3);
         let c = brain.cycle(&w);
         assert!(c.vlin.hypot(c.vlat) < 50.0 && c.vrot > 100.0, "{c:?}");
+        // The ball seen again resets the clock.
+        w.lps[lps::BALL] = Lpo { rho: 3000.0, theta: 0.5, reliability: 0.9, seen_ago: 0.0 };
+        at(&mut w, 4.0);
+        brain.cycle(&w);
+        w.lps[lps::BALL] = Lpo::default();
+        at(&mut w, 5.0);
+        w.my_pos.pose = Pose2::new(6000.0, 0.0, PI);
+        let c = brain.cycle(&w);
+        assert!(c.vlin.hypot(c.vlat) < 50.0, "seen 1 s ago: {c:?}");
     }
 
     /// Shot selection: the open side of the opponent's goal, away from its
