@@ -31,29 +31,29 @@ fn kidnapped_robots_find_themselves_again_with_the_fuzzy_grid() {
 
 fn kidnapped_robots_find_themselves_again_with(localizer: Localizer) {
     let cfg = config(1, localizer);
-    // Seed 2. Seed 3, used until session 34, changed with Milan's shots at the open side of
-    // the goal: a Chaos defender carried in front of its own goal, facing the
-    // side line, saw few landmarks for 20.6 s, and Milan's keeper, carried 14 s before the
-    // whistle, was not found again before it (`--kidnap 1 --half 40`, seeds 1–6: 15 or 16
-    // of 16 found, slowest 0.6–2.2 s but for seed 3). Seed 1, used until session 40, changed
-    // with Chaos at a Middle Size robot's speeds: its keeper, carried into the far corner
-    // facing it 9.4 s before the whistle, was not found before it (session 40, seeds 1–6: 15
-    // or 16 of 16 found, slowest 0.8–3.1 s but for seed 6, 12.2 s).
+    // A robot carried less than the 10 s a recovery may take before the final whistle may
+    // not be found before it: such a carry is not judged.
     let r = mrt_sim::play(&cfg, 2, (Stack::Milan, Stack::Chaos), None, false, |_| {}).unwrap();
     let robots = 2 * cfg.rules.team_size;
     assert!(r.kidnaps.len() >= robots * 2 - 1, "{} kidnaps", r.kidnaps.len());
-    for k in &r.kidnaps {
+    let judged = |k: &&mrt_sim::game::Kidnap| k.at + 10.0 <= r.duration;
+    let late = r.kidnaps.iter().filter(|k| !judged(k)).count();
+    assert!(
+        r.kidnaps.len() - late >= robots,
+        "{late} of {} carries in the last 10 s",
+        r.kidnaps.len()
+    );
+    for k in r.kidnaps.iter().filter(judged) {
         let after = k.recovered_after.unwrap_or_else(|| panic!("never found again: {k:?}"));
-        // The slowest recovery over seeds 1–8 (`mrt sim --percepts oracle --kidnap 1 --half
-        // 40 --metrics`, session 34) took 8.6 s, a robot carried to where it sees few
-        // landmarks; the median stays under 0.5 s (below).
+        // A robot carried to where it sees few landmarks takes several seconds (`mrt sim
+        // --percepts oracle --kidnap 1 --half 40 --metrics`); the median stays under 2 s.
         assert!(after < 10.0, "{k:?}");
     }
     let mut book = MetricsBook::default();
     book.add(&r);
     let m = book.metrics();
     assert_eq!(m.kidnap.count as usize, r.kidnaps.len());
-    assert_eq!(m.kidnap.recovered, m.kidnap.count);
+    assert!(m.kidnap.recovered as usize + late >= r.kidnaps.len(), "{m:?}");
     assert!(m.kidnap.median_recovery_s.is_some_and(|t| t < 2.0), "{m:?}");
     // The global localizer found some of them (the EKF, matching named landmarks, the others),
     // never wrongly.
