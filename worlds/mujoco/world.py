@@ -110,7 +110,6 @@ class UpView:
         body = mj.mj_name2id(model, mj.mjtObj.mjOBJ_BODY, self.BODY)
         self.mocap = int(model.body_mocapid[body])
         model.cam_resolution[self.cam_id] = (self.width, self.height)
-        model.cam_fovy[self.cam_id] = self.camera.fovy_deg()
         model.vis.global_.offwidth = max(model.vis.global_.offwidth, self.width)
         model.vis.global_.offheight = max(model.vis.global_.offheight, self.height)
         self.renderer = mj.Renderer(model, self.height, self.width)

@@ -21,10 +21,10 @@
 //! are in the robot frame.
 
 use crate::error::{positive, PlanError};
-use crate::kinematics::{Steering, Twist};
+use crate::kinematics::{nearer_end, Steering, Twist};
 use mrt_core::{angle_diff, Point2, Pose2, Vec2};
 use serde::{Deserialize, Serialize};
-use std::f64::consts::{FRAC_PI_2, PI};
+use std::f64::consts::PI;
 
 pub use mrt_msgs::Sonar;
 
@@ -255,15 +255,7 @@ impl PositionMode {
                     Twist::ZERO
                 } else {
                     let err = angle_diff(velocity.y.atan2(velocity.x), pose.theta);
-                    // Front or back, whichever is nearer: the error folded into (−π/2, π/2].
-                    let folded = if err > FRAC_PI_2 {
-                        err - PI
-                    } else if err <= -FRAC_PI_2 {
-                        err + PI
-                    } else {
-                        err
-                    };
-                    Twist::new(speed * err.cos(), 0.0, turn(folded))
+                    Twist::new(speed * err.cos(), 0.0, turn(nearer_end(err)))
                 }
             }
         };
@@ -471,6 +463,7 @@ pub fn sonar_obstacles(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use std::f64::consts::FRAC_PI_2;
 
     fn close(a: f64, b: f64) -> bool {
         (a - b).abs() < 1e-9

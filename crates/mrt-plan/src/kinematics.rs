@@ -115,6 +115,19 @@ impl WheelSpeeds<2> {
     }
 }
 
+/// The turn that brings a differential drive's front or back, whichever is nearer, onto a
+/// direction `err` radians off its heading (`err` in [−π, π]): `err` itself within ±π/2,
+/// else folded by π into that range.
+pub fn nearer_end(err: f64) -> f64 {
+    if err > std::f64::consts::FRAC_PI_2 {
+        err - std::f64::consts::PI
+    } else if err < -std::f64::consts::FRAC_PI_2 {
+        err + std::f64::consts::PI
+    } else {
+        err
+    }
+}
+
 /// Whether a base can move sideways.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 pub enum Steering {

@@ -16,9 +16,9 @@ use mrt_core::frames::MM_PER_M;
 use mrt_core::Pose2;
 use mrt_msgs::{Displacement, RobotCommand};
 use mrt_plan::kinematics::{
-    duty_cycle, integrate, DiffDrive, Kinematics, Omni3, OmniWheels, Steering, Twist, WheelSpeeds,
+    duty_cycle, integrate, nearer_end, DiffDrive, Kinematics, Omni3, OmniWheels, Steering, Twist,
+    WheelSpeeds,
 };
-use std::f64::consts::{FRAC_PI_2, PI};
 
 /// What a motor driver refuses.
 #[derive(Debug, thiserror::Error, PartialEq)]
@@ -168,13 +168,7 @@ pub fn follow_on_differential(t: Twist) -> Twist {
         return t;
     }
     let direction = t.vy.atan2(t.vx);
-    let toward = if direction > FRAC_PI_2 {
-        direction - PI
-    } else if direction < -FRAC_PI_2 {
-        direction + PI
-    } else {
-        direction
-    };
+    let toward = nearer_end(direction);
     let share = (t.vy.abs() / STEER_SPEED).min(1.0);
     let omega = (1.0 - share) * t.omega + share * STEER_GAIN * toward;
     Twist::new(t.speed() * direction.cos(), 0.0, omega)
