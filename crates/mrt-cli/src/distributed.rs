@@ -12,6 +12,7 @@ use anyhow::{anyhow, bail, Context as _, Result};
 use mrt_core::AgoraId;
 use mrt_dcdt::config::AgoraConfig;
 use mrt_dcdt::Message;
+use mrt_monitor::{Recorder, SharedRecorder, Tap};
 use mrt_msgs::MateReport;
 use mrt_msgs::{DeviceAct, DeviceFrame};
 use mrt_net::{NetConfig, NetLink};
@@ -43,6 +44,44 @@ pub struct RobotArgs {
     /// sensors, field, guidance and devices.
     #[arg(long)]
     pub config: PathBuf,
+    /// Record every message of the robot's Agora into this MCAP file (topics
+    /// `/<prefix>/<type>`, the robot's clock), finished when the robot ends.
+    #[arg(long, value_name = "FILE.mcap")]
+    pub record: Option<PathBuf>,
+    /// With --record: the topics' prefix, e.g. `home/1` (default: the robot's name in its
+    /// devices, else `robot-<id>`). `home/k` and `away/k` are what the web monitor matches
+    /// with the truth's robots.
+    #[arg(long, value_name = "PREFIX", requires = "record")]
+    pub record_as: Option<String>,
+}
+
+impl RobotArgs {
+    /// The recorder of `--record` and its tap for the robot's Agora (`default` prefix), or
+    /// none.
+    pub(crate) fn recording(
+        &self,
+        default: &str,
+    ) -> Result<Option<(SharedRecorder, Box<dyn mrt_dcdt::Member>)>> {
+        let Some(path) = &self.record else { return Ok(None) };
+        let rec = Recorder::create(path)?.shared();
+        let prefix = self.record_as.clone().unwrap_or_else(|| default.to_string());
+        let tap: Box<dyn mrt_dcdt::Member> = Box::new(Tap::new(prefix, rec.clone()));
+        Ok(Some((rec, tap)))
+    }
+}
+
+/// Finishes the recording of `mrt robot --record`, and says what it holds.
+pub(crate) fn finish_recording(rec: Option<SharedRecorder>, path: Option<&Path>) -> Result<()> {
+    if let (Some(rec), Some(path)) = (rec, path) {
+        let s = Recorder::finish_shared(rec)?;
+        eprintln!(
+            "recorded {} messages on {} topics into {}",
+            s.messages,
+            s.channels,
+            path.display()
+        );
+    }
+    Ok(())
 }
 
 /// Picks the loopback ports of one match: free now, distinct, and outside the system's
@@ -343,11 +382,23 @@ pub(crate) struct Launch {
 
 impl Launch {
     pub(crate) fn robot(&self, i: usize, file: &Path, log: &Path) -> Result<Child> {
+        self.robot_with(i, file, log, &[])
+    }
+
+    /// [`Launch::robot`] with more of `mrt robot`'s arguments (`--record FILE`).
+    pub(crate) fn robot_with(
+        &self,
+        i: usize,
+        file: &Path,
+        log: &Path,
+        more: &[std::ffi::OsString],
+    ) -> Result<Child> {
         let log = std::fs::File::create(log)?;
         Command::new(&self.exe)
             .arg("robot")
             .arg("--config")
             .arg(file)
+            .args(more)
             .stdin(Stdio::null())
             .stdout(Stdio::null())
             .stderr(log)
@@ -411,7 +462,7 @@ pub fn robot(args: &RobotArgs) -> Result<()> {
     let started = Instant::now();
     let file = RobotFile::from_file(&args.config).map_err(|e| anyhow!("{e}"))?;
     if file.devices.kind == "world" {
-        return crate::world::robot(&args.config, &file);
+        return crate::world::robot(args, &file);
     }
     let robot_cfg = file.config().map_err(|e| anyhow!("{}: {e}", args.config.display()))?;
     let spec = file.spec().map_err(|e| anyhow!("{}: {e}", args.config.display()))?;
@@ -435,8 +486,10 @@ pub fn robot(args: &RobotArgs) -> Result<()> {
     let behaviors = file.robot.behaviors.as_ref().map(|p| here.join(p));
     let dir = behaviors_dir(&[spec.stack], behaviors.as_deref()).map_err(|e| anyhow!("{e}"))?;
     let id = spec.robot;
-    let mut robot =
-        RemoteRobot::new(&robot_cfg, spec, &dir, Some(net)).map_err(|e| anyhow!("{e}"))?;
+    let (rec, extra) = args.recording(&format!("robot-{id}"))?.unzip();
+    let extra = extra.into_iter().collect();
+    let mut robot = RemoteRobot::with_members(&robot_cfg, spec, &dir, Some(net), extra)
+        .map_err(|e| anyhow!("{e}"))?;
     let agora = robot.agora().ok_or_else(|| anyhow!("the robot has no Agora"))?;
     let link = mrt_net::connect(agora)?;
     let online = link.presence();
@@ -478,7 +531,7 @@ pub fn robot(args: &RobotArgs) -> Result<()> {
         run.late_mates,
         link.stats()
     );
-    Ok(())
+    finish_recording(rec, args.record.as_deref())
 }
 
 #[cfg(test)]

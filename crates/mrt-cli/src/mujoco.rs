@@ -5,6 +5,10 @@
 
 use crate::distributed::{Launch, PortPicker, Robots};
 use anyhow::{anyhow, bail, Context as _, Result};
+use mrt_core::{Pose2, Time};
+use mrt_monitor::catalogue::schema_of;
+use mrt_monitor::{MatchInfo, RecordProfile, RecordSummary, Recorder, Recording, Truth};
+use mrt_msgs::GameState;
 use mrt_perception::camera::OmniFile;
 use mrt_robot::config::RobotFile;
 use mrt_robot::stacks::Stack;
@@ -73,6 +77,18 @@ pub struct MujocoArgs {
     /// thrown away with the match's temporary files, shown only when the world fails).
     #[arg(long, value_name = "DIR")]
     pub logs: Option<PathBuf>,
+    /// Records the match into this MCAP file: MuJoCo's truth on `/truth` and every robot's
+    /// messages on `/home/k/<type>` and `/away/k/<type>`, as `mrt sim --record` does, for
+    /// `mrt replay FILE --serve`.
+    #[arg(long, value_name = "FILE.mcap")]
+    pub record: Option<PathBuf>,
+    /// Saves the images the world sends the robots into this directory, as PNGs (what the
+    /// robots see: `<robot>_<step>.png`, `_up` for the omnidirectional camera).
+    #[arg(long, value_name = "DIR")]
+    pub save_frames: Option<PathBuf>,
+    /// With --save-frames: every K-th step.
+    #[arg(long, value_name = "K", default_value_t = 10, requires = "save_frames")]
+    pub frame_every: u64,
 }
 
 /// The §3.3.1 file of robot `i` of a team of the robots `first..` (at least two): the team's
@@ -183,11 +199,18 @@ pub fn play(args: &MujocoArgs) -> Result<()> {
         .args(["--scenario", if args.scenario == Scenario::Match { "match" } else { "empty-goal" }])
         .stdout(Stdio::piped())
         .stderr(Stdio::inherit());
-    if let Some(t) = &args.truth {
+    // A recording needs the truth: in the user's file, or one of the match's own.
+    let truth =
+        args.truth.clone().or_else(|| args.record.as_ref().map(|_| dir.join("truth.jsonl")));
+    if let Some(t) = &truth {
         world.arg("--truth").arg(t);
     }
     if up_camera.is_some() {
         world.arg("--up-camera").arg(&args.up_camera);
+    }
+    if let Some(frames) = &args.save_frames {
+        world.arg("--save-frames").arg(frames);
+        world.args(["--frame-every", &args.frame_every.to_string()]);
     }
     if std::env::var_os("MUJOCO_GL").is_none() {
         world.env("MUJOCO_GL", "egl");
@@ -195,8 +218,15 @@ pub fn play(args: &MujocoArgs) -> Result<()> {
     let world =
         world.spawn().with_context(|| format!("cannot start {python} {}", script.display()))?;
     let launch = Launch { exe: std::env::current_exe().context("cannot find the mrt executable")? };
+    let recordings: Vec<PathBuf> =
+        (0..files.len()).map(|i| dir.join(format!("robot-{i}.mcap"))).collect();
     for (i, file) in files.iter().enumerate() {
-        let child = launch.robot(i, file, &procs.log(i))?;
+        let mut more = Vec::new();
+        if args.record.is_some() {
+            more.extend(["--record".into(), recordings[i].clone().into_os_string()]);
+            more.extend(["--record-as".into(), topic_prefix(&names[i]).into()]);
+        }
+        let child = launch.robot_with(i, file, &procs.log(i), &more)?;
         procs.children.push((i, child));
     }
     let out = world.wait_with_output().context("the world did not end")?;
@@ -214,6 +244,27 @@ pub fn play(args: &MujocoArgs) -> Result<()> {
         let tails: Vec<String> =
             (0..files.len()).map(|i| format!("robot {i}:\n{}", procs.tail(i))).collect();
         bail!("the MuJoCo world ended with {}\n{}", out.status, tails.join("\n"));
+    }
+    if let (Some(path), Some(truth)) = (&args.record, &truth) {
+        let info = MatchInfo {
+            home: home.name().into(),
+            away: (args.scenario == Scenario::Match).then(|| away.name().into()),
+            seed: args.seed,
+            team_size: per_team,
+            period: RobotFile::default()
+                .config()
+                .map_err(|e| anyhow!("{e}"))?
+                .period()
+                .as_secs_f64(),
+            profile: RecordProfile::Full,
+        };
+        let s = record_match(path, &info, truth, &recordings, &names)?;
+        eprintln!(
+            "recorded {} messages on {} topics into {}",
+            s.messages,
+            s.channels,
+            path.display()
+        );
     }
     let report = String::from_utf8_lossy(&out.stdout);
     let line = report.lines().last().unwrap_or("").trim();
@@ -251,4 +302,138 @@ fn summary(v: &serde_json::Value, teams: &[(Stack, &str)]) -> String {
         v["real_time_factor"].as_f64().unwrap_or(0.0),
         v["render_ms"].as_f64().unwrap_or(0.0),
     )
+}
+
+/// The recording's topic prefix of the robot the world names `name` (`home-1` → `home/0`):
+/// what the web monitor matches with the truth's robots.
+fn topic_prefix(name: &str) -> String {
+    match name.rsplit_once('-') {
+        Some((side, k)) => match k.parse::<usize>() {
+            Ok(k) if k > 0 => format!("{side}/{}", k - 1),
+            _ => name.to_string(),
+        },
+        None => name.to_string(),
+    }
+}
+
+/// One line of the world's truth (`world.py --truth`) as the monitor's [`Truth`]: the robots
+/// in the order of `names` (home's, then away's).
+fn truth_of(line: &str, names: &[String]) -> Result<(Time, Truth)> {
+    let v: serde_json::Value = serde_json::from_str(line)?;
+    let num = |v: &serde_json::Value| v.as_f64().unwrap_or(0.0);
+    let pair = |v: &serde_json::Value, i: usize| (num(&v[i]), num(&v[i + 1]));
+    let state = match v["state"].as_str().unwrap_or("") {
+        "ready" => GameState::Ready,
+        "set" => GameState::Set,
+        "playing" => GameState::Playing,
+        "finished" => GameState::Finished,
+        _ => GameState::Initial,
+    };
+    let robots = names
+        .iter()
+        .map(|n| {
+            let r = &v["robots"][n];
+            Pose2::new(num(&r[0]), num(&r[1]), num(&r[2]))
+        })
+        .collect();
+    let goals = |side: &str| u32::try_from(v["score"][side].as_u64().unwrap_or(0)).unwrap_or(0);
+    let truth = Truth {
+        ball: pair(&v["ball"], 0),
+        ball_velocity: pair(&v["ball"], 2),
+        robots,
+        home: names.iter().filter(|n| n.starts_with("home")).count(),
+        score: (goals("home"), goals("away")),
+        state,
+    };
+    let t = v["time"].as_f64().filter(|t| t.is_finite() && *t >= 0.0);
+    let t = t.ok_or_else(|| anyhow!("a truth line without a time: {}", v["time"]))?;
+    Ok((Time::from_secs_f64(t), truth))
+}
+
+/// Writes the match's recording into `path`: `/match`, the truth of the file `truth` on
+/// `/truth` and every robot's own recording, all in log-time order (at one instant the truth
+/// first, then the robots in order). A robot whose recording is missing or damaged is left
+/// out with a warning: the rest is still worth replaying.
+fn record_match(
+    path: &Path,
+    info: &MatchInfo,
+    truth: &Path,
+    recordings: &[PathBuf],
+    names: &[String],
+) -> Result<RecordSummary> {
+    // Topics (with their schemas) and messages, each message (time, source, topic, json).
+    let mut topics: Vec<(String, String, Vec<u8>)> = Vec::new();
+    let mut messages: Vec<(Time, usize, usize, Vec<u8>)> = Vec::new();
+    let text = std::fs::read_to_string(truth)
+        .with_context(|| format!("cannot read the world's truth {}", truth.display()))?;
+    topics.push(("/truth".into(), "Truth".into(), serde_json::to_vec(&schema_of::<Truth>())?));
+    for (i, line) in text.lines().enumerate().filter(|(_, l)| !l.trim().is_empty()) {
+        let (t, truth) =
+            truth_of(line, names).with_context(|| format!("{}:{}", truth.display(), i + 1))?;
+        messages.push((t, 0, 0, serde_json::to_vec(&truth)?));
+    }
+    for (source, file) in recordings.iter().enumerate() {
+        let recording = match Recording::open(file) {
+            Ok(r) => r,
+            Err(e) => {
+                eprintln!("warning: robot {} left out of the recording: {e}", names[source]);
+                continue;
+            }
+        };
+        let mut index = std::collections::BTreeMap::new();
+        let scanned = recording.scan(|e| {
+            let topic = *index.entry(e.topic.to_string()).or_insert_with(|| {
+                topics.push((e.topic.into(), e.schema.into(), e.schema_data.to_vec()));
+                topics.len() - 1
+            });
+            messages.push((e.time, source + 1, topic, e.json.to_vec()));
+        });
+        if let Err(e) = scanned {
+            eprintln!("warning: robot {}'s recording is damaged: {e}", names[source]);
+        }
+    }
+    messages.sort_by_key(|&(t, source, _, _)| (t, source));
+    let mut rec = Recorder::create(path)?;
+    rec.record("/match", Time::ZERO, info)?;
+    for (time, _, topic, json) in &messages {
+        let (topic, schema, schema_data) = &topics[*topic];
+        let e = mrt_monitor::replay::Entry { topic, schema, schema_data, time: *time, json };
+        rec.copy(&e)?;
+    }
+    Ok(rec.finish()?)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_worlds_robot_names_become_the_monitors_prefixes() {
+        assert_eq!(topic_prefix("home-1"), "home/0");
+        assert_eq!(topic_prefix("away-3"), "away/2");
+        // Names the world did not make this way are kept.
+        for name in ["goalie", "home-0", "home-x", "a-b-c"] {
+            assert_eq!(topic_prefix(name), name);
+        }
+    }
+
+    #[test]
+    fn a_truth_line_becomes_the_monitors_truth() {
+        let names = ["home-1".to_string(), "home-2".to_string(), "away-1".to_string()];
+        let line = r#"{"time": 12.5, "state": "playing", "score": {"home": 2, "away": 1},
+            "ball": [1.0, -2.0, 0.5, 0.25], "robots": {"away-1": [3.0, 4.0, -1.0],
+            "home-1": [-1.0, 0.5, 0.1], "home-2": [0.0, 0.0, 3.0]}}"#;
+        let (t, truth) = truth_of(line, &names).unwrap();
+        assert_eq!(t, Time::from_secs_f64(12.5));
+        assert_eq!(truth.ball, (1.0, -2.0));
+        assert_eq!(truth.ball_velocity, (0.5, 0.25));
+        assert_eq!(
+            truth.robots,
+            [Pose2::new(-1.0, 0.5, 0.1), Pose2::new(0.0, 0.0, 3.0), Pose2::new(3.0, 4.0, -1.0)]
+        );
+        assert_eq!((truth.home, truth.score, truth.state), (2, (2, 1), GameState::Playing));
+        for bad in ["", "{", r#"{"time": -1}"#, r#"{"time": "x"}"#] {
+            assert!(truth_of(bad, &names).is_err(), "{bad}");
+        }
+    }
 }

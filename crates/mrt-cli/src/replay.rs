@@ -7,7 +7,7 @@ use mrt_core::Time;
 use mrt_monitor::serve::Server;
 use mrt_monitor::MatchInfo;
 use mrt_monitor::{Recording, Timeline};
-use mrt_msgs::{RobotCommand, WorldSnapshot};
+use mrt_msgs::{MateReport, RobotCommand, WorldSnapshot};
 use mrt_robot::files::FilesDir;
 use mrt_robot::stacks::{embedded_teamchaos, Stack};
 use std::collections::BTreeMap;
@@ -112,8 +112,9 @@ const SHOWN: usize = 20;
 fn rerun(args: &ReplayArgs, recording: &Recording, robot: &str) -> Result<()> {
     let file = args.file.display();
     // One pass over the file for the three topics this needs.
-    let [snapshots, commands] = ["WorldSnapshot", "RobotCommand"].map(|t| format!("/{robot}/{t}"));
-    let mut raw = recording.raw(&["/match", &snapshots, &commands])?;
+    let [snapshots, commands, reports] =
+        ["WorldSnapshot", "RobotCommand", "MateReport"].map(|t| format!("/{robot}/{t}"));
+    let mut raw = recording.raw(&["/match", &snapshots, &commands, &reports])?;
     let mut take = |topic: &str| raw.remove(topic).unwrap_or_default();
     let info = recording
         .decode::<MatchInfo>("/match", take("/match"))?
@@ -161,11 +162,15 @@ fn rerun(args: &ReplayArgs, recording: &Recording, robot: &str) -> Result<()> {
         (None, Stack::Chaos) => Some(embedded_teamchaos().map_err(|e| anyhow!("{e}"))?),
         (None, _) => None,
     };
+    // The robot's own reports say whether it kept goal (the empty goal's one robot is a field
+    // player); without them robot 0 of a team does.
+    let reports = recording.decode::<MateReport>(&reports, take(&reports))?;
+    let keeper = reports.first().map_or(k == 0, |(_, r)| r.keeper);
     let times: Vec<Time> = snapshots.iter().map(|(t, _)| *t).collect();
     let worlds = snapshots.into_iter().map(|(_, w)| w).collect();
     let period = Duration::from_secs_f64(info.period);
     let report =
-        mrt_robot::rerun::rerun(stack, k == 0, files.as_ref().map(FilesDir::path), period, worlds)
+        mrt_robot::rerun::rerun(stack, keeper, files.as_ref().map(FilesDir::path), period, worlds)
             .map_err(|e| anyhow!("{robot}: {e}"))?;
     let rerun = &report.cycles;
     let mut differing = Vec::new();
@@ -180,10 +185,10 @@ fn rerun(args: &ReplayArgs, recording: &Recording, robot: &str) -> Result<()> {
     let behaviors = args.behaviors.as_ref().map_or("the compiled-in behaviors".into(), |d| {
         format!("the behaviors of {}", d.display())
     });
-    let role = if k == 0 { "goalkeeper" } else { "field player" };
+    let role = if keeper { "goalkeeper" } else { "field player" };
     if args.json {
         let v = serde_json::json!({
-            "robot": robot, "stack": stack.name(), "keeper": k == 0, "cycles": rerun.len(),
+            "robot": robot, "stack": stack.name(), "keeper": keeper, "cycles": rerun.len(),
             "differing": differing.len(),
             "differences": differing.iter().map(|(t, f)| serde_json::json!({"t": t, "fields": f})).collect::<Vec<_>>(),
             "errors": errors.iter().map(|(t, e)| serde_json::json!({"t": t, "error": e})).collect::<Vec<_>>(),

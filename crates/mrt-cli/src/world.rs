@@ -1,6 +1,7 @@
 //! `mrt robot --config FILE` with `[devices] kind = "world"`: the robot program on the
 //! devices of a world that speaks the device protocol over zenoh (docs/devices.md).
 
+use crate::distributed::RobotArgs;
 use anyhow::{anyhow, Context as _, Result};
 use mrt_core::AgoraId;
 use mrt_dcdt::config::AgoraConfig;
@@ -33,7 +34,8 @@ impl WorldPort for Port {
 
 /// Runs the robot of `file` (read from `path`) on its world until the world's end. A world's
 /// camera sends images: the vision µAgent runs whatever `[vision] enabled` says.
-pub fn robot(path: &Path, file: &RobotFile) -> Result<()> {
+pub fn robot(args: &RobotArgs, file: &RobotFile) -> Result<()> {
+    let path = args.config.as_path();
     let here = path.parent().unwrap_or(Path::new("."));
     let at = |e: String| anyhow!("{}: {e}", path.display());
     let mut file = file.clone();
@@ -51,7 +53,10 @@ pub fn robot(path: &Path, file: &RobotFile) -> Result<()> {
         .transpose()?;
     let behaviors = file.robot.behaviors.as_ref().map(|p| here.join(p));
     let dir = behaviors_dir(&[spec.stack], behaviors.as_deref()).map_err(|e| anyhow!("{e}"))?;
-    let mut remote = RemoteRobot::new(&cfg, spec, &dir, net.clone()).map_err(|e| anyhow!("{e}"))?;
+    let (rec, extra) = args.recording(&name)?.unzip();
+    let extra = extra.into_iter().collect();
+    let mut remote = RemoteRobot::with_members(&cfg, spec, &dir, net.clone(), extra)
+        .map_err(|e| anyhow!("{e}"))?;
     // The team's network, when there is one; without it no teammate is waited for.
     let _team = match (&net, remote.agora()) {
         (Some(_), Some(agora)) => {
@@ -105,5 +110,5 @@ pub fn robot(path: &Path, file: &RobotFile) -> Result<()> {
     for f in &run.bye.faults {
         eprintln!("robot {name}: {} ×{}: {}", f.name, f.count, f.error.escape_debug());
     }
-    Ok(())
+    crate::distributed::finish_recording(rec, args.record.as_deref())
 }

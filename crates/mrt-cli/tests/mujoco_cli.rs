@@ -128,7 +128,8 @@ fn the_vision_finds_the_ball_in_fresh_mujoco_frames_under_four_lights() {
 }
 
 /// `mrt world mujoco`: the world and a robot process on its devices play a few seconds of the
-/// empty-goal scenario; every step is answered and the robot says goodbye.
+/// empty-goal scenario; every step is answered and the robot says goodbye. The recording
+/// holds the world's truth and the robot's messages, on the topics the web monitor reads.
 #[test]
 fn a_robot_process_plays_a_few_seconds_in_the_mujoco_world() {
     if let Some(why) = unavailable() {
@@ -140,8 +141,11 @@ fn a_robot_process_plays_a_few_seconds_in_the_mujoco_world() {
         eprintln!("skipped: a robot in the MuJoCo world, no zenoh for Python here");
         return;
     }
+    let record = std::env::temp_dir().join(format!("mrt-mujoco-{}.mcap", std::process::id()));
     let out = Command::new(env!("CARGO_BIN_EXE_mrt"))
         .args(["world", "mujoco", "--scenario", "empty-goal", "--seed", "5", "--steps", "40"])
+        .arg("--record")
+        .arg(&record)
         .arg("--python")
         .arg(python())
         .current_dir(repo())
@@ -158,4 +162,16 @@ fn a_robot_process_plays_a_few_seconds_in_the_mujoco_world() {
     assert_eq!(report["answered"]["home-1"].as_u64(), Some(steps), "{report}");
     assert_eq!(report["missing"]["home-1"].as_u64(), Some(0), "{report}");
     assert_eq!(report["byes"]["home-1"], true, "{report}");
+    let listing = Command::new(env!("CARGO_BIN_EXE_mrt")).arg("replay").arg(&record).output();
+    std::fs::remove_file(&record).ok();
+    let listing = String::from_utf8_lossy(&listing.unwrap().stdout).into_owned();
+    let count = |topic: &str| {
+        let line = listing.lines().find(|l| l.split_whitespace().next() == Some(topic));
+        let words: Vec<&str> = line.map(|l| l.split_whitespace().collect()).unwrap_or_default();
+        words.get(2).and_then(|n| n.parse::<u64>().ok()).unwrap_or(0)
+    };
+    assert_eq!(count("/match"), 1, "{listing}");
+    for topic in ["/truth", "/home/0/WorldSnapshot", "/home/0/Localization"] {
+        assert!(count(topic) >= 40, "{topic}: {listing}");
+    }
 }

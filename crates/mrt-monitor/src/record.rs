@@ -304,6 +304,18 @@ impl Recorder {
         Ok(())
     }
 
+    /// Writes a message read from another recording ([`Recording::scan`](crate::Recording::scan))
+    /// on its topic, with its schema and log time, when the profile keeps it: a recording
+    /// merged from several (each robot's own in `mrt world mujoco --record`).
+    pub fn copy(&mut self, e: &crate::replay::Entry<'_>) -> Result<(), RecordError> {
+        let schema = || serde_json::from_slice(e.schema_data).unwrap_or(serde_json::Value::Null);
+        let channel = self.channel(e.topic, e.schema, schema)?;
+        if self.due(channel, e.time) {
+            self.write(channel, e.time, e.json)?;
+        }
+        Ok(())
+    }
+
     /// Writes `value` as JSON on `topic` at `time`, its channel's schema `T`'s, when the
     /// profile keeps it ([`Recorder::due`]).
     pub fn record<T: Serialize + JsonSchema>(
@@ -435,6 +447,31 @@ mod tests {
         assert!(back.iter().all(|m| m.2 == "jsonschema" && m.3 == "json"));
         let decoded: GameInfo = serde_json::from_str(&back[0].5).unwrap();
         assert_eq!(decoded, game);
+    }
+
+    /// Messages copied from one recording into another keep their topics, schemas (name
+    /// and text), times and bytes.
+    #[test]
+    fn a_copied_message_keeps_its_topic_schema_time_and_bytes() {
+        let (from, to) = (temp("copy-from"), temp("copy-to"));
+        let mut rec = Recorder::create(&from).unwrap();
+        let game = GameInfo { attack: -1.0, ..Default::default() };
+        rec.record("/away/1/GameInfo", Time(700), &game).unwrap();
+        rec.record("/away/1/Localization", Time(800), &Localization::default()).unwrap();
+        rec.finish().unwrap();
+        let mut copy = Recorder::create(&to).unwrap();
+        crate::Recording::open(&from).unwrap().scan(|e| copy.copy(&e).unwrap()).unwrap();
+        assert_eq!(copy.finish().unwrap().messages, 2);
+        let (a, b) = (read_back(&from), read_back(&to));
+        let schema = |p: &Path| {
+            let bytes = std::fs::read(p).unwrap();
+            let s = mcap::MessageStream::new(&bytes).unwrap().next().unwrap().unwrap();
+            s.channel.schema.as_ref().unwrap().data.to_vec()
+        };
+        assert_eq!(schema(&from), schema(&to));
+        std::fs::remove_file(&from).ok();
+        std::fs::remove_file(&to).ok();
+        assert_eq!(a, b);
     }
 
     /// A compact recording keeps a `Localization` topic at 2 Hz of the simulated clock (the

@@ -73,6 +73,8 @@ pub struct Entry<'a> {
     pub topic: &'a str,
     /// Its schema's name, e.g. `WorldSnapshot`.
     pub schema: &'a str,
+    /// Its schema's text (a JSON Schema in MRT's recordings; empty when the channel has none).
+    pub schema_data: &'a [u8],
     /// Its log time.
     pub time: Time,
     /// The message, JSON.
@@ -83,7 +85,7 @@ pub struct Entry<'a> {
 /// schema, encoding) by id, the topics so far, and the messages read.
 #[derive(Default)]
 struct Scan {
-    schemas: BTreeMap<u16, (String, String)>,
+    schemas: BTreeMap<u16, (String, String, Vec<u8>)>,
     channels: BTreeMap<u16, (String, u16, String)>,
     topics: BTreeMap<String, TopicInfo>,
     index: u64,
@@ -120,10 +122,15 @@ impl<'a> Fields<'a> {
         Some(u64::from_le_bytes(self.take(8)?.try_into().ok()?))
     }
 
+    /// Bytes prefixed by their length (u32).
+    fn bytes(&mut self) -> Option<&'a [u8]> {
+        let n = usize::try_from(self.u32()?).ok()?;
+        self.take(n)
+    }
+
     /// A string prefixed by its length in bytes (u32); not UTF-8 is malformed.
     fn string(&mut self) -> Option<String> {
-        let n = usize::try_from(self.u32()?).ok()?;
-        std::str::from_utf8(self.take(n)?).ok().map(str::to_string)
+        std::str::from_utf8(self.bytes()?).ok().map(str::to_string)
     }
 }
 
@@ -249,9 +256,10 @@ impl Recording {
         let cut = |what: &str| self.corrupt(scan.index, &format!("a {what} record is cut short"));
         match opcode {
             OP_SCHEMA => {
-                let (id, name, encoding) = (|| Some((r.u16()?, r.string()?, r.string()?)))()
-                    .ok_or_else(|| cut("schema"))?;
-                scan.schemas.insert(id, (name, encoding));
+                let (id, name, encoding, text) =
+                    (|| Some((r.u16()?, r.string()?, r.string()?, r.bytes()?)))()
+                        .ok_or_else(|| cut("schema"))?;
+                scan.schemas.insert(id, (name, encoding, text.to_vec()));
             }
             OP_CHANNEL => {
                 let (id, schema, topic, encoding) =
@@ -271,8 +279,10 @@ impl Recording {
                 };
                 scan.index += 1;
                 let time = Time(log_time);
-                let (schema, schema_encoding) =
-                    scan.schemas.get(schema_id).map_or(("", ""), |(n, e)| (n.as_str(), e.as_str()));
+                let (schema, schema_encoding, schema_data) = scan
+                    .schemas
+                    .get(schema_id)
+                    .map_or(("", "", &[][..]), |(n, e, d)| (n.as_str(), e.as_str(), d.as_slice()));
                 let info = scan.topics.entry(topic.clone()).or_insert_with(|| TopicInfo {
                     topic: topic.clone(),
                     schema: schema.to_string(),
@@ -286,7 +296,7 @@ impl Recording {
                 info.first = info.first.min(time);
                 info.last = info.last.max(time);
                 if info.readable() {
-                    f(Entry { topic, schema, time, json: data });
+                    f(Entry { topic, schema, schema_data, time, json: data });
                 }
             }
             _ => {}

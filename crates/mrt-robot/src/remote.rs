@@ -14,7 +14,10 @@ use crate::devices::{Actuation, LinkedDevices, Loaded};
 use crate::members::{add_robot, member_faults, RobotSpec};
 use mrt_core::{SimClock, Time};
 use mrt_dcdt::config::AgoraConfig;
-use mrt_dcdt::{Agora, DeliveryWarranty, Endpoint, InnerLinkManager, RequestType, SteppedExecutor};
+use mrt_dcdt::{
+    Activation, Agora, DeliveryWarranty, Endpoint, InnerLinkManager, Member, RequestType,
+    SteppedExecutor,
+};
 use mrt_msgs::{DeviceAct, DeviceFrame, FinalWhistle, MateReport, MemberFault, RobotEnd};
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -79,6 +82,18 @@ impl RemoteRobot {
         behaviors: &Path,
         net: Option<AgoraConfig>,
     ) -> Result<RemoteRobot, String> {
+        RemoteRobot::with_members(cfg, spec, behaviors, net, Vec::new())
+    }
+
+    /// [`RemoteRobot::new`] with `extra` Members on the robot's Agora beside its own, each
+    /// run when a message reaches it (a recorder's tap, a probe).
+    pub fn with_members(
+        cfg: &RobotConfig,
+        spec: RobotSpec,
+        behaviors: &Path,
+        net: Option<AgoraConfig>,
+        extra: Vec<Box<dyn Member>>,
+    ) -> Result<RemoteRobot, String> {
         let period = cfg.period();
         let mut exec = SteppedExecutor::new(SimClock::new(), period);
         let community = InnerLinkManager::new();
@@ -89,6 +104,10 @@ impl RemoteRobot {
         let mut agora = builder.build().map_err(|e| e.to_string())?;
         let devices = Arc::new(Mutex::new(LinkedDevices::default()));
         add_robot(&mut agora, cfg, &spec, behaviors, devices.clone())?;
+        for member in extra {
+            let id = agora.add_boxed_member(member, Activation::OnMessage);
+            agora.activate_member(id).map_err(|e| e.to_string())?;
+        }
         let outbox = agora.endpoint();
         exec.add_agora(agora).map_err(|e| e.to_string())?;
         let runner_id = 1000 + spec.agora_id()?;
