@@ -151,6 +151,12 @@ pub const STEER_GAIN: f64 = 3.0;
 /// the turn with the behavior's own turn rate in proportion.
 pub const STEER_SPEED: f64 = 0.3;
 
+/// How near (rad) to square with the heading a request's direction is a tie between the
+/// base's front and back: the base then takes the end its behavior's own turn agrees with,
+/// so that the two turns add up instead of cancelling (a search that spins while it drifts
+/// sideways would otherwise stand still).
+pub const STEER_TIE: f64 = 0.35;
+
 /// A holonomic request (robot frame, m/s and rad/s) as a differential drive can follow it.
 /// With no sideways part it is returned as it is (forward, backward, turning). Otherwise the
 /// base drives the request's part along its heading, `speed · cos(direction)`, and turns
@@ -159,7 +165,8 @@ pub const STEER_SPEED: f64 = 0.3;
 /// behavior's own turn rate, which on a holonomic base would turn it while it slides (to
 /// face the ball on its way behind it), gives way to the steering as the sideways part grows
 /// to [`STEER_SPEED`]: a differential base must face where it goes, and turns to the ball
-/// once it is there and the request is small. The result has `vy = 0`.
+/// once it is there and the request is small. Within [`STEER_TIE`] of square, the end is the
+/// one the behavior's turn agrees with. The result has `vy = 0`.
 pub fn follow_on_differential(t: Twist) -> Twist {
     if !t.is_finite() {
         return Twist::ZERO;
@@ -168,7 +175,12 @@ pub fn follow_on_differential(t: Twist) -> Twist {
         return t;
     }
     let direction = t.vy.atan2(t.vx);
-    let toward = nearer_end(direction);
+    let mut toward = nearer_end(direction);
+    let square = (direction.abs() - std::f64::consts::FRAC_PI_2).abs() < STEER_TIE;
+    if square && t.omega != 0.0 && toward.signum() != t.omega.signum() {
+        // The other end: as far to turn within the tie, and the same way as the behavior.
+        toward -= std::f64::consts::PI.copysign(toward);
+    }
     let share = (t.vy.abs() / STEER_SPEED).min(1.0);
     let omega = (1.0 - share) * t.omega + share * STEER_GAIN * toward;
     Twist::new(t.speed() * direction.cos(), 0.0, omega)
@@ -207,6 +219,30 @@ mod tests {
         let slow = follow_on_differential(Twist::new(0.05, 0.01, -1.0));
         assert!(slow.omega < 0.0 && slow.omega > -1.0, "{slow:?}");
         assert_eq!(follow_on_differential(Twist::new(f64::NAN, 1.0, 0.0)), Twist::ZERO);
+    }
+
+    #[test]
+    fn a_spin_and_a_sideways_drift_never_cancel_on_a_differential_base() {
+        // A search turning at π rad/s while it drifts sideways (0.12 m/s, either side, a
+        // little ahead or behind): the base turns the behavior's way, at least as fast as
+        // the behavior's share of the turn.
+        for omega in [std::f64::consts::PI, -std::f64::consts::PI] {
+            for vy in [0.12, -0.12, 0.3, -0.3] {
+                for vx in [-0.03, -0.001, 0.0, 0.001, 0.03] {
+                    let d = follow_on_differential(Twist::new(vx, vy, omega));
+                    let share = (vy.abs() / STEER_SPEED).min(1.0);
+                    assert!(
+                        d.omega.signum() == omega.signum()
+                            && d.omega.abs() >= (1.0 - share) * omega.abs() - 1e-9,
+                        "{vx} {vy} {omega}: {d:?}"
+                    );
+                }
+            }
+        }
+        // Away from square the nearer end still wins whatever the behavior's turn: backing
+        // up, steered clockwise below the behavior's share of its counter-clockwise turn.
+        let d = follow_on_differential(Twist::new(-0.5, 0.1, 1.0));
+        assert!(d.vx < -0.4 && d.omega < 1.0 - 0.1 / STEER_SPEED, "{d:?}");
     }
 
     #[test]
