@@ -1,9 +1,11 @@
 //! `mrt replay FILE.mcap`: what a recording holds; (`--serve`) the recording in the web
 //! monitor; (`--robot R [--behaviors DIR]`) one robot's behaviors re-run on the world
-//! snapshots it had, and where their commands differ from the recorded ones (docs/monitor.md).
+//! snapshots it had, and where their commands differ from the recorded ones; (`--accuracy`)
+//! how far each robot's beliefs were from the recorded truth (docs/monitor.md).
 
 use anyhow::{anyhow, bail, Context as _, Result};
 use mrt_core::Time;
+use mrt_monitor::accuracy::Spread;
 use mrt_monitor::serve::Server;
 use mrt_monitor::MatchInfo;
 use mrt_monitor::{Recording, Timeline};
@@ -38,6 +40,11 @@ pub struct ReplayArgs {
     /// ones.
     #[arg(long, value_name = "DIR", requires = "robot")]
     pub behaviors: Option<PathBuf>,
+    /// How far each robot's beliefs were from the recorded truth: position and heading at
+    /// every Localization, the ball (and its velocity) while the robot saw it; mean, median
+    /// and 95th percentile, per robot and for all (`--json` for a machine).
+    #[arg(long, conflicts_with = "robot")]
+    pub accuracy: bool,
 }
 
 /// Runs `mrt replay`: lists the recording's topics with their schemas, message counts and
@@ -57,6 +64,9 @@ pub fn run(args: &ReplayArgs) -> Result<()> {
     }
     if let Some(robot) = &args.robot {
         return rerun(args, &recording, robot);
+    }
+    if args.accuracy {
+        return accuracy(args, &recording);
     }
     let topics = recording.topics()?;
     let secs = |t: mrt_core::Time| t.as_secs_f64();
@@ -100,6 +110,40 @@ pub fn run(args: &ReplayArgs) -> Result<()> {
             t.count,
             secs(t.first),
             secs(t.last)
+        );
+    }
+    Ok(())
+}
+
+/// `--accuracy`: each robot's beliefs against the recorded truth.
+fn accuracy(args: &ReplayArgs, recording: &Recording) -> Result<()> {
+    let list = mrt_monitor::accuracy::accuracy(recording)?;
+    if list.is_empty() {
+        bail!(
+            "{}: no robot's Localization with a /truth of its instant (record a match with \
+             mrt sim --record or mrt world mujoco --record)",
+            args.file.display()
+        );
+    }
+    if args.json {
+        outln!("{}", serde_json::to_string_pretty(&list)?);
+        return Ok(());
+    }
+    let show = |s: Option<Spread>, scale: f64, unit: &str| {
+        s.map_or("-".to_string(), |s| {
+            format!("{:.2} / {:.2} / {:.2} {unit}", s.mean * scale, s.median * scale, s.p95 * scale)
+        })
+    };
+    outln!("{}: beliefs against the truth, mean / median / p95", args.file.display());
+    for a in &list {
+        outln!(
+            "  {:<8} position {}  heading {}  ball while seen {} ({} cycles)  ball velocity {}",
+            a.robot,
+            show(a.position, 1.0, "m"),
+            show(a.heading, 180.0 / std::f64::consts::PI, "°"),
+            show(a.ball, 1.0, "m"),
+            a.ball.map_or(0, |b| b.count),
+            show(a.ball_velocity, 1.0, "m/s"),
         );
     }
     Ok(())

@@ -225,6 +225,42 @@ fn replay(args: &[&std::ffi::OsStr]) -> (bool, String, String) {
     (out.status.success(), text(&out.stdout), text(&out.stderr))
 }
 
+/// `mrt replay --accuracy` measures the recorded beliefs against the recorded truth as the
+/// simulator's own report does: the same figures for the whole match, one row per robot.
+#[test]
+fn replay_accuracy_gives_the_match_reports_figures() {
+    let (file, report) = record("accuracy", &["--half", "10"]);
+    let (ok, out, err) = replay(&[file.as_os_str(), "--accuracy".as_ref(), "--json".as_ref()]);
+    std::fs::remove_file(&file).ok();
+    assert!(ok, "{err}");
+    let v: Value = serde_json::from_str(&out).unwrap();
+    let rows = v.as_array().unwrap();
+    let names: Vec<&str> = rows.iter().filter_map(|r| r["robot"].as_str()).collect();
+    assert_eq!(names.len(), 9, "{names:?}");
+    assert_eq!(names.last(), Some(&"all"));
+    let all = &rows[8];
+    // The report's line, e.g. "position 0.01 m median, 0.07 m p95; heading 0.3° median, 1.7° p95".
+    let numbers = |line: &str| -> Vec<f64> {
+        line.replace("p95", "")
+            .split(|c: char| !(c.is_ascii_digit() || c == '.'))
+            .filter_map(|w| w.parse().ok())
+            .collect()
+    };
+    let line = report.lines().find(|l| l.contains("localization error")).unwrap();
+    let n = numbers(line.split_once("position").unwrap().1);
+    let deg = 180.0 / std::f64::consts::PI;
+    let close = |got: f64, printed: f64, half: f64| (got - printed).abs() <= half + 1e-9;
+    assert!(close(all["position"]["median"].as_f64().unwrap(), n[0], 0.005), "{line}\n{all}");
+    assert!(close(all["position"]["p95"].as_f64().unwrap(), n[1], 0.005), "{line}\n{all}");
+    assert!(close(all["heading"]["median"].as_f64().unwrap() * deg, n[2], 0.05), "{line}\n{all}");
+    assert!(close(all["heading"]["p95"].as_f64().unwrap() * deg, n[3], 0.05), "{line}\n{all}");
+    let line = report.lines().find(|l| l.contains("ball error while seen")).unwrap();
+    let n = numbers(line.split_once("seen:").unwrap().1);
+    assert!(close(all["ball"]["mean"].as_f64().unwrap(), n[0], 0.005), "{line}\n{all}");
+    assert!(close(all["ball"]["p95"].as_f64().unwrap(), n[1], 0.005), "{line}\n{all}");
+    assert!(close(all["ball_velocity"]["mean"].as_f64().unwrap(), n[2], 0.005), "{line}\n{all}");
+}
+
 /// A robot's behaviors re-run on the world snapshots it had give back
 /// exactly the recorded commands (Milan's Mr. BRIAN, Chaos' HFSM player and HBM keeper); an
 /// edited behavior shows where its commands differ; a behavior that does not load is reported

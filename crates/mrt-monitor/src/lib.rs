@@ -22,6 +22,8 @@
 //!   chosen rate ([`Recorder::with_images`]).
 //! - [`view`]: a [`Timeline`] of frames, each the simulator's truth and every robot's beliefs
 //!   in the field frame, from a recording or live from a recorder's listener.
+//! - [`accuracy`]: how far each robot's beliefs were from the truth in a recording that
+//!   holds both, the same method for every world (`mrt replay FILE --accuracy`).
 //! - `serve` (feature `serve`): the web monitor that draws a timeline in a browser
 //!   (`mrt sim --serve`, `mrt replay FILE --serve`).
 //!
@@ -40,6 +42,7 @@
 //! ```
 #![deny(missing_docs)]
 
+pub mod accuracy;
 pub mod camera;
 pub mod catalogue;
 pub mod foxglove;

@@ -508,7 +508,7 @@ fn parse<T: serde::de::DeserializeOwned>(json: &[u8]) -> Option<T> {
 }
 
 /// `home/k` is the truth's robot `k`, `away/k` its robot `home + k`.
-fn truth_index(name: &str, truth: Option<&Truth>) -> Option<usize> {
+pub(crate) fn truth_index(name: &str, truth: Option<&Truth>) -> Option<usize> {
     let truth = truth?;
     let (team, k) = name.rsplit_once('/')?;
     let k: usize = k.parse().ok()?;
