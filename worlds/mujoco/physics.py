@@ -19,7 +19,8 @@ loaded, in its MjSpec (field.xml is not changed):
 
 Robots not in play are deleted from the spec. Units: SI; the field frame of make_scene.py.
 
-Sensors are computed from the body's ACTUAL motion over a step (not from the set-points):
+Sensors are computed from the body's ACTUAL motion over a step (not from the set-points),
+with the errors of :class:`SensorErrors` when a match asks for them:
 the encoders by the differential drive's inverse kinematics of the displacement (a robot
 stuck at a wall reports (nearly) no turn of its wheels; a sideways shove is invisible to
 them), the two mice by the arc model of docs/devices.md (crates/mrt-perception/src/mice.rs,
@@ -430,13 +431,40 @@ class Physics:
 
 
 @dataclass
+class SensorErrors:
+    """What the mice and encoders get wrong, as in MRT's simulator (configs/sim/default.toml,
+    [odometry]; MRT manual §4.2): with probability `mice_miss` a mouse under-reads, 50-100 % of
+    its motion, then each of its axes is off by `mice_noise` times the motion's length
+    (Gaussian); each wheel's count is off by `wheel_noise` of itself (Gaussian)."""
+
+    mice_noise: float = 0.005
+    mice_miss: float = 0.02
+    wheel_noise: float = 0.05
+
+
+@dataclass
 class Odometer:
-    """A robot's encoders and mice between two steps: the pose at the previous reading."""
+    """A robot's encoders and mice between two steps: the pose at the previous reading, and
+    the sensors' errors (None: exact readings) drawn from `rng` (a numpy Generator)."""
 
     start: tuple[float, float, float]
+    errors: SensorErrors | None = None
+    rng: object = None
 
     def read(self, now: tuple[float, float, float]):
         """(mice, wheel turns) since the previous reading; then counts from `now`."""
         d = relative(self.start, now)
         self.start = now
-        return mice_readings(*d), wheel_turns(*d)
+        mice, turns = mice_readings(*d), wheel_turns(*d)
+        e, rng = self.errors, self.rng
+        if e is None or rng is None:
+            return mice, turns
+        out = []
+        for x, y in ((mice[0], mice[1]), (mice[2], mice[3])):
+            length = math.hypot(x, y)
+            if rng.random() < e.mice_miss:
+                read = rng.uniform(0.5, 1.0)
+                x, y = x * read, y * read
+            spread = e.mice_noise * length
+            out += [x + spread * rng.normal(), y + spread * rng.normal()]
+        return tuple(out), [t * (1.0 + e.wheel_noise * rng.normal()) for t in turns]

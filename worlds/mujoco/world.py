@@ -132,7 +132,8 @@ class Match:
     def __init__(self, scene, camera_file, home: int, away: int, scenario: str = "match",
                  half: float = 300.0, seed: int = 0, image: str = "jpeg",
                  render: bool = True, placed: bool = True, shadows: bool = True,
-                 samples: int | None = None, up_camera=None) -> None:
+                 samples: int | None = None, up_camera=None,
+                 exact_odometry: bool = False) -> None:
         if scenario not in ("match", "empty-goal"):
             raise ValueError(f"scenario must be match or empty-goal, not {scenario!r}")
         if scenario == "empty-goal":
@@ -174,7 +175,11 @@ class Match:
         for name, p in start.items():
             self.physics.place_robot(name, p)
         self.physics.place_ball(*ball)
-        self.odometers = {n: physics.Odometer(self.physics.pose(n)) for n in self.names}
+        # The sensors' errors, from a generator of their own: the same seed places the same
+        # robots and ball whether the odometry is exact or not.
+        self.sensor_errors = None if exact_odometry else physics.SensorErrors()
+        self.sensor_rng = np.random.default_rng([seed, 1])
+        self.odometers = {n: self._odometer(n) for n in self.names}
         # A robot put down by hand (at the start, or by the referee) is told where.
         self.placed = {n: p for n, p in start.items()} if placed else {}
         self.time = 0.0
@@ -234,6 +239,10 @@ class Match:
             for g in geoms:
                 groups[g] = 0
 
+    def _odometer(self, name: str) -> physics.Odometer:
+        """Robot `name`'s encoders and mice, counting from where it stands now."""
+        return physics.Odometer(self.physics.pose(name), self.sensor_errors, self.sensor_rng)
+
     def sense(self, name: str) -> dict:
         """Robot `name`'s readings now (and its odometry since the previous call)."""
         ph = self.physics
@@ -281,7 +290,7 @@ class Match:
             ph.place_ball(*d.ball)
         for name, p in d.robots.items():
             ph.place_robot(name, p)
-            self.odometers[name] = physics.Odometer(ph.pose(name))
+            self.odometers[name] = self._odometer(name)
             if self.tell_placed:
                 self.placed[name] = p
         return d.calls
@@ -312,7 +321,8 @@ def play(args) -> dict:
     m = Match(rf.find(args.scene, HERE), rf.find(args.camera, REPO), args.home, args.away,
               args.scenario, args.half, args.seed, args.image, placed=not args.no_placed,
               shadows=not args.no_shadows, samples=args.samples,
-              up_camera=rf.find(args.up_camera, REPO) if args.up_camera else None)
+              up_camera=rf.find(args.up_camera, REPO) if args.up_camera else None,
+              exact_odometry=args.exact_odometry)
     truth = open(args.truth, "w") if args.truth else None
     acts_log = open(args.acts, "w") if args.acts else None
     answered = dict.fromkeys(m.names, 0)
@@ -446,6 +456,9 @@ def parser() -> argparse.ArgumentParser:
                    help="the camera images' encoding (jpeg: quality 90)")
     p.add_argument("--no-placed", action="store_true",
                    help="never tell a robot where it was put down (it must find itself)")
+    p.add_argument("--exact-odometry", action="store_true",
+                   help="mice and encoders without the errors of MRT's simulator (noise, "
+                        "under-reading mice)")
     p.add_argument("--no-shadows", action="store_true",
                    help="draw no shadows (renders several times faster)")
     p.add_argument("--samples", type=int, metavar="N",

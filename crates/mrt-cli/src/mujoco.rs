@@ -86,6 +86,14 @@ pub struct MujocoArgs {
     /// robots see: `<robot>_<step>.png`, `_up` for the omnidirectional camera).
     #[arg(long, value_name = "DIR")]
     pub save_frames: Option<PathBuf>,
+    /// Mice and encoders without the errors MRT's simulator gives them (by default the
+    /// world adds the same noise and under-reading mice as `configs/sim/default.toml`).
+    #[arg(long)]
+    pub exact_odometry: bool,
+    /// Never tell a robot where it was put down (at the start, after a goal): it must find
+    /// itself from what it sees (MUREA, MRT manual ch. 7).
+    #[arg(long)]
+    pub unplaced: bool,
     /// With --save-frames: every K-th step.
     #[arg(long, value_name = "K", default_value_t = 10, requires = "save_frames")]
     pub frame_every: u64,
@@ -207,6 +215,12 @@ pub fn play(args: &MujocoArgs) -> Result<()> {
     }
     if up_camera.is_some() {
         world.arg("--up-camera").arg(&args.up_camera);
+    }
+    if args.exact_odometry {
+        world.arg("--exact-odometry");
+    }
+    if args.unplaced {
+        world.arg("--no-placed");
     }
     if let Some(frames) = &args.save_frames {
         world.arg("--save-frames").arg(frames);

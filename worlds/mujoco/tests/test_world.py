@@ -132,6 +132,45 @@ class KinematicsTest(unittest.TestCase):
 
 
 @needs_mujoco
+class SensorErrorsTest(unittest.TestCase):
+    """The mice and encoders err as MRT's simulator's do (configs/sim/default.toml)."""
+
+    def readings(self, errors, seed=7, n=4000):
+        import numpy as np
+
+        odo = ph.Odometer((0.0, 0.0, 0.0), errors, np.random.default_rng(seed))
+        out, x = [], 0.0
+        for _ in range(n):  # 0.1 m straight ahead each reading
+            x += 0.1
+            out.append(odo.read((x, 0.0, 0.0)))
+        return out
+
+    def test_without_errors_the_readings_are_exact(self):
+        exact = list(ph.mice_readings(0.1, 0.0, 0.0)) + ph.wheel_turns(0.1, 0.0, 0.0)
+        for mice, turns in self.readings(None, n=10):
+            for got, want in zip(list(mice) + turns, exact):
+                self.assertAlmostEqual(got, want, delta=1e-12)
+
+    def test_the_mice_under_read_and_scatter_and_the_wheels_scatter(self):
+        e = ph.SensorErrors()
+        got = self.readings(e)
+        ys = [m[1] for m, _ in got] + [m[3] for m, _ in got]
+        xs = [m[0] for m, _ in got] + [m[2] for m, _ in got]
+        mean = sum(ys) / len(ys)
+        # Under-reading 2 % of the time by 25 % on average: 0.5 % short on the mean.
+        self.assertAlmostEqual(mean, 0.1 * (1 - e.mice_miss * 0.25), delta=0.0002)
+        spread = math.sqrt(sum(v * v for v in xs) / len(xs))
+        self.assertAlmostEqual(spread, e.mice_noise * 0.1, delta=0.0001)
+        self.assertTrue(all(m[1] > 0.045 for m, _ in got))  # never below half, less noise
+        turn = ph.wheel_turns(0.1, 0.0, 0.0)[0]
+        ws = [t[0] / turn - 1.0 for _, t in got]
+        self.assertAlmostEqual(math.sqrt(sum(v * v for v in ws) / len(ws)), e.wheel_noise,
+                               delta=0.003)
+        # The same seed, the same errors.
+        self.assertEqual(got[:50], self.readings(e)[:50])
+        self.assertNotEqual(got[:50], self.readings(e, seed=8)[:50])
+
+
 class PhysicsTest(unittest.TestCase):
     def physics(self, home=1, away=0):
         model, data = ph.compile_scene(SCENE, home, away)
