@@ -147,3 +147,19 @@ fn a_robot_that_cannot_reach_the_ball_in_time_leaves_bringball_to_a_mate() {
     assert!((12.0..13.0).contains(&handed), "handed over at {handed} s");
     assert_eq!(two.outcomes().1, 1, "one failure booked");
 }
+
+/// The cool-down after a failure hands the activity to a teammate; a robot alone (or whose
+/// teammates cannot take it) goes on with it at once instead of walking off to a position.
+#[test]
+fn a_robot_alone_keeps_bringball_after_a_failure() {
+    let pos = [(-8000.0, 0.0), (2000.0, 0.0)];
+    let ball = Some((1000.0, 0.0));
+    let mut two = Coordinator::new(2);
+    for k in 0..300 {
+        let now = f64::from(k) * 0.1;
+        let c = two.cycle(now, &situation(1, &pos, ball, &[]), &[], 0.0);
+        assert_eq!(c.job.activity, "BringBall", "at {now} s");
+    }
+    // ReachBall timed out twice (at 12 s and 24 s), and both were booked.
+    assert_eq!(two.outcomes().1, 2);
+}

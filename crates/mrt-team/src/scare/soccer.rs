@@ -403,7 +403,18 @@ impl Coordinator {
                 leader = (*id, r.opportunity.iter().map(|v| f64::from(*v)).collect());
             }
         }
-        let allocation = allocate(&self.table, &leader.1, &agents, &self.params);
+        let mut allocation = allocate(&self.table, &leader.1, &agents, &self.params);
+        // The cool-down hands a failed activity to a teammate; when none takes it (a robot
+        // alone, or none able), this robot tries again at once rather than leave it undone.
+        let untaken = (0..n).any(|a| {
+            self.off_until.get(a).is_some_and(|until| now < *until)
+                && allocation.agenda.contains(&a)
+                && allocation.doing(a).is_empty()
+        });
+        if untaken {
+            agents[0] = Agent::new(self.id, sit.attitudes()).doing(self.doing);
+            allocation = allocate(&self.table, &leader.1, &agents, &self.params);
+        }
         let given = allocation.of(self.id);
         if given != self.doing || self.sequencer.is_none() {
             self.doing = given;
