@@ -188,6 +188,13 @@ impl Geometry {
         (ball.0 + radius * a.cos(), ball.1 + radius * a.sin())
     }
 
+    /// Whether a ball at `b` (team frame, mm) lies in a dead corner: within
+    /// [`CORNER_DEPTH`] of the opponent's goal line and wide of a post by more than a ball's radius,
+    /// where no shot at the net goes in.
+    pub fn dead_corner(&self, (bx, by): (f64, f64)) -> bool {
+        bx > self.half_length - CORNER_DEPTH && by.abs() > self.goal_half_width + 100.0
+    }
+
     /// Where along the opponent's goal line to shoot (mm from its centre): the open side,
     /// away from the robot the world model anchored nearest the goal's centre (within 1.5 m,
     /// not a teammate: the goalkeeper), two thirds of the way to the post; the centre when no
@@ -285,6 +292,16 @@ pub struct MilanBrain {
     ball_seen_at: Option<f64>,
 }
 
+/// How far behind the opponent's goal line (mm) the point lies that a Milan robot lines the
+/// ball up with for a shot.
+pub const SHOOT_THROUGH: f64 = 500.0;
+
+/// How deep (mm) the dead corners by the opponent's goal line reach into the field.
+pub const CORNER_DEPTH: f64 = 1000.0;
+
+/// How far in front of the opponent's goal line (mm) a ball is dribbled out of a dead corner.
+pub const CORNER_WAY_OUT: f64 = 1500.0;
+
 /// After this long (s) without the ball, more than one turn on the spot, a Milan robot that
 /// no teammate tells where the ball is counts it as lost (`BallLost`).
 pub const BALL_LOST_AFTER: f64 = 3.0;
@@ -324,30 +341,39 @@ impl MilanBrain {
         let job = w.job.as_ref();
         let flag = |b: bool| f64::from(u8::from(b));
         v.push(("PlayBall", flag(job.is_none_or(|j| j.aim.is_some())), 1.0));
-        v.push(("KickAllowed", flag(job.is_none_or(|j| j.kick)), 1.0));
+        let ball = w.lps[lps::BALL];
+        let ball_at = (ball.reliability >= 0.1).then(|| Geometry::ball_at(me, &ball));
+        // A ball by the opponent's goal line wide of a post, where no shot goes in: it is
+        // dribbled back out in front of the goal, not kicked (a kick would send it out).
+        let corner = ball_at.is_some_and(|b| field.dead_corner(b));
+        v.push(("KickAllowed", flag(job.is_none_or(|j| j.kick) && !corner), 1.0));
         v.push(("HoldPosition", flag(job.is_some_and(|j| j.position.is_some())), 1.0));
         if let Some((px, py)) = job.and_then(|j| j.position) {
             let (dx, dy) = (px - me.x, py - me.y);
             v.push(("PositionDistance", dx.hypot(dy), q));
             v.push(("PositionAngle", deg360(dy.atan2(dx) - me.theta), q));
         }
-        let ball = w.lps[lps::BALL];
-        let ball_at = (ball.reliability >= 0.1).then(|| Geometry::ball_at(me, &ball));
         if let Some((bx, by)) = ball_at {
             let r = ball.reliability;
             v.push(("BallDistance", ball.rho, r));
             v.push(("BallBearing", deg360(ball.theta), r));
             // The ball and the point 400 mm behind it on the line from where it should go:
-            // the job's aim (the net's open side, or a mate for a pass).
+            // the job's aim (the net's open side, or a mate for a pass), or out of a dead
+            // corner the spot in front of the goal.
             let aim = job.and_then(|j| j.aim).unwrap_or((field.half_length, field.open_side(w)));
+            let aim = if corner { (field.half_length - CORNER_WAY_OUT, 0.0) } else { aim };
             let at_net = (aim.0 - field.half_length).abs() < 1.0;
-            let spot = behind_ball(Point2::new(bx, by), Point2::new(aim.0, aim.1), 400.0)
+            // At the net the ball is lined up with a point behind the goal line, so that a
+            // ball that stopped on the line itself is still pushed in, not along it.
+            let through = if at_net { aim.0 + SHOOT_THROUGH } else { aim.0 };
+            let spot = behind_ball(Point2::new(bx, by), Point2::new(through, aim.1), 400.0)
                 .unwrap_or(Pose2::new(bx - 400.0, by, 0.0));
             // How far (degrees) the kick, along the robot's heading, would miss what it aims
             // at: the goal mouth less a ball's margin at each post for a shot at the net, a
-            // 0.8 m wide target round a mate for a pass; 0 on target. In the own half any
-            // kick that clears the ball forwards will do.
-            let miss = if at_net && bx < 0.0 {
+            // 0.8 m wide target round a mate for a pass; 0 on target. In the own third any
+            // kick that clears the ball forwards will do (from farther up, one that misses
+            // the goal sends the ball out over its line).
+            let miss = if at_net && bx < -field.half_length / 3.0 {
                 0.0
             } else {
                 let (mid, half) = if at_net {
@@ -581,8 +607,6 @@ mod tests {
     use super::*;
     use mrt_msgs::{AnchoredRobot, RobotClass};
 
-    /// The Parser gives Mr. BRIAN the robots MAP anchored: the nearest opponent (a teammate
-    /// nearer is skipped) and the free direction towards the opponent's net.
     #[test]
     fn orbit_goes_round_the_ball_the_shorter_way_and_never_through_it() {
         use std::f64::consts::PI;
@@ -625,6 +649,8 @@ mod tests {
         }
     }
 
+    /// The Parser gives Mr. BRIAN the robots MAP anchored: the nearest opponent (a teammate
+    /// nearer is skipped) and the free direction towards the opponent's net.
     #[test]
     fn milan_reads_the_nearest_opponent_and_the_free_direction() {
         let dir = embedded_milan().unwrap();
@@ -703,6 +729,59 @@ mod tests {
         w.my_pos.pose = Pose2::new(6000.0, 0.0, PI);
         let c = brain.cycle(&w);
         assert!(c.vlin.hypot(c.vlat) < 50.0, "seen 1 s ago: {c:?}");
+    }
+
+    /// A ball by the opponent's goal line wide of a post is dribbled back out towards the
+    /// spot in front of the goal, never kicked (no shot from there goes in; a kick sends it
+    /// out); in front of the goal the robot may shoot again. A clearance that only needs to
+    /// go forwards is for the own third: farther up, a kick must be on target.
+    #[test]
+    fn milan_dribbles_out_of_a_dead_corner_and_clears_only_from_its_own_third() {
+        use std::f64::consts::{FRAC_PI_2, PI};
+        let dir = embedded_milan().unwrap();
+        let brain = MilanBrain::new(&dir, false).unwrap();
+        let mut w = WorldSnapshot::default();
+        w.field.half_length = 9000.0;
+        w.field.goal_half_width = 1000.0;
+        w.my_pos.quality = 0.9;
+        let place = |w: &mut WorldSnapshot, me: Pose2, (bx, by): (f64, f64)| {
+            w.my_pos.pose = me;
+            let (dx, dy) = (bx - me.x, by - me.y);
+            let theta = dy.atan2(dx) - me.theta;
+            w.lps[lps::BALL] = Lpo { rho: dx.hypot(dy), theta, reliability: 0.9, seen_ago: 0.0 };
+        };
+        let get = |w: &WorldSnapshot, name: &str| {
+            let inputs = brain.inputs(w);
+            inputs.iter().find(|(n, _, _)| *n == name).map(|(_, v, _)| *v)
+        };
+        // The ball 1.6 m wide of the goal's centre, 0.4 m from the line; the robot behind it
+        // on the line from the spot (7500, 0), facing that spot: no kick, on target.
+        let ball: (f64, f64) = (8600.0, -1600.0);
+        let out = ball.1.atan2(ball.0 - 7500.0); // from the spot out to the ball
+        let me = Pose2::new(ball.0 + 400.0 * out.cos(), ball.1 + 400.0 * out.sin(), out + PI);
+        place(&mut w, me, ball);
+        assert_eq!(get(&w, "KickAllowed"), Some(0.0));
+        assert!(get(&w, "AimError").is_some_and(|e| e < 1e-6), "{:?}", get(&w, "AimError"));
+        assert!(get(&w, "Misalignment").is_some_and(|m| m < 1.0));
+        // In front of the goal, and 1.2 m out from the line however wide: it may kick.
+        for ball in [(8600.0, -800.0), (7700.0, -1600.0)] {
+            place(&mut w, Pose2::new(ball.0 - 400.0, ball.1, 0.0), ball);
+            assert_eq!(get(&w, "KickAllowed"), Some(1.0), "{ball:?}");
+        }
+        // A ball stopped on the goal line inside the mouth: the robot is sent in front of
+        // it (not along the line), to push it in.
+        let ball = (9000.0, -600.0);
+        place(&mut w, Pose2::new(8000.0, -1000.0, 0.0), ball);
+        let (d, a) = (get(&w, "ApproachDistance").unwrap(), get(&w, "ApproachAngle").unwrap());
+        let a = a.to_radians();
+        let spot = (8000.0 + d * a.cos(), -1000.0 + d * a.sin());
+        assert!(spot.0 < ball.0 - 250.0, "the spot {spot:?} is in front of the line");
+        // Facing north with the ball ahead: in the own third a clearance, in the middle
+        // third a kick that misses the goal by far.
+        place(&mut w, Pose2::new(-5000.0, 0.0, FRAC_PI_2), (-5000.0, 400.0));
+        assert_eq!(get(&w, "AimError"), Some(0.0));
+        place(&mut w, Pose2::new(-2000.0, 0.0, FRAC_PI_2), (-2000.0, 400.0));
+        assert!(get(&w, "AimError").is_some_and(|e| e > 60.0), "{:?}", get(&w, "AimError"));
     }
 
     /// Shot selection: the open side of the opponent's goal, away from its
