@@ -55,18 +55,18 @@ pub struct RobotArgs {
     pub record_as: Option<String>,
 }
 
+/// A Member added to a robot's Agora beside its own (`RemoteRobot::with_members`).
+type Extra = Box<dyn mrt_dcdt::Member>;
+
 impl RobotArgs {
-    /// The recorder of `--record` and its tap for the robot's Agora (`default` prefix), or
-    /// none.
-    pub(crate) fn recording(
-        &self,
-        default: &str,
-    ) -> Result<Option<(SharedRecorder, Box<dyn mrt_dcdt::Member>)>> {
-        let Some(path) = &self.record else { return Ok(None) };
+    /// The recorder of `--record` (none without it) and the Members to add to the robot's
+    /// Agora for it: its tap, recording under `--record-as` or `default`.
+    pub(crate) fn recording(&self, default: &str) -> Result<(Option<SharedRecorder>, Vec<Extra>)> {
+        let Some(path) = &self.record else { return Ok((None, Vec::new())) };
         let rec = Recorder::create(path)?.shared();
         let prefix = self.record_as.clone().unwrap_or_else(|| default.to_string());
-        let tap: Box<dyn mrt_dcdt::Member> = Box::new(Tap::new(prefix, rec.clone()));
-        Ok(Some((rec, tap)))
+        let tap: Extra = Box::new(Tap::new(prefix, rec.clone()));
+        Ok((Some(rec), vec![tap]))
     }
 }
 
@@ -486,8 +486,7 @@ pub fn robot(args: &RobotArgs) -> Result<()> {
     let behaviors = file.robot.behaviors.as_ref().map(|p| here.join(p));
     let dir = behaviors_dir(&[spec.stack], behaviors.as_deref()).map_err(|e| anyhow!("{e}"))?;
     let id = spec.robot;
-    let (rec, extra) = args.recording(&format!("robot-{id}"))?.unzip();
-    let extra = extra.into_iter().collect();
+    let (rec, extra) = args.recording(&format!("robot-{id}"))?;
     let mut robot = RemoteRobot::with_members(&robot_cfg, spec, &dir, Some(net), extra)
         .map_err(|e| anyhow!("{e}"))?;
     let agora = robot.agora().ok_or_else(|| anyhow!("the robot has no Agora"))?;

@@ -53,8 +53,7 @@ pub fn robot(args: &RobotArgs, file: &RobotFile) -> Result<()> {
         .transpose()?;
     let behaviors = file.robot.behaviors.as_ref().map(|p| here.join(p));
     let dir = behaviors_dir(&[spec.stack], behaviors.as_deref()).map_err(|e| anyhow!("{e}"))?;
-    let (rec, extra) = args.recording(&name)?.unzip();
-    let extra = extra.into_iter().collect();
+    let (rec, extra) = args.recording(&name)?;
     let mut remote = RemoteRobot::with_members(&cfg, spec, &dir, net.clone(), extra)
         .map_err(|e| anyhow!("{e}"))?;
     // The team's network, when there is one; without it no teammate is waited for.

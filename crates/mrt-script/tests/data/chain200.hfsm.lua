@@ -1,5 +1,5 @@
--- A 200-state machine for drawing tests and benchmarks (issue 17: `mrt hfsm dot --svg` on it
--- took 91 s): a chain of states, each tenth returning to the first, and one meta-state.
+-- A 200-state machine for drawing tests and benchmarks (`mrt hfsm dot --svg` must lay it out
+-- quickly): a chain of states, each tenth returning to the first, and one meta-state.
 machine "Inner" {
   initial = "A",
   states = { A = function() end, B = function() end },
