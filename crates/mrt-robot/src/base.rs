@@ -131,6 +131,16 @@ impl Base {
         Ok(Displacement::new(moved.x, moved.y, moved.theta))
     }
 
+    /// The wheel speeds (rad/s, in wheel order) that drive the body at `twist` (robot frame,
+    /// m/s and rad/s), unlimited; a differential base ignores `vy`. What a simulator's wheel
+    /// encoders count: the speed each wheel turns at for the body's set-point.
+    pub fn wheels_for(&self, twist: &Twist) -> Vec<f64> {
+        match self {
+            Base::Differential(k) => k.inverse(twist).0.to_vec(),
+            Base::Omni(k) => k.inverse(twist).0.to_vec(),
+        }
+    }
+
     /// Wheel speeds (as many as the base has wheels) → the body velocity.
     fn forward(&self, w: &[f64]) -> Twist {
         let at = |i: usize| w.get(i).copied().unwrap_or(0.0);
@@ -278,6 +288,21 @@ mod tests {
             assert!(d.dx > 0.3, "{d:?}");
             assert!(b.motion(&[0.1]).is_err());
         }
+    }
+
+    #[test]
+    fn the_wheels_for_a_twist_drive_that_twist() {
+        let t = Twist::new(0.6, 0.2, -0.8);
+        let omni = Base::parse("omni").unwrap();
+        let back = omni.forward(&omni.wheels_for(&t));
+        assert!((back.vx - t.vx).abs() < 1e-12 && (back.vy - t.vy).abs() < 1e-12);
+        assert!((back.omega - t.omega).abs() < 1e-12);
+        // A differential base drives the twist without its sideways part.
+        let diff = Base::parse("differential").unwrap();
+        let back = diff.forward(&diff.wheels_for(&t));
+        assert!((back.vx - t.vx).abs() < 1e-12 && back.vy == 0.0);
+        assert!((back.omega - t.omega).abs() < 1e-12);
+        assert_eq!((omni.wheels_for(&t).len(), diff.wheels_for(&t).len()), (3, 2));
     }
 
     #[test]

@@ -314,13 +314,14 @@ impl Pitch {
         let mice = cfg.odometry.mice()?;
         let mut kidnap_rng = ChaCha8Rng::seed_from_u64(seed ^ 0x6B69_646E_6170_0001);
         let kidnap_plan = Self::plan_kidnaps(cfg, robots, &mut kidnap_rng);
+        let base = Base::parse(&cfg.robot.base)?;
         Ok(Pitch {
             cfg: cfg.clone(),
-            base: Base::parse(&cfg.robot.base)?,
+            base,
             seed,
             world,
             referee,
-            odometers: (0..robots).map(|i| Odometer::new(i, mice)).collect(),
+            odometers: (0..robots).map(|i| Odometer::new(i, mice, base)).collect(),
             rngs,
             stats: Default::default(),
             hash: FNV_OFFSET,

@@ -507,7 +507,7 @@ pub fn run_mission(
     ));
     let building = Arc::new(Mutex::new(Building {
         world: IndoorWorld::new(map, events, mission.start, cfg),
-        odometer: Odometer::new(0, mice),
+        odometer: Odometer::new(0, mice, robot.base),
         rng: ChaCha8Rng::seed_from_u64(seed),
         cfg: cfg.clone(),
         base: robot.base,

@@ -14,9 +14,11 @@ use crate::world::{Drive, World};
 use mrt_core::frames::{Field, Framed};
 use mrt_core::{normalize_angle, Pose2};
 use mrt_msgs::robot::lps;
-use mrt_perception::mice::{Displacement, MiceOdometry};
+use mrt_msgs::MiceReadings;
+use mrt_perception::mice::MiceOdometry;
 use mrt_plan::guidance::Sonar;
-use mrt_plan::kinematics::{integrate, Twist};
+use mrt_plan::kinematics::Twist;
+use mrt_robot::base::Base;
 use rand::{Rng, RngCore};
 
 /// The robots' bodies as the odometry and sonar drivers read them: the soccer [`World`] and
@@ -210,21 +212,34 @@ pub fn mouse_errors(x: &mut f64, y: &mut f64, cfg: &OdometryConfig, rng: &mut dy
 pub struct Odometer {
     robot: usize,
     mice: MiceOdometry,
+    base: Base,
     last: Option<Pose2>,
     placements: u32,
     carries: u32,
 }
 
+/// What a robot's mice and wheel encoders counted since the last reading, as the devices
+/// count it: the mice's motion in their own frames (m), each wheel's turn (rad, in wheel
+/// order), and where the robot was put down meanwhile.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Counts {
+    /// The two optical mice, each in its own frame (MRT manual ch. 4), m.
+    pub mice: MiceReadings,
+    /// Each wheel's turn, rad, in the base's wheel order.
+    pub wheel_turns: Vec<f64>,
+    /// Put down by hand at this pose (field frame, m) since the last reading.
+    pub placed: Option<Framed<Field, Pose2>>,
+}
+
 impl Odometer {
-    /// The driver of robot `robot`'s mice (`mice`: their geometry) and wheels.
-    pub fn new(robot: usize, mice: MiceOdometry) -> Odometer {
-        Odometer { robot, mice, last: None, placements: 0, carries: 0 }
+    /// The driver of robot `robot`'s mice (`mice`: their geometry) and the wheels of its
+    /// `base`.
+    pub fn new(robot: usize, mice: MiceOdometry, base: Base) -> Odometer {
+        Odometer { robot, mice, base, last: None, placements: 0, carries: 0 }
     }
 
-    /// Reads the sensors: the mice see the body's true motion since the last reading (as the
-    /// manual's forward model gives it, §4.1), with noise and occasional under-reading (§4.2);
-    /// the wheels count the velocity set-point over `period` (they slip when the body is
-    /// blocked), with noise.
+    /// Reads the sensors as [`Odometer::count`] does and gives the wheels' motion as the
+    /// robot's encoder driver would: the arc their turns drive ([`Base::motion`]).
     pub fn read(
         &mut self,
         world: &dyn Bodies,
@@ -232,6 +247,28 @@ impl Odometer {
         period: f64,
         rng: &mut dyn RngCore,
     ) -> Odometry {
+        let counts = self.count(world, cfg, period, rng);
+        self.odometry(counts)
+    }
+
+    /// The reading of `counts` as the robot's drivers give it: the wheels' turns as the arc
+    /// they drive.
+    pub fn odometry(&self, counts: Counts) -> Odometry {
+        let wheels = self.base.motion(&counts.wheel_turns).unwrap_or_default();
+        Odometry { mice: counts.mice, wheels, placed: counts.placed }
+    }
+
+    /// Reads the sensors: the mice see the body's true motion since the last reading (as the
+    /// manual's forward model gives it, §4.1), with noise and occasional under-reading (§4.2);
+    /// each wheel turns at the speed the body's velocity set-point asks of it over `period`
+    /// (they slip when the body is blocked), each with a noise of its own.
+    pub fn count(
+        &mut self,
+        world: &dyn Bodies,
+        cfg: &OdometryConfig,
+        period: f64,
+        rng: &mut dyn RngCore,
+    ) -> Counts {
         let now = world.robot(self.robot).unwrap_or_default();
         let (count, at) = world.placement(self.robot);
         let mut placed = None;
@@ -254,10 +291,13 @@ impl Odometer {
         mouse_errors(&mut mice.x_right, &mut mice.y_right, cfg, rng);
         let drive = world.drive_setpoint(self.robot);
         let twist = Twist::new(drive.forward, drive.left, drive.turn);
-        let moved = integrate(Pose2::default(), &twist, period);
-        let mut noisy = |v: f64| v * (1.0 + cfg.wheel_noise * gauss(rng));
-        let wheels = Displacement::new(noisy(moved.x), noisy(moved.y), noisy(moved.theta));
-        Odometry { mice, wheels, placed }
+        let wheel_turns = self
+            .base
+            .wheels_for(&twist)
+            .into_iter()
+            .map(|w| w * period * (1.0 + cfg.wheel_noise * gauss(rng)))
+            .collect();
+        Counts { mice, wheel_turns, placed }
     }
 }
 
@@ -370,7 +410,7 @@ mod tests {
             ..Default::default()
         };
         let mice = exact.mice().unwrap();
-        let mut odo = Odometer::new(2, mice);
+        let mut odo = Odometer::new(2, mice, Base::parse("omni").unwrap());
         // The first reading tells where the robot was put down (start of the match).
         let first = odo.read(&w, &exact, 0.1, &mut rng);
         let placed = w.placement(2).1;
@@ -411,7 +451,7 @@ mod tests {
         let cfg = OdometryConfig { mice_miss_probability: 0.5, ..Default::default() };
         let mice = cfg.mice().unwrap();
         let mut rng = ChaCha8Rng::seed_from_u64(5);
-        let mut odo = Odometer::new(1, mice);
+        let mut odo = Odometer::new(1, mice, Base::parse("omni").unwrap());
         w.place_robot(1, Pose2::new(0.0, 0.0, 0.0));
         odo.read(&w, &cfg, 0.1, &mut rng);
         let (mut short, mut total) = (0, 0);
