@@ -175,9 +175,27 @@ def jpeg_image(image: Any, quality: int = 90) -> dict:
     return {"width": image.width, "height": image.height, "encoding": "jpeg", "data": data}
 
 
-def camera(time: float, image: dict, pan: float | None = None) -> dict:
-    """One front-camera image taken at world ``time`` (s), the pan joint at ``pan`` (rad, None: no joint)."""
-    return {"time": _num(time, "camera time"), "pan": _opt_num(pan, "pan"), "image": image}
+def camera(
+    time: float, image: dict | None, pan: float | None = None, objects: dict | None = None
+) -> dict:
+    """One front-camera frame taken at world ``time`` (s), the pan joint at ``pan`` (rad, None:
+    no joint): its ``image``, or the ``objects`` an object sensor saw (see :func:`seen`)."""
+    if image is None and objects is None:
+        raise ValueError("a camera frame has an image or objects")
+    frame = {"time": _num(time, "camera time"), "pan": _opt_num(pan, "pan"), "image": image}
+    if objects is not None:
+        frame["objects"] = objects
+    return frame
+
+
+def seen(distance: float, bearing: float) -> dict:
+    """One object an object sensor saw: ``distance`` (m) and ``bearing`` (rad, robot frame),
+    for ``objects = {"ball": seen(...), "east_net": ..., "west_net": ..., "landmarks": [...],
+    "robots": [...]}``."""
+    d = _num(distance, "distance")
+    if d < 0:
+        raise ValueError(f"distance must be >= 0, not {d}")
+    return {"distance": d, "bearing": _num(bearing, "bearing")}
 
 
 def sonar(bearing: float, range: float | None) -> dict:  # noqa: A002 - the protocol's name

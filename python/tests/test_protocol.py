@@ -26,6 +26,7 @@ from mrt_world import (
     parse_bye,
     pose,
     rgb8_image,
+    seen,
     sense,
     sense_key,
     sonar,
@@ -177,6 +178,14 @@ class Builders(unittest.TestCase):
             {"protocol": 1, "world": "w", "run": "r", "robot": "x", **sense(0, 0.0, game("playing", 1))}
         )
         validator.validate(json.loads(encode(full_sense())))
+        oracle = full_sense()
+        objects = {"ball": seen(2.0, 0.1), "west_net": None, "landmarks": [None, seen(4.0, -1.0)]}
+        oracle["camera"] = camera(0.3, None, objects=objects)
+        validator.validate(oracle)
+        with self.assertRaises(ValueError):
+            camera(0.3, None)
+        with self.assertRaises(ValueError):
+            seen(-1.0, 0.0)
         bad = full_sense()
         bad["game"]["state"] = "paused"
         self.assertFalse(validator.is_valid(bad))

@@ -2,12 +2,15 @@
 //! readings a taken step gives its devices ([`Readings`]).
 
 use crate::messages::{
-    Dropped, Encoding, End, GameReading, ImageData, Pose, RefereeState, Sense, TeamMarker, PROTOCOL,
+    Dropped, Encoding, End, GameReading, ImageData, ObjectsReading, Pose, RefereeState, Seen,
+    Sense, TeamMarker, LANDMARKS, PROTOCOL,
 };
 use base64::Engine;
 use mrt_core::frames::Framed;
 use mrt_core::Pose2;
-use mrt_msgs::{CameraFrame, GameInfo, GameState, Image, Marker, MiceReadings, Sonar};
+use mrt_msgs::{
+    CameraFrame, GameInfo, GameState, Image, Marker, MiceReadings, RobotSighting, Sighting, Sonar,
+};
 use std::time::{Duration, Instant};
 
 /// The largest message a robot reads, bytes.
@@ -306,13 +309,22 @@ fn readings(s: &Sense, wheels: usize) -> Result<Readings, Refusal> {
     }
     let placed = odometry.placed.as_ref().map(|p| pose(p, "odometry.placed")).transpose()?;
     let camera = match &s.camera {
-        Some(c) => Some(CameraFrame {
-            time: finite(c.time, "camera.time")?,
-            pan: c.pan.map(|p| finite(p, "camera.pan")).transpose()?,
-            image: Some(image(&c.image)?),
-            up_image: s.up_camera.as_ref().map(|u| image(&u.image)).transpose()?,
-            ..CameraFrame::default()
-        }),
+        Some(c) => {
+            if c.image.is_none() && c.objects.is_none() {
+                return Err(bad("camera has neither an image nor objects"));
+            }
+            let mut frame = CameraFrame {
+                time: finite(c.time, "camera.time")?,
+                pan: c.pan.map(|p| finite(p, "camera.pan")).transpose()?,
+                image: c.image.as_ref().map(image).transpose()?,
+                up_image: s.up_camera.as_ref().map(|u| image(&u.image)).transpose()?,
+                ..CameraFrame::default()
+            };
+            if let Some(o) = &c.objects {
+                objects(o, &mut frame)?;
+            }
+            Some(frame)
+        }
         None => None,
     };
     let sonars = match &s.sonars {
@@ -344,6 +356,50 @@ fn readings(s: &Sense, wheels: usize) -> Result<Readings, Refusal> {
     })
 }
 
+/// An object sensor's frame into `frame`: its sightings in the world model's order (ball,
+/// east net, west net, landmarks) and the robots.
+fn objects(o: &ObjectsReading, frame: &mut CameraFrame) -> Result<(), Refusal> {
+    if o.landmarks.len() > LANDMARKS {
+        return Err(bad(format!("{} landmarks, at most {LANDMARKS}", o.landmarks.len())));
+    }
+    let seen = |s: &Seen| -> Result<Sighting, Refusal> {
+        let distance = finite(s.distance, "camera.objects: a distance")?;
+        if distance < 0.0 {
+            return Err(bad("camera.objects: a distance is negative"));
+        }
+        Ok(Sighting { distance, bearing: finite(s.bearing, "camera.objects: a bearing")? })
+    };
+    let all = [&o.ball, &o.east_net, &o.west_net].into_iter().chain(&o.landmarks);
+    for (slot, s) in frame.sightings.iter_mut().zip(all) {
+        *slot = s.as_ref().map(seen).transpose()?;
+    }
+    frame.robots = o
+        .robots
+        .iter()
+        .map(|r| {
+            let sigma = match r.sigma {
+                Some([d, b]) => {
+                    Some((finite(d, "a robot's sigma")?, finite(b, "a robot's sigma")?))
+                }
+                None => None,
+            };
+            Ok(RobotSighting {
+                sighting: seen(&Seen { distance: r.distance, bearing: r.bearing })?,
+                sigma,
+                marker: r.marker.map(marker),
+            })
+        })
+        .collect::<Result<_, Refusal>>()?;
+    Ok(())
+}
+
+fn marker(m: TeamMarker) -> Marker {
+    match m {
+        TeamMarker::Magenta => Marker::Magenta,
+        TeamMarker::Cyan => Marker::Cyan,
+    }
+}
+
 fn game(g: &GameReading) -> Result<GameInfo, Refusal> {
     let attack = finite(g.attack, "game.attack")?;
     if attack != 1.0 && attack != -1.0 {
@@ -359,10 +415,7 @@ fn game(g: &GameReading) -> Result<GameInfo, Refusal> {
         },
         attack,
         kickoff_pose: g.kickoff_pose.as_ref().map(|p| pose(p, "game.kickoff_pose")).transpose()?,
-        marker: g.marker.map(|m| match m {
-            TeamMarker::Magenta => Marker::Magenta,
-            TeamMarker::Cyan => Marker::Cyan,
-        }),
+        marker: g.marker.map(marker),
     })
 }
 

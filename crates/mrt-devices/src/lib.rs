@@ -4,8 +4,9 @@
 //! each robot every step, and what the robot answers: UTF-8 JSON in SI units over zenoh keys
 //! that name the world and the robot, lock-step by default (docs/devices.md specifies it all;
 //! the JSON Schemas of [`schemas`] are published in `schemas/devices/1/`). This crate holds the
-//! messages ([`messages`]), the keys ([`Keys`]) and the robot's rules for what it takes
-//! ([`Gate`]); the robot that runs on them is `mrt_robot::world`, the transport `mrt robot`'s.
+//! messages ([`messages`]), the keys ([`Keys`]), the robot's rules for what it takes
+//! ([`Gate`]) and the world's side for a world written in Rust ([`world`]); the robot that
+//! runs on them is `mrt_robot::world`, the transport `mrt robot`'s.
 //!
 //! ```
 //! use mrt_devices::{Admitted, Gate, Keys};
@@ -27,6 +28,7 @@
 
 mod gate;
 pub mod messages;
+pub mod world;
 
 pub use gate::{
     image, is_name, Admitted, Gate, Readings, Refusal, MAX_IMAGE_SIDE, MAX_MESSAGE, MAX_TIME_STEP,

@@ -77,7 +77,7 @@ pub struct Pose {
     pub theta: f64,
 }
 
-/// One front-camera image.
+/// One front-camera frame: its image, or what an object sensor saw (at least one of them).
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize, JsonSchema)]
 pub struct CameraReading {
     /// When it was taken (world clock), s.
@@ -85,8 +85,63 @@ pub struct CameraReading {
     /// The pan joint's angle then, rad counter-clockwise (`None`: the camera has no joint).
     #[serde(default)]
     pub pan: Option<f64>,
-    /// The image.
-    pub image: ImageData,
+    /// The image (`None`: an object sensor's frame, [`CameraReading::objects`]).
+    #[serde(default)]
+    pub image: Option<ImageData>,
+    /// What an object sensor in the camera's place saw, for a world that knows it without
+    /// drawing an image (`mrt sim --percepts oracle`); the robot's vision then has nothing to
+    /// do and the world model reads these as they are.
+    #[serde(default)]
+    pub objects: Option<ObjectsReading>,
+}
+
+/// What an object sensor saw in one frame: distance and bearing from the robot's centre
+/// (robot frame, counter-clockwise from straight ahead), `None` for what it did not see.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize, JsonSchema)]
+pub struct ObjectsReading {
+    /// The ball.
+    #[serde(default)]
+    pub ball: Option<Seen>,
+    /// The net at +x.
+    #[serde(default)]
+    pub east_net: Option<Seen>,
+    /// The net at −x.
+    #[serde(default)]
+    pub west_net: Option<Seen>,
+    /// The field map's landmarks, in the map's order (the robot file's `[field]`), at most
+    /// [`LANDMARKS`].
+    #[serde(default)]
+    pub landmarks: Vec<Option<Seen>>,
+    /// Other robots in view: the nearest point of each (its foot on the floor).
+    #[serde(default)]
+    pub robots: Vec<RobotSeen>,
+}
+
+/// The most landmarks an [`ObjectsReading`] tells.
+pub const LANDMARKS: usize = mrt_msgs::FIELD_OBJECTS - 3;
+
+/// One object's distance and bearing.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize, JsonSchema)]
+pub struct Seen {
+    /// m, ≥ 0.
+    pub distance: f64,
+    /// rad.
+    pub bearing: f64,
+}
+
+/// One robot in view.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize, JsonSchema)]
+pub struct RobotSeen {
+    /// m, ≥ 0.
+    pub distance: f64,
+    /// rad.
+    pub bearing: f64,
+    /// The sensor's standard deviations `[distance m, bearing rad]`, when it knows them.
+    #[serde(default)]
+    pub sigma: Option<[f64; 2]>,
+    /// The colour of its marker band, when seen.
+    #[serde(default)]
+    pub marker: Option<TeamMarker>,
 }
 
 /// One image of the omnidirectional up camera.

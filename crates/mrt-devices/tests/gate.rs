@@ -155,7 +155,7 @@ fn a_new_run_is_followed_only_from_its_step_0_after_the_old_one_fell_silent() {
 
 fn image_sense(image: ImageData) -> Vec<u8> {
     let mut s = sense(0, 0.0);
-    s.camera = Some(CameraReading { time: 0.0, pan: Some(0.2), image });
+    s.camera = Some(CameraReading { time: 0.0, pan: Some(0.2), image: Some(image), objects: None });
     bytes(&s)
 }
 
