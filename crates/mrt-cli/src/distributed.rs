@@ -1,41 +1,31 @@
-//! `mrt sim --distributed`: the simulator in this process, each robot's Agora in a process of
-//! its own (`mrt robot --config FILE`, the real-robot entry point, with a robot file written
-//! for it), talking over zenoh on loopback (`mrt-net`).
+//! `mrt sim --distributed`: the simulator in this process as a world of the device protocol
+//! (docs/devices.md, `mrt_sim::remote`), each robot in a process of its own (`mrt robot
+//! --config FILE`, the entry point that plays on MuJoCo or on a real robot's bridge, with a
+//! robot file written for it), over zenoh on loopback.
 //!
 //! The robots run the same robot program as in one process (`mrt-robot`); only their devices
-//! differ (linked, over the network). Each team is a network of its own: for team `t` this process writes one
-//! MRT-manual §3.3.1 file per robot into a temporary directory, with the team's discovery port
-//! on the network line and static `ip link` lines to the simulator and to the lower-numbered
-//! teammates, so no robot depends on multicast and no robot hears the other team.
+//! differ. Each team is a DCDT network of its own for the teammates' reports: for team `t`
+//! this process writes one MRT-manual §3.3.1 file per robot into a temporary directory, with
+//! the team's discovery port on the network line and static `ip link` lines to teammates, so
+//! no robot depends on multicast and no robot hears the other team.
 
+use crate::world::{FIRST_ANSWER, PHASES};
 use anyhow::{anyhow, bail, Context as _, Result};
-use mrt_core::AgoraId;
-use mrt_dcdt::config::AgoraConfig;
-use mrt_dcdt::Message;
 use mrt_monitor::{Recorder, SharedRecorder, Tap};
-use mrt_msgs::MateReport;
-use mrt_msgs::{DeviceAct, DeviceFrame};
-use mrt_net::{NetConfig, NetLink};
+use mrt_net::{NetConfig, RawPort};
 use mrt_robot::config::RobotFile;
-use mrt_robot::members::behaviors_dir;
-use mrt_robot::remote::RemoteRobot;
 use mrt_robot::stacks::Stack;
 use mrt_sim::config::SimConfig;
 use mrt_sim::game::MatchReport;
-use mrt_sim::remote::{Patience, PitchServer};
+use mrt_sim::remote::{robot_name, Patience, PitchWorld, WorldPort, WORLD};
+use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
+use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
 /// How long robots may take to start (load behaviors, join the network).
 const START: Duration = Duration::from_secs(120);
-/// A robot without a frame for this long gives up (the simulator is gone).
-const SILENCE: Duration = Duration::from_secs(60);
-
-/// The Agora id of the simulator's side of team `t`'s network.
-fn sim_agora(t: usize) -> u32 {
-    201 + t as u32
-}
 
 /// `mrt robot --config FILE`: one robot's Agora on its configured devices.
 #[derive(clap::Args)]
@@ -192,21 +182,17 @@ impl Drop for Robots {
     }
 }
 
-/// The §3.3.1 file of robot `i`: its team's discovery port, static links to the simulator's
-/// port and to the lower-numbered teammates' ports.
-fn robot_net_file(i: usize, first: usize, discovery: u16, sim: u16, ports: &[u16]) -> String {
+/// The §3.3.1 file of robot `i` of a team of the robots `first..` (at least two): the team's
+/// discovery port and static links to the lower-numbered teammates; the first robot links to
+/// the second, so that it listens on its port (a full mesh on loopback, and on loopback with
+/// static links only, mrt-net does not scout: no socket is bound beyond 127.0.0.1).
+pub(crate) fn team_net_file(i: usize, first: usize, discovery: u16, ports: &[u16]) -> String {
     let mut text = format!(
-        "# Robot {i} of a distributed match (written by mrt sim --distributed).\n\
-         # Network line: this machine (loopback), the team's multicast group and discovery\n\
-         # port. On loopback with static links to loopback only, mrt-net does not scout: no\n\
-         # socket is bound beyond 127.0.0.1.\n\
-         127.0.0.1 224.0.0.224 {discovery}\n\
-         # Static links: the simulator, then the teammates numbered below this robot\n\
-         # (they link back, so each team is a full mesh).\n\
-         ip link 0 127.0.0.1 {} 127.0.0.1 {sim}\n",
-        ports[i]
+        "# Robot {i}'s team network (written by mrt for its match).\n\
+         127.0.0.1 224.0.0.224 {discovery}\n"
     );
-    for &p in &ports[first..i] {
+    let peers = if i == first { &ports[first + 1..first + 2] } else { &ports[first..i] };
+    for &p in peers {
         text.push_str(&format!("ip link 0 127.0.0.1 {} 127.0.0.1 {p}\n", ports[i]));
     }
     text
@@ -226,8 +212,18 @@ fn monitor_net_file(port: u16, discovery: u16, ports: &[u16]) -> String {
     text
 }
 
-/// Plays one match with every robot in a process of its own; `progress` gets the simulated
-/// time after each cycle; `restart` kills a robot's process mid-match and starts it again.
+/// What the simulator puts, on its zenoh session.
+struct Post(RawPort);
+
+impl WorldPort for Post {
+    fn put(&self, key: &str, bytes: Vec<u8>) -> Result<(), String> {
+        self.0.put(key, bytes).map_err(|e| e.to_string())
+    }
+}
+
+/// Plays one match with every robot in a process of its own, the simulator a world of the
+/// device protocol listening on loopback; `progress` gets the simulated time after each
+/// cycle; `restart` kills a robot's process mid-match and starts it again.
 pub fn play(
     cfg: &SimConfig,
     seed: u64,
@@ -248,26 +244,69 @@ pub fn play(
     std::fs::create_dir_all(&dir).with_context(|| format!("cannot create {}", dir.display()))?;
     let mut procs = Robots { dir: dir.clone(), children: Vec::new() };
     let mut picker = PortPicker::new();
+    let endpoint = format!("tcp/127.0.0.1:{}", picker.port()?);
     let ports = (0..robots).map(|_| picker.port()).collect::<Result<Vec<_>>>()?;
-    let sim_ports = [picker.port()?, picker.port()?];
-    let exe = std::env::current_exe().context("cannot find the mrt executable")?;
-    // The simulator's side of each team's network, listening for the robots.
-    let mut agoras = Vec::new();
-    let mut links = Vec::new();
-    for (t, &port) in sim_ports.iter().enumerate() {
-        let agora = mrt_dcdt::Agora::builder(sim_agora(t)).build()?;
-        links.push(NetLink::attach(&agora, &NetConfig::loopback(port, &[]))?);
-        agoras.push(agora);
-    }
+    // The simulator's side: a zenoh session listening for the robots, its mail, its world.
+    let session = NetConfig {
+        listen: vec![endpoint.clone()],
+        connect: Vec::new(),
+        multicast: None,
+        gossip: false,
+        bridge: false,
+    };
+    let port = RawPort::open(&session).context("cannot open the simulator's zenoh session")?;
+    let (tx, mail) = std::sync::mpsc::channel();
+    let run = format!("{:08x}", std::process::id() ^ (seed as u32).rotate_left(16));
+    let mut world = PitchWorld::new(
+        cfg,
+        seed,
+        2,
+        &run,
+        Box::new(Post(port.clone())),
+        mail,
+        Patience::default(),
+    )
+    .map_err(|e| anyhow!("{e}"))?;
+    world.record_frames(record);
+    let tx = Mutex::new(tx);
+    let _mail = port.subscribe(&world.subscription(), move |key, bytes| {
+        if let Ok(tx) = tx.lock() {
+            let _ = tx.send((key.to_string(), bytes));
+        }
+    })?;
+    // The robots on the network now, by their liveliness tokens; one whose token went away
+    // (its process ended) is not waited for.
+    let alive_keys: Vec<String> = world.robots().iter().map(|k| k.alive()).collect();
+    let alive = Arc::new(Mutex::new(BTreeSet::new()));
+    let presence = world.presence();
+    let _tokens = {
+        let (alive, keys) = (alive.clone(), alive_keys.clone());
+        port.watch_tokens(&format!("mrt/devices/1/{WORLD}/*/alive"), move |key, here| {
+            let Some(i) = keys.iter().position(|k| k == key) else { return };
+            if let Ok(mut a) = alive.lock() {
+                if here {
+                    a.insert(i);
+                } else {
+                    a.remove(&i);
+                    presence.mark_gone(i);
+                }
+            }
+        })?
+    };
     let mut files = Vec::new();
-    for (t, sim_port) in sim_ports.iter().enumerate() {
+    for t in 0..2 {
         let discovery = picker.port()?;
         let stack = if t == 0 { home } else { away };
         for i in t * n..(t + 1) * n {
-            let net = dir.join(format!("robot-{i}.cfg"));
-            std::fs::write(&net, robot_net_file(i, t * n, discovery, *sim_port, &ports))?;
+            let net = (n > 1).then(|| dir.join(format!("robot-{i}.cfg")));
+            if let Some(net) = &net {
+                std::fs::write(net, team_net_file(i, t * n, discovery, &ports))?;
+            }
             let file = dir.join(format!("robot-{i}.toml"));
-            std::fs::write(&file, robot_file(cfg, i, stack, behaviors, &net)?)?;
+            std::fs::write(
+                &file,
+                robot_file(cfg, i, stack, behaviors, &endpoint, net.as_deref())?,
+            )?;
             files.push(file);
         }
     }
@@ -275,54 +314,35 @@ pub fn play(
     let monitor = dir.join("monitor.cfg");
     std::fs::write(&monitor, monitor_net_file(picker.port()?, picker.port()?, &ports))?;
     eprintln!("network of this match: {} (mrt topic list --net FILE)", monitor.display());
-    let launch = Launch { exe };
+    let launch = Launch { exe: std::env::current_exe().context("cannot find the mrt executable")? };
     for (i, file) in files.iter().enumerate() {
         let child = launch.robot(i, file, &procs.log(i))?;
         procs.children.push((i, child));
     }
-    // The simulator subscribes to the robots' answers before any robot is ready.
-    let mut server =
-        PitchServer::new(cfg, seed, agoras, Patience::default()).map_err(|e| anyhow!("{e}"))?;
-    server.record_frames(record);
-    // Every robot subscribed to its frames: the match can start.
+    // Every robot listens, and has its teammates on its team's network: the match can start.
     let start = Instant::now();
-    for (t, link) in links.iter().enumerate() {
-        let want: Vec<AgoraId> =
-            (t * n..(t + 1) * n).map(|i| AgoraId(i as u32 + 1)).collect::<Vec<_>>();
-        while link.subscribers(DeviceFrame::TYPE) != want {
-            if let Some((i, status)) = procs.exited() {
-                bail!("robot {i} ended before the match ({status}):\n{}", procs.tail(i));
-            }
-            if start.elapsed() > START {
-                bail!(
-                    "robots {:?} of team {t} were not ready after {START:?} (ready: {:?}); \
-                     robot {}'s log:\n{}",
-                    want,
-                    link.subscribers(DeviceFrame::TYPE),
-                    t * n,
-                    procs.tail(t * n)
-                );
-            }
-            std::thread::sleep(Duration::from_millis(10));
+    while alive.lock().map_or(0, |a| a.len()) < robots {
+        if let Some((i, status)) = procs.exited() {
+            bail!("robot {i} ended before the match ({status}):\n{}", procs.tail(i));
         }
+        if start.elapsed() > START {
+            let ready = alive.lock().map(|a| a.clone()).unwrap_or_default();
+            let missing = (0..robots).find(|i| !ready.contains(i)).unwrap_or(0);
+            bail!(
+                "robots {:?} were not ready after {START:?}; robot {missing}'s log:\n{}",
+                (0..robots).filter(|i| !ready.contains(i)).collect::<Vec<_>>(),
+                procs.tail(missing)
+            );
+        }
+        std::thread::sleep(Duration::from_millis(10));
     }
     let mut progress = progress;
     let mut restarted: Option<(Instant, PathBuf)> = None;
     let mut failed_restart = None;
-    // A robot whose link closed (its process ended) is not waited for: the network's
-    // liveliness says so as soon as its session drops.
-    let presence = server.presence();
-    let report = server
+    let presence = world.presence();
+    let report = world
         .play(|t| {
             progress(t);
-            for (team, link) in links.iter().enumerate() {
-                let here = link.subscribers(DeviceFrame::TYPE);
-                for i in team * n..(team + 1) * n {
-                    if !here.contains(&AgoraId(i as u32 + 1)) {
-                        presence.mark_gone(i);
-                    }
-                }
-            }
             let Some(r) = restart else { return };
             if restarted.is_some() || failed_restart.is_some() || t < r.at {
                 return;
@@ -345,7 +365,6 @@ pub fn play(
         })
         .map_err(|e| anyhow!("{e}"))?;
     procs.wait(Duration::from_secs(5));
-    drop(links);
     if let Some(e) = failed_restart {
         return Err(e.context("cannot restart the robot"));
     }
@@ -411,20 +430,24 @@ impl Launch {
 }
 
 /// Robot `i`'s file in this match: the world's robot (`SimConfig::robot_file`), its stack,
-/// the behaviors, its devices linked over `net` to the simulator's Agora of its team.
+/// the behaviors, its devices the simulator's at `endpoint`, its team's network `net` (none
+/// for a team of one).
 fn robot_file(
     cfg: &SimConfig,
     i: usize,
     stack: Stack,
     behaviors: Option<&Path>,
-    net: &Path,
+    endpoint: &str,
+    net: Option<&Path>,
 ) -> Result<String> {
-    let n = cfg.rules.team_size.max(1);
     let mut file = cfg.robot_file(i, stack.name());
     // The robot resolves relative paths against its file's directory: give it absolute ones.
     file.robot.behaviors = behaviors.map(std::path::absolute).transpose()?;
-    file.devices.net = Some(net.to_path_buf());
-    file.devices.agora = sim_agora(i / n);
+    file.devices.kind = "world".into();
+    file.devices.world = Some(WORLD.into());
+    file.devices.name = Some(robot_name(i, cfg.rules.team_size));
+    file.devices.connect = vec![endpoint.into()];
+    file.devices.net = net.map(Path::to_path_buf);
     let text = file.to_toml().map_err(|e| anyhow!("{e}"))?;
     Ok(format!("# Robot {i} of a distributed match (written by mrt sim --distributed).\n{text}"))
 }
@@ -451,102 +474,43 @@ pub struct Rejoined {
     pub phases: String,
 }
 
-/// What a robot process writes to its log when it answers for the first time.
-const FIRST_ANSWER: &str = "first answer ";
-/// What a robot process writes to its log when it is ready to play.
-const PHASES: &str = "phases: ";
-
-/// `mrt robot --config FILE`: one robot's Agora on its configured devices, until the final
-/// whistle (linked devices: the simulator that drives them says when).
+/// `mrt robot --config FILE`: one robot's Agora on the devices its file names, until its
+/// world ends the match.
 pub fn robot(args: &RobotArgs) -> Result<()> {
     let started = Instant::now();
     let file = RobotFile::from_file(&args.config).map_err(|e| anyhow!("{e}"))?;
-    if file.devices.kind == "world" {
-        return crate::world::robot(args, &file);
-    }
-    let robot_cfg = file.config().map_err(|e| anyhow!("{}: {e}", args.config.display()))?;
-    let spec = file.spec().map_err(|e| anyhow!("{}: {e}", args.config.display()))?;
-    if file.devices.kind != "linked" {
+    if file.devices.kind != "world" {
         bail!(
-            "{}: devices.kind = \"{}\": this mrt drives linked devices and worlds only (a robot \
-             with its own hardware implements mrt_robot::devices::Devices; see ARCHITECTURE.md)",
+            "{}: devices.kind = \"{}\": this mrt drives worlds of the device protocol \
+             (kind = \"world\", docs/devices.md); a robot with its own hardware implements \
+             mrt_robot::devices::Devices (see ARCHITECTURE.md)",
             args.config.display(),
-            file.devices.kind
+            file.devices.kind.escape_debug()
         );
     }
-    // Paths in the file are relative to it.
-    let here = args.config.parent().unwrap_or(Path::new("."));
-    let net = file
-        .devices
-        .net
-        .as_ref()
-        .map(|p| here.join(p))
-        .ok_or_else(|| anyhow!("{}: devices.net is missing", args.config.display()))?;
-    let net = AgoraConfig::from_file(&net).map_err(|e| anyhow!("{e}"))?;
-    let behaviors = file.robot.behaviors.as_ref().map(|p| here.join(p));
-    let dir = behaviors_dir(&[spec.stack], behaviors.as_deref()).map_err(|e| anyhow!("{e}"))?;
-    let id = spec.robot;
-    let (rec, extra) = args.recording(&format!("robot-{id}"))?;
-    let mut robot = RemoteRobot::with_members(&robot_cfg, spec, &dir, Some(net), extra)
-        .map_err(|e| anyhow!("{e}"))?;
-    let agora = robot.agora().ok_or_else(|| anyhow!("the robot has no Agora"))?;
-    let link = mrt_net::connect(agora)?;
-    let online = link.presence();
-    robot.set_presence(move |j| online.contains(AgoraId(j + 1)));
-    let linked = Instant::now();
-    // Ready when the devices' side hears this robot's answers and every teammate its reports.
-    let sim = AgoraId(file.devices.agora);
-    let mates: Vec<AgoraId> = robot.mate_agoras().into_iter().map(AgoraId).collect();
-    let ready = link.wait_until(START, |l| {
-        l.subscribers(DeviceAct::TYPE).contains(&sim)
-            && mates.iter().all(|m| l.subscribers(MateReport::TYPE).contains(m))
-    });
-    if !ready {
-        bail!(
-            "robot {id}: the devices' Agora ({sim}) and teammates {mates:?} not all found after \
-             {START:?} (found: {:?})",
-            link.agoras()
-        );
-    }
-    eprintln!(
-        "robot {id}: {PHASES}behaviors loaded and linked {:.3} s, ready {:.3} s after start",
-        (linked - started).as_secs_f64(),
-        started.elapsed().as_secs_f64()
-    );
-    robot.open();
-    let run = robot.run(SILENCE).map_err(|e| anyhow!("robot {id}: {e}"))?;
-    if let (Some(f), Some(t)) = (run.first_frame, run.first_answer) {
-        eprintln!(
-            "robot {id}: {FIRST_ANSWER}{:.3} s after start (first frame {:.3} s)",
-            (t - started).as_secs_f64(),
-            (f - started).as_secs_f64()
-        );
-    }
-    // Let the last word leave before the session closes.
-    std::thread::sleep(Duration::from_millis(300));
-    eprintln!(
-        "robot {id}: {} cycles, teammates late in {}; {:?}",
-        run.cycles,
-        run.late_mates,
-        link.stats()
-    );
-    finish_recording(rec, args.record.as_deref())
+    crate::world::robot(args, &file, started)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use mrt_dcdt::config::AgoraConfig;
 
     #[test]
-    fn robot_files_link_to_the_simulator_and_the_lower_teammates() {
+    fn team_files_make_a_full_mesh_on_loopback() {
         let ports = [7000, 7001, 7002, 7003];
-        let text = robot_net_file(3, 2, 9000, 7100, &ports);
-        let cfg = AgoraConfig::parse(&text, "robot-3.cfg").unwrap();
-        let net = NetConfig::from_agora_config(&cfg).unwrap();
-        assert_eq!(net.connect, ["tcp/127.0.0.1:7100", "tcp/127.0.0.1:7002"]);
-        assert!(net.listen.contains(&"tcp/127.0.0.1:7003".to_string()));
+        let net = |i, first| {
+            let text = team_net_file(i, first, 9000, &ports);
+            let cfg = AgoraConfig::parse(&text, "robot.cfg").unwrap();
+            NetConfig::from_agora_config(&cfg).unwrap()
+        };
+        assert_eq!(net(3, 2).connect, ["tcp/127.0.0.1:7002"]);
+        assert!(net(3, 2).listen.contains(&"tcp/127.0.0.1:7003".to_string()));
+        // The first robot links to the second.
+        assert_eq!(net(2, 2).connect, ["tcp/127.0.0.1:7003"]);
         // Loopback only: no multicast scouting, whose sockets bind 0.0.0.0.
-        assert_eq!(net.multicast, None);
-        assert!(net.listen.iter().chain(&net.connect).all(|e| e.starts_with("tcp/127.0.0.1:")));
+        assert_eq!(net(3, 2).multicast, None);
+        let n = net(1, 0);
+        assert!(n.listen.iter().chain(&n.connect).all(|e| e.starts_with("tcp/127.0.0.1:")));
     }
 }

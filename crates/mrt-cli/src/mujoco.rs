@@ -3,7 +3,7 @@
 //! world's devices, docs/devices.md), each team on a DCDT network of its own for the
 //! teammates' reports.
 
-use crate::distributed::{Launch, PortPicker, Robots};
+use crate::distributed::{team_net_file, Launch, PortPicker, Robots};
 use anyhow::{anyhow, bail, Context as _, Result};
 use mrt_core::{Pose2, Time};
 use mrt_monitor::catalogue::schema_of;
@@ -97,21 +97,6 @@ pub struct MujocoArgs {
     /// With --save-frames: every K-th step.
     #[arg(long, value_name = "K", default_value_t = 10, requires = "save_frames")]
     pub frame_every: u64,
-}
-
-/// The §3.3.1 file of robot `i` of a team of the robots `first..` (at least two): the team's
-/// discovery port and static links to the lower-numbered teammates; the first robot links to
-/// the second, so that it listens on its port (a full mesh on loopback).
-fn team_net_file(i: usize, first: usize, discovery: u16, ports: &[u16]) -> String {
-    let mut text = format!(
-        "# Robot {i} of a MuJoCo match (written by mrt world mujoco): its team's network.\n\
-         127.0.0.1 224.0.0.224 {discovery}\n"
-    );
-    let peers = if i == first { &ports[first + 1..first + 2] } else { &ports[first..i] };
-    for &p in peers {
-        text.push_str(&format!("ip link 0 127.0.0.1 {} 127.0.0.1 {p}\n", ports[i]));
-    }
-    text
 }
 
 /// Robot `i`'s file: `name` in the world reached at `endpoint`, on its team's network `net`

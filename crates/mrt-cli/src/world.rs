@@ -2,10 +2,12 @@
 //! devices of a world that speaks the device protocol over zenoh (docs/devices.md).
 
 use crate::distributed::RobotArgs;
-use anyhow::{anyhow, Context as _, Result};
+use anyhow::{anyhow, bail, Context as _, Result};
 use mrt_core::AgoraId;
 use mrt_dcdt::config::AgoraConfig;
+use mrt_dcdt::Message as _;
 use mrt_devices::Keys;
+use mrt_msgs::MateReport;
 use mrt_net::{NetConfig, RawPort};
 use mrt_robot::config::RobotFile;
 use mrt_robot::members::behaviors_dir;
@@ -15,10 +17,16 @@ use std::path::Path;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc::{sync_channel, TrySendError};
 use std::sync::Arc;
-use std::time::Duration;
+use std::time::{Duration, Instant};
 
 /// A robot that hears nothing from its world for this long gives up.
 const SILENCE: Duration = Duration::from_secs(30);
+/// How long a robot waits for its teammates to join the team's network.
+const TEAM: Duration = Duration::from_secs(120);
+/// What a robot writes to its log when it is ready to play.
+pub(crate) const PHASES: &str = "phases: ";
+/// What a robot writes to its log when it answers for the first time.
+pub(crate) const FIRST_ANSWER: &str = "first answer ";
 /// Messages from the world waiting for the robot (a lock-step world has one at a time).
 const QUEUE: usize = 64;
 /// zenoh's default multicast scouting group, where a world with no `connect` is found.
@@ -32,14 +40,13 @@ impl WorldPort for Port {
     }
 }
 
-/// Runs the robot of `file` (read from `path`) on its world until the world's end. A world's
-/// camera sends images: the vision µAgent runs whatever `[vision] enabled` says.
-pub fn robot(args: &RobotArgs, file: &RobotFile) -> Result<()> {
+/// Runs the robot of `file` (read from `path`) on its world until the world's end. The vision
+/// µAgent runs when `[vision] enabled` says so (a world that sends images needs it; one that
+/// sends an object sensor's frames does not).
+pub fn robot(args: &RobotArgs, file: &RobotFile, started: Instant) -> Result<()> {
     let path = args.config.as_path();
     let here = path.parent().unwrap_or(Path::new("."));
     let at = |e: String| anyhow!("{}: {e}", path.display());
-    let mut file = file.clone();
-    file.vision.enabled = true;
     let cfg = file.config().map_err(at)?;
     let spec = file.spec().map_err(at)?;
     let d = &file.devices;
@@ -56,10 +63,23 @@ pub fn robot(args: &RobotArgs, file: &RobotFile) -> Result<()> {
     let (rec, extra) = args.recording(&name)?;
     let mut remote = RemoteRobot::with_members(&cfg, spec, &dir, net.clone(), extra)
         .map_err(|e| anyhow!("{e}"))?;
+    let linked = Instant::now();
     // The team's network, when there is one; without it no teammate is waited for.
     let _team = match (&net, remote.agora()) {
         (Some(_), Some(agora)) => {
             let link = mrt_net::connect(agora)?;
+            // Ready once every teammate hears this robot's reports: the first report goes
+            // out in the first step, and a report sent before a teammate listens is lost.
+            let mates: Vec<AgoraId> = remote.mate_agoras().into_iter().map(AgoraId).collect();
+            let heard = |l: &mrt_net::NetLink| {
+                mates.iter().all(|m| l.subscribers(MateReport::TYPE).contains(m))
+            };
+            if !link.wait_until(TEAM, heard) {
+                bail!(
+                    "robot {name}: teammates {mates:?} not all on the team's network after                      {TEAM:?} (found: {:?})",
+                    link.agoras()
+                );
+            }
             let online = link.presence();
             remote.set_presence(move |j| online.contains(AgoraId(j + 1)));
             Some(link)
@@ -94,9 +114,21 @@ pub fn robot(args: &RobotArgs, file: &RobotFile) -> Result<()> {
     let _end = port.subscribe(&keys.end(), mailer(WorldMail::End))?;
     let _alive = port.declare_token(&keys.alive())?;
     eprintln!("robot {name}: listening to world {world} ({})", keys.sense());
+    eprintln!(
+        "robot {name}: {PHASES}behaviors loaded and linked {:.3} s, ready {:.3} s after start",
+        (linked - started).as_secs_f64(),
+        started.elapsed().as_secs_f64()
+    );
     let robot = WorldRobot::new(remote, cfg.base, keys);
     let run =
         robot.run(&rx, &Port(port.clone()), SILENCE).map_err(|e| anyhow!("robot {name}: {e}"))?;
+    if let (Some(f), Some(t)) = (run.robot.first_frame, run.robot.first_answer) {
+        eprintln!(
+            "robot {name}: {FIRST_ANSWER}{:.3} s after start (first frame {:.3} s)",
+            (t - started).as_secs_f64(),
+            (f - started).as_secs_f64()
+        );
+    }
     // Let the last word leave before the session closes.
     std::thread::sleep(Duration::from_millis(300));
     let dropped = serde_json::to_string(&run.bye.dropped).unwrap_or_default();

@@ -1,5 +1,6 @@
-//! `mrt robot --config FILE`: the real-robot entry point (the distributed match starts its
-//! robots with it; `sim_cli.rs` plays such a match). Here: the shipped robot file reads, and a
+//! `mrt robot --config FILE`: the entry point of a robot on any world of the device protocol
+//! (the distributed match and the MuJoCo world start their robots with it; `sim_cli.rs` plays
+//! such a match). Here: the shipped robot file reads, and a
 //! bad file is refused with its file, line and column before anything starts.
 #![cfg(feature = "net")]
 #![allow(clippy::unwrap_used)]
@@ -8,15 +9,15 @@ use mrt_robot::config::RobotFile;
 use std::process::Command;
 
 fn shipped() -> std::path::PathBuf {
-    std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../configs/robot/linked.toml")
+    std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../configs/robot/robot.toml")
 }
 
 #[test]
-fn the_shipped_robot_file_describes_a_linked_chaos_field_player() {
+fn the_shipped_robot_file_describes_a_chaos_field_player_on_a_world() {
     let f = RobotFile::from_file(shipped()).unwrap();
     let spec = f.spec().unwrap();
     assert_eq!((spec.robot, spec.keeper, spec.stack.name()), (1, false, "chaos"));
-    assert_eq!((f.devices.kind.as_str(), f.devices.agora), ("linked", 201));
+    assert_eq!((f.devices.kind.as_str(), f.devices.world.as_deref()), ("world", Some("sim")));
     // Its values are the defaults, written out.
     let defaults = RobotFile::default();
     assert_eq!(
@@ -46,9 +47,15 @@ fn a_bad_robot_file_is_refused_with_its_place() {
     std::fs::write(&bad, "[devices]\nkind = \"usb\"\n").unwrap();
     let (ok, err) = robot(&bad);
     assert!(!ok && err.contains("devices.kind = \"usb\"") && err.contains("Devices"), "{err}");
-    std::fs::write(&bad, "[devices]\nnet = \"missing.cfg\"\n").unwrap();
+    std::fs::write(&bad, "[devices]\nworld = \"w\"\nnet = \"missing.cfg\"\n").unwrap();
     let (ok, err) = robot(&bad);
     assert!(!ok && err.contains("missing.cfg"), "{err}");
+    std::fs::write(&bad, "[devices]\nkind = \"world\"\n").unwrap();
+    let (ok, err) = robot(&bad);
+    assert!(!ok && err.contains("devices.world is missing"), "{err}");
+    std::fs::write(&bad, "[devices]\nworld = \"No Name\"\n").unwrap();
+    let (ok, err) = robot(&bad);
+    assert!(!ok && err.contains("bad.toml: devices") && err.contains("is not a name"), "{err}");
     let (ok, err) = robot(&dir.join("none.toml"));
     assert!(!ok && err.contains("none.toml"), "{err}");
     std::fs::remove_dir_all(&dir).unwrap();

@@ -155,6 +155,11 @@ impl Answers {
         })
     }
 
+    /// The world's run.
+    pub fn run(&self) -> &str {
+        &self.run
+    }
+
     /// Robot `i`'s keys.
     pub fn keys(&self, i: usize) -> Option<&Keys> {
         self.robots.get(i)

@@ -478,6 +478,25 @@ impl RawPort {
             .map_err(|e| NetError::Zenoh(e.to_string()))
     }
 
+    /// Calls `f` with the key of every liveliness token matching `key_expr` that is on the
+    /// network now or appears later (`true`), and of each one that goes away (`false`: its
+    /// owner dropped it, or its session ended), on zenoh's receiving thread.
+    pub fn watch_tokens(
+        &self,
+        key_expr: &str,
+        f: impl Fn(&str, bool) + Send + Sync + 'static,
+    ) -> Result<RawSubscription, NetError> {
+        Self::check(key_expr)?;
+        self.0
+            .liveliness()
+            .declare_subscriber(key_expr.to_string())
+            .history(true)
+            .callback(move |s: Sample| f(s.key_expr().as_str(), s.kind() == SampleKind::Put))
+            .wait()
+            .map(RawSubscription)
+            .map_err(|e| NetError::Zenoh(e.to_string()))
+    }
+
     /// Puts `bytes` on `key` (reliably: blocks when the link is congested).
     pub fn put(&self, key: &str, bytes: Vec<u8>) -> Result<(), NetError> {
         Self::check(key)?;

@@ -107,6 +107,15 @@ impl Base {
         Ok(self.forward(&self.wheel_speeds(duty)?))
     }
 
+    /// The body velocity (robot frame, m/s and rad/s) that wheel speeds (rad/s, in wheel
+    /// order) drive: what a simulator does with a robot's wheel set-points.
+    pub fn twist_of(&self, wheels: &[f64]) -> Result<Twist, DriverError> {
+        if wheels.len() != self.wheels() {
+            return Err(DriverError::WheelCount { wheels: self.wheels(), got: wheels.len() });
+        }
+        Ok(self.forward(wheels))
+    }
+
     /// The wheel speeds (rad/s, in wheel order) that duty cycles ask for: each duty cycle,
     /// clamped to `[-1, 1]` (NaN: 0), times the wheels' top speed.
     pub fn wheel_speeds(&self, duty: &[f64]) -> Result<Vec<f64>, DriverError> {
@@ -294,15 +303,16 @@ mod tests {
     fn the_wheels_for_a_twist_drive_that_twist() {
         let t = Twist::new(0.6, 0.2, -0.8);
         let omni = Base::parse("omni").unwrap();
-        let back = omni.forward(&omni.wheels_for(&t));
+        let back = omni.twist_of(&omni.wheels_for(&t)).unwrap();
         assert!((back.vx - t.vx).abs() < 1e-12 && (back.vy - t.vy).abs() < 1e-12);
         assert!((back.omega - t.omega).abs() < 1e-12);
         // A differential base drives the twist without its sideways part.
         let diff = Base::parse("differential").unwrap();
-        let back = diff.forward(&diff.wheels_for(&t));
+        let back = diff.twist_of(&diff.wheels_for(&t)).unwrap();
         assert!((back.vx - t.vx).abs() < 1e-12 && back.vy == 0.0);
         assert!((back.omega - t.omega).abs() < 1e-12);
         assert_eq!((omni.wheels_for(&t).len(), diff.wheels_for(&t).len()), (3, 2));
+        assert!(diff.twist_of(&[1.0]).is_err());
     }
 
     #[test]

@@ -341,20 +341,15 @@ impl Default for LocalizationSection {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct DevicesSection {
-    /// `linked`: the devices are reached over the bus ([`crate::devices::LinkedDevices`]: a
-    /// simulator in another process, or a board that speaks DCDT). A team whose robot has its
-    /// own hardware implements [`crate::devices::Devices`] in Rust (ARCHITECTURE.md, "Adding
-    /// a real robot").
-    /// `world`: a world that speaks the device protocol over zenoh (docs/devices.md:
-    /// MuJoCo, a Python world, a real robot's bridge; [`crate::world`]).
+    /// `world` (the default and, in this mrt, the only kind): a world that speaks the device
+    /// protocol over zenoh (docs/devices.md: `mrt sim --distributed`, MuJoCo, a Python world,
+    /// a real robot's bridge; [`crate::world`]). A team whose robot has its own hardware
+    /// implements [`crate::devices::Devices`] in Rust (ARCHITECTURE.md, "Adding a real
+    /// robot").
     pub kind: String,
-    /// The robot's Agora configuration file (MRT manual §3.3.1), relative to this file: for
-    /// `linked`, the network of the devices' side and the teammates; for `world`, the
+    /// The robot's Agora configuration file (MRT manual §3.3.1), relative to this file: the
     /// teammates' network (optional: a robot without one hears no teammate).
     pub net: Option<PathBuf>,
-    /// For `linked`: the Agora id of the devices' side (the simulator's Agora of this robot's
-    /// team).
-    pub agora: u32,
     /// For `world`: the world's name, as in its keys.
     pub world: Option<String>,
     /// For `world`: the robot's name in that world (default `robot-<id>`).
@@ -367,9 +362,8 @@ pub struct DevicesSection {
 impl Default for DevicesSection {
     fn default() -> Self {
         DevicesSection {
-            kind: "linked".into(),
+            kind: "world".into(),
             net: None,
-            agora: 201,
             world: None,
             name: None,
             connect: Vec::new(),

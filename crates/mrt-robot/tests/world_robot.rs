@@ -77,7 +77,12 @@ fn sense(step: u64) -> Sense {
                 })
                 .collect(),
         ),
-        camera: Some(CameraReading { time: 0.1 * step as f64, pan: None, image: image() }),
+        camera: Some(CameraReading {
+            time: 0.1 * step as f64,
+            pan: None,
+            image: Some(image()),
+            objects: None,
+        }),
         game: GameReading { state: RefereeState::Playing, attack: 1.0, ..GameReading::default() },
         ..Sense::default()
     }

@@ -442,6 +442,14 @@ impl Pitch {
         self.odometers[i].read(&self.world, &self.cfg.odometry, period, &mut self.rngs[i])
     }
 
+    /// What robot `i`'s mice and wheel encoders counted since its last reading, as the devices
+    /// count it (the wheels' turns, rad): [`Pitch::odometry`] for a world of the device
+    /// protocol.
+    pub fn odometry_counts(&mut self, i: usize) -> crate::sensor::Counts {
+        let period = self.cfg.rules.control_period;
+        self.odometers[i].count(&self.world, &self.cfg.odometry, period, &mut self.rngs[i])
+    }
+
     /// What robot `i`'s camera sees now: its image (vision percepts), or the object sensor's
     /// sightings (oracle percepts).
     pub fn camera(&mut self, i: usize) -> CameraFrame {
