@@ -45,7 +45,7 @@ SERVO_TIME = 0.02  # s: how fast the body follows its wheels (velocity servo gai
 STALL_SLIP = 2.0  # rad/s: the most a wheel's speed runs ahead of the body's motion (a blocked
 #                   robot's motors stall instead of spinning on)
 
-# --- sensors and actuators (configs/robot/linked.toml) --------------------------------------
+# --- sensors and actuators (configs/robot/robot.toml) --------------------------------------
 MICE_DISTANCE = 0.2  # m: [sensors] mice_distance
 PAN_SPEED = 3.0  # rad/s: [gaze] pan_speed
 PAN_LIMIT = 1.5  # rad: [gaze] pan_min / pan_max

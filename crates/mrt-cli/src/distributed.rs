@@ -30,7 +30,7 @@ const START: Duration = Duration::from_secs(120);
 /// `mrt robot --config FILE`: one robot's Agora on its configured devices.
 #[derive(clap::Args)]
 pub struct RobotArgs {
-    /// The robot file (TOML; see configs/robot/linked.toml): which robot, its stack, body,
+    /// The robot file (TOML; see configs/robot/robot.toml): which robot, its stack, body,
     /// sensors, field, guidance and devices.
     #[arg(long)]
     pub config: PathBuf,

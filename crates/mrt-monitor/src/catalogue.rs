@@ -5,10 +5,9 @@ use mrt_core::{Message, MsgType};
 use mrt_dcdt::describe::{DescribeError, SelfDescribing};
 use mrt_dcdt::{DeliveryWarranty, Endpoint, Msg};
 use mrt_msgs::{
-    BehaviorPush, BehaviorPushReply, BehaviorStatus, CameraFrame, DeviceAct, DeviceFrame,
-    FinalWhistle, GameInfo, HfsmStructure, Localization, MateReport, MotorCommand, Odometry,
-    Percepts, PlanRequest, PlannedPath, ReloadRequest, RobotCommand, RobotEnd, SonarScan,
-    WorldSnapshot,
+    BehaviorPush, BehaviorPushReply, BehaviorStatus, CameraFrame, GameInfo, HfsmStructure,
+    Localization, MateReport, MotorCommand, Odometry, Percepts, PlanRequest, PlannedPath,
+    ReloadRequest, RobotCommand, SonarScan, WorldSnapshot,
 };
 use schemars::JsonSchema;
 use serde::de::DeserializeOwned;
@@ -112,10 +111,6 @@ catalogue! {
     MotorCommand,
     Odometry,
     CameraFrame => camera_frame_json,
-    DeviceFrame,
-    DeviceAct,
-    FinalWhistle,
-    RobotEnd,
     GameInfo,
     Localization,
     Percepts,

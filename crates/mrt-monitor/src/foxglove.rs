@@ -7,8 +7,7 @@
 //! - `/<robot>/pose`: `foxglove.FrameTransform`, where the robot believes it is
 //!   (`Localization`), parent `field`, child `<robot>`;
 //! - `/log`: `foxglove.Log`, the errors and faults the robots report on the bus (a behavior's
-//!   errors in `BehaviorStatus`, a refused `BehaviorPush`, a `PlannedPath` with no path, the
-//!   Members' faults in `RobotEnd` and `DeviceAct`).
+//!   errors in `BehaviorStatus`, a refused `BehaviorPush`, a `PlannedPath` with no path).
 //!
 //! The types follow Foxglove's documented JSON schemas
 //! (<https://docs.foxglove.dev/docs/visualization/message-schemas/>): the same field names,
@@ -20,7 +19,7 @@
 use crate::camera::Timestamp;
 use crate::view::Truth;
 use mrt_core::{Pose2, Time};
-use mrt_msgs::{BehaviorPushReply, BehaviorStatus, DeviceAct, PlannedPath, RobotEnd};
+use mrt_msgs::{BehaviorPushReply, BehaviorStatus, PlannedPath};
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 use std::borrow::Cow;
@@ -609,21 +608,6 @@ pub fn logs_of(m: &mrt_dcdt::Msg, robot: &str, time: Time) -> Vec<Log> {
         if !p.error.is_empty() {
             out.push(Log::new(robot, "PlannedPath", LogLevel::WARNING, &p.error, time));
         }
-    } else if let Ok(end) = m.get::<RobotEnd>() {
-        for f in &end.faults {
-            let what = format!(
-                "{} faulted {} times{}: {}",
-                f.name,
-                f.count,
-                if f.never_ran { " (never ran)" } else { "" },
-                f.error
-            );
-            out.push(Log::new(robot, "RobotEnd", LogLevel::ERROR, &what, time));
-        }
-    } else if let Ok(act) = m.get::<DeviceAct>() {
-        for f in &act.faults {
-            out.push(Log::new(robot, "DeviceAct", LogLevel::ERROR, f, time));
-        }
     }
     out
 }
@@ -632,7 +616,7 @@ pub fn logs_of(m: &mrt_dcdt::Msg, robot: &str, time: Time) -> Vec<Log> {
 mod tests {
     use super::*;
     use mrt_core::Message;
-    use mrt_msgs::{GameState, MemberFault};
+    use mrt_msgs::GameState;
     use serde_json::{json, Value};
 
     fn keys(v: &Value) -> Vec<&str> {
@@ -772,18 +756,13 @@ mod tests {
         assert_eq!((v["file"].as_str(), v["line"].as_u64()), (Some("attacker.lua"), Some(3)));
         assert_eq!(v["name"], "away/1 BehaviorStatus");
         assert_eq!(v["timestamp"], json!({"sec": 1, "nsec": 0}));
-        let end = RobotEnd {
-            robot: 3,
-            faults: vec![MemberFault {
-                name: "behavior".into(),
-                count: 2,
-                never_ran: false,
-                error: "no such file".into(),
-            }],
-        };
-        let logs = logs_of(&msg(end), "home/3", Time(0));
-        assert_eq!(logs[0].message, "behavior faulted 2 times: no such file");
-        assert_eq!((logs[0].level, logs[0].file.as_str(), logs[0].line), (LogLevel::ERROR, "", 0));
+        let path = PlannedPath { error: "no way round".into(), ..Default::default() };
+        let logs = logs_of(&msg(path), "home/3", Time(0));
+        assert_eq!(logs[0].message, "no way round");
+        assert_eq!(
+            (logs[0].level, logs[0].file.as_str(), logs[0].line),
+            (LogLevel::WARNING, "", 0)
+        );
         assert!(logs_of(&msg(BehaviorStatus::default()), "home/0", Time(0)).is_empty());
         let schema = crate::catalogue::schema_of::<Log>();
         assert_eq!(schema["title"], "foxglove.Log");

@@ -37,8 +37,6 @@ pub const COMPACT_DECIMATED: &[&str] = &[
     "Odometry",
     "Localization",
     "CameraFrame",
-    "DeviceFrame",
-    "DeviceAct",
     "foxglove.FrameTransform",
 ];
 

@@ -403,53 +403,6 @@ impl Samples for CameraFrame {
     }
 }
 
-impl Samples for DeviceFrame {
-    fn samples() -> Vec<Self> {
-        let filled = DeviceFrame {
-            robot: 3,
-            cycle: 1200,
-            odometry: filled_odometry(),
-            camera: filled_camera(),
-            game: GameInfo::samples().pop().unwrap_or_default(),
-            sonars: vec![Sonar::new(0.0, 1.5)],
-            not_awaited: vec![4, 5],
-        };
-        vec![DeviceFrame::default(), filled]
-    }
-}
-
-impl Samples for DeviceAct {
-    fn samples() -> Vec<Self> {
-        let filled = DeviceAct {
-            robot: 3,
-            cycle: 1200,
-            duty: Some(vec![0.5, -0.5, 0.25]),
-            kick: true,
-            pan: Some(-0.3),
-            faults: vec!["guidance: late".to_owned()],
-        };
-        vec![DeviceAct::default(), filled]
-    }
-}
-
-impl Samples for FinalWhistle {
-    fn samples() -> Vec<Self> {
-        vec![FinalWhistle::default(), FinalWhistle { cycles: 30_000 }]
-    }
-}
-
-impl Samples for RobotEnd {
-    fn samples() -> Vec<Self> {
-        let fault = MemberFault {
-            name: "vision".to_owned(),
-            count: 2,
-            never_ran: false,
-            error: "panicked".to_owned(),
-        };
-        vec![RobotEnd::default(), RobotEnd { robot: 4, faults: vec![fault] }]
-    }
-}
-
 impl Samples for GameInfo {
     fn samples() -> Vec<Self> {
         let filled = GameInfo {

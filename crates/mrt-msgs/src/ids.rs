@@ -38,14 +38,8 @@ pub const MOTOR_COMMAND: MsgType = reserved(0x42);
 pub const ODOMETRY: MsgType = reserved(0x43);
 /// [`crate::CameraFrame`]: what the camera (object sensor) saw.
 pub const CAMERA_FRAME: MsgType = reserved(0x44);
-/// [`crate::DeviceFrame`]: a robot's device readings from a simulator in another process.
-pub const DEVICE_FRAME: MsgType = reserved(0x45);
-/// [`crate::DeviceAct`]: what a robot's drivers did, back to that simulator.
-pub const DEVICE_ACT: MsgType = reserved(0x46);
-/// [`crate::FinalWhistle`]: the match is over.
-pub const FINAL_WHISTLE: MsgType = reserved(0x47);
-/// [`crate::RobotEnd`]: a robot's last word, its Members' faults.
-pub const ROBOT_END: MsgType = reserved(0x48);
+// 0x45–0x48 carried a simulator's device frames over the bus before the device protocol
+// (docs/devices.md) replaced them: retired, never to be given to another type.
 /// [`crate::GameInfo`]: the game controller's news.
 pub const GAME_INFO: MsgType = reserved(0x49);
 /// [`crate::Localization`]: the world model's own pose estimate, for monitors.
@@ -82,10 +76,6 @@ pub const TABLE: &[(MsgType, &str)] = &[
     (MOTOR_COMMAND, "MotorCommand"),
     (ODOMETRY, "Odometry"),
     (CAMERA_FRAME, "CameraFrame"),
-    (DEVICE_FRAME, "DeviceFrame"),
-    (DEVICE_ACT, "DeviceAct"),
-    (FINAL_WHISTLE, "FinalWhistle"),
-    (ROBOT_END, "RobotEnd"),
     (GAME_INFO, "GameInfo"),
     (LOCALIZATION, "Localization"),
     (PERCEPTS, "Percepts"),
@@ -134,10 +124,6 @@ mod tests {
             (0xFFFF_0042, "MotorCommand"),
             (0xFFFF_0043, "Odometry"),
             (0xFFFF_0044, "CameraFrame"),
-            (0xFFFF_0045, "DeviceFrame"),
-            (0xFFFF_0046, "DeviceAct"),
-            (0xFFFF_0047, "FinalWhistle"),
-            (0xFFFF_0048, "RobotEnd"),
             (0xFFFF_0049, "GameInfo"),
             (0xFFFF_004A, "Localization"),
             (0xFFFF_004B, "Percepts"),

@@ -21,7 +21,6 @@
 //! | [`PlanRequest`], [`PlannedPath`] | guidance (or SCARE) ↔ planner | manual ch. 9 (SPIKE) |
 //! | [`BehaviorStatus`], [`ReloadRequest`], [`BehaviorPush`], [`BehaviorPushReply`] | behavior Member ↔ monitors, editors | TeamChaos `001` §3.2 |
 //! | [`HfsmStructure`] (the machine's states and transitions) | HFSM Member → monitors | ThinkingCap `001` §4.1, §5.1 |
-//! | [`DeviceFrame`], [`DeviceAct`], [`FinalWhistle`], [`RobotEnd`] | distributed simulator ↔ robot | MRT's own |
 //!
 //! Three standard messages live with their engine and take their id from [`ids`] too: the
 //! blackboard's `BbUpdate` (`mrt-blackboard`), the bus's XML `SelfDescribing` message
@@ -40,7 +39,7 @@
 
 mod acting;
 mod behavior;
-mod device;
+mod fault;
 pub mod ids;
 mod localization;
 pub mod robot;
@@ -55,7 +54,7 @@ pub use behavior::{
     BehaviorPush, BehaviorPushReply, BehaviorStatus, HfsmMachine, HfsmState, HfsmStructure,
     HfsmTransition, ReloadRequest,
 };
-pub use device::{DeviceAct, DeviceFrame, FinalWhistle, MemberFault, RobotEnd};
+pub use fault::MemberFault;
 pub use localization::{BallBelief, FilterCounts, Localization};
 pub use mrt_core::{Message, MsgType};
 pub use robot::{
@@ -104,10 +103,6 @@ messages! {
     MotorCommand => MOTOR_COMMAND,
     Odometry => ODOMETRY,
     CameraFrame => CAMERA_FRAME,
-    DeviceFrame => DEVICE_FRAME,
-    DeviceAct => DEVICE_ACT,
-    FinalWhistle => FINAL_WHISTLE,
-    RobotEnd => ROBOT_END,
     GameInfo => GAME_INFO,
     Localization => LOCALIZATION,
     Percepts => PERCEPTS,

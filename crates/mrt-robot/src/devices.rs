@@ -8,9 +8,9 @@
 //! - a real robot: a team implements [`Devices`] for its base, camera and mice (see
 //!   ARCHITECTURE.md, "Adding a real robot");
 //! - the simulated pitch in the same process (`mrt_sim::devices::PitchDevices`);
-//! - [`LinkedDevices`]: hardware (or a simulator) reached over the bus: it holds the readings
-//!   of the cycle's [`DeviceFrame`](mrt_msgs::DeviceFrame) and gathers what the drivers did
-//!   into a [`DeviceAct`](mrt_msgs::DeviceAct) (see [`crate::remote`]).
+//! - [`LinkedDevices`]: a world reached over the network (docs/devices.md): it holds the
+//!   readings of the step the world sent and gathers what the drivers did for the robot's
+//!   answer (see [`crate::remote`] and [`crate::world`]).
 
 use mrt_msgs::{CameraFrame, GameInfo, Odometry, Sonar};
 use std::sync::{Arc, Mutex};

@@ -1,13 +1,14 @@
-//! The robot side of a simulator that runs elsewhere (`mrt sim --distributed`): one robot's
-//! Agora with the Members of [`add_robot`] on [`LinkedDevices`], run one cycle per
-//! [`DeviceFrame`] the simulator sends, answering with a [`DeviceAct`].
+//! The robot program on devices that are loaded from outside each cycle: one robot's Agora
+//! with the Members of [`add_robot`] on [`LinkedDevices`], run one cycle per step its world
+//! sends ([`RemoteRobot::cycle`]; the device protocol's robot, [`crate::world::WorldRobot`],
+//! drives it).
 //!
 //! **Same match as one process.** Teammates' reports must arrive as they do on one bus, where
 //! robot `i` hears in cycle `k` the reports its lower-numbered teammates sent in cycle `k` and
 //! the others' of cycle `k − 1`. A [`RemoteRobot`] waits for exactly those reports (by their
 //! creation time) before it runs a cycle. A teammate that stays silent (killed, far too slow)
-//! is not waited for again until it speaks. The simulator's side is
-//! `mrt_sim::remote::PitchServer`.
+//! or leaves the team's network is not waited for again until it speaks. The simulator's
+//! side is `mrt_sim::remote::PitchWorld`.
 
 use crate::config::RobotConfig;
 use crate::devices::{Actuation, LinkedDevices, Loaded};
@@ -15,10 +16,9 @@ use crate::members::{add_robot, member_faults, RobotSpec};
 use mrt_core::{SimClock, Time};
 use mrt_dcdt::config::AgoraConfig;
 use mrt_dcdt::{
-    Activation, Agora, DeliveryWarranty, Endpoint, InnerLinkManager, Member, RequestType,
-    SteppedExecutor,
+    Activation, Agora, Endpoint, InnerLinkManager, Member, RequestType, SteppedExecutor,
 };
-use mrt_msgs::{DeviceAct, DeviceFrame, FinalWhistle, MateReport, MemberFault, RobotEnd};
+use mrt_msgs::{MateReport, MemberFault};
 use std::collections::BTreeMap;
 use std::path::Path;
 use std::sync::{Arc, Mutex};
@@ -28,8 +28,8 @@ fn robot_index(id: u32) -> usize {
     usize::try_from(id).unwrap_or(usize::MAX)
 }
 
-/// One robot whose simulator runs elsewhere: its Agora with the Members of [`add_robot`] on a
-/// [`SteppedExecutor`], and the runner's own endpoints (module doc).
+/// One robot on devices loaded each cycle: its Agora with the Members of [`add_robot`] on a
+/// [`SteppedExecutor`], and the runner's own endpoint for teammates' reports (module doc).
 pub struct RemoteRobot {
     spec: RobotSpec,
     exec: SteppedExecutor,
@@ -38,8 +38,6 @@ pub struct RemoteRobot {
     /// a teammate's report reaches the robot's Members before this endpoint sees it.
     inbox: Endpoint,
     _runner: Agora,
-    /// On the robot's Agora, whose link sends what it publishes.
-    outbox: Endpoint,
     /// Teammates (robot numbers), and the creation time of each one's latest report.
     mates: BTreeMap<u32, Option<Time>>,
     /// Teammates not waited for (silent once, until they speak again).
@@ -47,9 +45,6 @@ pub struct RemoteRobot {
     period: Duration,
     /// How long to wait for a teammate's report before running without it.
     mate_wait: Duration,
-    /// A frame or the whistle that arrived while waiting for teammates (the simulator gave up
-    /// on this robot's answer and went on): handled first in the next round.
-    early: Vec<Event>,
     /// Whether teammate `j` (robot index) is on the network at all (default: assumed).
     on_network: Box<dyn Fn(u32) -> bool + Send>,
     /// Whether this robot ran a cycle yet (a robot started mid-match has no reports from the
@@ -65,7 +60,7 @@ pub struct RobotRun {
     /// Cycles in which some teammate's report came too late (the match may differ from the
     /// single-process one from then on).
     pub late_mates: u64,
-    /// When the first frame came.
+    /// When the first step came.
     pub first_frame: Option<Instant>,
     /// When the robot sent its first answer (for a robot restarted mid-match: when it
     /// rejoined).
@@ -108,7 +103,6 @@ impl RemoteRobot {
             let id = agora.add_boxed_member(member, Activation::OnMessage);
             agora.activate_member(id).map_err(|e| e.to_string())?;
         }
-        let outbox = agora.endpoint();
         exec.add_agora(agora).map_err(|e| e.to_string())?;
         let runner_id = 1000 + spec.agora_id()?;
         let mut runner = exec
@@ -132,12 +126,10 @@ impl RemoteRobot {
             devices,
             inbox,
             _runner: runner,
-            outbox,
             mates,
             absent: Vec::new(),
             period,
             mate_wait: Duration::from_secs(2),
-            early: Vec::new(),
             on_network: Box::new(|_| true),
             ran: false,
         })
@@ -166,24 +158,13 @@ impl RemoteRobot {
         self.on_network = Box::new(on_network);
     }
 
-    /// Ready for the match: from now on the simulator's frames reach this robot (they are
-    /// sent once every robot subscribed).
-    pub fn open(&self) {
-        self.inbox.subscribe_to::<DeviceFrame>(RequestType::Remote);
-        self.inbox.subscribe_to::<FinalWhistle>(RequestType::Remote);
-    }
-
-    fn note(&mut self, m: &mrt_dcdt::MsgRef) -> Option<Event> {
+    /// Notes a teammate's report: its creation time, and that the teammate speaks again.
+    fn note(&mut self, m: &mrt_dcdt::MsgRef) {
         if let Ok(r) = m.get::<MateReport>() {
             if let Some(t) = self.mates.get_mut(&r.id) {
                 *t = Some(m.header().creation_time);
                 self.absent.retain(|&j| j != r.id);
             }
-            None
-        } else if let Ok(f) = m.get::<DeviceFrame>() {
-            (robot_index(f.robot) == self.spec.robot).then(|| Event::Frame(Box::new(f.clone())))
-        } else {
-            m.get::<FinalWhistle>().ok().map(|_| Event::Whistle)
         }
     }
 
@@ -211,63 +192,6 @@ impl RemoteRobot {
         self.mates.keys().all(|&j| self.mate_ready(j, now))
     }
 
-    /// Runs cycles as the simulator's frames come, until the final whistle (then the Members
-    /// close and their faults are sent) or `silence` without any frame.
-    pub fn run(mut self, silence: Duration) -> Result<RobotRun, String> {
-        let mut run = RobotRun::default();
-        let mut last = Instant::now();
-        loop {
-            let mut frame = None;
-            let mut whistle = false;
-            let mut events = std::mem::take(&mut self.early);
-            while let Some(m) = self.inbox.receive_msg() {
-                events.extend(self.note(&m));
-            }
-            for e in events {
-                match e {
-                    Event::Frame(f) => frame = Some(f),
-                    Event::Whistle => whistle = true,
-                }
-            }
-            if whistle {
-                return self.end(run);
-            }
-            let Some(frame) = frame else {
-                if last.elapsed() > silence {
-                    return Err(format!("no frame from the simulator for {silence:?}"));
-                }
-                self.inbox.wait_msg(Duration::from_millis(50));
-                continue;
-            };
-            last = Instant::now();
-            run.first_frame.get_or_insert(last);
-            // The clock of cycle k, also for a robot restarted in the middle of a match.
-            let period = u64::try_from(self.period.as_nanos()).unwrap_or(u64::MAX);
-            let input = Cycle {
-                at: Time(frame.cycle.saturating_mul(period)),
-                first: frame.cycle == 0,
-                not_awaited: frame.not_awaited,
-                readings: Loaded {
-                    odometry: Some(frame.odometry),
-                    camera: Some(frame.camera),
-                    game: Some(frame.game),
-                    sonars: Some(frame.sonars),
-                },
-            };
-            let act = self.cycle(input, &mut run)?;
-            let answer = DeviceAct {
-                robot: frame.robot,
-                cycle: frame.cycle,
-                duty: act.duty,
-                kick: act.kick,
-                pan: act.pan,
-                faults: act.faults,
-            };
-            self.outbox.publish_with(answer, DeliveryWarranty::Reliable, 128);
-            run.first_answer.get_or_insert_with(Instant::now);
-        }
-    }
-
     /// Runs one control cycle on `input`'s readings at its time, after the teammates'
     /// reports due then (module doc), and says what the drivers did.
     pub fn cycle(&mut self, input: Cycle, run: &mut RobotRun) -> Result<Actuation, String> {
@@ -275,13 +199,6 @@ impl RemoteRobot {
             self.exec.clock().set(input.at);
         }
         let now = self.exec.now();
-        // Teammates the devices' side gave up on are not waited for here either (a process
-        // killed and started again may not even be seen to leave the network).
-        for j in input.not_awaited {
-            if self.mates.contains_key(&j) && !self.absent.contains(&j) {
-                self.absent.push(j);
-            }
-        }
         // A robot started in the middle of the match waits for no teammate in its first
         // cycle: their reports of this cycle may have left before it subscribed.
         let late_joiner = !self.ran && !input.first;
@@ -325,22 +242,10 @@ impl RemoteRobot {
             }
             self.inbox.wait_msg(Duration::from_millis(2));
             while let Some(m) = self.inbox.receive_msg() {
-                // Reports, as a rule: the next frame waits for this cycle's answer, unless
-                // the simulator stopped waiting for it.
-                if let Some(e) = self.note(&m) {
-                    self.early.push(e);
-                }
+                self.note(&m);
             }
         }
         true
-    }
-
-    fn end(self, run: RobotRun) -> Result<RobotRun, String> {
-        let robot = u32::try_from(self.spec.robot).map_err(|e| e.to_string())?;
-        let RemoteRobot { spec, exec, outbox, .. } = self;
-        let faults = finish(&spec, exec)?;
-        outbox.publish_with(RobotEnd { robot, faults }, DeliveryWarranty::Reliable, 128);
-        Ok(run)
     }
 
     /// The match is over: the Members close; their faults (failed to start, failed jobs,
@@ -364,13 +269,6 @@ pub struct Cycle {
     /// Whether it is the first cycle of the match (no teammate's report of an earlier one to
     /// wait for).
     pub first: bool,
-    /// Teammates (robot numbers) the devices' side is not waiting for.
-    pub not_awaited: Vec<u32>,
     /// The devices' readings.
     pub readings: Loaded,
-}
-
-enum Event {
-    Frame(Box<DeviceFrame>),
-    Whistle,
 }

@@ -147,7 +147,6 @@ impl WorldRobot {
         let cycle = Cycle {
             at: Time::from_secs_f64(r.time),
             first: r.step == 0,
-            not_awaited: Vec::new(),
             readings: Loaded { odometry, camera: r.camera, game: Some(r.game), sonars: r.sonars },
         };
         let did = self.robot.cycle(cycle, run)?;

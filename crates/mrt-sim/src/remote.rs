@@ -68,6 +68,10 @@ impl Default for Patience {
     }
 }
 
+/// How long (world time, s) a robot's last answer holds: after that without a new one its
+/// wheels stop (the device protocol's safe command).
+pub const HOLD: f64 = 0.5;
+
 /// The simulator's name in the device protocol's keys.
 pub const WORLD: &str = "sim";
 
@@ -119,6 +123,8 @@ pub struct PitchWorld {
     period_ns: u64,
     cycle: u64,
     silent: Vec<bool>,
+    /// The step each robot last answered.
+    answered: Vec<Option<u64>>,
     patience: Patience,
     gone: Presence,
 }
@@ -156,6 +162,7 @@ impl PitchWorld {
             period_ns,
             cycle: 0,
             silent: vec![false; robots],
+            answered: vec![None; robots],
             patience,
             gone: Presence::new(robots),
         })
@@ -244,9 +251,15 @@ impl PitchWorld {
                     self.silent[i] = true;
                     self.pitch.fault(i, 1, &format!("robot process silent from cycle {k}"));
                 }
+                // The safe command: a robot without an answer for HOLD stands still.
+                let since = self.answered[i].map_or(k + 1, |a| k - a);
+                if since as f64 * self.period_ns as f64 / 1e9 > HOLD + 1e-9 {
+                    self.pitch.drive(i, Twist::default().into());
+                }
                 continue;
             };
             self.silent[i] = false;
+            self.answered[i] = Some(k);
             self.gone.back(i);
             self.apply(i, &act);
         }
@@ -588,6 +601,45 @@ mod tests {
         let run = home.join().unwrap().expect("the robot heard the end");
         // Late in cycle 1 (its teammate's report of cycle 0 never came), never again.
         assert_eq!((run.robot.cycles, run.robot.late_mates), (10, 1), "{run:?}");
+    }
+
+    /// A robot's last answer holds for half a second of world time; after that without an
+    /// answer its wheels stop (the protocol's safe command).
+    #[test]
+    fn a_robot_without_an_answer_for_half_a_second_stands_still() {
+        let cfg = short(5.0, 1);
+        let (field, mut world) =
+            pitch(&cfg, 1, Patience { cycle: Duration::from_millis(50), ..short_patience() });
+        let key = world.robots()[0].act();
+        let drive = |w: &PitchWorld| w.pitch.world().drive_setpoint(0).forward;
+        // Answer every step with a drive forward until the referee lets the robots move.
+        let mut k = 0;
+        while drive(&world) == 0.0 {
+            assert!(k < 100, "the robot never moved");
+            let mut act = act_of("home-1", k);
+            act.twist = Some(mrt_devices::messages::BodyTwist { vx: 0.5, vy: 0.0, omega: 0.0 });
+            field.to_world.send((key.clone(), serde_json::to_vec(&act).unwrap())).unwrap();
+            world.cycle().unwrap();
+            k += 1;
+        }
+        // Silent: 0.5 s (five cycles) on the last set-point, then still.
+        for _ in 0..5 {
+            world.cycle().unwrap();
+            assert_eq!(drive(&world), 0.5);
+        }
+        world.cycle().unwrap();
+        assert_eq!(drive(&world), 0.0);
+    }
+
+    fn act_of(robot: &str, step: u64) -> Act {
+        Act {
+            protocol: PROTOCOL,
+            world: WORLD.into(),
+            run: "test-run".into(),
+            robot: robot.into(),
+            step,
+            ..Act::default()
+        }
     }
 
     /// What a robot sends that the world cannot use is counted and dropped; its last good

@@ -35,10 +35,6 @@ macro_rules! message_types {
         $f!(mrt_msgs::CameraFrame);
         $f!(mrt_msgs::SonarScan);
         $f!(mrt_msgs::MotorCommand);
-        $f!(mrt_msgs::DeviceFrame);
-        $f!(mrt_msgs::DeviceAct);
-        $f!(mrt_msgs::FinalWhistle);
-        $f!(mrt_msgs::RobotEnd);
         $f!(mrt_msgs::GameInfo);
         $f!(mrt_msgs::Localization);
         $f!(mrt_msgs::Percepts);
@@ -93,9 +89,6 @@ fn wire_seeds(_root: &Path) -> Result<Vec<Seed>, FuzzError> {
     default_frame!(mrt_msgs::Odometry);
     default_frame!(mrt_msgs::CameraFrame);
     default_frame!(mrt_msgs::SonarScan);
-    default_frame!(mrt_msgs::DeviceFrame);
-    default_frame!(mrt_msgs::DeviceAct);
-    default_frame!(mrt_msgs::RobotEnd);
     default_frame!(mrt_msgs::BehaviorPushReply);
     default_frame!(mrt_msgs::HfsmStructure);
     let pushed = mrt_msgs::BehaviorPush {
