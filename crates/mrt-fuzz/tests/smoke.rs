@@ -51,6 +51,7 @@ smoke_tests! {
     world => "world",
     mcap => "mcap",
     devices => "devices",
+    device_answers => "device-answers",
 }
 
 /// A harness that panics on inputs holding `!`, and allocates 300 MiB on inputs holding `@`.

@@ -82,6 +82,7 @@ pub static TARGETS: &[Target] = &[
     lua::WORLD,
     recording::MCAP,
     devices::DEVICES,
+    devices::ANSWERS,
 ];
 
 /// The target of that name.
