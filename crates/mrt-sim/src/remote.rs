@@ -252,7 +252,7 @@ impl PitchWorld {
                     self.pitch.fault(i, 1, &format!("robot process silent from cycle {k}"));
                 }
                 // The safe command: a robot without an answer for HOLD stands still.
-                let since = self.answered[i].map_or(k + 1, |a| k - a);
+                let since = self.answered[i].map_or(k.saturating_add(1), |a| k.saturating_sub(a));
                 if since as f64 * self.period_ns as f64 / 1e9 > HOLD + 1e-9 {
                     self.pitch.drive(i, Twist::default().into());
                 }
