@@ -195,11 +195,7 @@ impl Gate {
         }
         let version: Version =
             serde_json::from_slice(bytes).map_err(|e| Refusal::Malformed(e.to_string()))?;
-        match version.protocol {
-            Some(p) if p == u64::from(PROTOCOL) => {}
-            Some(p) => return Err(Refusal::Protocol(p)),
-            None => return Err(Refusal::Malformed("no protocol number".into())),
-        }
+        version_is_ours(version.protocol)?;
         let sense: Sense =
             serde_json::from_slice(bytes).map_err(|e| Refusal::Malformed(e.to_string()))?;
         if sense.world != self.world || sense.robot != self.robot {
@@ -268,6 +264,15 @@ impl Gate {
             e.count(&mut self.dropped);
         }
         r
+    }
+}
+
+/// Whether a message's `protocol` is the version these types speak.
+pub(crate) fn version_is_ours(protocol: Option<u64>) -> Result<(), Refusal> {
+    match protocol {
+        Some(p) if p == u64::from(PROTOCOL) => Ok(()),
+        Some(p) => Err(Refusal::Protocol(p)),
+        None => Err(Refusal::Malformed("no protocol number".into())),
     }
 }
 

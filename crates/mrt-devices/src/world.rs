@@ -203,11 +203,7 @@ impl Answers {
         let keys = &self.robots[i];
         let header: Header =
             serde_json::from_slice(bytes).map_err(|e| Refusal::Malformed(e.to_string()))?;
-        match header.protocol {
-            Some(p) if p == u64::from(PROTOCOL) => {}
-            Some(p) => return Err(Refusal::Protocol(p)),
-            None => return Err(Refusal::Malformed("no protocol number".into())),
-        }
+        crate::gate::version_is_ours(header.protocol)?;
         if header.world.as_deref() != Some(keys.world())
             || header.robot.as_deref() != Some(keys.robot())
             || header.run.as_deref() != Some(self.run.as_str())
