@@ -182,18 +182,23 @@ impl Drop for Robots {
     }
 }
 
-/// The §3.3.1 file of robot `i` of a team of the robots `first..` (at least two): the team's
-/// discovery port and static links to the lower-numbered teammates; the first robot links to
-/// the second, so that it listens on its port (a full mesh on loopback, and on loopback with
-/// static links only, mrt-net does not scout: no socket is bound beyond 127.0.0.1).
-pub(crate) fn team_net_file(i: usize, first: usize, discovery: u16, ports: &[u16]) -> String {
+/// The §3.3.1 file of robot `i` of the team of robots `team`: the team's discovery port and
+/// a static link to every teammate (a full mesh on loopback, and on loopback with static links
+/// only, mrt-net does not scout: no socket is bound beyond 127.0.0.1). Each end of a pair
+/// connects to the other, so a robot that starts again reaches every teammate at once instead
+/// of waiting for a teammate's next connection retry.
+pub(crate) fn team_net_file(
+    i: usize,
+    team: std::ops::Range<usize>,
+    discovery: u16,
+    ports: &[u16],
+) -> String {
     let mut text = format!(
         "# Robot {i}'s team network (written by mrt for its match).\n\
          127.0.0.1 224.0.0.224 {discovery}\n"
     );
-    let peers = if i == first { &ports[first + 1..first + 2] } else { &ports[first..i] };
-    for &p in peers {
-        text.push_str(&format!("ip link 0 127.0.0.1 {} 127.0.0.1 {p}\n", ports[i]));
+    for j in team.filter(|&j| j != i) {
+        text.push_str(&format!("ip link 0 127.0.0.1 {} 127.0.0.1 {}\n", ports[i], ports[j]));
     }
     text
 }
@@ -300,7 +305,7 @@ pub fn play(
         for i in t * n..(t + 1) * n {
             let net = (n > 1).then(|| dir.join(format!("robot-{i}.cfg")));
             if let Some(net) = &net {
-                std::fs::write(net, team_net_file(i, t * n, discovery, &ports))?;
+                std::fs::write(net, team_net_file(i, t * n..(t + 1) * n, discovery, &ports))?;
             }
             let file = dir.join(format!("robot-{i}.toml"));
             std::fs::write(
@@ -499,18 +504,18 @@ mod tests {
     #[test]
     fn team_files_make_a_full_mesh_on_loopback() {
         let ports = [7000, 7001, 7002, 7003];
-        let net = |i, first| {
-            let text = team_net_file(i, first, 9000, &ports);
+        let net = |i| {
+            let text = team_net_file(i, 2..4, 9000, &ports);
             let cfg = AgoraConfig::parse(&text, "robot.cfg").unwrap();
             NetConfig::from_agora_config(&cfg).unwrap()
         };
-        assert_eq!(net(3, 2).connect, ["tcp/127.0.0.1:7002"]);
-        assert!(net(3, 2).listen.contains(&"tcp/127.0.0.1:7003".to_string()));
-        // The first robot links to the second.
-        assert_eq!(net(2, 2).connect, ["tcp/127.0.0.1:7003"]);
+        // Each robot links to every teammate, and to nobody of the other team.
+        assert_eq!(net(3).connect, ["tcp/127.0.0.1:7002"]);
+        assert!(net(3).listen.contains(&"tcp/127.0.0.1:7003".to_string()));
+        assert_eq!(net(2).connect, ["tcp/127.0.0.1:7003"]);
         // Loopback only: no multicast scouting, whose sockets bind 0.0.0.0.
-        assert_eq!(net(3, 2).multicast, None);
-        let n = net(1, 0);
+        assert_eq!(net(3).multicast, None);
+        let n = net(2);
         assert!(n.listen.iter().chain(&n.connect).all(|e| e.starts_with("tcp/127.0.0.1:")));
     }
 }

@@ -157,7 +157,10 @@ pub fn play(args: &MujocoArgs) -> Result<()> {
             let i = t * per_team + k;
             let net = dir.join(format!("robot-{i}.cfg"));
             if per_team > 1 {
-                std::fs::write(&net, team_net_file(i, t * per_team, discovery, &ports))?;
+                std::fs::write(
+                    &net,
+                    team_net_file(i, t * per_team..(t + 1) * per_team, discovery, &ports),
+                )?;
             }
             let net = (per_team > 1).then_some(net.as_path());
             let file = dir.join(format!("robot-{i}.toml"));

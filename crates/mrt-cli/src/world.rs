@@ -76,7 +76,8 @@ pub fn robot(args: &RobotArgs, file: &RobotFile, started: Instant) -> Result<()>
             };
             if !link.wait_until(TEAM, heard) {
                 bail!(
-                    "robot {name}: teammates {mates:?} not all on the team's network after                      {TEAM:?} (found: {:?})",
+                    "robot {name}: teammates {mates:?} not all on the team's network after \
+                     {TEAM:?} (found: {:?})",
                     link.agoras()
                 );
             }

@@ -176,6 +176,15 @@ impl NetConfig {
             set(&mut c, "scouting/multicast/address", &format!("\"{m}\""))?;
         }
         set(&mut c, "scouting/gossip/enabled", if self.gossip { "true" } else { "false" })?;
+        // Opening a peer session waits until every static peer is connected and has sent its
+        // declarations, for at most `scouting/delay` (500 ms by default). When two peers dial
+        // each other at once (a robot that starts again beside teammates that keep retrying
+        // it), zenoh keeps one of the two links and the wait runs to its end although both are
+        // connected. 100 ms bounds that; a program that must not lose its first messages
+        // waits for its receivers' interest instead (`NetLink::wait_until`).
+        if self.multicast.is_none() {
+            set(&mut c, "scouting/delay", "100")?;
+        }
         // Keep trying the static peers: a restarted robot is found again.
         set(&mut c, "connect/timeout_ms", "-1")?;
         set(
