@@ -505,14 +505,14 @@ mod tests {
     fn team_files_make_a_full_mesh_on_loopback() {
         let ports = [7000, 7001, 7002, 7003];
         let net = |i| {
-            let text = team_net_file(i, 2..4, 9000, &ports);
+            let text = team_net_file(i, 1..4, 9000, &ports);
             let cfg = AgoraConfig::parse(&text, "robot.cfg").unwrap();
             NetConfig::from_agora_config(&cfg).unwrap()
         };
         // Each robot links to every teammate, and to nobody of the other team.
-        assert_eq!(net(3).connect, ["tcp/127.0.0.1:7002"]);
+        assert_eq!(net(3).connect, ["tcp/127.0.0.1:7001", "tcp/127.0.0.1:7002"]);
         assert!(net(3).listen.contains(&"tcp/127.0.0.1:7003".to_string()));
-        assert_eq!(net(2).connect, ["tcp/127.0.0.1:7003"]);
+        assert_eq!(net(2).connect, ["tcp/127.0.0.1:7001", "tcp/127.0.0.1:7003"]);
         // Loopback only: no multicast scouting, whose sockets bind 0.0.0.0.
         assert_eq!(net(3).multicast, None);
         let n = net(2);
