@@ -35,6 +35,7 @@ SET_TIME = 1.0  # s in `set`
 READY_TOLERANCE = 0.3  # m from its kickoff place that counts as there
 OUT_INSET = 0.5  # m inside the line where a ball out is put back
 ENTRY_SPACING = 1.2  # m between robots entering on the side line
+POSSESSION_RANGE = 1.0  # m from the ball within which the closest robot has it
 
 MARKERS = {"home": "magenta", "away": "cyan"}
 
@@ -57,6 +58,25 @@ class Decision:
     ball: tuple[float, float] | None = None
     robots: dict[str, tuple[float, float, float]] = field(default_factory=dict)
     calls: list[str] = field(default_factory=list)
+
+
+@dataclass
+class Stats:
+    """One team's statistics: kicks that reached the ball, those of them heading into the
+    goal mouth, and steps in which the team had the robot closest to the ball."""
+
+    shots: int = 0
+    on_target: int = 0
+    possession_steps: int = 0
+
+
+def heads_into_goal(ball, heading: float, line: float, mouth: float) -> bool:
+    """Whether the ball at `ball` (x, y), sent along `heading` (rad), crosses the goal line
+    x = `line` (m) within `mouth` (m) of the field's axis."""
+    c, s = math.cos(heading), math.sin(heading)
+    if abs(c) < 1e-9 or (line - ball[0]) * c <= 0.0:
+        return False
+    return abs(ball[1] + (line - ball[0]) / c * s) < mouth
 
 
 class Referee:
@@ -84,6 +104,31 @@ class Referee:
         self.formation: dict[str, tuple[float, float, float]] = {}
         self.kicking: str | None = None
         self.until = INITIAL_TIME if start == "initial" else 0.0  # when initial/ready/set end
+        self.stats = {team: Stats() for team in ("home", "away")}
+
+    # ------------------------------------------------------------ the match's statistics
+
+    def shot(self, name: str, ball, heading: float) -> None:
+        """Counts robot `name`'s kick that reached the ball at `ball` (x, y) along `heading`
+        (rad): a shot, and on target when that line crosses the goal line the robot's team
+        attacks between the posts, less the ball's radius (as `mrt sim` counts them)."""
+        team = team_of(name)
+        s = self.stats[team]
+        s.shots += 1
+        line = self.attack(team) * LENGTH / 2
+        if heads_into_goal(ball, heading, line, GOAL_WIDTH / 2 - BALL_RADIUS):
+            s.on_target += 1
+
+    def account(self, ball, poses) -> None:
+        """Counts one step's possession: the team of the robot closest to the ball, if it is
+        within POSSESSION_RANGE m of the ball's centre."""
+        best = None
+        for n, p in poses.items():
+            d = math.hypot(p[0] - ball[0], p[1] - ball[1])
+            if d < POSSESSION_RANGE and (best is None or d < best[0]):
+                best = (d, team_of(n))
+        if best is not None:
+            self.stats[best[1]].possession_steps += 1
 
     # ------------------------------------------------------------ what the robots are told
 

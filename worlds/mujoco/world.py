@@ -186,7 +186,6 @@ class Match:
         self.steps = 0
         self.render_seconds: list[float] = []
         self.up_seconds: list[float] = []
-        self.kicks = 0
 
     def _empty_goal_start(self, rng):
         hl, hw, m = LENGTH / 2 - 0.5, WIDTH / 2 - 0.5, 0.5
@@ -274,12 +273,16 @@ class Match:
         """Applies one robot's command (wheel set-points rad/s, pan set-point rad, kick).
         The kicker fires only in play."""
         self.physics.command(name, wheels, pan)
-        if kick and self.referee.state == "playing" and self.physics.kick(name):
-            self.kicks += 1
+        if kick and self.referee.state == "playing":
+            _, _, heading = self.physics.pose(name)
+            bx, by, _, _ = self.physics.ball()
+            if self.physics.kick(name):
+                self.referee.shot(name, (bx, by), heading)
 
     def advance(self) -> list[str]:
         """One step of physics, then the referee; returns the referee's calls."""
         ph = self.physics
+        self.referee.account(ph.ball(), {n: ph.pose(n) for n in self.names})
         ph.step(STEP)
         self.steps += 1
         self.time = round(self.steps * STEP, 9)
@@ -383,6 +386,9 @@ def play(args) -> dict:
         "play_time": round(m.referee.play_time, 3),
         "score": dict(m.referee.score),
         "goals": [{"team": g["team"], "time": g["time"]} for g in m.referee.goals],
+        "stats": {team: {"shots": st.shots, "on_target": st.on_target,
+                         "possession_steps": st.possession_steps}
+                  for team, st in m.referee.stats.items()},
         "answered": answered,
         "missing": {n: world.steps - answered[n] for n in m.names},
         "render_ms": (round(1000 * float(np.mean(m.render_seconds)), 2)

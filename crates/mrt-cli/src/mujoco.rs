@@ -12,6 +12,7 @@ use mrt_msgs::GameState;
 use mrt_perception::camera::OmniFile;
 use mrt_robot::config::RobotFile;
 use mrt_robot::stacks::Stack;
+use mrt_sim::game::TeamStats;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::Duration;
@@ -273,6 +274,10 @@ pub fn play(args: &MujocoArgs) -> Result<()> {
     let v: serde_json::Value = serde_json::from_str(line)
         .with_context(|| format!("the world's report is not JSON: {}", line.escape_debug()))?;
     outln!("{}", summary(&v, &teams));
+    let names: Vec<&str> = teams.iter().map(|(s, _)| s.name()).collect();
+    for line in crate::sim::team_lines(&names, &team_stats(&v)) {
+        outln!("{line}");
+    }
     outln!("{line}");
     Ok(())
 }
@@ -304,6 +309,21 @@ fn summary(v: &serde_json::Value, teams: &[(Stack, &str)]) -> String {
         v["real_time_factor"].as_f64().unwrap_or(0.0),
         v["render_ms"].as_f64().unwrap_or(0.0),
     )
+}
+
+/// Each team's goals, shots and possession steps in the world's report (home's, then away's).
+fn team_stats(v: &serde_json::Value) -> [TeamStats; 2] {
+    let count = |v: &serde_json::Value| u32::try_from(v.as_u64().unwrap_or(0)).unwrap_or(u32::MAX);
+    ["home", "away"].map(|side| {
+        let s = &v["stats"][side];
+        TeamStats {
+            goals: count(&v["score"][side]),
+            shots: count(&s["shots"]),
+            shots_on_target: count(&s["on_target"]),
+            possession_cycles: s["possession_steps"].as_u64().unwrap_or(0),
+            ..TeamStats::default()
+        }
+    })
 }
 
 /// The recording's topic prefix of the robot the world names `name` (`home-1` → `home/0`):
@@ -417,6 +437,25 @@ mod tests {
         for name in ["goalie", "home-0", "home-x", "a-b-c"] {
             assert_eq!(topic_prefix(name), name);
         }
+    }
+
+    #[test]
+    fn the_worlds_statistics_become_each_teams_line() {
+        let v: serde_json::Value = serde_json::from_str(
+            r#"{"score": {"home": 2, "away": 0}, "stats": {
+                "home": {"shots": 5, "on_target": 3, "possession_steps": 300},
+                "away": {"shots": 1, "on_target": 0, "possession_steps": 100}}}"#,
+        )
+        .unwrap();
+        let stats = team_stats(&v);
+        assert_eq!((stats[0].goals, stats[0].shots, stats[0].shots_on_target), (2, 5, 3));
+        assert_eq!((stats[1].shots, stats[1].possession_cycles), (1, 100));
+        let lines = crate::sim::team_lines(&["milan", "chaos"], &stats);
+        assert!(lines[0].contains("shots   5 (  3 on target)  possession  75.0 %"), "{lines:?}");
+        assert!(lines[1].contains("possession  25.0 %"), "{lines:?}");
+        // A report without statistics (an older world) counts nothing.
+        let none = team_stats(&serde_json::json!({}));
+        assert_eq!(none, [TeamStats::default(), TeamStats::default()]);
     }
 
     #[test]

@@ -137,13 +137,15 @@ fn accuracy(args: &ReplayArgs, recording: &Recording) -> Result<()> {
     outln!("{}: beliefs against the truth, mean / median / p95", args.file.display());
     for a in &list {
         outln!(
-            "  {:<8} position {}  heading {}  ball while seen {} ({} cycles)  ball velocity {}",
+            "  {:<8} position {}  heading {}  ball while seen {} ({} cycles)  ball velocity {}  \
+             found itself {}",
             a.robot,
             show(a.position, 1.0, "m"),
             show(a.heading, 180.0 / std::f64::consts::PI, "°"),
             show(a.ball, 1.0, "m"),
             a.ball.map_or(0, |b| b.count),
             show(a.ball_velocity, 1.0, "m/s"),
+            a.found_after.map_or("never".to_string(), |s| format!("after {s:.1} s")),
         );
     }
     Ok(())

@@ -406,17 +406,8 @@ pub fn run(args: &SimArgs) -> Result<()> {
     bar.finish_and_clear();
     let (h, a) = (stacks.0.name(), stacks.1.name());
     outln!("{h} (home) {} : {} {a} (away)   seed {}", report.score.0, report.score.1, report.seed);
-    let total =
-        (report.stats[0].possession_cycles + report.stats[1].possession_cycles).max(1) as f64;
-    for (i, name) in [(0, h), (1, a)] {
-        let s = &report.stats[i];
-        outln!(
-            "  {name:<8} goals {:>2}  shots {:>3} ({:>3} on target)  possession {:>5.1} %",
-            s.goals,
-            s.shots,
-            s.shots_on_target,
-            100.0 * s.possession_cycles as f64 / total
-        );
+    for line in team_lines(&[h, a], &report.stats) {
+        outln!("{line}");
     }
     for (i, name) in [(0, h), (1, a)] {
         let s = &report.stats[i];
@@ -604,6 +595,26 @@ fn bench(args: &SimArgs, cfg: &SimConfig, stacks: (Stack, Stack)) -> Result<()> 
         if median >= 100.0 { "met" } else { "not met" }
     );
     Ok(())
+}
+
+/// A match's line for each team named (home's, then away's, if it played): goals, shots (on
+/// target) and the team's share of the cycles in which one of its robots was the closest to
+/// the ball.
+pub(crate) fn team_lines(names: &[&str], stats: &[TeamStats; 2]) -> Vec<String> {
+    let total = (stats[0].possession_cycles + stats[1].possession_cycles).max(1) as f64;
+    names
+        .iter()
+        .zip(stats)
+        .map(|(name, s)| {
+            format!(
+                "  {name:<8} goals {:>2}  shots {:>3} ({:>3} on target)  possession {:>5.1} %",
+                s.goals,
+                s.shots,
+                s.shots_on_target,
+                100.0 * s.possession_cycles as f64 / total
+            )
+        })
+        .collect()
 }
 
 /// Wilson score interval (95 %) of `k` successes in `n` trials, in percent.

@@ -259,6 +259,9 @@ fn replay_accuracy_gives_the_match_reports_figures() {
     assert!(close(all["ball"]["mean"].as_f64().unwrap(), n[0], 0.005), "{line}\n{all}");
     assert!(close(all["ball"]["p95"].as_f64().unwrap(), n[1], 0.005), "{line}\n{all}");
     assert!(close(all["ball_velocity"]["mean"].as_f64().unwrap(), n[2], 0.005), "{line}\n{all}");
+    // The simulator tells each robot where it was put down: every one knows from its first
+    // estimate.
+    assert_eq!(all["found_after"].as_f64(), Some(0.0), "{all}");
 }
 
 /// A robot's behaviors re-run on the world snapshots it had give back

@@ -128,7 +128,8 @@ fn the_vision_finds_the_ball_in_fresh_mujoco_frames_under_four_lights() {
 }
 
 /// `mrt world mujoco`: the world and a robot process on its devices play a few seconds of the
-/// empty-goal scenario; every step is answered and the robot says goodbye. The recording
+/// empty-goal scenario; every step is answered, the robot says goodbye and the report has the
+/// team's shots and possession. The recording
 /// holds the world's truth and the robot's messages, on the topics the web monitor reads.
 #[test]
 fn a_robot_process_plays_a_few_seconds_in_the_mujoco_world() {
@@ -162,6 +163,12 @@ fn a_robot_process_plays_a_few_seconds_in_the_mujoco_world() {
     assert_eq!(report["answered"]["home-1"].as_u64(), Some(steps), "{report}");
     assert_eq!(report["missing"]["home-1"].as_u64(), Some(0), "{report}");
     assert_eq!(report["byes"]["home-1"], true, "{report}");
+    // The team's line, as `mrt sim` prints it, from the world's statistics.
+    let team = text.lines().nth(1).unwrap_or("");
+    assert!(team.trim_start().starts_with("milan") && team.contains("possession"), "{text}");
+    for key in ["shots", "on_target", "possession_steps"] {
+        assert!(report["stats"]["home"][key].is_u64(), "{key}: {report}");
+    }
     let listing = Command::new(env!("CARGO_BIN_EXE_mrt")).arg("replay").arg(&record).output();
     std::fs::remove_file(&record).ok();
     let listing = String::from_utf8_lossy(&listing.unwrap().stdout).into_owned();

@@ -52,7 +52,15 @@ pub struct Accuracy {
     pub ball: Option<Spread>,
     /// Its ball's velocity against the truth's, in those cycles when it had one.
     pub ball_velocity: Option<Spread>,
+    /// Seconds from its first `Localization` to the first one within [`FOUND_WITHIN`] of the
+    /// truth: how long a robot put down where it was not told took to find itself (0 for one
+    /// that knew); `None` when it never did. For `all`, the slowest robot's.
+    pub found_after: Option<f64>,
 }
+
+/// How close to the truth (m) a robot's estimate must come for it to have found itself: the
+/// same bound as a kidnapped robot's recovery in `mrt sim --metrics`.
+pub const FOUND_WITHIN: f64 = 0.3;
 
 /// Every robot's [`Accuracy`] in `recording`, in topic order, then all robots together
 /// (named `all`). Robots the truth does not hold (`home/k`, `away/k` beyond its robots) are
@@ -74,14 +82,21 @@ pub fn accuracy(recording: &Recording) -> Result<Vec<Accuracy>, ReplayError> {
         }
     })?;
     let mut all = [Vec::new(), Vec::new(), Vec::new(), Vec::new()];
+    let mut slowest = Some(0.0_f64);
     let mut out = Vec::new();
     for (robot, list) in beliefs {
         let mut errors = [Vec::new(), Vec::new(), Vec::new(), Vec::new()];
+        let (mut first, mut found) = (None, None);
         for (t, l) in list {
             let Some((_, truth)) = truths.range(..=t).next_back() else { continue };
             let Some(i) = truth_index(&robot, Some(truth)) else { continue };
             let (p, real) = (l.pose.inner, truth.robots[i]);
-            errors[0].push((p.x - real.x).hypot(p.y - real.y));
+            let off = (p.x - real.x).hypot(p.y - real.y);
+            let first = *first.get_or_insert(t);
+            if found.is_none() && off < FOUND_WITHIN {
+                found = Some((t - first).as_secs_f64());
+            }
+            errors[0].push(off);
             errors[1].push(normalize_angle(p.theta - real.theta).abs());
             if let Some(ball) = l.ball.filter(|b| b.seen_ago <= 0.0) {
                 errors[2].push((ball.at.0 - truth.ball.0).hypot(ball.at.1 - truth.ball.1));
@@ -97,10 +112,11 @@ pub fn accuracy(recording: &Recording) -> Result<Vec<Accuracy>, ReplayError> {
         for (a, e) in all.iter_mut().zip(&errors) {
             a.extend_from_slice(e);
         }
-        out.push(spreads(robot, errors));
+        slowest = slowest.zip(found).map(|(a, b)| a.max(b));
+        out.push(Accuracy { found_after: found, ..spreads(robot, errors) });
     }
     if !out.is_empty() {
-        out.push(spreads("all".into(), all));
+        out.push(Accuracy { found_after: slowest, ..spreads("all".into(), all) });
     }
     Ok(out)
 }
@@ -112,6 +128,7 @@ fn spreads(robot: String, [position, heading, ball, velocity]: [Vec<f64>; 4]) ->
         heading: Spread::of(heading),
         ball: Spread::of(ball),
         ball_velocity: Spread::of(velocity),
+        found_after: None,
     }
 }
 
@@ -179,6 +196,42 @@ mod tests {
         near(a[1].ball_velocity, 1.0, 5);
         assert_eq!(a[2].position.unwrap().count, 20);
         assert_eq!(a[2].ball.unwrap().count, 5);
+        assert_eq!(a[0].found_after, Some(0.0));
+    }
+
+    /// A robot put down 5 m from where it believes it is, whose estimate closes 0.5 m a
+    /// cycle: 0.5 m off at the tenth cycle, within 0.3 m at the eleventh, 1.0 s after its
+    /// first estimate. One that
+    /// stays 1 m off never finds itself, and then neither does `all`.
+    #[test]
+    fn a_robot_found_itself_when_its_estimate_first_came_near_the_truth() {
+        let path = std::env::temp_dir().join(format!("mrt-found-{}.mcap", std::process::id()));
+        let mut rec = Recorder::create(&path).unwrap();
+        for k in 0..20u64 {
+            let t = Time::from_secs_f64(1.0 + k as f64 * 0.1);
+            let truth = Truth {
+                ball: (0.0, 0.0),
+                ball_velocity: (0.0, 0.0),
+                robots: vec![Pose2::new(0.0, 0.0, 0.0), Pose2::new(1.0, 1.0, 0.0)],
+                home: 2,
+                score: (0, 0),
+                state: GameState::Playing,
+            };
+            rec.record("/truth", t, &truth).unwrap();
+            let off = (5.0 - 0.5 * k as f64).max(0.05);
+            let home =
+                Localization { pose: Framed::new(Pose2::new(0.0, off, 0.0)), ..Default::default() };
+            rec.record("/home/0/Localization", t, &home).unwrap();
+            let lost =
+                Localization { pose: Framed::new(Pose2::new(2.0, 1.0, 0.0)), ..Default::default() };
+            rec.record("/home/1/Localization", t, &lost).unwrap();
+        }
+        rec.finish().unwrap();
+        let a = accuracy(&Recording::open(&path).unwrap()).unwrap();
+        std::fs::remove_file(&path).ok();
+        let found = a[0].found_after.unwrap();
+        assert!((found - 1.0).abs() < 1e-6, "{found}");
+        assert_eq!((a[1].found_after, a[2].found_after), (None, None));
     }
 
     #[test]

@@ -423,6 +423,31 @@ class RefereeTest(unittest.TestCase):
         r.update(0.1, 0.1, (-9.5, 0.0), {"home-1": (0, 0, 0)})
         self.assertEqual((r.state, r.score), ("finished", {"home": 0, "away": 1}))
 
+    def test_a_shot_is_on_target_when_its_line_crosses_the_mouth_it_attacks(self):
+        # By hand: the east goal line at x = 9 m, the mouth 1 - 0.11 = 0.89 m either side.
+        # From (5, 0) at 10 degrees the ball crosses at 4 tan 10 = 0.705 m: in; at 15, 1.07 m.
+        self.assertTrue(rr.heads_into_goal((5.0, 0.0), math.radians(10), 9.0, 0.89))
+        self.assertFalse(rr.heads_into_goal((5.0, 0.0), math.radians(15), 9.0, 0.89))
+        self.assertFalse(rr.heads_into_goal((5.0, 0.0), math.pi, 9.0, 0.89))
+        self.assertFalse(rr.heads_into_goal((5.0, 0.0), math.pi / 2, 9.0, 0.89))
+        r = self.playing(half=100)
+        r.shot("home-2", (5.0, 0.0), math.radians(10))  # home attacks east: on target
+        r.shot("home-2", (5.0, 0.0), math.radians(15))
+        r.shot("away-1", (5.0, 0.0), 0.0)  # away attacks west: not at its goal
+        r.shot("away-1", (-5.0, 0.3), math.pi)
+        self.assertEqual((r.stats["home"].shots, r.stats["home"].on_target), (2, 1))
+        self.assertEqual((r.stats["away"].shots, r.stats["away"].on_target), (2, 1))
+        r.half = 2  # the halves swap the goals
+        r.shot("home-1", (-5.0, 0.3), math.pi)
+        self.assertEqual(r.stats["home"].on_target, 2)
+
+    def test_possession_goes_to_the_closest_robot_within_a_metre(self):
+        r = self.playing(half=100)
+        r.account((-2.5, 2.0), self.poses())  # home-2 at 0.5 m
+        r.account((3.2, -2.0), self.poses(home_2=(3.0, -1.5, 0)))  # away-2 closer, 0.2 m
+        r.account((0.0, 4.0), self.poses())  # nobody within 1 m
+        self.assertEqual([r.stats[t].possession_steps for t in ("home", "away")], [1, 1])
+
 
 @needs_mujoco
 class MatchTest(unittest.TestCase):
@@ -460,6 +485,23 @@ class MatchTest(unittest.TestCase):
         self.assertAlmostEqual(x, 2.0, delta=0.05)
         self.assertEqual((vx, vy), (0.0, 0.0))
         self.assertEqual(m.referee.state, "playing")
+
+    def test_a_kick_that_reaches_the_ball_counts_as_a_shot_only_in_play(self):
+        m = self.match(home=1, away=0, scenario="match", half=100)
+        m.physics.place_robot("home-1", (5.0, 0.0, 0.0))
+        m.physics.place_ball(5.0 + 0.25 + 0.11 + 0.05, 0.0)
+        m.physics.time = 10.0
+        m.act("home-1", kick=True)  # before play: the kicker does not fire
+        self.assertEqual((m.referee.stats["home"].shots, m.physics.ball()[2]), (0, 0.0))
+        m.referee.state = "playing"
+        m.act("home-1", kick=True)
+        self.assertEqual((m.referee.stats["home"].shots, m.referee.stats["home"].on_target),
+                         (1, 1))
+        m.advance()
+        self.assertEqual(m.referee.stats["home"].possession_steps, 1)
+        m.physics.time = 20.0
+        m.act("home-1", kick=True)  # the ball is gone: no shot
+        self.assertEqual(m.referee.stats["home"].shots, 1)
 
     def test_the_empty_goal_start_comes_from_the_seed(self):
         a, b, c = (self.match(home=1, away=0, scenario="empty-goal", seed=s) for s in (3, 3, 4))
