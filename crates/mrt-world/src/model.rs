@@ -33,7 +33,9 @@ use crate::field::FieldMap;
 use crate::gm::FuzzyGrid;
 use crate::murea::{Fix, Perception};
 use crate::relocalize::{self, CameraNoise, FrameSeen, Localizer, Relocalizer};
-use crate::track::{sighting_covariance, Track, TrackCounts, BALL_ACCEL, BALL_MANEUVER};
+use crate::track::{
+    sighting_covariance, Track, TrackCounts, BALL_ACCEL, BALL_MANEUVER, BALL_TOP_SPEED,
+};
 use mrt_core::frames::{Attack, Field, Framed, Team, MM_PER_M};
 use mrt_core::{normalize_angle, Point2, Pose2, Time, Vec2};
 use mrt_msgs::robot::{lps, AnchoredRobot, Estimate, Lpo, WorldSnapshot};
@@ -123,7 +125,7 @@ struct Memory {
 /// MAP's tracker of a ball rolling with `damping` (1/s): the quiet and the manoeuvre model
 /// mixed by the IMM ([`crate::track`]).
 fn ball_track(damping: f64) -> Track {
-    Track::new(damping, BALL_ACCEL).with_maneuver(BALL_MANEUVER)
+    Track::new(damping, BALL_ACCEL).with_maneuver(BALL_MANEUVER).with_top_speed(BALL_TOP_SPEED)
 }
 
 /// How fast the uncertainty of an unseen ball grows, m/s (it may roll away).
