@@ -185,6 +185,14 @@ fn detect_one(
                     "bearing_deg": round3(p.at.y.atan2(p.at.x).to_degrees()),
                 }));
             }
+            for r in &sight.percepts.robots {
+                objects.push(serde_json::json!({
+                    "class": "robot",
+                    "distance_m": round3(r.sighting.distance),
+                    "bearing_deg": round3(r.sighting.bearing.to_degrees()),
+                    "marker": r.marker,
+                }));
+            }
             (sight.ball, sight.posts, agent.classes())
         }
         Detector::Up { up, lut, radius } => {

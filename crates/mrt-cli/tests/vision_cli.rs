@@ -135,7 +135,8 @@ fn render(args: &[&str]) -> (bool, String) {
 }
 
 /// `mrt vision render` draws what the simulator's camera sees; `mrt vision detect` finds the
-/// ball in it where it was put: 2 m ahead-left of a robot at (-3, 1) facing 30°.
+/// ball in it where it was put, 2 m ahead-left of a robot at (-3, 1) facing 30°, and the robot
+/// in view with its team's marker.
 #[test]
 fn detect_finds_the_ball_in_a_rendered_frame() {
     let dir = std::env::temp_dir().join(format!("mrt-vision-render-{}", std::process::id()));
@@ -165,6 +166,15 @@ fn detect_finds_the_ball_in_a_rendered_frame() {
     let d = ball["distance_m"].as_f64().unwrap();
     let b = ball["bearing_deg"].as_f64().unwrap();
     assert!((d - 2.0).abs() < 0.1 && (b - 10.0).abs() < 1.5, "{line}");
+    // The away robot at (0, 2) is 3.16 m away at -11.6°, its nearest point 2.91 m; the home
+    // one at (1, 0.5) is 37° to the right, out of view.
+    let robots: Vec<&serde_json::Value> =
+        line["objects"].as_array().unwrap().iter().filter(|o| o["class"] == "robot").collect();
+    assert_eq!(robots.len(), 1, "{line}");
+    let d = robots[0]["distance_m"].as_f64().unwrap();
+    let b = robots[0]["bearing_deg"].as_f64().unwrap();
+    assert!((d - 2.91).abs() < 0.15 && (b + 11.6).abs() < 2.0, "{line}");
+    assert_eq!(robots[0]["marker"], "cyan", "{line}");
     std::fs::remove_dir_all(&dir).ok();
 }
 
