@@ -602,8 +602,8 @@ mod tests {
     }
 
     /// With a top speed, a kick restarts the track at its first sighting, moving at the
-    /// speed it took; a sighting farther than the top speed could reach is still left out
-    /// once, and restarts the track the second time.
+    /// speed it took; a sighting farther off than the top speed could reach is left out, and
+    /// the track rolls on.
     #[test]
     fn a_kick_within_the_top_speed_restarts_the_track_at_its_first_sighting() {
         let mut t = Track::new(0.0, 2.0).with_maneuver(8.0).with_top_speed(8.0);
