@@ -13,8 +13,10 @@ the other robots, those in view (their nearest point on the floor inside the ima
 RANGE m away), those found (a reported robot within BEARING_MATCH degrees and DISTANCE_MATCH of
 the distance of one of them; a robot whose nearest point is out of view, found by its bearing
 alone, is not scored), the error of their nearest point's distance (%) and
-bearing (degrees), their markers (right, wrong, none: home wears magenta, away cyan), and
-phantoms (reported robots that match no robot of the truth, in view or not).
+bearing (degrees), their markers (right, wrong, none: home wears magenta, away cyan), the
+misplaced (reported within BEARING_MATCH of a robot but not within DISTANCE_MATCH of its
+distance: a robot half hidden, or split in two) and phantoms (reported where no robot of the
+truth stands within BEARING_MATCH, in view or not).
 
 A robot is a disc of ROBOT_RADIUS m: its nearest point lies that much closer than its centre.
 Needs numpy, not MuJoCo.
@@ -88,7 +90,7 @@ def score(camera: rf.Camera, truths: list[dict], detections: dict[str, list[dict
     """The scores (module doc) of `detections` (objects by frame file name) against `truths`."""
     ball_range, ball_bearing, with_ball, found, false_balls, empty = [], [], 0, 0, 0, 0
     robot_range, robot_bearing = [], []
-    in_view = matched = phantoms = 0
+    in_view = matched = misplaced = phantoms = 0
     markers = {"right": 0, "wrong": 0, "none": 0}
     for t in truths:
         objects = detections.get(t["file"], [])
@@ -119,7 +121,10 @@ def score(camera: rf.Camera, truths: list[dict], detections: dict[str, list[dict
 
             close = [(off(r), k) for k, r in enumerate(everyone) if k not in taken and near(r)]
             if not close:
-                phantoms += 1
+                if any(off(r) <= BEARING_MATCH for r in everyone):
+                    misplaced += 1  # where a robot stands, at the wrong distance
+                else:
+                    phantoms += 1
                 continue
             _, k = min(close)
             taken.add(k)
@@ -140,7 +145,7 @@ def score(camera: rf.Camera, truths: list[dict], detections: dict[str, list[dict
         "robots": {"in_view": in_view, "found": matched,
                    "distance_error_pct": spread(robot_range),
                    "bearing_error_deg": spread(robot_bearing),
-                   "markers": markers, "phantoms": phantoms},
+                   "markers": markers, "misplaced": misplaced, "phantoms": phantoms},
     }
 
 

@@ -48,6 +48,7 @@ class ScoreTest(unittest.TestCase):
                 {"class": "robot", "distance_m": 2.75 * 1.02, "bearing_deg": 0.5,
                  "marker": "cyan"},
                 {"class": "robot", "distance_m": 5.0, "bearing_deg": 25.0, "marker": None},
+                {"class": "robot", "distance_m": 1.5, "bearing_deg": -1.0, "marker": None},
             ],
             "b.png": [
                 {"class": "ball", "distance_m": 3.0, "bearing_deg": 0.0},
@@ -61,7 +62,10 @@ class ScoreTest(unittest.TestCase):
         self.assertAlmostEqual(ball["bearing_error_deg"]["worst"], 1.0, places=3)
         self.assertEqual((ball["empty_frames"], ball["balls_in_empty_frames"]), (1, 1))
         robots = s["robots"]
-        self.assertEqual((robots["in_view"], robots["found"], robots["phantoms"]), (2, 2, 1))
+        self.assertEqual((robots["in_view"], robots["found"]), (2, 2))
+        # 5 m at 25 degrees: nobody there; 1.5 m dead ahead: where the away robot stands,
+        # but at half its distance.
+        self.assertEqual((robots["misplaced"], robots["phantoms"]), (1, 1))
         self.assertAlmostEqual(robots["distance_error_pct"]["median"], 2.0, places=2)
         self.assertAlmostEqual(robots["bearing_error_deg"]["worst"], 1.0, delta=0.01)
         self.assertEqual(robots["markers"], {"right": 1, "wrong": 1, "none": 0})
