@@ -9,7 +9,9 @@
 
 Prints one JSON object: for the ball, how many frames with a ball it was found in, its range
 error (relative, %) and bearing error (degrees), and balls reported in frames without one; for
-the other robots, those in view (their nearest point on the floor inside the image, at most
+the nets (the centres of the goal lines, east the yellow goal), those wholly in view (both
+posts' feet in the image, at most NET_RANGE m away), those reported and their errors, and
+those reported of a goal not wholly in view; for the other robots, those in view (their nearest point on the floor inside the image, at most
 RANGE m away), those found (a reported robot within BEARING_MATCH degrees and DISTANCE_MATCH of
 the distance of one of them; a robot whose nearest point is out of view, found by its bearing
 alone, is not scored), the error of their nearest point's distance (%) and
@@ -38,6 +40,8 @@ sys.path.insert(0, str(HERE))
 import render_frames as rf  # noqa: E402
 
 ROBOT_RADIUS = 0.25  # m, the field's robots (robots/*.xml)
+HALF_LENGTH, GOAL_HALF_WIDTH = 9.0, 1.0  # m: the goal lines' x, the posts' y (field.xml)
+NET_RANGE = 25.0  # m: a net farther away is not counted as in view (as mrt vision survey)
 RANGE = 7.0  # m: how far the vision tells robots (mrt_robot::config::VISION_ROBOT_RANGE)
 BEARING_MATCH = 10.0  # degrees
 DISTANCE_MATCH = 0.3  # of the true distance
@@ -64,6 +68,14 @@ def relative(pose, x, y):
     return math.hypot(rx, ry), math.atan2(ry, rx)
 
 
+def in_image(camera: rf.Camera, pose, x: float, y: float) -> bool:
+    """Whether the floor point (x, y) shows in the camera's image from `pose`."""
+    uv, z = camera.project(pose, np.array([[x, y, 0.0]]))
+    u, v = uv[0]
+    return bool(z[0] > 0 and MARGIN_PX <= u <= camera.width - MARGIN_PX
+                and MARGIN_PX <= v <= camera.height - MARGIN_PX)
+
+
 def robots_seen_from(camera: rf.Camera, truth: dict) -> list[dict]:
     """The truth's robots as the camera's robot sees them: each one's nearest floor point's
     distance (from the point under the camera) and bearing, its team, and whether it is in
@@ -78,11 +90,23 @@ def robots_seen_from(camera: rf.Camera, truth: dict) -> list[dict]:
         if view:
             # The nearest point on the floor, towards the camera.
             nx, ny = x - (x - fx) / d * ROBOT_RADIUS, y - (y - fy) / d * ROBOT_RADIUS
-            uv, z = camera.project(pose, np.array([[nx, ny, 0.0]]))
-            u, v = uv[0]
-            view = bool(z[0] > 0 and MARGIN_PX <= u <= camera.width - MARGIN_PX
-                        and MARGIN_PX <= v <= camera.height - MARGIN_PX)
+            view = in_image(camera, pose, nx, ny)
         out.append({"distance": near, "bearing": b, "team": team, "in_view": view})
+    return out
+
+
+def nets_seen_from(camera: rf.Camera, truth: dict) -> dict[str, dict]:
+    """The east and the west net (the centres of the goal lines) as the camera's robot sees
+    them: distance, bearing, and whether the goal is wholly in view (both posts' feet in the
+    image, at most NET_RANGE away)."""
+    pose = truth["camera_pose"]
+    fx, fy = camera.foot(pose)
+    out = {}
+    for goal, x in (("east", HALF_LENGTH), ("west", -HALF_LENGTH)):
+        d, b = relative((fx, fy, pose[2]), x, 0.0)
+        view = d <= NET_RANGE and all(in_image(camera, pose, x, y)
+                                      for y in (GOAL_HALF_WIDTH, -GOAL_HALF_WIDTH))
+        out[goal] = {"distance": d, "bearing": b, "in_view": view}
     return out
 
 
@@ -92,8 +116,20 @@ def score(camera: rf.Camera, truths: list[dict], detections: dict[str, list[dict
     robot_range, robot_bearing = [], []
     in_view = matched = misplaced = phantoms = 0
     markers = {"right": 0, "wrong": 0, "none": 0}
+    net_range, net_bearing, nets_in_view, nets_found, nets_unseen = [], [], 0, 0, 0
     for t in truths:
         objects = detections.get(t["file"], [])
+        nets = nets_seen_from(camera, t)
+        nets_in_view += sum(n["in_view"] for n in nets.values())
+        for o in (o for o in objects if o.get("class") == "net"):
+            n = nets.get(o.get("goal"))
+            if n is None or not n["in_view"]:
+                nets_unseen += 1
+                continue
+            nets_found += 1
+            net_range.append(100 * abs(o["distance_m"] - n["distance"]) / n["distance"])
+            err = math.remainder(math.radians(o["bearing_deg"]) - n["bearing"], math.tau)
+            net_bearing.append(abs(math.degrees(err)))
         balls = [o for o in objects if o.get("class") == "ball"]
         if t.get("distance") is not None:
             with_ball += 1
@@ -142,6 +178,9 @@ def score(camera: rf.Camera, truths: list[dict], detections: dict[str, list[dict
         "ball": {"frames_with_ball": with_ball, "found": found,
                  "range_error_pct": spread(ball_range), "bearing_error_deg": spread(ball_bearing),
                  "empty_frames": empty, "balls_in_empty_frames": false_balls},
+        "nets": {"in_view": nets_in_view, "found": nets_found,
+                 "distance_error_pct": spread(net_range), "bearing_error_deg": spread(net_bearing),
+                 "not_wholly_in_view": nets_unseen},
         "robots": {"in_view": in_view, "found": matched,
                    "distance_error_pct": spread(robot_range),
                    "bearing_error_deg": spread(robot_bearing),

@@ -185,6 +185,18 @@ fn detect_one(
                     "bearing_deg": round3(p.at.y.atan2(p.at.x).to_degrees()),
                 }));
             }
+            // The nets (sightings 1 and 2: the east and the west goal): the centres of the
+            // goal lines, when a goal is wholly in view, as the world model localizes on them.
+            for (k, goal) in [(1, "east"), (2, "west")] {
+                if let Some(n) = sight.percepts.sightings[k] {
+                    objects.push(serde_json::json!({
+                        "class": "net",
+                        "goal": goal,
+                        "distance_m": round3(n.distance),
+                        "bearing_deg": round3(n.bearing.to_degrees()),
+                    }));
+                }
+            }
             for r in &sight.percepts.robots {
                 objects.push(serde_json::json!({
                     "class": "robot",

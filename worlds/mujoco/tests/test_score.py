@@ -80,6 +80,27 @@ class ScoreTest(unittest.TestCase):
                                               "bearing_deg": 0.0, "marker": None}]})
         self.assertEqual((s["robots"]["found"], s["robots"]["phantoms"]), (0, 0))
 
+    def test_a_net_is_scored_when_its_goal_is_wholly_in_view(self):
+        # 5 m from the east goal line, facing it: both posts' feet in view, the net 5 m ahead.
+        # Facing west from the same spot, the east goal is behind, the west one 13 m ahead.
+        ahead = frame("d.png", pose=(4.0, 0.0, 0.0))
+        behind = frame("e.png", pose=(4.0, 0.0, math.pi))
+        nets = sf.nets_seen_from(CAMERA, ahead)
+        self.assertTrue(nets["east"]["in_view"])
+        self.assertFalse(nets["west"]["in_view"])
+        self.assertAlmostEqual(nets["east"]["distance"], 5.0)
+        self.assertFalse(sf.nets_seen_from(CAMERA, behind)["east"]["in_view"])
+        self.assertTrue(sf.nets_seen_from(CAMERA, behind)["west"]["in_view"])
+        s = sf.score(CAMERA, [ahead, behind], {
+            "d.png": [{"class": "net", "goal": "east", "distance_m": 5.1, "bearing_deg": -0.5}],
+            "e.png": [{"class": "net", "goal": "east", "distance_m": 5.0, "bearing_deg": 0.0}],
+        })
+        n = s["nets"]
+        # The west net, in view in e.png, was not reported; the east one there is behind.
+        self.assertEqual((n["in_view"], n["found"], n["not_wholly_in_view"]), (2, 1, 1))
+        self.assertAlmostEqual(n["distance_error_pct"]["mean"], 2.0, places=3)
+        self.assertAlmostEqual(n["bearing_error_deg"]["mean"], 0.5, places=3)
+
     def test_a_spread_is_of_its_errors(self):
         self.assertIsNone(sf.spread([]))
         s = sf.spread([float(k) for k in range(1, 11)])
