@@ -178,26 +178,29 @@ fn detect_finds_the_ball_in_a_rendered_frame() {
     std::fs::remove_dir_all(&dir).ok();
 }
 
-/// From the centre spot facing east, the east goal is wholly in view: `detect` reports its
-/// net, the centre of its goal line, 9 m ahead.
+/// Facing the east goal from 9, 5 and 3 m, the goal is wholly in view: `detect` reports its
+/// net, the centre of its goal line, within 3 % (near the goal too, where the posts slant
+/// outwards in the image and the slant's columns do not stand on the carpet).
 #[test]
 fn detect_reports_the_net_of_a_goal_wholly_in_view() {
     let dir = std::env::temp_dir().join(format!("mrt-vision-net-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
-    let png = dir.join("net.png");
-    let (ok, err) = render(&["--at", "0,0,0", "--out", png.to_str().unwrap()]);
-    assert!(ok, "{err}");
-    let (ok, out, err) = detect(&[&png], &[]);
+    for (x, want) in [(0.0, 9.0), (4.0, 5.0), (6.0, 3.0)] {
+        let png = dir.join(format!("net-{x}.png"));
+        let (ok, err) = render(&["--at", &format!("{x},0,0"), "--out", png.to_str().unwrap()]);
+        assert!(ok, "{err}");
+        let (ok, out, err) = detect(&[&png], &[]);
+        assert!(ok, "{err}");
+        let line: serde_json::Value = serde_json::from_str(out.trim()).unwrap();
+        let nets: Vec<&serde_json::Value> =
+            line["objects"].as_array().unwrap().iter().filter(|o| o["class"] == "net").collect();
+        assert_eq!(nets.len(), 1, "{line}");
+        assert_eq!(nets[0]["goal"], "east", "{line}");
+        let d = nets[0]["distance_m"].as_f64().unwrap();
+        let b = nets[0]["bearing_deg"].as_f64().unwrap();
+        assert!((d - want).abs() < 0.03 * want && b.abs() < 1.0, "from x = {x}: {line}");
+    }
     std::fs::remove_dir_all(&dir).ok();
-    assert!(ok, "{err}");
-    let line: serde_json::Value = serde_json::from_str(out.trim()).unwrap();
-    let nets: Vec<&serde_json::Value> =
-        line["objects"].as_array().unwrap().iter().filter(|o| o["class"] == "net").collect();
-    assert_eq!(nets.len(), 1, "{line}");
-    assert_eq!(nets[0]["goal"], "east", "{line}");
-    let d = nets[0]["distance_m"].as_f64().unwrap();
-    let b = nets[0]["bearing_deg"].as_f64().unwrap();
-    assert!((d - 9.0).abs() < 0.45 && b.abs() < 1.0, "{line}");
 }
 
 #[test]

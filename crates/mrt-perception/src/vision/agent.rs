@@ -391,10 +391,23 @@ impl VisionAgent {
         if pixels < MIN_GOAL_PIXELS || count[0] > 0 || count[w - 1] > 0 {
             return None;
         }
-        // The outermost columns where the goal stands on the carpet.
-        let foot = |col: usize| self.goal_foot(class, count, col);
-        let (pl, l) = (0..w).find_map(foot)?;
-        let (pr, r) = (0..w).rev().find_map(foot)?;
+        // The outermost columns where the goal stands on the carpet. Under a tilted camera a
+        // post slants outwards upwards, and the outermost such column can be the slant's, its
+        // lowest goal pixel a few rows above the post's foot: walk inwards while the foot
+        // comes lower in the image.
+        let foot = |col: usize| self.goal_foot(class, count, col).map(|f| (col, f));
+        let lowest = |start: (usize, (Pixel, Point2<f64>)), step: fn(usize) -> Option<usize>| {
+            let mut at = start;
+            while let Some(next) = step(at.0).filter(|&c| c < w).and_then(foot) {
+                if next.1 .0.y <= at.1 .0.y {
+                    break;
+                }
+                at = next;
+            }
+            at.1
+        };
+        let (pl, l) = lowest((0..w).find_map(foot)?, |c| c.checked_add(1));
+        let (pr, r) = lowest((0..w).rev().find_map(foot)?, |c| c.checked_sub(1));
         // The two feet are the goal's posts (or a post and a back corner): as far apart as
         // the goal is wide, give or take its depth. Anything else is not the whole goal.
         let apart = (l - r).norm();
