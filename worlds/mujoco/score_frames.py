@@ -7,18 +7,20 @@
         frames/side/ > frames/side/detect.jsonl
     python score_frames.py frames/side frames/side/detect.jsonl --camera configs/vision/camera.toml
 
-Prints one JSON object: for the ball, how many frames with a ball it was found in, its range
-error (relative, %) and bearing error (degrees), and balls reported in frames without one; for
-the nets (the centres of the goal lines, east the yellow goal), those wholly in view (both
-posts' feet in the image, at most NET_RANGE m away), those reported and their errors, and
-those reported of a goal not wholly in view; for the other robots, those in view (their nearest point on the floor inside the image, at most
-RANGE m away), those found (a reported robot within BEARING_MATCH degrees and DISTANCE_MATCH of
-the distance of one of them; a robot whose nearest point is out of view, found by its bearing
-alone, is not scored), the error of their nearest point's distance (%) and
-bearing (degrees), their markers (right, wrong, none: home wears magenta, away cyan), the
-misplaced (reported within BEARING_MATCH of a robot but not within DISTANCE_MATCH of its
-distance: a robot half hidden, or split in two) and phantoms (reported where no robot of the
-truth stands within BEARING_MATCH, in view or not).
+Prints one JSON object:
+- the ball: how many frames with a ball it was found in, its range error (relative, %) and
+  bearing error (degrees), and balls reported in frames without one;
+- the nets (the centres of the goal lines, east the yellow goal): those wholly in view (both
+  posts' feet in the image, at most NET_RANGE m away), those reported and their errors, and
+  those reported of a goal not wholly in view;
+- the other robots: those in view (their nearest point on the floor inside the image, at most
+  RANGE m away); those found (a robot reported within BEARING_MATCH degrees and DISTANCE_MATCH
+  of the distance of one of them; one whose nearest point is out of view, found by its bearing
+  alone, is not scored), with the error of their nearest point's distance (%) and bearing
+  (degrees) and their markers (right, wrong, none: home wears magenta, away cyan); the
+  misplaced (reported within BEARING_MATCH of a robot but not within DISTANCE_MATCH of its
+  distance: a robot half hidden, or split in two); and phantoms (reported where no robot of
+  the truth stands within BEARING_MATCH, in view or not).
 
 A robot is a disc of ROBOT_RADIUS m: its nearest point lies that much closer than its centre.
 Needs numpy, not MuJoCo.
