@@ -8,7 +8,11 @@
 //! (every [`SAMPLE_STEP`]th pixel of every [`SAMPLE_STEP`]th row, the pixels of the field's
 //! hue and saturation at any value from [`CARPET_MIN_VALUE`] up), and each channel gets the
 //! gain that brings that mean to the colour file's `[white_balance] carpet` (a von Kries
-//! correction). When all three gains are within [`DEAD_BAND`] of one they are left at one, so
+//! correction). A corrected level past 255 is clipped, channel by channel, where that leaves a
+//! near-white pixel (saturation up to [`WHITE_SATURATION`]: a white line stays white, as an
+//! overexposed camera shows it); any other pixel is scaled down as a whole, so that it keeps
+//! its hue: a ball lit by a camera's headlight beside a carpet seen at a grazing angle stays
+//! orange, where clipping each channel would turn it yellow. When all three gains are within [`DEAD_BAND`] of one they are left at one, so
 //! that images under the light the classes were set for are classified exactly as they come;
 //! an image with too little carpet ([`MIN_CARPET_SHARE`]) is left as it is too.
 //!
@@ -35,17 +39,14 @@ pub const DEAD_BAND: f64 = 0.03;
 /// are corrected that far only.
 pub const MAX_GAIN: f64 = 4.0;
 
-/// One gain a channel, as three tables of the 256 levels.
-#[derive(Clone)]
+/// A pixel that clipping each channel at 255 leaves this little saturated is clipped so;
+/// a more saturated one keeps its hue.
+pub const WHITE_SATURATION: f32 = 0.25;
+
+/// One gain a channel.
+#[derive(Clone, Debug)]
 pub struct Gains {
     factors: [f64; 3],
-    maps: [[u8; 256]; 3],
-}
-
-impl std::fmt::Debug for Gains {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("Gains").field("factors", &self.factors).finish_non_exhaustive()
-    }
 }
 
 impl Default for Gains {
@@ -64,14 +65,7 @@ impl Gains {
         if factors.iter().all(|f| (f - 1.0).abs() <= DEAD_BAND) {
             factors = [1.0; 3];
         }
-        let maps = factors.map(|f| {
-            let mut map = [0u8; 256];
-            for (v, m) in map.iter_mut().enumerate() {
-                *m = (v as f64 * f).round().min(255.0) as u8;
-            }
-            map
-        });
-        Gains { factors, maps }
+        Gains { factors }
     }
 
     /// The gains, red, green, blue.
@@ -84,10 +78,9 @@ impl Gains {
         self.factors == [1.0; 3]
     }
 
-    /// A pixel, corrected.
-    #[inline]
-    pub fn apply(&self, [r, g, b]: [u8; 3]) -> [u8; 3] {
-        [self.maps[0][usize::from(r)], self.maps[1][usize::from(g)], self.maps[2][usize::from(b)]]
+    /// A pixel, corrected: each channel times its gain, then [`fit`] into 0–255.
+    pub fn apply(&self, px: [u8; 3]) -> [u8; 3] {
+        fit(std::array::from_fn(|c| f32::from(px[c]) * self.factors[c] as f32))
     }
 
     /// The gains that bring the mean colour of the carpet in `rgb` (an RGB888 image
@@ -122,6 +115,21 @@ impl Gains {
     }
 }
 
+/// A corrected colour (levels from 0 up, any of them maybe past 255) as 8-bit levels: clipped
+/// channel by channel where that leaves it near white, else scaled down as a whole to keep its
+/// hue (see the module's doc).
+#[inline]
+fn fit(v: [f32; 3]) -> [u8; 3] {
+    let top = v[0].max(v[1]).max(v[2]);
+    let low = v[0].min(v[1]).min(v[2]);
+    // Without a branch: the table's build runs this 32 768 times, on pixels of either kind.
+    let keep_hue = top > 255.0 && low < 255.0 * (1.0 - WHITE_SATURATION);
+    let scale = if keep_hue { 255.0 / top } else { 1.0 };
+    // Levels are never negative: adding a half and truncating rounds them (a float-to-int
+    // cast saturates at 255), without a call to `round`.
+    v.map(|v| (v * scale + 0.5).min(255.0) as u8)
+}
+
 /// The lookup table for one image's light: the colour file's table ([`Lut`]) read through the
 /// image's gains, rebuilt for each image that needs a correction (32 768 entries, cheaper than
 /// correcting each pixel of a 320 × 240 image), so that classifying costs what it costs
@@ -131,7 +139,13 @@ pub struct BalancedLut {
     table: Box<[u8; 1 << 15]>,
     /// The gains the table was built for (the next image under the same light reuses it).
     built_for: Option<[f64; 3]>,
+    /// Each channel's 32 RGB15 cell middles times its gain.
+    levels: [[f32; 32]; 3],
 }
+
+/// A cell of the table whose class is found when a pixel first falls in it: one whose
+/// corrected colour keeps its hue (no class has this number).
+const UNRESOLVED: u8 = u8::MAX;
 
 impl std::fmt::Debug for BalancedLut {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
@@ -141,7 +155,7 @@ impl std::fmt::Debug for BalancedLut {
 
 impl Default for BalancedLut {
     fn default() -> Self {
-        BalancedLut { table: Box::new([0; 1 << 15]), built_for: None }
+        BalancedLut { table: Box::new([0; 1 << 15]), built_for: None, levels: [[0.0; 32]; 3] }
     }
 }
 
@@ -162,27 +176,61 @@ impl BalancedLut {
             self.build(lut, &gains);
         }
         for (px, o) in rgb.chunks_exact(3).zip(out.iter_mut()) {
-            *o = self.table[usize::from(rgb15_of(px[0], px[1], px[2]))];
+            *o = self.class(lut, usize::from(rgb15_of(px[0], px[1], px[2])));
         }
         gains
     }
 
-    /// The table of `lut` under `gains`: each channel's five bits through its gain, at the
-    /// middle of their 8-bit cell.
+    /// The table of `lut` under `gains`: each RGB15 cell's middle colour, corrected as
+    /// [`Gains::apply`] corrects it. A cell whose colour passes 255 and keeps its hue is left
+    /// [`UNRESOLVED`] (most cells of a strong gain; few pixels of an image fall in them);
+    /// every other cell's corrected colour is each channel's own, clipped at 255.
     fn build(&mut self, lut: &Lut, gains: &Gains) {
-        let five = |ch: usize, shift: u32| -> [usize; 32] {
-            std::array::from_fn(|v| usize::from(gains.maps[ch][(v << 3) | 4] >> 3) << shift)
+        self.levels = std::array::from_fn(|ch| {
+            std::array::from_fn(|v| ((v << 3) | 4) as f32 * gains.factors[ch] as f32)
+        });
+        let white = 255.0 * (1.0 - WHITE_SATURATION);
+        // A channel's RGB15 bits, and whether its level passes 255 or lies below white.
+        let bits = |ch: usize, shift: u32| -> [(usize, bool, bool); 32] {
+            std::array::from_fn(|v| {
+                let level = self.levels[ch][v];
+                (
+                    usize::from((level + 0.5).min(255.0) as u8 >> 3) << shift,
+                    level > 255.0,
+                    level < white,
+                )
+            })
         };
-        let (r, g, b) = (five(0, 10), five(1, 5), five(2, 0));
+        let (red, green, blue) = (bits(0, 10), bits(1, 5), bits(2, 0));
         let raw = lut.raw();
-        for (rows, &r) in self.table.chunks_exact_mut(1 << 10).zip(&r) {
-            for (row, &g) in rows.chunks_exact_mut(1 << 5).zip(&g) {
-                for (slot, &b) in row.iter_mut().zip(&b) {
-                    *slot = raw[r | g | b];
+        for (rows, &(r, r_over, r_low)) in self.table.chunks_exact_mut(1 << 10).zip(&red) {
+            for (row, &(g, g_over, g_low)) in rows.chunks_exact_mut(1 << 5).zip(&green) {
+                for (slot, &(b, b_over, b_low)) in row.iter_mut().zip(&blue) {
+                    let keeps_hue = (r_over | g_over | b_over) & (r_low | g_low | b_low);
+                    *slot = if keeps_hue { UNRESOLVED } else { raw[r | g | b] };
                 }
             }
         }
         self.built_for = Some(gains.factors);
+    }
+
+    /// The class of an RGB15 cell under the gains the table was built for.
+    #[inline]
+    fn class(&mut self, lut: &Lut, cell: usize) -> u8 {
+        match self.table[cell] {
+            UNRESOLVED => self.resolve(lut, cell),
+            class => class,
+        }
+    }
+
+    /// The class of an [`UNRESOLVED`] cell, kept in the table.
+    #[cold]
+    fn resolve(&mut self, lut: &Lut, cell: usize) -> u8 {
+        let level = |ch: usize, shift: usize| self.levels[ch][(cell >> shift) & 31];
+        let [r, g, b] = fit([level(0, 10), level(1, 5), level(2, 0)]);
+        let class = lut.raw()[usize::from(rgb15_of(r, g, b))];
+        self.table[cell] = class;
+        class
     }
 }
 
@@ -228,6 +276,32 @@ mod tests {
         }
     }
 
+    /// A headlight on the camera: the carpet, seen at a grazing angle, is dark and the ball
+    /// facing the lamp bright. The gains that lift the carpet would push the ball past 255 in
+    /// red and green, which clipped one by one is yellow; it keeps its orange, and a white line
+    /// beside it stays white.
+    #[test]
+    fn a_colour_pushed_past_255_keeps_its_hue_and_white_stays_white() {
+        let lut = Lut::new(&ColorTable::shipped());
+        let (w, h) = (64usize, 48usize);
+        let mut rgb = Vec::with_capacity(w * h * 3);
+        for y in 0..h {
+            for x in 0..w {
+                let ball = (x as f64 - 32.0).hypot(y as f64 - 24.0) < 6.0;
+                let c = match (ball, y >= 40) {
+                    (true, _) => [173, 76, 10],
+                    (false, true) => [70, 72, 68],
+                    (false, false) => [9, 38, 15],
+                };
+                rgb.extend_from_slice(&c);
+            }
+        }
+        let (seen, gains) = classes(&lut, &rgb);
+        assert!(gains.factors().iter().all(|&g| g > 3.0), "{gains:?}");
+        assert_eq!(seen[24 * w + 32], ColorClass::Ball as u8, "{gains:?}");
+        assert_eq!(seen[44 * w + 32], ColorClass::Line as u8, "{gains:?}");
+    }
+
     #[test]
     fn without_carpet_or_a_white_balance_nothing_is_corrected() {
         let lut = Lut::new(&ColorTable::shipped());
@@ -258,7 +332,7 @@ mod tests {
             let [r, g, b, _] = state.to_le_bytes();
             let [cr, cg, cb] = gains.apply([r, g, b]);
             let direct = lut.class(cr, cg, cb) as u8;
-            same += usize::from(balanced.table[usize::from(rgb15_of(r, g, b))] == direct);
+            same += usize::from(balanced.class(&lut, usize::from(rgb15_of(r, g, b))) == direct);
         }
         assert!(same as f64 > 0.93 * n as f64, "{same} of {n}");
     }
@@ -267,7 +341,9 @@ mod tests {
     fn gains_are_bounded_and_numbers() {
         assert_eq!(Gains::new([f64::NAN, f64::INFINITY, 1e9]).factors(), [1.0, 1.0, MAX_GAIN]);
         assert_eq!(Gains::new([0.0; 3]).factors(), [1.0 / MAX_GAIN; 3]);
-        assert_eq!(Gains::new([3.0; 3]).apply([100, 0, 255]), [255, 0, 255], "clipped");
+        assert_eq!(Gains::new([3.0; 3]).apply([100, 0, 255]), [100, 0, 255], "kept below 255");
+        assert_eq!(Gains::new([3.0; 3]).apply([170, 76, 10]), [255, 114, 15], "keeps its hue");
+        assert_eq!(Gains::new([1.9, 1.6, 1.4]).apply([165, 190, 150]), [255, 255, 210], "white");
         assert!(Gains::for_carpet(&[], 0, [30.0, 130.0, 50.0], |_| true).is_unity());
     }
 }
