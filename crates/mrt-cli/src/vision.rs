@@ -132,7 +132,9 @@ fn open_device(device: &Path, _: (u32, u32)) -> Result<Box<dyn ImageSource>> {
 }
 
 /// What `detect` runs on each image: the vision µAgent of a pinhole camera (front mode), or
-/// the up mode's ball finder on an omnidirectional camera's image (seed `003` §3.2.1).
+/// the up mode's ball finder on an omnidirectional camera's image (ISocRob-2000 report §3.2.1).
+/// One is built for a whole run, so its size does not matter.
+#[allow(clippy::large_enum_variant)]
 enum Detector {
     Front(VisionAgent),
     Up { up: UpMode, lut: Lut, radius: f64 },
