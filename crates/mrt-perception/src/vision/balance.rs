@@ -78,7 +78,8 @@ impl Gains {
         self.factors == [1.0; 3]
     }
 
-    /// A pixel, corrected: each channel times its gain, then [`fit`] into 0–255.
+    /// A pixel, corrected: each channel times its gain, then brought into 0–255 (a colour
+    /// pushed past 255 scaled down as a whole to keep its hue, unless it is near white).
     pub fn apply(&self, px: [u8; 3]) -> [u8; 3] {
         fit(std::array::from_fn(|c| f32::from(px[c]) * self.factors[c] as f32))
     }
