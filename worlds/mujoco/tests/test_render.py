@@ -172,12 +172,17 @@ class SceneTest(unittest.TestCase):
         if why:
             self.skipTest(why)
 
-    def test_every_scene_loads_with_lights_and_no_headlight(self):
+    def test_every_scene_loads_and_is_lit_by_its_lights_or_the_headlamp_alone(self):
         mj = rf.mujoco_module()
-        for name in SCENES:
+        names = sorted(p.stem for p in (HERE / "scenes").glob("*.xml"))
+        self.assertTrue(set(SCENES) <= set(names), names)
+        for name in names:
             m = mj.MjModel.from_xml_path(str(HERE / "scenes" / f"{name}.xml"))
-            self.assertGreater(m.nlight, 0, name)
-            self.assertEqual(m.vis.headlight.active, 0, name)
+            if name == "headlamp":
+                self.assertEqual((m.nlight, m.vis.headlight.active), (0, 1), name)
+            else:
+                self.assertGreater(m.nlight, 0, name)
+                self.assertEqual(m.vis.headlight.active, 0, name)
             for obj, what in ((mj.mjtObj.mjOBJ_BODY, "ball"), (mj.mjtObj.mjOBJ_BODY, "viewer"),
                               (mj.mjtObj.mjOBJ_CAMERA, "eye"), (mj.mjtObj.mjOBJ_BODY, "home0"),
                               (mj.mjtObj.mjOBJ_BODY, "away0")):

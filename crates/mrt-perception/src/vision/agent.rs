@@ -46,6 +46,10 @@ pub const MARKER_MIN_PIXELS: u32 = 2;
 /// Pixels of neither the robot's body nor a marker (edges, blur) crossed going up a robot
 /// before its top is taken as reached.
 pub const MARKER_GAP: usize = 2;
+/// How high above its foot, at least, a robot's body (its dark and marker pixels) must reach
+/// in the image, m: a shadow on the carpet or the dark band at a wall's foot is as dark as a
+/// robot but lies flat or low (the body is dark up to its marker band, 0.48 m).
+pub const ROBOT_MIN_RISE: f64 = 0.3;
 /// Field-line scan lines: every this many columns.
 pub const LINE_STEP: usize = 8;
 /// The longest white run that is a line, pixels.
@@ -516,7 +520,7 @@ impl VisionAgent {
     /// carpet, the first run of robot pixels is a robot's foot; neighbouring columns whose
     /// feet are within [`SAME_ROBOT`] of each other on the floor are one robot, seen at its
     /// lowest foot, with the colour of the marker band its columns show above the foot
-    /// ([`VisionAgent::marker`]).
+    /// ([`VisionAgent::marker`]), if its body rises [`ROBOT_MIN_RISE`] above the foot.
     /// (Cheaper than labelling the dark blobs, which are large, and it gives the foot.)
     /// Each robot's box in the image (its columns, from its foot up to the top the marker
     /// scan reached) goes into `shown`.
@@ -582,6 +586,12 @@ impl VisionAgent {
             let px = Pixel::new((g.0 + g.1) as f64 / 2.0 + 0.5, g.2 as f64 + 1.0);
             if let Some(at) = self.camera.unproject(px) {
                 let (marker, top) = self.marker((g.0..=g.1).step_by(OBSTACLE_STEP), g.2);
+                // Where the body must reach: the image's top, or the row of a point
+                // ROBOT_MIN_RISE above the foot.
+                let rise = self.camera.project(Point3::new(at.x, at.y, ROBOT_MIN_RISE));
+                if top > 0 && rise.is_some_and(|r| top as f64 > r.y) {
+                    continue;
+                }
                 out.push(RobotSighting {
                     sighting: sighting(at),
                     sigma: self.sigma(px, 1.0),
@@ -728,6 +738,53 @@ mod tests {
                 "{i:?} out of the image"
             );
         }
+    }
+
+    /// A 160 × 120 image of carpet with, 1.6 m ahead, either a robot (a dark board facing the
+    /// camera, 0.4 m wide, its marker band magenta from 0.48 to 0.6 m) or a shadow as wide and
+    /// 0.5 m long lying flat on the carpet, as dark as the robot's body.
+    fn robot_or_shadow(standing: bool) -> (Pinhole, Image) {
+        let cam = Pinhole::new(Intrinsics::centred(160, 120, 130.0), 0.45, 0.35);
+        let (w, h) = (160usize, 120usize);
+        let mut image = Image::new(w as u32, h as u32);
+        for row in 0..h {
+            for col in 0..w {
+                let px = Pixel::new(col as f64 + 0.5, row as f64 + 0.5);
+                let ray = cam.ray(px);
+                let body =
+                    (ray.x > 0.0).then(|| cam.centre() + ray * ((1.6 - cam.centre().x) / ray.x));
+                let rgb = match (standing, body, cam.unproject(px)) {
+                    (true, Some(p), _) if p.y.abs() < 0.2 && (0.0..0.48).contains(&p.z) => {
+                        [22, 22, 26]
+                    }
+                    (true, Some(p), _) if p.y.abs() < 0.2 && (0.48..0.6).contains(&p.z) => {
+                        [200, 40, 190]
+                    }
+                    (false, _, Some(f)) if f.y.abs() < 0.2 && (1.6..2.1).contains(&f.x) => {
+                        [22, 22, 26]
+                    }
+                    _ => [30, 130, 50],
+                };
+                image.rgb[(row * w + col) * 3..][..3].copy_from_slice(&rgb);
+            }
+        }
+        (cam, image)
+    }
+
+    /// A robot standing on the carpet is seen, with its marker, at its foot; a shadow as dark
+    /// and as wide lying flat on the carpet is no robot.
+    #[test]
+    fn a_robot_rises_from_the_carpet_and_a_shadow_does_not() {
+        let (cam, robot) = robot_or_shadow(true);
+        let mut agent = VisionAgent::new(cam, &ColorTable::shipped(), 0.11);
+        let seen = agent.see(&robot, 0.0, 0.0).unwrap().robots;
+        assert_eq!(seen.len(), 1, "{seen:?}");
+        assert_eq!(seen[0].marker, Some(Marker::Magenta));
+        assert!((seen[0].sighting.distance - 1.6).abs() < 0.05, "{:?}", seen[0]);
+        assert!(seen[0].sighting.bearing.abs() < 0.02, "{:?}", seen[0]);
+        let (_, shadow) = robot_or_shadow(false);
+        let seen = agent.see(&shadow, 0.0, 0.0).unwrap().robots;
+        assert!(seen.is_empty(), "a shadow taken for a robot: {seen:?}");
     }
 
     proptest! {
