@@ -35,6 +35,10 @@ pub struct FilterCounts {
     /// Field-line points that corrected the pose.
     #[serde(default)]
     pub line_corrections: u64,
+    /// Corrections refused because their result was not finite (the pose and its
+    /// uncertainty kept as they were).
+    #[serde(default)]
+    pub refused: u64,
 }
 
 /// A robot's own pose estimate after a cycle, in the field frame (m, rad; not the team frame

@@ -63,6 +63,9 @@ struct Innovation {
 /// Field-line points farther than this do not correct the pose, m: their place on the floor
 /// rests on a pixel row that spans many centimetres there.
 pub const LINE_RANGE: f64 = 4.0;
+/// Field-line points nearer than this do not correct the pose either, m: a point at the
+/// robot's own centre carries no bearing (no camera sees the floor under itself).
+pub const LINE_MIN_RANGE: f64 = 0.05;
 /// At most this many field-line points of a frame correct the pose, the nearest first.
 pub const LINE_CORRECTIONS: usize = 12;
 /// A field-line point corrects the pose only when the line it lies beside is nearer than
@@ -541,15 +544,26 @@ impl WorldModel {
             return false;
         }
         let k = self.cov * h.transpose() * s_inv;
-        let step = k * nu;
+        // Joseph form: stays symmetric and positive.
+        let i_kh = Matrix3::identity() - k * h;
+        self.commit(k * nu, i_kh * self.cov * i_kh.transpose() + k * r * k.transpose());
+        true
+    }
+
+    /// Moves the pose by an EKF correction's `step` and sets its covariance to `cov`, unless
+    /// either is not finite: then both stay as they were and the refusal is counted.
+    /// Returns whether it was applied.
+    fn commit(&mut self, step: Vector3<f64>, cov: Matrix3<f64>) -> bool {
+        if !(step.iter().chain(cov.iter()).all(|v| v.is_finite())) {
+            self.counts.refused += 1;
+            return false;
+        }
         self.pose = Pose2::new(
             self.pose.x + step[0],
             self.pose.y + step[1],
             normalize_angle(self.pose.theta + step[2]),
         );
-        // Joseph form: stays symmetric and positive.
-        let i_kh = Matrix3::identity() - k * h;
-        self.cov = i_kh * self.cov * i_kh.transpose() + k * r * k.transpose();
+        self.cov = cov;
         true
     }
 
@@ -879,7 +893,7 @@ impl WorldModel {
         let mut near: Vec<(f64, f64, f64)> = line_points
             .iter()
             .map(|&(x, y)| (x.hypot(y), x, y))
-            .filter(|&(d, _, _)| d.is_finite() && d <= LINE_RANGE)
+            .filter(|&(d, _, _)| d.is_finite() && (LINE_MIN_RANGE..=LINE_RANGE).contains(&d))
             .collect();
         near.sort_by(|a, b| a.0.total_cmp(&b.0));
         for &(d, x, y) in near.iter().take(LINE_CORRECTIONS) {
@@ -904,14 +918,10 @@ impl WorldModel {
                 continue;
             }
             let k = self.cov * h.transpose() / s_var;
-            self.pose = Pose2::new(
-                self.pose.x + k[0] * nu,
-                self.pose.y + k[1] * nu,
-                normalize_angle(self.pose.theta + k[2] * nu),
-            );
             let i_kh = Matrix3::identity() - k * h;
-            self.cov = i_kh * self.cov * i_kh.transpose() + k * r * k.transpose();
-            self.counts.line_corrections += 1;
+            if self.commit(k * nu, i_kh * self.cov * i_kh.transpose() + k * r * k.transpose()) {
+                self.counts.line_corrections += 1;
+            }
         }
     }
 
@@ -1589,6 +1599,35 @@ mod tests {
         let odd = [line(truth, (8.8, 5.8), (8.8, 5.8), 2), line(truth, (7.5, 5.6), (7.5, 5.6), 2)];
         m.percepts(&Percepts { time: 0.4, line_points: odd.concat(), ..Default::default() });
         assert_eq!(m.counts().line_corrections, before);
+    }
+
+    /// A correction whose step or covariance is not finite is refused and counted; the
+    /// pose and its uncertainty stay as they were.
+    #[test]
+    fn a_correction_that_is_not_finite_is_refused_and_counted() {
+        let mut m = model();
+        m.place(Framed::new(Pose2::new(1.0, 2.0, 0.5)));
+        let (pose, cov) = (m.pose, m.cov);
+        let nan = Vector3::new(0.1, f64::NAN, 0.0);
+        assert!(!m.commit(nan, Matrix3::identity()));
+        assert!(!m.commit(Vector3::zeros(), Matrix3::identity() * f64::INFINITY));
+        assert_eq!((m.pose, m.cov, m.counts().refused), (pose, cov, 2));
+        assert!(m.commit(Vector3::new(0.1, 0.0, 0.0), cov));
+        assert_eq!((m.pose.x, m.counts().refused), (1.1, 2));
+    }
+
+    /// Line points at the robot's centre carry no bearing: two of them, one a hair off it,
+    /// leave the pose and its uncertainty finite (a case a property test once drew).
+    #[test]
+    fn line_points_at_the_robot_s_own_foot_leave_the_pose_and_its_sigma_finite() {
+        let mut m = model();
+        m.place(Framed::new(Pose2::new(-1.924532815054719, 0.49055413021987215, 0.0)));
+        let points = vec![(-4.0e-151, 0.0), (0.0, 0.0)];
+        m.percepts(&Percepts { time: 0.1, line_points: points, ..Default::default() });
+        let e = m.pose().inner;
+        assert!(e.x.is_finite() && e.y.is_finite() && e.theta.is_finite(), "{e:?}");
+        let (sxy, st) = m.sigma();
+        assert!(sxy.is_finite() && st.is_finite(), "σ {sxy}, {st}");
     }
 
     /// A coordinate of a line point: mostly near the robot, sometimes anything at all.
