@@ -132,6 +132,19 @@ fn finite(f: &str, v: f64) -> mlua::Result<f64> {
     }
 }
 
+/// How far from the field's centre a behavior's target may lie, mm (1000 km).
+pub const MAX_TARGET: f64 = 1e9;
+
+/// The largest set-point a behavior's speed is taken at, mm/s or deg/s (1 km/s): every base
+/// scales a command beyond its top speed down as a whole, so a larger one means the same,
+/// and one near `f64::MAX` would overflow to infinity on its way to the wheels.
+pub const MAX_SETPOINT: f64 = 1e6;
+
+/// A speed set-point: finite (else the script's error), clamped to ±[`MAX_SETPOINT`].
+fn setpoint(f: &str, v: f64) -> mlua::Result<f64> {
+    Ok(finite(f, v)?.clamp(-MAX_SETPOINT, MAX_SETPOINT))
+}
+
 const INTEGER: i64 = 1;
 const FLOAT: i64 = 2;
 const STRING: i64 = 3;
@@ -395,9 +408,10 @@ fn install_inner(lua: &Lua, io: Rc<RefCell<RobotIo>>, memory_limit: usize) -> ml
     // Control actions.
     type TargetArgs = (f64, f64, f64, Option<bool>, Option<bool>);
     func!("setTarget", io, |_lua, (x, y, theta, avoid, plan): TargetArgs| {
-        if !(x.is_finite() && y.is_finite() && theta.is_finite()) {
+        if !(x.abs() <= MAX_TARGET && y.abs() <= MAX_TARGET && theta.is_finite()) {
             return Err(mlua::Error::runtime(format!(
-                "bad argument: setTarget needs finite numbers, not ({x}, {y}, {theta})"
+                "bad argument: setTarget needs finite numbers, x and y within ±{MAX_TARGET:e} mm, \
+                 not ({x}, {y}, {theta})"
             )));
         }
         let pose = mrt_core::Pose2::new(x, y, theta);
@@ -409,17 +423,18 @@ fn install_inner(lua: &Lua, io: Rc<RefCell<RobotIo>>, memory_limit: usize) -> ml
         Ok(())
     });
     // A set-point that is not a finite number is the script's fault, reported as one: NaN
-    // would silently stop the robot and infinity saturate it.
+    // would silently stop the robot and infinity saturate it. A huge finite one is taken as
+    // MAX_SETPOINT, far beyond any base's top speed, like any other too fast.
     func!("setVlin", io, |_lua, v: f64| {
-        io.borrow_mut().command.vlin = finite("setVlin", v)?;
+        io.borrow_mut().command.vlin = setpoint("setVlin", v)?;
         Ok(())
     });
     func!("setVrot", io, |_lua, v: f64| {
-        io.borrow_mut().command.vrot = finite("setVrot", v)?;
+        io.borrow_mut().command.vrot = setpoint("setVrot", v)?;
         Ok(())
     });
     func!("setVlat", io, |_lua, v: f64| {
-        io.borrow_mut().command.vlat = finite("setVlat", v)?;
+        io.borrow_mut().command.vlat = setpoint("setVlat", v)?;
         Ok(())
     });
     func!("setKick", io, |_lua, id: i64| {

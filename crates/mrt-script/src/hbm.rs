@@ -47,6 +47,15 @@ pub const DEFAULT_VARIABLES: &str = include_str!("hbm_defaults.lua");
 /// How deep `use` may nest: deeper is a runaway hierarchy.
 pub const MAX_DEPTH: usize = 32;
 
+/// The most labels a control variable may have: the exact centroid's cost grows with the
+/// cube of the labels asserted at once (32 overlapping ones take about 0.2 ms, 64 about 2).
+pub const MAX_LABELS: usize = 32;
+
+/// The largest magnitude of a control variable's range and of its labels' parameters (the
+/// behaviors' units, mm/s and deg/s): far beyond any robot, small enough that the
+/// defuzzifier's sums stay finite.
+pub const MAX_MAGNITUDE: f64 = 1e9;
+
 /// The robot command field a control variable drives.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum Drives {
@@ -73,7 +82,20 @@ fn set_of(t: &Table) -> mlua::Result<FuzzySet> {
     for (i, slot) in p.iter_mut().enumerate().take(arity) {
         *slot = t.raw_get(i + 2)?;
     }
-    FuzzySet::from_parts(name, &p[..arity]).ok_or_else(|| err(format!("{name}: bad parameters")))
+    checked_set(name, &p[..arity])
+}
+
+/// The set `name` of parameters `p`, if they are finite, within ±[`MAX_MAGNITUDE`] and in
+/// increasing order: the same checks for a set `TRI` built and one a script built by hand.
+fn checked_set(name: &str, p: &[f64]) -> mlua::Result<FuzzySet> {
+    let set =
+        FuzzySet::from_parts(name, p).ok_or_else(|| err(format!("{name}: bad parameters")))?;
+    if !set.is_ordered() || !p.iter().all(|v| v.abs() <= MAX_MAGNITUDE) {
+        return Err(err(format!(
+            "{name}{p:?}: parameters must be numbers within ±{MAX_MAGNITUDE:e}, in increasing order"
+        )));
+    }
+    Ok(set)
 }
 
 /// A truth value from Lua: a number (clamped to `[0, 1]`) or a boolean.
@@ -435,14 +457,7 @@ fn set_fn(lua: &Lua, g: &Table, kind: usize, meta: &Table) -> mlua::Result<()> {
         if args.len() != arity {
             return Err(err(format!("{name} takes {arity} numbers, got {}", args.len())));
         }
-        let set = FuzzySet::from_parts(name, &args)
-            .ok_or_else(|| err(format!("{name}: bad parameters")))?;
-        if !set.is_ordered() || args.iter().any(|p| !p.is_finite()) {
-            return Err(err(format!(
-                "{name}{:?}: parameters must be finite and in increasing order",
-                &args[..]
-            )));
-        }
+        checked_set(name, &args)?;
         let t = lua.create_table_with_capacity(1 + arity, 0)?;
         t.raw_set(1, kind)?;
         for (i, p) in args.iter().enumerate() {
@@ -516,10 +531,23 @@ fn install(lua: &Lua, shared: &Rc<Shared>) -> mlua::Result<()> {
                     names.join(", ")
                 )));
             };
-            v.min *= k;
-            v.max *= k;
-            v.labels.iter_mut().for_each(|(_, set)| *set = set.scaled(k));
-            Ok(())
+            let labels = v
+                .labels
+                .iter()
+                .map(|(l, set)| {
+                    Ok((l.clone(), checked_set(set.identifier(), &set.scaled(k).params())?))
+                })
+                .collect::<mlua::Result<Vec<_>>>();
+            let (min, max) = (v.min * k, v.max * k);
+            match labels {
+                Ok(labels) if min.abs() <= MAX_MAGNITUDE && max.abs() <= MAX_MAGNITUDE => {
+                    (v.min, v.max, v.labels) = (min, max, labels);
+                    Ok(())
+                }
+                _ => Err(err(format!(
+                    "scale('{name}', {k}): the variable would reach beyond ±{MAX_MAGNITUDE:e}"
+                ))),
+            }
         })?,
     )?;
 
@@ -641,15 +669,18 @@ fn declare(t: &Table) -> mlua::Result<(ControlVariable, Option<Drives>)> {
             )))
         }
     };
-    if !(min.is_finite() && max.is_finite())
-        || min.partial_cmp(&max) != Some(std::cmp::Ordering::Less)
-    {
-        return Err(err(format!("variable '{name}': min {min} must be below max {max}")));
+    if !(min.abs() <= MAX_MAGNITUDE && max.abs() <= MAX_MAGNITUDE) || min >= max {
+        return Err(err(format!(
+            "variable '{name}': min {min} must be below max {max}, both within ±{MAX_MAGNITUDE:e}"
+        )));
     }
     let labels: Table = t.get("labels")?;
     let mut list = Vec::new();
     for pair in labels.pairs::<String, Table>() {
         let (label, set) = pair?;
+        if list.len() == MAX_LABELS {
+            return Err(err(format!("variable '{name}' has more than {MAX_LABELS} labels")));
+        }
         list.push((label, set_of(&set)?));
     }
     if list.is_empty() {

@@ -258,6 +258,29 @@ fn a_set_point_that_is_not_finite_is_a_reported_fault() {
     }
 }
 
+/// A huge finite speed means what any speed beyond the base's top speed means: it is taken
+/// as MAX_SETPOINT, with its sign, and never overflows on its way to the wheels. A target
+/// farther than MAX_TARGET is the script's error.
+#[test]
+fn a_huge_set_point_is_clamped_and_a_target_beyond_reach_refused() {
+    use mrt_script::chaos::{MAX_SETPOINT, MAX_TARGET};
+    let (rt, io) = setup();
+    io.borrow_mut().begin_cycle(WorldSnapshot::default(), "b");
+    let src = "chaos.setVlin(1e308) chaos.setVrot(-1.7e308) chaos.setVlat(3 * 10^6)";
+    let s = Script::from_source(&rt, "huge.lua", src, LoadStrategy::Compiled).unwrap();
+    s.call::<()>(&rt).unwrap();
+    let c = io.borrow().command.clone();
+    assert_eq!((c.vlin, c.vrot, c.vlat), (MAX_SETPOINT, -MAX_SETPOINT, MAX_SETPOINT));
+    assert!((c.vlin * 4.8).is_finite(), "a scaled set-point stays finite");
+    for call in ["chaos.setTarget(1e308, 0, 0)", "chaos.setTarget(0, -2e9, 0)"] {
+        io.borrow_mut().begin_cycle(WorldSnapshot::default(), "b");
+        let s = Script::from_source(&rt, "far.lua", call, LoadStrategy::Compiled).unwrap();
+        let e = s.call::<()>(&rt).unwrap_err().to_string();
+        assert!(e.contains(&format!("{MAX_TARGET:e}")), "{call}: {e}");
+        assert_eq!(io.borrow().command.target, None, "{call}");
+    }
+}
+
 #[test]
 fn needs_keep_one_entry_per_object_however_often_they_are_set() {
     let (rt, io) = setup();

@@ -271,8 +271,14 @@ fn scale_stretches_a_default_variable_once_also_after_a_reload() {
     let (reloaded, errors) = cap.reload_changed();
     assert!(errors.is_empty() && reloaded.iter().any(|r| r == "hbm"), "{reloaded:?} {errors:?}");
     close(cap.cycle(ball_at(1000.0, 100)).command.vlin, 1000.0);
-    for (k, bad) in
-        [r#"scale("go", 0)"#, r#"scale("go", -2)"#, r#"scale("speed", 2)"#].into_iter().enumerate()
+    for (k, bad) in [
+        r#"scale("go", 0)"#,
+        r#"scale("go", -2)"#,
+        r#"scale("speed", 2)"#,
+        r#"scale("go", 1e300) scale("go", 1e300)"#,
+    ]
+    .into_iter()
+    .enumerate()
     {
         let d = Dir::new(&format!("badscale{k}"));
         d.write("hbm.lua", bad);
@@ -397,7 +403,7 @@ fn a_behavior_using_itself_is_an_error_naming_the_chain() {
 #[test]
 fn bad_rules_and_arguments_are_errors_with_file_and_line_not_panics() {
     let dir = Dir::new("badargs");
-    let cases: [(&str, &str); 17] = [
+    let cases: [(&str, &str); 22] = [
         (
             r#"rule(1, "speed", "FAST")"#,
             "no control variable 'speed' (known: go, turn, strafe, kick)",
@@ -423,12 +429,36 @@ fn bad_rules_and_arguments_are_errors_with_file_and_line_not_panics() {
         ("AND(0.5, {})", "AND: a truth value must be a number or a boolean, not table"),
         ("TRI(1, 2)", "TRI takes 3 numbers, got 2"),
         ("TRI('a', 1, 2)", "error converting Lua string to f64"),
-        ("TRI(2, 1, 0)", "TRI[2.0, 1.0, 0.0]: parameters must be finite and in increasing order"),
-        ("TOR(0, math.huge)", "parameters must be finite and in increasing order"),
+        (
+            "TRI(2, 1, 0)",
+            "TRI[2.0, 1.0, 0.0]: parameters must be numbers within ±1e9, in increasing order",
+        ),
+        ("TOR(0, math.huge)", "parameters must be numbers within ±1e9, in increasing order"),
         ("TRI(0, 1, 2)('x')", "bad argument"),
         (
             r#"variable { name = "v", min = 1, max = 0, labels = { A = SNG(0) } }"#,
             "variable 'v': min 1 must be below max 0",
+        ),
+        (
+            r#"variable { name = "v", min = -1e308, max = 0, labels = { A = SNG(0) } }"#,
+            "both within ±1e9",
+        ),
+        // Labels built by hand as tables get the checks TRI and its kin make.
+        (
+            r#"variable { name = "v", min = 0, max = 1, labels = { A = {0, 0/0, 0/0, 0/0} } }"#,
+            "TRI[NaN, NaN, NaN]: parameters must be numbers within ±1e9",
+        ),
+        (
+            r#"variable { name = "v", min = 0, max = 1, labels = { A = {0, 3, 2, 1} } }"#,
+            "TRI[3.0, 2.0, 1.0]: parameters must be numbers within ±1e9, in increasing order",
+        ),
+        (
+            r#"variable { name = "v", min = 0, max = 1, labels = { A = {1, -1e308, 0, 0, 1e308} } }"#,
+            "TRA[-1e308, 0.0, 0.0, 1e308]: parameters must be numbers within ±1e9",
+        ),
+        (
+            r#"local l = {} for i = 1, 33 do l["L" .. i] = SNG(i) end variable { name = "v", min = 0, max = 100, labels = l }"#,
+            "variable 'v' has more than 32 labels",
         ),
     ];
     for (k, (src, _)) in cases.iter().enumerate() {
@@ -468,7 +498,7 @@ fn errors_in_hbm_lua_or_a_behavior_file_fail_the_load_naming_the_file() {
     let e = Hbm::load_dir(&rt, dir.path(), io).err().unwrap();
     let (file, line, message) = runtime_error(&e);
     assert_eq!((file.as_str(), line), ("hbm.lua", 2), "{e}");
-    assert!(message.contains("parameters must be finite and in increasing order"), "{e}");
+    assert!(message.contains("parameters must be numbers within ±1e9, in increasing order"), "{e}");
     assert!(e.to_string().starts_with(&format!("{}:2:", setup.display())), "{e}");
 
     // A behavior that does not compile.
