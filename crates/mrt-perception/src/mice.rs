@@ -48,7 +48,7 @@
 //! nearly the same vector (straight runs). The chord of each mouse's arc, `2 r sin(|Δθ|/2)` with
 //! `r = l / |Δθ|`, is evaluated as `l · sinc(Δθ/2)`, finite when `Δθ = 0`.
 
-use crate::error::{non_negative, positive, PerceptionError};
+use crate::error::{non_negative, PerceptionError};
 use mrt_core::{arc_velocity, sinc, Pose2};
 use serde::{Deserialize, Serialize};
 use std::f64::consts::FRAC_PI_2;
@@ -110,14 +110,24 @@ fn sign(x: f64) -> f64 {
     }
 }
 
+/// How far apart two mice on a robot can be, m: eq. (4.1) divides by this distance, so one
+/// of a millimetre would turn every reading's last bit into a spin, and mice farther apart
+/// than 2 m are not on one robot.
+pub const MICE_DISTANCE: std::ops::RangeInclusive<f64> = 0.01..=2.0;
+
 impl MiceOdometry {
-    /// A sensor with the mice `distance` metres apart (finite, > 0); readings whose `x̄` differ
-    /// by more than `tolerance` metres (finite, ≥ 0) fail [`MiceOdometry::check`].
+    /// A sensor with the mice `distance` metres apart (within [`MICE_DISTANCE`]); readings
+    /// whose `x̄` differ by more than `tolerance` metres (finite, ≥ 0) fail
+    /// [`MiceOdometry::check`].
     pub fn new(distance: f64, tolerance: f64) -> Result<Self, PerceptionError> {
-        Ok(Self {
-            distance: positive("distance", distance)?,
-            tolerance: non_negative("tolerance", tolerance)?,
-        })
+        if !MICE_DISTANCE.contains(&distance) {
+            return Err(PerceptionError::InvalidParameter {
+                name: "distance",
+                value: distance,
+                expected: "between 0.01 and 2 m (MICE_DISTANCE)",
+            });
+        }
+        Ok(Self { distance, tolerance: non_negative("tolerance", tolerance)? })
     }
 
     /// `D`, metres.
@@ -429,7 +439,10 @@ mod tests {
         // The unchecked form still answers (by the manual's formulas as they are).
         let d = m.displacement_unchecked(&bad);
         assert!(d.dx.is_finite() && d.dtheta.is_finite());
-        assert!(MiceOdometry::new(0.0, 1e-3).is_err());
+        for d in [0.0, 1e-300, 0.009, 2.5, 1e6, f64::NAN, f64::INFINITY] {
+            assert!(MiceOdometry::new(d, 1e-3).is_err(), "{d}");
+        }
+        assert!(MiceOdometry::new(0.01, 1e-3).is_ok() && MiceOdometry::new(2.0, 1e-3).is_ok());
         assert!(MiceOdometry::new(0.2, -1.0).is_err());
     }
 

@@ -561,10 +561,20 @@ impl SimConfig {
         {
             return Err("sensor.half_fov and robot.kick_half_angle must be at most π".into());
         }
-        if self.rules.control_period > 10.0 || self.rules.physics_step > 1.0 {
-            return Err(
-                "rules.control_period must be at most 10 s and rules.physics_step 1 s".into()
-            );
+        // Physical bounds: a field no hall holds, or a time step that would take a match years
+        // to simulate, is a typo.
+        let within = [
+            ("field.length", self.field.length, 2.0, 200.0),
+            ("field.width", self.field.width, 2.0, 200.0),
+            ("field.border", self.field.border, 0.0, 20.0),
+            ("rules.physics_step", self.rules.physics_step, 1e-4, 1.0),
+            ("rules.control_period", self.rules.control_period, 1e-3, 10.0),
+            ("rules.half_duration", self.rules.half_duration, 0.1, 86_400.0),
+        ];
+        for (name, v, min, max) in within {
+            if !(min..=max).contains(&v) {
+                return Err(format!("{name} must be between {min} and {max}, not {v}"));
+            }
         }
         if self.field.penalty_area_depth >= self.field.length / 2.0
             || self.field.penalty_area_width > self.field.width
@@ -773,6 +783,11 @@ mod tests {
             ("[sensor]\nhalf_fov = 7.0\n", "half_fov"),
             ("[field]\npenalty_area_depth = 12.0\n", "penalty area"),
             ("[robot]\nbase = \"legs\"\n", "robot.base must be differential or omni"),
+            ("[rules]\nphysics_step = 1e-9\n", "rules.physics_step must be between 0.0001 and 1"),
+            ("[field]\nlength = 1e6\n", "field.length must be between 2 and 200"),
+            ("[field]\nwidth = 1e6\n", "field.width must be between 2 and 200"),
+            ("[odometry]\nmice_distance = 1e-300\n", "between 0.01 and 2 m"),
+            ("[rules]\nhalf_duration = 1e12\n", "rules.half_duration must be between"),
         ] {
             let e = SimConfig::from_toml(text, "bad.toml").unwrap_err().to_string();
             assert!(e.contains(needle), "{text}: {e}");
