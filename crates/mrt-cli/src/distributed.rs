@@ -245,6 +245,7 @@ pub fn play(
         }
     }
     let robots = 2 * n;
+    mrt_robot::files::remove_orphans("distributed");
     let dir = std::env::temp_dir().join(format!("mrt-distributed-{}-{seed}", std::process::id()));
     std::fs::create_dir_all(&dir).with_context(|| format!("cannot create {}", dir.display()))?;
     let mut procs = Robots { dir: dir.clone(), children: Vec::new() };

@@ -1,5 +1,6 @@
-//! Ctrl-C. By default it ends the program at once (exit status 130), after removing the
-//! compiled-in behaviors' directories that the killed process would otherwise leave behind.
+//! Ctrl-C, and likewise SIGTERM and SIGHUP. By default it ends the program at once (exit
+//! status 130), after removing the compiled-in behaviors' directories that the killed process
+//! would otherwise leave behind.
 //! A command that must finish what it writes (`mrt record --net`: an MCAP file without its
 //! summary and index is only readable by scanning it) asks for [`finish_on_ctrl_c`]: the first
 //! Ctrl-C then only raises [`interrupted`], which the command polls, and a second one ends the

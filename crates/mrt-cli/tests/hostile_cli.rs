@@ -85,24 +85,33 @@ fn a_run_leaves_no_files_behind() {
     assert!(embedded_dirs_of(pid).is_empty(), "{:?}", embedded_dirs_of(pid));
 }
 
+/// Ctrl-C, a `kill` and a closed terminal end a match the same way: exit status 130, the
+/// compiled-in behaviors' directory removed.
 #[test]
 fn an_interrupted_run_leaves_no_files_behind() {
-    let mut child = mrt()
-        .args(["sim", "--half", "3000", "--home", "chaos", "--away", "chaser"])
-        .stdout(Stdio::null())
-        .stderr(Stdio::null())
-        .spawn()
-        .unwrap();
-    let pid = child.id();
-    let started = Instant::now();
-    while embedded_dirs_of(pid).is_empty() {
-        assert!(started.elapsed() < Duration::from_secs(60), "the match never started");
-        std::thread::sleep(Duration::from_millis(20));
+    for signal in ["-INT", "-TERM", "-HUP"] {
+        let mut child = mrt()
+            .args(["sim", "--half", "3000", "--home", "chaos", "--away", "chaser"])
+            .stdout(Stdio::null())
+            .stderr(Stdio::null())
+            .spawn()
+            .unwrap();
+        let pid = child.id();
+        let started = Instant::now();
+        let spawned = std::time::SystemTime::now() - Duration::from_millis(50);
+        // The directory this process wrote (an earlier process of the same id may have left
+        // one).
+        let written = |p: &PathBuf| {
+            std::fs::metadata(p).and_then(|m| m.modified()).is_ok_and(|t| t >= spawned)
+        };
+        while !embedded_dirs_of(pid).iter().any(written) {
+            assert!(started.elapsed() < Duration::from_secs(60), "the match never started");
+            std::thread::sleep(Duration::from_millis(20));
+        }
+        let kill = Command::new("kill").args([signal, &pid.to_string()]).status().unwrap();
+        assert!(kill.success());
+        let status = child.wait().unwrap();
+        assert_eq!(status.code(), Some(130), "{signal}: {status:?}");
+        assert!(embedded_dirs_of(pid).is_empty(), "{signal}: {:?}", embedded_dirs_of(pid));
     }
-    // Ctrl-C.
-    let kill = Command::new("kill").args(["-INT", &pid.to_string()]).status().unwrap();
-    assert!(kill.success());
-    let status = child.wait().unwrap();
-    assert_eq!(status.code(), Some(130), "{status:?}");
-    assert!(embedded_dirs_of(pid).is_empty(), "{:?}", embedded_dirs_of(pid));
 }

@@ -3,8 +3,9 @@
 //!
 //! The directory is removed when the last [`FilesDir`] handle on it is dropped: when the run
 //! ends, also on an error (the handles unwind with it) and, through [`remove_embedded_dirs`]
-//! from the binary's Ctrl-C handler, on an interrupt. A run no longer leaves
-//! `/tmp/mrt-teamchaos-<pid>` behind.
+//! from the binary's Ctrl-C handler, on an interrupt. A process killed outright (SIGKILL)
+//! leaves its directory; the next process to write one removes those of processes no
+//! longer running.
 
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicU64, Ordering};
@@ -67,6 +68,7 @@ pub(crate) fn embedded(name: &'static str, files: &[(&str, &str)]) -> Result<Fil
         return Ok(FilesDir { path: w.0.clone(), _written: Some(w) });
     }
     let n = COUNT.fetch_add(1, Ordering::Relaxed);
+    remove_orphans(name);
     let dir = std::env::temp_dir().join(format!("mrt-{name}-{}-{n}", std::process::id()));
     // A directory left by an earlier process with the same id must not add stale files.
     if dir.exists() {
@@ -84,6 +86,27 @@ pub(crate) fn embedded(name: &'static str, files: &[(&str, &str)]) -> Result<Fil
     Ok(FilesDir { path: dir, _written: Some(written) })
 }
 
+/// Removes the directories `mrt-<name>-<pid>-<n>` in the temporary directory that processes
+/// no longer running left behind (killed with SIGKILL, which no handler sees). Only where
+/// `/proc` tells which processes run.
+pub fn remove_orphans(name: &str) {
+    let proc = Path::new("/proc");
+    if !proc.join("self").exists() {
+        return;
+    }
+    let prefix = format!("mrt-{name}-");
+    let Ok(entries) = std::fs::read_dir(std::env::temp_dir()) else { return };
+    for entry in entries.flatten() {
+        let file = entry.file_name();
+        let Some(rest) = file.to_str().and_then(|f| f.strip_prefix(&prefix)) else { continue };
+        let Some((pid, n)) = rest.split_once('-') else { continue };
+        let ours = pid.parse::<u32>().is_ok() && n.parse::<u64>().is_ok();
+        if ours && !proc.join(pid).exists() {
+            let _ = std::fs::remove_dir_all(entry.path());
+        }
+    }
+}
+
 /// Removes every compiled-in directory this process has written and still uses: for a
 /// Ctrl-C handler that is about to exit the process (the handles are not dropped then).
 pub fn remove_embedded_dirs() {
@@ -98,6 +121,30 @@ pub fn remove_embedded_dirs() {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Writing a directory removes those left by processes that no longer run, and only
+    /// those: not a running process's, not one of another name or form.
+    #[test]
+    fn writing_a_directory_removes_those_dead_processes_left() {
+        if !Path::new("/proc/self").exists() {
+            return;
+        }
+        let tmp = std::env::temp_dir();
+        // No process has an id above the kernel's pid_max (at most 2^22).
+        let dead = tmp.join("mrt-unit-orphans-999999999-0");
+        let alive = tmp.join(format!("mrt-unit-orphans-{}-77", std::process::id()));
+        let other = tmp.join("mrt-unit-orphans-notapid-0");
+        for d in [&dead, &alive, &other] {
+            std::fs::create_dir_all(d.join("sub")).unwrap();
+        }
+        let written = embedded("unit-orphans", &[("a.txt", "A")]).unwrap();
+        assert!(!dead.exists(), "a dead process's directory is removed");
+        assert!(alive.exists() && other.exists(), "the others are kept");
+        for d in [&alive, &other] {
+            std::fs::remove_dir_all(d).unwrap();
+        }
+        drop(written);
+    }
 
     #[test]
     fn the_directory_lives_as_long_as_a_handle_and_is_shared_meanwhile() {
