@@ -241,11 +241,32 @@ fn odd_parameters_and_inputs_are_errors_not_panics() {
         spike.plan(p(f64::NAN, 1.0), p(2.0, 2.0)),
         Err(PlanError::NonFiniteInput { .. })
     ));
-    // Outside the area: shut in.
-    assert!(spike.plan(p(-5.0, 1.0), p(2.0, 2.0)).is_err());
+    // Outside the area, near or absurdly far: said so.
+    for (from, to, why) in [
+        (p(-5.0, 1.0), p(2.0, 2.0), "the start is outside the map"),
+        (p(1.0, 1.0), p(1e300, 1e300), "the goal is outside the map"),
+    ] {
+        let e = spike.plan(from, to).unwrap_err().to_string();
+        assert_eq!(e, format!("no path: {why}"));
+    }
     // A moving shape with odd numbers is left out.
     let odd = [Shape::Disc { centre: p(f64::NAN, 1.0), radius: 1.0 }, Shape::Polygon(vec![])];
     assert!(spike.plan_among(p(1.0, 1.0), p(9.0, 9.0), &odd).is_ok());
+}
+
+/// A disc that covers the map shuts the start in, however large its radius (beyond
+/// MAX_COORD, infinite), and a path it crosses is blocked.
+#[test]
+fn a_disc_larger_than_the_map_leaves_no_path() {
+    let map = PlanMap::new(p(0.0, 0.0), p(10.0, 10.0)).unwrap();
+    let spike = Spike::new(map, SpikeParams::default()).unwrap();
+    let clear = spike.plan(p(1.0, 1.0), p(9.0, 9.0)).unwrap();
+    for radius in [20.0, 1e6, 1e7, 1e300, f64::INFINITY] {
+        let disc = [Shape::Disc { centre: p(5.0, 5.0), radius }];
+        let e = spike.plan_among(p(1.0, 1.0), p(9.0, 9.0), &disc).unwrap_err();
+        assert_eq!(e.to_string(), "no path: the start is shut in", "radius {radius}");
+        assert!(clear.is_blocked_by(&disc, 0.35), "radius {radius}");
+    }
 }
 
 proptest! {

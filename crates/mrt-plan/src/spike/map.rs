@@ -92,6 +92,20 @@ impl Shape {
     }
 }
 
+impl Shape {
+    /// A moving obstacle as the planner takes it: a disc larger than [`MAX_COORD`] (one that
+    /// covers any map) at that radius, any other valid shape as it is, an invalid one
+    /// (a number not finite or out of range, a negative radius) not at all.
+    pub(super) fn bounded(&self) -> Option<Shape> {
+        match *self {
+            Shape::Disc { centre, radius } if radius > MAX_COORD => {
+                Shape::Disc { centre, radius: MAX_COORD }.bounded()
+            }
+            _ => self.is_valid().then(|| self.clone()),
+        }
+    }
+}
+
 /// The largest coordinate or radius a map or a moving object may have, m: a thousand
 /// kilometres, well inside what the geometry computes without overflow.
 pub const MAX_COORD: f64 = 1e6;

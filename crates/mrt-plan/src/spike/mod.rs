@@ -138,7 +138,10 @@ impl Plan {
     /// radius and safety): then the path must be planned again.
     pub fn is_blocked_by(&self, moving: &[Shape], clearance: f64) -> bool {
         self.waypoints.windows(2).any(|w| {
-            moving.iter().any(|s| s.is_valid() && s.segment_distance(w[0], w[1]) < clearance)
+            moving
+                .iter()
+                .filter_map(Shape::bounded)
+                .any(|s| s.segment_distance(w[0], w[1]) < clearance)
         })
     }
 }
@@ -263,15 +266,23 @@ impl Spike {
                 return Err(PlanError::NonFiniteInput { name });
             }
         }
-        let moving: Vec<&Shape> = moving.iter().filter(|s| s.is_valid()).collect();
+        let moving: Vec<Shape> = moving.iter().filter_map(Shape::bounded).collect();
+        let moving: Vec<&Shape> = moving.iter().collect();
         let mut tree = Tree::new(self, &moving);
         let start = tree.snap(from);
         let goal = tree.snap(to);
         if tree.full {
             return Err(PlanError::TooManyCells { cells: MAX_CELLS });
         }
-        let start = start.ok_or(PlanError::NoPath { reason: "the start is shut in" })?;
-        let goal = goal.ok_or(PlanError::NoPath { reason: "the goal is shut in" })?;
+        let (min, max) = (self.map.min, self.map.max);
+        let inside = |p: Point2| (min.x..=max.x).contains(&p.x) && (min.y..=max.y).contains(&p.y);
+        let why = |p: Point2, shut: &'static str, outside: &'static str| PlanError::NoPath {
+            reason: if inside(p) { shut } else { outside },
+        };
+        let start = start
+            .ok_or_else(|| why(from, "the start is shut in", "the start is outside the map"))?;
+        let goal =
+            goal.ok_or_else(|| why(to, "the goal is shut in", "the goal is outside the map"))?;
         let (chain, expanded) = tree.search((start.1, start.0), (goal.1, goal.0))?;
         let corners = funnel(&tree.portals(&chain, start.0, goal.0));
         let mut waypoints = tree.pull_tight(&corners);
