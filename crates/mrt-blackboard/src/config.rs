@@ -111,7 +111,7 @@ pub fn parse(text: &str, file: &Path) -> Result<Vec<Binding>, ConfigError> {
 
 /// Reads `file` and binds its values on `bb`. Returns how many bindings it had.
 pub fn load_file(bb: &Blackboard, file: &Path) -> Result<usize, ConfigError> {
-    let text = std::fs::read_to_string(file)
+    let text = mrt_core::read_text(file, mrt_core::MAX_CONFIG_BYTES)
         .map_err(|source| ConfigError::Io { file: file.to_path_buf(), source })?;
     load_text(bb, &text, file)
 }
@@ -136,13 +136,14 @@ pub fn load_text(bb: &Blackboard, text: &str, file: &Path) -> Result<usize, Conf
     Ok(bindings.len())
 }
 
-/// Loads `dir/config.dat`, then `dir/config-<robot>.dat`, the ones that exist. Returns the
-/// files read.
+/// Loads `dir/config.dat`, then `dir/config-<robot>.dat`, the ones that exist (anything of
+/// that name that is no regular file, a link to a device, is an error). Returns the files
+/// read.
 pub fn load_dir(bb: &Blackboard, dir: &Path) -> Result<Vec<PathBuf>, ConfigError> {
     let mut read = Vec::new();
     for name in ["config.dat".to_string(), format!("config-{}.dat", bb.robot())] {
         let file = dir.join(name);
-        if file.is_file() {
+        if file.exists() {
             load_file(bb, &file)?;
             read.push(file);
         }
@@ -224,6 +225,18 @@ mod tests {
         );
         let missing = load_file(&bb(1), &dir.join("nothere.dat")).unwrap_err().to_string();
         assert!(missing.contains("nothere.dat"), "{missing}");
+        // A byte-order mark before the first line is no part of it.
+        std::fs::write(dir.join("config-5.dat"), "\u{feff}local.var.c Int 7\n").unwrap();
+        let five = bb(5);
+        load_dir(&five, &dir).unwrap();
+        assert_eq!(five.get::<i64>("local.var.c").unwrap(), 7);
+        // A config.dat that is a link to a device is refused, not taken as absent.
+        #[cfg(unix)]
+        if Path::new("/dev/zero").exists() {
+            std::os::unix::fs::symlink("/dev/zero", dir.join("config-6.dat")).unwrap();
+            let e = load_dir(&bb(6), &dir).unwrap_err().to_string();
+            assert!(e.contains("config-6.dat") && e.contains("not a regular file"), "{e}");
+        }
         std::fs::remove_dir_all(&dir).unwrap();
     }
 

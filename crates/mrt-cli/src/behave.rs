@@ -39,7 +39,7 @@ impl Worlds {
                 cycles: cycles.unwrap_or(1),
             });
         };
-        let text = std::fs::read_to_string(path)
+        let text = mrt_core::read_text(path, mrt_core::MAX_LOG_BYTES)
             .with_context(|| format!("cannot read {}", path.display()))?;
         let list = parse_worlds(&text).map_err(|e| match e {
             WorldsError::Syntax { .. } => anyhow::anyhow!("{}:{e}", path.display()),

@@ -386,7 +386,7 @@ fn record_match(
     // Topics (with their schemas) and messages, each message (time, source, topic, json).
     let mut topics: Vec<(String, String, Vec<u8>)> = Vec::new();
     let mut messages: Vec<(Time, usize, usize, Vec<u8>)> = Vec::new();
-    let text = std::fs::read_to_string(truth)
+    let text = mrt_core::read_text(truth, mrt_core::MAX_LOG_BYTES)
         .with_context(|| format!("cannot read the world's truth {}", truth.display()))?;
     topics.push(("/truth".into(), "Truth".into(), serde_json::to_vec(&schema_of::<Truth>())?));
     for (i, line) in text.lines().enumerate().filter(|(_, l)| !l.trim().is_empty()) {

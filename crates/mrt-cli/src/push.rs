@@ -65,7 +65,7 @@ fn prepare(args: &PushArgs) -> Result<BehaviorPush> {
             args.file.display()
         );
     }
-    let source = std::fs::read_to_string(&args.file)
+    let source = mrt_core::read_text(&args.file, mrt_core::MAX_SCRIPT_BYTES)
         .with_context(|| format!("cannot read {}", args.file.display()))?;
     // The editor's check: a file that does not compile is not sent.
     let shown = args.file.display().to_string();

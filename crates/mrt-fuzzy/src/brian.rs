@@ -266,9 +266,17 @@ impl BrianFiles {
 /// Reads a file as UTF-8 text; invalid UTF-8 is an error at the line and column of the first
 /// invalid byte.
 fn read(path: &Path) -> Result<String, BrianError> {
-    let bytes = std::fs::read(path)
+    let bytes = mrt_core::read_bounded(path, mrt_core::MAX_SCRIPT_BYTES)
         .map_err(|source| BrianError::Io { file: path.to_path_buf(), source })?;
-    crate::lexer::utf8(bytes, path)
+    crate::lexer::utf8(without_bom(bytes), path)
+}
+
+/// `bytes` without the byte-order mark some editors write at the start of a UTF-8 file.
+fn without_bom(mut bytes: Vec<u8>) -> Vec<u8> {
+    if bytes.starts_with(b"\xef\xbb\xbf") {
+        bytes.drain(..3);
+    }
+    bytes
 }
 
 /// Where a configuration's files come from: the disk, or memory ([`BrianSources`]).
@@ -391,7 +399,8 @@ impl BrianSources {
             let kind = entry.file_type().map_err(io(&path))?;
             let name = rel.join(entry.file_name());
             if kind.is_file() {
-                let bytes = std::fs::read(&path).map_err(io(&path))?;
+                let bytes =
+                    mrt_core::read_bounded(&path, mrt_core::MAX_SCRIPT_BYTES).map_err(io(&path))?;
                 self.files.insert(name, bytes);
             } else if kind.is_dir() && depth < SOURCES_DEPTH {
                 self.read_under(&path, &name, depth + 1)?;

@@ -66,6 +66,10 @@ pub enum ReplayError {
 /// for no more memory than this. MRT's chunks are under a megabyte.
 pub const RECORD_LIMIT: usize = 64 << 20;
 
+/// The largest recording [`Recording::open`] reads, bytes (4 GiB: it is read whole); a path
+/// that is not a regular file is refused too.
+pub const MAX_RECORDING_BYTES: u64 = 4 << 30;
+
 /// One message of a recording, as read.
 #[derive(Clone, Copy, Debug)]
 pub struct Entry<'a> {
@@ -183,7 +187,7 @@ pub struct Recording {
 impl Recording {
     /// Reads the file at `path`.
     pub fn open(path: &Path) -> Result<Recording, ReplayError> {
-        let bytes = std::fs::read(path)
+        let bytes = mrt_core::read_bounded(path, MAX_RECORDING_BYTES)
             .map_err(|source| ReplayError::Io { path: path.to_path_buf(), source })?;
         Ok(Recording::from_bytes(bytes, path))
     }

@@ -149,7 +149,7 @@ impl Hbm {
         let setup_path = dir.join("hbm.lua");
         let setup = |rt: &LuaRuntime| {
             setup_path
-                .is_file()
+                .exists()
                 .then(|| Script::from_file(rt, &setup_path, LoadStrategy::Compiled))
                 .transpose()
         };
@@ -439,7 +439,8 @@ pub fn behavior_files(dir: &Path) -> Result<Vec<(String, PathBuf)>, ScriptError>
             let file = p.file_name()?.to_str()?;
             let name = file.strip_suffix(".lua")?;
             let skip = name == "hbm" || name.ends_with(".hfsm") || name.starts_with('.');
-            (!skip && p.is_file()).then(|| (name.to_string(), p.clone()))
+            // Anything else of the name (a link to a device) is read, and refused there.
+            (!skip && !p.is_dir()).then(|| (name.to_string(), p.clone()))
         })
         .collect();
     files.sort();

@@ -152,7 +152,7 @@ impl Hfsm {
         io: Rc<RefCell<RobotIo>>,
     ) -> Result<Hfsm, ScriptError> {
         let path = path.as_ref();
-        let source = std::fs::read_to_string(path)
+        let source = mrt_core::read_text(path, mrt_core::MAX_SCRIPT_BYTES)
             .map_err(|source| ScriptError::Io { file: path.display().to_string(), source })?;
         let mut h = Hfsm::from_source(rt, &path.display().to_string(), &source, io)?;
         h.path_on_disk = Some(path.to_path_buf());
@@ -340,7 +340,7 @@ impl Hfsm {
     pub fn reload(&mut self, rt: &LuaRuntime) -> Result<(), ScriptError> {
         let Some(path) = self.path_on_disk.clone() else { return Ok(()) };
         self.modified = mtime(&path);
-        let source = std::fs::read_to_string(&path)
+        let source = mrt_core::read_text(&path, mrt_core::MAX_SCRIPT_BYTES)
             .map_err(|source| ScriptError::Io { file: self.file.clone(), source })?;
         self.reload_source(rt, &source)
     }
@@ -576,7 +576,7 @@ fn build(rt: &LuaRuntime, file: &str, source: &str) -> Result<(Vec<Machine>, usi
                 return Ok(());
             }
             included.borrow_mut().push(shown.clone());
-            let text = std::fs::read_to_string(&path)
+            let text = mrt_core::read_text(&path, mrt_core::MAX_SCRIPT_BYTES)
                 .map_err(|e| mlua::Error::runtime(format!("include \"{name}\": {e}")))?;
             let outer = std::mem::replace(&mut *cur.borrow_mut(), shown.clone());
             let result = lua.load(text).set_name(format!("@{shown}")).set_mode(ChunkMode::Text).exec();

@@ -226,7 +226,7 @@ fn compile_and_write(dir: &Path, file: &str, source: String) -> Result<Written, 
     let compiled = compile_source(file, source)?;
     let path = std::path::absolute(dir.join(file)).unwrap_or_else(|_| dir.join(file));
     let io = |source| ScriptError::Io { file: file.to_string(), source };
-    let previous = match std::fs::read(&path) {
+    let previous = match mrt_core::read_bounded(&path, mrt_core::MAX_SCRIPT_BYTES) {
         Ok(bytes) => Previous::Was(bytes),
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => Previous::Absent,
         Err(e) => return Err(io(e)),

@@ -238,7 +238,7 @@ fn compile(rt: &LuaRuntime, name: &str, source: &str) -> Result<Function, Script
 }
 
 fn read(path: &Path) -> Result<String, ScriptError> {
-    std::fs::read_to_string(path)
+    mrt_core::read_text(path, mrt_core::MAX_SCRIPT_BYTES)
         .map_err(|source| ScriptError::Io { file: path.display().to_string(), source })
 }
 

@@ -115,7 +115,7 @@ thread_local! {
 /// behavior emptied on purpose is therefore not reloaded: delete its rules instead, or leave a
 /// comment in it.)
 pub(crate) fn compile_file(path: &Path, name: &str) -> Option<Result<Compiled, ScriptError>> {
-    let source = match std::fs::read_to_string(path) {
+    let source = match mrt_core::read_text(path, mrt_core::MAX_SCRIPT_BYTES) {
         Ok(s) if s.is_empty() => return None,
         Ok(s) => s,
         Err(source) => return Some(Err(ScriptError::Io { file: name.to_string(), source })),

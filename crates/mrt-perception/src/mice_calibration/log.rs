@@ -169,8 +169,10 @@ impl CalibrationLog {
     /// Reads and parses the log file at `path`.
     pub fn read(path: &Path) -> Result<CalibrationLog, CalibrationError> {
         let file = path.display().to_string();
-        match std::fs::read(path) {
-            Ok(bytes) => CalibrationLog::parse(&file, &bytes),
+        match mrt_core::read_bounded(path, mrt_core::MAX_LOG_BYTES) {
+            Ok(bytes) => {
+                CalibrationLog::parse(&file, bytes.strip_prefix(b"\xef\xbb\xbf").unwrap_or(&bytes))
+            }
             Err(source) => Err(CalibrationError::Io { file, source }),
         }
     }
