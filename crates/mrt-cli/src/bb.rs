@@ -5,6 +5,7 @@ use anyhow::{anyhow, bail, Context as _, Result};
 use clap::{Args, Subcommand};
 use mrt_blackboard::relay::{ClientOptions, RelayClient, RelayConfig, DEFAULT_PORT};
 use mrt_blackboard::{Blackboard, Relay};
+use mrt_core::printable;
 use std::net::SocketAddr;
 use std::path::PathBuf;
 use std::sync::Arc;
@@ -30,21 +31,6 @@ fn seconds(text: &str) -> Result<f64, String> {
         Ok(s) if s.is_finite() && s > 0.0 && s <= 86_400.0 => Ok(s),
         _ => Err(format!("`{text}` is not a number of seconds between 0 and 86400")),
     }
-}
-
-/// `text` safe to print on a terminal: control characters (escape sequences, bells, C1
-/// controls) and bidirectional overrides are shown as `\u{..}` instead of acting.
-pub fn printable(text: &str) -> String {
-    let mut out = String::with_capacity(text.len());
-    for c in text.chars() {
-        let bidi = matches!(c, '\u{200e}' | '\u{200f}' | '\u{202a}'..='\u{202e}' | '\u{2066}'..='\u{2069}');
-        if c.is_control() || bidi {
-            out.push_str(&format!("\\u{{{:x}}}", u32::from(c)));
-        } else {
-            out.push(c);
-        }
-    }
-    out
 }
 
 /// `mrt bb` commands.

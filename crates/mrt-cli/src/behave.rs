@@ -79,7 +79,7 @@ pub fn behave(
         let time = w.time;
         let c = cap.cycle(w);
         for e in &c.errors {
-            eprintln!("error: cycle {k}: {e}");
+            eprintln!("error: cycle {k}: {}", mrt_core::printable(&e.to_string()));
         }
         failed += u64::from(!c.errors.is_empty());
         let line = cycle_line(k, time, &c);

@@ -15,12 +15,12 @@ pub fn check(dir: &Path) -> Result<()> {
     match Brian::from_dir(dir) {
         Ok(b) => {
             for w in b.warnings() {
-                eprintln!("{w}");
+                eprintln!("{}", mrt_core::printable(&w.to_string()));
             }
             Ok(())
         }
         Err(e) => {
-            eprintln!("{e}");
+            eprintln!("{}", mrt_core::printable(&e.to_string()));
             std::process::exit(1);
         }
     }

@@ -303,7 +303,7 @@ fn is_broken_pipe(e: &anyhow::Error) -> bool {
     })
 }
 
-fn main() -> Result<()> {
+fn main() -> std::process::ExitCode {
     tracing_subscriber::fmt()
         .with_env_filter(
             tracing_subscriber::EnvFilter::try_from_default_env()
@@ -315,8 +315,14 @@ fn main() -> Result<()> {
         .init();
     interrupt::install();
     match run(Cli::parse().command) {
-        Err(e) if is_broken_pipe(&e) => Ok(()),
-        other => other,
+        Ok(()) => std::process::ExitCode::SUCCESS,
+        Err(e) if is_broken_pipe(&e) => std::process::ExitCode::SUCCESS,
+        Err(e) => {
+            // An error may quote its input (a script's message, a file's name or line):
+            // escape sequences in it are shown, not obeyed.
+            eprintln!("Error: {}", mrt_core::printable(&format!("{e:?}")));
+            std::process::ExitCode::FAILURE
+        }
     }
 }
 

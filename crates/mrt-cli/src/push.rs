@@ -93,11 +93,12 @@ pub fn push(args: &PushArgs) -> Result<()> {
     match (&reply.installed, &reply.error) {
         (true, _) => {
             if !args.json {
+                // The reply comes over the network: its names are escaped.
                 outln!(
                     "robot {}: {} installed (swapped in: {})",
                     reply.robot,
-                    reply.file,
-                    reply.reloaded.join(", ")
+                    mrt_core::printable(&reply.file),
+                    mrt_core::printable(&reply.reloaded.join(", "))
                 );
             }
             Ok(())

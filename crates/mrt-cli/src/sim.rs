@@ -515,7 +515,7 @@ pub fn run(args: &SimArgs) -> Result<()> {
             "  robot {} ({team} #{k}) faulted {} times{from} (stood still meanwhile): {}",
             f.robot,
             f.count,
-            f.message
+            mrt_core::printable(&f.message)
         );
     }
     let seeing = match cfg.sensor.percepts {
@@ -776,7 +776,7 @@ fn indoor(args: &SimArgs, cfg: &SimConfig) -> Result<()> {
         report.final_error
     );
     for f in &report.faults {
-        outln!("  fault: {f}");
+        outln!("  fault: {}", mrt_core::printable(&f.to_string()));
     }
     if let Some(path) = &args.plot {
         std::fs::write(path, mrt_sim::plot::indoor(&map, &report))

@@ -52,6 +52,7 @@ fn a_hostile_behavior_stops_its_robot_and_the_match_goes_on() {
         ),
         ("print", "goalkeeper.lua", "print('milan 0 : 99 chaos (away)') chaos.setVlin(0/0)"),
         ("error", "goalkeeper.lua", "error(string.rep('E', 1e6))"),
+        ("escapes", "goalkeeper.lua", r#"error("\27[2J\27[Hmatch OK: no faults")"#),
     ];
     for (case, file, text) in cases {
         let dir = hostile_copy(case, file, text);
@@ -67,6 +68,11 @@ fn a_hostile_behavior_stops_its_robot_and_the_match_goes_on() {
         assert!(stdout.contains("faulted"), "{case}: the robot is reported: {stdout}");
         assert!(!stdout.contains("0 : 99"), "{case}: a script prints nothing on stdout: {stdout}");
         assert!(stdout.len() < 16 * 1024, "{case}: {} bytes of report", stdout.len());
+        // A script's text is shown, never obeyed by the terminal.
+        assert!(!stdout.contains('\u{1b}') && !stderr.contains('\u{1b}'), "{case}: {stdout}");
+        if case == "escapes" {
+            assert!(stdout.contains("\\u{1b}[2J"), "{case}: the escape is shown: {stdout}");
+        }
         assert!(stderr.len() < 4 << 20, "{case}: {} bytes of log", stderr.len());
         std::fs::remove_dir_all(&dir).unwrap();
     }

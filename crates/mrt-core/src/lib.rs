@@ -44,6 +44,7 @@ mod geometry;
 mod ids;
 mod message;
 mod read;
+mod text;
 mod time;
 
 pub use file_error::{line_column, FileError};
@@ -54,6 +55,7 @@ pub use geometry::{
 pub use ids::{AgoraId, MemberId, MsgType};
 pub use message::{Message, RESERVED_TYPES_START};
 pub use read::{read_bounded, read_text, MAX_CONFIG_BYTES, MAX_LOG_BYTES, MAX_SCRIPT_BYTES};
+pub use text::printable;
 pub use time::{Clock, SharedClock, SimClock, Time, WallClock};
 
 /// The names most MRT code needs, for `use mrt_core::prelude::*`.
