@@ -42,13 +42,8 @@ impl FileError {
     /// regular file, UTF-8, a byte-order mark left out: [`crate::read_text`]): its text and
     /// its name for error messages, or the [`FileError::Io`] that names it.
     pub fn read(path: &std::path::Path) -> Result<(String, String), FileError> {
-        FileError::read_at_most(path, crate::MAX_CONFIG_BYTES)
-    }
-
-    /// [`FileError::read`] for a file of another kind, at most `limit` bytes.
-    pub fn read_at_most(path: &std::path::Path, limit: u64) -> Result<(String, String), FileError> {
         let file = path.display().to_string();
-        match crate::read_text(path, limit) {
+        match crate::read_text(path, crate::MAX_CONFIG_BYTES) {
             Ok(text) => Ok((text, file)),
             Err(source) => Err(FileError::Io { file, source }),
         }

@@ -120,8 +120,9 @@ impl AgoraConfig {
     /// Reads and parses a configuration file.
     pub fn from_file(path: impl AsRef<Path>) -> Result<AgoraConfig, ConfigError> {
         let path = path.as_ref();
-        match mrt_core::read_text(path, mrt_core::MAX_CONFIG_BYTES) {
-            Ok(text) => Self::parse_bytes(text.as_bytes(), path),
+        // Read as bytes: `parse_bytes` gives invalid UTF-8 its line.
+        match mrt_core::read_bounded(path, mrt_core::MAX_CONFIG_BYTES) {
+            Ok(bytes) => Self::parse_bytes(&bytes, path),
             Err(source) => Err(ConfigError::Io { file: path.to_path_buf(), source }),
         }
     }

@@ -586,10 +586,9 @@ impl VisionAgent {
             let px = Pixel::new((g.0 + g.1) as f64 / 2.0 + 0.5, g.2 as f64 + 1.0);
             if let Some(at) = self.camera.unproject(px) {
                 let (marker, top) = self.marker((g.0..=g.1).step_by(OBSTACLE_STEP), g.2);
-                // Where the body must reach: the image's top, or the row of a point
-                // ROBOT_MIN_RISE above the foot.
-                let rise = self.camera.project(Point3::new(at.x, at.y, ROBOT_MIN_RISE));
-                if top > 0 && rise.is_some_and(|r| top as f64 > r.y) {
+                // The body must reach the image's top or rise ROBOT_MIN_RISE above the foot.
+                let risen = px.y - top as f64;
+                if top > 0 && self.rows_up(at, ROBOT_MIN_RISE).is_some_and(|rows| risen < rows) {
                     continue;
                 }
                 out.push(RobotSighting {
