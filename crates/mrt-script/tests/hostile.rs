@@ -99,7 +99,7 @@ fn pathological_patterns_are_refused_before_they_run() {
     ] {
         let e = run(&rt, name, src).unwrap_err();
         assert!(
-            matches!(e, ScriptError::Runtime { .. }) && e.to_string().contains("may take up to"),
+            matches!(e, ScriptError::Runtime { .. }) && e.to_string().contains("needs up to"),
             "{name}: {e}"
         );
         // The error names the script's line, not the sandbox's wrapper.
@@ -116,6 +116,158 @@ fn pathological_patterns_are_refused_before_they_run() {
     )
     .unwrap();
     assert_eq!(v.as_string().unwrap().to_str().unwrap(), "attacker2nil");
+}
+
+/// A C call whose work its arguments decide is paid for from the budget or refused before it
+/// runs: none of these may take longer than a fraction of a second.
+#[test]
+fn library_calls_with_unbounded_work_are_refused_before_they_run() {
+    let rt = rt();
+    for (name, src) in [
+        ("rep.lua", "return string.rep('', math.maxinteger)"),
+        ("rep_sep.lua", "return string.rep('', math.maxinteger, '')"),
+        ("rep_str.lua", "return ('x'):rep('9223372036854775807')"),
+        ("rep_float.lua", "return string.rep('', 2^62)"),
+        (
+            "insert.lua",
+            "local t = setmetatable({}, {__len = function() return math.maxinteger - 1 end}) \
+             table.insert(t, 1, 0)",
+        ),
+        (
+            "remove.lua",
+            "local t = setmetatable({}, {__len = function() return math.maxinteger - 1 end}) \
+             table.remove(t, 1)",
+        ),
+        (
+            "sort.lua",
+            "local t = setmetatable({}, {__len = function() return 2^31 - 2 end}) table.sort(t)",
+        ),
+        ("unpack.lua", "return table.unpack({}, 1, 1e8)"),
+        ("concat.lua", "return table.concat({}, '', 1, math.maxinteger)"),
+        ("move.lua", "table.move({}, 1, 1e15, 1, {})"),
+        ("move_str.lua", "table.move({}, '1', '1e15', 1, {})"),
+        (
+            "reader.lua",
+            "local big = string.rep('-', 1 << 20) local n = 0 \
+             return load(function() n = n + 1 if n < 100 then return big end end)",
+        ),
+    ] {
+        let started = std::time::Instant::now();
+        let e = run(&rt, name, src).unwrap_err();
+        assert!(started.elapsed().as_secs_f64() < 0.5, "{name}: {:?}", started.elapsed());
+        assert!(
+            matches!(e, ScriptError::Runtime { .. } | ScriptError::Budget { .. }),
+            "{name}: {e}"
+        );
+        assert!(e.to_string().contains("steps") || e.to_string().contains("budget"), "{name}: {e}");
+        assert!(e.to_string().starts_with(name), "the script is named: {e}");
+        still_works(&rt);
+    }
+}
+
+/// The same calls in a loop, each small enough to pass alone: they add up to the budget.
+#[test]
+fn library_calls_in_a_loop_spend_the_budget() {
+    let rt = rt();
+    for (name, src) in [
+        ("rep_loop.lua", "while true do local s = string.rep('', 1e5) end"),
+        ("upper_loop.lua", "local s = string.rep('a', 1e6) while true do local u = s:upper() end"),
+        (
+            "format_loop.lua",
+            "local s = string.rep('a', 1e6) while true do local u = ('%s'):format(s) end",
+        ),
+        (
+            "sort_loop.lua",
+            "local t = {} for i = 1, 2e4 do t[i] = -i end while true do table.sort(t) end",
+        ),
+        ("load_loop.lua", "local s = 'return 1' .. string.rep(' ', 1e5) while true do load(s) end"),
+        (
+            "find_loop.lua",
+            "local h = string.rep('a', 1e6) while true do string.find(h, 'b', 1, true) end",
+        ),
+        (
+            "concat_loop.lua",
+            "local t = {} for i = 1, 1e4 do t[i] = 'x' end while true do table.concat(t) end",
+        ),
+    ] {
+        let started = std::time::Instant::now();
+        assert_budget(&rt, name, src);
+        assert!(started.elapsed().as_secs_f64() < 2.0, "{name}: {:?}", started.elapsed());
+    }
+}
+
+/// A plain find (or a pattern without special characters) is linear: a haystack of megabytes
+/// and a needle of megabytes is one quick call, with Lua's results.
+#[test]
+fn a_plain_find_is_linear_and_gives_luas_positions() {
+    let rt = LuaRuntime::new(Sandbox { instruction_budget: 10_000_000, memory_limit: 32 << 20 })
+        .unwrap();
+    let started = std::time::Instant::now();
+    let v = run(
+        &rt,
+        "find.lua",
+        "local hay = string.rep('a', 9e6) local needle = string.rep('a', 4e6) .. 'b' \
+         return tostring(string.find(hay, needle, 1, true)) .. ' ' .. tostring(hay:find(needle))",
+    )
+    .unwrap();
+    assert_eq!(v.as_string().unwrap().to_str().unwrap(), "nil nil");
+    assert!(started.elapsed().as_secs_f64() < 1.0, "{:?}", started.elapsed());
+    let v = run(
+        &rt,
+        "positions.lua",
+        "local s = 'hello world' \
+         local a, b = s:find('o', 6, true) local c, d = s:find('', 12) local e = s:find('', 13) \
+         local f, g = s:find('wor', -5) local h, i = string.find(12345, 34) \
+         return table.concat({a, b, c, d, tostring(e), f, g, h, i}, ',')",
+    )
+    .unwrap();
+    assert_eq!(v.as_string().unwrap().to_str().unwrap(), "8,8,12,11,nil,7,9,3,4");
+    // One result for a miss, as Lua gives.
+    let v = run(&rt, "miss.lua", "return select('#', ('abc'):find('x', 1, true))").unwrap();
+    assert_eq!(v.as_i64(), Some(1));
+    let e = run(&rt, "bad.lua", "return string.find({}, 'x', 1, true)").unwrap_err();
+    assert!(e.to_string().contains("bad argument #1 to 'find'"), "{e}");
+}
+
+/// `load` cannot make an error name another file, and a reader's pieces still load.
+#[test]
+fn a_loaded_chunk_cannot_pass_for_a_file() {
+    let rt = rt();
+    for (name, src) in [
+        ("at.lua", "load('error(\"boom\")', '@goalkeeper.lua')()"),
+        ("eq.lua", "load('error(\"boom\")', '=goalkeeper.lua')()"),
+        ("code.lua", "load('@goalkeeper.lua')()"),
+    ] {
+        let e = run(&rt, name, src).unwrap_err();
+        assert!(!e.to_string().starts_with("goalkeeper.lua"), "{name}: {e}");
+    }
+    let v = run(
+        &rt,
+        "reader_ok.lua",
+        "local parts, n = {'return ', '4', '2'}, 0 \
+         return load(function() n = n + 1 return parts[n] end)()",
+    )
+    .unwrap();
+    assert_eq!(v.as_i64(), Some(42));
+    let v = run(&rt, "reader_bad.lua", "return select(2, load(function() return {} end))").unwrap();
+    assert!(v.as_string().unwrap().to_str().unwrap().contains("must return a string"));
+}
+
+#[test]
+fn ordinary_library_calls_still_work() {
+    let rt = rt();
+    let v = run(
+        &rt,
+        "lib.lua",
+        "local t = {3, 1, 2} table.sort(t) table.insert(t, 1, 0) table.insert(t, 9) \
+         local r = table.remove(t, 1) local u = {table.unpack(t, 1, 2)} \
+         local s = table.concat(t, ',') .. ';' .. ('ab'):rep(3, '-') .. ';' .. ('%d|%s'):format(r, 'x') \
+         .. ';' .. ('Hello'):upper():lower():reverse() .. ';' .. #u .. ';' .. string.byte('A') \
+         .. ';' .. table.pack(1, 2, 3).n \
+         return s",
+    )
+    .unwrap();
+    assert_eq!(v.as_string().unwrap().to_str().unwrap(), "1,2,3,9;ab-ab-ab;0|x;olleh;2;65;3");
 }
 
 #[test]
