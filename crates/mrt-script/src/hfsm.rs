@@ -36,6 +36,11 @@
 //!   state runs.
 //! - Scripts see the machine through `hfsm.path()` (e.g. `"Attacker/Score/Align"`),
 //!   `hfsm.state()` (the leaf state) and `hfsm.time()` (milliseconds in the leaf state).
+//! - **Limits**: a file (with what it includes) defines at most [`MAX_MACHINES`] machines,
+//!   [`MAX_STATES`] states and [`MAX_TRANSITIONS`] transitions in all, and meta-states nest at
+//!   most [`MAX_NESTING`] machines deep; a file beyond them is refused with the limit it passed
+//!   before anything deep is walked, so no file can exhaust a thread's stack or take long to
+//!   load.
 
 use crate::chaos::RobotIo;
 use crate::runtime::LuaRuntime;
@@ -50,6 +55,19 @@ use std::path::{Path, PathBuf};
 
 mod draw;
 use std::rc::Rc;
+
+/// Machines one HFSM file may define, with the files it includes.
+pub const MAX_MACHINES: usize = 256;
+
+/// States of all the machines of one HFSM file together.
+pub const MAX_STATES: usize = 4096;
+
+/// Transitions of all the machines of one HFSM file together.
+pub const MAX_TRANSITIONS: usize = 16384;
+
+/// Machines in the longest chain of meta-states (the root's level counted): a deeper
+/// hierarchy is refused.
+pub const MAX_NESTING: usize = 32;
 
 /// A state of a machine.
 struct State {
@@ -602,6 +620,14 @@ fn build(rt: &LuaRuntime, file: &str, source: &str) -> Result<(Vec<Machine>, usi
             "no machine defined (write `machine \"Name\" { ... }`)".into(),
         ));
     }
+    if raw.len() > MAX_MACHINES {
+        let (_, _, line, at) = &raw[MAX_MACHINES];
+        return Err(invalid(
+            at,
+            *line,
+            format!("more than {MAX_MACHINES} machines in one HFSM ({} defined)", raw.len()),
+        ));
+    }
     let mut index = HashMap::new();
     for (i, (name, _, line, at)) in raw.iter().enumerate() {
         if index.insert(name.clone(), i).is_some() {
@@ -611,6 +637,7 @@ fn build(rt: &LuaRuntime, file: &str, source: &str) -> Result<(Vec<Machine>, usi
     let make_dispatch: Function =
         lua.load(DISPATCH).set_name("=hfsm dispatch").eval().map_err(ScriptError::setup)?;
     let mut machines = Vec::with_capacity(raw.len());
+    let (mut all_states, mut all_transitions) = (0, 0);
     for (name, body, line, at) in &raw {
         let e =
             |line: usize, m: &str, msg: String| invalid(at, line, format!("machine '{m}': {msg}"));
@@ -623,13 +650,19 @@ fn build(rt: &LuaRuntime, file: &str, source: &str) -> Result<(Vec<Machine>, usi
         let mut states = Vec::new();
         for pair in states_t.pairs::<String, Value>() {
             let (sname, v) = pair.map_err(lua_err)?;
+            all_states += 1;
+            if all_states > MAX_STATES {
+                return Err(e(line, name, format!("more than {MAX_STATES} states in one HFSM")));
+            }
             states.push(state(&sname, v, &index).map_err(|msg| e(line, name, msg))?);
         }
         if states.is_empty() {
             return Err(e(line, name, "has no states".into()));
         }
         states.sort_by(|a, b| a.name.cmp(&b.name));
-        let find = |s: &str| states.iter().position(|st| st.name == s);
+        let by_name: HashMap<&str, usize> =
+            states.iter().enumerate().map(|(i, st)| (st.name.as_str(), i)).collect();
+        let find = |s: &str| by_name.get(s).copied();
         let known = || states.iter().map(|s| s.name.as_str()).collect::<Vec<_>>().join(", ");
         let initial: Option<String> = body.get("initial").map_err(lua_err)?;
         let initial = initial.ok_or_else(|| e(line, name, "has no initial state".into()))?;
@@ -642,8 +675,17 @@ fn build(rt: &LuaRuntime, file: &str, source: &str) -> Result<(Vec<Machine>, usi
         })?;
         let mut transitions = Vec::new();
         let list: Option<Table> = body.get("transitions").map_err(lua_err)?;
-        let list: Vec<mlua::Result<Table>> =
-            list.map(|l| l.sequence_values::<Table>().collect()).unwrap_or_default();
+        let list: Vec<mlua::Result<Table>> = list
+            .map(|l| l.sequence_values::<Table>().take(MAX_TRANSITIONS + 1).collect())
+            .unwrap_or_default();
+        all_transitions += list.len();
+        if all_transitions > MAX_TRANSITIONS {
+            return Err(e(
+                line,
+                name,
+                format!("more than {MAX_TRANSITIONS} transitions in one HFSM"),
+            ));
+        }
         for (k, t) in list.into_iter().enumerate() {
             let t = t.map_err(lua_err)?;
             let from: String = t.get("from").map_err(lua_err)?;
@@ -705,9 +747,13 @@ fn build(rt: &LuaRuntime, file: &str, source: &str) -> Result<(Vec<Machine>, usi
         });
         let transitions: Vec<Transition> = transitions.into_iter().map(|(t, _)| t).collect();
         let mut dispatch = Vec::with_capacity(states.len());
+        let mut rest = transitions.as_slice();
         for s in 0..states.len() {
-            let tests: Vec<&Function> =
-                transitions.iter().filter(|t| t.from == s).map(|t| &t.test).collect();
+            // Sorted by `from`: this state's transitions come first in what is left.
+            let k = rest.iter().position(|t| t.from != s).unwrap_or(rest.len());
+            let (own, after) = rest.split_at(k);
+            rest = after;
+            let tests: Vec<&Function> = own.iter().map(|t| &t.test).collect();
             dispatch.push(if tests.is_empty() {
                 None
             } else {
@@ -718,12 +764,14 @@ fn build(rt: &LuaRuntime, file: &str, source: &str) -> Result<(Vec<Machine>, usi
         machines.push(Machine { name: name.to_string(), initial, states, transitions, dispatch });
     }
     check_containment(&machines, &raw)?;
-    let used: Vec<usize> = machines
-        .iter()
-        .flat_map(|m| m.states.iter())
-        .filter_map(|s| if let StateKind::Meta(i) = s.kind { Some(i) } else { None })
-        .collect();
-    let root = (0..machines.len()).find(|i| !used.contains(i)).unwrap_or(0);
+    check_nesting(&machines, &raw)?;
+    let mut used = vec![false; machines.len()];
+    for s in machines.iter().flat_map(|m| m.states.iter()) {
+        if let StateKind::Meta(i) = s.kind {
+            used[i] = true;
+        }
+    }
+    let root = used.iter().position(|u| !u).unwrap_or(0);
     Ok((machines, root))
 }
 
@@ -798,6 +846,47 @@ fn check_containment(machines: &[Machine], raw: &[RawMachine]) -> Result<(), Scr
                     "meta-state machine '{}' contains itself: {}",
                     names[0],
                     names.join(" -> ")
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// Refuses meta-states nested deeper than [`MAX_NESTING`] machines, naming the chain. The
+/// machines contain no cycle (checked before) and are at most [`MAX_MACHINES`], which bounds
+/// the recursion.
+fn check_nesting(machines: &[Machine], raw: &[RawMachine]) -> Result<(), ScriptError> {
+    /// The longest chain of machines from `m` down (`m` first), memoized in `longest`.
+    fn chain(m: usize, machines: &[Machine], longest: &mut [Option<Vec<usize>>]) -> Vec<usize> {
+        if let Some(c) = &longest[m] {
+            return c.clone();
+        }
+        let mut best = Vec::new();
+        for s in &machines[m].states {
+            if let StateKind::Meta(inner) = s.kind {
+                let c = chain(inner, machines, longest);
+                if c.len() > best.len() {
+                    best = c;
+                }
+            }
+        }
+        best.insert(0, m);
+        best.truncate(MAX_NESTING + 1);
+        longest[m] = Some(best.clone());
+        best
+    }
+    let mut longest = vec![None; machines.len()];
+    for m in 0..machines.len() {
+        let c = chain(m, machines, &mut longest);
+        if c.len() > MAX_NESTING {
+            let names: Vec<&str> = c.iter().map(|&i| machines[i].name.as_str()).collect();
+            return Err(invalid(
+                &raw[m].3,
+                raw[m].2,
+                format!(
+                    "meta-states nested more than {MAX_NESTING} machines deep: {} -> ...",
+                    names[..MAX_NESTING.min(names.len())].join(" -> ")
                 ),
             ));
         }

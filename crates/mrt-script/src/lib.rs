@@ -53,7 +53,7 @@ mod watch;
 mod watchdog;
 
 pub use cap::{Cycle, ThinkingCap, FAULT_LIMIT, RUNAWAY_LIMIT};
-pub use runtime::{Interrupt, LuaRuntime, Sandbox, MAX_TEXT, PRINT_LINES_PER_CALL};
+pub use runtime::{Interrupt, LuaRuntime, Sandbox, MAX_TEXT, PRINT_LINES_PER_CALL, STEP_BYTES};
 pub use script::{LoadStrategy, Script, ScriptError};
 pub use watch::{compile_source, Change, Compiled, ScriptWatcher};
 pub use watchdog::{Watchdog, DEFAULT_DEADLINE, LOAD_DEADLINE, MAX_RESTARTS};

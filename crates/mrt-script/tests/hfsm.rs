@@ -840,3 +840,71 @@ fn state_names_are_escaped_in_the_drawing() {
     assert!(svg.contains("a&lt;b") && svg.contains("c&amp;d") && svg.contains("M&lt;&amp;&gt;"));
     assert!(!svg.contains("a<b"));
 }
+
+/// A chain of `n` machines, each a meta-state of the next, written as the Lua loop a hostile
+/// file would use.
+fn chain(n: usize) -> String {
+    format!(
+        "for i = 1, {n} do\n\
+           local inner = i < {n} and meta('M' .. (i + 1)) or true\n\
+           machine('M' .. i) {{ initial = 's', states = {{ s = inner }} }}\n\
+         end"
+    )
+}
+
+#[test]
+fn deep_and_huge_machines_are_refused_before_anything_deep_is_walked() {
+    use mrt_script::hfsm::{MAX_MACHINES, MAX_NESTING, MAX_STATES, MAX_TRANSITIONS};
+    // Run on a thread with a small stack: a walk as deep as the file would overflow it.
+    let refused = std::thread::Builder::new()
+        .stack_size(256 << 10)
+        .spawn(|| {
+            let many = load_err(&chain(20_000)).to_string();
+            let deep = load_err(&chain(MAX_NESTING + 1)).to_string();
+            (many, deep)
+        })
+        .unwrap()
+        .join()
+        .unwrap();
+    assert!(refused.0.contains(&format!("more than {MAX_MACHINES} machines")), "{}", refused.0);
+    assert!(refused.1.contains(&format!("nested more than {MAX_NESTING}")), "{}", refused.1);
+    assert!(refused.1.contains("M1 -> M2 -> M3"), "names the chain: {}", refused.1);
+    // At the limit it loads and enters every level.
+    let (rt, _io, mut h) = load(&chain(MAX_NESTING));
+    h.step(&rt).unwrap();
+    assert_eq!(h.path().matches('/').count(), MAX_NESTING);
+
+    let states = |n: usize| {
+        format!(
+            "local s = {{}} for i = 1, {n} do s['s' .. i] = true end\n\
+             machine 'Big' {{ initial = 's1', states = s }}"
+        )
+    };
+    let e = load_err(&states(MAX_STATES + 1)).to_string();
+    assert!(e.contains(&format!("more than {MAX_STATES} states")), "{e}");
+    let e = load_err(&format!(
+        "local t = {{}} for i = 1, {} do t[i] = {{ from = 'a', to = 'b', test = 'false' }} end\n\
+         machine 'T' {{ initial = 'a', states = {{ a = true, b = true }}, transitions = t }}",
+        MAX_TRANSITIONS + 1
+    ))
+    .to_string();
+    assert!(e.contains(&format!("more than {MAX_TRANSITIONS} transitions")), "{e}");
+}
+
+#[test]
+fn a_machine_at_the_size_limits_loads_quickly() {
+    // Every state with transitions to its neighbours: no work grows with states × transitions.
+    let n = mrt_script::hfsm::MAX_STATES;
+    let source = format!(
+        "local s, t = {{}}, {{}} for i = 1, {n} do s['s' .. i] = true\n\
+           t[#t + 1] = {{ from = 's' .. i, to = 's' .. (i % {n} + 1), test = 'false' }}\n\
+           t[#t + 1] = {{ from = 's' .. i, to = 's1', test = function() return false end }}\n\
+         end\n\
+         machine 'Big' {{ initial = 's1', states = s, transitions = t }}"
+    );
+    let started = std::time::Instant::now();
+    let (rt, _io, mut h) = load(&source);
+    h.step(&rt).unwrap();
+    assert_eq!(h.path(), "Big/s1");
+    assert!(started.elapsed().as_secs_f64() < 3.0, "{:?}", started.elapsed());
+}
