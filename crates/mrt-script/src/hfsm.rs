@@ -877,13 +877,13 @@ fn check_nesting(machines: &[Machine], raw: &[RawMachine]) -> Result<(), ScriptE
         best
     }
     let mut longest = vec![None; machines.len()];
-    for m in 0..machines.len() {
+    for (m, (_, _, line, at)) in raw.iter().enumerate().take(machines.len()) {
         let c = chain(m, machines, &mut longest);
         if c.len() > MAX_NESTING {
             let names: Vec<&str> = c.iter().map(|&i| machines[i].name.as_str()).collect();
             return Err(invalid(
-                &raw[m].3,
-                raw[m].2,
+                at,
+                *line,
                 format!(
                     "meta-states nested more than {MAX_NESTING} machines deep: {} -> ...",
                     names[..MAX_NESTING.min(names.len())].join(" -> ")
