@@ -1,11 +1,14 @@
-//! `mrt behave` and `mrt hfsm dot`: try a Lua behavior or HFSM offline, draw an HFSM.
+//! `mrt behave` and `mrt hfsm dot`: try a Lua behavior or HFSM offline, draw an HFSM. Both
+//! run the scripts as a match does: `behave` under the [`Watchdog`] (the simulated clock's
+//! deadline, a stopped behavior restarting from its files), `hfsm dot` on a thread of its own
+//! within the load deadline.
 
 use anyhow::{bail, Context as _, Result};
 use mrt_msgs::robot::WorldSnapshot;
 use mrt_script::chaos::{self, RobotIo};
 use mrt_script::hfsm::Hfsm;
 use mrt_script::offline::{cycle_line, parse_worlds, world_at, WorldsError};
-use mrt_script::{LuaRuntime, Sandbox, ThinkingCap};
+use mrt_script::{LuaRuntime, Sandbox, ThinkingCap, Watchdog, LOAD_DEADLINE, SIMULATED_DEADLINE};
 use std::cell::RefCell;
 use std::io::Write as _;
 use std::path::Path;
@@ -63,13 +66,17 @@ pub fn behave(
     }
     let worlds = Worlds::load(world, cycles)?;
     let dir = file.parent().filter(|d| !d.as_os_str().is_empty()).unwrap_or(Path::new("."));
-    let name = file.file_name().and_then(|n| n.to_str()).unwrap_or_default();
-    let mut cap = if name.ends_with(".hfsm.lua") {
-        ThinkingCap::with_hfsm(dir, file, Sandbox::default())
-    } else {
-        let stem = name.strip_suffix(".lua").unwrap_or(name);
-        ThinkingCap::with_behavior(dir, stem, Sandbox::default())
-    }
+    let name = file.file_name().and_then(|n| n.to_str()).unwrap_or_default().to_string();
+    let (dir, machine) = (dir.to_path_buf(), file.to_path_buf());
+    let top = name.clone();
+    let mut cap = Watchdog::start(&name, SIMULATED_DEADLINE, move || {
+        if top.ends_with(".hfsm.lua") {
+            ThinkingCap::with_hfsm(&dir, &machine, Sandbox::default())
+        } else {
+            let stem = top.strip_suffix(".lua").unwrap_or(&top);
+            ThinkingCap::with_behavior(&dir, stem, Sandbox::default())
+        }
+    })
     .map_err(|e| anyhow::anyhow!("{e}"))?;
     let mut failed: u64 = 0;
     let stdout = std::io::stdout();
@@ -94,11 +101,7 @@ pub fn behave(
 
 /// Writes an HFSM file as Graphviz dot (to `dot`, or standard output) and as SVG.
 pub fn hfsm_dot(file: &Path, dot: Option<&Path>, svg: Option<&Path>) -> Result<()> {
-    let rt = LuaRuntime::new(Sandbox::default()).map_err(|e| anyhow::anyhow!("{e}"))?;
-    let io = Rc::new(RefCell::new(RobotIo::default()));
-    chaos::install(&rt, io.clone()).map_err(|e| anyhow::anyhow!("{e}"))?;
-    let hfsm = Hfsm::from_file(&rt, file, io).map_err(|e| anyhow::anyhow!("{e}"))?;
-    let text = hfsm.to_dot(true);
+    let (text, drawing) = draw_within_deadline(file, svg.is_some())?;
     match dot {
         Some(p) => {
             std::fs::write(p, &text).with_context(|| format!("cannot write {}", p.display()))?
@@ -108,9 +111,37 @@ pub fn hfsm_dot(file: &Path, dot: Option<&Path>, svg: Option<&Path>) -> Result<(
             std::io::stdout().lock().write_all(text.as_bytes())?
         }
     }
-    if let Some(p) = svg {
-        std::fs::write(p, hfsm.to_svg())
-            .with_context(|| format!("cannot write {}", p.display()))?;
+    if let (Some(p), Some(drawing)) = (svg, drawing) {
+        std::fs::write(p, drawing).with_context(|| format!("cannot write {}", p.display()))?;
     }
     Ok(())
+}
+
+/// The dot text (and the SVG drawing when asked) of an HFSM file, loaded on a thread of its
+/// own within [`LOAD_DEADLINE`], as a robot loads its behaviors.
+fn draw_within_deadline(file: &Path, svg: bool) -> Result<(String, Option<String>)> {
+    let path = file.to_path_buf();
+    let (tx, rx) = std::sync::mpsc::channel();
+    std::thread::Builder::new()
+        .name("hfsm-dot".into())
+        .spawn(move || {
+            let drawn = (|| {
+                let rt = LuaRuntime::new(Sandbox::default())?;
+                let io = Rc::new(RefCell::new(RobotIo::default()));
+                chaos::install(&rt, io.clone())?;
+                let hfsm = Hfsm::from_file(&rt, &path, io)?;
+                Ok::<_, mrt_script::ScriptError>((hfsm.to_dot(true), svg.then(|| hfsm.to_svg())))
+            })();
+            let _ = tx.send(drawn.map_err(|e| e.to_string()));
+        })
+        .context("cannot start the thread that loads the HFSM")?;
+    match rx.recv_timeout(LOAD_DEADLINE) {
+        Ok(drawn) => drawn.map_err(|e| anyhow::anyhow!("{e}")),
+        Err(std::sync::mpsc::RecvTimeoutError::Timeout) => {
+            bail!("{}: did not load within {} s", file.display(), LOAD_DEADLINE.as_secs())
+        }
+        Err(std::sync::mpsc::RecvTimeoutError::Disconnected) => {
+            bail!("{}: loading stopped unexpectedly", file.display())
+        }
+    }
 }

@@ -53,6 +53,19 @@ fn a_hostile_behavior_stops_its_robot_and_the_match_goes_on() {
         ("print", "goalkeeper.lua", "print('milan 0 : 99 chaos (away)') chaos.setVlin(0/0)"),
         ("error", "goalkeeper.lua", "error(string.rep('E', 1e6))"),
         ("escapes", "goalkeeper.lua", r#"error("\27[2J\27[Hmatch OK: no faults")"#),
+        ("rep", "goalkeeper.lua", "local s = string.rep('', math.maxinteger)"),
+        (
+            "insert",
+            "goalkeeper.lua",
+            "table.insert(setmetatable({}, {__len = function() return math.maxinteger - 1 end}), 1, 0)",
+        ),
+        (
+            "find",
+            "goalkeeper.lua",
+            "local h = string.rep('a', 9e6) for i = 1, 1e9 do string.find(h, 'aab', 1, true) end",
+        ),
+        // At the top of the HBM file, run when every robot loads its behaviors.
+        ("top", "hbm.lua", "string.rep('', math.maxinteger, '')"),
     ];
     for (case, file, text) in cases {
         let dir = hostile_copy(case, file, text);
@@ -66,6 +79,9 @@ fn a_hostile_behavior_stops_its_robot_and_the_match_goes_on() {
         assert!(out.status.success(), "{case}: {stderr}");
         assert!(stdout.contains("10 s of play simulated"), "{case}: the match finished: {stdout}");
         assert!(stdout.contains("faulted"), "{case}: the robot is reported: {stdout}");
+        if case == "top" {
+            assert!(stdout.contains("failed to init"), "{case}: as a load error: {stdout}");
+        }
         assert!(!stdout.contains("0 : 99"), "{case}: a script prints nothing on stdout: {stdout}");
         assert!(stdout.len() < 16 * 1024, "{case}: {} bytes of report", stdout.len());
         // A script's text is shown, never obeyed by the terminal.
@@ -76,6 +92,41 @@ fn a_hostile_behavior_stops_its_robot_and_the_match_goes_on() {
         assert!(stderr.len() < 4 << 20, "{case}: {} bytes of log", stderr.len());
         std::fs::remove_dir_all(&dir).unwrap();
     }
+}
+
+/// `mrt behave` and `mrt hfsm dot` protect themselves as a match does: a call the budget pays
+/// for ends in an error, a file of 20 000 nested machines is refused, and neither hangs nor
+/// aborts.
+#[test]
+fn behave_and_hfsm_dot_end_with_an_error_on_hostile_files() {
+    let dir = std::env::temp_dir().join(format!("mrt-hostile-offline-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(dir.join("hbm.lua"), "").unwrap();
+    std::fs::write(dir.join("rep.lua"), "local s = string.rep('', math.maxinteger)").unwrap();
+    let chain = "for i = 1, 20000 do\n\
+                   local inner = i < 20000 and meta('M' .. (i + 1)) or true\n\
+                   machine('M' .. i) { initial = 's', states = { s = inner } }\n\
+                 end";
+    std::fs::write(dir.join("deep.hfsm.lua"), chain).unwrap();
+    for args in [
+        vec!["behave".to_string(), dir.join("rep.lua").display().to_string()],
+        vec!["behave".to_string(), dir.join("deep.hfsm.lua").display().to_string()],
+        vec![
+            "hfsm".to_string(),
+            "dot".to_string(),
+            dir.join("deep.hfsm.lua").display().to_string(),
+        ],
+    ] {
+        let started = Instant::now();
+        let out = mrt().args(&args).output().unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{args:?}: an error, not a crash: {stderr}");
+        assert!(started.elapsed() < Duration::from_secs(20), "{args:?}: {:?}", started.elapsed());
+        let expected = if args[1].ends_with("rep.lua") { "string.rep" } else { "256 machines" };
+        assert!(stderr.contains(expected), "{args:?}: {stderr}");
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 #[test]

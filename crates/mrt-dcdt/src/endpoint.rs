@@ -80,6 +80,12 @@ impl Endpoint {
         self.shared.clock.now()
     }
 
+    /// Whether the Agora's clock is simulated (it advances only when its world steps it), so
+    /// that wall-clock time says nothing about the robot's cycle.
+    pub fn clock_is_simulated(&self) -> bool {
+        self.shared.clock.is_simulated()
+    }
+
     fn index(&self) -> usize {
         self.member.0 as usize
     }

@@ -13,7 +13,8 @@
 //! [`FAULT_LIMIT`] cycles in a row, are broken, not unlucky (the robot stood still in each of
 //! those cycles anyway): the robot is **stopped** (the safe command, no Lua run, so a hostile
 //! behavior costs its match nothing from then on) until a file is reloaded, and
-//! [`ScriptError::Stopped`] says so once.
+//! [`ScriptError::Stopped`] says so once; under the [`Watchdog`](crate::Watchdog) it restarts
+//! from its files after a back-off.
 
 use crate::chaos::{self, RobotIo};
 use crate::hbm::Hbm;
@@ -27,12 +28,12 @@ use std::cell::RefCell;
 use std::path::{Path, PathBuf};
 use std::rc::Rc;
 
-/// Runaway cycles (budget or memory overruns) in a row after which the robot is stopped until
-/// a behavior file is reloaded.
+/// Runaway cycles (budget or memory overruns) in a row after which the robot is stopped (until
+/// a behavior file is reloaded, or the [`Watchdog`](crate::Watchdog) restarts it).
 pub const RUNAWAY_LIMIT: u32 = 3;
 
 /// Failing cycles (any error of the HFSM or the behavior) in a row after which the robot is
-/// stopped until a behavior file is reloaded: 2 s of the seed's 100 ms cycle.
+/// stopped like a runaway: 2 s of the seed's 100 ms cycle.
 pub const FAULT_LIMIT: u32 = 20;
 
 /// What one cycle did.

@@ -56,4 +56,7 @@ pub use cap::{Cycle, ThinkingCap, FAULT_LIMIT, RUNAWAY_LIMIT};
 pub use runtime::{Interrupt, LuaRuntime, Sandbox, MAX_TEXT, PRINT_LINES_PER_CALL, STEP_BYTES};
 pub use script::{LoadStrategy, Script, ScriptError};
 pub use watch::{compile_source, Change, Compiled, ScriptWatcher};
-pub use watchdog::{Watchdog, DEFAULT_DEADLINE, LOAD_DEADLINE, MAX_RESTARTS};
+pub use watchdog::{
+    Watchdog, DEFAULT_DEADLINE, HEALTHY_CYCLES, LOAD_DEADLINE, MAX_BACKOFF, MAX_RESTARTS,
+    RESTART_AFTER, SIMULATED_DEADLINE,
+};

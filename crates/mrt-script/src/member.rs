@@ -15,12 +15,15 @@
 //! A Lua state belongs to one thread, and Members may move between threads, so the scripts run
 //! on a worker thread owned by the Member, under the [`Watchdog`]: each cycle is one
 //! synchronous round trip (a few microseconds), so the stepped executor stays deterministic,
-//! and a cycle that does not end within the deadline stops the behavior, not the robot.
+//! and a cycle that does not end within the deadline stops the behavior, not the robot, until
+//! it restarts from its files. On a simulated clock the deadline is [`SIMULATED_DEADLINE`], a
+//! backstop the instruction budget makes unreachable for a behavior of Lua code, so that a
+//! busy machine cannot change a match.
 
 use crate::cap::ThinkingCap;
 use crate::push::Pusher;
 use crate::runtime::Sandbox;
-use crate::watchdog::{Watchdog, DEFAULT_DEADLINE};
+use crate::watchdog::{Watchdog, DEFAULT_DEADLINE, SIMULATED_DEADLINE};
 use mrt_dcdt::{Context, Member, MemberError, Message, RequestType};
 use mrt_msgs::robot::WorldSnapshot;
 use std::path::PathBuf;
@@ -46,7 +49,8 @@ pub struct BehaviorMember {
     top: Top,
     sandbox: Sandbox,
     watch: bool,
-    deadline: Duration,
+    /// Set by [`BehaviorMember::with_deadline`]; by the clock otherwise.
+    deadline: Option<Duration>,
     worker: Option<Watchdog>,
     world: WorldSnapshot,
     blackboard: Option<mrt_blackboard::Blackboard>,
@@ -75,7 +79,7 @@ impl BehaviorMember {
             top,
             sandbox: Sandbox::default(),
             watch: false,
-            deadline: DEFAULT_DEADLINE,
+            deadline: None,
             worker: None,
             world: WorldSnapshot::default(),
             blackboard: None,
@@ -101,13 +105,14 @@ impl BehaviorMember {
         self
     }
 
-    /// Sets the watchdog's deadline for one cycle ([`DEFAULT_DEADLINE`] by default).
+    /// Sets the watchdog's deadline for one cycle ([`DEFAULT_DEADLINE`] by default,
+    /// [`SIMULATED_DEADLINE`] on a simulated clock).
     pub fn with_deadline(mut self, deadline: Duration) -> Self {
-        self.deadline = deadline;
+        self.deadline = Some(deadline);
         self
     }
 
-    fn spawn(&self) -> Result<Watchdog, MemberError> {
+    fn spawn(&self, simulated: bool) -> Result<Watchdog, MemberError> {
         let (dir, top, sandbox, watch, bb) =
             (self.dir.clone(), self.top.clone(), self.sandbox, self.watch, self.blackboard.clone());
         let load = move || {
@@ -120,7 +125,11 @@ impl BehaviorMember {
             }
             Ok(cap)
         };
-        Watchdog::start(&self.name, self.deadline, load).map_err(|e| e.to_string().into())
+        let deadline = self.deadline.unwrap_or(match simulated {
+            true => SIMULATED_DEADLINE,
+            false => DEFAULT_DEADLINE,
+        });
+        Watchdog::start(&self.name, deadline, load).map_err(|e| e.to_string().into())
     }
 }
 
@@ -135,7 +144,7 @@ impl Member for BehaviorMember {
         ctx.subscribe_to::<ReloadRequest>(RequestType::All);
         ctx.subscribe_to::<BehaviorPush>(RequestType::All);
         self.pusher = Some(Pusher::new(ctx.agora_id().0, self.dir.clone()));
-        self.worker = Some(self.spawn()?);
+        self.worker = Some(self.spawn(ctx.clock_is_simulated())?);
         Ok(())
     }
 

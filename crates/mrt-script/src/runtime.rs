@@ -74,7 +74,7 @@ pub(crate) struct Meter {
     /// The budget.
     limit: u64,
     /// Set by the watchdog: abort the running call at the next check.
-    interrupted: AtomicBool,
+    interrupted: Arc<AtomicBool>,
     /// `print` lines written during the current call.
     printed: AtomicUsize,
     /// Where the current call ran past its budget: the script (its chunk name) and the line.
@@ -134,14 +134,31 @@ impl Meter {
 }
 
 /// Stops the call running in a [`LuaRuntime`] from another thread (the watchdog's handle).
-#[derive(Clone, Debug)]
-pub struct Interrupt(Arc<Meter>);
+#[derive(Clone, Debug, Default)]
+pub struct Interrupt(Arc<AtomicBool>);
+
+thread_local! {
+    /// The handle the next runtime made on this thread obeys ([`Interrupt::for_next_runtime`]).
+    static NEXT: std::cell::RefCell<Option<Interrupt>> = const { std::cell::RefCell::new(None) };
+}
 
 impl Interrupt {
+    /// Makes the next [`LuaRuntime`] created on this thread obey this handle, so that loading
+    /// behaviors (which makes the runtime and runs the scripts' top level) can be stopped
+    /// before the runtime exists to give its own handle.
+    pub fn obeyed_by_next_runtime(&self) {
+        NEXT.with(|n| *n.borrow_mut() = Some(self.clone()));
+    }
+
+    /// Forgets a handle no runtime took up ([`Interrupt::obeyed_by_next_runtime`]).
+    pub(crate) fn forget_next() {
+        NEXT.with(|n| n.borrow_mut().take());
+    }
+
     /// Aborts the running call at its next budget check (within 1000 VM instructions of Lua
     /// code; a C function in progress finishes first) and every call after it.
     pub fn interrupt(&self) {
-        self.0.interrupted.store(true, Ordering::Relaxed);
+        self.0.store(true, Ordering::Relaxed);
     }
 }
 
@@ -313,7 +330,9 @@ impl LuaRuntime {
         for name in REMOVED {
             globals.set(name, mlua::Nil).map_err(ScriptError::setup)?;
         }
-        let meter = Arc::new(Meter { limit: sandbox.instruction_budget, ..Meter::default() });
+        let interrupted = NEXT.with(|n| n.borrow_mut().take()).unwrap_or_default().0;
+        let meter =
+            Arc::new(Meter { limit: sandbox.instruction_budget, interrupted, ..Meter::default() });
         install_prelude(&lua, &meter).map_err(ScriptError::setup)?;
         lua.set_memory_limit(sandbox.memory_limit).map_err(ScriptError::setup)?;
         // Behaviors make short-lived garbage every cycle (tables, closures, strings): the
@@ -370,7 +389,7 @@ impl LuaRuntime {
 
     /// The watchdog's handle on this runtime.
     pub fn interrupt_handle(&self) -> Interrupt {
-        Interrupt(self.meter.clone())
+        Interrupt(self.meter.interrupted.clone())
     }
 
     /// Whether the watchdog interrupted this runtime (every call fails from then on).
@@ -480,9 +499,9 @@ fn install_prelude(lua: &Lua, meter: &Arc<Meter>) -> mlua::Result<()> {
         if n <= 0 {
             return Ok(());
         }
-        let n = n as f64;
+        let (count, n) = (n, n as f64);
         let bytes = n * s.as_bytes().len() as f64 + (n - 1.0) * sep as f64;
-        m.charge(lua, (n + bytes) / STEP_BYTES as f64, || format!("string.rep: {n:.0} copies"))
+        m.charge(lua, (n + bytes) / STEP_BYTES as f64, || format!("string.rep: {count} copies"))
     })?;
     let helpers = [spent, log, charge, spend, pattern_cost, span_cost, find_plain, rep_cost];
     lua.load(PRELUDE)

@@ -57,8 +57,9 @@ pub enum ScriptError {
         deadline_ms: u64,
     },
     /// The robot was stopped: its behaviors ran away (budget or memory) or failed this many
-    /// cycles in a row. It stands still, running no Lua, until a behavior file is reloaded.
-    #[error("{file}: stopped after {cycles} cycles in a row {why}; the robot stands still until a behavior file is reloaded")]
+    /// cycles in a row. It stands still, running no Lua, until its behaviors restart from
+    /// their files (the [`Watchdog`](crate::Watchdog)'s back-off) or a file is reloaded.
+    #[error("{file}: stopped after {cycles} cycles in a row {why}; the robot stands still until its behaviors restart from their files")]
     Stopped {
         /// The HFSM file or the behavior at the top.
         file: String,

@@ -968,13 +968,73 @@ fn the_watchdog_stops_a_behavior_that_blocks_where_the_hook_cannot_see() {
         assert!(m.errors.is_empty(), "{:?}", m.errors);
         assert_eq!(m.command.vlin, 100.0);
     }
-    // A reload request starts a fresh worker from the files: the robot runs again.
+    // The back-off is over but the blocked call still runs: the restart waits for it. Once
+    // it ends, the robot restarts from its files by itself, saying so once.
     hold.store(false, Ordering::Relaxed);
-    robot.reload_requested().unwrap();
+    let mut restarted = None;
+    for t in 50..250 {
+        let c = robot.cycle(ball_at(500.0, t * 100));
+        assert!(c.errors.is_empty(), "{:?}", c.errors);
+        if c.command.vlin == 300.0 {
+            restarted = Some(c.reloaded);
+            break;
+        }
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    assert_eq!(restarted, Some(vec!["blocker".to_string()]));
     assert!(!robot.stopped());
-    let c = robot.cycle(ball_at(500.0, 6000));
+    let c = robot.cycle(ball_at(500.0, 30_000));
+    assert!(c.errors.is_empty() && c.reloaded.is_empty(), "{:?}", c.errors);
+    assert_eq!(c.command.vlin, 300.0);
+}
+
+/// Behaviors that keep failing stop the robot, which stands still for the back-off and then
+/// restarts from its files: the edited file if it was fixed meanwhile, and a longer back-off
+/// if it fails again. Counted in cycles, so a simulated match stays deterministic.
+#[test]
+fn a_stopped_robot_restarts_from_its_files_after_a_back_off() {
+    use mrt_script::{Watchdog, FAULT_LIMIT, RESTART_AFTER};
+    let dir = Dir::new("backoff");
+    dir.write("hbm.lua", SINGLETON_HBM);
+    dir.write("broken.lua", r#"always("go", "FAST") error("broken")"#);
+    let path = dir.path().to_path_buf();
+    let mut robot = Watchdog::start("broken", Duration::from_secs(5), move || {
+        ThinkingCap::with_behavior(&path, "broken", Sandbox::default())
+    })
+    .unwrap();
+    let mut t = 0;
+    let mut cycle = |robot: &mut Watchdog| {
+        t += 1;
+        robot.cycle(ball_at(500.0, t * 100))
+    };
+    // Stopped after FAULT_LIMIT failing cycles, said once.
+    for k in 1..=FAULT_LIMIT {
+        let c = cycle(&mut robot);
+        assert!(!c.errors.is_empty(), "cycle {k} fails");
+    }
+    assert!(robot.stopped());
+    assert_eq!(robot.restart_in(), Some(RESTART_AFTER));
+    for _ in 0..RESTART_AFTER {
+        let c = cycle(&mut robot);
+        assert!(c.errors.is_empty() && c.command == RobotCommand::default(), "{:?}", c.errors);
+    }
+    // Restarted: the same broken file fails again, and the next back-off is twice as long.
+    let c = cycle(&mut robot);
+    assert_eq!(c.reloaded, vec!["broken".to_string()]);
+    assert!(!c.errors.is_empty());
+    for _ in 1..FAULT_LIMIT {
+        cycle(&mut robot);
+    }
+    assert_eq!(robot.restart_in(), Some(2 * RESTART_AFTER));
+    // Fixed during the wait: the restart runs the fixed file.
+    dir.edit("broken.lua", r#"always("go", "FAST")"#);
+    for _ in 0..2 * RESTART_AFTER {
+        assert_eq!(cycle(&mut robot).command, RobotCommand::default());
+    }
+    let c = cycle(&mut robot);
     assert!(c.errors.is_empty(), "{:?}", c.errors);
     assert_eq!(c.command.vlin, 300.0);
+    assert!(!robot.stopped());
 }
 
 #[test]
