@@ -45,12 +45,30 @@ pub struct ReplayArgs {
     /// and 95th percentile, per robot and for all (`--json` for a machine).
     #[arg(long, conflicts_with = "robot")]
     pub accuracy: bool,
+    /// Write a clean copy of the recording into OUT: every message of a damaged file (cut
+    /// short, or left by a process that was killed while it wrote) up to the damage, with
+    /// its summary and index, for `mrt replay` and other MCAP tools.
+    #[arg(long, value_name = "OUT", conflicts_with_all = ["serve", "robot", "accuracy"])]
+    pub recover: Option<PathBuf>,
 }
 
 /// Runs `mrt replay`: lists the recording's topics with their schemas, message counts and
 /// time spans.
 pub fn run(args: &ReplayArgs) -> Result<()> {
-    let recording = Recording::open(&args.file)?;
+    let (recording, damage) = Recording::open_salvaged(&args.file)?;
+    if let Some(d) = &damage {
+        eprintln!(
+            "warning: {}: damaged after {} messages ({:.1} s): {}; reading what comes before{}",
+            args.file.display(),
+            d.kept,
+            d.until.as_secs_f64(),
+            mrt_core::printable(&d.why),
+            if args.recover.is_none() { " (--recover OUT writes a clean copy)" } else { "" }
+        );
+    }
+    if let Some(out) = &args.recover {
+        return recover(&recording, out, damage.is_some());
+    }
     if let Some(addr) = args.serve {
         let timeline = Timeline::of_recording(&recording)?;
         let frames = timeline.end();
@@ -112,6 +130,24 @@ pub fn run(args: &ReplayArgs) -> Result<()> {
             secs(t.last)
         );
     }
+    Ok(())
+}
+
+/// `--recover OUT`: the readable messages of `recording` into a new, finished file.
+fn recover(recording: &Recording, out: &std::path::Path, damaged: bool) -> Result<()> {
+    let mut copy = mrt_monitor::Recorder::create(out)?;
+    let mut failed = None;
+    recording.scan(|e| {
+        if failed.is_none() {
+            failed = copy.copy(&e).err();
+        }
+    })?;
+    if let Some(e) = failed {
+        return Err(e).with_context(|| format!("cannot write {}", out.display()));
+    }
+    let s = copy.finish()?;
+    let state = if damaged { "recovered" } else { "copied (the recording was intact)" };
+    outln!("{state}: {} messages on {} topics into {}", s.messages, s.channels, out.display());
     Ok(())
 }
 

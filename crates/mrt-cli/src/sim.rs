@@ -232,9 +232,25 @@ fn play_one(
     }
     let recorder = recorder(args, cfg, timeline)?;
     let behaviors = args.behaviors.as_deref();
-    let report = play_recorded(cfg, seed, stacks, behaviors, record, recorder.clone(), progress)
+    if args.record.is_some() {
+        // A recording is finished, with its summary and index, when Ctrl-C ends the match.
+        crate::interrupt::finish_on_ctrl_c();
+    }
+    let mut progress = progress;
+    let mut played = 0.0;
+    let go_on = |t: f64| {
+        progress(t);
+        played = t;
+        !crate::interrupt::interrupted()
+    };
+    let report = play_recorded(cfg, seed, stacks, behaviors, record, recorder.clone(), go_on)
         .map_err(|e| anyhow!("{e}"))?;
     let mut notes = Vec::new();
+    if crate::interrupt::interrupted() {
+        notes.push(format!(
+            "interrupted after {played:.1} s of play: the report and the recording cover that much"
+        ));
+    }
     let finished = recorder.map(Recorder::finish_shared).transpose()?;
     if let Some(t) = timeline {
         t.lock().map_err(|_| anyhow!("the monitor's timeline lock is poisoned"))?.finish();

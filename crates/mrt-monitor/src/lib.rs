@@ -56,6 +56,6 @@ pub mod view;
 
 pub use profile::RecordProfile;
 pub use record::{RecordError, RecordSummary, Recorder, SharedRecorder};
-pub use replay::{Recording, ReplayError};
+pub use replay::{Damage, Recording, ReplayError};
 pub use tap::Tap;
 pub use view::{MatchInfo, SharedTimeline, Timeline, Truth};

@@ -93,6 +93,8 @@ struct Scan {
     channels: BTreeMap<u16, (String, u16, String)>,
     topics: BTreeMap<String, TopicInfo>,
     index: u64,
+    /// Records read (the file's magic was MCAP's once there is one).
+    records: u64,
 }
 
 /// MCAP's opcodes of the records read (the others are passed over).
@@ -182,6 +184,20 @@ impl TopicInfo {
 pub struct Recording {
     path: PathBuf,
     bytes: Vec<u8>,
+    /// Whether its scans end quietly where the file is damaged ([`Recording::open_salvaged`]).
+    salvaged: bool,
+}
+
+/// Where a damaged recording (cut short, a process killed while it wrote) stops being
+/// readable, and what is kept before it ([`Recording::open_salvaged`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Damage {
+    /// The messages read before the damage.
+    pub kept: u64,
+    /// The latest log time among them.
+    pub until: Time,
+    /// What is wrong there.
+    pub why: String,
 }
 
 impl Recording {
@@ -194,15 +210,53 @@ impl Recording {
 
     /// A recording of `bytes`, called `path` in errors.
     pub fn from_bytes(bytes: Vec<u8>, path: &Path) -> Recording {
-        Recording { path: path.to_path_buf(), bytes }
+        Recording { path: path.to_path_buf(), bytes, salvaged: false }
+    }
+
+    /// Reads the file at `path` as far as it is readable: a recording cut short or damaged
+    /// (after its first record) reads up to the damage, every scan of it ending there without
+    /// an error, and the [`Damage`] says how much was kept. A file that is not MCAP at all is
+    /// still an error.
+    pub fn open_salvaged(path: &Path) -> Result<(Recording, Option<Damage>), ReplayError> {
+        Recording::open(path)?.salvage()
+    }
+
+    /// This recording read as far as it is readable ([`Recording::open_salvaged`]).
+    pub fn salvage(mut self) -> Result<(Recording, Option<Damage>), ReplayError> {
+        let recording = &mut self;
+        let (topics, damage) = recording.scan_salvaging(|_| {}, true)?;
+        let damage = damage.map(|e| Damage {
+            kept: topics.iter().map(|t| t.count).sum(),
+            until: topics.iter().map(|t| t.last).max().unwrap_or_default(),
+            why: e.to_string(),
+        });
+        recording.salvaged = damage.is_some();
+        Ok((self, damage))
     }
 
     /// Calls `f` with every message of a readable channel ([`TopicInfo::readable`]), in file
     /// order, and returns every topic with its counts (readable or not).
     pub fn scan(&self, f: impl FnMut(Entry<'_>)) -> Result<Vec<TopicInfo>, ReplayError> {
-        let read = std::panic::AssertUnwindSafe(|| self.scan_unguarded(f));
-        std::panic::catch_unwind(read)
-            .unwrap_or_else(|_| Err(ReplayError::Corrupt { path: self.path.clone() }))
+        self.scan_salvaging(f, self.salvaged).map(|(topics, _)| topics)
+    }
+
+    /// [`Recording::scan`]; with `salvage`, an error after the first record ends the scan
+    /// with what was read and the error beside it.
+    fn scan_salvaging(
+        &self,
+        mut f: impl FnMut(Entry<'_>),
+        salvage: bool,
+    ) -> Result<(Vec<TopicInfo>, Option<ReplayError>), ReplayError> {
+        let mut scan = Scan::default();
+        let read = std::panic::AssertUnwindSafe(|| self.scan_unguarded(&mut scan, &mut f));
+        let result = std::panic::catch_unwind(read)
+            .unwrap_or_else(|_| Err(ReplayError::Corrupt { path: self.path.clone() }));
+        let topics = scan.topics.into_values().collect();
+        match result {
+            Ok(()) => Ok((topics, None)),
+            Err(e) if salvage && scan.records > 0 => Ok((topics, Some(e))),
+            Err(e) => Err(e),
+        }
     }
 
     /// [`Recording::scan`] without the guard against the reader's panics. `mcap`'s sans-I/O
@@ -212,14 +266,17 @@ impl Recording {
     /// size they claim: the crate's own record parser allocates whatever length a string
     /// claims, and its chunk decompression loops forever on some damaged chunks (both found
     /// by fuzzing: this module's property test, `mrt-fuzz run mcap`).
-    fn scan_unguarded(&self, mut f: impl FnMut(Entry<'_>)) -> Result<Vec<TopicInfo>, ReplayError> {
+    fn scan_unguarded(
+        &self,
+        scan: &mut Scan,
+        f: &mut impl FnMut(Entry<'_>),
+    ) -> Result<(), ReplayError> {
         use mcap::sans_io::linear_reader::{LinearReadEvent, LinearReader, LinearReaderOptions};
         let options = LinearReaderOptions::default()
             .with_record_length_limit(RECORD_LIMIT)
             .with_emit_chunks(true);
         let mut reader = LinearReader::new_with_options(options);
         let mut rest: &[u8] = &self.bytes;
-        let mut scan = Scan::default();
         while let Some(event) = reader.next_event() {
             let (opcode, data) = match event.map_err(|e| self.mcap_error(scan.index, e))? {
                 LinearReadEvent::ReadRequest(n) => {
@@ -231,8 +288,9 @@ impl Recording {
                 }
                 LinearReadEvent::Record { opcode, data } => (opcode, data),
             };
+            scan.records += 1;
             if opcode != OP_CHUNK {
-                self.take(&mut scan, opcode, data, &mut f)?;
+                self.take(scan, opcode, data, f)?;
                 continue;
             }
             let inner = self.chunk(data, scan.index)?;
@@ -240,11 +298,11 @@ impl Recording {
             while !body.is_empty() {
                 let (opcode, data, after) = split_record(body)
                     .ok_or_else(|| self.corrupt(scan.index, "a record runs past its chunk"))?;
-                self.take(&mut scan, opcode, data, &mut f)?;
+                self.take(scan, opcode, data, f)?;
                 body = after;
             }
         }
-        Ok(scan.topics.into_values().collect())
+        Ok(())
     }
 
     /// One record outside or inside a chunk: schemas and channels are kept, messages counted
@@ -424,6 +482,57 @@ mod tests {
         let bytes = std::fs::read(&path).unwrap();
         std::fs::remove_file(&path).ok();
         (bytes, path)
+    }
+
+    /// A recording of `n` GameInfo messages (`attack` = 0, 1, ...), many chunks long.
+    fn long_recording(n: u64) -> Vec<u8> {
+        let path = std::env::temp_dir().join(format!(
+            "mrt-monitor-long-{}-{:?}.mcap",
+            std::process::id(),
+            std::thread::current().id()
+        ));
+        let mut rec = Recorder::create(&path).unwrap();
+        for k in 0..n {
+            let game = GameInfo { attack: k as f64, ..Default::default() };
+            rec.record("/home/0/GameInfo", Time(k * 1_000_000), &game).unwrap();
+        }
+        rec.finish().unwrap();
+        let bytes = std::fs::read(&path).unwrap();
+        std::fs::remove_file(&path).ok();
+        bytes
+    }
+
+    /// A recording cut anywhere reads up to the cut: the messages before it, in order, none
+    /// invented, and the damage says how many; a whole file has none.
+    #[test]
+    fn a_recording_cut_short_reads_up_to_the_cut() {
+        let n = 40_000;
+        let bytes = long_recording(n);
+        let path = PathBuf::from("cut.mcap");
+        let (whole, damage) = Recording::from_bytes(bytes.clone(), &path).salvage().unwrap();
+        assert_eq!(damage, None);
+        assert_eq!(whole.topics().unwrap()[0].count, n);
+        let mut kept_before = u64::MAX;
+        for cut in [bytes.len() - 1, bytes.len() * 3 / 4, bytes.len() / 2, bytes.len() / 4] {
+            let cut_short = Recording::from_bytes(bytes[..cut].to_vec(), &path);
+            assert!(cut_short.topics().is_err(), "a strict read refuses a file cut at {cut}");
+            let (r, damage) = cut_short.salvage().unwrap();
+            let damage = damage.expect("damaged");
+            let mut attacks = Vec::new();
+            r.scan(|e| {
+                let g: GameInfo = serde_json::from_slice(e.json).unwrap();
+                attacks.push(g.attack);
+            })
+            .unwrap();
+            assert_eq!(attacks.len() as u64, damage.kept, "cut at {cut}");
+            assert!(attacks.iter().enumerate().all(|(i, &a)| a == i as f64), "in order, a prefix");
+            assert!(damage.kept <= kept_before, "a shorter file keeps no more");
+            assert_eq!(damage.until, Time(damage.kept.saturating_sub(1) * 1_000_000));
+            kept_before = damage.kept;
+        }
+        assert!(kept_before > 0 && kept_before < n / 2, "a quarter of the file: {kept_before}");
+        // Not MCAP at all is still an error.
+        assert!(Recording::from_bytes(b"not a recording".to_vec(), &path).salvage().is_err());
     }
 
     #[test]

@@ -292,20 +292,24 @@ impl BusMatch {
     /// Plays until the end or until `max_seconds` of simulated time, calling `progress` with
     /// the simulated time after each cycle.
     pub fn play_until(
-        mut self,
+        self,
         max_seconds: f64,
         mut progress: impl FnMut(f64),
     ) -> Result<MatchReport, String> {
-        loop {
-            let (over, time) = {
-                let p = lock_pitch(&self.pitch)?;
-                (p.finished(), p.world().time())
-            };
-            if over || time >= max_seconds {
-                break;
-            }
+        self.play_while(|t| {
+            progress(t);
+            t < max_seconds
+        })
+    }
+
+    /// Plays until the end, or until `go_on` (called with the simulated time after each
+    /// cycle, and once before the first) says `false`: an interrupted match reports what was
+    /// played.
+    pub fn play_while(mut self, mut go_on: impl FnMut(f64) -> bool) -> Result<MatchReport, String> {
+        let mut time = lock_pitch(&self.pitch)?.world().time();
+        while go_on(time) && !lock_pitch(&self.pitch)?.finished() {
             self.cycle()?;
-            progress(lock_pitch(&self.pitch)?.world().time());
+            time = lock_pitch(&self.pitch)?.world().time();
         }
         // Members that failed to start, failed jobs or panicked (each was restarted).
         let reports = self.exec.finish();

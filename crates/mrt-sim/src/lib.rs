@@ -54,11 +54,17 @@ pub fn play(
     record: bool,
     mut progress: impl FnMut(f64),
 ) -> Result<game::MatchReport, String> {
-    play_recorded(cfg, seed, (home, away), behaviors, record, None, &mut progress)
+    let go_on = |t| {
+        progress(t);
+        true
+    };
+    play_recorded(cfg, seed, (home, away), behaviors, record, None, go_on)
 }
 
 /// [`play`], with every robot's messages and the truth written into `recorder` when given
-/// ([`bus::BusMatch::recorded`]; `mrt sim --record`).
+/// ([`bus::BusMatch::recorded`]; `mrt sim --record`); `go_on` is called with the simulated
+/// time after each cycle and ends the match early when it says `false` (Ctrl-C), so that the
+/// recording can be finished ([`bus::BusMatch::play_while`]).
 pub fn play_recorded(
     cfg: &config::SimConfig,
     seed: u64,
@@ -66,9 +72,9 @@ pub fn play_recorded(
     behaviors: Option<&Path>,
     record: bool,
     recorder: Option<mrt_monitor::SharedRecorder>,
-    mut progress: impl FnMut(f64),
+    go_on: impl FnMut(f64) -> bool,
 ) -> Result<game::MatchReport, String> {
     let mut m = bus::BusMatch::recorded(cfg, seed, home, Some(away), behaviors, recorder)?;
     m.record_frames(record);
-    m.play(&mut progress)
+    m.play_while(go_on)
 }
