@@ -49,7 +49,9 @@ pub struct RelayConfig {
     pub token: Option<String>,
     /// Clients served at once (default 256); one more is told `ERR 503` and closed.
     pub max_clients: usize,
-    /// Clients served at once from one source address (default 64).
+    /// Clients served at once from one source address other than this machine's (default
+    /// 64). On loopback every local program shares one address, so there the limit is per
+    /// client: [`RelayConfig::max_clients`] and [`RelayConfig::first_request_timeout`].
     pub max_clients_per_address: usize,
     /// Longest request line, bytes, the newline included (default 4096).
     pub max_line: usize,
@@ -58,6 +60,9 @@ pub struct RelayConfig {
     pub line_timeout: Duration,
     /// With a token, a client must authenticate this long after connecting (default 10 s).
     pub auth_timeout: Duration,
+    /// A client must send its first complete request this long after connecting (default
+    /// 10 s): connections opened and left silent cannot hold the relay's places.
+    pub first_request_timeout: Duration,
     /// A client that sends nothing for this long is closed (default 10 min).
     pub idle_timeout: Duration,
     /// A reply or push the client does not take within this (its socket stays full) drops
@@ -98,6 +103,7 @@ impl Default for RelayConfig {
             max_line: 4096,
             line_timeout: Duration::from_secs(10),
             auth_timeout: Duration::from_secs(10),
+            first_request_timeout: Duration::from_secs(10),
             idle_timeout: Duration::from_secs(600),
             write_timeout: Duration::from_secs(5),
             max_watches: 256,
@@ -381,7 +387,7 @@ impl Shared {
             return Err(Refusal::new(503, "too many clients"));
         }
         let n = per.entry(ip).or_insert(0);
-        if *n >= self.cfg.max_clients_per_address {
+        if *n >= self.cfg.max_clients_per_address && !ip.is_loopback() {
             return Err(Refusal::new(503, format!("too many clients from {ip}")));
         }
         *n += 1;
@@ -589,6 +595,7 @@ impl<'a> Client<'a> {
         // When the first byte of the unfinished line in `buf` arrived.
         let mut line_started: Option<Instant> = None;
         let mut next_push = connected + self.refresh;
+        let mut requests: u64 = 0;
         while !self.shared.stop.load(Ordering::SeqCst) {
             let now = Instant::now();
             let mut until = (now + STOP_POLL).min(last_input + self.cfg.idle_timeout);
@@ -601,6 +608,9 @@ impl<'a> Client<'a> {
             if !self.authorised {
                 until = until.min(connected + self.cfg.auth_timeout);
             }
+            if requests == 0 {
+                until = until.min(connected + self.cfg.first_request_timeout);
+            }
             let wait = until.saturating_duration_since(now).max(Duration::from_millis(1));
             self.stream.set_read_timeout(Some(wait))?;
             match self.stream.read(&mut chunk) {
@@ -612,6 +622,7 @@ impl<'a> Client<'a> {
                     buf.extend_from_slice(&chunk[..n]);
                     while let Some(end) = buf.iter().position(|&b| b == b'\n') {
                         let line: Vec<u8> = buf.drain(..=end).collect();
+                        requests += 1;
                         if let Flow::Close = self.handle(&line[..line.len() - 1])? {
                             return Ok(());
                         }
@@ -643,6 +654,12 @@ impl<'a> Client<'a> {
                 let secs = self.cfg.auth_timeout.as_secs_f64();
                 let why = format!("no AUTH <token> within {secs} s");
                 return self.reply(&Refusal::new(401, why).line());
+            }
+            if requests == 0 && now >= connected + self.cfg.first_request_timeout {
+                count(&self.shared.stats.too_slow);
+                let secs = self.cfg.first_request_timeout.as_secs_f64();
+                let why = format!("no request within {secs} s of connecting");
+                return self.reply(&Refusal::new(408, why).line());
             }
             if now >= last_input + self.cfg.idle_timeout {
                 return self.reply(&Refusal::new(408, "idle for too long").line());
@@ -1147,6 +1164,35 @@ impl RelayClient {
 mod tests {
     use super::*;
     use proptest::prelude::*;
+
+    /// A remote address gets at most its share of places; loopback, which every local program
+    /// shares, only the total.
+    #[test]
+    fn the_per_address_limit_spares_loopback() {
+        let cfg = RelayConfig { max_clients: 5, max_clients_per_address: 2, ..Default::default() };
+        let shared = Shared {
+            bb: Blackboard::new(1, Arc::new(mrt_core::WallClock::new())),
+            cfg,
+            stop: AtomicBool::new(false),
+            stats: RelayStats::default(),
+            active: AtomicUsize::new(0),
+            per_address: Mutex::default(),
+            watches: AtomicUsize::new(0),
+            bucket: Mutex::new(Bucket { tokens: 0.0, last: Instant::now() }),
+            auth: Mutex::default(),
+        };
+        let remote: IpAddr = "192.0.2.7".parse().unwrap();
+        assert!(shared.admit(remote).is_ok() && shared.admit(remote).is_ok());
+        let refused = shared.admit(remote).unwrap_err();
+        assert_eq!(refused.line(), "ERR 503 too many clients from 192.0.2.7");
+        let local: IpAddr = "127.0.0.1".parse().unwrap();
+        for _ in 0..3 {
+            shared.admit(local).unwrap();
+        }
+        assert_eq!(shared.admit(local).unwrap_err().line(), "ERR 503 too many clients");
+        shared.leave(remote);
+        assert!(shared.admit(remote).is_ok(), "a place given back is taken again");
+    }
 
     #[test]
     fn every_command_parses() {

@@ -87,14 +87,44 @@ fn trickling_clients_are_dropped_and_a_fresh_client_is_served() {
     // Their places are free: a fresh client is served.
     let mut c = RelayClient::connect(addr, None).unwrap();
     assert_eq!(c.request("LSTW").unwrap(), "LSTW 0");
+}
 
-    // One source address gets at most `max_clients_per_address` places.
-    let cfg = RelayConfig { max_clients_per_address: 2, ..RelayConfig::default() };
+/// Silent connections held every place: 64 idle loopback connections (the per-address limit,
+/// which every local program shares) locked every local client out for the 10 min idle
+/// timeout. Now loopback is limited per client: a connection must send its first request
+/// within `first_request_timeout`, and the per-address limit applies to remote addresses only.
+#[test]
+fn silent_local_connections_cannot_lock_local_clients_out() {
+    let bb = board(BbLimits::default());
+    let cfg = RelayConfig {
+        max_clients: 8,
+        max_clients_per_address: 2,
+        first_request_timeout: Duration::from_millis(300),
+        ..RelayConfig::default()
+    };
     let relay = start(&bb, cfg);
-    let _two = [raw(relay.local_addr()), raw(relay.local_addr())];
-    eventually("2 clients served", || relay.clients() == 2);
-    let (mut r, _w) = raw(relay.local_addr());
-    assert_eq!(line(&mut r), "ERR 503 too many clients from 127.0.0.1");
+    let addr = relay.local_addr();
+    // More loopback clients than one address's share are served.
+    let mut talking: Vec<RelayClient> =
+        (0..3).map(|_| RelayClient::connect(addr, None).unwrap()).collect();
+    for c in &mut talking {
+        assert_eq!(c.request("LSTW").unwrap(), "LSTW 0");
+    }
+    // Five silent ones fill the rest; a ninth is refused while they hold their places.
+    let silent: Vec<_> = (0..5).map(|_| raw(addr)).collect();
+    eventually("8 clients served", || relay.clients() == 8);
+    let (mut r, _w) = raw(addr);
+    assert_eq!(line(&mut r), "ERR 503 too many clients");
+    // The silent ones are closed at the first-request deadline; the talking ones stay.
+    for (mut r, _) in silent {
+        assert_eq!(line(&mut r), "ERR 408 no request within 0.3 s of connecting");
+    }
+    eventually("the silent clients are gone", || relay.clients() == 3);
+    let mut fresh = RelayClient::connect(addr, None).unwrap();
+    assert_eq!(fresh.request("LSTW").unwrap(), "LSTW 0");
+    for c in &mut talking {
+        assert_eq!(c.request("LSTW").unwrap(), "LSTW 0", "a client that spoke is not closed");
+    }
 }
 
 /// Bullet 2: a million `SETV`s of new names took 343 MB and `LSTV` answered with a 192 MB
