@@ -112,6 +112,10 @@ class World:
         self._subscribers.append(
             self.session.liveliness().declare_subscriber(alive, self._on_alive, history=True)
         )
+        # Held while the world runs: its robots end as soon as it is gone.
+        self._world_token = self.session.liveliness().declare_token(
+            f"mrt/devices/{PROTOCOL}/{name}/alive"
+        )
 
     # ------------------------------------------------------------ session
 
@@ -127,6 +131,7 @@ class World:
             for subscriber in self._subscribers:
                 subscriber.undeclare()
             self._subscribers.clear()
+            self._world_token.undeclare()
             self.session.close()
 
     def _on_alive(self, sample: zenoh.Sample) -> None:

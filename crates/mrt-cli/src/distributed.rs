@@ -261,8 +261,22 @@ pub fn play(
         bridge: false,
     };
     let port = RawPort::open(&session).context("cannot open the simulator's zenoh session")?;
+    // Held while the simulator runs: its robots end as soon as it is gone.
+    let _alive = port.declare_token(&mrt_devices::world_alive(WORLD))?;
     let (tx, mail) = std::sync::mpsc::channel();
-    let run = format!("{:08x}", std::process::id() ^ (seed as u32).rotate_left(16));
+    // The match's token: robots take only this run's `sense` and `end`, so a program on the
+    // network that does not follow the match cannot guess what to forge.
+    let run = {
+        use std::hash::{BuildHasher, Hasher};
+        let mut h = std::collections::hash_map::RandomState::new().build_hasher();
+        h.write_u64(seed);
+        h.write_u128(
+            std::time::SystemTime::now()
+                .duration_since(std::time::UNIX_EPOCH)
+                .map_or(0, |d| d.as_nanos()),
+        );
+        format!("{:016x}", h.finish())
+    };
     let mut world = PitchWorld::new(
         cfg,
         seed,

@@ -113,6 +113,13 @@ pub fn robot(args: &RobotArgs, file: &RobotFile, started: Instant) -> Result<()>
     };
     let _senses = port.subscribe(&keys.sense(), mailer(WorldMail::Sense))?;
     let _end = port.subscribe(&keys.end(), mailer(WorldMail::End))?;
+    // A world that holds its liveliness token and loses it is gone: end at once.
+    let gone = tx.clone();
+    let _world = port.watch_tokens(&keys.world_alive(), move |_, here| {
+        if !here {
+            let _ = gone.try_send(WorldMail::Gone);
+        }
+    })?;
     let _alive = port.declare_token(&keys.alive())?;
     eprintln!("robot {name}: listening to world {world} ({})", keys.sense());
     eprintln!(

@@ -99,3 +99,46 @@ fn the_python_worlds_own_tests_pass() {
     assert!(out.status.success(), "{err}");
     assert!(!err.contains("skipped"), "with the requirements installed, nothing is skipped: {err}");
 }
+
+/// A robot whose world disappears mid-match (its process killed) ends within a couple of
+/// seconds, saying so, instead of waiting out its silence: the world holds a liveliness token
+/// while it runs.
+#[test]
+fn a_robot_ends_soon_after_its_world_is_gone() {
+    if !python().args(["-c", "import zenoh, mrt_world"]).output().is_ok_and(|o| o.status.success())
+    {
+        eprintln!("skipped: the Python world, no zenoh for Python here");
+        return;
+    }
+    let port = free_port();
+    let endpoint = format!("tcp/127.0.0.1:{port}");
+    let dir = std::env::temp_dir().join(format!("mrt-world-gone-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("robot.toml");
+    let shipped = std::fs::read_to_string(repo().join("configs/robot/world.toml")).unwrap();
+    std::fs::write(&file, shipped.replace("tcp/127.0.0.1:7470", &endpoint)).unwrap();
+    let mut world = python()
+        .args(["-m", "mrt_world.stub", "--world", "stub", "--robot", "home-1"])
+        .args(["--steps", "100000", "--listen", &endpoint, "--timeout", "60"])
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    let robot = Command::new(env!("CARGO_BIN_EXE_mrt"))
+        .args(["robot", "--config"])
+        .arg(&file)
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    // Let the match run a while, then kill the world.
+    std::thread::sleep(std::time::Duration::from_secs(6));
+    world.kill().unwrap();
+    let killed = std::time::Instant::now();
+    let _ = world.wait();
+    let out = robot.wait_with_output().unwrap();
+    let took = killed.elapsed();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(took < std::time::Duration::from_secs(5), "{took:?}: {err}");
+    assert!(!out.status.success() && err.contains("went away"), "{err}");
+    let _ = std::fs::remove_dir_all(&dir);
+}

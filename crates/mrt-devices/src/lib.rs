@@ -95,6 +95,17 @@ impl Keys {
     pub fn end(&self) -> String {
         format!("mrt/devices/{PROTOCOL}/{}/end", self.world)
     }
+
+    /// The world's liveliness token ([`world_alive`]).
+    pub fn world_alive(&self) -> String {
+        world_alive(&self.world)
+    }
+}
+
+/// The liveliness token world `world` holds while it runs: a robot that saw it and sees it go
+/// ends at once (its world is gone) instead of waiting out its silence.
+pub fn world_alive(world: &str) -> String {
+    format!("mrt/devices/{PROTOCOL}/{world}/alive")
 }
 
 /// The JSON Schema of each message, by file name (`sense.schema.json`, …): what

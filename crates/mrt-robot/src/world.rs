@@ -30,6 +30,8 @@ pub enum WorldMail {
     Sense(Vec<u8>),
     /// Bytes put on the world's `end` key.
     End(Vec<u8>),
+    /// The world's liveliness token, seen before, went away: its process or its link ended.
+    Gone,
 }
 
 /// How a world robot's match went.
@@ -112,6 +114,12 @@ impl WorldRobot {
                     Ok(_) => return self.end(run, port),
                     Err(refusal) => self.log(&refusal),
                 },
+                WorldMail::Gone => {
+                    return Err(format!(
+                        "world {} went away without ending the match",
+                        self.keys.world()
+                    ))
+                }
             }
         }
     }
