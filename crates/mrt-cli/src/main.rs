@@ -377,10 +377,11 @@ fn run(command: Command) -> Result<()> {
         Command::Check { files } => {
             let mut failed = 0;
             for f in &files {
-                match AgoraConfig::from_file(f) {
+                let checked = AgoraConfig::from_file(f).map_err(anyhow::Error::from);
+                match checked.and_then(|cfg| check_network(f, cfg)) {
                     Ok(cfg) => outln!("# {}: ok\n{cfg}", f.display()),
                     Err(e) => {
-                        eprintln!("error: {e}");
+                        eprintln!("error: {}", mrt_core::printable(&e.to_string()));
                         failed += 1;
                     }
                 }
@@ -391,4 +392,15 @@ fn run(command: Command) -> Result<()> {
         }
     }
     Ok(())
+}
+
+/// What the network makes of a configuration (serial lines' options, addresses), as an
+/// Agora that starts with it would: `mrt check` refuses what the Agora would.
+fn check_network(file: &std::path::Path, cfg: AgoraConfig) -> anyhow::Result<AgoraConfig> {
+    #[cfg(feature = "net")]
+    if let Err(e) = mrt_net::NetConfig::from_agora_config(&cfg) {
+        anyhow::bail!("{}: {e}", file.display());
+    }
+    let _ = file;
+    Ok(cfg)
 }

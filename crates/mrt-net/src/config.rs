@@ -42,6 +42,9 @@ pub enum NetError {
 /// The baud rate of a serial line unless its device field says otherwise.
 pub const DEFAULT_BAUD_RATE: u32 = 115_200;
 
+/// The baud rates a serial line's device field may give (what serial drivers offer).
+pub const BAUD_RATES: std::ops::RangeInclusive<u32> = 50..=4_000_000;
+
 /// zenoh's endpoint for a `ser` line's device field `<path>[,baudrate=<n>][,connect]`, and
 /// whether this end opens the line (`connect`) or waits for the other end to open it (the
 /// default). A serial line joins exactly two Agoras; zenoh needs one end of it to listen and
@@ -59,7 +62,10 @@ fn serial_endpoint(device: &str) -> Result<(String, bool), NetError> {
             None if option == "connect" => connect = true,
             None if option == "listen" => connect = false,
             Some(("baudrate", n)) => {
-                baud = n.parse().map_err(|_| bad(format!("baudrate `{n}` is not a number")))?
+                let (low, high) = (BAUD_RATES.start(), BAUD_RATES.end());
+                baud = n.parse().ok().filter(|b| BAUD_RATES.contains(b)).ok_or_else(|| {
+                    bad(format!("baudrate `{n}` is not a rate of {low} to {high}"))
+                })?
             }
             _ => {
                 return Err(bad(format!(
@@ -271,6 +277,17 @@ mod tests {
     fn serial(device: &str) -> Result<NetConfig, NetError> {
         let text = format!("10.0.0.1 224.0.0.5 2003\nser link 0 {device}\n");
         NetConfig::from_agora_config(&AgoraConfig::parse(&text, "s.cfg").unwrap())
+    }
+
+    #[test]
+    fn a_baud_rate_outside_what_drivers_offer_is_refused() {
+        for bad in ["0", "49", "4000001", "99999999999999999999", "-1", "fast", ""] {
+            let e = serial(&format!("/dev/ttyS0,baudrate={bad}")).unwrap_err().to_string();
+            assert!(e.contains("is not a rate of 50 to 4000000"), "{bad}: {e}");
+        }
+        for good in ["50", "9600", "4000000"] {
+            assert!(serial(&format!("/dev/ttyS0,baudrate={good}")).is_ok(), "{good}");
+        }
     }
 
     #[test]
