@@ -301,7 +301,7 @@ mod tests {
         opens.zenoh_config().unwrap();
         waits.zenoh_config().unwrap();
         for (bad, says) in [
-            ("/dev/ttyS0,baudrate=fast", "`fast` is not a number"),
+            ("/dev/ttyS0,baudrate=fast", "`fast` is not a rate of 50 to 4000000"),
             ("/dev/ttyS0,parity=odd", "unknown option `parity=odd`"),
             (",connect", "no device path"),
         ] {
