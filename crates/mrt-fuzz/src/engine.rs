@@ -77,6 +77,9 @@ pub struct Site {
     pub reproduces_alone: bool,
 }
 
+/// An execution longer than this counts as a hang (no input of a parser should take it).
+pub const HANG: Duration = Duration::from_secs(1);
+
 /// What a run found.
 #[derive(Clone, Debug)]
 pub struct Report {
@@ -100,6 +103,8 @@ pub struct Report {
     pub duration: Duration,
     /// The slowest execution and its index.
     pub slowest: (Duration, u64),
+    /// Executions that took longer than [`HANG`] (their inputs are saved like failures').
+    pub hangs: u64,
     /// The largest peak allocation of one execution, bytes.
     pub peak_bytes: u64,
 }
@@ -266,6 +271,7 @@ fn run_here(target: &'static Target, opts: &RunOptions) -> Result<Report, FuzzEr
         seeds: fuzzer.seeds.len(),
         duration: Duration::ZERO,
         slowest: (Duration::ZERO, 0),
+        hangs: 0,
         peak_bytes: 0,
     };
     let started = Instant::now();
@@ -277,6 +283,12 @@ fn run_here(target: &'static Target, opts: &RunOptions) -> Result<Report, FuzzEr
         let took = t0.elapsed();
         if took > report.slowest.0 {
             report.slowest = (took, k);
+        }
+        if took > HANG {
+            report.hangs += 1;
+            if let Some(dir) = &opts.crash_dir {
+                report.saved.push(save(dir, target, seed, k, opts.seed, &input)?);
+            }
         }
         report.execs += 1;
         let (site, message) = match outcome {

@@ -87,7 +87,7 @@ fn target(name: &str) -> Result<&'static Target, FuzzError> {
 fn print_report(r: &Report) {
     let secs = r.duration.as_secs_f64();
     println!(
-        "{:<12} {:>9} execs {:>8.1} s {:>9.0}/s  seeds {:>3}  accepted {:>4.1}%  panics {}  sites {}  big allocations {}  slowest {:.1} ms (exec {})  peak {:.1} MiB",
+        "{:<12} {:>9} execs {:>8.1} s {:>9.0}/s  seeds {:>3}  accepted {:>4.1}%  panics {}  sites {}  big allocations {}  over 1 s {}  slowest {:.1} ms (exec {})  peak {:.1} MiB",
         r.target,
         r.execs,
         secs,
@@ -97,6 +97,7 @@ fn print_report(r: &Report) {
         r.panics,
         r.sites.len(),
         r.big_allocations,
+        r.hangs,
         r.slowest.0.as_secs_f64() * 1e3,
         r.slowest.1,
         r.peak_bytes as f64 / f64::from(1 << 20),
