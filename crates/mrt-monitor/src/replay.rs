@@ -196,7 +196,7 @@ pub struct Damage {
     pub kept: u64,
     /// The latest log time among them.
     pub until: Time,
-    /// What is wrong there.
+    /// What is wrong there (without the file's name).
     pub why: String,
 }
 
@@ -225,10 +225,14 @@ impl Recording {
     pub fn salvage(mut self) -> Result<(Recording, Option<Damage>), ReplayError> {
         let recording = &mut self;
         let (topics, damage) = recording.scan_salvaging(|_| {}, true)?;
-        let damage = damage.map(|e| Damage {
-            kept: topics.iter().map(|t| t.count).sum(),
-            until: topics.iter().map(|t| t.last).max().unwrap_or_default(),
-            why: e.to_string(),
+        let named = format!("{}: ", recording.path.display());
+        let damage = damage.map(|e| {
+            let text = e.to_string();
+            Damage {
+                kept: topics.iter().map(|t| t.count).sum(),
+                until: topics.iter().map(|t| t.last).max().unwrap_or_default(),
+                why: text.strip_prefix(&named).unwrap_or(&text).to_string(),
+            }
         });
         recording.salvaged = damage.is_some();
         Ok((self, damage))

@@ -21,7 +21,7 @@ use mrt_core::{Point2, Pose2};
 use mrt_fuzzy::brian::Brian;
 use mrt_msgs::robot::{lps, Field, GameState, Lpo, RobotCommand, Target, WorldSnapshot};
 use mrt_plan::guidance::behind_ball;
-use mrt_script::{Sandbox, ThinkingCap, Watchdog, DEFAULT_DEADLINE};
+use mrt_script::{Sandbox, ThinkingCap, Watchdog, SIMULATED_DEADLINE};
 use std::path::Path;
 
 /// A behavior stack.
@@ -246,7 +246,8 @@ impl ChaosBrain {
         let sandbox = Sandbox::default();
         let path = dir.path().to_path_buf();
         let name = if keeper { CHAOS_KEEPER } else { CHAOS_PLAYER };
-        let cap = Watchdog::start(name, DEFAULT_DEADLINE, move || {
+        // It plays on a simulated clock (tests, benches): the budget is its deadline.
+        let cap = Watchdog::start(name, SIMULATED_DEADLINE, move || {
             if keeper {
                 ThinkingCap::with_behavior(&path, CHAOS_KEEPER, sandbox)
             } else {
