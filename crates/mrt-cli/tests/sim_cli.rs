@@ -38,6 +38,37 @@ fn a_short_match_reports_score_stats_and_reproduces_from_its_seed() {
 
 /// `mrt sim` plays through rendered camera images and the robots' vision by
 /// default; `--percepts oracle` is the object sensor's fast mode.
+/// The same seed gives the same match on a busy machine: threads spinning on every core beside
+/// it change nothing (the behaviors' deadline on a simulated clock is their budget, the
+/// wall-clock one only a backstop far beyond a starved cycle).
+#[test]
+fn a_busy_machine_does_not_change_the_match() {
+    let args = ["--half", "15", "--seed", "3", "--home", "chaos", "--away", "chaos"];
+    let (ok, quiet, err) = run(&args);
+    assert!(ok, "{err}");
+    let stop = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
+    let cores = std::thread::available_parallelism().map_or(2, usize::from);
+    let spinners: Vec<_> = (0..2 * cores)
+        .map(|_| {
+            let stop = stop.clone();
+            std::thread::spawn(move || {
+                let mut x = 0u64;
+                while !stop.load(std::sync::atomic::Ordering::Relaxed) {
+                    x = std::hint::black_box(x.wrapping_mul(6364136223846793005).wrapping_add(1));
+                }
+            })
+        })
+        .collect();
+    let (ok, busy, err) = run(&args);
+    stop.store(true, std::sync::atomic::Ordering::Relaxed);
+    for s in spinners {
+        s.join().unwrap();
+    }
+    assert!(ok, "{err}");
+    assert_eq!(hash_of(&quiet), hash_of(&busy), "quiet:\n{quiet}\nbusy:\n{busy}");
+    assert!(!err.contains("stopped"), "no behavior was stopped: {err}");
+}
+
 #[test]
 fn the_default_match_is_seen_through_camera_images() {
     let (ok, out, err) = run(&["--half", "3"]);

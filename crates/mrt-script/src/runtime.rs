@@ -17,7 +17,7 @@
 //!   `table.sort` (n log n comparisons) — a table's length through `__len` included — and the
 //!   text `load` compiles, a reader function's pieces included;
 //! - a plain `string.find` (and one whose pattern has no special characters) runs in linear
-//!   time, outside Lua's quadratic search;
+//!   time, outside Lua's quadratic search, charged an instruction a byte searched;
 //! - work in proportion to what a call returns (`string.format`, `sub`, `upper`, `byte`...)
 //!   is charged when it returns.
 //!
@@ -481,7 +481,9 @@ fn install_prelude(lua: &Lua, meter: &Arc<Meter>) -> mlua::Result<()> {
                     None => return Ok(none), // Lua reports the bad argument.
                 },
             };
-            m.spend((s.len() + p.len()) as u64 / STEP_BYTES as u64);
+            // A search's worst case costs about an instruction a byte (a periodic needle).
+            let scanned = (s.len() + p.len()) as f64;
+            m.charge(lua, scanned, || format!("string.find: {scanned} bytes to search"))?;
             Ok(match find_bytes(&s, &p, init) {
                 Some((i, j)) => (true, Some(i), Some(j)),
                 None => (true, None, None),

@@ -1077,3 +1077,33 @@ fn a_panicking_behavior_thread_is_reported_and_restarted() {
     assert_eq!(c.command.vlin, 300.0);
     assert!(!armed.load(std::sync::atomic::Ordering::Relaxed));
 }
+
+/// A restarted robot is on probation: the first cycle that runs away again stops it at once,
+/// so that a hostile behavior costs one budget per restart, not three.
+#[test]
+fn a_restarted_robot_that_runs_away_again_is_stopped_at_once() {
+    use mrt_script::{Watchdog, RESTART_AFTER, RUNAWAY_LIMIT};
+    let dir = Dir::new("probation");
+    dir.write("hbm.lua", SINGLETON_HBM);
+    dir.write("spin.lua", "while true do end");
+    let path = dir.path().to_path_buf();
+    let sandbox = Sandbox { instruction_budget: 100_000, ..Sandbox::default() };
+    let mut robot = Watchdog::start("spin", Duration::from_secs(5), move || {
+        ThinkingCap::with_behavior(&path, "spin", sandbox)
+    })
+    .unwrap();
+    let mut t = 0;
+    let mut cycle = |robot: &mut Watchdog| {
+        t += 1;
+        let c = robot.cycle(ball_at(500.0, t * 100));
+        c.errors.iter().filter(|e| matches!(e, ScriptError::Budget { .. })).count()
+    };
+    let first: usize = (0..RUNAWAY_LIMIT).map(|_| cycle(&mut robot)).sum();
+    assert!(robot.stopped());
+    assert_eq!(first, RUNAWAY_LIMIT as usize);
+    let again: usize = (0..=RESTART_AFTER).map(|_| cycle(&mut robot)).sum();
+    // Restarted, ran away once, stopped again with twice the back-off.
+    assert!(robot.stopped());
+    assert_eq!(again, 1);
+    assert_eq!(robot.restart_in(), Some(2 * RESTART_AFTER));
+}
