@@ -503,7 +503,8 @@ fn install_prelude(lua: &Lua, meter: &Arc<Meter>) -> mlua::Result<()> {
         }
         let (count, n) = (n, n as f64);
         let bytes = n * s.as_bytes().len() as f64 + (n - 1.0) * sep as f64;
-        m.charge(lua, (n + bytes) / STEP_BYTES as f64, || format!("string.rep: {count} copies"))
+        // Lua copies piece by piece: an instruction a copy, and the bytes.
+        m.charge(lua, n + bytes / STEP_BYTES as f64, || format!("string.rep: {count} copies"))
     })?;
     let helpers = [spent, log, charge, spend, pattern_cost, span_cost, find_plain, rep_cost];
     lua.load(PRELUDE)

@@ -13,8 +13,8 @@
 //! **restarts from its files** after a back-off counted in cycles: [`RESTART_AFTER`] cycles,
 //! doubling with each stop that follows a restart within [`HEALTHY_CYCLES`], up to
 //! [`MAX_BACKOFF`]; a reload request restarts it at once. Until it has run [`HEALTHY_CYCLES`]
-//! cycles, a restarted robot is on probation: one cycle that runs away (budget or memory)
-//! stops it again, so that a hostile behavior costs one budget per restart. A restart waits for the thread left
+//! cycles, a restarted robot is on probation: one cycle that fails (an error, a runaway)
+//! stops it again, so that a hostile behavior costs one cycle per restart. A restart waits for the thread left
 //! behind to end, so a robot never has more than one such thread. Each stop and restart is
 //! logged once with its cause. A worker that panics is reported and restarted at once
 //! ([`MAX_RESTARTS`] times in a row, then with the back-off). The robot's other Members, and
@@ -231,19 +231,14 @@ impl Watchdog {
             Ok(Done::Installed(_)) => safe(Vec::new()),
             Err(errors) => safe(errors),
         };
-        let runaway =
-            |e: &ScriptError| matches!(e, ScriptError::Budget { .. } | ScriptError::Memory { .. });
         if cycle.errors.iter().any(|e| matches!(e, ScriptError::Stopped { .. })) {
             // The behaviors are broken, not unlucky: a fresh start from the files later.
             self.worker = None;
             self.stopped_now("its behaviors kept failing");
-        } else if self.stops > 0
-            && self.running < HEALTHY_CYCLES
-            && cycle.errors.iter().any(runaway)
-        {
-            // On probation after a restart: one runaway stops it again.
+        } else if self.stops > 0 && self.running < HEALTHY_CYCLES && !cycle.errors.is_empty() {
+            // On probation after a restart: one failing cycle stops it again.
             self.worker = None;
-            self.stopped_now("its behaviors ran away again after a restart");
+            self.stopped_now("its behaviors failed again after a restart");
         }
         self.running = self.running.saturating_add(1);
         if self.running >= HEALTHY_CYCLES {
