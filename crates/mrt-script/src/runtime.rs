@@ -14,7 +14,7 @@
 //!   need more than the call has left is refused without running: Lua patterns at their worst
 //!   case (`string.find`, `match`, `gmatch`, `gsub`), `string.rep`'s count, the elements
 //!   `table.insert` and `table.remove` shift, `table.move`, `table.concat`, `table.unpack`,
-//!   `table.sort` (n log n comparisons) — a table's length through `__len` included — and the
+//!   `table.sort` (2 n log n) — a table's length through `__len` included — and the
 //!   text `load` compiles, a reader function's pieces included;
 //! - a plain `string.find` (and one whose pattern has no special characters) runs in linear
 //!   time, outside Lua's quadratic search, charged an instruction a byte searched;
@@ -459,7 +459,8 @@ fn install_prelude(lua: &Lua, meter: &Arc<Meter>) -> mlua::Result<()> {
                 return Ok(()); // The function itself reports the bad argument.
             };
             let n = (to as f64 - from as f64 + 1.0).max(0.0);
-            let steps = if sort && n > 1.0 { n * n.log2() } else { n };
+            // A comparison of the sort reads and writes elements: two instructions' worth.
+            let steps = if sort && n > 1.0 { 2.0 * n * n.log2() } else { n };
             m.charge(lua, steps, || format!("{name}: {n:.0} elements"))
         })?;
     let m = meter.clone();
