@@ -380,6 +380,21 @@ struct Shared {
 }
 
 impl Shared {
+    fn new(bb: Blackboard, cfg: RelayConfig) -> Shared {
+        let rate = cfg.max_pushes_per_second as f64;
+        Shared {
+            bb,
+            cfg,
+            stop: AtomicBool::new(false),
+            stats: RelayStats::default(),
+            active: AtomicUsize::new(0),
+            per_address: Mutex::default(),
+            watches: AtomicUsize::new(0),
+            bucket: Mutex::new(Bucket { tokens: rate, last: Instant::now() }),
+            auth: Mutex::default(),
+        }
+    }
+
     /// Takes a client's place, if one is free (in total and for its address).
     fn admit(&self, ip: IpAddr) -> Result<(), Refusal> {
         let mut per = lock(&self.per_address);
@@ -440,18 +455,7 @@ impl Relay {
             .map_err(|source| RelayError::Bind { addr: cfg.addr, source })?;
         let addr =
             listener.local_addr().map_err(|source| RelayError::Bind { addr: cfg.addr, source })?;
-        let rate = cfg.max_pushes_per_second as f64;
-        let shared = Arc::new(Shared {
-            bb,
-            cfg,
-            stop: AtomicBool::new(false),
-            stats: RelayStats::default(),
-            active: AtomicUsize::new(0),
-            per_address: Mutex::default(),
-            watches: AtomicUsize::new(0),
-            bucket: Mutex::new(Bucket { tokens: rate, last: Instant::now() }),
-            auth: Mutex::default(),
-        });
+        let shared = Arc::new(Shared::new(bb, cfg));
         let acceptor = {
             let shared = shared.clone();
             std::thread::Builder::new()
@@ -1170,17 +1174,7 @@ mod tests {
     #[test]
     fn the_per_address_limit_spares_loopback() {
         let cfg = RelayConfig { max_clients: 5, max_clients_per_address: 2, ..Default::default() };
-        let shared = Shared {
-            bb: Blackboard::new(1, Arc::new(mrt_core::WallClock::new())),
-            cfg,
-            stop: AtomicBool::new(false),
-            stats: RelayStats::default(),
-            active: AtomicUsize::new(0),
-            per_address: Mutex::default(),
-            watches: AtomicUsize::new(0),
-            bucket: Mutex::new(Bucket { tokens: 0.0, last: Instant::now() }),
-            auth: Mutex::default(),
-        };
+        let shared = Shared::new(Blackboard::new(1, Arc::new(mrt_core::WallClock::new())), cfg);
         let remote: IpAddr = "192.0.2.7".parse().unwrap();
         assert!(shared.admit(remote).is_ok() && shared.admit(remote).is_ok());
         let refused = shared.admit(remote).unwrap_err();

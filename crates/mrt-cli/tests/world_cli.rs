@@ -24,6 +24,25 @@ fn free_port() -> u16 {
     std::net::TcpListener::bind("127.0.0.1:0").unwrap().local_addr().unwrap().port()
 }
 
+/// A scratch directory `case` with the shipped world robot file pointed at `endpoint`, and
+/// `mrt robot` started on it.
+fn robot_on(case: &str, endpoint: &str) -> (PathBuf, std::process::Child) {
+    let dir = std::env::temp_dir().join(format!("mrt-world-{case}-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("robot.toml");
+    let shipped = std::fs::read_to_string(repo().join("configs/robot/world.toml")).unwrap();
+    let text = shipped.replace("tcp/127.0.0.1:7470", endpoint);
+    assert!(text.contains(endpoint), "the shipped world robot file names an endpoint");
+    std::fs::write(&file, text).unwrap();
+    let robot = Command::new(env!("CARGO_BIN_EXE_mrt"))
+        .args(["robot", "--config"])
+        .arg(&file)
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    (dir, robot)
+}
+
 #[test]
 fn a_python_world_drives_a_robot_process_for_100_steps_and_its_bad_messages_are_dropped() {
     match python().args(["-c", "import zenoh, mrt_world"]).output() {
@@ -41,14 +60,6 @@ fn a_python_world_drives_a_robot_process_for_100_steps_and_its_bad_messages_are_
     }
     let port = free_port();
     let endpoint = format!("tcp/127.0.0.1:{port}");
-    let dir = std::env::temp_dir().join(format!("mrt-world-cli-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let file = dir.join("robot.toml");
-    let shipped = std::fs::read_to_string(repo().join("configs/robot/world.toml")).unwrap();
-    let text = shipped.replace("tcp/127.0.0.1:7470", &endpoint);
-    assert!(text.contains(&endpoint), "the shipped world robot file names an endpoint");
-    std::fs::write(&file, text).unwrap();
-
     let world = python()
         .args(["-m", "mrt_world.stub", "--world", "stub", "--robot", "home-1", "--steps", "100"])
         .args(["--listen", &endpoint, "--image", "jpeg", "--hostile", "--timeout", "60"])
@@ -56,12 +67,7 @@ fn a_python_world_drives_a_robot_process_for_100_steps_and_its_bad_messages_are_
         .stderr(Stdio::piped())
         .spawn()
         .unwrap();
-    let robot = Command::new(env!("CARGO_BIN_EXE_mrt"))
-        .args(["robot", "--config"])
-        .arg(&file)
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
+    let (dir, robot) = robot_on("cli", &endpoint);
     let world = world.wait_with_output().unwrap();
     let robot = robot.wait_with_output().unwrap();
     let world_err = String::from_utf8_lossy(&world.stderr);
@@ -112,11 +118,6 @@ fn a_robot_ends_soon_after_its_world_is_gone() {
     }
     let port = free_port();
     let endpoint = format!("tcp/127.0.0.1:{port}");
-    let dir = std::env::temp_dir().join(format!("mrt-world-gone-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let file = dir.join("robot.toml");
-    let shipped = std::fs::read_to_string(repo().join("configs/robot/world.toml")).unwrap();
-    std::fs::write(&file, shipped.replace("tcp/127.0.0.1:7470", &endpoint)).unwrap();
     let mut world = python()
         .args(["-m", "mrt_world.stub", "--world", "stub", "--robot", "home-1"])
         .args(["--steps", "100000", "--listen", &endpoint, "--timeout", "60"])
@@ -124,12 +125,7 @@ fn a_robot_ends_soon_after_its_world_is_gone() {
         .stderr(Stdio::null())
         .spawn()
         .unwrap();
-    let robot = Command::new(env!("CARGO_BIN_EXE_mrt"))
-        .args(["robot", "--config"])
-        .arg(&file)
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
+    let (dir, robot) = robot_on("gone", &endpoint);
     // Let the match run a while, then kill the world.
     std::thread::sleep(std::time::Duration::from_secs(6));
     world.kill().unwrap();

@@ -360,9 +360,15 @@ fn a_map_file_reads_and_its_errors_name_the_place() {
         "[field]\nlength = 18\nwidth = 12\n{}",
         "[[disc]]\ncentre = [0, 0]\nradius = 1\n".repeat(40_000)
     );
+    // A thousand copies of a door, which the fuzzer found made a plan take over a second.
+    let doors = format!(
+        "[field]\nlength = 18\nwidth = 12\n{}",
+        "[[door]]\nfrom = [0, 0.55]\nto = [0, 1.45]\n".repeat(1000)
+    );
     for (text, starts) in [
         (far, "f.toml: obstacle 7: a number is not finite or beyond"),
         (long.as_str(), "f.toml: 1440031 bytes: a map file may have at most 1048576"),
+        (doors.as_str(), "f.toml: 1000 doors: a map may have at most 256"),
     ] {
         let err = PlanMap::from_toml(text, "f.toml").unwrap_err().to_string();
         assert!(err.starts_with(starts), "{err:?} for {text:?}");

@@ -114,6 +114,10 @@ pub const MAX_COORD: f64 = 1e6;
 /// on what parsing it allocates.
 pub const MAX_MAP_BYTES: usize = 1 << 20;
 
+/// The most doors a map file may have: the planner holds every cell against every door, so
+/// that doors bound a plan's time as [`MAX_CELLS`](super::MAX_CELLS) bounds its cells.
+pub const MAX_DOORS: usize = 256;
+
 /// How far `p` lies from the segment `a`–`b`.
 pub(super) fn segment_distance(p: Point2, a: Point2, b: Point2) -> f64 {
     let d = b - a;
@@ -301,7 +305,8 @@ impl PlanMap {
     /// [`mrt_core::FileError::Parse`] for malformed TOML or an unknown key,
     /// [`mrt_core::FileError::Invalid`] for an area and a field both or neither, a size that
     /// is not positive, a number that is not finite or beyond [`MAX_COORD`], a polygon of
-    /// fewer than 3 corners, or a file longer than [`MAX_MAP_BYTES`].
+    /// fewer than 3 corners, more than [`MAX_DOORS`] doors, or a file longer than
+    /// [`MAX_MAP_BYTES`].
     pub fn from_toml(text: &str, file: &str) -> Result<PlanMap, mrt_core::FileError> {
         if text.len() > MAX_MAP_BYTES {
             return Err(mrt_core::FileError::Invalid {
@@ -339,6 +344,12 @@ impl PlanMap {
                 )));
             }
             map = map.with(Shape::Polygon(p.corners.into_iter().map(point).collect()));
+        }
+        if parsed.door.len() > MAX_DOORS {
+            return Err(invalid(format!(
+                "{} doors: a map may have at most {MAX_DOORS}",
+                parsed.door.len()
+            )));
         }
         for d in parsed.door {
             map = map.with_door(Door { a: point(d.from), b: point(d.to) });

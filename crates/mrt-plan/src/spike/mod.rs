@@ -57,7 +57,7 @@ pub mod draw;
 mod map;
 mod tree;
 
-pub use map::{Door, PlanMap, Shape, MAX_COORD, MAX_MAP_BYTES};
+pub use map::{Door, PlanMap, Shape, MAX_COORD, MAX_DOORS, MAX_MAP_BYTES};
 
 use crate::error::{positive, PlanError};
 use mrt_core::{Point2, Pose2};
