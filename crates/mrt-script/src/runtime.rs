@@ -208,7 +208,12 @@ load = function(chunk, name, _mode, ...)
   if type(chunk) == "function" then
     local reader, parts = chunk, {}
     while true do
-      local piece = reader()
+      -- As Lua's own `load`: an error in the reader is `load`'s result, not raised.
+      local ok, piece = raw_pcall(reader)
+      if not ok then
+        if spent() then error(piece, 0) end
+        return nil, piece
+      end
       if piece == nil or piece == "" then break end
       if type(piece) ~= "string" then return nil, "reader function must return a string" end
       charge("load", #piece)

@@ -255,6 +255,12 @@ fn a_loaded_chunk_cannot_pass_for_a_file() {
     assert_eq!(v.as_i64(), Some(42));
     let v = run(&rt, "reader_bad.lua", "return select(2, load(function() return {} end))").unwrap();
     assert!(v.as_string().unwrap().to_str().unwrap().contains("must return a string"));
+    // A reader that raises: `load` returns the error, as Lua's does.
+    let v = run(&rt, "reader_err.lua", "return select(2, load(function() error('no more') end))")
+        .unwrap();
+    assert!(v.as_string().unwrap().to_str().unwrap().contains("no more"));
+    // A reader that runs away is the call's end, not `load`'s result.
+    assert_budget(&rt, "reader_loop.lua", "load(function() while true do end end)");
 }
 
 #[test]
