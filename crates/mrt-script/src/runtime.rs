@@ -43,9 +43,12 @@ pub struct Sandbox {
 }
 
 impl Default for Sandbox {
-    /// 10 million instructions per call (a few milliseconds), 32 MiB.
+    /// A million instructions per call, 32 MiB. A million instructions take a few
+    /// milliseconds, a few percent of a robot's cycle even on a slow board, so a runaway call
+    /// costs its robot one cycle and the other robots nothing; TeamChaos' behaviors need a few
+    /// thousand a cycle.
     fn default() -> Self {
-        Self { instruction_budget: 10_000_000, memory_limit: 32 << 20 }
+        Self { instruction_budget: 1_000_000, memory_limit: 32 << 20 }
     }
 }
 

@@ -709,7 +709,8 @@ fn a_memory_bomb_gives_a_memory_error_and_a_stop_command_for_that_cycle() {
              for i = 1, 1e9 do t[i] = string.rep("x", 1000) .. i end
            end"#,
     );
-    let sandbox = Sandbox { memory_limit: 8 << 20, ..Default::default() };
+    // A budget that pays for the strings, so that memory is what ends the call.
+    let sandbox = Sandbox { instruction_budget: 100_000_000, memory_limit: 8 << 20 };
     let mut cap = ThinkingCap::with_behavior(dir.path(), "bomb", sandbox).unwrap();
     assert_eq!(cap.cycle(ball_at(500.0, 0)).command.vlin, 100.0);
     let c = cap.cycle(ball_at(2000.0, 100));
