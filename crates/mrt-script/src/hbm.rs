@@ -264,7 +264,7 @@ impl Hbm {
             running.clear();
             running.push(name.to_string());
         }
-        rt.reset_budget();
+        let _call = rt.start_call();
         let result = function.call::<()>(());
         self.shared.running.borrow_mut().clear();
         result.map_err(|e| ScriptError::from_lua(&self.file_of(name), rt, e))?;

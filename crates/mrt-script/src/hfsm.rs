@@ -226,7 +226,7 @@ impl Hfsm {
     /// one it entered) and the error names the script and line.
     pub fn step(&mut self, rt: &LuaRuntime) -> Result<Option<Taken>, ScriptError> {
         let now = self.io.borrow().world.time;
-        rt.reset_budget();
+        let _call = rt.start_call();
         let mut taken = None;
         let incomplete =
             self.active.last().and_then(|a| match self.machines[a.machine].states[a.state].kind {
@@ -606,7 +606,7 @@ fn build(rt: &LuaRuntime, file: &str, source: &str) -> Result<(Vec<Machine>, usi
     g.set("machine", machine).map_err(ScriptError::setup)?;
     g.set("meta", meta).map_err(ScriptError::setup)?;
     g.set("include", include).map_err(ScriptError::setup)?;
-    rt.reset_budget();
+    let _call = rt.start_call();
     lua.load(source)
         .set_name(format!("@{file}"))
         .set_mode(ChunkMode::Text)

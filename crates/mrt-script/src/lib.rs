@@ -39,6 +39,9 @@
 //! The user guide is `docs/behaviors.md`; the seed's behaviors ship in `behaviors/teamchaos/`.
 #![deny(missing_docs)]
 
+// The one module of the workspace with `unsafe`: a C allocator around Lua's.
+#[allow(unsafe_code)]
+mod alloc;
 pub mod blackboard;
 mod cap;
 pub mod chaos;

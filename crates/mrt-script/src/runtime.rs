@@ -19,12 +19,16 @@
 //! - a plain `string.find` (and one whose pattern has no special characters) runs in linear
 //!   time, outside Lua's quadratic search, charged an instruction a byte searched;
 //! - work in proportion to what a call returns (`string.format`, `sub`, `upper`, `byte`...)
-//!   is charged when it returns.
+//!   is charged when it returns;
+//! - every byte the state allocates is charged too ([`STEP_BYTES`] an instruction), which
+//!   meters `..` on long strings, and a call that has spent its budget cannot allocate a
+//!   large block (the charging allocator, `alloc.rs`).
 //!
 //! A chunk name given to `load` names the chunk as a string, never as a file (an error cannot
-//! blame another script). What none of this sees (a Rust function that blocks, string
-//! concatenation with `..` of very long strings) is the [`Watchdog`](crate::Watchdog)'s.
+//! blame another script). What none of this sees (a Rust function that blocks) is the
+//! [`Watchdog`](crate::Watchdog)'s.
 
+use crate::alloc;
 use crate::script::ScriptError;
 use mlua::{HookTriggers, Lua, LuaOptions, MultiValue, StdLib, Value, VmState};
 use std::sync::atomic::{AtomicBool, AtomicU64, AtomicUsize, Ordering};
@@ -82,6 +86,8 @@ pub(crate) struct Meter {
     printed: AtomicUsize,
     /// Where the current call ran past its budget: the script (its chunk name) and the line.
     overrun_at: Mutex<Option<(String, usize)>>,
+    /// Calls in progress ([`LuaRuntime::start_call`]).
+    calls: AtomicUsize,
 }
 
 impl Meter {
@@ -131,8 +137,22 @@ impl Meter {
     }
 
     /// Pays `steps` for work already done; an overrun is raised at the next budget check.
-    fn spend(&self, steps: u64) {
+    pub(crate) fn spend(&self, steps: u64) {
         self.used.fetch_add(steps, Ordering::Relaxed);
+    }
+
+    /// A call is running and has spent its budget: it may not grow its memory much further.
+    pub(crate) fn refuses_growth(&self) -> bool {
+        self.calls.load(Ordering::Relaxed) > 0 && self.spent()
+    }
+}
+
+/// A call in progress, from [`LuaRuntime::start_call`] until dropped.
+pub(crate) struct Call<'a>(&'a Meter);
+
+impl Drop for Call<'_> {
+    fn drop(&mut self) {
+        self.0.calls.fetch_sub(1, Ordering::Relaxed);
     }
 }
 
@@ -171,6 +191,16 @@ pub struct LuaRuntime {
     pub(crate) lua: Lua,
     sandbox: Sandbox,
     meter: Arc<Meter>,
+    /// The charging allocator, taken out when the runtime is dropped.
+    allocator: Option<alloc::Installed>,
+}
+
+impl Drop for LuaRuntime {
+    fn drop(&mut self) {
+        if let Some(installed) = self.allocator.take() {
+            alloc::uninstall(&self.lua, installed);
+        }
+    }
 }
 
 /// Globals removed from the base library: they reach files or load arbitrary code.
@@ -343,6 +373,7 @@ impl LuaRuntime {
             Arc::new(Meter { limit: sandbox.instruction_budget, interrupted, ..Meter::default() });
         install_prelude(&lua, &meter).map_err(ScriptError::setup)?;
         lua.set_memory_limit(sandbox.memory_limit).map_err(ScriptError::setup)?;
+        let allocator = Some(alloc::install(&lua, meter.clone()).map_err(ScriptError::setup)?);
         // Behaviors make short-lived garbage every cycle (tables, closures, strings): the
         // generational collector reclaims it in small steps, keeping the heap near its live size.
         lua.gc_set_mode(mlua::state::GcMode::Generational(mlua::state::GcGenParams::default()));
@@ -370,7 +401,7 @@ impl LuaRuntime {
             },
         )
         .map_err(ScriptError::setup)?;
-        Ok(LuaRuntime { lua, sandbox, meter })
+        Ok(LuaRuntime { lua, sandbox, meter, allocator })
     }
 
     /// The limits.
@@ -378,11 +409,13 @@ impl LuaRuntime {
         self.sandbox
     }
 
-    /// Starts a new call's budget.
-    pub(crate) fn reset_budget(&self) {
+    /// Starts a call with a fresh budget; the call lasts until the result is dropped.
+    pub(crate) fn start_call(&self) -> Call<'_> {
         self.meter.used.store(0, Ordering::Relaxed);
         self.meter.printed.store(0, Ordering::Relaxed);
         self.meter.overrun_at.lock().unwrap_or_else(PoisonError::into_inner).take();
+        self.meter.calls.fetch_add(1, Ordering::Relaxed);
+        Call(&self.meter)
     }
 
     /// Where the last budget overrun happened (script, line), if in a script; cleared.

@@ -305,7 +305,7 @@ impl Script {
     /// Runs the script once (one behavior tick) within the sandbox's budget, returning what
     /// the chunk returns. A failed call leaves the runtime and the script usable.
     pub fn call<R: FromLuaMulti>(&self, rt: &LuaRuntime) -> Result<R, ScriptError> {
-        rt.reset_budget();
+        let _call = rt.start_call();
         let fresh = match (self.strategy, &self.path) {
             (LoadStrategy::ReloadFromFile, Some(p)) => Some(compile(rt, &self.name, &read(p)?)?),
             (LoadStrategy::Source, _) | (LoadStrategy::ReloadFromFile, None) => {

@@ -199,6 +199,40 @@ fn library_calls_in_a_loop_spend_the_budget() {
     }
 }
 
+/// `..` copies its strings inside one VM instruction: it is paid by the bytes it allocates,
+/// and once the budget is spent the next large string is refused, so the call ends at once.
+#[test]
+fn concatenation_is_paid_by_the_bytes_it_allocates() {
+    let rt = rt();
+    for (name, src) in [
+        // 2 MB a copy, four instructions an iteration: minutes on the instruction count alone.
+        (
+            "double.lua",
+            "local s = 'x' for i = 1, 20 do s = s .. s end while true do local t = s .. s end",
+        ),
+        // Quadratic: each iteration copies everything so far.
+        ("append.lua", "local s = '' while true do s = s .. 'x' end"),
+        // The same inside a protected call and a coroutine.
+        (
+            "pcall_concat.lua",
+            "local s = string.rep('x', 1e5) \
+             while true do pcall(function() while true do local t = s .. s .. s end end) end",
+        ),
+        (
+            "coroutine_concat.lua",
+            "local s = string.rep('x', 1e5) \
+             coroutine.wrap(function() while true do local t = s .. s end end)()",
+        ),
+    ] {
+        let started = std::time::Instant::now();
+        assert_budget(&rt, name, src);
+        assert!(started.elapsed().as_secs_f64() < 0.5, "{name}: {:?}", started.elapsed());
+    }
+    // The refusal belongs to the spent call: a script with a long text compiles and runs after.
+    let long = format!("return #'{}'", "y".repeat(300_000));
+    assert_eq!(run(&rt, "long.lua", &long).unwrap().as_i64(), Some(300_000));
+}
+
 /// A plain find (or a pattern without special characters) is linear: a haystack of megabytes
 /// and a needle of megabytes is one quick call, with Lua's results.
 #[test]
