@@ -164,6 +164,15 @@ fn runtime_error(file: &str, text: &str) -> ScriptError {
     while let Some(rest) = message.strip_prefix("runtime error: ") {
         message = rest;
     }
+    // An argument error raised inside the runtime's own wrappers names the script, not them.
+    if let Some(rest) = message
+        .strip_prefix(crate::runtime::PRELUDE_NAME)
+        .and_then(|r| r.strip_prefix(':')?.split_once(':'))
+        .filter(|(line, _)| line.parse::<usize>().is_ok())
+        .map(|(_, rest)| rest.trim_start())
+    {
+        message = rest;
+    }
     let mut position = script_position(message);
     if let Some((_, _, rest)) = &position {
         message = rest;

@@ -267,6 +267,24 @@ fn a_plain_find_is_linear_and_gives_luas_positions() {
     assert!(e.to_string().contains("bad argument #1 to 'find'"), "{e}");
 }
 
+/// A bad argument to a library function the sandbox wraps is blamed on the script's line, as
+/// Lua would, never on the wrapper.
+#[test]
+fn a_bad_argument_to_a_wrapped_function_names_the_scripts_line() {
+    let rt = rt();
+    for src in ["local x = 1\nlocal s = ('%d'):format(nil)", "local x = 1\nstring.rep()"] {
+        let e = run(&rt, "args.lua", src).unwrap_err();
+        match &e {
+            ScriptError::Runtime { file, line, message, .. } => {
+                assert_eq!((file.as_str(), *line), ("args.lua", 2), "{e}");
+                assert!(message.starts_with("bad argument"), "{e}");
+            }
+            other => panic!("{other}"),
+        }
+        assert!(!e.to_string().contains("sandbox"), "{e}");
+    }
+}
+
 /// `load` cannot make an error name another file, and a reader's pieces still load.
 #[test]
 fn a_loaded_chunk_cannot_pass_for_a_file() {
