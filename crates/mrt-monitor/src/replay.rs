@@ -186,6 +186,8 @@ pub struct Recording {
     bytes: Vec<u8>,
     /// Whether its scans end quietly where the file is damaged ([`Recording::open_salvaged`]).
     salvaged: bool,
+    /// The topics, once a scan has counted them ([`Recording::salvage`]).
+    topics: Option<Vec<TopicInfo>>,
 }
 
 /// Where a damaged recording (cut short, a process killed while it wrote) stops being
@@ -210,7 +212,7 @@ impl Recording {
 
     /// A recording of `bytes`, called `path` in errors.
     pub fn from_bytes(bytes: Vec<u8>, path: &Path) -> Recording {
-        Recording { path: path.to_path_buf(), bytes, salvaged: false }
+        Recording { path: path.to_path_buf(), bytes, salvaged: false, topics: None }
     }
 
     /// Reads the file at `path` as far as it is readable: a recording cut short or damaged
@@ -235,6 +237,7 @@ impl Recording {
             }
         });
         recording.salvaged = damage.is_some();
+        recording.topics = Some(topics);
         Ok((self, damage))
     }
 
@@ -414,7 +417,10 @@ impl Recording {
 
     /// Every topic with its counts.
     pub fn topics(&self) -> Result<Vec<TopicInfo>, ReplayError> {
-        self.scan(|_| {})
+        match &self.topics {
+            Some(topics) => Ok(topics.clone()),
+            None => self.scan(|_| {}),
+        }
     }
 
     /// The messages of `topic` decoded as `T`, in log-time order.

@@ -184,7 +184,7 @@ impl Watchdog {
         }
         self.stops = 0;
         self.panics = 0;
-        if self.behind.as_ref().is_some_and(|t| !t.is_finished()) {
+        if self.behind_runs() {
             // Restarts at the first cycle after the stopped call ends.
             if let Some(stop) = &mut self.stop {
                 stop.wait = 0;
@@ -252,12 +252,13 @@ impl Watchdog {
     /// Counts one cycle of a stopped robot's wait; restarts it when the wait is over and the
     /// thread it left behind has ended. Whether it restarted.
     fn wait_for_restart(&mut self) -> Result<bool, ScriptError> {
+        let behind_runs = self.behind_runs();
         let Some(stop) = &mut self.stop else { return Ok(false) };
         if stop.wait > 0 {
             stop.wait -= 1;
             return Ok(false);
         }
-        if self.behind.as_ref().is_some_and(|t| !t.is_finished()) {
+        if behind_runs {
             if !std::mem::replace(&mut stop.reported_wait, true) {
                 tracing::warn!(behavior = %self.name, "restart waits for the stopped call to end");
             }
@@ -274,10 +275,16 @@ impl Watchdog {
         }
     }
 
+    /// Whether the thread of a worker left behind still runs (its interrupted call has not
+    /// ended yet).
+    fn behind_runs(&self) -> bool {
+        self.behind.as_ref().is_some_and(|t| !t.is_finished())
+    }
+
     /// A fresh worker from the files, unless the thread left behind still runs (then `false`);
     /// a worker that does not load schedules the next try.
     fn restart(&mut self) -> Result<bool, ScriptError> {
-        if self.behind.as_ref().is_some_and(|t| !t.is_finished()) {
+        if self.behind_runs() {
             return Ok(false);
         }
         self.behind = None;
