@@ -118,7 +118,7 @@ pub struct ObjectsReading {
 }
 
 /// The most landmarks an [`ObjectsReading`] tells.
-pub const LANDMARKS: usize = mrt_msgs::FIELD_OBJECTS - 3;
+pub const LANDMARKS: usize = mrt_msgs::sighting::COUNT - mrt_msgs::sighting::LANDMARK0;
 
 /// One object's distance and bearing.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize, JsonSchema)]

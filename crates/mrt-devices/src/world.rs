@@ -12,7 +12,9 @@ use crate::messages::{
 use crate::Keys;
 use base64::Engine;
 use mrt_core::Pose2;
-use mrt_msgs::{CameraFrame, GameInfo, GameState, Image, Marker, MiceReadings, Sighting, Sonar};
+use mrt_msgs::{
+    sighting, CameraFrame, GameInfo, GameState, Image, Marker, MiceReadings, Sighting, Sonar,
+};
 
 fn pose(p: &Pose2) -> Pose {
     Pose { x: p.x, y: p.y, theta: p.theta }
@@ -66,10 +68,10 @@ pub fn camera(frame: &CameraFrame) -> (CameraReading, Option<UpCameraReading>) {
     let objects = frame.image.is_none().then(|| {
         let at = |k: usize| frame.sightings.get(k).copied().flatten().as_ref().map(seen);
         ObjectsReading {
-            ball: at(0),
-            east_net: at(1),
-            west_net: at(2),
-            landmarks: (3..frame.sightings.len()).map(at).collect(),
+            ball: at(sighting::BALL),
+            east_net: at(sighting::EAST_NET),
+            west_net: at(sighting::WEST_NET),
+            landmarks: (sighting::LANDMARK0..frame.sightings.len()).map(at).collect(),
             robots: frame
                 .robots
                 .iter()
@@ -264,8 +266,8 @@ mod tests {
     fn frame(with_image: bool) -> CameraFrame {
         let mut f =
             CameraFrame { time: 0.30000000000000004, pan: Some(-0.1), ..Default::default() };
-        f.sightings[0] = Some(Sighting { distance: 1.0 / 3.0, bearing: 0.1 });
-        f.sightings[7] = Some(Sighting { distance: 4.2, bearing: -2.9 });
+        f.sightings[sighting::BALL] = Some(Sighting { distance: 1.0 / 3.0, bearing: 0.1 });
+        f.sightings[sighting::NORTH_HALFWAY] = Some(Sighting { distance: 4.2, bearing: -2.9 });
         f.robots.push(RobotSighting {
             sighting: Sighting { distance: 2.0, bearing: 0.7 },
             sigma: Some((0.1, 0.02)),

@@ -155,7 +155,7 @@ mod tests {
             up_image: Some(image),
             ..Default::default()
         };
-        frame.sightings[0] = Some(Sighting { distance: 2.0, bearing: 0.1 });
+        frame.sightings[mrt_msgs::sighting::BALL] = Some(Sighting { distance: 2.0, bearing: 0.1 });
         let header = MsgHeader {
             msg_type: CameraFrame::TYPE,
             member_id: mrt_core::MemberId(1),

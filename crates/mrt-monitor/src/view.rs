@@ -652,7 +652,8 @@ mod tests {
             PlannedPath { poses: vec![Pose2::new(500.0, -250.0, 0.0)], ..Default::default() };
         t.ingest("/away/0/PlannedPath", at(0.0), &json(&path));
         let mut seen = Percepts { line_points: vec![(1.0, -0.5)], ..Default::default() };
-        seen.sightings[0] = Some(Sighting { distance: 2.0, bearing: std::f64::consts::FRAC_PI_2 });
+        seen.sightings[mrt_msgs::sighting::BALL] =
+            Some(Sighting { distance: 2.0, bearing: std::f64::consts::FRAC_PI_2 });
         t.ingest("/away/0/Percepts", at(0.0), &json(&seen));
         t.ingest("/away/0/SonarScan", at(0.0), b"{}");
         assert_eq!(t.end(), 0, "the instant is still open");

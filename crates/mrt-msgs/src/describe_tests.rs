@@ -290,8 +290,8 @@ fn robot_sighting() -> RobotSighting {
 
 fn filled_camera() -> CameraFrame {
     let mut sightings = [None; FIELD_OBJECTS];
-    sightings[lps::BALL] = Some(sighting());
-    sightings[lps::LANDMARK0] = Some(sighting());
+    sightings[sighting::BALL] = Some(sighting());
+    sightings[sighting::LANDMARK0] = Some(sighting());
     CameraFrame {
         time: 3.25,
         sightings,
@@ -432,9 +432,9 @@ impl Samples for Localization {
 impl Samples for Percepts {
     fn samples() -> Vec<Self> {
         let mut filled = Percepts { time: 3.25, ..Percepts::default() };
-        filled.sightings[lps::BALL] = Some(sighting());
-        filled.sigmas[lps::BALL] = Some((0.02, 0.01));
-        filled.pixels[lps::BALL] = 120;
+        filled.sightings[sighting::BALL] = Some(sighting());
+        filled.sigmas[sighting::BALL] = Some((0.02, 0.01));
+        filled.pixels[sighting::BALL] = 120;
         filled.line_points = vec![(1.0, 0.5), (1.2, 0.5)];
         filled.robots = vec![robot_sighting()];
         let post =

@@ -61,6 +61,7 @@ pub use robot::{
     lps, AnchoredRobot, Estimate, Field, GameState, Lpo, Mate, RobotClass, RobotCommand, ScareJob,
     Target, WorldSnapshot,
 };
+pub use sensing::sighting;
 pub use sensing::{
     CameraFrame, DetectionKind, Displacement, GameInfo, Image, ImageDetection, ImageDetections,
     Marker, MiceReadings, Odometry, Percepts, PostSighting, RobotSighting, Sighting, Sonar,

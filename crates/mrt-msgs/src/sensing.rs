@@ -128,8 +128,39 @@ pub struct Odometry {
     pub placed: Option<Framed<Field, Pose2>>,
 }
 
-/// How many objects the camera knows: the ball, two nets, six landmarks (as many as LPS slots).
-pub const FIELD_OBJECTS: usize = lps::COUNT;
+/// Indices into [`CameraFrame::sightings`] and [`Percepts::sightings`]: the objects a camera
+/// tells apart by colour (ISocRob-2000 report §3.2.1), in the one order every part of MRT
+/// uses. The field map says where each stands (`mrt_world::field::FieldMap::object`).
+pub mod sighting {
+    /// The ball.
+    pub const BALL: usize = 0;
+    /// The east net (the centre of its goal line).
+    pub const EAST_NET: usize = 1;
+    /// The west net.
+    pub const WEST_NET: usize = 2;
+    /// The corner post at the north-east corner, the first landmark.
+    pub const NE_CORNER: usize = 3;
+    /// The corner post at the south-east corner.
+    pub const SE_CORNER: usize = 4;
+    /// The corner post at the north-west corner.
+    pub const NW_CORNER: usize = 5;
+    /// The corner post at the south-west corner.
+    pub const SW_CORNER: usize = 6;
+    /// The post at the north end of the half-way line.
+    pub const NORTH_HALFWAY: usize = 7;
+    /// The post at the south end of the half-way line, the last landmark.
+    pub const SOUTH_HALFWAY: usize = 8;
+    /// The first landmark: landmarks are `LANDMARK0..COUNT`.
+    pub const LANDMARK0: usize = NE_CORNER;
+    /// How many objects the camera knows.
+    pub const COUNT: usize = SOUTH_HALFWAY + 1;
+}
+
+/// How many objects the camera knows: the ball, two nets, six landmarks ([`sighting`]).
+pub const FIELD_OBJECTS: usize = sighting::COUNT;
+
+// The world model anchors each sighting in an LPS slot of the same index.
+const _: () = assert!(FIELD_OBJECTS == lps::COUNT && sighting::LANDMARK0 == lps::LANDMARK0);
 
 /// One object detected in one frame: distance (m) and bearing (rad, counter-clockwise from
 /// the robot's heading), with the sensor's noise.

@@ -635,7 +635,7 @@ fn fixed_things(map: &FieldMap, cfg: &SimConfig) -> Vec<Thing> {
         cuboid(x(hl, hl + t), -gw, gw, gh - t); // crossbar
     }
     let (r, top) = (cfg.render.post_radius, cfg.render.post_height);
-    for k in 3..mrt_msgs::FIELD_OBJECTS {
+    for k in mrt_msgs::sighting::LANDMARK0..mrt_msgs::FIELD_OBJECTS {
         let Some(p) = map.object(k) else { continue };
         let (outer, inner) = if map.east_pattern(k) == Some(true) {
             (palette::YELLOW, palette::BLUE)

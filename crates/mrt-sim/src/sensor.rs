@@ -13,8 +13,7 @@ use crate::referee::Referee;
 use crate::world::{Drive, World};
 use mrt_core::frames::{Field, Framed};
 use mrt_core::{normalize_angle, Pose2};
-use mrt_msgs::robot::lps;
-use mrt_msgs::MiceReadings;
+use mrt_msgs::{sighting, MiceReadings};
 use mrt_perception::mice::MiceOdometry;
 use mrt_plan::guidance::Sonar;
 use mrt_plan::kinematics::Twist;
@@ -161,9 +160,9 @@ pub fn look(
         // The truth, in the robot's frame: what a perfect camera would measure.
         let (dist, bearing) = Framed::<Field, _>::new(me)
             .range_bearing(Framed::new(mrt_core::Point2::new(target.0, target.1)));
-        let occluded =
-            k == lps::BALL && robots.iter().any(|&(_, c)| blocks((me.x, me.y), target, c, r_robot));
-        let range = if k == lps::BALL { cfg.range } else { cfg.landmark_range };
+        let occluded = k == sighting::BALL
+            && robots.iter().any(|&(_, c)| blocks((me.x, me.y), target, c, r_robot));
+        let range = if k == sighting::BALL { cfg.range } else { cfg.landmark_range };
         let visible = dist <= range && in_view(bearing) && !occluded;
         let missed = rng.random_bool(miss);
         if visible && !missed {
@@ -325,10 +324,7 @@ mod tests {
         (w, r)
     }
 
-    /// Field objects in sensor order.
-    const EAST_NET: usize = 1;
-    const WEST_NET: usize = 2;
-    const NW_CORNER: usize = 5;
+    use mrt_msgs::sighting::{EAST_NET, NW_CORNER, WEST_NET};
 
     #[test]
     fn distance_and_bearing_of_what_the_camera_sees() {
@@ -339,7 +335,7 @@ mod tests {
         w.place_robot(1, Pose2::new(-2.0, 0.0, std::f64::consts::FRAC_PI_2));
         w.place_ball(0.0, 2.0);
         let f = look(&w, 1, 0.0, &exact(), |_| Marker::Cyan, &mut rng);
-        let ball = f.sightings[lps::BALL].unwrap();
+        let ball = f.sightings[sighting::BALL].unwrap();
         assert!((ball.distance - 2.828427).abs() < 1e-5, "{ball:?}");
         assert!((ball.bearing + std::f64::consts::FRAC_PI_4).abs() < 1e-6, "{ball:?}"); // f32
                                                                                         // The west net (-9, 0) is 7 m away on the left (bearing +π/2); the east net is 11 m
@@ -360,7 +356,7 @@ mod tests {
         assert_eq!(g.kickoff_pose.map(|p| p.inner), r.kickoff_pose(1));
         assert_eq!(f.time, w.time());
         // No velocity, though the ball is seen: a camera does not measure one.
-        assert!(f.sightings[lps::BALL].is_some());
+        assert!(f.sightings[sighting::BALL].is_some());
         assert_eq!(f.ball_velocity, None);
     }
 
@@ -370,12 +366,11 @@ mod tests {
         let mut rng = ChaCha8Rng::seed_from_u64(2);
         w.place_robot(1, Pose2::new(-3.0, 0.0, 0.0));
         w.place_ball(0.0, 0.0);
-        assert!(
-            look(&w, 1, 0.0, &exact(), |_| Marker::Cyan, &mut rng).sightings[lps::BALL].is_some()
-        );
+        assert!(look(&w, 1, 0.0, &exact(), |_| Marker::Cyan, &mut rng).sightings[sighting::BALL]
+            .is_some());
         w.place_robot(6, Pose2::new(-1.5, 0.05, 0.0)); // in the line of sight
         let hidden = look(&w, 1, 0.0, &exact(), |_| Marker::Cyan, &mut rng);
-        assert_eq!((hidden.sightings[lps::BALL], hidden.ball_velocity), (None, None));
+        assert_eq!((hidden.sightings[sighting::BALL], hidden.ball_velocity), (None, None));
         assert!(hidden.sightings[WEST_NET].is_some(), "landmarks stand above the robots");
     }
 
@@ -387,14 +382,14 @@ mod tests {
         w.place_robot(1, Pose2::new(-5.0, 0.0, std::f64::consts::PI)); // facing west
         w.place_ball(-1.0, 0.0);
         let f = look(&w, 1, 0.0, &cfg, |_| Marker::Cyan, &mut rng);
-        assert_eq!(f.sightings[lps::BALL], None, "4 m behind the robot");
+        assert_eq!(f.sightings[sighting::BALL], None, "4 m behind the robot");
         assert!(f.sightings[WEST_NET].is_some(), "west net 4 m ahead");
         assert_eq!(f.sightings[EAST_NET], None, "east net 14 m behind");
         assert_eq!(f.sightings[NW_CORNER], None, "corner (-9, 6): 7.2 m, out of range");
         // The pan joint turned half round: the camera looks east, at the ball, and the
         // bearing stays in the robot's frame.
         let turned = look(&w, 1, std::f64::consts::PI, &cfg, |_| Marker::Cyan, &mut rng);
-        let ball = turned.sightings[lps::BALL].expect("the ball is in view");
+        let ball = turned.sightings[sighting::BALL].expect("the ball is in view");
         assert!((ball.bearing.abs() - std::f64::consts::PI).abs() < 1e-6, "{ball:?}");
         assert_eq!(turned.sightings[WEST_NET], None, "now behind the camera");
     }
@@ -489,7 +484,7 @@ mod tests {
             let mut rng = ChaCha8Rng::seed_from_u64(seed);
             (0..400)
                 .filter_map(|_| {
-                    look(&w, 1, 0.0, &cfg, |_| Marker::Cyan, &mut rng).sightings[lps::BALL]
+                    look(&w, 1, 0.0, &cfg, |_| Marker::Cyan, &mut rng).sightings[sighting::BALL]
                 })
                 .map(|s| s.distance * 1000.0)
                 .collect::<Vec<_>>()

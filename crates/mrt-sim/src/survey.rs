@@ -247,7 +247,7 @@ pub fn survey(cfg: &SimConfig, seed: u64, scenes: usize) -> Result<SurveyReport,
         // The ball.
         let truth =
             [(sight(viewer, ball.0, ball.1), visible("ball", ball.0, ball.1, cfg.ball.radius))];
-        ball_t.add(&truth, p.sightings[0].as_slice());
+        ball_t.add(&truth, p.sightings[mrt_msgs::sighting::BALL].as_slice());
         // The nets (the centres of the goal lines): in view when the feet of both posts of
         // the goal are.
         for k in [1, 2] {
@@ -258,7 +258,7 @@ pub fn survey(cfg: &SimConfig, seed: u64, scenes: usize) -> Result<SurveyReport,
             net_t.add(&[(sight(viewer, at.x, at.y), seen_whole)], p.sightings[k].as_slice());
         }
         // The landmark posts, at their feet.
-        let truth: Vec<(Sighting, bool)> = (3..mrt_msgs::FIELD_OBJECTS)
+        let truth: Vec<(Sighting, bool)> = (mrt_msgs::sighting::LANDMARK0..mrt_msgs::FIELD_OBJECTS)
             .filter_map(|k| map.object(k))
             .map(|at| (sight(viewer, at.x, at.y), visible("post", at.x, at.y, 0.0)))
             .collect();

@@ -21,7 +21,7 @@ impl Brain for Needs {
 
 /// The south-east corner post: the second landmark of the field map (team frame of the home
 /// team in the first half, which attacks east).
-const SE_CORNER: usize = lps::LANDMARK0 + 1;
+use mrt_msgs::sighting::SE_CORNER;
 
 fn config(gaze: bool) -> SimConfig {
     let mut cfg = SimConfig::oracle();

@@ -4,6 +4,7 @@
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
 use mrt_core::Pose2;
+use mrt_msgs::sighting::{BALL, EAST_NET, WEST_NET};
 use mrt_msgs::Image;
 use mrt_perception::vision::blobs::{find_ball, BallPercept};
 use mrt_perception::vision::colors::{ColorClass, ColorTable, Lut};
@@ -295,16 +296,16 @@ fn the_vision_agent_finds_ball_nets_and_robots_in_a_rendered_frame() {
     let image = renderer.render(&scene, me, 0.0, None, &mut CameraState::default());
     let p = agent.see(&image, 3.0, 0.0).unwrap();
     assert_eq!(p.time, 3.0);
-    let ball = p.sightings[0].expect("the ball");
+    let ball = p.sightings[BALL].expect("the ball");
     let (d, b) = truth(me, 6.5, 0.0);
     assert!((ball.distance - d).abs() < 0.05 * d && (ball.bearing - b).abs() < 0.026, "{ball:?}");
-    let net = p.sightings[1].expect("the east net");
+    let net = p.sightings[EAST_NET].expect("the east net");
     let (d, b) = truth(me, 9.0, 0.0);
     // The posts' feet, or the back corners seen past them: within the goal's depth (0.6 m).
     assert!((net.distance - d).abs() < 0.6 && (net.bearing - b).abs() < 0.1, "{net:?} vs {d} {b}");
-    assert!(p.sightings[2].is_none(), "the west net is behind");
-    assert!(p.sigmas[0].is_some_and(|(sd, sb)| sd > 0.0 && sd < 0.1 && sb > 0.0));
-    assert!(p.pixels[0] > 50);
+    assert!(p.sightings[WEST_NET].is_none(), "the west net is behind");
+    assert!(p.sigmas[BALL].is_some_and(|(sd, sb)| sd > 0.0 && sd < 0.1 && sb > 0.0));
+    assert!(p.pixels[BALL] > 50);
     // The opponent: its nearest point is its radius short of its centre, and its marker is
     // the away team's cyan.
     let (d, b) = truth(me, 7.0, 1.2);
@@ -324,10 +325,10 @@ fn the_vision_agent_finds_ball_nets_and_robots_in_a_rendered_frame() {
     let back = Pose2::new(-5.0, -0.5, std::f64::consts::PI);
     let image = renderer.render(&Scene::default(), back, 0.0, None, &mut CameraState::default());
     let p = agent.see(&image, 3.1, 0.0).unwrap();
-    let net = p.sightings[2].expect("the west net");
+    let net = p.sightings[WEST_NET].expect("the west net");
     let (d, b) = truth(back, -9.0, 0.0);
     assert!((net.distance - d).abs() < 0.6 && (net.bearing - b).abs() < 0.1, "{net:?} vs {d} {b}");
-    assert!(p.sightings[0].is_none() && p.sightings[1].is_none());
+    assert!(p.sightings[BALL].is_none() && p.sightings[EAST_NET].is_none());
     // An image of the wrong size is refused, not read.
     let small = mrt_msgs::Image::new(10, 10);
     assert!(agent.see(&small, 0.0, 0.0).is_err());
@@ -360,7 +361,10 @@ fn a_goal_cut_by_the_image_side_gives_the_corner_in_view() {
     for (me, (x, y), east) in cases {
         let image = renderer.render(&Scene::default(), me, 0.0, None, &mut CameraState::default());
         let p = agent.see(&image, 0.0, 0.0).unwrap();
-        assert!(p.sightings[1].is_none() && p.sightings[2].is_none(), "no net from {me:?}");
+        assert!(
+            p.sightings[EAST_NET].is_none() && p.sightings[WEST_NET].is_none(),
+            "no net from {me:?}"
+        );
         assert_eq!(p.goal_corners.len(), 1, "from {me:?}: {:?}", p.goal_corners);
         let c = p.goal_corners[0];
         let (d, b) = relative(me, x, y);
@@ -376,7 +380,7 @@ fn a_goal_cut_by_the_image_side_gives_the_corner_in_view() {
     let me = Pose2::new(4.0, 0.3, 0.0);
     let image = renderer.render(&Scene::default(), me, 0.0, None, &mut CameraState::default());
     let p = agent.see(&image, 0.0, 0.0).unwrap();
-    assert!(p.sightings[1].is_some() && p.goal_corners.is_empty(), "{p:?}");
+    assert!(p.sightings[EAST_NET].is_some() && p.goal_corners.is_empty(), "{p:?}");
 }
 
 /// The open space (seed `003` eq. 18) on a rendered frame: an empty goal's is in its mouth;
@@ -592,14 +596,14 @@ fn the_up_camera_gives_the_ball_the_front_camera_cannot_see() {
         let scene = Scene { ball: Some((viewer.x + d * c, viewer.y + d * s)), robots: vec![] };
         let a = front.render(&scene, viewer, 0.0, None, &mut CameraState::default());
         let b = up.render(&scene, viewer, 0.0, None, &mut CameraState::default());
-        assert!(agent.see(&a, 0.0, 0.0).unwrap().sightings[0].is_some() == (bearing == 0.0));
+        assert!(agent.see(&a, 0.0, 0.0).unwrap().sightings[BALL].is_some() == (bearing == 0.0));
         let p = agent.see_with_up(&a, Some(&b), 0.0, 0.0).unwrap();
-        let ball = p.sightings[0].unwrap_or_else(|| panic!("the ball at {bearing} rad"));
+        let ball = p.sightings[BALL].unwrap_or_else(|| panic!("the ball at {bearing} rad"));
         assert!((ball.distance - d).abs() < 0.05 * d, "{ball:?}");
         let off = (ball.bearing - bearing + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU)
             - std::f64::consts::PI;
         assert!(off.abs() < 1.5f64.to_radians(), "{ball:?}");
-        assert!(p.sigmas[0].is_some() && p.pixels[0] > 0);
+        assert!(p.sigmas[BALL].is_some() && p.pixels[BALL] > 0);
     }
     // An up image of the wrong size is refused, not misread.
     let small = mrt_msgs::Image::new(10, 10);

@@ -4,19 +4,17 @@
 //!
 //! The landmarks are the objects the camera tells apart by colour (ISocRob seed `003`
 //! §3.2.1: the two goals, the corner posts, the posts at the ends of the half-way line), in the
-//! order of the camera's sightings ([`mrt_msgs::CameraFrame::sightings`]): after the ball,
-//! [`EAST_NET`], [`WEST_NET`], then the four corners (NE, SE, NW, SW) and the north and south
-//! ends of the half-way line. This table exists once: the simulator computes what a camera
+//! order of the camera's sightings ([`mrt_msgs::sighting`]): after the ball, the east and the
+//! west net, then the four corners (NE, SE, NW, SW) and the north and south ends of the
+//! half-way line. This table exists once: the simulator computes what a camera
 //! sees from it, and the world model corrects its pose with it.
 
 use mrt_core::{Point2, Vec2};
+use mrt_msgs::sighting::{
+    EAST_NET, NE_CORNER, NORTH_HALFWAY, NW_CORNER, SE_CORNER, SOUTH_HALFWAY, SW_CORNER, WEST_NET,
+};
 use mrt_msgs::{Field, FIELD_OBJECTS};
 use serde::{Deserialize, Serialize};
-
-/// Camera sighting index of the east net (the centre of its goal line).
-pub const EAST_NET: usize = 1;
-/// Camera sighting index of the west net.
-pub const WEST_NET: usize = 2;
 
 /// A straight field line, from `a` to `b` (m, field frame).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -103,12 +101,12 @@ impl FieldMap {
         let at = match k {
             EAST_NET => (hl, 0.0),
             WEST_NET => (-hl, 0.0),
-            3 => (hl, hw),
-            4 => (hl, -hw),
-            5 => (-hl, hw),
-            6 => (-hl, -hw),
-            7 => (0.0, hw),
-            8 => (0.0, -hw),
+            NE_CORNER => (hl, hw),
+            SE_CORNER => (hl, -hw),
+            NW_CORNER => (-hl, hw),
+            SW_CORNER => (-hl, -hw),
+            NORTH_HALFWAY => (0.0, hw),
+            SOUTH_HALFWAY => (0.0, -hw),
             _ => return None,
         };
         Some(Point2::new(at.0, at.1))

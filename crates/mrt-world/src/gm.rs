@@ -648,7 +648,7 @@ impl FuzzyGrid {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::field::EAST_NET;
+    use mrt_msgs::sighting::EAST_NET;
     use proptest::prelude::*;
     use std::f64::consts::FRAC_PI_2;
 

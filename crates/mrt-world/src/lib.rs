@@ -15,7 +15,7 @@
 //! ```
 //! use mrt_core::frames::Framed;
 //! use mrt_core::Pose2;
-//! use mrt_msgs::{CameraFrame, GameInfo, GameState, Sighting, lps};
+//! use mrt_msgs::{sighting, CameraFrame, GameInfo, GameState, Sighting, lps};
 //! use mrt_perception::mice::MiceOdometry;
 //! use mrt_world::{field::FieldMap, model::WorldModel};
 //!
@@ -26,8 +26,8 @@
 //! // The camera sees the east net 9 m straight ahead and the ball 2 m to the front left.
 //! model.game(GameInfo { state: GameState::Playing, attack: 1.0, kickoff_pose: None, marker: None });
 //! let mut frame = CameraFrame::default();
-//! frame.sightings[mrt_world::field::EAST_NET] = Some(Sighting { distance: 9.0, bearing: 0.0 });
-//! frame.sightings[lps::BALL] = Some(Sighting { distance: 2.0, bearing: 0.5 });
+//! frame.sightings[mrt_msgs::sighting::EAST_NET] = Some(Sighting { distance: 9.0, bearing: 0.0 });
+//! frame.sightings[sighting::BALL] = Some(Sighting { distance: 2.0, bearing: 0.5 });
 //! let w = model.camera(&frame);
 //! assert!((w.lps[lps::BALL].rho - 2000.0).abs() < 1e-6, "LPS distances are in mm");
 //! assert_eq!(w.lps[lps::BALL].reliability, 1.0);

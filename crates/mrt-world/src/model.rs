@@ -40,7 +40,7 @@ use mrt_core::frames::{Attack, Field, Framed, Team, MM_PER_M};
 use mrt_core::{normalize_angle, Point2, Pose2, Time, Vec2};
 use mrt_msgs::robot::{lps, AnchoredRobot, Estimate, Lpo, WorldSnapshot};
 use mrt_msgs::{
-    BallBelief, CameraFrame, GameInfo, Localization, Odometry, Percepts, PostSighting,
+    sighting, BallBelief, CameraFrame, GameInfo, Localization, Odometry, Percepts, PostSighting,
     RobotSighting, Sighting, Sonar, SonarScan, FIELD_OBJECTS,
 };
 use mrt_perception::mice::{Displacement, MiceOdometry};
@@ -595,7 +595,8 @@ impl WorldModel {
         let perceived = self.global().then(|| {
             relocalize::perceptions(&self.map, self.noise, FrameSeen::of(&frame.sightings))
         });
-        let velocity = frame.sightings[lps::BALL].map(|z| self.track_ball(frame.time, &z, None));
+        let velocity =
+            frame.sightings[sighting::BALL].map(|z| self.track_ball(frame.time, &z, None));
         let robots = &frame.robots;
         let frame_pan = frame.pan;
         let frame = CameraFrame {
@@ -679,9 +680,9 @@ impl WorldModel {
             let (s, c) = self.pose.theta.sin_cos();
             (c * vx - s * vy, s * vx + c * vy)
         });
-        if let Some(z) = frame.sightings[lps::BALL] {
+        if let Some(z) = frame.sightings[sighting::BALL] {
             // How sure the ball's place is: the sighting's error and the corrected pose's.
-            let sd = self.noise.sigma(z.distance, sigmas[lps::BALL]);
+            let sd = self.noise.sigma(z.distance, sigmas[sighting::BALL]);
             let (_, r) = self.sighted_at(z.distance, z.bearing, sd);
             self.ball_seen_sigma = (r.trace() / 2.0).max(0.0).sqrt();
         }
@@ -809,8 +810,8 @@ impl WorldModel {
                 self.counts.posts_named += 1;
             }
         }
-        frame.ball_velocity =
-            p.sightings[lps::BALL].map(|z| self.track_ball(p.time, &z, p.sigmas[lps::BALL]));
+        frame.ball_velocity = p.sightings[sighting::BALL]
+            .map(|z| self.track_ball(p.time, &z, p.sigmas[sighting::BALL]));
         self.observe(&frame, &sigmas, &p.robots, p.pan, perceived, &p.line_points)
     }
 
@@ -1098,7 +1099,7 @@ mod tests {
         }
         // One net reported 3 m too close: gated out, the pose does not move.
         let mut bad = frame(truth, 0.3, &landmarks());
-        if let Some(s) = &mut bad.sightings[1] {
+        if let Some(s) = &mut bad.sightings[sighting::EAST_NET] {
             s.distance -= 3.0;
         }
         m.odometry(&exact_mice(Pose2::default()));
@@ -1582,7 +1583,7 @@ mod tests {
         // The frame at `time` with the east net seen at `net` and the touch line's points.
         let with_net = |time: f64, net: (f64, f64)| Percepts {
             time,
-            sightings: frame(truth, time, &[(crate::field::EAST_NET, net)]).sightings,
+            sightings: frame(truth, time, &[(mrt_msgs::sighting::EAST_NET, net)]).sightings,
             line_points: touch.clone(),
             ..Default::default()
         };

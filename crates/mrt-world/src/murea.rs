@@ -56,8 +56,9 @@
 //! assert!(fix.quality > 0.9, "rounded distances and bearings fit almost exactly");
 //! ```
 
-use crate::field::{FieldMap, Segment, EAST_NET, WEST_NET};
+use crate::field::{FieldMap, Segment};
 use mrt_core::{normalize_angle, Point2, Pose2};
+use mrt_msgs::sighting::{EAST_NET, WEST_NET};
 use mrt_msgs::FIELD_OBJECTS;
 use std::cmp::Ordering;
 use std::collections::BinaryHeap;

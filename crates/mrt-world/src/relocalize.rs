@@ -559,7 +559,7 @@ impl Relocalizer {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::field::{EAST_NET, WEST_NET};
+    use mrt_msgs::sighting::{EAST_NET, WEST_NET};
 
     const NOISE: CameraNoise = CameraNoise { distance: 0.03, bearing: 0.02 };
 

@@ -19,16 +19,12 @@ use super::lines::line_points;
 use super::posts::{find_posts_in, PostPercept, PostShape};
 use super::up::UpMode;
 use crate::camera::{Camera, Omni, Pinhole, Pixel};
+use mrt_msgs::sighting::{BALL, EAST_NET, WEST_NET};
 use mrt_msgs::{
     DetectionKind, Image, ImageDetection, ImageDetections, Marker, Percepts, PostSighting,
     RobotSighting, Sighting,
 };
 use nalgebra::{Point2, Point3, Vector2};
-
-/// Sighting index of the ball, the east and the west net (the world model's order).
-const BALL: usize = 0;
-const EAST_NET: usize = 1;
-const WEST_NET: usize = 2;
 
 /// Pixels a goal must show to count.
 pub const MIN_GOAL_PIXELS: u32 = 30;
