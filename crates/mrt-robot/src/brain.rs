@@ -23,30 +23,6 @@ pub trait Brain {
     }
 }
 
-/// A robot whose software could not start (a behavior file that does not load, ...): it stands
-/// still for the whole match, and its reason is booked once.
-#[derive(Debug)]
-pub struct Stopped {
-    reason: Option<String>,
-}
-
-impl Stopped {
-    /// A robot stopped for `reason`.
-    pub fn new(reason: impl Into<String>) -> Stopped {
-        Stopped { reason: Some(reason.into()) }
-    }
-}
-
-impl Brain for Stopped {
-    fn cycle(&mut self, _world: &WorldSnapshot) -> RobotCommand {
-        RobotCommand::default()
-    }
-
-    fn take_faults(&mut self) -> Vec<String> {
-        self.reason.take().into_iter().collect()
-    }
-}
-
 /// Runs any `Send` [`Brain`] as a behavior Member: world snapshot in, command out, and the
 /// brain's faults as a [`BehaviorStatus`] for the robot's fault book.
 pub struct BrainMember {

@@ -13,15 +13,13 @@
 //! TeamChaos tuned its behaviors for AIBO walking speeds (about 0.3 m/s); on a Middle Size
 //! League base the Chaos brain's [`Commander`] adapts them to the body.
 
-use crate::brain::{Brain, Stopped};
-use crate::commander::Commander;
+use crate::brain::Brain;
 use crate::config::RobotConfig;
 use crate::files::FilesDir;
 use mrt_core::{Point2, Pose2};
 use mrt_fuzzy::brian::Brian;
 use mrt_msgs::robot::{lps, Field, GameState, Lpo, RobotCommand, Target, WorldSnapshot};
 use mrt_plan::guidance::behind_ball;
-use mrt_script::{Sandbox, ThinkingCap, Watchdog, SIMULATED_DEADLINE};
 use std::path::Path;
 
 /// A behavior stack.
@@ -229,59 +227,6 @@ pub const CHAOS_KEEPER: &str = "goalkeeper";
 /// The Chaos field players' machine file.
 pub const CHAOS_PLAYER: &str = "player.hfsm.lua";
 
-/// A robot driven by ThinkingCap, under the [`Watchdog`]: a behavior that blocks past the
-/// deadline stops this robot (reported), never the match.
-pub struct ChaosBrain {
-    cap: Watchdog,
-    body: Commander,
-    faults: Vec<String>,
-    /// Keeps compiled-in files on disk while the robot may reload them.
-    _files: FilesDir,
-}
-
-impl ChaosBrain {
-    /// The goalkeeper (`goalkeeper.lua`) or a field player (`player.hfsm.lua`) of `dir`, on
-    /// the robot of `cfg`.
-    pub fn new(dir: &FilesDir, keeper: bool, cfg: &RobotConfig) -> Result<ChaosBrain, String> {
-        let sandbox = Sandbox::default();
-        let path = dir.path().to_path_buf();
-        let name = if keeper { CHAOS_KEEPER } else { CHAOS_PLAYER };
-        // It plays on a simulated clock (tests, benches): the budget is its deadline.
-        let cap = Watchdog::start(name, SIMULATED_DEADLINE, move || {
-            if keeper {
-                ThinkingCap::with_behavior(&path, CHAOS_KEEPER, sandbox)
-            } else {
-                ThinkingCap::with_hfsm(&path, path.join(CHAOS_PLAYER), sandbox)
-            }
-        });
-        Ok(ChaosBrain {
-            cap: cap.map_err(|e| e.to_string())?,
-            body: Commander::chaos(cfg),
-            faults: Vec::new(),
-            _files: dir.clone(),
-        })
-    }
-}
-
-impl Brain for ChaosBrain {
-    fn cycle(&mut self, world: &WorldSnapshot) -> RobotCommand {
-        let mut seen = world.clone();
-        self.body.perceive(&mut seen);
-        let c = self.cap.cycle(seen);
-        // One fault per faulty cycle, named by its first error.
-        if let Some(e) = c.errors.first() {
-            self.faults.push(e.to_string());
-        }
-        let mut cmd = c.command;
-        self.body.act(&mut cmd);
-        cmd
-    }
-
-    fn take_faults(&mut self) -> Vec<String> {
-        std::mem::take(&mut self.faults)
-    }
-}
-
 /// A robot driven by Mr. BRIAN: the manual's Parser turns the world snapshot into crisp
 /// inputs `(name, value, reliability)`, the engine runs one cycle, the Messenger turns
 /// `SpeedModule`/`SpeedAngle` (a holonomic direction of motion), `Rotation` and `Kick` into
@@ -472,38 +417,20 @@ impl Brain for MilanBrain {
     }
 }
 
-/// The brains of one team of `size` robots (robot 0 keeps goal). `behaviors` overrides the
-/// compiled-in TeamChaos files.
-pub fn team(
-    stack: Stack,
-    cfg: &RobotConfig,
-    behaviors: Option<&Path>,
-) -> Result<Vec<Box<dyn Brain + Send>>, String> {
-    let size = cfg.team_size;
-    if stack != Stack::Chaos {
-        return (0..size).map(|i| send_brain(stack, i == 0)).collect();
-    }
-    let dir = match behaviors {
-        Some(d) => FilesDir::user(d),
-        None => embedded_teamchaos()?,
-    };
-    // A robot whose behaviors do not load stands still and is reported; the match goes on.
-    Ok((0..size)
-        .map(|i| match ChaosBrain::new(&dir, i == 0, cfg) {
-            Ok(b) => Box::new(b) as Box<dyn Brain + Send>,
-            Err(e) => Box::new(Stopped::new(e)),
-        })
-        .collect())
+/// The brains of one team of `size` robots (robot 0 keeps goal) of a stack that runs as a
+/// brain (Milan, the Chaser). TeamChaos and ISocRob run as Members of their own
+/// (`members::add_robot`).
+pub fn team(stack: Stack, cfg: &RobotConfig) -> Result<Vec<Box<dyn Brain + Send>>, String> {
+    (0..cfg.team_size).map(|i| send_brain(stack, i == 0)).collect()
 }
 
-/// The brain of a Milan or baseline robot (the goalkeeper when `keeper`). The Chaos stack
-/// needs its behavior files: a [`ChaosBrain`], or on the bus its behavior Member.
+/// The brain of a Milan or baseline robot (the goalkeeper when `keeper`).
 pub fn send_brain(stack: Stack, keeper: bool) -> Result<Box<dyn Brain + Send>, String> {
     match stack {
         Stack::Milan => Ok(Box::new(MilanBrain::new(&embedded_milan()?, keeper)?)),
         Stack::Chaser => Ok(Box::new(Chaser { keeper })),
         Stack::Chaos => {
-            Err("the Chaos stack runs in a Lua state (ChaosBrain, BehaviorMember)".into())
+            Err("the Chaos stack runs as its behavior Member (members::add_robot)".into())
         }
         Stack::Isocrob => {
             Err("an ISocRob robot needs its blackboard and Proxy (members::add_robot)".into())

@@ -7,7 +7,7 @@
 #![allow(missing_docs, clippy::unwrap_used)]
 
 use criterion::{criterion_group, criterion_main, Criterion};
-use mrt_robot::stacks::{team, Stack};
+use mrt_robot::stacks::Stack;
 use mrt_sim::bus::BusMatch;
 use mrt_sim::config::SimConfig;
 use mrt_sim::world::{Drive, World};
@@ -45,14 +45,6 @@ fn bench(c: &mut Criterion) {
         b.iter(|| {
             let stacks = (Stack::Chaos, Stack::Chaser);
             mrt_sim::play(&short, 1, stacks, None, false, |_| {}).unwrap()
-        })
-    });
-    g.bench_function("chaos_vs_chaser_brains", |b| {
-        b.iter(|| {
-            let robot = short.robot().unwrap();
-            let home = team(Stack::Chaos, &robot, None).unwrap();
-            let away = team(Stack::Chaser, &robot, None).unwrap();
-            BusMatch::with_brains(&short, 1, home, away).unwrap().play(|_| {}).unwrap()
         })
     });
     g.bench_function("milan_vs_chaos_bus", |b| {

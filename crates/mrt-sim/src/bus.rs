@@ -449,30 +449,9 @@ mod tests {
         assert!(faults[0].error.contains("dropped 3 and refused 1"), "{}", faults[0].error);
     }
 
-    /// A stack gives the same match whether it runs as its own Members (the TeamChaos
-    /// behavior Member) or as a brain in a `BrainMember` (`ChaosBrain`): the robot cycle
-    /// around it is the same.
-    #[test]
-    fn a_stack_plays_the_same_match_as_members_and_as_brains() {
-        let cfg = short(15.0, 2);
-        let members = BusMatch::new(&cfg, 9, Stack::Chaos, Some(Stack::Chaser), None)
-            .unwrap()
-            .play(|_| {})
-            .unwrap();
-        let robot = cfg.robot().unwrap();
-        let home = mrt_robot::stacks::team(Stack::Chaos, &robot, None).unwrap();
-        let away = mrt_robot::stacks::team(Stack::Chaser, &robot, None).unwrap();
-        let brains = BusMatch::with_brains(&cfg, 9, home, away).unwrap().play(|_| {}).unwrap();
-        assert_eq!(
-            (members.score, members.trajectory_hash),
-            (brains.score, brains.trajectory_hash)
-        );
-    }
-
     /// Bad behavior files never stop a match: a file that does not compile stops the robots
     /// that load it (they stand still), a behavior that runs away is cut off by its budget;
-    /// both are reported with the file and line, whether the stack runs as its Members or as
-    /// brains.
+    /// both are reported with the file and line.
     #[test]
     fn broken_or_runaway_behaviors_stop_their_robot_and_are_reported() {
         let tmp = std::env::temp_dir().join(format!("mrt-sim-broken-{}", std::process::id()));
@@ -497,18 +476,12 @@ mod tests {
             .unwrap()
             .play(|_| {})
             .unwrap();
-        let robot = cfg.robot().unwrap();
-        let home = mrt_robot::stacks::team(Stack::Chaos, &robot, Some(&broken)).unwrap();
-        let away = mrt_robot::stacks::team(Stack::Chaser, &robot, None).unwrap();
-        let brains = BusMatch::with_brains(&cfg, 1, home, away).unwrap().play(|_| {}).unwrap();
-        for r in [&bus, &brains] {
-            assert!((r.duration - 10.0).abs() < 0.011, "the match went on: {}", r.duration);
-            let robots: Vec<usize> = r.faults.iter().map(|f| f.robot).collect();
-            assert_eq!(robots, [0, 1], "{:?}", r.faults);
-            assert!(r.faults.iter().all(|f| f.message.contains(&want)), "{:?}", r.faults);
-            assert!(r.faults.iter().all(|f| f.first_at == Some(0.0)), "from the start");
-            assert_eq!(r.stats[0].shots, 0, "stopped robots do not play");
-        }
+        assert!((bus.duration - 10.0).abs() < 0.011, "the match went on: {}", bus.duration);
+        let robots: Vec<usize> = bus.faults.iter().map(|f| f.robot).collect();
+        assert_eq!(robots, [0, 1], "{:?}", bus.faults);
+        assert!(bus.faults.iter().all(|f| f.message.contains(&want)), "{:?}", bus.faults);
+        assert!(bus.faults.iter().all(|f| f.first_at == Some(0.0)), "from the start");
+        assert_eq!(bus.stats[0].shots, 0, "stopped robots do not play");
         // 2. A goalkeeper behavior that never ends: the budget cuts it off every cycle.
         let looping = tmp.join("looping");
         copy(&looping);
