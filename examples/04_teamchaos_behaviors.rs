@@ -9,7 +9,7 @@
 //! the opponent's net and kicks.
 //!
 //! Half-way, the example **edits `go2ball.lua` on disk** (slow instead of fast) and the robot
-//! walks slower from the next cycle on, without a restart; then it saves a **broken** version,
+//! asks for a slower walk from the next cycle on, without a restart; then it saves a **broken** version,
 //! which is rejected with `file:line: message` while the robot keeps walking. Finally the
 //! goalkeeper (a hierarchy of 12 fuzzy behaviors) meets three situations.
 //!
@@ -93,9 +93,15 @@ impl Field {
         w
     }
 
-    /// Moves the robot as commanded for `dt` seconds (forward, sideways to the left, turning);
-    /// a kick sends the ball 5 m on.
+    /// Moves the robot as commanded for `dt` seconds (forward, sideways to the left, turning),
+    /// at most at a Middle Size base's top speeds (1.2 m/s, 4 rad/s), as guidance would; a
+    /// kick sends the ball 5 m on.
     fn advance(&mut self, vlin: f64, vlat: f64, vrot_deg: f64, kick: Option<i64>, dt: f64) {
+        let (top, top_turn) = (1200.0, 4f64.to_degrees());
+        let speed = vlin.hypot(vlat);
+        let slow = if speed > top { top / speed } else { 1.0 };
+        let (vlin, vlat, vrot_deg) =
+            (vlin * slow, vlat * slow, vrot_deg.clamp(-top_turn, top_turn));
         let theta = self.robot.theta + vrot_deg.to_radians() * dt;
         let (c, s) = (theta.cos(), theta.sin());
         let (x, y) =

@@ -230,9 +230,13 @@ function behindBall(d)
   return clampToField(x, y)
 end
 
--- The control variables at a Middle Size robot's speeds: the defaults are the seed's, for a
--- four-legged AIBO (go up to 0.3 m/s, turn 90 deg/s, strafe 0.2 m/s). The same labels, scaled,
--- so the rules read the same.
-scale("go", 4)
-scale("turn", 2)
-scale("strafe", 4)
+-- The control variables at a Middle Size robot's speeds, the one place they are adapted: the
+-- defaults are the seed's, for a four-legged AIBO (go up to 0.3 m/s, turn 90 deg/s, strafe
+-- 0.2 m/s). The same labels, scaled, so the rules read the same. The set-points they become
+-- (centroids): go FAST 4.8 m/s, SLOW 2.9 m/s; turn HARDLEFT 450 deg/s, LEFT 270 deg/s; strafe
+-- LEFT 1.9 m/s. The base drives at most 1.2 m/s and 4 rad/s (229 deg/s), so every label but
+-- STAY and NONE asks for its top speed: the team plays at full speed, and blends of STAY with
+-- a faster label slow it down near a target.
+scale("go", 19.2)
+scale("turn", 6)
+scale("strafe", 19.2)

@@ -2,40 +2,35 @@
 //! the body): how a team's behaviors are adapted to the robot they run on.
 //!
 //! TeamChaos tuned its behaviors for AIBO walking speeds (about 0.3 m/s) and the AIBO's head;
-//! on a Middle Size League base the Commander scales the behaviors' set-points and measures
-//! distances from a point ahead of the robot's centre, as the seed's Commander Module turned
-//! set-points into a walking style for its own body.
+//! on a Middle Size League base its `hbm.lua` scales the control variables (the one place the
+//! speeds are adapted), and the Commander measures distances from a point ahead of the robot's
+//! centre, as the seed's Commander Module turned set-points into a walking style for its own
+//! body.
 
 use crate::config::RobotConfig;
-use mrt_msgs::{RobotCommand, WorldSnapshot};
+use mrt_msgs::WorldSnapshot;
 
 /// How a team's behaviors are adapted to the robot's body: TeamChaos' Commander Module (seed
 /// `001` §2.1), which turned the behaviors' set-points into a walking style for the AIBO's
-/// legs. Here the world state shifts LPS distances ([`Commander::perceive`]) and guidance
-/// scales set-points ([`Commander::act`]).
+/// legs. Here the world state's LPS distances are shifted ([`Commander::perceive`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Commander {
     /// Subtracted from every LPS distance (mm).
     pub edge: f64,
-    /// Multiplies linear set-points.
-    pub linear: f64,
-    /// Multiplies turning set-points.
-    pub turn: f64,
 }
 
 impl Commander {
     /// No adaptation.
-    pub const PLAIN: Commander = Commander { edge: 0.0, linear: 1.0, turn: 1.0 };
+    pub const PLAIN: Commander = Commander { edge: 0.0 };
 
-    /// TeamChaos' behaviors on the configured robot: linear set-points ×4.8 (FAST, 250 mm/s,
-    /// becomes the base's 1.2 m/s) and turning ×3 (they were tuned for AIBO walking, about
-    /// 0.3 m/s); distances from a point ahead of the robot's centre chosen so that the
+    /// TeamChaos' behaviors on the configured robot: distances from a point ahead of the
+    /// robot's centre chosen so that the
     /// behaviors' "touching" (`TOUCHING` in `hbm.lua` reaches 0.5 at 250 mm, where `dokick`
     /// fires) falls 30 mm inside the kicker's reach: a kick never fires at a ball it cannot
     /// reach and wastes the valve's recharge.
     pub fn chaos(cfg: &RobotConfig) -> Commander {
         let reach = (cfg.radius + cfg.ball_radius + cfg.kick_reach) * 1000.0;
-        Commander { edge: (reach - 280.0).max(0.0), linear: 4.8, turn: 3.0 }
+        Commander { edge: (reach - 280.0).max(0.0) }
     }
 
     /// The camera driver's side: distances from the robot's edge.
@@ -43,12 +38,5 @@ impl Commander {
         for o in &mut w.lps {
             o.rho = (o.rho - self.edge).max(0.0);
         }
-    }
-
-    /// The motor driver's side: scaled set-points.
-    pub fn act(&self, cmd: &mut RobotCommand) {
-        cmd.vlin *= self.linear;
-        cmd.vlat *= self.linear;
-        cmd.vrot *= self.turn;
     }
 }

@@ -358,11 +358,10 @@ impl Member for GazeControl {
     }
 }
 
-/// Guidance of one robot: the behaviors' command, adapted to the body, through the Guidance
-/// µAgent with the latest world state and sonar scan.
+/// Guidance of one robot: the behaviors' command through the Guidance µAgent with the latest
+/// world state and sonar scan.
 struct Guide {
     robot: usize,
-    body: Commander,
     guidance: Guidance,
     world: WorldSnapshot,
     scan: SonarScan,
@@ -426,7 +425,6 @@ impl Member for Guide {
             }
         }
         if let Some(mut cmd) = last {
-            self.body.act(&mut cmd);
             let now = self.world.time.as_secs_f64();
             let (needs, played) =
                 (self.world.needs_localization, self.world.game_state == GameState::Playing);
@@ -661,7 +659,6 @@ fn add_cycle(
     };
     let guide = Guide {
         robot,
-        body: commander,
         guidance: cfg.guidance,
         world: WorldSnapshot::default(),
         scan: SonarScan::default(),

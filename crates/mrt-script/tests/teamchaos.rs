@@ -18,14 +18,14 @@ use mrt_script::{Cycle, Sandbox, ScriptError, ThinkingCap};
 use std::path::{Path, PathBuf};
 
 /// The team's `hbm.lua` scales the control variables to a Middle Size robot's speeds
-/// (`scale("go", 4)`, ...): the same labels as the defaults (the seed's, for a four-legged
+/// (`scale("go", 19.2)`, ...): the same labels as the defaults (the seed's, for a four-legged
 /// robot), stretched by these factors.
 /// Every hand computation below is done with the default labels, then scaled.
-const GO: f64 = 4.0;
+const GO: f64 = 19.2;
 /// `turn`'s scale (°/s).
-const TURN: f64 = 2.0;
+const TURN: f64 = 6.0;
 /// `strafe`'s scale (mm/s).
-const STRAFE: f64 = 4.0;
+const STRAFE: f64 = 19.2;
 
 fn dir() -> PathBuf {
     PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../../behaviors/teamchaos"))
@@ -660,6 +660,53 @@ fn copy_behaviors(to: &Path, names: &[&str]) {
     for n in names {
         std::fs::copy(dir().join(n), to.join(n)).unwrap();
     }
+}
+
+/// What each label of the team's control variables asks the base for: `hbm.lua`'s scales are
+/// the one place Chaos' AIBO-era speeds are adapted, so these are the set-points the robot
+/// cycle hands to guidance. Every label but STAY and NONE asks for more than the Middle Size
+/// base's top speed (1.2 m/s, 4 rad/s = 229 °/s), which guidance then drives at.
+#[test]
+fn the_labels_become_these_set_points_on_a_middle_size_base() {
+    let tmp =
+        std::env::temp_dir().join(format!("mrt-script-teamchaos-{}-labels", std::process::id()));
+    let _ = std::fs::remove_dir_all(&tmp);
+    std::fs::create_dir_all(&tmp).unwrap();
+    copy_behaviors(&tmp, &["hbm.lua"]);
+    // (variable, label, the command field, the set-point: mm/s or °/s)
+    let cases = [
+        ("go", "FAST", 4800.0),
+        ("go", "SLOW", 2880.0),
+        ("go", "STAY", 0.0),
+        ("go", "BACK", -4800.0),
+        ("turn", "HARDLEFT", 450.0),
+        ("turn", "LEFT", 270.0),
+        ("turn", "RIGHT", -270.0),
+        ("strafe", "LEFT", 1920.0),
+        ("strafe", "NONE", 0.0),
+    ];
+    for (variable, label, want) in cases {
+        let name = format!("{variable}_{label}").to_lowercase();
+        std::fs::write(
+            tmp.join(format!("{name}.lua")),
+            format!("always(\"{variable}\", \"{label}\")"),
+        )
+        .unwrap();
+        let mut cap = ThinkingCap::with_behavior(&tmp, &name, Sandbox::default()).unwrap();
+        let c = cap.cycle(World::at(0).0);
+        assert!(c.errors.is_empty(), "{name}: {:?}", c.errors);
+        let got = match variable {
+            "go" => c.command.vlin,
+            "turn" => c.command.vrot,
+            _ => c.command.vlat,
+        };
+        assert!((got - want).abs() < 1e-6 * want.abs().max(1.0), "{name}: {got}, want {want}");
+        if want != 0.0 {
+            let top = if variable == "turn" { 4f64.to_degrees() } else { 1200.0 };
+            assert!(got.abs() > top, "{name}: {got} is within the base's top speed {top}");
+        }
+    }
+    std::fs::remove_dir_all(&tmp).unwrap();
 }
 
 #[test]
