@@ -204,6 +204,7 @@ pub struct GuidanceSection {
 }
 
 impl Default for GuidanceSection {
+    /// 0.35 m from the centre (0.1 m from a 0.25 m robot's edge), ±30°.
     fn default() -> Self {
         GuidanceSection { safety_distance: 0.35, half_cone: std::f64::consts::PI / 6.0 }
     }

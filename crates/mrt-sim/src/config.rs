@@ -355,32 +355,14 @@ impl OdometryConfig {
     }
 }
 
-/// Guidance (ISocRob §3.2.3) between the behaviors and the motors.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(default, deny_unknown_fields)]
-pub struct GuidanceConfig {
-    /// Velocity mode halts the translation when a sonar within `half_cone` of the direction
-    /// of motion reads less than this, m from the robot's centre.
-    pub safety_distance: f64,
-    /// See `safety_distance`, radians.
-    pub half_cone: f64,
-}
-
-impl Default for GuidanceConfig {
-    /// 0.35 m from the centre (0.1 m from a 0.25 m robot's edge), ±30°.
-    fn default() -> Self {
-        Self { safety_distance: 0.35, half_cone: std::f64::consts::PI / 6.0 }
-    }
-}
-
 impl SimConfig {
     /// Robot `id`'s robot file in this world: its base, size, kicker reach, mice, camera noise,
     /// guidance and the field it plays on, from this world's sections, with `stack` driving it
     /// (what `mrt sim --distributed` gives each robot process).
     pub fn robot_file(&self, id: usize, stack: &str) -> mrt_robot::config::RobotFile {
         use mrt_robot::config::{
-            BodySection, DevicesSection, GazeSection, GuidanceSection, RobotFile, RobotSection,
-            SensorsSection, VisionSection,
+            BodySection, DevicesSection, GazeSection, RobotFile, RobotSection, SensorsSection,
+            VisionSection,
         };
         RobotFile {
             robot: RobotSection {
@@ -405,10 +387,7 @@ impl SimConfig {
                 ball_radius: self.ball.radius,
             },
             field: self.field.map(),
-            guidance: GuidanceSection {
-                safety_distance: self.guidance.safety_distance,
-                half_cone: self.guidance.half_cone,
-            },
+            guidance: self.guidance.clone(),
             devices: DevicesSection::default(),
             vision: VisionSection {
                 enabled: self.sensor.percepts == PerceptSource::Vision,
@@ -452,8 +431,8 @@ pub struct SimConfig {
     pub sensor: SensorConfig,
     /// The sonar ring.
     pub sonar: SonarConfig,
-    /// Guidance.
-    pub guidance: GuidanceConfig,
+    /// Guidance: the robot file's `[guidance]` section, for every robot.
+    pub guidance: mrt_robot::config::GuidanceSection,
     /// The odometry sensors.
     pub odometry: OdometryConfig,
     /// Every robot's camera: a camera file's keys (`mrt_perception::camera::CameraFile`;
