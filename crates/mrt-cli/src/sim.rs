@@ -78,7 +78,7 @@ pub struct SimArgs {
     /// series) or vision (every camera renders images, the robots' vision µAgent finds the
     /// ball and the goals in them). Default: the configuration's `[sensor] percepts`.
     #[arg(long, value_enum)]
-    pub percepts: Option<Percepts>,
+    pub percepts: Option<PerceptsArg>,
     /// Which estimator keeps each robot's pose: murea (the EKF tracks, MUREA finds the robot
     /// again when it is lost), gm (the EKF tracks, ThinkingCap's fuzzy grid follows and moves
     /// it when sure it is elsewhere) or ekf (the EKF alone). Default: the configuration's
@@ -147,9 +147,9 @@ pub enum WorldKind {
     Indoor,
 }
 
-/// `--percepts`.
+/// `--percepts` (the command line's name for `mrt_sim::config::PerceptSource`).
 #[derive(Clone, Copy, Debug, clap::ValueEnum)]
-pub enum Percepts {
+pub enum PerceptsArg {
     /// The object sensor.
     Oracle,
     /// Rendered images through the vision µAgent.
@@ -166,8 +166,8 @@ fn config(args: &SimArgs) -> Result<SimConfig> {
     }
     if let Some(p) = args.percepts {
         cfg.sensor.percepts = match p {
-            Percepts::Oracle => mrt_sim::config::PerceptSource::Oracle,
-            Percepts::Vision => mrt_sim::config::PerceptSource::Vision,
+            PerceptsArg::Oracle => mrt_sim::config::PerceptSource::Oracle,
+            PerceptsArg::Vision => mrt_sim::config::PerceptSource::Vision,
         };
     }
     if let Some(l) = args.localizer {
