@@ -22,7 +22,7 @@ use mrt_msgs::{
 };
 use mrt_plan::kinematics::integrate;
 use mrt_robot::config::{RobotConfig, RobotFile};
-use mrt_robot::devices::Devices;
+use mrt_robot::devices::{DeviceError, Devices};
 use mrt_robot::members::{add_robot, RobotSpec};
 use mrt_robot::stacks::Stack;
 use std::sync::{Arc, Mutex};
@@ -41,11 +41,12 @@ pub struct TableRobot {
 }
 
 impl Devices for TableRobot {
-    fn odometry(&mut self) -> Result<Odometry, String> {
+    fn odometry(&mut self) -> Result<Odometry, DeviceError> {
         // The motors move the robot for one period by the base's own kinematics; the mice
         // read that motion (the MRT manual's §4.1 forward model).
         let before = self.pose;
-        let twist = self.cfg.base.twist_for(&self.duty).map_err(|e| e.to_string())?;
+        let twist =
+            self.cfg.base.twist_for(&self.duty).map_err(|e| DeviceError::Refused(e.to_string()))?;
         self.pose = integrate(self.pose, &twist, self.cfg.control_period);
         let d = self.pose.relative_to(&before);
         let placed = (!self.placed).then_some(Framed::new(before));
@@ -58,7 +59,7 @@ impl Devices for TableRobot {
         })
     }
 
-    fn camera(&mut self) -> Result<CameraFrame, String> {
+    fn camera(&mut self) -> Result<CameraFrame, DeviceError> {
         let mut frame = CameraFrame::default();
         for k in 0..FIELD_OBJECTS {
             let at = match self.cfg.field.object(k) {
@@ -73,20 +74,20 @@ impl Devices for TableRobot {
         Ok(frame)
     }
 
-    fn game(&mut self) -> Result<GameInfo, String> {
+    fn game(&mut self) -> Result<GameInfo, DeviceError> {
         Ok(GameInfo { state: GameState::Playing, attack: 1.0, kickoff_pose: None, marker: None })
     }
 
-    fn sonars(&mut self) -> Result<Vec<Sonar>, String> {
+    fn sonars(&mut self) -> Result<Vec<Sonar>, DeviceError> {
         Ok((0..16).map(|i| Sonar::new(Sonar::ring_bearing(i, 16), f64::INFINITY)).collect())
     }
 
-    fn set_duty(&mut self, duty: &[f64]) -> Result<(), String> {
+    fn set_duty(&mut self, duty: &[f64]) -> Result<(), DeviceError> {
         self.duty = duty.to_vec();
         Ok(())
     }
 
-    fn kick(&mut self) -> Result<(), String> {
+    fn kick(&mut self) -> Result<(), DeviceError> {
         self.kicks.push(self.cycle);
         // A kick that reaches the ball sends it 3 m on along the robot's heading.
         let (dx, dy) = (self.ball.0 - self.pose.x, self.ball.1 - self.pose.y);
@@ -97,8 +98,8 @@ impl Devices for TableRobot {
         Ok(())
     }
 
-    fn fault(&mut self, message: &str) -> Result<(), String> {
-        Err(format!("the robot's software failed: {message}"))
+    fn fault(&mut self, message: &str) -> Result<(), DeviceError> {
+        Err(DeviceError::Refused(format!("the robot's software failed: {message}")))
     }
 }
 

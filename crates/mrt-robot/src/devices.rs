@@ -15,30 +15,48 @@
 use mrt_msgs::{CameraFrame, GameInfo, Odometry, Sonar};
 use std::sync::{Arc, Mutex};
 
-/// A robot's devices (module doc). Errors are the device's own words; the driver Member
-/// reports them as job errors.
+/// What a device could not do. The driver Member that asked reports it as its job's error;
+/// the robot's other Members go on.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+pub enum DeviceError {
+    /// The world sent no such reading for this cycle (`"odometry"`, `"camera"`...).
+    #[error("no {0} reading this cycle")]
+    NotRead(&'static str),
+    /// This robot has no such device (`"kicker"`, `"pan joint on its camera"`...).
+    #[error("this robot has no {0}")]
+    Absent(&'static str),
+    /// The device refused what it was asked (a duty cycle out of range, a pan that is not an
+    /// angle...), in its own words.
+    #[error("{0}")]
+    Refused(String),
+    /// The device cannot be reached: a panic while it was in use left its lock poisoned.
+    #[error("the {0}'s lock is poisoned")]
+    Poisoned(&'static str),
+}
+
+/// A robot's devices (module doc).
 pub trait Devices: Send {
     /// The mice and the wheels since the last reading (first in a cycle).
-    fn odometry(&mut self) -> Result<Odometry, String>;
+    fn odometry(&mut self) -> Result<Odometry, DeviceError>;
     /// What the object sensor sees now (after the odometry).
-    fn camera(&mut self) -> Result<CameraFrame, String>;
+    fn camera(&mut self) -> Result<CameraFrame, DeviceError>;
     /// The game controller's news (the referee's state, which way the team attacks, the
     /// robot's kickoff pose).
-    fn game(&mut self) -> Result<GameInfo, String>;
+    fn game(&mut self) -> Result<GameInfo, DeviceError>;
     /// The sonar ring (after the camera).
-    fn sonars(&mut self) -> Result<Vec<Sonar>, String>;
+    fn sonars(&mut self) -> Result<Vec<Sonar>, DeviceError>;
     /// Drives the motors: one PWM duty cycle per wheel.
-    fn set_duty(&mut self, duty: &[f64]) -> Result<(), String>;
+    fn set_duty(&mut self, duty: &[f64]) -> Result<(), DeviceError>;
     /// Fires the kicker.
-    fn kick(&mut self) -> Result<(), String>;
+    fn kick(&mut self) -> Result<(), DeviceError>;
     /// Turns the camera's pan joint to `pan` (rad, counter-clockwise from straight ahead),
     /// asked by the gaze control (`[gaze]` of the robot file) once per cycle within the
     /// joint's range and speed. A robot without a pan joint keeps this default, an error.
-    fn set_pan(&mut self, pan: f64) -> Result<(), String> {
-        Err(format!("this robot's camera has no pan joint (asked for {pan} rad)"))
+    fn set_pan(&mut self, _pan: f64) -> Result<(), DeviceError> {
+        Err(DeviceError::Absent("pan joint on its camera"))
     }
     /// Books a fault of the robot's software now (a script error with its file and line).
-    fn fault(&mut self, message: &str) -> Result<(), String>;
+    fn fault(&mut self, message: &str) -> Result<(), DeviceError>;
 }
 
 /// One robot's devices, shared by its driver Members.
@@ -106,43 +124,43 @@ impl LinkedDevices {
     }
 }
 
-fn unread<T>(slot: &mut Option<T>, what: &str) -> Result<T, String> {
-    slot.take().ok_or_else(|| format!("no {what} reading this cycle"))
+fn unread<T>(slot: &mut Option<T>, what: &'static str) -> Result<T, DeviceError> {
+    slot.take().ok_or(DeviceError::NotRead(what))
 }
 
 impl Devices for LinkedDevices {
-    fn odometry(&mut self) -> Result<Odometry, String> {
+    fn odometry(&mut self) -> Result<Odometry, DeviceError> {
         unread(&mut self.odometry, "odometry")
     }
 
-    fn camera(&mut self) -> Result<CameraFrame, String> {
+    fn camera(&mut self) -> Result<CameraFrame, DeviceError> {
         unread(&mut self.camera, "camera")
     }
 
-    fn game(&mut self) -> Result<GameInfo, String> {
+    fn game(&mut self) -> Result<GameInfo, DeviceError> {
         unread(&mut self.game, "game controller")
     }
 
-    fn sonars(&mut self) -> Result<Vec<Sonar>, String> {
+    fn sonars(&mut self) -> Result<Vec<Sonar>, DeviceError> {
         unread(&mut self.sonars, "sonar")
     }
 
-    fn set_duty(&mut self, duty: &[f64]) -> Result<(), String> {
+    fn set_duty(&mut self, duty: &[f64]) -> Result<(), DeviceError> {
         self.duty = Some(duty.to_vec());
         Ok(())
     }
 
-    fn kick(&mut self) -> Result<(), String> {
+    fn kick(&mut self) -> Result<(), DeviceError> {
         self.kick = true;
         Ok(())
     }
 
-    fn set_pan(&mut self, pan: f64) -> Result<(), String> {
+    fn set_pan(&mut self, pan: f64) -> Result<(), DeviceError> {
         self.pan = Some(pan);
         Ok(())
     }
 
-    fn fault(&mut self, message: &str) -> Result<(), String> {
+    fn fault(&mut self, message: &str) -> Result<(), DeviceError> {
         self.faults.push(message.to_string());
         Ok(())
     }
@@ -165,8 +183,9 @@ mod tests {
         });
         assert_eq!(d.game().unwrap(), GameInfo::default());
         assert_eq!(d.camera().unwrap(), frame);
-        assert!(d.camera().unwrap_err().contains("no camera reading"), "read once");
-        assert!(d.sonars().unwrap_err().contains("no sonar reading"), "none loaded");
+        assert_eq!(d.camera(), Err(DeviceError::NotRead("camera")), "read once");
+        assert_eq!(d.sonars(), Err(DeviceError::NotRead("sonar")), "none loaded");
+        assert_eq!(d.sonars().unwrap_err().to_string(), "no sonar reading this cycle");
         d.set_duty(&[0.1, -0.2]).unwrap();
         d.set_duty(&[0.3, 0.4]).unwrap();
         d.kick().unwrap();

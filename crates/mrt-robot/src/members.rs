@@ -46,7 +46,7 @@ use crate::base::Base;
 use crate::brain::BrainMember;
 use crate::commander::Commander;
 use crate::config::RobotConfig;
-use crate::devices::{Devices, SharedDevices};
+use crate::devices::{DeviceError, Devices, SharedDevices};
 use crate::files::FilesDir;
 use crate::isocrob::IsocrobBrain;
 use crate::look_around::LookAround;
@@ -92,7 +92,7 @@ pub(crate) struct Driver<M> {
     pub(crate) kind: &'static str,
     pub(crate) robot: usize,
     pub(crate) devices: SharedDevices,
-    pub(crate) read: fn(&mut dyn Devices) -> Result<M, String>,
+    pub(crate) read: fn(&mut dyn Devices) -> Result<M, DeviceError>,
 }
 
 impl<M: Message> Member for Driver<M> {

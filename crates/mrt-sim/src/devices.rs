@@ -7,7 +7,7 @@ use crate::drivers::SimulatedAirboard;
 use crate::game::Pitch;
 use mrt_msgs::{CameraFrame, GameInfo, Odometry, Sonar};
 use mrt_robot::base::MotorDriver;
-use mrt_robot::devices::Devices;
+use mrt_robot::devices::{DeviceError, Devices};
 use std::sync::{Arc, Mutex};
 
 /// The devices of robot `robot` on a pitch in this process.
@@ -25,42 +25,42 @@ impl PitchDevices {
         Ok(PitchDevices { pitch, robot, airboard })
     }
 
-    fn with<T>(&self, f: impl FnOnce(&mut Pitch, usize) -> T) -> Result<T, String> {
-        let mut p = self.pitch.lock().map_err(|_| "the pitch lock is poisoned".to_string())?;
+    fn with<T>(&self, f: impl FnOnce(&mut Pitch, usize) -> T) -> Result<T, DeviceError> {
+        let mut p = self.pitch.lock().map_err(|_| DeviceError::Poisoned("pitch"))?;
         Ok(f(&mut p, self.robot))
     }
 }
 
 impl Devices for PitchDevices {
-    fn odometry(&mut self) -> Result<Odometry, String> {
+    fn odometry(&mut self) -> Result<Odometry, DeviceError> {
         self.with(|p, i| p.odometry(i))
     }
 
-    fn camera(&mut self) -> Result<CameraFrame, String> {
+    fn camera(&mut self) -> Result<CameraFrame, DeviceError> {
         self.with(|p, i| p.camera(i))
     }
 
-    fn game(&mut self) -> Result<GameInfo, String> {
+    fn game(&mut self) -> Result<GameInfo, DeviceError> {
         self.with(|p, i| p.game_info(i))
     }
 
-    fn sonars(&mut self) -> Result<Vec<Sonar>, String> {
+    fn sonars(&mut self) -> Result<Vec<Sonar>, DeviceError> {
         self.with(|p, i| p.sonar(i))
     }
 
-    fn set_duty(&mut self, duty: &[f64]) -> Result<(), String> {
-        self.airboard.set_duty(duty).map_err(|e| e.to_string())
+    fn set_duty(&mut self, duty: &[f64]) -> Result<(), DeviceError> {
+        self.airboard.set_duty(duty).map_err(|e| DeviceError::Refused(e.to_string()))
     }
 
-    fn kick(&mut self) -> Result<(), String> {
+    fn kick(&mut self) -> Result<(), DeviceError> {
         self.with(|p, i| p.kick(i))
     }
 
-    fn set_pan(&mut self, pan: f64) -> Result<(), String> {
-        self.with(|p, i| p.set_pan(i, pan))?
+    fn set_pan(&mut self, pan: f64) -> Result<(), DeviceError> {
+        self.with(|p, i| p.set_pan(i, pan))?.map_err(DeviceError::Refused)
     }
 
-    fn fault(&mut self, message: &str) -> Result<(), String> {
+    fn fault(&mut self, message: &str) -> Result<(), DeviceError> {
         self.with(|p, i| p.fault(i, 1, message))
     }
 }

@@ -32,7 +32,7 @@ use mrt_dcdt::SteppedExecutor;
 use mrt_msgs::{CameraFrame, GameInfo, Odometry, Sonar};
 use mrt_plan::spike::{PlanMap, Shape};
 use mrt_robot::base::Base;
-use mrt_robot::devices::{Devices, SharedDevices};
+use mrt_robot::devices::{DeviceError, Devices, SharedDevices};
 use mrt_robot::members::member_faults;
 use mrt_robot::mission::{add_roby, Mission, MissionEvent, Roby, RobyBody};
 use rand::SeedableRng;
@@ -432,45 +432,45 @@ struct Building {
 struct IndoorDevices(Arc<Mutex<Building>>);
 
 impl IndoorDevices {
-    fn with<T>(&self, f: impl FnOnce(&mut Building) -> T) -> Result<T, String> {
-        let mut b = self.0.lock().map_err(|_| "the building's lock is poisoned".to_string())?;
+    fn with<T>(&self, f: impl FnOnce(&mut Building) -> T) -> Result<T, DeviceError> {
+        let mut b = self.0.lock().map_err(|_| DeviceError::Poisoned("building"))?;
         Ok(f(&mut b))
     }
 }
 
 impl Devices for IndoorDevices {
-    fn odometry(&mut self) -> Result<Odometry, String> {
+    fn odometry(&mut self) -> Result<Odometry, DeviceError> {
         self.with(|b| {
             let period = b.cfg.rules.control_period;
             b.odometer.read(&b.world, &b.cfg.odometry, period, &mut b.rng)
         })
     }
 
-    fn camera(&mut self) -> Result<CameraFrame, String> {
-        Err("the indoor robot has no camera".into())
+    fn camera(&mut self) -> Result<CameraFrame, DeviceError> {
+        Err(DeviceError::Absent("camera"))
     }
 
-    fn game(&mut self) -> Result<GameInfo, String> {
-        Err("there is no game controller indoors".into())
+    fn game(&mut self) -> Result<GameInfo, DeviceError> {
+        Err(DeviceError::Absent("game controller (there is none indoors)"))
     }
 
-    fn sonars(&mut self) -> Result<Vec<Sonar>, String> {
+    fn sonars(&mut self) -> Result<Vec<Sonar>, DeviceError> {
         self.with(|b| sonar_ring(&b.world, 0, &b.cfg.sonar, &mut b.rng))
     }
 
-    fn set_duty(&mut self, duty: &[f64]) -> Result<(), String> {
+    fn set_duty(&mut self, duty: &[f64]) -> Result<(), DeviceError> {
         self.with(|b| {
-            let twist = b.base.twist_for(duty).map_err(|e| e.to_string())?;
+            let twist = b.base.twist_for(duty).map_err(|e| DeviceError::Refused(e.to_string()))?;
             b.world.drive(Drive::from(twist));
             Ok(())
         })?
     }
 
-    fn kick(&mut self) -> Result<(), String> {
-        Err("the indoor robot has no kicker".into())
+    fn kick(&mut self) -> Result<(), DeviceError> {
+        Err(DeviceError::Absent("kicker"))
     }
 
-    fn fault(&mut self, message: &str) -> Result<(), String> {
+    fn fault(&mut self, message: &str) -> Result<(), DeviceError> {
         self.with(|b| b.faults.push(message.to_string()))
     }
 }
