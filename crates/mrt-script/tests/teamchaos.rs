@@ -15,7 +15,7 @@
 use mrt_core::{Pose2, Time};
 use mrt_msgs::robot::{lps, Estimate, GameState, Lpo, WorldSnapshot};
 use mrt_script::{Cycle, Sandbox, ScriptError, ThinkingCap};
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 /// The team's `hbm.lua` scales the control variables to a Middle Size robot's speeds
 /// (`scale("go", 19.2)`, ...): the same labels as the defaults (the seed's, for a four-legged
@@ -655,11 +655,17 @@ fn the_attacker_aligns_first_when_approaching_a_misaligned_ball() {
     close(cycles[4].command.vlat, 100.0 * STRAFE);
 }
 
-/// Copies the shared predicates and one behavior of the shipped directory into `to`.
-fn copy_behaviors(to: &Path, names: &[&str]) {
+/// A fresh scratch directory for `test` holding copies of the shipped files `names` (the
+/// shared predicates, a behavior...).
+fn scratch_copy(test: &str, names: &[&str]) -> PathBuf {
+    let to =
+        std::env::temp_dir().join(format!("mrt-script-teamchaos-{}-{test}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&to);
+    std::fs::create_dir_all(&to).unwrap();
     for n in names {
         std::fs::copy(dir().join(n), to.join(n)).unwrap();
     }
+    to
 }
 
 /// What each label of the team's control variables asks the base for: `hbm.lua`'s scales are
@@ -668,11 +674,7 @@ fn copy_behaviors(to: &Path, names: &[&str]) {
 /// base's top speed (1.2 m/s, 4 rad/s = 229 °/s), which guidance then drives at.
 #[test]
 fn the_labels_become_these_set_points_on_a_middle_size_base() {
-    let tmp =
-        std::env::temp_dir().join(format!("mrt-script-teamchaos-{}-labels", std::process::id()));
-    let _ = std::fs::remove_dir_all(&tmp);
-    std::fs::create_dir_all(&tmp).unwrap();
-    copy_behaviors(&tmp, &["hbm.lua"]);
+    let tmp = scratch_copy("labels", &["hbm.lua"]);
     // (variable, label, the command field, the set-point: mm/s or °/s)
     let cases = [
         ("go", "FAST", 4800.0),
@@ -711,11 +713,7 @@ fn the_labels_become_these_set_points_on_a_middle_size_base() {
 
 #[test]
 fn an_hfsm_naming_an_unknown_behavior_keeps_the_last_good_one_running() {
-    let tmp =
-        std::env::temp_dir().join(format!("mrt-script-teamchaos-{}-nothere", std::process::id()));
-    let _ = std::fs::remove_dir_all(&tmp);
-    std::fs::create_dir_all(&tmp).unwrap();
-    copy_behaviors(&tmp, &["hbm.lua", "go2ball.lua"]);
+    let tmp = scratch_copy("nothere", &["hbm.lua", "go2ball.lua"]);
     let machine = tmp.join("m.hfsm.lua");
     std::fs::write(
         &machine,
