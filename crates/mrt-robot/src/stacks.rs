@@ -11,7 +11,8 @@
 //! - **Chaser**: the hand-written baseline player ([`Chaser`]).
 //!
 //! TeamChaos tuned its behaviors for AIBO walking speeds (about 0.3 m/s); on a Middle Size
-//! League base the Chaos brain's [`Commander`] adapts them to the body.
+//! League base its `hbm.lua` scales the speeds and the
+//! [`Commander`](crate::commander::Commander) shifts the distances to the body.
 
 use crate::brain::Brain;
 use crate::config::RobotConfig;
