@@ -1,0 +1,102 @@
+//! The `Guide` Member: the behaviors' command through guidance, and [`guide`], one cycle of it.
+
+use super::*;
+
+/// Guidance of one robot: the behaviors' command through the Guidance µAgent with the latest
+/// world state and sonar scan.
+pub(super) struct Guide {
+    pub(super) robot: usize,
+    pub(super) guidance: Guidance,
+    pub(super) world: WorldSnapshot,
+    pub(super) scan: SonarScan,
+    /// The planner's latest path, and when it came (s, the world's clock).
+    pub(super) path: Option<(PlannedPath, f64)>,
+    /// The goal last asked of the planner, and when.
+    pub(super) asked: Option<(Pose2, f64)>,
+    /// Turning to look for landmarks when the world model needs to localize, on a robot
+    /// whose camera cannot pan (`None` with a pan joint: the gaze looks instead).
+    pub(super) look: Option<LookAround>,
+}
+
+impl Guide {
+    /// A target to reach along a planned path (`plan`): the planner is asked when its path
+    /// is for another goal or a second old; meanwhile the command drives to the path's
+    /// carrot in position mode, or, before any path, as the target says without planning.
+    fn follow(&mut self, cmd: &mut RobotCommand, ctx: &mut Context<'_>) {
+        let Some(target) = cmd.target.filter(|t| t.plan) else { return };
+        let now = self.world.time.as_secs_f64();
+        let to = target.pose;
+        let current = self.path.as_ref().filter(|(p, _)| plans_for(p, to));
+        let stale = current.is_none_or(|(_, at)| now - at >= REPLAN);
+        let waiting =
+            self.asked.is_some_and(|(goal, at)| same_goal(goal, to) && now - at < REPLAN / 2.0);
+        if stale && !waiting {
+            ctx.publish(PlanRequest { to });
+            self.asked = Some((to, now));
+        }
+        let next = current.and_then(|(p, _)| carrot(&p.poses, self.world.my_pos.pose));
+        cmd.target = Some(match next {
+            Some(pose) => Target { pose, avoid: false, plan: false },
+            None => Target { plan: false, ..target },
+        });
+    }
+}
+
+impl Member for Guide {
+    fn name(&self) -> String {
+        format!("guide-{}", self.robot)
+    }
+
+    fn init(&mut self, ctx: &mut Context<'_>) -> Result<(), MemberError> {
+        ctx.subscribe_to::<RobotCommand>(RequestType::Local);
+        ctx.subscribe_to::<WorldSnapshot>(RequestType::Local);
+        ctx.subscribe_to::<SonarScan>(RequestType::Local);
+        ctx.subscribe_to::<PlannedPath>(RequestType::Local);
+        Ok(())
+    }
+
+    fn do_your_job(&mut self, ctx: &mut Context<'_>) -> Result<(), MemberError> {
+        let mut last = None;
+        while let Some(m) = ctx.receive_msg() {
+            if let Ok(c) = m.get::<RobotCommand>() {
+                last = Some(c.clone());
+            } else if let Ok(w) = m.get::<WorldSnapshot>() {
+                self.world.clone_from(w);
+            } else if let Ok(p) = m.get::<PlannedPath>() {
+                self.path = Some((p.clone(), self.world.time.as_secs_f64()));
+            } else {
+                self.scan.clone_from(m.get::<SonarScan>()?);
+            }
+        }
+        if let Some(mut cmd) = last {
+            let now = self.world.time.as_secs_f64();
+            let (needs, played) =
+                (self.world.needs_localization, self.world.game_state == GameState::Playing);
+            if let Some(rate) = self.look.as_mut().and_then(|l| l.step(now, needs, played)) {
+                cmd = RobotCommand { vrot: rate.to_degrees(), ..RobotCommand::default() };
+            }
+            let planned = cmd.target.is_some_and(|t| t.plan);
+            self.follow(&mut cmd, ctx);
+            let mut out = guide(&self.guidance, &cmd, &self.world, &self.scan.sonars);
+            if planned {
+                // Position mode along the path, halted by the sonars as velocity mode is.
+                out = guide(&self.guidance, &out, &self.world, &self.scan.sonars);
+            }
+            ctx.publish(MotorCommand(out));
+        }
+        Ok(())
+    }
+}
+
+/// Guidance for one robot's cycle: the behaviors' command `cmd`, the world state the robot
+/// believes (its pose, the ball where it is known) and its sonar ring.
+pub fn guide(
+    g: &Guidance,
+    cmd: &RobotCommand,
+    w: &WorldSnapshot,
+    sonars: &[Sonar],
+) -> RobotCommand {
+    let ball = w.global_ball;
+    let ball = (ball.quality >= 0.1).then(|| Point2::new(ball.pose.x, ball.pose.y));
+    g.guide(cmd, &w.my_pos.pose, ball, sonars).command
+}

@@ -1,0 +1,155 @@
+//! The world-state Member: the robot's beliefs, its teammates' reports, roles and SCARE.
+
+use super::*;
+
+/// A team ball of at least this quality is known to the role allocation (the Lua players'
+/// `ballKnown`).
+const BALL_KNOWN: f64 = 0.2;
+
+/// The world-state Member of one robot: odometry and camera frames into its [`WorldModel`],
+/// teammates from their reports over the bus; publishes the [`WorldSnapshot`] and its own
+/// [`MateReport`].
+pub(super) struct WorldState {
+    pub(super) robot: usize,
+    pub(super) keeper: bool,
+    pub(super) body: Commander,
+    pub(super) model: WorldModel,
+    pub(super) mates: BTreeMap<u32, MateReport>,
+    /// The team's ball booking (TeamChaos seed `001` §3.3, [`mrt_team::booking`]): fed by the
+    /// behaviors' `bookBall`/`releaseBookedBall` and the teammates' reports.
+    pub(super) booking: BallBooking,
+    /// Teammates' booking reports received since the last frame.
+    pub(super) booking_news: Vec<(u32, BookingReport)>,
+    /// The behaviors' latest `bookBall` (true) or `releaseBookedBall` (false) not yet applied.
+    pub(super) book: Option<bool>,
+    /// The role the team agreed on at the last frame ([`mrt_team::roles`], `getRole`).
+    pub(super) role: Role,
+    /// SCARE (MRT manual ch. 11, [`mrt_team::scare`]): the activity the team gives this
+    /// robot, its sub-task and goal, into the snapshot's `job` for Team Milan's parametric
+    /// behaviors (Team Milan only).
+    pub(super) scare: Option<Coordinator>,
+}
+
+impl Member for WorldState {
+    fn name(&self) -> String {
+        format!("world-state-{}", self.robot)
+    }
+
+    fn init(&mut self, ctx: &mut Context<'_>) -> Result<(), MemberError> {
+        ctx.subscribe_to::<Odometry>(RequestType::Local);
+        ctx.subscribe_to::<CameraFrame>(RequestType::Local);
+        ctx.subscribe_to::<Percepts>(RequestType::Local);
+        ctx.subscribe_to::<GameInfo>(RequestType::Local);
+        ctx.subscribe_to::<SonarScan>(RequestType::Local);
+        ctx.subscribe_to::<MateReport>(RequestType::Remote);
+        ctx.subscribe_to::<RobotCommand>(RequestType::Local);
+        Ok(())
+    }
+
+    fn do_your_job(&mut self, ctx: &mut Context<'_>) -> Result<(), MemberError> {
+        let mut frame = None;
+        while let Some(m) = ctx.receive_msg() {
+            if let Ok(o) = m.get::<Odometry>() {
+                self.model.odometry(o);
+            } else if let Ok(f) = m.get::<CameraFrame>() {
+                // A frame with an image is the vision µAgent's to read; its percepts follow.
+                if f.image.is_none() {
+                    frame = Some(m);
+                }
+            } else if m.is::<Percepts>() {
+                frame = Some(m);
+            } else if let Ok(g) = m.get::<GameInfo>() {
+                self.model.game(*g);
+            } else if let Ok(scan) = m.get::<SonarScan>() {
+                // Read with the next frame (MAP's merger: echoes of robots out of view).
+                self.model.sonars(scan);
+            } else if let Ok(c) = m.get::<RobotCommand>() {
+                self.book = c.book_ball.or(self.book);
+            } else {
+                let r = m.get::<MateReport>()?;
+                self.booking_news.push((r.id, r.booking.clone()));
+                self.mates.insert(r.id, r.clone());
+            }
+        }
+        let Some(frame) = frame else { return Ok(()) };
+        let mut w = match frame.get::<Percepts>() {
+            Ok(p) => self.model.percepts(p),
+            Err(_) => self.model.camera(frame.get::<CameraFrame>()?),
+        };
+        let id = u32::try_from(self.robot).unwrap_or(u32::MAX);
+        // The ball's uncertainty in mm, as the reports and the team ball count it.
+        let ball_sigma = self.model.ball_sigma().map(|s| s * 1000.0);
+        let mut report =
+            MateReport::of(id, self.keeper, &w).with_ball_sigma(ball_sigma.unwrap_or(0.0));
+        // The ball booking on this frame's clock: the news, the behaviors' wish, the report.
+        let now = w.time.as_secs_f64();
+        for (from, b) in self.booking_news.drain(..) {
+            self.booking.receive(now, from, &b);
+        }
+        if let Some(yes) = self.book.take() {
+            self.booking.want(now, yes);
+        }
+        self.booking.update(now);
+        report.booking = self.booking.report(now);
+        w.ball_booked = self.booking.holds(now);
+        // Teammates and their ball as the bus told them, not as the simulator knows them.
+        merge_team(&mut w, ball_sigma, self.mates.values());
+        // The roles, from the teammates heard lately (within the booking's `silent`: the
+        // booking already keeps when each was last heard) and the team ball.
+        let me = Player {
+            id,
+            at: (w.my_pos.pose.x, w.my_pos.pose.y),
+            keeper: self.keeper,
+            said: self.role,
+        };
+        let heard: Vec<&MateReport> =
+            self.mates.values().filter(|r| self.booking.hears(r.id, now) && r.id != id).collect();
+        let players: Vec<Player> = std::iter::once(me)
+            .chain(heard.iter().map(|r| Player {
+                id: r.id,
+                at: (r.pose.pose.x, r.pose.pose.y),
+                keeper: r.keeper,
+                said: Role::from_name(&r.role).unwrap_or(Role::Defender),
+            }))
+            .collect();
+        let ball = (w.global_ball.quality > BALL_KNOWN)
+            .then_some((w.global_ball.pose.x, w.global_ball.pose.y));
+        self.role = allocate(&players, ball).first().map_or(self.role, |r| r.1);
+        report.role = self.role.name().to_string();
+        w.role = self.role.name().to_string();
+        // SCARE, on the same teammates and team ball.
+        if let Some(scare) = &mut self.scare {
+            let sit = situation(&w, self.keeper, ball, &heard);
+            let shot = Geometry::of(&w.field).open_side(&w);
+            let reports: Vec<_> = heard.iter().map(|r| (r.id, &r.scare)).collect();
+            let cycle = scare.cycle(now, &sit, &reports, shot);
+            report.scare = cycle.report;
+            w.job = Some(cycle.job);
+        }
+        ctx.publish(report);
+        ctx.publish(self.model.localization());
+        self.body.perceive(&mut w);
+        ctx.publish(w);
+        Ok(())
+    }
+}
+
+/// What SCARE's soccer activities read of a robot's beliefs: its pose, the team ball when
+/// known, the teammates heard lately, the robots it anchored as opponents (or of unknown
+/// team), the field.
+pub(super) fn situation(
+    w: &WorldSnapshot,
+    keeper: bool,
+    ball: Option<(f64, f64)>,
+    heard: &[&MateReport],
+) -> Situation {
+    Situation {
+        me: (w.my_pos.pose.x, w.my_pos.pose.y, w.my_pos.pose.theta),
+        keeper,
+        ball,
+        mates: heard.iter().map(|r| (r.id, (r.pose.pose.x, r.pose.pose.y), r.keeper)).collect(),
+        opponents: w.opponents(WorldSnapshot::ANCHORED).map(|r| (r.x, r.y)).collect(),
+        half_length: w.field.half_length,
+        goal_half_width: w.field.goal_half_width,
+    }
+}
