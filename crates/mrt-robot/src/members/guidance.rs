@@ -1,10 +1,11 @@
-//! The `Guide` Member: the behaviors' command through guidance, and [`guide`], one cycle of it.
+//! The guidance Member (`guide-<n>`): the behaviors' command through guidance each cycle
+//! ([`guided_command`]).
 
 use super::*;
 
 /// Guidance of one robot: the behaviors' command through the Guidance µAgent with the latest
 /// world state and sonar scan.
-pub(super) struct Guide {
+pub(super) struct GuidanceMember {
     pub(super) robot: usize,
     pub(super) guidance: Guidance,
     pub(super) world: WorldSnapshot,
@@ -18,7 +19,7 @@ pub(super) struct Guide {
     pub(super) look: Option<LookAround>,
 }
 
-impl Guide {
+impl GuidanceMember {
     /// A target to reach along a planned path (`plan`): the planner is asked when its path
     /// is for another goal or a second old; meanwhile the command drives to the path's
     /// carrot in position mode, or, before any path, as the target says without planning.
@@ -42,7 +43,7 @@ impl Guide {
     }
 }
 
-impl Member for Guide {
+impl Member for GuidanceMember {
     fn name(&self) -> String {
         format!("guide-{}", self.robot)
     }
@@ -77,10 +78,10 @@ impl Member for Guide {
             }
             let planned = cmd.target.is_some_and(|t| t.plan);
             self.follow(&mut cmd, ctx);
-            let mut out = guide(&self.guidance, &cmd, &self.world, &self.scan.sonars);
+            let mut out = guided_command(&self.guidance, &cmd, &self.world, &self.scan.sonars);
             if planned {
                 // Position mode along the path, halted by the sonars as velocity mode is.
-                out = guide(&self.guidance, &out, &self.world, &self.scan.sonars);
+                out = guided_command(&self.guidance, &out, &self.world, &self.scan.sonars);
             }
             ctx.publish(MotorCommand(out));
         }
@@ -90,7 +91,7 @@ impl Member for Guide {
 
 /// Guidance for one robot's cycle: the behaviors' command `cmd`, the world state the robot
 /// believes (its pose, the ball where it is known) and its sonar ring.
-pub fn guide(
+fn guided_command(
     g: &Guidance,
     cmd: &RobotCommand,
     w: &WorldSnapshot,

@@ -26,7 +26,7 @@
 //!    camera's pan joint to the object the behaviors need most ([`Devices::set_pan`]);
 //! 4. **`planner-<n>`** (SPIKE, MRT manual ch. 9, on message): plans a path for each
 //!    [`PlanRequest`] round the robots the world model anchored ([`crate::planner`]);
-//! 4. **`Guide`** (guidance, ISocRob §3.2.3, on message): turns the behaviors'
+//! 4. **`guide-<n>`** (`GuidanceMember`; guidance, ISocRob §3.2.3, on message): turns the behaviors'
 //!    [`RobotCommand`] into a [`MotorCommand`] with [`mrt_plan::guide::Guidance`]: velocity
 //!    mode halted by the sonars, or position and potential-field modes to a target posture,
 //!    or, for a target with `plan`, position mode along the planner's path, halted by the
@@ -91,8 +91,7 @@ mod world_state;
 pub(crate) use driver::Driver;
 use fault_book::FaultBook;
 use gaze::GazeControl;
-pub use guidance::guide;
-use guidance::Guide;
+use guidance::GuidanceMember;
 pub(crate) use motor::Motor;
 use vision::Vision;
 use world_state::WorldState;
@@ -249,7 +248,7 @@ fn add_cycle(
         role: if keeper { Role::Goalkeeper } else { Role::Defender },
         scare: scare.then(|| Coordinator::new(u32::try_from(robot).unwrap_or(u32::MAX))),
     };
-    let guide = Guide {
+    let guide = GuidanceMember {
         robot,
         guidance: cfg.guidance,
         world: WorldSnapshot::default(),
