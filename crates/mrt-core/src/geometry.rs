@@ -52,6 +52,53 @@ pub fn angle_diff(to: f64, from: f64) -> f64 {
     normalize_angle(to - from)
 }
 
+/// A velocity of a body in its own frame (the robot frame: x forward, y to the left): `vx`
+/// forward and `vy` to the left in m/s, `omega` counter-clockwise in rad/s. What behaviors ask
+/// of guidance, guidance of the motor driver, and a world's motor model does with the wheels.
+#[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct Twist {
+    /// Forward speed, m/s.
+    pub vx: f64,
+    /// Leftward speed, m/s (always 0 for a differential drive after its wheel limits).
+    pub vy: f64,
+    /// Turn rate, rad/s, counter-clockwise.
+    pub omega: f64,
+}
+
+impl Twist {
+    /// Standing still.
+    pub const ZERO: Twist = Twist { vx: 0.0, vy: 0.0, omega: 0.0 };
+
+    /// A twist.
+    pub const fn new(vx: f64, vy: f64, omega: f64) -> Self {
+        Self { vx, vy, omega }
+    }
+
+    /// True if all three components are finite.
+    pub fn is_finite(&self) -> bool {
+        self.vx.is_finite() && self.vy.is_finite() && self.omega.is_finite()
+    }
+
+    /// Every component multiplied by `k`.
+    pub fn scaled(&self, k: f64) -> Twist {
+        Twist::new(self.vx * k, self.vy * k, self.omega * k)
+    }
+
+    /// The translational speed `√(vx² + vy²)`, m/s.
+    pub fn speed(&self) -> f64 {
+        self.vx.hypot(self.vy)
+    }
+
+    /// With every component that is not finite set to 0: what a motor driver does with a
+    /// broken set-point.
+    pub fn finite_or_zero(&self) -> Twist {
+        let f = |x: f64| if x.is_finite() { x } else { 0.0 };
+        Twist::new(f(self.vx), f(self.vy), f(self.omega))
+    }
+}
+
 /// A posture on the plane: position `(x, y)` and heading `theta` (radians, in `(-π, π]`).
 #[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]

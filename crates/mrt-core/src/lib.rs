@@ -50,7 +50,7 @@ mod time;
 pub use file_error::{line_column, FileError};
 pub use geometry::{
     angle_diff, arc_displacement, arc_velocity, normalize_angle, normalize_angle_positive,
-    ring_runs, sinc, Point2, Pose2, Vec2,
+    ring_runs, sinc, Point2, Pose2, Twist, Vec2,
 };
 pub use ids::{AgoraId, MemberId, MsgType};
 pub use message::{Message, RESERVED_TYPES_START};
@@ -61,7 +61,7 @@ pub use time::{Clock, SharedClock, SimClock, Time, WallClock};
 /// The names most MRT code needs, for `use mrt_core::prelude::*`.
 pub mod prelude {
     pub use crate::{
-        AgoraId, Clock, MemberId, MsgType, Point2, Pose2, SharedClock, SimClock, Time, Vec2,
+        AgoraId, Clock, MemberId, MsgType, Point2, Pose2, SharedClock, SimClock, Time, Twist, Vec2,
         WallClock,
     };
 }

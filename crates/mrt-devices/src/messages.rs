@@ -1,6 +1,7 @@
 //! The messages of the device protocol (docs/devices.md), as they are on the wire: UTF-8 JSON,
 //! SI units. Fields a robot does not know are ignored, so a world may send more.
 
+use mrt_core::Twist;
 use schemars::JsonSchema;
 use serde::{Deserialize, Serialize};
 
@@ -244,24 +245,13 @@ pub struct Act {
     /// `None`: keep the previous ones.
     pub wheels: Option<Vec<f64>>,
     /// The body velocity these wheel speeds give (robot frame); `None` with `wheels`.
-    pub twist: Option<BodyTwist>,
+    pub twist: Option<Twist>,
     /// Fire the kicker now.
     pub kick: bool,
     /// The camera's pan set-point, rad (`None`: leave the joint where it is).
     pub pan: Option<f64>,
     /// Faults of the robot's software booked this cycle.
     pub faults: Vec<String>,
-}
-
-/// A body velocity in the robot frame.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize, JsonSchema)]
-pub struct BodyTwist {
-    /// Forward, m/s.
-    pub vx: f64,
-    /// To the left, m/s.
-    pub vy: f64,
-    /// Counter-clockwise, rad/s.
-    pub omega: f64,
 }
 
 /// The match is over, world → all its robots.

@@ -16,48 +16,11 @@
 //! for an omni wheel).
 
 use crate::error::{positive, PlanError};
+pub use mrt_core::Twist;
 use mrt_core::{arc_displacement, Pose2};
 use nalgebra::{Matrix3, Vector3};
 use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
-
-/// A velocity of the robot in its own frame: `vx` forward, `vy` to the left (m/s), `omega`
-/// counter-clockwise (rad/s).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
-#[serde(default)]
-pub struct Twist {
-    /// Forward speed, m/s.
-    pub vx: f64,
-    /// Leftward speed, m/s (always 0 for a differential drive after [`Kinematics::limit`]).
-    pub vy: f64,
-    /// Turn rate, rad/s, counter-clockwise.
-    pub omega: f64,
-}
-
-impl Twist {
-    /// Standing still.
-    pub const ZERO: Twist = Twist { vx: 0.0, vy: 0.0, omega: 0.0 };
-
-    /// A twist.
-    pub const fn new(vx: f64, vy: f64, omega: f64) -> Self {
-        Self { vx, vy, omega }
-    }
-
-    /// True if all three components are finite.
-    pub fn is_finite(&self) -> bool {
-        self.vx.is_finite() && self.vy.is_finite() && self.omega.is_finite()
-    }
-
-    /// Every component multiplied by `k`.
-    pub fn scaled(&self, k: f64) -> Twist {
-        Twist::new(self.vx * k, self.vy * k, self.omega * k)
-    }
-
-    /// The translational speed `√(vx² + vy²)`, m/s.
-    pub fn speed(&self) -> f64 {
-        self.vx.hypot(self.vy)
-    }
-}
 
 /// Wheel angular speeds (rad/s), one per wheel: `[left, right]` for a [`DiffDrive`], wheels in
 /// the order of [`Omni3Params::wheel_angles`] for an [`Omni3`].

@@ -11,7 +11,7 @@ use crate::base::Base;
 use crate::devices::Loaded;
 use crate::remote::{Cycle, RemoteRobot, RobotRun};
 use mrt_core::Time;
-use mrt_devices::messages::{BodyTwist, Fault};
+use mrt_devices::messages::Fault;
 use mrt_devices::{Act, Admitted, Bye, Gate, Keys, Readings, Refusal, PROTOCOL};
 use mrt_msgs::{Displacement, Odometry};
 use std::sync::mpsc::{Receiver, RecvTimeoutError};
@@ -162,7 +162,7 @@ impl WorldRobot {
             Some(duty) => {
                 let speeds = self.base.wheel_speeds(duty).map_err(|e| e.to_string())?;
                 let t = self.base.twist_for(duty).map_err(|e| e.to_string())?;
-                (Some(speeds), Some(BodyTwist { vx: t.vx, vy: t.vy, omega: t.omega }))
+                (Some(speeds), Some(t))
             }
             None => (None, None),
         };

@@ -7,10 +7,11 @@
 #![allow(missing_docs, clippy::unwrap_used)]
 
 use criterion::{criterion_group, criterion_main, Criterion};
+use mrt_core::Twist;
 use mrt_robot::stacks::Stack;
 use mrt_sim::bus::BusMatch;
 use mrt_sim::config::SimConfig;
-use mrt_sim::world::{Drive, World};
+use mrt_sim::world::World;
 use std::time::Duration;
 
 fn bench(c: &mut Criterion) {
@@ -23,7 +24,7 @@ fn bench(c: &mut Criterion) {
             i,
             mrt_core::Pose2::new(-3.0 + i as f64, 0.5 * i as f64 - 2.0, 0.3 * i as f64),
         );
-        world.drive(i, Drive { forward: 1.0, left: 0.0, turn: 0.5 });
+        world.drive(i, Twist::new(1.0, 0.0, 0.5));
     }
     c.bench_function("physics_step_8_robots", |b| b.iter(|| world.step()));
 

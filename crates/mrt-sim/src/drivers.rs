@@ -5,7 +5,6 @@
 //! motion exactly as on a real base (a differential drive cannot move sideways; a command
 //! beyond a wheel's top speed is scaled down as a whole, keeping its direction).
 
-use crate::world::Drive;
 use mrt_robot::base::{Base, DriverError, MotorDriver};
 
 /// The simulated AIRBoard of one robot: duty cycles in, the robot's wheels turn in the world.
@@ -32,7 +31,7 @@ impl MotorDriver for SimulatedAirboard {
     }
 
     fn set_duty(&mut self, duty: &[f64]) -> Result<(), DriverError> {
-        let drive = Drive::from(self.base.twist_for(duty)?);
+        let drive = self.base.twist_for(duty)?;
         if let Ok(mut p) = self.pitch.lock() {
             p.drive(self.robot, drive);
         }

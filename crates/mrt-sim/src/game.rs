@@ -10,8 +10,9 @@ use crate::config::{PerceptSource, SimConfig};
 use crate::referee::{Call, Referee, Team};
 use crate::render::{CameraState, Renderer, Scene};
 use crate::sensor::{self, sonar_ring, Odometer};
-use crate::world::{Drive, World};
+use crate::world::World;
 use mrt_core::frames::MM_PER_M;
+use mrt_core::Twist;
 use mrt_core::{normalize_angle, Pose2};
 use mrt_msgs::robot::{GameState, RobotCommand};
 use mrt_msgs::Sonar;
@@ -675,9 +676,9 @@ impl Pitch {
 
     /// Sets robot `i`'s body velocity (what its motor driver achieved). Outside `READY` and
     /// `PLAYING` the robot is held still.
-    pub fn drive(&mut self, i: usize, drive: Drive) {
+    pub fn drive(&mut self, i: usize, drive: Twist) {
         let moving = matches!(self.referee.state(), GameState::Ready | GameState::Playing);
-        self.world.drive(i, if moving { drive } else { Drive::default() });
+        self.world.drive(i, if moving { drive } else { Twist::ZERO });
     }
 
     /// Fires robot `i`'s kicker (only while `PLAYING`) as the cycle's physics starts: every
@@ -716,8 +717,7 @@ impl Pitch {
     /// Applies robot `i`'s command (mm/s, deg/s) through its base's kinematics and motor
     /// duty cycles, as its driver would; a kick request fires the kicker.
     pub fn apply(&mut self, i: usize, cmd: &RobotCommand) {
-        let drive =
-            self.base.twist_for(&self.base.duties(cmd)).map(Drive::from).unwrap_or_default();
+        let drive = self.base.twist_for(&self.base.duties(cmd)).unwrap_or_default();
         self.drive(i, drive);
         if cmd.kick.is_some() {
             self.kick(i);

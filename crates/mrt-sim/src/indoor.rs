@@ -25,8 +25,9 @@
 
 use crate::config::SimConfig;
 use crate::sensor::{sonar_ring, Bodies, Odometer};
-use crate::world::{accelerate, v, Drive, SonarRing};
+use crate::world::{accelerate, v, SonarRing};
 use mrt_core::SimClock;
+use mrt_core::Twist;
 use mrt_core::{FileError, Point2, Pose2};
 use mrt_dcdt::SteppedExecutor;
 use mrt_msgs::{CameraFrame, GameInfo, Odometry, Sonar};
@@ -198,7 +199,7 @@ pub fn embedded() -> Result<(PlanMap, Mission, IndoorEvents), String> {
 pub struct IndoorWorld {
     physics: PhysicsWorld,
     robot: RigidBodyHandle,
-    drive: Drive,
+    drive: Twist,
     /// The doors that close, each with the wall it becomes and whether it is closed yet.
     doors: Vec<(DoorCloses, ColliderHandle, bool)>,
     persons: Vec<(Person, RigidBodyHandle)>,
@@ -272,7 +273,7 @@ impl IndoorWorld {
         IndoorWorld {
             physics,
             robot,
-            drive: Drive::default(),
+            drive: Twist::ZERO,
             doors,
             persons,
             cfg: cfg.clone(),
@@ -286,14 +287,14 @@ impl IndoorWorld {
     }
 
     /// Sets the robot's velocity set-point, within its top speeds.
-    pub fn drive(&mut self, drive: Drive) {
+    pub fn drive(&mut self, drive: Twist) {
         let r = &self.cfg.robot;
         let clamp = |x: f64, m: f64| if x.is_finite() { x.clamp(-m, m) } else { 0.0 };
-        self.drive = Drive {
-            forward: clamp(drive.forward, r.max_speed),
-            left: clamp(drive.left, r.max_speed),
-            turn: clamp(drive.turn, r.max_turn_rate),
-        };
+        self.drive = Twist::new(
+            clamp(drive.vx, r.max_speed),
+            clamp(drive.vy, r.max_speed),
+            clamp(drive.omega, r.max_turn_rate),
+        );
     }
 
     /// Where the people are now, with their radii.
@@ -346,7 +347,7 @@ impl Bodies for IndoorWorld {
     fn carried(&self, _: usize) -> u32 {
         0
     }
-    fn drive_setpoint(&self, _: usize) -> Drive {
+    fn drive_setpoint(&self, _: usize) -> Twist {
         self.drive
     }
     fn robot_radius(&self) -> f64 {
@@ -461,7 +462,7 @@ impl Devices for IndoorDevices {
     fn set_duty(&mut self, duty: &[f64]) -> Result<(), DeviceError> {
         self.with(|b| {
             let twist = b.base.twist_for(duty).map_err(|e| DeviceError::Refused(e.to_string()))?;
-            b.world.drive(Drive::from(twist));
+            b.world.drive(twist);
             Ok(())
         })?
     }

@@ -10,11 +10,12 @@
 //!
 //! ```
 //! use mrt_sim::config::SimConfig;
-//! use mrt_sim::world::{Drive, World};
+//! use mrt_core::Twist;
+//! use mrt_sim::world::World;
 //!
 //! let mut world = World::new(&SimConfig::default(), 1);
 //! world.place_robot(0, mrt_core::Pose2::new(0.0, 0.0, 0.0));
-//! world.drive(0, Drive { forward: 1.0, left: 0.0, turn: 0.0 });
+//! world.drive(0, Twist { vx: 1.0, vy: 0.0, omega: 0.0 });
 //! for _ in 0..100 {
 //!     world.step(); // 10 ms each
 //! }

@@ -19,7 +19,8 @@
 
 use crate::config::SimConfig;
 use crate::sensor::mouse_errors;
-use crate::world::{Drive, World};
+use crate::world::World;
+use mrt_core::Twist;
 use mrt_core::{normalize_angle, Pose2};
 use mrt_perception::mice_calibration::log::CalibrationLog;
 use mrt_perception::mice_calibration::{
@@ -229,7 +230,7 @@ fn validate(
     let (mut last, mut path) = (start, 0.0);
     let (mut cal, mut ideal, mut reduced) = (Pose2::default(), Pose2::default(), Pose2::default());
     for (forward, turn, seconds) in legs {
-        world.drive(0, Drive { forward, left: 0.0, turn });
+        world.drive(0, Twist { vx: forward, vy: 0.0, omega: turn });
         for step in 1..=(seconds / cfg.rules.physics_step).round() as u64 {
             world.step();
             if step % per_read != 0 {
@@ -330,10 +331,10 @@ fn drive(
         }
         let drive = match kind {
             RunKind::Straight => {
-                Drive { forward: (GAIN * left).clamp(-SPEED, SPEED), left: 0.0, turn: 0.0 }
+                Twist { vx: (GAIN * left).clamp(-SPEED, SPEED), vy: 0.0, omega: 0.0 }
             }
             RunKind::Turn => {
-                Drive { forward: 0.0, left: 0.0, turn: (GAIN * left).clamp(-TURN_RATE, TURN_RATE) }
+                Twist { vx: 0.0, vy: 0.0, omega: (GAIN * left).clamp(-TURN_RATE, TURN_RATE) }
             }
         };
         world.drive(0, drive);

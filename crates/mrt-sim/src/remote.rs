@@ -31,11 +31,11 @@ use crate::bus::book_fault;
 use crate::config::SimConfig;
 use crate::game::{MatchReport, Pitch};
 use crate::referee::Call;
+use mrt_core::Twist;
 use mrt_devices::messages::{Bye, End};
 use mrt_devices::world::{self as wire, Answer, Answers};
 use mrt_devices::{Act, Keys, Sense, PROTOCOL};
 use mrt_msgs::MemberFault;
-use mrt_plan::kinematics::Twist;
 use mrt_robot::base::Base;
 pub use mrt_robot::world::WorldPort;
 use std::collections::BTreeMap;
@@ -254,7 +254,7 @@ impl PitchWorld {
                 // The safe command: a robot without an answer for HOLD stands still.
                 let since = self.answered[i].map_or(k.saturating_add(1), |a| k.saturating_sub(a));
                 if since as f64 * self.period_ns as f64 / 1e9 > HOLD + 1e-9 {
-                    self.pitch.drive(i, Twist::default().into());
+                    self.pitch.drive(i, Twist::ZERO);
                 }
                 continue;
             };
@@ -271,12 +271,12 @@ impl PitchWorld {
     /// its camera's pan, its faults.
     fn apply(&mut self, i: usize, act: &Act) {
         let twist = match (&act.twist, &act.wheels) {
-            (Some(t), _) => Some(Ok(Twist::new(t.vx, t.vy, t.omega))),
+            (Some(t), _) => Some(Ok(*t)),
             (None, Some(w)) => Some(self.base.twist_of(w).map_err(|e| e.to_string())),
             (None, None) => None,
         };
         match twist {
-            Some(Ok(t)) => self.pitch.drive(i, t.into()),
+            Some(Ok(t)) => self.pitch.drive(i, t),
             Some(Err(e)) => self.pitch.fault(i, 1, &format!("motor driver: {e}")),
             None => {}
         }
@@ -611,13 +611,13 @@ mod tests {
         let (field, mut world) =
             pitch(&cfg, 1, Patience { cycle: Duration::from_millis(50), ..short_patience() });
         let key = world.robots()[0].act();
-        let drive = |w: &PitchWorld| w.pitch.world().drive_setpoint(0).forward;
+        let drive = |w: &PitchWorld| w.pitch.world().drive_setpoint(0).vx;
         // Answer every step with a drive forward until the referee lets the robots move.
         let mut k = 0;
         while drive(&world) == 0.0 {
             assert!(k < 100, "the robot never moved");
             let mut act = act_of("home-1", k);
-            act.twist = Some(mrt_devices::messages::BodyTwist { vx: 0.5, vy: 0.0, omega: 0.0 });
+            act.twist = Some(Twist::new(0.5, 0.0, 0.0));
             field.to_world.send((key.clone(), serde_json::to_vec(&act).unwrap())).unwrap();
             world.cycle().unwrap();
             k += 1;

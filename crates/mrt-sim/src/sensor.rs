@@ -10,13 +10,13 @@
 
 use crate::config::{OdometryConfig, SensorConfig, SonarConfig};
 use crate::referee::Referee;
-use crate::world::{Drive, World};
+use crate::world::World;
 use mrt_core::frames::{Field, Framed};
+use mrt_core::Twist;
 use mrt_core::{normalize_angle, Pose2};
 use mrt_msgs::{sighting, MiceReadings};
 use mrt_perception::mice::MiceOdometry;
 use mrt_plan::guidance::Sonar;
-use mrt_plan::kinematics::Twist;
 use mrt_robot::base::Base;
 use rand::{Rng, RngCore};
 
@@ -30,7 +30,7 @@ pub trait Bodies {
     /// How often robot `i` was carried elsewhere without being told.
     fn carried(&self, i: usize) -> u32;
     /// Robot `i`'s velocity set-point.
-    fn drive_setpoint(&self, i: usize) -> Drive;
+    fn drive_setpoint(&self, i: usize) -> Twist;
     /// The robots' radius, m.
     fn robot_radius(&self) -> f64;
     /// Robot `i`'s sonar ring: each sonar's distance from the robot's edge ([`World::sonar`]).
@@ -47,7 +47,7 @@ impl Bodies for World {
     fn carried(&self, i: usize) -> u32 {
         World::carried(self, i)
     }
-    fn drive_setpoint(&self, i: usize) -> Drive {
+    fn drive_setpoint(&self, i: usize) -> Twist {
         World::drive_setpoint(self, i)
     }
     fn robot_radius(&self) -> f64 {
@@ -288,8 +288,7 @@ impl Odometer {
         let mut mice = self.mice.readings_for(d.x, d.y, normalize_angle(d.theta));
         mouse_errors(&mut mice.x_left, &mut mice.y_left, cfg, rng);
         mouse_errors(&mut mice.x_right, &mut mice.y_right, cfg, rng);
-        let drive = world.drive_setpoint(self.robot);
-        let twist = Twist::new(drive.forward, drive.left, drive.turn);
+        let twist = world.drive_setpoint(self.robot);
         let wheel_turns = self
             .base
             .wheels_for(&twist)
@@ -412,12 +411,12 @@ mod tests {
         assert_eq!(first.placed.map(|p| p.inner), Some(placed));
         let d = mice.displacement(&first.mice).unwrap();
         assert!(d.dx.hypot(d.dy) < 1e-6 && d.dtheta.abs() < 1e-6, "f32 physics: {d:?}");
-        // Drive forward, sideways and turning for 0.3 s: the mice invert to the body's true
+        // Twist forward, sideways and turning for 0.3 s: the mice invert to the body's true
         // motion (manual §4.1; they read it whole, as one arc), the wheels to the set-point.
         let start = Pose2::new(0.0, 0.0, 0.3);
         w.place_robot(2, start);
         odo.read(&w, &exact, 0.1, &mut rng);
-        let drive = crate::world::Drive { forward: 0.8, left: 0.3, turn: 1.0 };
+        let drive = Twist { vx: 0.8, vy: 0.3, omega: 1.0 };
         w.drive(2, drive);
         for _ in 0..30 {
             w.step();
@@ -451,7 +450,7 @@ mod tests {
         odo.read(&w, &cfg, 0.1, &mut rng);
         let (mut short, mut total) = (0, 0);
         for _ in 0..200 {
-            w.drive(1, crate::world::Drive { forward: 0.5, left: 0.5, turn: 0.0 });
+            w.drive(1, Twist { vx: 0.5, vy: 0.5, omega: 0.0 });
             for _ in 0..10 {
                 w.step();
             }

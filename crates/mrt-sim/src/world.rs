@@ -6,30 +6,12 @@
 //! the referee, `referee.rs`).
 
 use crate::config::SimConfig;
-use mrt_core::Pose2;
+use mrt_core::{Pose2, Twist};
 use rapier2d::prelude::*;
-
-/// A robot's velocity set-point in its own frame (m/s forward, m/s to the left, rad/s).
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct Drive {
-    /// Forward speed.
-    pub forward: f64,
-    /// Sideways speed, left positive (0 for a differential drive).
-    pub left: f64,
-    /// Turning rate, counter-clockwise positive.
-    pub turn: f64,
-}
-
-impl From<mrt_plan::kinematics::Twist> for Drive {
-    /// A body velocity (robot frame, m/s and rad/s): what a base does with its duty cycles.
-    fn from(t: mrt_plan::kinematics::Twist) -> Drive {
-        Drive { forward: t.vx, left: t.vy, turn: t.omega }
-    }
-}
 
 struct Robot {
     body: RigidBodyHandle,
-    drive: Drive,
+    drive: Twist,
     /// Simulated time when the kicker is charged again.
     kick_ready_at: f64,
     /// How often the robot was put down by hand, and where last.
@@ -115,7 +97,7 @@ impl World {
                 );
                 Robot {
                     body,
-                    drive: Drive::default(),
+                    drive: Twist::ZERO,
                     kick_ready_at: 0.0,
                     placed: (0, Pose2::default()),
                     carried: 0,
@@ -170,7 +152,7 @@ impl World {
     /// Puts a robot at rest at a pose, with a stopped drive.
     pub fn place_robot(&mut self, i: usize, pose: Pose2) {
         let Some(r) = self.robots.get_mut(i) else { return };
-        r.drive = Drive::default();
+        r.drive = Twist::ZERO;
         r.placed = (r.placed.0.wrapping_add(1), pose);
         let body = &mut self.physics.bodies[r.body];
         body.set_position(Pose::new(v(pose.x, pose.y), pose.theta as f32), true);
@@ -182,7 +164,7 @@ impl World {
     /// robot of localization tests (its mice, off the floor, feel nothing of the carry).
     pub fn carry_robot(&mut self, i: usize, pose: Pose2) {
         let Some(r) = self.robots.get_mut(i) else { return };
-        r.drive = Drive::default();
+        r.drive = Twist::ZERO;
         r.carried = r.carried.wrapping_add(1);
         let body = &mut self.physics.bodies[r.body];
         body.set_position(Pose::new(v(pose.x, pose.y), pose.theta as f32), true);
@@ -204,23 +186,23 @@ impl World {
 
     /// Robot `i`'s velocity set-point (what its wheels turn at; the body may lag behind or be
     /// blocked).
-    pub fn drive_setpoint(&self, i: usize) -> Drive {
-        self.robots.get(i).map_or(Drive::default(), |r| r.drive)
+    pub fn drive_setpoint(&self, i: usize) -> Twist {
+        self.robots.get(i).map_or(Twist::ZERO, |r| r.drive)
     }
 
     /// Sets a robot's velocity set-point (limited to the robot's top speeds).
-    pub fn drive(&mut self, i: usize, drive: Drive) {
+    pub fn drive(&mut self, i: usize, drive: Twist) {
         let r = &self.cfg.robot;
         let finite = |x: f64| if x.is_finite() { x } else { 0.0 };
-        let (mut fw, mut left) = (finite(drive.forward), finite(drive.left));
+        let (mut fw, mut left) = (finite(drive.vx), finite(drive.vy));
         let speed = fw.hypot(left);
         if speed > r.max_speed {
             fw *= r.max_speed / speed;
             left *= r.max_speed / speed;
         }
-        let turn = finite(drive.turn).clamp(-r.max_turn_rate, r.max_turn_rate);
+        let turn = finite(drive.omega).clamp(-r.max_turn_rate, r.max_turn_rate);
         if let Some(robot) = self.robots.get_mut(i) {
-            robot.drive = Drive { forward: fw, left, turn };
+            robot.drive = Twist::new(fw, left, turn);
         }
     }
 
@@ -277,17 +259,17 @@ impl World {
 
 /// Changes `body`'s velocity towards the set-point `drive` (robot frame) by at most `max_dv`
 /// (m/s) and `max_dw` (rad/s): one physics step of a robot's motors.
-pub(crate) fn accelerate(body: &mut RigidBody, drive: Drive, max_dv: f64, max_dw: f64) {
+pub(crate) fn accelerate(body: &mut RigidBody, drive: Twist, max_dv: f64, max_dw: f64) {
     let th = f64::from(body.rotation().angle());
     let (c, s) = (th.cos(), th.sin());
-    let target = (drive.forward * c - drive.left * s, drive.forward * s + drive.left * c);
+    let target = (drive.vx * c - drive.vy * s, drive.vx * s + drive.vy * c);
     let now = body.linvel();
     let (dvx, dvy) = (target.0 - f64::from(now.x), target.1 - f64::from(now.y));
     let dv = dvx.hypot(dvy);
     let k = if dv > max_dv { max_dv / dv } else { 1.0 };
     body.set_linvel(v(f64::from(now.x) + dvx * k, f64::from(now.y) + dvy * k), true);
     let w = f64::from(body.angvel());
-    let dw = (drive.turn - w).clamp(-max_dw, max_dw);
+    let dw = (drive.omega - w).clamp(-max_dw, max_dw);
     body.set_angvel((w + dw) as f32, true);
 }
 
@@ -360,7 +342,7 @@ mod tests {
     fn robots_accelerate_within_their_limits_and_respect_top_speed() {
         let mut w = world(1);
         w.place_robot(0, Pose2::new(0.0, 0.0, 0.0));
-        w.drive(0, Drive { forward: 5.0, left: 0.0, turn: 0.0 });
+        w.drive(0, Twist { vx: 5.0, vy: 0.0, omega: 0.0 });
         w.step();
         let after_one = w.robot(0).unwrap().x;
         // 2 m/s² for 10 ms: 0.02 m/s, so about 0.2 mm in the first step.
@@ -376,7 +358,7 @@ mod tests {
     fn a_robot_turns_and_drives_along_its_heading() {
         let mut w = world(1);
         w.place_robot(0, Pose2::new(0.0, 0.0, std::f64::consts::FRAC_PI_2));
-        w.drive(0, Drive { forward: 1.0, left: 0.0, turn: 0.0 });
+        w.drive(0, Twist { vx: 1.0, vy: 0.0, omega: 0.0 });
         for _ in 0..200 {
             w.step();
         }
@@ -463,8 +445,8 @@ mod tests {
             let mut w = world(2);
             w.place_robot(0, Pose2::new(-1.0, 0.0, 0.0));
             w.place_robot(1, Pose2::new(1.0, 0.2, std::f64::consts::PI));
-            w.drive(0, Drive { forward: 1.0, left: 0.0, turn: 0.3 });
-            w.drive(1, Drive { forward: 1.0, left: 0.1, turn: 0.0 });
+            w.drive(0, Twist { vx: 1.0, vy: 0.0, omega: 0.3 });
+            w.drive(1, Twist { vx: 1.0, vy: 0.1, omega: 0.0 });
             for _ in 0..500 {
                 w.step();
             }
