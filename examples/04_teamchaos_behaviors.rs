@@ -19,6 +19,7 @@
 #![allow(clippy::print_stdout)] // examples talk to the user
 
 use anyhow::{Context as _, Result};
+use mrt_core::frames::{pose_in_millimetres, setpoints_of};
 use mrt_core::{Pose2, Time};
 use mrt_msgs::robot::{lps, Estimate, Lpo, WorldSnapshot};
 use mrt_script::{Sandbox, ThinkingCap};
@@ -163,12 +164,14 @@ pub fn run(scratch: &Path, verbose: bool) -> Result<Outcome> {
         let c = attacker.cycle(field.snapshot(Time::from_millis(k * 100)));
         events.extend(c.errors.iter().map(ToString::to_string));
         let cmd = &c.command;
-        field.advance(cmd.vlin, cmd.vlat, cmd.vrot, cmd.kick, 0.1);
+        // The set-points in the behaviors' own units, as the script wrote them.
+        let (vlin, vlat, vrot) = setpoints_of(cmd.twist);
+        field.advance(vlin, vlat, vrot, cmd.kick, 0.1);
         let step = Step {
             path: c.path.clone(),
             behavior: c.behavior.clone().unwrap_or_default(),
-            vlin: cmd.vlin,
-            vrot: cmd.vrot,
+            vlin,
+            vrot,
             kick: cmd.kick,
             events,
         };
@@ -187,7 +190,7 @@ pub fn run(scratch: &Path, verbose: bool) -> Result<Outcome> {
                 step.path,
                 step.behavior,
                 step.vlin,
-                cmd.vlat,
+                vlat,
                 step.vrot
             );
             for e in &step.events {
@@ -242,22 +245,24 @@ fn run_goalkeeper(dir: &Path, verbose: bool) -> Result<Vec<KeeperMove>> {
             anyhow::bail!("goalkeeper, {name}: {e}");
         }
         let m = &c.command;
+        let (vlin, vlat, vrot) = setpoints_of(m.twist);
+        let target = m.target.map(|t| pose_in_millimetres(t.pose.inner));
         if verbose {
-            let to = m.target.map_or(String::new(), |t| {
-                format!("  to ({:.0}, {:.0}) facing {:.2} rad", t.pose.x, t.pose.y, t.pose.theta)
+            let to = target.map_or(String::new(), |t| {
+                format!("  to ({:.0}, {:.0}) facing {:.2} rad", t.x, t.y, t.theta)
             });
             println!(
-                "  {name:<34} vlin {:>6.1}  vrot {:>6.1}  vlat {:>6.1}  landmarks {}{to}",
-                m.vlin, m.vrot, m.vlat, m.track_landmarks
+                "  {name:<34} vlin {vlin:>6.1}  vrot {vrot:>6.1}  vlat {vlat:>6.1}  landmarks {}{to}",
+                m.track_landmarks
             );
         }
         out.push(KeeperMove {
             situation: name,
-            vlin: m.vlin,
-            vrot: m.vrot,
-            vlat: m.vlat,
+            vlin,
+            vrot,
+            vlat,
             track_landmarks: m.track_landmarks,
-            target: m.target.map(|t| t.pose),
+            target,
         });
     }
     Ok(out)

@@ -300,8 +300,8 @@ fn rerun(args: &ReplayArgs, recording: &Recording, robot: &str) -> Result<()> {
     Ok(())
 }
 
-/// What differs between the recorded command and the re-run's, field by field (units of
-/// `RobotCommand`: mm/s and degrees/s); nothing when both are absent or equal.
+/// What differs between the recorded command and the re-run's, field by field (SI, as
+/// `RobotCommand` holds them: m/s, rad/s, m); nothing when both are absent or equal.
 fn differences(recorded: Option<&RobotCommand>, rerun: Option<&RobotCommand>) -> Vec<String> {
     let (a, b) = match (recorded, rerun) {
         (None, None) => return Vec::new(),
@@ -312,12 +312,12 @@ fn differences(recorded: Option<&RobotCommand>, rerun: Option<&RobotCommand>) ->
     let mut out = Vec::new();
     let close = |x: f64, y: f64| (x - y).abs() <= 1e-6 * (1.0 + x.abs().max(y.abs()));
     for (name, x, y, unit) in [
-        ("vlin", a.vlin, b.vlin, "mm/s"),
-        ("vlat", a.vlat, b.vlat, "mm/s"),
-        ("vrot", a.vrot, b.vrot, "°/s"),
+        ("vx", a.twist.vx, b.twist.vx, "m/s"),
+        ("vy", a.twist.vy, b.twist.vy, "m/s"),
+        ("omega", a.twist.omega, b.twist.omega, "rad/s"),
     ] {
         if !close(x, y) {
-            out.push(format!("{name} {x:.1} → {y:.1} {unit}"));
+            out.push(format!("{name} {x:.4} → {y:.4} {unit}"));
         }
     }
     if a.kick != b.kick {
@@ -330,7 +330,7 @@ fn differences(recorded: Option<&RobotCommand>, rerun: Option<&RobotCommand>) ->
         out.push(format!("book_ball {:?} → {:?}", a.book_ball, b.book_ball));
     }
     let pose = |t: &Option<mrt_msgs::Target>| {
-        t.map(|t| (t.pose.x, t.pose.y, t.pose.theta, t.avoid, t.plan))
+        t.map(|t| (t.pose.inner.x, t.pose.inner.y, t.pose.inner.theta, t.avoid, t.plan))
     };
     match (pose(&a.target), pose(&b.target)) {
         (Some(p), Some(q))

@@ -60,7 +60,8 @@ fn behave_without_a_world_sees_nothing_and_the_goalkeeper_scans() {
     assert_eq!(cycles.len(), 3);
     // Ball not seen: gkscanobj -> lookball turns (50 deg/s in its first 400 ms) and the
     // landmarks are tracked.
-    assert_eq!(cycles[0]["command"]["vrot"], 50.0);
+    let omega = cycles[0]["command"]["twist"]["omega"].as_f64().unwrap_or_default();
+    assert!((omega - 50f64.to_radians()).abs() < 1e-12, "{omega} rad/s");
     assert_eq!(cycles[0]["command"]["track_landmarks"], true);
 }
 
@@ -73,7 +74,7 @@ fn behave_reports_script_errors_and_exits_non_zero() {
     assert!(!out.status.success());
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("bad.lua:2: runtime error") && err.contains("setVlin"), "{err}");
-    assert_eq!(lines(&out)[0]["command"]["vlin"], 0.0, "the safe command: stand still");
+    assert_eq!(lines(&out)[0]["command"]["twist"]["vx"], 0.0, "the safe command: stand still");
     std::fs::write(dir.join("broken.lua"), "if then\n").unwrap();
     let out = mrt().arg("behave").arg(dir.join("broken.lua")).output().unwrap();
     assert!(!out.status.success());

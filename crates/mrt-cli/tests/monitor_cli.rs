@@ -355,7 +355,7 @@ fn replay_robot_reruns_its_behaviors_on_the_recorded_snapshots() {
         .unwrap();
     assert!(n > 0, "{out}");
     assert!(
-        out.contains("vlin -1200.0 → -900.0 mm/s") || out.contains("vlin 1200.0 → 900.0 mm/s"),
+        out.contains("vx -1.2000 → -0.9000 m/s") || out.contains("vx 1.2000 → 0.9000 m/s"),
         "{out}"
     );
 

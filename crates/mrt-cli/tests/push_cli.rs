@@ -86,7 +86,7 @@ fn a_running_robot_takes_a_pushed_behavior_or_keeps_its_own_with_the_error_and_l
     let stop = agora.shutdown_handle();
     let robot = std::thread::spawn(move || agora.lets_work().unwrap());
     // Before the kickoff the player stands: no speed.
-    assert_eq!(fresh_command(&commands, Duration::from_secs(10)).vlin, 0.0);
+    assert_eq!(fresh_command(&commands, Duration::from_secs(10)).twist.vx, 0.0);
 
     // The editor's side: the network file, and edited copies of two files.
     let editor = scratch("push-editor");
@@ -125,7 +125,7 @@ fn a_running_robot_takes_a_pushed_behavior_or_keeps_its_own_with_the_error_and_l
     let reply: serde_json::Value = serde_json::from_str(text(&out.stdout).trim()).unwrap();
     assert_eq!(reply["installed"], false);
     assert!(reply["line"].as_u64().is_some_and(|l| l > 0), "{reply}");
-    assert_eq!(fresh_command(&commands, Duration::from_secs(2)).vlin, 0.0, "the robot stopped");
+    assert_eq!(fresh_command(&commands, Duration::from_secs(2)).twist.vx, 0.0, "the robot stopped");
     // It compiled, so it was written; refused, it was taken back: the disk holds what runs.
     assert_eq!(std::fs::read_to_string(robot_dir.join("player.hfsm.lua")).unwrap(), machine);
 
@@ -140,8 +140,8 @@ fn a_running_robot_takes_a_pushed_behavior_or_keeps_its_own_with_the_error_and_l
     let out = push(&net, &fast, &[]);
     assert!(out.status.success(), "{}", text(&out.stderr));
     assert!(text(&out.stdout).contains("robot 5: stand.lua installed"), "{}", text(&out.stdout));
-    let vlin = fresh_command(&commands, Duration::from_secs(2)).vlin;
-    assert!(vlin > 500.0, "the pushed stand.lua does not run: vlin {vlin} mm/s");
+    let vx = fresh_command(&commands, Duration::from_secs(2)).twist.vx;
+    assert!(vx > 0.5, "the pushed stand.lua does not run: {vx} m/s forward");
     eprintln!(
         "push to a running robot: {:.2} s, process start included",
         t.elapsed().as_secs_f64()

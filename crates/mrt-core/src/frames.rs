@@ -9,9 +9,10 @@
 //! carries its frame in its type; the conversions are named functions, each tested.
 //!
 //! Units are SI inside (metres, radians, seconds). Two edges use others because a seed's format
-//! says so: the behaviors' world snapshot and commands are in millimetres and degrees per second
-//! (TeamChaos' Lua API, seed `001` §3.3; Mr. BRIAN's rule files, MRT manual ch. 10).
-//! [`MM_PER_M`] is the one conversion factor.
+//! says so: behaviors write set-points in mm/s and degrees/s and read distances in millimetres
+//! (TeamChaos' Lua API, ThinkingCap report §3.3; Mr. BRIAN's rule files, MRT manual ch. 10).
+//! The functions here are the one place those units are converted ([`twist_from_setpoints`],
+//! [`pose_in_metres`], ...); [`MM_PER_M`] is the one conversion factor.
 //!
 //! ```
 //! use mrt_core::frames::{Attack, Field, Framed, Robot};
@@ -27,13 +28,54 @@
 //! assert!((team.inner.x - 0.0).abs() < 1e-12 && (team.inner.y + 2.0).abs() < 1e-12);
 //! ```
 
-use crate::geometry::{normalize_angle, Point2, Pose2};
+use crate::geometry::{normalize_angle, Point2, Pose2, Twist};
 use serde::{Deserialize, Deserializer, Serialize, Serializer};
 use std::f64::consts::PI;
 use std::marker::PhantomData;
 
 /// Millimetres per metre: the one conversion to the snapshot's and the rule files' unit.
 pub const MM_PER_M: f64 = 1000.0;
+
+/// A length or speed at a millimetre edge (mm, mm/s), in metres (m, m/s).
+pub fn metres(mm: f64) -> f64 {
+    mm / MM_PER_M
+}
+
+/// A length or speed (m, m/s), in millimetres (mm, mm/s) for a millimetre edge.
+pub fn millimetres(m: f64) -> f64 {
+    m * MM_PER_M
+}
+
+/// A point at a millimetre edge, in metres.
+pub fn point_in_metres(mm: Point2) -> Point2 {
+    mm / MM_PER_M
+}
+
+/// A point in metres, in millimetres for a millimetre edge.
+pub fn point_in_millimetres(m: Point2) -> Point2 {
+    m * MM_PER_M
+}
+
+/// A pose at a millimetre edge (mm, heading in radians), in metres; the heading is kept.
+pub fn pose_in_metres(mm: Pose2) -> Pose2 {
+    Pose2 { x: metres(mm.x), y: metres(mm.y), theta: mm.theta }
+}
+
+/// A pose in metres, in millimetres (heading in radians, kept) for a millimetre edge.
+pub fn pose_in_millimetres(m: Pose2) -> Pose2 {
+    Pose2 { x: millimetres(m.x), y: millimetres(m.y), theta: m.theta }
+}
+
+/// The behaviors' set-points (`setVlin`, `setVlat` in mm/s, `setVrot` in degrees/s: TeamChaos'
+/// Lua API and Mr. BRIAN's outputs) as a twist in the robot frame (m/s, rad/s).
+pub fn twist_from_setpoints(vlin: f64, vlat: f64, vrot: f64) -> Twist {
+    Twist::new(metres(vlin), metres(vlat), vrot.to_radians())
+}
+
+/// A twist as the behaviors' set-points `(vlin, vlat, vrot)`: mm/s, mm/s, degrees/s.
+pub fn setpoints_of(t: Twist) -> (f64, f64, f64) {
+    (millimetres(t.vx), millimetres(t.vy), t.omega.to_degrees())
+}
 
 /// The field frame: metres from the centre spot, x towards the east goal, y to the north.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -210,6 +252,19 @@ mod tests {
         assert!(close(r, 8f64.sqrt()) && close(b, -PI / 4.0), "{r} {b}");
         let back = me.at_range_bearing(r, b).inner;
         assert!(close(back.x, 0.0) && close(back.y, 2.0));
+    }
+
+    #[test]
+    fn the_edge_units_convert_once_each_way() {
+        let t = twist_from_setpoints(4800.0, -1920.0, 180.0);
+        assert!(close(t.vx, 4.8) && close(t.vy, -1.92) && close(t.omega, PI), "{t:?}");
+        let (vlin, vlat, vrot) = setpoints_of(t);
+        assert!(close(vlin, 4800.0) && close(vlat, -1920.0) && close(vrot, 180.0));
+        let p = pose_in_metres(Pose2::new(1500.0, -250.0, 3.0));
+        assert!(close(p.x, 1.5) && close(p.y, -0.25) && p.theta == 3.0, "{p:?}");
+        assert_eq!(pose_in_millimetres(p), Pose2::new(1500.0, -250.0, 3.0));
+        assert_eq!(point_in_metres(Point2::new(500.0, 0.0)), Point2::new(0.5, 0.0));
+        assert_eq!(point_in_millimetres(Point2::new(0.5, 0.0)), Point2::new(500.0, 0.0));
     }
 
     proptest! {

@@ -567,7 +567,15 @@ impl RobotView {
     }
 
     fn planned(&mut self, p: &PlannedPath) {
-        self.path = p.poses.iter().map(|q| self.field_point(q.x, q.y)).collect();
+        let attack = self.attack();
+        self.path = p
+            .poses
+            .iter()
+            .map(|q| {
+                let f = q.to_field(attack).inner;
+                (f.x, f.y)
+            })
+            .collect();
     }
 
     fn status(&mut self, b: BehaviorStatus) {
@@ -579,9 +587,9 @@ impl RobotView {
 
     fn command(&mut self, c: &RobotCommand) {
         self.command = Some(CommandView {
-            vlin: c.vlin / MM_PER_M,
-            vlat: c.vlat / MM_PER_M,
-            vrot: c.vrot.to_radians(),
+            vlin: c.twist.vx,
+            vlat: c.twist.vy,
+            vrot: c.twist.omega,
             kick: c.kick.is_some(),
         });
     }
@@ -648,8 +656,8 @@ mod tests {
             ..Default::default()
         };
         t.ingest("/away/0/WorldSnapshot", at(0.0), &json(&w));
-        let path =
-            PlannedPath { poses: vec![Pose2::new(500.0, -250.0, 0.0)], ..Default::default() };
+        let pose = Framed::new(Pose2::new(0.5, -0.25, 0.0));
+        let path = PlannedPath { poses: vec![pose], ..Default::default() };
         t.ingest("/away/0/PlannedPath", at(0.0), &json(&path));
         let mut seen = Percepts { line_points: vec![(1.0, -0.5)], ..Default::default() };
         seen.sightings[mrt_msgs::sighting::BALL] =

@@ -5,7 +5,7 @@
 
 use crate::*;
 use mrt_core::frames::Framed;
-use mrt_core::{Pose2, Time, Vec2};
+use mrt_core::{Pose2, Time, Twist, Vec2};
 use mrt_dcdt::describe::{AttrValue, SelfDescribing};
 use std::collections::HashSet;
 
@@ -91,10 +91,11 @@ fn every_catalogue_message_has_a_form() {
 fn default_forms() {
     let f = form_of(&ReloadRequest);
     assert_eq!(f.to_xml(), "<message timestamp=\"1.500000000\">\n  <object name=\"ReloadRequest\" class=\"ReloadRequest\"/>\n</message>");
-    // A newtype message is its content under its own name.
+    // A struct field is an object of its own, named by its path.
     let f = form_of(&MotorCommand::default());
-    assert_eq!(f.objects.len(), 1);
-    assert_eq!(attr(&f, "MotorCommand", "vlin"), (num(0.0), 0.0, 1.0));
+    assert_eq!(f.objects.len(), 2);
+    assert_eq!(attr(&f, "MotorCommand", "kick"), (sym("false"), 0.0, 1.0));
+    assert_eq!(attr(&f, "twist", "vx"), (num(0.0), 0.0, 1.0));
     // Nothing seen: every LPS object has reliability 0, and so have its attributes.
     let f = form_of(&WorldSnapshot::default());
     assert_eq!(class(&f, "lps[8]"), "Lpo");
@@ -108,27 +109,26 @@ fn default_forms() {
 #[test]
 fn a_robot_command_in_xml() {
     let command = RobotCommand {
-        vlin: 300.0,
-        vrot: -15.5,
-        vlat: 0.0,
+        twist: Twist::new(0.3, 0.0, -0.25),
         kick: Some(2),
         needs: vec![(0, 0.8)],
         track_landmarks: false,
         behavior: Some("Score".to_owned()),
         book_ball: Some(true),
-        target: Some(Target { pose: Pose2::new(1000.0, -500.0, 0.5), avoid: true, plan: false }),
+        target: Some(Target {
+            pose: Framed::new(Pose2::new(1.0, -0.5, 0.5)),
+            avoid: true,
+            plan: false,
+        }),
     };
     // Checked by hand against the rules of `mrt_dcdt::describe`: the message is the first
     // object, named and classed `RobotCommand`; its numbers in field order (`kick`'s i64 too)
     // have a `value`; `needs`, a sequence of pairs, gives `needs[0][0]` (the LPS index) and
-    // `needs[0][1]` (the necessity); bools and the behavior's name are symbols; the struct
-    // `target` is the next object, `target`, and its pose the one after, `target.pose`, of
-    // class `Pose2`. No field names an uncertainty: variability 0, reliability 1 everywhere.
+    // `needs[0][1]` (the necessity); bools and the behavior's name are symbols; the structs
+    // are the next objects: `twist`, `target`, and the target's pose, `target.pose`, of class
+    // `Pose2`. No field names an uncertainty: variability 0, reliability 1 everywhere.
     let expected = r#"<message timestamp="1.500000000">
   <object name="RobotCommand" class="RobotCommand">
-    <attribute name="vlin" value="300" variability="0" reliability="1"/>
-    <attribute name="vrot" value="-15.5" variability="0" reliability="1"/>
-    <attribute name="vlat" value="0" variability="0" reliability="1"/>
     <attribute name="kick" value="2" variability="0" reliability="1"/>
     <attribute name="needs[0][0]" value="0" variability="0" reliability="1"/>
     <attribute name="needs[0][1]" value="0.8" variability="0" reliability="1"/>
@@ -136,13 +136,18 @@ fn a_robot_command_in_xml() {
     <attribute name="behavior" symbol="Score" variability="0" reliability="1"/>
     <attribute name="book_ball" symbol="true" variability="0" reliability="1"/>
   </object>
+  <object name="twist" class="Twist">
+    <attribute name="vx" value="0.3" variability="0" reliability="1"/>
+    <attribute name="vy" value="0" variability="0" reliability="1"/>
+    <attribute name="omega" value="-0.25" variability="0" reliability="1"/>
+  </object>
   <object name="target" class="Target">
     <attribute name="avoid" symbol="true" variability="0" reliability="1"/>
     <attribute name="plan" symbol="false" variability="0" reliability="1"/>
   </object>
   <object name="target.pose" class="Pose2">
-    <attribute name="x" value="1000" variability="0" reliability="1"/>
-    <attribute name="y" value="-500" variability="0" reliability="1"/>
+    <attribute name="x" value="1" variability="0" reliability="1"/>
+    <attribute name="y" value="-0.5" variability="0" reliability="1"/>
     <attribute name="theta" value="0.5" variability="0" reliability="1"/>
   </object>
 </message>"#;
@@ -386,8 +391,8 @@ impl Samples for SonarScan {
 
 impl Samples for MotorCommand {
     fn samples() -> Vec<Self> {
-        let mut filled = RobotCommand::samples();
-        vec![MotorCommand::default(), MotorCommand(filled.pop().unwrap_or_default())]
+        let filled = MotorCommand { twist: Twist::new(1.2, -0.3, 0.5), kick: true };
+        vec![MotorCommand::default(), filled]
     }
 }
 
@@ -493,15 +498,15 @@ impl Samples for HfsmStructure {
 
 impl Samples for PlanRequest {
     fn samples() -> Vec<Self> {
-        vec![PlanRequest::default(), PlanRequest { to: Pose2::new(3000.0, 0.0, 0.0) }]
+        vec![PlanRequest::default(), PlanRequest { to: Framed::new(Pose2::new(3.0, 0.0, 0.0)) }]
     }
 }
 
 impl Samples for PlannedPath {
     fn samples() -> Vec<Self> {
         let filled = PlannedPath {
-            to: Pose2::new(3000.0, 0.0, 0.0),
-            poses: vec![Pose2::identity(), Pose2::new(250.0, 0.0, 0.0)],
+            to: Framed::new(Pose2::new(3.0, 0.0, 0.0)),
+            poses: vec![Framed::new(Pose2::identity()), Framed::new(Pose2::new(0.25, 0.0, 0.0))],
             length: 0.25,
             error: String::new(),
         };

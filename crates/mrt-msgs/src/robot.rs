@@ -3,7 +3,8 @@
 //! [`RobotCommand`] (velocities, kick, perceptual needs, behavior selection). The world model
 //! and the simulator fill the snapshot; behaviors (Lua or fuzzy) fill the command.
 
-use mrt_core::{Pose2, Time, Vec2};
+use mrt_core::frames::{setpoints_of, Framed, Team};
+use mrt_core::{Pose2, Time, Twist, Vec2};
 use serde::{Deserialize, Serialize};
 
 /// Indices of the local perceptual space (LPS) objects (`BALL`, `NET1`, ... of chaoslib).
@@ -316,17 +317,16 @@ impl WorldSnapshot {
 }
 
 /// Everything a behavior may ask for in one cycle. Fields not set keep their defaults
-/// (standing still, no kick, no needs).
+/// (standing still, no kick, no needs). SI like the rest of the bus: the behaviors' own units
+/// (`setVlin` in mm/s, `setVrot` in degrees/s, `setTarget` in mm) are converted where they
+/// are written ([`mrt_core::frames::twist_from_setpoints`]).
 #[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
 pub struct RobotCommand {
-    /// Linear velocity, mm/s (`setVlin`).
-    pub vlin: f64,
-    /// Rotational velocity, degrees/s (`setVrot`).
-    pub vrot: f64,
-    /// Lateral velocity, mm/s (`setVlat`).
-    pub vlat: f64,
+    /// The velocity to drive, robot frame: m/s forward and to the left, rad/s
+    /// counter-clockwise (`setVlin`, `setVlat`, `setVrot`).
+    pub twist: Twist,
     /// A kicking routine to perform (`setKick`).
     pub kick: Option<i64>,
     /// Perceptual needs `(LPS index, necessity)` (`setNeeded`); the largest wins per index.
@@ -337,28 +337,44 @@ pub struct RobotCommand {
     pub behavior: Option<String>,
     /// A booking request: `Some(true)` book the ball, `Some(false)` release it.
     pub book_ball: Option<bool>,
-    /// A posture for guidance to reach instead of the velocities above (`setTarget`).
+    /// A posture for guidance to reach instead of the velocity above (`setTarget`).
     pub target: Option<Target>,
 }
 
-/// A posture handed to guidance (ISocRob, seed `003` §3.2.3): instead of velocities, the
+/// A posture handed to guidance (ISocRob-2000 report §3.2.3): instead of velocities, the
 /// behavior says where to be and guidance drives there, in position mode or, with `avoid`, in
 /// potential-field mode around what the sonars see.
 #[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
 pub struct Target {
-    /// Where to be, in the team frame like [`Estimate::pose`]: mm, heading in radians.
-    pub pose: Pose2,
+    /// Where to be, team frame: metres, heading in radians.
+    pub pose: Framed<Team, Pose2>,
     /// Go round obstacles (potential-field mode) rather than straight (position mode).
     pub avoid: bool,
     /// Go along a path the planner (SPIKE) plans round the robots the world model anchored,
-    /// in position mode from pose to pose, the sonars still halting the robot (`avoid` is
-    /// then used only until the first path comes).
+    /// in position mode from pose to pose, the sonars halting the robot as in velocity mode
+    /// (`avoid` is then used only until the first path comes).
     pub plan: bool,
 }
 
 impl RobotCommand {
+    /// The forward velocity in the behaviors' unit, mm/s (what `setVlin` took).
+    pub fn vlin(&self) -> f64 {
+        setpoints_of(self.twist).0
+    }
+
+    /// The leftward velocity in the behaviors' unit, mm/s (what `setVlat` took).
+    pub fn vlat(&self) -> f64 {
+        setpoints_of(self.twist).1
+    }
+
+    /// The turn rate in the behaviors' unit, degrees/s counter-clockwise (what `setVrot`
+    /// took).
+    pub fn vrot(&self) -> f64 {
+        setpoints_of(self.twist).2
+    }
+
     /// The necessity asserted for an LPS index this cycle (0 when none), combined by max.
     pub fn need(&self, index: usize) -> f64 {
         self.needs.iter().filter(|(i, _)| *i == index).map(|(_, v)| *v).fold(0.0, f64::max)
@@ -375,7 +391,7 @@ mod tests {
         assert_eq!(w.lps.len(), lps::COUNT);
         assert_eq!(w.lps[lps::BALL].reliability, 0.0);
         let mut c = RobotCommand::default();
-        assert_eq!((c.vlin, c.kick, c.need(lps::BALL)), (0.0, None, 0.0));
+        assert_eq!((c.twist, c.kick, c.need(lps::BALL)), (Twist::ZERO, None, 0.0));
         c.needs.push((lps::NET1, 0.7));
         c.needs.push((lps::NET1, 0.4));
         assert_eq!(c.need(lps::NET1), 0.7, "needs combine by max");

@@ -1,50 +1,52 @@
-//! The Guidance µAgent of ISocRob (seed `003`, §3.2.3) as one call per control cycle: it sits
-//! between the behaviors and the motor driver and runs the mode the behavior's command asks
-//! for, with the sonar ring as its obstacle sensor.
+//! The Guidance µAgent of ISocRob (ISocRob-2000 report §3.2.3) as one call per control
+//! cycle: it sits between the behaviors and the motor driver and runs the mode the behavior's
+//! command asks for, with the sonar ring as its obstacle sensor.
 //!
 //! - a command **without a target** is a velocity reference: **velocity mode**
 //!   ([`VelocityGuard`]) passes it on unless a sonar sees an obstacle in the direction of
 //!   motion, then the translation is halted. Echoes from where the world model puts the ball
 //!   are not obstacles here: a soccer robot must be able to touch the ball, and with a sonar
-//!   ring it could not otherwise (the seed's footnote on the headaches of halting);
+//!   ring it could not otherwise (the report's footnote on the headaches of halting);
 //! - a command with a [`Target`] without `avoid`: **position mode** ([`PositionMode`]);
 //! - with `avoid`: **potential-field mode** ([`PotentialField`]): the sonar echoes, the ball's
-//!   included as the seed says, repel; the target attracts.
+//!   included as the report says, repel; the target attracts;
+//! - with `plan` (a pose on a planned path): **path mode**, position mode halted by the sonars
+//!   as velocity mode is.
 //!
-//! At this boundary the units are the behaviors' ([`RobotCommand`]: mm/s, degrees/s; poses in
-//! the team frame in mm), inside they are [`crate::guidance`]'s (m, rad).
+//! SI throughout: the command's twist in m/s and rad/s, poses in the team frame in metres.
 //!
 //! ```
+//! use mrt_core::frames::Framed;
+//! use mrt_core::{Point2, Pose2, Twist};
 //! use mrt_msgs::robot::{RobotCommand, Target};
-//! use mrt_core::{Point2, Pose2};
 //! use mrt_plan::guidance::Sonar;
 //! use mrt_plan::guide::{Guidance, Mode};
 //!
 //! let guidance = Guidance::default();
-//! let me = Pose2::new(0.0, 0.0, 0.0);
+//! let me = Framed::new(Pose2::new(0.0, 0.0, 0.0));
 //! // Forward at 1 m/s, a wall 0.3 m ahead (sonar 0): halted, still turning.
 //! let ring: Vec<Sonar> = (0..16).map(|i| Sonar::new(Sonar::ring_bearing(i, 16), 0.3)).collect();
-//! let go = RobotCommand { vlin: 1000.0, vrot: 30.0, ..Default::default() };
-//! let g = guidance.guide(&go, &me, None, &ring);
-//! assert!(g.halted && g.command.vlin == 0.0 && g.command.vrot == 30.0);
+//! let go = RobotCommand { twist: Twist::new(1.0, 0.0, 0.5), ..Default::default() };
+//! let g = guidance.guide(&go, me, None, &ring);
+//! assert!(g.halted && g.twist == Twist::new(0.0, 0.0, 0.5));
 //! // The same echo where the ball is: not an obstacle, the robot goes on to the ball.
-//! let g = guidance.guide(&go, &me, Some(Point2::new(410.0, 0.0)), &ring);
-//! assert!(!g.halted && g.command.vlin == 1000.0);
+//! let g = guidance.guide(&go, me, Some(Framed::new(Point2::new(0.41, 0.0))), &ring);
+//! assert!(!g.halted && g.twist == go.twist);
 //! // Go to (1 m, 0) in position mode: straight ahead, at most 1.2 m/s.
 //! let to = RobotCommand {
-//!     target: Some(Target { pose: Pose2::new(1000.0, 0.0, 0.0), avoid: false, plan: false }),
+//!     target: Some(Target { pose: Framed::new(Pose2::new(1.0, 0.0, 0.0)), avoid: false, plan: false }),
 //!     ..Default::default()
 //! };
-//! let g = guidance.guide(&to, &me, None, &[]);
+//! let g = guidance.guide(&to, me, None, &[]);
 //! assert_eq!(g.mode, Mode::Position);
-//! assert!((g.command.vlin - 1200.0).abs() < 1e-9 && g.command.vlat.abs() < 1e-9);
+//! assert!((g.twist.vx - 1.2).abs() < 1e-9 && g.twist.vy.abs() < 1e-9);
 //! ```
 
 use crate::guidance::{
     GuidanceCommand, Obstacle, PositionMode, PotentialField, Sonar, VelocityGuard,
 };
-use crate::kinematics::Twist;
-use mrt_core::{Point2, Pose2};
+use mrt_core::frames::{Framed, Team};
+use mrt_core::{Point2, Pose2, Twist};
 use mrt_msgs::robot::{RobotCommand, Target};
 
 /// The mode guidance ran in one cycle.
@@ -57,17 +59,19 @@ pub enum Mode {
     Position,
     /// To a target posture around what the sonars see.
     Potential,
+    /// To a pose on a planned path, straight, halted by the sonars.
+    Path,
 }
 
 /// What guidance hands to the motor driver.
-#[derive(Clone, Debug, Default, PartialEq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Guided {
-    /// The command to drive: velocities in mm/s and degrees/s, the behavior's kick, needs and
-    /// the rest kept, the target consumed.
-    pub command: RobotCommand,
+    /// The body velocity to drive, robot frame (m/s, rad/s).
+    pub twist: Twist,
     /// The mode that made it.
     pub mode: Mode,
-    /// Velocity mode: a sonar halted the translation. Target modes: the target is reached.
+    /// Velocity and path modes: a sonar halted the translation. Position and potential modes:
+    /// the target is reached.
     pub halted: bool,
 }
 
@@ -104,43 +108,52 @@ impl Guidance {
         Guidance { guard, field, ball_radius }
     }
 
-    /// One cycle: `cmd` from the behaviors, the robot's pose `me` and the ball's position (team
-    /// frame, mm; `None` when unknown), the sonar ring (robot frame, m from the centre).
+    /// One cycle: `cmd` from the behaviors, the robot's pose `me` and the ball's position
+    /// (`None` when unknown), the sonar ring (robot frame, m from the centre).
     pub fn guide(
         &self,
         cmd: &RobotCommand,
-        me: &Pose2,
-        ball: Option<Point2>,
+        me: Framed<Team, Pose2>,
+        ball: Option<Framed<Team, Point2>>,
         sonars: &[Sonar],
     ) -> Guided {
-        let pose = Pose2::new(me.x / 1000.0, me.y / 1000.0, me.theta);
-        let Some(Target { pose: target, avoid, .. }) = cmd.target else {
+        let pose = me.inner;
+        let Some(Target { pose: target, avoid, plan }) = cmd.target else {
             // Velocity mode: the reference itself, or its turn only.
-            let ball = ball.map(|b| Point2::new(b.x / 1000.0, b.y / 1000.0));
-            let echoes: Vec<Sonar> =
-                sonars.iter().filter(|s| !self.is_ball(&pose, ball, s)).copied().collect();
-            let twist = Twist::new(cmd.vlin / 1000.0, cmd.vlat / 1000.0, cmd.vrot.to_radians());
-            let halted = self.guard.apply(&twist, &echoes).done;
-            let mut command = cmd.clone();
-            if halted {
-                (command.vlin, command.vlat) = (0.0, 0.0);
-            }
-            return Guided { command, mode: Mode::Velocity, halted };
+            let (twist, halted) = self.halt_for_echoes(cmd.twist, &pose, ball, sonars);
+            return Guided { twist, mode: Mode::Velocity, halted };
         };
-        let target = Pose2::new(target.x / 1000.0, target.y / 1000.0, target.theta);
+        let target = target.inner;
+        if plan {
+            let GuidanceCommand { twist, .. } = self.position().command(&pose, &target);
+            let (twist, halted) = self.halt_for_echoes(twist, &pose, ball, sonars);
+            return Guided { twist, mode: Mode::Path, halted };
+        }
         let (mode, GuidanceCommand { twist, done }) = if avoid {
             (Mode::Potential, self.field.command(&pose, &target, &echo_obstacles(&pose, sonars)))
         } else {
             (Mode::Position, self.position().command(&pose, &target))
         };
-        let command = RobotCommand {
-            vlin: twist.vx * 1000.0,
-            vlat: twist.vy * 1000.0,
-            vrot: twist.omega.to_degrees(),
-            target: None,
-            ..cmd.clone()
-        };
-        Guided { command, mode, halted: done }
+        Guided { twist, mode, halted: done }
+    }
+
+    /// Velocity mode's guard: `twist` with its translation stopped when a sonar that does not
+    /// see the ball sees an obstacle in the direction of motion, and whether it was.
+    fn halt_for_echoes(
+        &self,
+        twist: Twist,
+        pose: &Pose2,
+        ball: Option<Framed<Team, Point2>>,
+        sonars: &[Sonar],
+    ) -> (Twist, bool) {
+        let ball = ball.map(|b| b.inner);
+        let echoes: Vec<Sonar> =
+            sonars.iter().filter(|s| !self.is_ball(pose, ball, s)).copied().collect();
+        if self.guard.apply(&twist, &echoes).done {
+            (Twist::new(0.0, 0.0, twist.omega), true)
+        } else {
+            (twist, false)
+        }
     }
 
     /// Position mode with the potential field's gains and limits.
@@ -212,35 +225,39 @@ mod tests {
         (0..16).map(|i| Sonar::new(Sonar::ring_bearing(i, 16), range)).collect()
     }
 
-    /// Velocity mode passes a reference through unchanged when nothing is near (mm/s and
-    /// degrees/s in, the same out), halts the translation for a robot ahead but not for the
-    /// ball, and looks sideways for a sideways motion.
+    fn at(x: f64, y: f64, theta: f64) -> Framed<Team, Pose2> {
+        Framed::new(Pose2::new(x, y, theta))
+    }
+
+    fn ball(x: f64, y: f64) -> Option<Framed<Team, Point2>> {
+        Some(Framed::new(Point2::new(x, y)))
+    }
+
+    /// Velocity mode passes a reference through unchanged when nothing is near, halts the
+    /// translation for a robot ahead but not for the ball, and looks sideways for a sideways
+    /// motion.
     #[test]
     fn velocity_mode_halts_for_obstacles_not_for_the_ball() {
         let g = Guidance::default();
-        let me = Pose2::new(1000.0, 500.0, std::f64::consts::FRAC_PI_2); // facing +y
-        let go = RobotCommand { vlin: 800.0, vrot: -20.0, kick: Some(1), ..Default::default() };
-        let free = g.guide(&go, &me, None, &ring(f64::INFINITY));
-        assert_eq!(
-            (free.command.clone(), free.mode, free.halted),
-            (go.clone(), Mode::Velocity, false)
-        );
-        // An echo 0.4 m ahead (inside 0.5 m): halted, turning and kick kept.
+        let me = at(1.0, 0.5, std::f64::consts::FRAC_PI_2); // facing +y
+        let go = RobotCommand { twist: Twist::new(0.8, 0.0, -0.35), ..Default::default() };
+        let free = g.guide(&go, me, None, &ring(f64::INFINITY));
+        assert_eq!((free.twist, free.mode, free.halted), (go.twist, Mode::Velocity, false));
+        // An echo 0.4 m ahead (inside 0.5 m): halted, turning kept.
         let mut near = ring(f64::INFINITY);
         near[0].range = 0.4;
-        let h = g.guide(&go, &me, None, &near);
-        assert!(h.halted && h.command.vlin == 0.0 && h.command.vrot == go.vrot);
-        assert_eq!(h.command.kick, Some(1));
-        // The ball 0.51 m ahead in the field (1000, 1010): its near side at 0.4 m is that echo.
-        let b = g.guide(&go, &me, Some(Point2::new(1000.0, 1010.0)), &near);
-        assert!(!b.halted && b.command.vlin == 800.0, "{b:?}");
+        let h = g.guide(&go, me, None, &near);
+        assert!(h.halted && h.twist == Twist::new(0.0, 0.0, -0.35), "{h:?}");
+        // The ball 0.51 m ahead in the field (1, 1.01): its near side at 0.4 m is that echo.
+        let b = g.guide(&go, me, ball(1.0, 1.01), &near);
+        assert!(!b.halted && b.twist == go.twist, "{b:?}");
         // The ball elsewhere (behind the robot) does not hide the echo ahead.
-        assert!(g.guide(&go, &me, Some(Point2::new(1000.0, 0.0)), &near).halted);
-        // Moving left (vlat) looks at sonar 4 (90°), not sonar 0.
-        let left = RobotCommand { vlat: 500.0, ..Default::default() };
-        assert!(!g.guide(&left, &me, None, &near).halted);
+        assert!(g.guide(&go, me, ball(1.0, 0.0), &near).halted);
+        // Moving left looks at sonar 4 (90°), not sonar 0.
+        let left = RobotCommand { twist: Twist::new(0.0, 0.5, 0.0), ..Default::default() };
+        assert!(!g.guide(&left, me, None, &near).halted);
         near[4].range = 0.3;
-        assert!(g.guide(&left, &me, None, &near).halted);
+        assert!(g.guide(&left, me, None, &near).halted);
     }
 
     /// Clustering by hand, robot at the origin facing +x, four sonars at 0°, 90°, 180°, 270°
@@ -287,18 +304,39 @@ mod tests {
     #[test]
     fn position_mode_by_hand() {
         let g = Guidance::default();
-        let cmd = RobotCommand {
-            target: Some(Target { pose: Pose2::new(500.0, 200.0, 0.0), avoid: false, plan: false }),
+        let target = Target { pose: at(0.5, 0.2, 0.0), avoid: false, plan: false };
+        let cmd = RobotCommand { target: Some(target), ..Default::default() };
+        let out = g.guide(&cmd, at(0.0, 0.0, 0.0), None, &ring(0.3));
+        assert_eq!(out.mode, Mode::Position);
+        assert!((out.twist.vx - 0.75).abs() < 1e-9, "{out:?}");
+        assert!((out.twist.vy - 0.3).abs() < 1e-9 && out.twist.omega.abs() < 1e-9);
+        // There: done, standing still.
+        let there = g.guide(&cmd, at(0.5, 0.2, 0.0), None, &[]);
+        assert!(there.halted && there.twist.speed() == 0.0);
+    }
+
+    /// Path mode is position mode halted by the sonars: the same twist with nothing near, its
+    /// translation stopped by an echo in the way, but not by the ball's.
+    #[test]
+    fn path_mode_is_position_mode_halted_by_the_sonars() {
+        let g = Guidance::default();
+        let to = |plan| RobotCommand {
+            target: Some(Target { pose: at(0.5, 0.0, 0.0), avoid: false, plan }),
             ..Default::default()
         };
-        let out = g.guide(&cmd, &Pose2::new(0.0, 0.0, 0.0), None, &ring(0.3));
-        assert_eq!(out.mode, Mode::Position);
-        assert!((out.command.vlin - 750.0).abs() < 1e-9, "{out:?}");
-        assert!((out.command.vlat - 300.0).abs() < 1e-9 && out.command.vrot.abs() < 1e-9);
-        assert_eq!(out.command.target, None, "the target is consumed");
-        // There: done, standing still.
-        let at = g.guide(&cmd, &Pose2::new(500.0, 200.0, 0.0), None, &[]);
-        assert!(at.halted && at.command.vlin == 0.0 && at.command.vlat == 0.0);
+        let me = at(0.0, 0.0, 0.0);
+        let free = g.guide(&to(true), me, None, &ring(f64::INFINITY));
+        assert_eq!(free.mode, Mode::Path);
+        assert_eq!(free.twist, g.guide(&to(false), me, None, &[]).twist);
+        assert!(!free.halted && free.twist.vx > 0.5, "{free:?}");
+        let mut near = ring(f64::INFINITY);
+        near[0].range = 0.3;
+        let h = g.guide(&to(true), me, None, &near);
+        assert!(h.halted && h.twist.vx == 0.0 && h.mode == Mode::Path, "{h:?}");
+        // The echo is the ball's (0.41 m ahead, its near side at 0.3 m): on it goes.
+        assert!(!g.guide(&to(true), me, ball(0.41, 0.0), &near).halted);
+        // Position mode itself drives into the echo.
+        assert!(g.guide(&to(false), me, None, &near).twist.vx > 0.5);
     }
 
     /// Potential-field mode walks round an obstacle that position mode would drive into: a
@@ -317,7 +355,7 @@ mod tests {
                 .map(|i| {
                     let bearing = Sonar::ring_bearing(i, 16);
                     let dir = p.theta + bearing;
-                    let (ox, oy) = (obstacle.x - p.x / 1000.0, obstacle.y - p.y / 1000.0);
+                    let (ox, oy) = (obstacle.x - p.x, obstacle.y - p.y);
                     // The ray from the centre meets the circle of radius 0.25 m?
                     let along = ox * dir.cos() + oy * dir.sin();
                     let off2 = ox * ox + oy * oy - along * along;
@@ -330,22 +368,22 @@ mod tests {
                 })
                 .collect()
         };
-        let target = Target { pose: Pose2::new(2000.0, 0.0, 0.0), avoid: true, plan: false };
+        let target = Target { pose: at(2.0, 0.0, 0.0), avoid: true, plan: false };
         let cmd = RobotCommand { target: Some(target), ..Default::default() };
         let mut me = Pose2::new(0.0, 0.0, 0.0);
         let mut closest = f64::INFINITY;
         for _ in 0..400 {
-            let out = g.guide(&cmd, &me, None, &sonars_at(&me));
+            let out = g.guide(&cmd, Framed::new(me), None, &sonars_at(&me));
             assert_eq!(out.mode, Mode::Potential);
-            let c = out.command;
+            let t = out.twist;
             let dt = 0.02;
             let (s, co) = me.theta.sin_cos();
-            me.x += (c.vlin * co - c.vlat * s) * dt;
-            me.y += (c.vlin * s + c.vlat * co) * dt;
-            me.theta += c.vrot.to_radians() * dt;
-            closest = closest.min((me.x / 1000.0 - obstacle.x).hypot(me.y / 1000.0 - obstacle.y));
+            me.x += (t.vx * co - t.vy * s) * dt;
+            me.y += (t.vx * s + t.vy * co) * dt;
+            me.theta += t.omega * dt;
+            closest = closest.min((me.x - obstacle.x).hypot(me.y - obstacle.y));
         }
-        assert!((me.x - 2000.0).abs() < 50.0 && me.y.abs() < 50.0, "reached: {me:?}");
+        assert!((me.x - 2.0).abs() < 0.05 && me.y.abs() < 0.05, "reached: {me:?}");
         assert!(closest > 0.5, "never touched the obstacle (0.25 + 0.25 m): {closest}");
     }
 }

@@ -12,9 +12,8 @@
 //! a sideways request turns the base while it drives the part of the request along its
 //! heading, and the behavior, which sees the robot turn, closes the loop.
 
-use mrt_core::frames::MM_PER_M;
 use mrt_core::Pose2;
-use mrt_msgs::{Displacement, RobotCommand};
+use mrt_msgs::Displacement;
 use mrt_plan::kinematics::{
     duty_cycle, integrate, nearer_end, DiffDrive, Kinematics, Omni3, OmniWheels, Steering, Twist,
     WheelSpeeds,
@@ -77,18 +76,12 @@ impl Base {
         }
     }
 
-    /// The processing side: a command (mm/s, deg/s) → one duty cycle per wheel. A command
-    /// beyond the wheels' top speed is scaled down as a whole (direction kept). On a
-    /// differential base a sideways part steers the base toward it
-    /// ([`follow_on_differential`]).
-    pub fn duties(&self, cmd: &RobotCommand) -> Vec<f64> {
-        let finite = |x: f64| if x.is_finite() { x } else { 0.0 };
-        // The command's edge units (mm/s, deg/s: the behaviors' own) to SI.
-        let twist = Twist::new(
-            finite(cmd.vlin) / MM_PER_M,
-            finite(cmd.vlat) / MM_PER_M,
-            finite(cmd.vrot).to_radians(),
-        );
+    /// The processing side: a body velocity (robot frame, m/s and rad/s; a component that is
+    /// not finite is 0) → one duty cycle per wheel. A twist beyond the wheels' top speed is
+    /// scaled down as a whole (direction kept). On a differential base a sideways part steers
+    /// the base toward it ([`follow_on_differential`]).
+    pub fn duties(&self, twist: &Twist) -> Vec<f64> {
+        let twist = twist.finite_or_zero();
         match self {
             Base::Differential(k) => {
                 let w = k.inverse(&k.limit(&follow_on_differential(twist)));
@@ -209,20 +202,20 @@ pub fn follow_on_differential(t: Twist) -> Twist {
 mod tests {
     use super::*;
 
-    fn cmd(vlin: f64, vlat: f64, vrot: f64) -> RobotCommand {
-        RobotCommand { vlin, vlat, vrot, ..Default::default() }
+    fn cmd(vx: f64, vy: f64, omega: f64) -> Twist {
+        Twist::new(vx, vy, omega)
     }
 
     #[test]
     fn a_differential_base_steers_toward_a_sideways_request() {
         let b = Base::parse("differential").unwrap();
         // Ahead and to the left: forward at the request's projection, turning left.
-        let d = b.twist_for(&b.duties(&cmd(500.0, 400.0, 0.0))).unwrap();
+        let d = b.twist_for(&b.duties(&cmd(0.5, 0.4, 0.0))).unwrap();
         assert!(d.vy == 0.0 && d.omega > 0.5 && d.vx > 0.0, "{d:?}");
         let straight = follow_on_differential(Twist::new(0.5, 0.4, 0.0));
         assert!((straight.vx - 0.5).abs() < 1e-9, "{straight:?}");
         // A pure strafe to the right turns right in place.
-        let d = b.twist_for(&b.duties(&cmd(0.0, -400.0, 0.0))).unwrap();
+        let d = b.twist_for(&b.duties(&cmd(0.0, -0.4, 0.0))).unwrap();
         assert!(d.vx.abs() < 1e-9 && d.omega < -1.0, "{d:?}");
         // Behind and to the left: backs up, turning its back toward it (clockwise).
         let d = follow_on_differential(Twist::new(-0.5, 0.1, 0.0));
@@ -267,7 +260,7 @@ mod tests {
     #[test]
     fn an_omni_base_moves_any_way_and_commands_round_trip() {
         let b = Base::parse("omni").unwrap();
-        let d = b.twist_for(&b.duties(&cmd(300.0, -400.0, 45.0))).unwrap();
+        let d = b.twist_for(&b.duties(&cmd(0.3, -0.4, 45f64.to_radians()))).unwrap();
         assert!((d.vx - 0.3).abs() < 1e-9 && (d.vy + 0.4).abs() < 1e-9, "{d:?}");
         assert!((d.omega - 45f64.to_radians()).abs() < 1e-9);
     }
@@ -278,7 +271,7 @@ mod tests {
     #[test]
     fn too_fast_is_scaled_down_keeping_the_direction() {
         let b = Base::parse("omni").unwrap();
-        let duty = b.duties(&cmd(5000.0, 0.0, 0.0));
+        let duty = b.duties(&cmd(5.0, 0.0, 0.0));
         assert!(duty.iter().all(|x| x.abs() <= 1.0 + 1e-12));
         let d = b.twist_for(&duty).unwrap();
         assert!((d.vx - 1.2 / 60f64.to_radians().sin()).abs() < 1e-6 && d.vy.abs() < 1e-9, "{d:?}");
@@ -289,7 +282,7 @@ mod tests {
         for b in [Base::parse("differential").unwrap(), Base::parse("omni").unwrap()] {
             // What one second at these duty cycles turns the wheels by, moves the robot by
             // the arc of the twist they make.
-            let duty = b.duties(&cmd(400.0, 0.0, 30.0));
+            let duty = b.duties(&cmd(0.4, 0.0, 30f64.to_radians()));
             let turns = b.wheel_speeds(&duty).unwrap();
             let d = b.motion(&turns).unwrap();
             let p = integrate(Pose2::default(), &b.twist_for(&duty).unwrap(), 1.0);

@@ -30,6 +30,7 @@ use crate::brain::Brain;
 use crate::stacks::{drive_to, walk_to_kickoff, Geometry};
 use mrt_blackboard::config::load_text;
 use mrt_blackboard::{Blackboard, Pattern};
+use mrt_core::frames::Framed;
 use mrt_core::{normalize_angle, Pose2};
 use mrt_msgs::robot::{lps, GameState, RobotCommand, Target, WorldSnapshot};
 use mrt_team::isocrob::{
@@ -76,7 +77,7 @@ fn team_ball_heading(w: &WorldSnapshot) -> Option<f64> {
 
 /// [`drive_to`] at up to 1.5 m/s.
 fn go(me: Pose2, target: (f64, f64), face: f64, c: &mut RobotCommand) {
-    drive_to(me, target, face, 1500.0, c);
+    drive_to(me, target, face, 1.5, c);
 }
 
 /// One ISocRob robot: the Machine µAgent and the Kicker µAgent on a shared blackboard.
@@ -304,7 +305,7 @@ impl IsocrobBrain {
             AttackerState::Home | AttackerState::ShouldIGo => {
                 let face = look_at_ball(w, p.seen_ball);
                 c.target = Some(Target {
-                    pose: Pose2::new(home.0 * MM, home.1 * MM, face),
+                    pose: Framed::new(Pose2::new(home.0, home.1, face)),
                     avoid: true,
                     plan: false,
                 });
@@ -349,7 +350,7 @@ impl IsocrobBrain {
             AttackerState::SearchBall => {
                 let turn =
                     team_ball_heading(w).map_or(1.0, |h| normalize_angle(h - me.theta).signum());
-                c.vrot = turn * p.search_speed.to_degrees();
+                c.twist.omega = turn * p.search_speed;
             }
         }
         c
@@ -372,7 +373,7 @@ impl IsocrobBrain {
         let face = look_at_ball(w, p.seen_ball);
         RobotCommand {
             target: Some(Target {
-                pose: Pose2::new((-hl + p.keeper.axis) * MM, y * MM, face),
+                pose: Framed::new(Pose2::new(-hl + p.keeper.axis, y, face)),
                 avoid: false,
                 plan: false,
             }),
@@ -537,7 +538,7 @@ mod tests {
         assert_eq!(r.state(), AttackerState::RunAndKick);
         let c = r.cycle(&w);
         assert_eq!(c.kick, Some(1), "{c:?}");
-        assert!(c.vlin > 0.0);
+        assert!(c.twist.vx > 0.0);
     }
 
     /// Attacker 2 of its team with the Machine's parameter `name` set to `value` on its
@@ -569,7 +570,7 @@ mod tests {
         assert_eq!(r.state(), AttackerState::RunAndKick);
         let c = r.cycle(&far);
         assert_eq!((c.kick, r.state()), (None, AttackerState::RunAndKick), "{c:?}");
-        assert!(c.vlin > 0.0, "pushes on: {c:?}");
+        assert!(c.twist.vx > 0.0, "pushes on: {c:?}");
         let c = r.cycle(&world(0.1, me, (7400.0, 0.0)));
         assert_eq!(c.kick, Some(1), "within reach: {c:?}");
     }
@@ -592,13 +593,13 @@ mod tests {
         assert_eq!(r.state(), AttackerState::FaceGoal);
         let c = r.cycle(&w);
         assert_eq!(r.state(), AttackerState::FaceGoal);
-        assert!(c.vrot.abs() < 1e-9, "keeps facing the ball: {c:?}");
+        assert!(c.twist.omega.abs() < 1e-9, "keeps facing the ball: {c:?}");
         // By hand: the posture is 350 mm behind the ball, at about (−349, 623) mm; the robot
         // is at −90° about the ball and the posture at about 176°, the shorter way clockwise.
         // The waypoint is 0.6 rad on, at −124° on the 600 mm circle: (−339, 105) mm, in the
         // robot's frame (facing +y) 105 mm ahead and 339 mm to its left.
-        assert!(c.vlat > 0.0 && c.vlin > 0.0, "{c:?}");
-        assert!((c.vlin / c.vlat - 105.0 / 339.0).abs() < 0.02, "{c:?}");
+        assert!(c.twist.vy > 0.0 && c.twist.vx > 0.0, "{c:?}");
+        assert!((c.twist.vx / c.twist.vy - 105.0 / 339.0).abs() < 0.02, "{c:?}");
     }
 
     /// With `ahead` 0.3 rad, FACE_GOAL hands over to RUN_AND_KICK only when the robot faces
@@ -632,7 +633,7 @@ mod tests {
         r.cycle(&w);
         let c = r.cycle(&w);
         assert_eq!(r.state(), AttackerState::ShouldIGo);
-        c.target.unwrap().pose
+        c.target.unwrap().pose.inner
     }
 
     /// With `def.guard` 0.33, the defender waits on the line from the centre of its own goal
@@ -641,9 +642,9 @@ mod tests {
     #[test]
     fn the_defender_guards_the_line_from_its_goal_to_the_ball() {
         let t = waiting_at(Role::Defender, 0, "def.guard", 0.33);
-        assert!((t.x + 7020.0).abs() < 1e-6 && (t.y - 990.0).abs() < 1e-6, "{t:?}");
+        assert!((t.x + 7.02).abs() < 1e-9 && (t.y - 0.99).abs() < 1e-9, "{t:?}");
         let t = waiting_at(Role::Defender, 0, "def.guard", 0.0);
-        assert!((t.x + 5000.0).abs() < 1e-6 && (t.y - 1250.0).abs() < 1e-6, "{t:?}");
+        assert!((t.x + 5.0).abs() < 1e-9 && (t.y - 1.25).abs() < 1e-9, "{t:?}");
     }
 
     /// With `att.support` 2 m, an attacker not going for the ball waits 2 m ahead of where
@@ -652,9 +653,9 @@ mod tests {
     #[test]
     fn an_attacker_waits_ahead_of_the_ball_to_support() {
         let t = waiting_at(Role::Attacker, 1, "att.support", 2.0);
-        assert!((t.x + 1000.0).abs() < 1e-6 && (t.y + 1250.0).abs() < 1e-6, "{t:?}");
+        assert!((t.x + 1.0).abs() < 1e-9 && (t.y + 1.25).abs() < 1e-9, "{t:?}");
         let t = waiting_at(Role::Attacker, 1, "att.support", -1.5);
-        assert!((t.x + 4500.0).abs() < 1e-6 && (t.y + 1250.0).abs() < 1e-6, "{t:?}");
+        assert!((t.x + 4.5).abs() < 1e-9 && (t.y + 1.25).abs() < 1e-9, "{t:?}");
     }
 
     /// The goalkeeper stands on its axis (0.4 m before its goal line) in front of the ball,
@@ -666,8 +667,8 @@ mod tests {
         let mut r = IsocrobBrain::new(1, Role::Goalkeeper, 0, bb.clone()).unwrap();
         let me = Pose2::new(-8600.0, 0.0, 0.0);
         let c = r.cycle(&world(0.0, me, (-5000.0, 500.0)));
-        let t = c.target.unwrap().pose;
-        assert!((t.x + 8600.0).abs() < 1e-9 && (t.y - 500.0).abs() < 1e-9, "{t:?}");
+        let t = c.target.unwrap().pose.inner;
+        assert!((t.x + 8.6).abs() < 1e-9 && (t.y - 0.5).abs() < 1e-9, "{t:?}");
         assert_eq!(bb.get::<String>("local.var.machine.state").unwrap(), "FOLLOW");
         assert_eq!(bb.get::<String>("local.var.machine.role").unwrap(), "goalkeeper");
     }

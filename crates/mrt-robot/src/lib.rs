@@ -32,7 +32,7 @@
 //! w.game_state = mrt_msgs::GameState::Playing;
 //! w.lps[lps::BALL] = Lpo { rho: 1000.0, theta: 0.0, reliability: 1.0, seen_ago: 0.0 };
 //! let cmd = Chaser::default().cycle(&w);
-//! assert!(cmd.vlin > 0.0, "{cmd:?}");
+//! assert!(cmd.twist.vx > 0.0, "{cmd:?}");
 //! ```
 #![deny(missing_docs)]
 

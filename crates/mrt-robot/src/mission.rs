@@ -52,7 +52,7 @@ use crate::members::{Driver, Motor};
 use crate::planner::carrot_at;
 use mrt_core::{FileError, Point2, Pose2};
 use mrt_dcdt::{Activation, Agora, Context, Member, MemberError, RequestType};
-use mrt_msgs::{MotorCommand, Odometry, RobotCommand, SonarScan};
+use mrt_msgs::{MotorCommand, Odometry, SonarScan};
 use mrt_perception::mice::{update_pose, MiceOdometry};
 use mrt_plan::guidance::{PositionMode, PositionParams, Sonar, VelocityGuard};
 use mrt_plan::kinematics::Twist;
@@ -644,12 +644,7 @@ impl Member for RobyMember {
             .lock()
             .map_err(|_| MemberError::from("Roby's lock is poisoned"))?
             .step(now, &odometry, &scan.sonars);
-        ctx.publish(MotorCommand(RobotCommand {
-            vlin: twist.vx * 1000.0,
-            vlat: twist.vy * 1000.0,
-            vrot: twist.omega.to_degrees(),
-            ..RobotCommand::default()
-        }));
+        ctx.publish(MotorCommand { twist, kick: false });
         Ok(())
     }
 }

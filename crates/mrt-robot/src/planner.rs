@@ -12,6 +12,7 @@
 //! old. Meanwhile it drives in position mode towards a point [`LOOKAHEAD`] ahead on the path
 //! ([`carrot`]), with the sonars halting the robot as in velocity mode.
 
+use mrt_core::frames::{metres, point_in_metres, pose_in_metres, Framed, Team};
 use mrt_core::{Point2, Pose2};
 use mrt_dcdt::{Context, Member, MemberError, MsgRef, RequestType};
 use mrt_msgs::{PlanRequest, PlannedPath, WorldSnapshot};
@@ -20,8 +21,8 @@ use mrt_plan::spike::{PlanMap, Shape, Spike, SpikeParams};
 /// Anchored robots at least this reliable are planned round.
 pub const PLAN_RELIABILITY: f64 = 0.3;
 
-/// Guidance drives towards the path's pose this far ahead of the robot, mm.
-pub const LOOKAHEAD: f64 = 500.0;
+/// Guidance drives towards the path's pose this far ahead of the robot, m.
+pub const LOOKAHEAD: f64 = 0.5;
 
 /// A path older than this is asked for again (the robots round it move), s.
 pub const REPLAN: f64 = 1.0;
@@ -33,7 +34,7 @@ pub(crate) struct Planner {
     /// The latest world snapshot, kept as received and read only when a request comes (no
     /// copy each cycle).
     world: Option<MsgRef>,
-    /// SPIKE on the field last planned on: its size between the lines, mm.
+    /// SPIKE on the field last planned on: its size between the lines, m.
     spike: Option<((f64, f64), Spike)>,
 }
 
@@ -46,40 +47,35 @@ impl Planner {
 
     /// SPIKE on the field the world snapshot names (made again when the field changes).
     fn spike(&mut self, field: &mrt_msgs::Field) -> Result<&Spike, String> {
-        let size = (2.0 * field.half_length, 2.0 * field.half_width);
+        // The world snapshot's millimetres (what behaviors read) to SI.
+        let size = (metres(2.0 * field.half_length), metres(2.0 * field.half_width));
         if self.spike.as_ref().is_none_or(|(s, _)| *s != size) {
-            let map = PlanMap::soccer_field(size.0 / 1000.0, size.1 / 1000.0)
-                .map_err(|e| e.to_string())?;
+            let map = PlanMap::soccer_field(size.0, size.1).map_err(|e| e.to_string())?;
             let spike = Spike::new(map, self.params).map_err(|e| e.to_string())?;
             self.spike = Some((size, spike));
         }
         self.spike.as_ref().map(|(_, s)| s).ok_or_else(|| "no planner".to_string())
     }
 
-    /// The answer to a request for `to` (team frame, mm), from world snapshot `w`.
-    fn plan(&mut self, w: &WorldSnapshot, to: Pose2) -> PlannedPath {
-        let me = w.my_pos.pose;
+    /// The answer to a request for `to`, from world snapshot `w`.
+    fn plan(&mut self, w: &WorldSnapshot, to: Framed<Team, Pose2>) -> PlannedPath {
         let radius = self.params.robot_radius;
         let moving: Vec<Shape> = w
             .robots
             .iter()
             .filter(|r| r.reliability >= PLAN_RELIABILITY)
-            .map(|r| Shape::Disc { centre: Point2::new(r.x / 1000.0, r.y / 1000.0), radius })
+            .map(|r| Shape::Disc { centre: point_in_metres(Point2::new(r.x, r.y)), radius })
             .collect();
-        let from = Point2::new(me.x / 1000.0, me.y / 1000.0);
-        let goal = Point2::new(to.x / 1000.0, to.y / 1000.0);
-        let planned = self
-            .spike(&w.field)
-            .and_then(|s| s.plan_among(from, goal, &moving).map_err(|e| e.to_string()));
+        let from = pose_in_metres(w.my_pos.pose).position();
+        let planned = self.spike(&w.field).and_then(|s| {
+            s.plan_among(from, to.inner.position(), &moving).map_err(|e| e.to_string())
+        });
         match planned {
             Ok(plan) => {
-                let mut poses: Vec<Pose2> = plan
-                    .poses
-                    .iter()
-                    .map(|p| Pose2::new(p.x * 1000.0, p.y * 1000.0, p.theta))
-                    .collect();
+                let mut poses: Vec<Framed<Team, Pose2>> =
+                    plan.poses.iter().copied().map(Framed::new).collect();
                 if let Some(last) = poses.last_mut() {
-                    last.theta = to.theta;
+                    last.inner.theta = to.inner.theta;
                 }
                 PlannedPath { to, poses, length: plan.length, error: String::new() }
             }
@@ -118,49 +114,66 @@ impl Member for Planner {
     }
 }
 
-/// Where guidance drives next on `path` from `me` (team frame, mm): the first pose past the
-/// one nearest the robot that is at least [`LOOKAHEAD`] away, or the path's last pose.
-/// `None` for an empty path.
-pub fn carrot(path: &[Pose2], me: Pose2) -> Option<Pose2> {
-    carrot_at(path, me, LOOKAHEAD)
+/// Where guidance drives next on `path` from `me`: the first pose past the one nearest the
+/// robot that is at least [`LOOKAHEAD`] away, or the path's last pose. `None` for an empty
+/// path.
+pub fn carrot(
+    path: &[Framed<Team, Pose2>],
+    me: Framed<Team, Pose2>,
+) -> Option<Framed<Team, Pose2>> {
+    carrot_by(path, me.inner.position(), |p| p.inner.position(), LOOKAHEAD)
 }
 
-/// The first pose of `path` past the one nearest `me` that is at least `lookahead` away
-/// (in the path's unit), or the path's last pose; `None` for an empty path.
+/// The first pose of `path` past the one nearest `me` that is at least `lookahead` away (in
+/// the path's unit), or the path's last pose; `None` for an empty path.
 pub fn carrot_at(path: &[Pose2], me: Pose2, lookahead: f64) -> Option<Pose2> {
-    let d = |p: &Pose2| (p.x - me.x).hypot(p.y - me.y);
+    carrot_by(path, me.position(), Pose2::position, lookahead)
+}
+
+/// [`carrot_at`] for poses of any kind, `at` telling where each is.
+fn carrot_by<P: Copy>(
+    path: &[P],
+    me: Point2,
+    at: impl Fn(&P) -> Point2,
+    lookahead: f64,
+) -> Option<P> {
+    let d = |p: &P| (at(p) - me).norm();
     let nearest = (0..path.len()).min_by(|&a, &b| d(&path[a]).total_cmp(&d(&path[b])))?;
     path[nearest..].iter().find(|p| d(p) >= lookahead).or(path.last()).copied()
 }
 
 /// Whether `path` was planned for `to` ([`same_goal`]).
-pub fn plans_for(path: &PlannedPath, to: Pose2) -> bool {
+pub fn plans_for(path: &PlannedPath, to: Framed<Team, Pose2>) -> bool {
     same_goal(path.to, to)
 }
 
-/// Whether two goals are one for the planner: within 200 mm and 0.3 rad.
-pub fn same_goal(a: Pose2, b: Pose2) -> bool {
-    (a.x - b.x).hypot(a.y - b.y) <= 200.0
-        && mrt_core::normalize_angle(a.theta - b.theta).abs() <= 0.3
+/// Whether two goals are one for the planner: within 0.2 m and 0.3 rad.
+pub fn same_goal(a: Framed<Team, Pose2>, b: Framed<Team, Pose2>) -> bool {
+    let (a, b) = (a.inner, b.inner);
+    (a.x - b.x).hypot(a.y - b.y) <= 0.2 && mrt_core::normalize_angle(a.theta - b.theta).abs() <= 0.3
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
 
+    fn at(x: f64, y: f64, theta: f64) -> Framed<Team, Pose2> {
+        Framed::new(Pose2::new(x, y, theta))
+    }
+
     #[test]
     fn the_carrot_is_half_a_metre_ahead_on_the_path_then_the_goal() {
-        let path: Vec<Pose2> =
-            (0..=8).map(|k| Pose2::new(250.0 * f64::from(k), 0.0, 0.0)).collect();
-        // At (260, 100): nearest pose (250, 0); the first from there 500 mm away is (750, 0)
-        // (distance hypot(490, 100) = 500.1).
-        assert_eq!(carrot(&path, Pose2::new(260.0, 100.0, 0.0)), Some(Pose2::new(750.0, 0.0, 0.0)));
+        let path: Vec<Framed<Team, Pose2>> =
+            (0..=8).map(|k| at(0.25 * f64::from(k), 0.0, 0.0)).collect();
+        // At (0.26, 0.1): nearest pose (0.25, 0); the first from there 0.5 m away is (0.75, 0)
+        // (distance hypot(0.49, 0.1) = 0.5001).
+        assert_eq!(carrot(&path, at(0.26, 0.1, 0.0)), Some(at(0.75, 0.0, 0.0)));
         // Near the end: the goal.
-        assert_eq!(carrot(&path, Pose2::new(1900.0, 0.0, 0.0)), Some(Pose2::new(2000.0, 0.0, 0.0)));
-        assert_eq!(carrot(&[], Pose2::default()), None);
-        let planned = PlannedPath { to: Pose2::new(2000.0, 0.0, 0.0), ..PlannedPath::default() };
-        assert!(plans_for(&planned, Pose2::new(2150.0, 0.0, 0.2)));
-        assert!(!plans_for(&planned, Pose2::new(2300.0, 0.0, 0.0)));
+        assert_eq!(carrot(&path, at(1.9, 0.0, 0.0)), Some(at(2.0, 0.0, 0.0)));
+        assert_eq!(carrot(&[], at(0.0, 0.0, 0.0)), None);
+        let planned = PlannedPath { to: at(2.0, 0.0, 0.0), ..PlannedPath::default() };
+        assert!(plans_for(&planned, at(2.15, 0.0, 0.2)));
+        assert!(!plans_for(&planned, at(2.3, 0.0, 0.0)));
     }
 
     /// The planner on a field with a robot anchored between the start and the goal: the path
@@ -178,14 +191,15 @@ mod tests {
             reliability: 0.9,
             ..Default::default()
         });
-        let path = planner.plan(&w, Pose2::new(3000.0, 0.0, 1.0));
+        let path = planner.plan(&w, at(3.0, 0.0, 1.0));
         assert!(path.error.is_empty(), "{path:?}");
         assert!(path.length > 6.0 && path.length < 6.5, "{}", path.length);
-        let nearest = path.poses.iter().map(|p| p.x.hypot(p.y)).fold(f64::INFINITY, f64::min);
-        assert!(nearest >= 590.0, "{nearest}");
-        assert_eq!(path.poses.last().map(|p| p.theta), Some(1.0));
+        let nearest =
+            path.poses.iter().map(|p| p.inner.x.hypot(p.inner.y)).fold(f64::INFINITY, f64::min);
+        assert!(nearest >= 0.59, "{nearest}");
+        assert_eq!(path.poses.last().map(|p| p.inner.theta), Some(1.0));
         // A goal inside the walls' band is moved out; one far outside the field is refused.
-        let outside = planner.plan(&w, Pose2::new(50_000.0, 0.0, 0.0));
+        let outside = planner.plan(&w, at(50.0, 0.0, 0.0));
         assert!(outside.poses.is_empty() && outside.error.contains("no path"), "{outside:?}");
     }
 }

@@ -17,6 +17,7 @@
 use crate::brain::Brain;
 use crate::config::RobotConfig;
 use crate::files::FilesDir;
+use mrt_core::frames::{millimetres, pose_in_metres, twist_from_setpoints, Framed};
 use mrt_core::{Point2, Pose2};
 use mrt_fuzzy::brian::Brian;
 use mrt_msgs::robot::{lps, Field, GameState, Lpo, RobotCommand, Target, WorldSnapshot};
@@ -395,11 +396,11 @@ impl Brain for MilanBrain {
         let inputs = self.inputs(w);
         let out = self.brian.run(&inputs);
         let mut c = RobotCommand::default();
+        // Mr. BRIAN's outputs: SpeedModule mm/s, SpeedAngle degrees, Rotation degrees/s.
         let speed = out.get("SpeedModule").copied().unwrap_or(0.0);
         let dir = out.get("SpeedAngle").copied().unwrap_or(0.0).to_radians();
-        c.vlin = speed * dir.cos();
-        c.vlat = speed * dir.sin();
-        c.vrot = out.get("Rotation").copied().unwrap_or(0.0);
+        let rotation = out.get("Rotation").copied().unwrap_or(0.0);
+        c.twist = twist_from_setpoints(speed * dir.cos(), speed * dir.sin(), rotation);
         if out.get("Kick").is_some_and(|k| *k > 0.5) {
             c.kick = Some(1);
         }
@@ -448,27 +449,27 @@ pub struct Chaser {
     pub keeper: bool,
 }
 
-/// Velocities towards a target point `(tx, ty)` (team frame, mm), turning to `face` (rad):
-/// the holonomic base's forward and sideways components at up to `max_speed` mm/s, slowing
-/// within `max_speed / 2` mm of the point, and a turn of 3°/s per degree off, at most 200°/s.
-/// The hand-written players' way to drive (the Chaser, ISocRob's Machine).
+/// Velocities towards a target point `(tx, ty)` (team frame, mm, as the world snapshot
+/// gives positions), turning to `face` (rad): the holonomic base's forward and sideways
+/// components at up to `max_speed` (m/s), slowing within `max_speed / 2` m of the point, and
+/// a turn of 3 rad/s per radian off, at most 200°/s. The hand-written players' way to drive
+/// (the Chaser, ISocRob's Machine).
 pub fn drive_to(me: Pose2, (tx, ty): (f64, f64), face: f64, max_speed: f64, c: &mut RobotCommand) {
     let (dx, dy) = (tx - me.x, ty - me.y);
     let err = mrt_core::normalize_angle(face - me.theta);
-    c.vrot = (err.to_degrees() * 3.0).clamp(-200.0, 200.0);
-    // Move in the robot frame (holonomic base): forward and sideways components.
+    let vrot = (err.to_degrees() * 3.0).clamp(-200.0, 200.0);
+    // Move in the robot frame (holonomic base): forward and sideways components, mm/s.
     let (s, co) = (me.theta.sin(), me.theta.cos());
     let (fw, left) = (dx * co + dy * s, -dx * s + dy * co);
     let d = dx.hypot(dy).max(1.0);
-    let speed = (d * 2.0).min(max_speed);
-    c.vlin = fw / d * speed;
-    c.vlat = left / d * speed;
+    let speed = (d * 2.0).min(millimetres(max_speed));
+    c.twist = twist_from_setpoints(fw / d * speed, left / d * speed, vrot);
 }
 
 impl Chaser {
     /// [`drive_to`] at up to 1.2 m/s.
     fn go(me: Pose2, target: (f64, f64), face: f64, c: &mut RobotCommand) {
-        drive_to(me, target, face, 1200.0, c);
+        drive_to(me, target, face, 1.2, c);
     }
 }
 
@@ -477,7 +478,7 @@ impl Chaser {
 pub fn walk_to_kickoff(w: &WorldSnapshot) -> Option<RobotCommand> {
     let pose = w.kickoff_pose.filter(|_| w.game_state == GameState::Ready)?;
     Some(RobotCommand {
-        target: Some(Target { pose, avoid: true, plan: false }),
+        target: Some(Target { pose: Framed::new(pose_in_metres(pose)), avoid: true, plan: false }),
         needs: vec![(lps::BALL, 1.0)],
         ..RobotCommand::default()
     })
@@ -492,7 +493,7 @@ impl Brain for Chaser {
         let ball = w.lps[lps::BALL];
         c.needs.push((lps::BALL, 1.0));
         if ball.reliability < 0.2 {
-            c.vrot = 60.0; // look around
+            c.twist.omega = 60f64.to_radians(); // look around
             return c;
         }
         let me = w.my_pos.pose;
@@ -614,7 +615,7 @@ mod tests {
         assert!(free.is_some_and(|f| f.abs() < 1e-9), "{free:?}");
         // Mr. BRIAN takes every input the Parser gives (they are in ctof.txt).
         let c = brain.cycle(&w);
-        assert!(c.vlin.is_finite());
+        assert!(c.twist.vx.is_finite());
     }
 
     /// A field player that does not see the ball turns on the spot; once it has not seen it
@@ -632,23 +633,35 @@ mod tests {
         w.my_pos.pose = Pose2::new(6000.0, 0.0, FRAC_PI_2);
         let at = |w: &mut WorldSnapshot, t: f64| w.time = Time::from_secs_f64(t);
         let c = brain.cycle(&w);
-        assert!(c.vlin.hypot(c.vlat) < 50.0 && c.vrot > 100.0, "just lost: turns {c:?}");
+        assert!(
+            c.twist.vx.hypot(c.twist.vy) < 0.05 && c.twist.omega > 100f64.to_radians(),
+            "just lost: turns {c:?}"
+        );
         at(&mut w, 3.5);
         let c = brain.cycle(&w);
-        assert!(c.vlat > 500.0 && c.vlin.abs() < 100.0 && c.vrot > 100.0, "{c:?}");
+        assert!(
+            c.twist.vy > 0.5 && c.twist.vx.abs() < 0.1 && c.twist.omega > 100f64.to_radians(),
+            "{c:?}"
+        );
         // Facing the centre: ahead, still turning.
         w.my_pos.pose = Pose2::new(6000.0, 0.0, PI);
         let c = brain.cycle(&w);
-        assert!(c.vlin > 500.0 && c.vlat.abs() < 100.0 && c.vrot > 100.0, "{c:?}");
+        assert!(
+            c.twist.vx > 0.5 && c.twist.vy.abs() < 0.1 && c.twist.omega > 100f64.to_radians(),
+            "{c:?}"
+        );
         // A teammate knows where the ball is: no walk.
         w.global_ball.quality = 0.8;
         let c = brain.cycle(&w);
-        assert!(c.vlin.hypot(c.vlat) < 50.0, "{c:?}");
+        assert!(c.twist.vx.hypot(c.twist.vy) < 0.05, "{c:?}");
         w.global_ball.quality = 0.0;
         // On the centre spot: it turns where it stands.
         w.my_pos.pose = Pose2::new(100.0, -100.0, 0.3);
         let c = brain.cycle(&w);
-        assert!(c.vlin.hypot(c.vlat) < 50.0 && c.vrot > 100.0, "{c:?}");
+        assert!(
+            c.twist.vx.hypot(c.twist.vy) < 0.05 && c.twist.omega > 100f64.to_radians(),
+            "{c:?}"
+        );
         // The ball seen again resets the clock.
         w.lps[lps::BALL] = Lpo { rho: 3000.0, theta: 0.5, reliability: 0.9, seen_ago: 0.0 };
         at(&mut w, 4.0);
@@ -657,7 +670,7 @@ mod tests {
         at(&mut w, 5.0);
         w.my_pos.pose = Pose2::new(6000.0, 0.0, PI);
         let c = brain.cycle(&w);
-        assert!(c.vlin.hypot(c.vlat) < 50.0, "seen 1 s ago: {c:?}");
+        assert!(c.twist.vx.hypot(c.twist.vy) < 0.05, "seen 1 s ago: {c:?}");
     }
 
     /// A ball by the opponent's goal line wide of a post is dribbled back out towards the

@@ -93,7 +93,7 @@ fn bench(c: &mut Criterion) {
                 std::fs::write(&path, body(k)).unwrap();
                 loop {
                     let cycle = cap.cycle(WorldSnapshot::default());
-                    if cycle.command.vlin == k as f64 {
+                    if cycle.command.vlin() == k as f64 {
                         break;
                     }
                     assert!(

@@ -184,7 +184,7 @@ mod tests {
         for _ in 0..3 {
             let c = cap.cycle(mrt_msgs::robot::WorldSnapshot::default());
             assert!(c.errors.is_empty(), "{:?}", c.errors);
-            assert_eq!(c.command.vlin, 250.0);
+            assert_eq!(c.command.vlin(), 250.0);
         }
         assert_eq!(bb.get::<i64>("local.var.behavior.cycles").unwrap(), 3);
         // Without a blackboard, `bb` is nil: the script fails with its file and line.

@@ -14,6 +14,7 @@
 use crate::runtime::LuaRuntime;
 use crate::script::ScriptError;
 use mlua::{Lua, LuaString, Table, Value};
+use mrt_core::frames::{metres, pose_in_metres, Framed};
 use mrt_core::Time;
 use mrt_msgs::robot::{lps, RobotCommand, WorldSnapshot};
 use std::cell::RefCell;
@@ -414,7 +415,8 @@ fn install_inner(lua: &Lua, io: Rc<RefCell<RobotIo>>, memory_limit: usize) -> ml
                  not ({x}, {y}, {theta})"
             )));
         }
-        let pose = mrt_core::Pose2::new(x, y, theta);
+        // The Lua API's millimetres to the command's metres.
+        let pose = Framed::new(pose_in_metres(mrt_core::Pose2::new(x, y, theta)));
         io.borrow_mut().command.target = Some(mrt_msgs::robot::Target {
             pose,
             avoid: avoid.unwrap_or(true),
@@ -424,17 +426,18 @@ fn install_inner(lua: &Lua, io: Rc<RefCell<RobotIo>>, memory_limit: usize) -> ml
     });
     // A set-point that is not a finite number is the script's fault, reported as one: NaN
     // would silently stop the robot and infinity saturate it. A huge finite one is taken as
-    // MAX_SETPOINT, far beyond any base's top speed, like any other too fast.
+    // MAX_SETPOINT, far beyond any base's top speed, like any other too fast. The Lua API's
+    // mm/s and degrees/s become the command's m/s and rad/s here.
     func!("setVlin", io, |_lua, v: f64| {
-        io.borrow_mut().command.vlin = setpoint("setVlin", v)?;
+        io.borrow_mut().command.twist.vx = metres(setpoint("setVlin", v)?);
         Ok(())
     });
     func!("setVrot", io, |_lua, v: f64| {
-        io.borrow_mut().command.vrot = setpoint("setVrot", v)?;
+        io.borrow_mut().command.twist.omega = setpoint("setVrot", v)?.to_radians();
         Ok(())
     });
     func!("setVlat", io, |_lua, v: f64| {
-        io.borrow_mut().command.vlat = setpoint("setVlat", v)?;
+        io.borrow_mut().command.twist.vy = metres(setpoint("setVlat", v)?);
         Ok(())
     });
     func!("setKick", io, |_lua, id: i64| {

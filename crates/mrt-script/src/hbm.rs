@@ -33,6 +33,7 @@ use crate::runtime::LuaRuntime;
 use crate::script::{LoadStrategy, Script, ScriptError};
 use crate::watch::Change;
 use mlua::{Lua, LuaString, MetaMethod, Table, Value, Variadic};
+use mrt_core::frames::metres;
 use mrt_fuzzy::hbm::{Blender, ControlVariable, Defuzzification};
 use mrt_fuzzy::FuzzySet;
 use mrt_msgs::robot::lps;
@@ -177,7 +178,7 @@ impl Hbm {
     /// chaos::install(&rt, io.clone())?;
     /// let hbm = Hbm::from_sources(&rt, None, &[("stop", r#"always("go", "STAY")"#)], io.clone())?;
     /// hbm.run(&rt, "stop")?;
-    /// assert_eq!(io.borrow().command.vlin, 0.0);
+    /// assert_eq!(io.borrow().command.twist.vx, 0.0);
     /// # Ok::<(), mrt_script::ScriptError>(())
     /// ```
     pub fn from_sources(
@@ -274,9 +275,10 @@ impl Hbm {
         for (v, drives) in self.drives.iter().enumerate() {
             let (Some(drives), Some(value)) = (drives, cdb.output(v)) else { continue };
             match drives {
-                Drives::Vlin => c.vlin = value,
-                Drives::Vrot => c.vrot = value,
-                Drives::Vlat => c.vlat = value,
+                // The control variables' mm/s and degrees/s, as `setVlin` and `setVrot` take them.
+                Drives::Vlin => c.twist.vx = metres(value),
+                Drives::Vrot => c.twist.omega = value.to_radians(),
+                Drives::Vlat => c.twist.vy = metres(value),
                 Drives::Kick => c.kick = (value != 0.0).then_some(value as i64),
             }
         }

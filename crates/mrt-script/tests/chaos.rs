@@ -2,6 +2,7 @@
 
 #![allow(clippy::unwrap_used)]
 
+use mrt_core::frames::{twist_from_setpoints, Framed};
 use mrt_core::{Pose2, Time};
 use mrt_msgs::robot::{lps, Estimate, GameState, Lpo, Mate, WorldSnapshot};
 use mrt_script::chaos::{install, GlobalValue, RobotIo};
@@ -34,7 +35,7 @@ fn lookball_turns_towards_where_the_ball_was_and_speeds_up_after_400_ms() {
     s.call::<()>(&rt).unwrap();
     {
         let io = io.borrow();
-        assert_eq!((io.command.vlin, io.command.vrot, io.command.vlat), (0.0, -50.0, 0.0));
+        assert_eq!((io.command.vlin(), io.command.vrot(), io.command.vlat()), (0.0, -50.0, 0.0));
         assert_eq!(io.command.need(lps::BALL), 1.0);
         assert_eq!(io.global("BALL_DIRECTION"), Some(&GlobalValue::Integer(-1)));
     }
@@ -42,16 +43,16 @@ fn lookball_turns_towards_where_the_ball_was_and_speeds_up_after_400_ms() {
     // but isNew is 0, so the stored direction is used), still slow.
     io.borrow_mut().begin_cycle(world_with_ball(0.8, 1300), "lookball");
     s.call::<()>(&rt).unwrap();
-    assert_eq!(io.borrow().command.vrot, -50.0);
+    assert_eq!(io.borrow().command.vrot(), -50.0);
     // 500 ms after it started: faster.
     io.borrow_mut().begin_cycle(world_with_ball(0.8, 1500), "lookball");
     s.call::<()>(&rt).unwrap();
-    assert_eq!(io.borrow().command.vrot, -75.0);
+    assert_eq!(io.borrow().command.vrot(), -75.0);
     // Another behavior ran in between: lookball is new again and re-reads the direction.
     io.borrow_mut().begin_cycle(world_with_ball(0.8, 1600), "go2ball");
     io.borrow_mut().begin_cycle(world_with_ball(0.8, 1700), "lookball");
     s.call::<()>(&rt).unwrap();
-    assert_eq!(io.borrow().command.vrot, 50.0);
+    assert_eq!(io.borrow().command.vrot(), 50.0);
 }
 
 #[test]
@@ -159,7 +160,8 @@ fn control_coordination_and_persistence_write_the_command() {
     assert_eq!((sum, text.as_str(), none), (9.5, "hi", None));
     let io = io.borrow();
     let c = &io.command;
-    assert_eq!((c.vlin, c.vrot, c.vlat, c.kick), (120.0, -30.0, 5.0, Some(2)));
+    // The Lua API's mm/s and degrees/s, in the command's SI units.
+    assert_eq!((c.twist, c.kick), (twist_from_setpoints(120.0, 5.0, -30.0), Some(2)));
     assert_eq!((c.need(lps::NET1), c.need(lps::BALL)), (0.7, 1.0), "max per object; clamped to 1");
     assert!(c.track_landmarks);
     assert_eq!((c.behavior.as_deref(), c.book_ball), (Some("go2ball"), Some(true)));
@@ -214,7 +216,7 @@ fn kickoff_pose_and_targets() {
     r.unwrap();
     assert_eq!(
         target,
-        Some(Target { pose: Pose2::new(-4000.0, 1500.0, 0.5), avoid: true, plan: false })
+        Some(Target { pose: Framed::new(Pose2::new(-4.0, 1.5, 0.5)), avoid: true, plan: false })
     );
     let (r, target) = run(WorldSnapshot::default(), go);
     r.unwrap();
@@ -223,14 +225,14 @@ fn kickoff_pose_and_targets() {
     r.unwrap();
     assert_eq!(
         target,
-        Some(Target { pose: Pose2::new(100.0, 200.0, 0.0), avoid: false, plan: true }),
+        Some(Target { pose: Framed::new(Pose2::new(0.1, 0.2, 0.0)), avoid: false, plan: true }),
         "a target reached along a planned path"
     );
     let (r, target) = run(WorldSnapshot::default(), "chaos.setTarget(100, 200, 0, false)");
     r.unwrap();
     assert_eq!(
         target,
-        Some(Target { pose: Pose2::new(100.0, 200.0, 0.0), avoid: false, plan: false })
+        Some(Target { pose: Framed::new(Pose2::new(0.1, 0.2, 0.0)), avoid: false, plan: false })
     );
     let (r, _) = run(WorldSnapshot::default(), "chaos.setTarget(0/0, 0, 0)");
     assert!(r.unwrap_err().to_string().contains("setTarget needs finite numbers"));
@@ -253,7 +255,7 @@ fn a_set_point_that_is_not_finite_is_a_reported_fault() {
             "{call}: {e}"
         );
         let c = &io.borrow().command;
-        assert!(c.vlin.is_finite() && c.vrot.is_finite() && c.vlat.is_finite());
+        assert!(c.vlin().is_finite() && c.vrot().is_finite() && c.vlat().is_finite());
         assert!(c.needs.is_empty());
     }
 }
@@ -270,8 +272,8 @@ fn a_huge_set_point_is_clamped_and_a_target_beyond_reach_refused() {
     let s = Script::from_source(&rt, "huge.lua", src, LoadStrategy::Compiled).unwrap();
     s.call::<()>(&rt).unwrap();
     let c = io.borrow().command.clone();
-    assert_eq!((c.vlin, c.vrot, c.vlat), (MAX_SETPOINT, -MAX_SETPOINT, MAX_SETPOINT));
-    assert!((c.vlin * 4.8).is_finite(), "a scaled set-point stays finite");
+    assert_eq!(c.twist, twist_from_setpoints(MAX_SETPOINT, MAX_SETPOINT, -MAX_SETPOINT));
+    assert!((c.twist.vx * 4.8).is_finite(), "a scaled set-point stays finite");
     for call in ["chaos.setTarget(1e308, 0, 0)", "chaos.setTarget(0, -2e9, 0)"] {
         io.borrow_mut().begin_cycle(WorldSnapshot::default(), "b");
         let s = Script::from_source(&rt, "far.lua", call, LoadStrategy::Compiled).unwrap();

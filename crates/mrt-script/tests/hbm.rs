@@ -210,10 +210,10 @@ fn rules_assert_labels_and_drive_the_command() {
 
     let c = run(&rt, &io, &hbm, "walk", ball_at(1000.0, 0)).unwrap();
     // go: FAST 0.25, SLOW 0.75 → (0.25·300 + 0.75·100) / (0.25 + 0.75) = 150.
-    close(c.vlin, 150.0);
+    close(c.vlin(), 150.0);
     // turn: LEFT 1, NONE 0.5, RIGHT 0 → (1·90 + 0.5·0) / 1.5 = 60.
-    close(c.vrot, 60.0);
-    assert_eq!(c.vlat, 33.0, "strafe was not asserted: the direct setVlat stands");
+    close(c.vrot(), 60.0);
+    assert_eq!(c.vlat(), 33.0, "strafe was not asserted: the direct setVlat stands");
     // kick (choice): HEADKICK 0.6 is the strongest and reaches 0.5 → kick 2.
     assert_eq!(c.kick, Some(2));
     assert_eq!(c.need(lps::BALL), 1.0);
@@ -228,7 +228,7 @@ fn rules_assert_labels_and_drive_the_command() {
     // Each run starts from nothing asserted: still gives go = 0 and no kick (FRONTKICK 0.3 <
     // 0.5); turn is not asserted, so vrot stays 0 (the command's default).
     let c = run(&rt, &io, &hbm, "still", ball_at(1000.0, 100)).unwrap();
-    assert_eq!((c.vlin, c.vrot, c.vlat, c.kick), (0.0, 0.0, 0.0, None));
+    assert_eq!((c.vlin(), c.vrot(), c.vlat(), c.kick), (0.0, 0.0, 0.0, None));
     assert_eq!(hbm.degrees("mood"), [("HAPPY".to_string(), 0.0), ("SAD".to_string(), 0.0)]);
 }
 
@@ -247,11 +247,11 @@ fn default_variables_use_mamdani_centroids() {
     dir.write("slow.lua", r#"rule(0.4, "go", "SLOW")"#);
     let (rt, io, hbm) = load(&dir);
     let c = run(&rt, &io, &hbm, "fast", ball_at(1000.0, 0)).unwrap();
-    close(c.vlin, 250.0);
-    close(c.vrot, 45.0);
-    close(c.vlat, -100.0);
+    close(c.vlin(), 250.0);
+    close(c.vrot(), 45.0);
+    close(c.vlat(), -100.0);
     let c = run(&rt, &io, &hbm, "slow", ball_at(1000.0, 0)).unwrap();
-    close(c.vlin, 150.0);
+    close(c.vlin(), 150.0);
 }
 
 /// `scale` stretches a default variable (its range and every label) for a robot of other
@@ -265,12 +265,12 @@ fn scale_stretches_a_default_variable_once_also_after_a_reload() {
     dir.write("fast.lua", r#"always("go", "FAST") always("turn", "LEFT")"#);
     let mut cap = ThinkingCap::with_behavior(dir.path(), "fast", Sandbox::default()).unwrap();
     let c = cap.cycle(ball_at(1000.0, 0)).command;
-    close(c.vlin, 1000.0);
-    close(c.vrot, 90.0);
+    close(c.vlin(), 1000.0);
+    close(c.vrot(), 90.0);
     dir.edit("hbm.lua", "scale(\"go\", 4) scale(\"turn\", 2) -- edited\n");
     let (reloaded, errors) = cap.reload_changed();
     assert!(errors.is_empty() && reloaded.iter().any(|r| r == "hbm"), "{reloaded:?} {errors:?}");
-    close(cap.cycle(ball_at(1000.0, 100)).command.vlin, 1000.0);
+    close(cap.cycle(ball_at(1000.0, 100)).command.vlin(), 1000.0);
     for (k, bad) in [
         r#"scale("go", 0)"#,
         r#"scale("go", -2)"#,
@@ -311,28 +311,28 @@ fn cdb_blends_sub_behaviors_by_their_activation() {
 
     // Alone, at activation 1: go 300, turn 90.
     let c = run(&rt, &io, &hbm, "fast", ball_at(1000.0, 0)).unwrap();
-    close(c.vlin, 300.0);
-    close(c.vrot, 90.0);
+    close(c.vlin(), 300.0);
+    close(c.vrot(), 90.0);
     close(activation(&io), 1.0);
 
     // mix: FAST at 0.3, SLOW at 0.7 →
     //   go   = (0.3·300 + 0.7·100) / (0.3 + 0.7) = (90 + 70) / 1 = 160,
     //   turn = (0.3·90 + 0.7·(−90)) / 1 = −36.
     let c = run(&rt, &io, &hbm, "mix", ball_at(1000.0, 100)).unwrap();
-    close(c.vlin, 160.0);
-    close(c.vrot, -36.0);
+    close(c.vlin(), 160.0);
+    close(c.vrot(), -36.0);
     close(activation(&io), 0.3);
 
     // outer uses mix at 0.5: fast runs at min(0.3, 0.5) = 0.3, slow at min(0.7, 0.5) = 0.5 →
     //   go   = (0.3·300 + 0.5·100) / 0.8 = 140 / 0.8 = 175,
     //   turn = (0.3·90 − 0.5·90) / 0.8 = −18 / 0.8 = −22.5.
     let c = run(&rt, &io, &hbm, "outer", ball_at(1000.0, 200)).unwrap();
-    close(c.vlin, 175.0);
-    close(c.vrot, -22.5);
+    close(c.vlin(), 175.0);
+    close(c.vrot(), -22.5);
 
     // A behavior used at 0 (or false) is not run at all.
     let c = run(&rt, &io, &hbm, "never", ball_at(1000.0, 300)).unwrap();
-    close(c.vlin, 0.0);
+    close(c.vlin(), 0.0);
 }
 
 #[test]
@@ -372,7 +372,7 @@ fn a_behavior_using_itself_is_an_error_naming_the_chain() {
     let (file, line, message) = runtime_error(&e);
     assert_eq!((file.as_str(), line), ("selfish.lua", 2), "{e}");
     assert!(message.contains("use: behavior 'selfish' uses itself: selfish -> selfish"), "{e}");
-    assert_eq!(io.borrow().command.vlin, 0.0, "on error nothing fuzzy is written");
+    assert_eq!(io.borrow().command.vlin(), 0.0, "on error nothing fuzzy is written");
 
     // Through another behavior: the error is raised where pong uses ping again.
     let e = run(&rt, &io, &hbm, "ping", ball_at(1000.0, 100)).unwrap_err();
@@ -394,7 +394,7 @@ fn a_behavior_using_itself_is_an_error_naming_the_chain() {
 
     // The hierarchy is usable again after the errors.
     let c = run(&rt, &io, &hbm, "fine", ball_at(1000.0, 400)).unwrap();
-    close(c.vlin, 150.0);
+    close(c.vlin(), 150.0);
     // Running an unknown behavior at top level is an error too.
     let e = run(&rt, &io, &hbm, "ghost", ball_at(1000.0, 500)).unwrap_err();
     assert!(e.to_string().contains("no behavior named 'ghost'"), "{e}");
@@ -485,7 +485,7 @@ fn bad_rules_and_arguments_are_errors_with_file_and_line_not_panics() {
     }
     // Still usable.
     let c = run(&rt, &io, &hbm, "fine", ball_at(1000.0, 9000)).unwrap();
-    close(c.vlin, 250.0);
+    close(c.vlin(), 250.0);
 }
 
 #[test]
@@ -534,7 +534,7 @@ fn hot_reload_swaps_good_edits_and_keeps_the_old_version_on_bad_ones() {
         let c = cap.cycle(ball_at(1000.0, t));
         assert!(c.errors.is_empty(), "{:?}", c.errors);
         assert_eq!(c.behavior.as_deref(), Some("walker"));
-        c.command.vlin
+        c.command.vlin()
     };
     assert_eq!((cycle(&mut cap), cycle(&mut cap)), (100.0, 100.0));
     let (reloaded, errors) = cap.reload_changed();
@@ -593,14 +593,14 @@ fn hbm_reload_changed_directly() {
     dir.write("hbm.lua", SINGLETON_HBM);
     dir.write("b.lua", r#"always("turn", "LEFT")"#);
     let (rt, io, mut hbm) = load(&dir);
-    close(run(&rt, &io, &hbm, "b", ball_at(0.0, 0)).unwrap().vrot, 90.0);
+    close(run(&rt, &io, &hbm, "b", ball_at(0.0, 0)).unwrap().vrot(), 90.0);
     dir.edit("b.lua", r#"always("turn", "RIGHT")"#);
     assert_eq!(hbm.reload_changed(&rt).0, ["b"]);
-    close(run(&rt, &io, &hbm, "b", ball_at(0.0, 100)).unwrap().vrot, -90.0);
+    close(run(&rt, &io, &hbm, "b", ball_at(0.0, 100)).unwrap().vrot(), -90.0);
     dir.edit("b.lua", r#"always("turn", "NONE""#);
     let (done, errors) = hbm.reload_changed(&rt);
     assert!(done.is_empty() && errors.len() == 1, "{done:?} {errors:?}");
-    close(run(&rt, &io, &hbm, "b", ball_at(0.0, 200)).unwrap().vrot, -90.0);
+    close(run(&rt, &io, &hbm, "b", ball_at(0.0, 200)).unwrap().vrot(), -90.0);
 }
 
 /// The watcher (`ThinkingCap::watch`) reports the edit; the cycle that reloads it already
@@ -612,7 +612,7 @@ fn a_watched_directory_reloads_at_the_next_cycle() {
     dir.write("walker.lua", r#"always("go", "SLOW")"#);
     let mut cap = ThinkingCap::with_behavior(dir.path(), "walker", Sandbox::default()).unwrap();
     cap.watch(dir.path()).unwrap();
-    assert_eq!(cap.cycle(ball_at(1000.0, 0)).command.vlin, 100.0);
+    assert_eq!(cap.cycle(ball_at(1000.0, 0)).command.vlin(), 100.0);
     dir.edit("walker.lua", r#"always("go", "FAST")"#);
     let mut seen = None;
     for k in 1..1000 {
@@ -621,18 +621,18 @@ fn a_watched_directory_reloads_at_the_next_cycle() {
             seen = Some(c);
             break;
         }
-        assert_eq!(c.command.vlin, 100.0);
+        assert_eq!(c.command.vlin(), 100.0);
         std::thread::sleep(Duration::from_millis(5));
     }
     let c = seen.expect("the edit was never picked up");
     assert_eq!(c.reloaded, ["walker"]);
-    assert_eq!(c.command.vlin, 300.0);
+    assert_eq!(c.command.vlin(), 300.0);
 
     let path = dir.edit("walker.lua", "always(\"go\",");
     let mut seen = None;
     for k in 1000..2000 {
         let c = cap.cycle(ball_at(1000.0, k * 100));
-        assert_eq!(c.command.vlin, 300.0, "the old version keeps running");
+        assert_eq!(c.command.vlin(), 300.0, "the old version keeps running");
         if !c.errors.is_empty() {
             seen = Some(c);
             break;
@@ -662,7 +662,7 @@ fn a_runaway_loop_gives_a_budget_error_and_a_stop_command_for_that_cycle() {
     let mut cap = ThinkingCap::with_behavior(dir.path(), "spin", sandbox).unwrap();
     let c = cap.cycle(ball_at(500.0, 0));
     assert!(c.errors.is_empty());
-    assert_eq!((c.command.vlin, c.command.vrot, c.command.kick), (300.0, 42.0, Some(1)));
+    assert_eq!((c.command.vlin(), c.command.vrot(), c.command.kick), (300.0, 42.0, Some(1)));
     // The ball at 2 m: the loop runs away. Budget error; the robot gets the stop command.
     let c = cap.cycle(ball_at(2000.0, 100));
     assert_eq!(c.errors.len(), 1);
@@ -679,7 +679,7 @@ fn a_runaway_loop_gives_a_budget_error_and_a_stop_command_for_that_cycle() {
     for t in [200, 300] {
         let c = cap.cycle(ball_at(500.0, t));
         assert!(c.errors.is_empty(), "{:?}", c.errors);
-        assert_eq!((c.command.vlin, c.command.vrot), (300.0, 42.0));
+        assert_eq!((c.command.vlin(), c.command.vrot()), (300.0, 42.0));
     }
     // The same inside a sub-behavior: the error names the sub-behavior's file and line.
     let mut cap = ThinkingCap::with_behavior(dir.path(), "outer", sandbox).unwrap();
@@ -694,7 +694,7 @@ fn a_runaway_loop_gives_a_budget_error_and_a_stop_command_for_that_cycle() {
     let c = cap.cycle(ball_at(500.0, 100));
     assert!(c.errors.is_empty(), "{:?}", c.errors);
     // turn LEFT (90) from outer; spin's direct setVrot(42) is overridden by the asserted turn.
-    assert_eq!((c.command.vlin, c.command.vrot), (300.0, 90.0));
+    assert_eq!((c.command.vlin(), c.command.vrot()), (300.0, 90.0));
 }
 
 #[test]
@@ -712,7 +712,7 @@ fn a_memory_bomb_gives_a_memory_error_and_a_stop_command_for_that_cycle() {
     // A budget that pays for the strings, so that memory is what ends the call.
     let sandbox = Sandbox { instruction_budget: 100_000_000, memory_limit: 8 << 20 };
     let mut cap = ThinkingCap::with_behavior(dir.path(), "bomb", sandbox).unwrap();
-    assert_eq!(cap.cycle(ball_at(500.0, 0)).command.vlin, 100.0);
+    assert_eq!(cap.cycle(ball_at(500.0, 0)).command.vlin(), 100.0);
     let c = cap.cycle(ball_at(2000.0, 100));
     match &c.errors[..] {
         [ScriptError::Memory { file, limit }] => {
@@ -724,7 +724,7 @@ fn a_memory_bomb_gives_a_memory_error_and_a_stop_command_for_that_cycle() {
     for t in 2..6 {
         let c = cap.cycle(ball_at(500.0, t * 100));
         assert!(c.errors.is_empty(), "{:?}", c.errors);
-        assert_eq!(c.command.vlin, 100.0);
+        assert_eq!(c.command.vlin(), 100.0);
     }
     assert!(cap.runtime().used_memory() < 8 << 20);
 }
@@ -778,13 +778,13 @@ fn a_failing_hbm_lua_edit_keeps_the_old_variables() {
     dir.write("hbm.lua", SINGLETON_HBM);
     dir.write("walker.lua", r#"rule(0.5, "go", "SLOW") rule(0.5, "go", "FAST")"#);
     let mut cap = ThinkingCap::with_behavior(dir.path(), "walker", Sandbox::default()).unwrap();
-    close(cap.cycle(ball_at(1000.0, 0)).command.vlin, 200.0);
+    close(cap.cycle(ball_at(1000.0, 0)).command.vlin(), 200.0);
     dir.edit("hbm.lua", &format!("error('not yet')\n{SINGLETON_HBM}"));
     let (reloaded, errors) = cap.reload_changed();
     assert!(reloaded.is_empty(), "{reloaded:?}");
     assert!(errors[0].to_string().contains("hbm.lua:1: runtime error: not yet"), "{errors:?}");
     // Observed: 167.857 (the default centroid variable).
-    close(cap.cycle(ball_at(1000.0, 100)).command.vlin, 200.0);
+    close(cap.cycle(ball_at(1000.0, 100)).command.vlin(), 200.0);
 }
 
 /// `getBehaviorInfo` inside a behavior run through `use` is that behavior's own: new the
@@ -803,7 +803,7 @@ fn a_used_behavior_has_its_own_behavior_info() {
     let info = |cap: &mut ThinkingCap, rho: f64, t: u64| {
         let c = cap.cycle(ball_at(rho, t));
         assert!(c.errors.is_empty(), "{:?}", c.errors);
-        (c.command.vlat, c.command.kick)
+        (c.command.vlat(), c.command.kick)
     };
     assert_eq!(info(&mut cap, 2000.0, 0), (0.0, None), "inner not run");
     assert_eq!(info(&mut cap, 2000.0, 100), (0.0, None));
@@ -889,7 +889,7 @@ fn a_behavior_that_keeps_running_away_is_stopped_until_a_file_is_reloaded() {
     assert!(errors.is_empty() && done.len() == 1, "{done:?} {errors:?}");
     let c = cap.cycle(ball_at(500.0, 3000));
     assert!(c.errors.is_empty(), "{:?}", c.errors);
-    assert_eq!(c.command.vlin, 300.0);
+    assert_eq!(c.command.vlin(), 300.0);
 }
 
 /// A behavior directory whose `blocker` calls `block()`, a Rust function the factory adds to
@@ -944,7 +944,7 @@ fn the_watchdog_stops_a_behavior_that_blocks_where_the_hook_cannot_see() {
     .unwrap();
     let c = robot.cycle(ball_at(500.0, 0));
     assert!(c.errors.is_empty(), "{:?}", c.errors);
-    assert_eq!(c.command.vlin, 300.0);
+    assert_eq!(c.command.vlin(), 300.0);
 
     // The behavior blocks (until the end of the test): the cycle ends at the deadline with the
     // safe command and the watchdog's error, and the robot is stopped.
@@ -967,7 +967,7 @@ fn the_watchdog_stops_a_behavior_that_blocks_where_the_hook_cannot_see() {
         assert!(c.errors.is_empty() && c.command == RobotCommand::default());
         let m = mate.cycle(ball_at(500.0, t * 100));
         assert!(m.errors.is_empty(), "{:?}", m.errors);
-        assert_eq!(m.command.vlin, 100.0);
+        assert_eq!(m.command.vlin(), 100.0);
     }
     // The back-off is over but the blocked call still runs: the restart waits for it. Once
     // it ends, the robot restarts from its files by itself, saying so once.
@@ -976,7 +976,7 @@ fn the_watchdog_stops_a_behavior_that_blocks_where_the_hook_cannot_see() {
     for t in 50..250 {
         let c = robot.cycle(ball_at(500.0, t * 100));
         assert!(c.errors.is_empty(), "{:?}", c.errors);
-        if c.command.vlin == 300.0 {
+        if c.command.vlin() == 300.0 {
             restarted = Some(c.reloaded);
             break;
         }
@@ -986,7 +986,7 @@ fn the_watchdog_stops_a_behavior_that_blocks_where_the_hook_cannot_see() {
     assert!(!robot.stopped());
     let c = robot.cycle(ball_at(500.0, 30_000));
     assert!(c.errors.is_empty() && c.reloaded.is_empty(), "{:?}", c.errors);
-    assert_eq!(c.command.vlin, 300.0);
+    assert_eq!(c.command.vlin(), 300.0);
 }
 
 /// Behaviors that keep failing stop the robot, which stands still for the back-off and then
@@ -1033,7 +1033,7 @@ fn a_stopped_robot_restarts_from_its_files_after_a_back_off() {
     }
     let c = cycle(&mut robot);
     assert!(c.errors.is_empty(), "{:?}", c.errors);
-    assert_eq!(c.command.vlin, 300.0);
+    assert_eq!(c.command.vlin(), 300.0);
     assert!(!robot.stopped());
 }
 
@@ -1074,7 +1074,7 @@ fn a_panicking_behavior_thread_is_reported_and_restarted() {
     assert!(!robot.stopped(), "restarted");
     let c = robot.cycle(ball_at(500.0, 100));
     assert!(c.errors.is_empty(), "{:?}", c.errors);
-    assert_eq!(c.command.vlin, 300.0);
+    assert_eq!(c.command.vlin(), 300.0);
     assert!(!armed.load(std::sync::atomic::Ordering::Relaxed));
 }
 

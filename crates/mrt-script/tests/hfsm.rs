@@ -539,7 +539,7 @@ fn a_runtime_error_in_state_code_names_the_file_and_line_and_the_next_step_works
                }";
     let (rt, io, mut h) = load(src);
     step(&rt, &io, &mut h, world(0, 300.0)).unwrap();
-    assert_eq!(io.borrow().command.vlin, 300.0);
+    assert_eq!(io.borrow().command.vlin(), 300.0);
     let e = step(&rt, &io, &mut h, world(100, 2000.0)).unwrap_err();
     match &e {
         ScriptError::Runtime { file, line, message, .. } => {
@@ -551,7 +551,7 @@ fn a_runtime_error_in_state_code_names_the_file_and_line_and_the_next_step_works
     assert!(e.to_string().starts_with("test.hfsm.lua:4: runtime error: ball too far"), "{e}");
     // The machine is still in A and the next step runs normally.
     step(&rt, &io, &mut h, world(200, 500.0)).unwrap();
-    assert_eq!((h.path().as_str(), io.borrow().command.vlin), ("M/A", 500.0));
+    assert_eq!((h.path().as_str(), io.borrow().command.vlin()), ("M/A", 500.0));
 
     // An endless loop in a test is stopped by the budget; the next step works.
     let (rt, io) = {
@@ -608,7 +608,7 @@ fn reload_keeps_the_active_path_while_its_states_exist() {
     step(&rt, &io, &mut h, world(0, 500.0)).unwrap();
     step(&rt, &io, &mut h, world(100, 2000.0)).unwrap();
     step(&rt, &io, &mut h, world(200, 50.0)).unwrap();
-    assert_eq!((h.path().as_str(), io.borrow().command.vlin), ("Top/Play/B", 20.0));
+    assert_eq!((h.path().as_str(), io.borrow().command.vlin()), ("Top/Play/B", 20.0));
 
     // New code in B (vlin 21), a new state C: the path stays, the new code runs.
     let v2 = V1
@@ -617,7 +617,7 @@ fn reload_keeps_the_active_path_while_its_states_exist() {
     h.reload_source(&rt, &v2).unwrap();
     assert_eq!(h.path(), "Top/Play/B");
     assert_eq!(step(&rt, &io, &mut h, world(300, 500.0)).unwrap(), None);
-    assert_eq!((h.path().as_str(), io.borrow().command.vlin), ("Top/Play/B", 21.0));
+    assert_eq!((h.path().as_str(), io.borrow().command.vlin()), ("Top/Play/B", 21.0));
     // The time in the state is kept: B was entered at 200 ms.
     assert!((h.time_in_state(Time::from_millis(350)) - 150.0).abs() < 1e-9);
 
@@ -627,7 +627,7 @@ fn reload_keeps_the_active_path_while_its_states_exist() {
     let e = h.reload_source(&rt, &v2.replace("initial = \"A\"", "initial = \"Q\"")).unwrap_err();
     assert!(e.to_string().contains("initial state 'Q'"), "{e}");
     step(&rt, &io, &mut h, world(400, 500.0)).unwrap();
-    assert_eq!((h.path().as_str(), io.borrow().command.vlin), ("Top/Play/B", 21.0));
+    assert_eq!((h.path().as_str(), io.borrow().command.vlin()), ("Top/Play/B", 21.0));
 
     // A reload without state B: the machine starts over from the root's initial state.
     let v3 = V1
@@ -636,7 +636,7 @@ fn reload_keeps_the_active_path_while_its_states_exist() {
     h.reload_source(&rt, &v3).unwrap();
     let t = step(&rt, &io, &mut h, world(500, 500.0)).unwrap();
     assert_eq!(t, None);
-    assert_eq!((h.path().as_str(), io.borrow().command.vlin), ("Top/Wait", 1.0));
+    assert_eq!((h.path().as_str(), io.borrow().command.vlin()), ("Top/Wait", 1.0));
 }
 
 #[test]
@@ -762,7 +762,7 @@ fn a_failing_enter_hook_of_a_meta_state_does_not_leave_the_machine_without_a_lea
     assert!(e.to_string().contains("enter failed"), "{e}");
     // The hook succeeds from now on: the next step must reach M's initial state X and run it.
     step(&rt, &io, &mut h, world(200, 0.0)).unwrap();
-    assert_eq!((h.path().as_str(), io.borrow().command.vlin), ("T/M/X", 7.0));
+    assert_eq!((h.path().as_str(), io.borrow().command.vlin()), ("T/M/X", 7.0));
 }
 
 /// `include "x.hfsm.lua"` reuses the machines of another file of the same directory without
@@ -790,7 +790,7 @@ fn include_reuses_machines_from_another_file() {
     assert_eq!(h.root(), "Top", "the including machine is the root");
     io.borrow_mut().new_cycle(WorldSnapshot::default());
     h.step(&rt).unwrap();
-    assert_eq!((h.path().as_str(), io.borrow().command.vlin), ("Top/M/X", 3.0));
+    assert_eq!((h.path().as_str(), io.borrow().command.vlin()), ("Top/M/X", 3.0));
     // An error inside the included file names that file and its line.
     std::fs::write(
         dir.join("inner.hfsm.lua"),

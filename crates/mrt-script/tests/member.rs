@@ -69,10 +69,10 @@ fn the_attacker_member_reads_the_world_and_drives_the_motor() {
     // Ball ahead: the attacker walks to it; ball at the side (1.2 rad > 0.8): it faces it again.
     let at = |path: &str| log.iter().position(|(_, s)| s.path == path);
     let going = at("Attacker/GoToBall").unwrap();
-    assert!(log[going + 1].0.vlin > 100.0, "{:?}", log[going + 1]);
+    assert!(log[going + 1].0.vlin() > 100.0, "{:?}", log[going + 1]);
     let facing = log.iter().rposition(|(_, s)| s.path == "Attacker/FaceBall").unwrap();
     assert!(facing > going);
-    assert!(log[facing].0.vrot > 0.0, "ball on the left: turn left, {:?}", log[facing].0);
+    assert!(log[facing].0.vrot() > 0.0, "ball on the left: turn left, {:?}", log[facing].0);
 }
 
 #[test]

@@ -12,6 +12,7 @@
 
 #![allow(clippy::unwrap_used)]
 
+use mrt_core::frames::pose_in_millimetres;
 use mrt_core::{Pose2, Time};
 use mrt_msgs::robot::{lps, Estimate, GameState, Lpo, WorldSnapshot};
 use mrt_script::{Cycle, Sandbox, ScriptError, ThinkingCap};
@@ -143,9 +144,10 @@ fn small_step_left(off: f64) -> f64 {
 #[track_caller]
 fn assert_target(c: &Cycle, (x, y, theta): (f64, f64, f64)) {
     let t = c.command.target.unwrap_or_else(|| panic!("no target: {:?}", c.command));
-    close(t.pose.x, x);
-    close(t.pose.y, y);
-    close(t.pose.theta, theta);
+    let p = pose_in_millimetres(t.pose.inner);
+    close(p.x, x);
+    close(p.y, y);
+    close(p.theta, theta);
     assert!(!t.avoid && !t.plan, "{t:?}");
 }
 
@@ -196,7 +198,7 @@ fn the_shipped_directory_loads_every_behavior_and_each_runs_cleanly() {
     for name in c.hbm().names() {
         for w in [World(WorldSnapshot::default()), busy.clone()] {
             let c = run(&name, w);
-            for v in [c.command.vlin, c.command.vrot, c.command.vlat] {
+            for v in [c.command.vlin(), c.command.vrot(), c.command.vlat()] {
                 assert!(v.is_finite() && v.abs() <= 300.0 * GO, "{name}: {:?}", c.command);
             }
         }
@@ -212,7 +214,7 @@ fn trackbnet1_needs_the_ball_always_and_the_net_when_close() {
     assert!((c.command.need(lps::BALL) - 1.0).abs() < 1e-9);
     assert!((c.command.need(lps::NET1) - 0.7).abs() < 1e-9, "{:?}", c.command.needs);
     // It moves nothing.
-    assert_eq!((c.command.vlin, c.command.vrot, c.command.vlat), (0.0, 0.0, 0.0));
+    assert_eq!((c.command.vlin(), c.command.vrot(), c.command.vlat()), (0.0, 0.0, 0.0));
     // Ball at 1 m: not close, NET1 is not needed; at 200 mm fully close.
     let c = run("trackbnet1", World::at(0).ball(1000.0, 0.0));
     assert_eq!((c.command.need(lps::BALL), c.command.need(lps::NET1)), (1.0, 0.0));
@@ -228,40 +230,40 @@ fn trackbnet1_needs_the_ball_always_and_the_net_when_close() {
 fn faceball_turns_towards_the_ball() {
     // θ = 0.6: headedRight = TOR(0.05, 0.5)(0.6) = 1 → turn LEFT alone → +45 °/s.
     let c = run("faceball", World::at(0).ball(1500.0, 0.6));
-    close(c.command.vrot, 45.0 * TURN);
-    close(c.command.vlin, 0.0);
-    close(c.command.vlat, 0.0);
+    close(c.command.vrot(), 45.0 * TURN);
+    close(c.command.vlin(), 0.0);
+    close(c.command.vlat(), 0.0);
     assert_eq!(c.command.need(lps::BALL), 1.0);
     // θ = −0.6: turn RIGHT → −45.
-    close(run("faceball", World::at(0).ball(1500.0, -0.6)).command.vrot, -45.0 * TURN);
+    close(run("faceball", World::at(0).ball(1500.0, -0.6)).command.vrot(), -45.0 * TURN);
     // θ = 0: only NONE → 0.
-    close(run("faceball", World::at(0).ball(1500.0, 0.0)).command.vrot, 0.0);
+    close(run("faceball", World::at(0).ball(1500.0, 0.0)).command.vrot(), 0.0);
     // θ = 0.2: LEFT = (0.2 − 0.05) / 0.45 = 1/3 and NONE = TRI(−0.3, 0, 0.3)(0.2) = 1/3.
     // NONE clipped at 1/3 is a trapezium −45..45 with top −30..30; LEFT clipped is 0..90 with
     // top 15..75; their max is 1/3 from −30 to 75 with ramps −45..−30 and 75..90: symmetric
     // about (−45 + 90) / 2 = 22.5.
-    close(run("faceball", World::at(0).ball(1500.0, 0.2)).command.vrot, 22.5 * TURN);
-    close(run("faceball", World::at(0).ball(1500.0, -0.2)).command.vrot, -22.5 * TURN);
+    close(run("faceball", World::at(0).ball(1500.0, 0.2)).command.vrot(), 22.5 * TURN);
+    close(run("faceball", World::at(0).ball(1500.0, -0.2)).command.vrot(), -22.5 * TURN);
 }
 
 #[test]
 fn go2ball_goes_forward_when_the_ball_is_ahead_and_far_not_when_at_the_side() {
     // Ahead (θ 0) at 2 m: ballAhead 1, ballClose 0 → go FAST alone → 250; turn NONE → 0.
     let c = run("go2ball", World::at(0).ball(2000.0, 0.0));
-    close(c.command.vlin, 250.0 * GO);
-    close(c.command.vrot, 0.0);
-    close(c.command.vlat, 0.0);
+    close(c.command.vlin(), 250.0 * GO);
+    close(c.command.vrot(), 0.0);
+    close(c.command.vlat(), 0.0);
     // At the side (θ 1.2): ballAhead 0 → go STAY → 0, turn LEFT → 45.
     let c = run("go2ball", World::at(0).ball(2000.0, 1.2));
-    close(c.command.vlin, 0.0);
-    close(c.command.vrot, 45.0 * TURN);
+    close(c.command.vlin(), 0.0);
+    close(c.command.vrot(), 45.0 * TURN);
     // Ahead at 400 mm: ballClose 0.7 → FAST 0.3, SLOW 0.7. The max of SLOW clipped at 0.7 and
     // FAST clipped at 0.3 rises 0 → 0.7 over [0, 105], stays 0.7 to 195, follows SLOW down to
     // 0.3 at 255, then FAST's 0.3 to 300: centroid 22398.75 / 143.25 = 156.36.
     let c = run("go2ball", World::at(0).ball(400.0, 0.0));
     let want = centroid(&[(0.0, 0.0), (105.0, 0.7), (195.0, 0.7), (255.0, 0.3), (300.0, 0.3)]);
     close(want, 22398.75 / 143.25);
-    close(c.command.vlin, want * GO);
+    close(c.command.vlin(), want * GO);
 }
 
 #[test]
@@ -270,18 +272,18 @@ fn dokick_kicks_when_the_ball_is_ahead_and_touching() {
     // go SLOW at NOT(0.75) = 0.25 → 150.
     let c = run("dokick", World::at(0).ball(200.0, 0.0));
     assert_eq!(c.command.kick, Some(1));
-    close(c.command.vlin, 150.0 * GO);
+    close(c.command.vlin(), 150.0 * GO);
     // 1 m: not touching → no kick, SLOW 1 → 150.
     let c = run("dokick", World::at(0).ball(1000.0, 0.0));
     assert_eq!(c.command.kick, None);
-    close(c.command.vlin, 150.0 * GO);
+    close(c.command.vlin(), 150.0 * GO);
     // 300 mm: touching (350 − 300) / 200 = 0.25 < 0.5 → no kick.
     assert_eq!(run("dokick", World::at(0).ball(300.0, 0.0)).command.kick, None);
     // 200 mm but off to the side (θ 1): not ahead → no kick, STAY, turn LEFT.
     let c = run("dokick", World::at(0).ball(200.0, 1.0));
     assert_eq!(c.command.kick, None);
-    close(c.command.vlin, 0.0);
-    close(c.command.vrot, 45.0 * TURN);
+    close(c.command.vlin(), 0.0);
+    close(c.command.vrot(), 45.0 * TURN);
 }
 
 #[test]
@@ -289,25 +291,25 @@ fn alignbnet1_strafes_to_put_the_net_behind_the_ball() {
     // Net seen 0.5 rad left of the ball: netLeftOfBall = TOR(0.05, 0.4)(0.5) = 1 → strafe
     // RIGHT → −100; ball ahead → turn NONE → 0; go STAY → 0.
     let c = run("alignbnet1", World::at(0).aims_by_camera().ball(400.0, 0.0).net1(3000.0, 0.5));
-    close(c.command.vlat, -100.0 * STRAFE);
-    close(c.command.vrot, 0.0);
-    close(c.command.vlin, 0.0);
+    close(c.command.vlat(), -100.0 * STRAFE);
+    close(c.command.vrot(), 0.0);
+    close(c.command.vlin(), 0.0);
     assert_eq!((c.command.need(lps::BALL), c.command.need(lps::NET1)), (1.0, 1.0));
     // Net right of the ball → strafe LEFT → +100; behind it → NONE → 0.
     close(
         run("alignbnet1", World::at(0).aims_by_camera().ball(400.0, 0.1).net1(3000.0, -0.4))
             .command
-            .vlat,
+            .vlat(),
         100.0 * STRAFE,
     );
     close(
         run("alignbnet1", World::at(0).aims_by_camera().ball(400.0, 0.0).net1(3000.0, 0.0))
             .command
-            .vlat,
+            .vlat(),
         0.0,
     );
     // Net not seen: no strafe rule fires, vlat stays at its default 0.
-    close(run("alignbnet1", World::at(0).aims_by_camera().ball(400.0, 0.0)).command.vlat, 0.0);
+    close(run("alignbnet1", World::at(0).aims_by_camera().ball(400.0, 0.0)).command.vlat(), 0.0);
 }
 
 /// A robot localized well (quality 0.9 ≥ `AIM_BY_POSE`) aims by its pose, not by a net its
@@ -322,10 +324,10 @@ fn a_well_localized_robot_aims_by_its_pose_not_by_a_net_seen_off_its_middle() {
     let c = run("alignbnet1", w.clone());
     let want = small_step_left((-1000.0f64).atan2(9000.0));
     assert!(want > 0.0 && want < 40.0, "{want}");
-    close(c.command.vlat, want * STRAFE);
+    close(c.command.vlat(), want * STRAFE);
     // The same robot lost (quality 0.5) follows its camera: the net left of the ball, a step
     // to the right.
-    close(run("alignbnet1", w.aims_by_camera()).command.vlat, -100.0 * STRAFE);
+    close(run("alignbnet1", w.aims_by_camera()).command.vlat(), -100.0 * STRAFE);
 }
 
 /// The aim moves away from the opponent's goalkeeper: with an opponent anchored at
@@ -340,7 +342,7 @@ fn a_well_localized_robot_aims_by_its_pose_not_by_a_net_seen_off_its_middle() {
 fn alignbnet1_aims_at_the_side_of_the_net_away_from_its_keeper() {
     use mrt_msgs::{AnchoredRobot, RobotClass};
     let w = World::at(0).me(0.0, 0.0, 0.0, 0.9).ball(400.0, 0.0).net1(9000.0, 0.0);
-    close(run("alignbnet1", w.clone()).command.vlat, 0.0);
+    close(run("alignbnet1", w.clone()).command.vlat(), 0.0);
     let (x, y) = (8700.0f64, 500.0f64);
     let mut guarded = w;
     guarded.0.robots.push(AnchoredRobot {
@@ -357,7 +359,7 @@ fn alignbnet1_aims_at_the_side_of_the_net_away_from_its_keeper() {
     let c = run("alignbnet1", guarded);
     let want = small_step_left((-750.0f64).atan2(9000.0));
     assert!(want > 0.0 && want < 30.0, "{want}");
-    close(c.command.vlat, want * STRAFE);
+    close(c.command.vlat(), want * STRAFE);
 }
 
 /// Near our net (within `CLEAR_ZONE`, 3 m of its centre) the attacker clears the ball straight
@@ -380,9 +382,9 @@ fn alignbnet1_clears_a_ball_near_our_net_straight_away_from_it() {
             .net1(9000.0, 0.3)
     };
     let near = run("alignbnet1", scene(0.0)).command;
-    close(near.vlat, 0.0);
-    close(near.vrot, 0.0);
-    close(run("alignbnet1", scene(6000.0)).command.vlat, 100.0 * STRAFE);
+    close(near.vlat(), 0.0);
+    close(near.vrot(), 0.0);
+    close(run("alignbnet1", scene(6000.0)).command.vlat(), 100.0 * STRAFE);
 }
 
 #[test]
@@ -423,13 +425,13 @@ fn goalkeeper_scans_for_a_lost_ball_turning_towards_where_it_was() {
     let w = |t| World::at(t).me(-8500.0, 0.0, 0.0, 0.9).ball_lost(-0.7, 3.0);
     let c = cap.cycle(w(1000).0);
     assert!(c.errors.is_empty(), "{:?}", c.errors);
-    assert_eq!((c.command.vlin, c.command.vrot, c.command.vlat), (0.0, -50.0, 0.0));
+    assert_eq!((c.command.vlin(), c.command.vrot(), c.command.vlat()), (0.0, -50.0, 0.0));
     assert!(c.command.track_landmarks);
     assert_eq!(c.command.need(lps::BALL), 1.0);
     let c = cap.cycle(w(1300).0);
-    assert_eq!(c.command.vrot, -50.0);
+    assert_eq!(c.command.vrot(), -50.0);
     let c = cap.cycle(w(1500).0);
-    assert_eq!(c.command.vrot, -75.0, "faster after 400 ms");
+    assert_eq!(c.command.vrot(), -75.0, "faster after 400 ms");
 }
 
 #[test]
@@ -441,9 +443,9 @@ fn goalkeeper_gets_out_of_its_net() {
         "goalkeeper",
         World::at(0).me(-9200.0, 0.0, 0.0, 0.9).ball(1000.0, 0.0).global_ball(-8200.0, 0.0),
     );
-    close(c.command.vlin, 150.0 * GO);
-    close(c.command.vrot, 45.0 * TURN);
-    close(c.command.vlat, 0.0);
+    close(c.command.vlin(), 150.0 * GO);
+    close(c.command.vrot(), 45.0 * TURN);
+    close(c.command.vlat(), 0.0);
     assert_eq!(c.command.target, None);
     assert!(c.command.track_landmarks);
     assert_eq!(c.command.need(lps::NET1), 1.0);
@@ -461,9 +463,9 @@ fn goalkeeper_clears_a_ball_in_the_penalty_area() {
         World::at(0).me(-7700.0, 0.0, 0.0, 0.9).ball(200.0, 0.0).global_ball(-7500.0, 0.0),
     );
     assert_eq!(c.command.kick, Some(1));
-    close(c.command.vlin, 150.0 * GO);
-    close(c.command.vrot, 0.0);
-    close(c.command.vlat, 0.0);
+    close(c.command.vlin(), 150.0 * GO);
+    close(c.command.vrot(), 0.0);
+    close(c.command.vlat(), 0.0);
     assert_eq!(c.command.need(lps::BALL), 1.0);
     // The ball 1.5 m ahead, still in the area (x = −7200): too far to run out for
     // (TOL(800, 1500)(1500) = 0), so gkcutb holds the spot (−8600, 0), 100 mm ahead, facing
@@ -493,9 +495,9 @@ fn goalkeeper_cuts_the_ball_from_its_goal_area_and_localizes_when_lost() {
         "goalkeeper",
         World::at(0).me(-8500.0, 500.0, 0.0, 0.2).ball(4528.0, theta).global_ball(-4000.0, 1000.0),
     );
-    close(c.command.vlin, 0.0);
-    close(c.command.vrot, 0.0);
-    close(c.command.vlat, 0.0);
+    close(c.command.vlin(), 0.0);
+    close(c.command.vrot(), 0.0);
+    close(c.command.vlat(), 0.0);
     assert!(c.command.track_landmarks);
     assert_eq!((c.command.need(lps::NET1), c.command.need(lps::NET2)), (0.6, 0.6));
 }
@@ -595,35 +597,35 @@ fn the_attacker_hfsm_faces_walks_scores_and_follows_the_ball() {
     );
     let cmd = |k: usize| &cycles[k].command;
     // 0: faceball, ball left (θ 1.2) → turn LEFT 45, no forward motion.
-    close(cmd(0).vrot, 45.0 * TURN);
-    close(cmd(0).vlin, 0.0);
+    close(cmd(0).vrot(), 45.0 * TURN);
+    close(cmd(0).vlin(), 0.0);
     // 2: go2ball, ball ahead at 2 m → FAST 250; well localized → no landmark tracking.
-    close(cmd(2).vlin, 250.0 * GO);
+    close(cmd(2).vlin(), 250.0 * GO);
     assert!(!cmd(2).track_landmarks);
     assert_eq!(cmd(2).need(lps::NET1), 0.0);
     // 3: quality 0.5 < 0.6 → trackLandMarks; nets unseen > 5 s → NET1 needed at 0.5.
     assert!(cmd(3).track_landmarks);
     assert_eq!(cmd(3).need(lps::NET1), 0.5);
-    close(cmd(3).vlin, 250.0 * GO);
+    close(cmd(3).vlin(), 250.0 * GO);
     // 4: ApproachBall runs go2ball at 450 mm: ballClose = (750 − 450)/500 = 0.6 → SLOW 0.6,
     //    FAST 0.4: the max rises 0 → 0.6 over [0, 90], stays 0.6 to 210, follows SLOW down to
     //    0.4 at 240, then FAST's 0.4 to 300: centroid 22260 / 138 = 161.30. No landmarks.
     let want = centroid(&[(0.0, 0.0), (90.0, 0.6), (210.0, 0.6), (240.0, 0.4), (300.0, 0.4)]);
     close(want, 22260.0 / 138.0);
-    close(cmd(4).vlin, want * GO);
+    close(cmd(4).vlin(), want * GO);
     assert!(!cmd(4).track_landmarks);
     // 5: dokick at 450 mm: not touching → no kick, SLOW → 150.
     assert_eq!(cmd(5).kick, None);
-    close(cmd(5).vlin, 150.0 * GO);
+    close(cmd(5).vlin(), 150.0 * GO);
     // 6: alignbnet1, net 0.5 rad left of the ball → strafe RIGHT −100, no forward motion.
-    close(cmd(6).vlat, -100.0 * STRAFE);
-    close(cmd(6).vlin, 0.0);
+    close(cmd(6).vlat(), -100.0 * STRAFE);
+    close(cmd(6).vlin(), 0.0);
     // 7: dokick at 200 mm → kick 1.
     assert_eq!(cmd(7).kick, Some(1));
     // 8: back in GoToBall, ball 1.2 m ahead → FAST 250.
-    close(cmd(8).vlin, 250.0 * GO);
+    close(cmd(8).vlin(), 250.0 * GO);
     // 9: faceball, ball right → −45.
-    close(cmd(9).vrot, -45.0 * TURN);
+    close(cmd(9).vrot(), -45.0 * TURN);
 }
 
 #[test]
@@ -652,7 +654,7 @@ fn the_attacker_aligns_first_when_approaching_a_misaligned_ball() {
         ]
     );
     assert_eq!(cycles[4].taken.as_ref().map(|t| t.name.as_str()), Some("Misaligned"));
-    close(cycles[4].command.vlat, 100.0 * STRAFE);
+    close(cycles[4].command.vlat(), 100.0 * STRAFE);
 }
 
 /// A fresh scratch directory for `test` holding copies of the shipped files `names` (the
@@ -698,9 +700,9 @@ fn the_labels_become_these_set_points_on_a_middle_size_base() {
         let c = cap.cycle(World::at(0).0);
         assert!(c.errors.is_empty(), "{name}: {:?}", c.errors);
         let got = match variable {
-            "go" => c.command.vlin,
-            "turn" => c.command.vrot,
-            _ => c.command.vlat,
+            "go" => c.command.vlin(),
+            "turn" => c.command.vrot(),
+            _ => c.command.vlat(),
         };
         assert!((got - want).abs() < 1e-6 * want.abs().max(1.0), "{name}: {got}, want {want}");
         if want != 0.0 {
@@ -734,7 +736,7 @@ fn an_hfsm_naming_an_unknown_behavior_keeps_the_last_good_one_running() {
     let c = cap.cycle(World::at(0).ball(2000.0, 0.0).0);
     assert!(c.errors.is_empty(), "{:?}", c.errors);
     assert_eq!((c.path.as_str(), c.behavior.as_deref()), ("M/Go", Some("go2ball")));
-    close(c.command.vlin, 250.0 * GO);
+    close(c.command.vlin(), 250.0 * GO);
     // Ball at 200 mm: the state asks for "nothere". The cycle reports it (file and line of
     // the call) and go2ball keeps running: ballClose(200) = 1 → SLOW alone → 150.
     let c = cap.cycle(World::at(100).ball(200.0, 0.0).0);
@@ -750,11 +752,11 @@ fn an_hfsm_naming_an_unknown_behavior_keeps_the_last_good_one_running() {
         other => panic!("{other:?}"),
     }
     assert_eq!((c.path.as_str(), c.behavior.as_deref()), ("M/Go", Some("go2ball")));
-    close(c.command.vlin, 150.0 * GO);
+    close(c.command.vlin(), 150.0 * GO);
     // And back to normal.
     let c = cap.cycle(World::at(200).ball(2000.0, 0.0).0);
     assert!(c.errors.is_empty(), "{:?}", c.errors);
-    close(c.command.vlin, 250.0 * GO);
+    close(c.command.vlin(), 250.0 * GO);
     let _ = std::fs::remove_dir_all(&tmp);
 }
 
@@ -796,17 +798,17 @@ fn a_runaway_hfsm_gets_the_safe_command_for_that_cycle() {
     let mut w = WorldSnapshot { game_state: GameState::Playing, ..Default::default() };
     w.lps[lps::BALL] = Lpo { rho: 2000.0, theta: 0.0, reliability: 0.9, seen_ago: 0.0 };
     let walking = cap.cycle(w.clone());
-    assert!(walking.errors.is_empty() && walking.command.vlin > 200.0, "{walking:?}");
+    assert!(walking.errors.is_empty() && walking.command.vlin() > 200.0, "{walking:?}");
     let stuck = cap.cycle(WorldSnapshot { game_state: GameState::Finished, ..w.clone() });
     assert!(
         matches!(stuck.errors.first(), Some(ScriptError::Budget { line: 3, .. })),
         "{:?}",
         stuck.errors
     );
-    assert_eq!((stuck.command.vlin, stuck.command.vrot, stuck.command.kick), (0.0, 0.0, None));
+    assert_eq!((stuck.command.vlin(), stuck.command.vrot(), stuck.command.kick), (0.0, 0.0, None));
     assert_eq!(stuck.behavior, None);
     let again = cap.cycle(w);
-    assert!(again.errors.is_empty() && again.command.vlin > 200.0, "{again:?}");
+    assert!(again.errors.is_empty() && again.command.vlin() > 200.0, "{again:?}");
     std::fs::remove_dir_all(&scratch).unwrap();
 }
 
@@ -914,15 +916,15 @@ fn field_players_share_the_roles_by_their_distance_to_the_ball() {
     assert_eq!(second[2].command.book_ball, Some(false), "a supporter gives the booking back");
     assert_eq!(second[2].behavior.as_deref(), Some("gotopos"));
     let c = &second[2].command;
-    close(c.vlin, -250.0 * GO);
-    close(c.vlat, 100.0 * STRAFE);
-    close(c.vrot, 0.0);
+    close(c.vlin(), -250.0 * GO);
+    close(c.vlat(), 100.0 * STRAFE);
+    close(c.vrot(), 0.0);
 
     let third = run4(&|w| w.mate(2, -1000.0, 300.0, false).mate(3, -1500.0, -200.0, false));
     assert_eq!(third[2].path, "Player/Defend");
     let c = &third[2].command;
-    close(c.vlin, -250.0 * GO);
-    close(c.vlat, 0.0);
+    close(c.vlin(), -250.0 * GO);
+    close(c.vlat(), 0.0);
 }
 
 /// The attacker-to-be hands over to the seed's Attacker once it is behind the ball (more than
@@ -1022,9 +1024,9 @@ fn the_supporter_stays_out_of_our_goal_mouth() {
     let paths: Vec<&str> = cycles.iter().map(|c| c.path.as_str()).collect();
     assert_eq!(paths[2..], ["Player/Support", "Player/Support"], "{paths:?}");
     let c = &cycles[3].command;
-    close(c.vlin, 0.0);
-    close(c.vlat, 0.0);
-    close(c.vrot, 0.0);
+    close(c.vlin(), 0.0);
+    close(c.vlat(), 0.0);
+    close(c.vrot(), 0.0);
 }
 
 /// The behaviors read the field from the world model (`getField`): on a 12 m field the
@@ -1040,8 +1042,8 @@ fn the_behaviors_play_on_the_field_the_world_model_describes() {
     small.0.field.half_length = 6000.0;
     let on_small = run("goalkeeper", small);
     let on_default = run("goalkeeper", w);
-    assert!(on_small.command.vrot > 20.0 && on_small.command.need(lps::NET1) > 0.7);
-    assert!(on_default.command.vrot.abs() < 1e-9, "{:?}", on_default.command);
+    assert!(on_small.command.vrot() > 20.0 && on_small.command.need(lps::NET1) > 0.7);
+    assert!(on_default.command.vrot().abs() < 1e-9, "{:?}", on_default.command);
 }
 
 /// In READY the referee tells each robot its kickoff place (`getKickoffPose`): a field player
@@ -1056,7 +1058,8 @@ fn in_ready_the_players_and_the_goalkeeper_walk_to_their_kickoff_places() {
         w.0.kickoff_pose = Some(place);
         w
     };
-    let want = Some(mrt_msgs::robot::Target { pose: place, avoid: true, plan: false });
+    let pose = mrt_core::frames::Framed::new(mrt_core::Pose2::new(-3.0, 1.2, 0.0));
+    let want = Some(mrt_msgs::robot::Target { pose, avoid: true, plan: false });
     let mut player =
         ThinkingCap::with_hfsm(dir(), dir().join("player.hfsm.lua"), Sandbox::default()).unwrap();
     let c = player.cycle(ready(World::at(0).me(-5000.0, -5000.0, 1.57, 0.9).ball(4000.0, 0.5)).0);

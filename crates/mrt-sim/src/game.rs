@@ -14,7 +14,8 @@ use crate::world::World;
 use mrt_core::frames::MM_PER_M;
 use mrt_core::Twist;
 use mrt_core::{normalize_angle, Pose2};
-use mrt_msgs::robot::{GameState, RobotCommand};
+use mrt_msgs::robot::GameState;
+use mrt_msgs::MotorCommand;
 use mrt_msgs::Sonar;
 use mrt_msgs::{
     AnchoredRobot, BallBelief, CameraFrame, GameInfo, Localization, Odometry, RobotClass,
@@ -714,12 +715,12 @@ impl Pitch {
         }
     }
 
-    /// Applies robot `i`'s command (mm/s, deg/s) through its base's kinematics and motor
-    /// duty cycles, as its driver would; a kick request fires the kicker.
-    pub fn apply(&mut self, i: usize, cmd: &RobotCommand) {
-        let drive = self.base.twist_for(&self.base.duties(cmd)).unwrap_or_default();
+    /// Applies a motor command to robot `i` through its base's kinematics and motor duty
+    /// cycles, as its driver would; a kick request fires the kicker.
+    pub fn apply(&mut self, i: usize, cmd: &MotorCommand) {
+        let drive = self.base.twist_for(&self.base.duties(&cmd.twist)).unwrap_or_default();
         self.drive(i, drive);
-        if cmd.kick.is_some() {
+        if cmd.kick {
             self.kick(i);
         }
     }

@@ -3,7 +3,8 @@
 //! each stack scoring alone.
 #![allow(missing_docs, clippy::unwrap_used, clippy::expect_used)]
 
-use mrt_msgs::RobotCommand;
+use mrt_core::Twist;
+use mrt_msgs::{MotorCommand, RobotCommand};
 use mrt_sim::bus::BusMatch;
 use mrt_sim::config::SimConfig;
 use mrt_sim::game::Pitch;
@@ -48,7 +49,7 @@ fn guidance_halts_a_robot_before_the_wall_and_without_it_the_robot_hits() {
     cfg.rules.ready_duration = 100.0;
     cfg.rules.team_size = 2;
     let start = mrt_core::Pose2::new(3.0, 5.75, std::f64::consts::FRAC_PI_2);
-    let go = RobotCommand { vlin: 400.0, ..RobotCommand::default() };
+    let go = RobotCommand { twist: Twist::new(0.4, 0.0, 0.0), ..RobotCommand::default() };
     let edge = |p: &Pitch| 7.0 - p.world().robot(1).unwrap().y - cfg.robot.radius;
     // Guided: the robot's own cycle, on the bus.
     let stand = || Box::new(Always(RobotCommand::default())) as Box<dyn Brain + Send>;
@@ -66,7 +67,7 @@ fn guidance_halts_a_robot_before_the_wall_and_without_it_the_robot_hits() {
     let mut unguided = f64::INFINITY;
     for _ in 0..40 {
         assert_eq!(pitch.sonar(1).len(), 16);
-        pitch.apply(1, &go);
+        pitch.apply(1, &MotorCommand { twist: go.twist, kick: false });
         pitch.advance();
         unguided = unguided.min(edge(&pitch));
     }

@@ -4,15 +4,16 @@
 //! the straight line: position mode alone would run into them.
 #![allow(missing_docs, clippy::unwrap_used, clippy::expect_used)]
 
+use mrt_core::frames::{Framed, Team};
 use mrt_core::Pose2;
 use mrt_msgs::{RobotCommand, Target, WorldSnapshot};
 use mrt_robot::brain::Brain;
 use mrt_sim::bus::BusMatch;
 use mrt_sim::config::SimConfig;
 
-/// Asks to be at `to` (team frame, mm), straight (position mode) or along a planned path.
+/// Asks to be at `to`, straight (position mode) or along a planned path.
 struct GoTo {
-    to: Pose2,
+    to: Framed<Team, Pose2>,
     plan: bool,
 }
 impl Brain for GoTo {
@@ -39,7 +40,7 @@ fn walk(plan: bool, seconds: f64) -> ((f64, f64), f64) {
     cfg.sensor.miss_probability = 0.0;
     // The walker and a teammate standing out of the way; the other team stands in the way.
     let walker: Vec<Box<dyn Brain + Send>> =
-        vec![Box::new(GoTo { to: Pose2::new(4000.0, 0.0, 0.0), plan }), Box::new(Stand)];
+        vec![Box::new(GoTo { to: Framed::new(Pose2::new(4.0, 0.0, 0.0)), plan }), Box::new(Stand)];
     let wall: Vec<Box<dyn Brain + Send>> = vec![Box::new(Stand), Box::new(Stand)];
     let mut m = BusMatch::with_brains(&cfg, 1, walker, wall).unwrap();
     {

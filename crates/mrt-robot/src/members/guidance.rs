@@ -2,6 +2,8 @@
 //! ([`guided_command`]).
 
 use super::*;
+use mrt_core::frames::{point_in_metres, pose_in_metres, Framed, Team};
+use mrt_core::Twist;
 
 /// Guidance of one robot: the behaviors' command through the Guidance µAgent with the latest
 /// world state and sonar scan.
@@ -13,7 +15,7 @@ pub(super) struct GuidanceMember {
     /// The planner's latest path, and when it came (s, the world's clock).
     pub(super) path: Option<(PlannedPath, f64)>,
     /// The goal last asked of the planner, and when.
-    pub(super) asked: Option<(Pose2, f64)>,
+    pub(super) asked: Option<(Framed<Team, Pose2>, f64)>,
     /// Turning to look for landmarks when the world model needs to localize, on a robot
     /// whose camera cannot pan (`None` with a pan joint: the gaze looks instead).
     pub(super) look: Option<LookAround>,
@@ -23,7 +25,7 @@ impl GuidanceMember {
     /// A target to reach along a planned path (`plan`): the planner is asked when its path
     /// is for another goal or a second old; meanwhile the command drives to the path's
     /// carrot in position mode, or, before any path, as the target says without planning.
-    fn follow(&mut self, cmd: &mut RobotCommand, ctx: &mut Context<'_>) {
+    fn follow(&mut self, cmd: &mut RobotCommand, me: Framed<Team, Pose2>, ctx: &mut Context<'_>) {
         let Some(target) = cmd.target.filter(|t| t.plan) else { return };
         let now = self.world.time.as_secs_f64();
         let to = target.pose;
@@ -35,9 +37,10 @@ impl GuidanceMember {
             ctx.publish(PlanRequest { to });
             self.asked = Some((to, now));
         }
-        let next = current.and_then(|(p, _)| carrot(&p.poses, self.world.my_pos.pose));
+        let next = current.and_then(|(p, _)| carrot(&p.poses, me));
         cmd.target = Some(match next {
-            Some(pose) => Target { pose, avoid: false, plan: false },
+            // Path mode: position mode to the carrot, halted by the sonars.
+            Some(pose) => Target { pose, avoid: false, plan: true },
             None => Target { plan: false, ..target },
         });
     }
@@ -74,30 +77,17 @@ impl Member for GuidanceMember {
             let (needs, played) =
                 (self.world.needs_localization, self.world.game_state == GameState::Playing);
             if let Some(rate) = self.look.as_mut().and_then(|l| l.step(now, needs, played)) {
-                cmd = RobotCommand { vrot: rate.to_degrees(), ..RobotCommand::default() };
+                cmd = RobotCommand { twist: Twist::new(0.0, 0.0, rate), ..RobotCommand::default() };
             }
-            let planned = cmd.target.is_some_and(|t| t.plan);
-            self.follow(&mut cmd, ctx);
-            let mut out = guided_command(&self.guidance, &cmd, &self.world, &self.scan.sonars);
-            if planned {
-                // Position mode along the path, halted by the sonars as velocity mode is.
-                out = guided_command(&self.guidance, &out, &self.world, &self.scan.sonars);
-            }
-            ctx.publish(MotorCommand(out));
+            // The world snapshot's edge units (mm: what behaviors read) to SI, once.
+            let me = Framed::new(pose_in_metres(self.world.my_pos.pose));
+            let ball = self.world.global_ball;
+            let ball =
+                (ball.quality >= 0.1).then(|| Framed::new(point_in_metres(ball.pose.position())));
+            self.follow(&mut cmd, me, ctx);
+            let guided = self.guidance.guide(&cmd, me, ball, &self.scan.sonars);
+            ctx.publish(MotorCommand { twist: guided.twist, kick: cmd.kick.is_some() });
         }
         Ok(())
     }
-}
-
-/// Guidance for one robot's cycle: the behaviors' command `cmd`, the world state the robot
-/// believes (its pose, the ball where it is known) and its sonar ring.
-fn guided_command(
-    g: &Guidance,
-    cmd: &RobotCommand,
-    w: &WorldSnapshot,
-    sonars: &[Sonar],
-) -> RobotCommand {
-    let ball = w.global_ball;
-    let ball = (ball.quality >= 0.1).then(|| Point2::new(ball.pose.x, ball.pose.y));
-    g.guide(cmd, &w.my_pos.pose, ball, sonars).command
 }

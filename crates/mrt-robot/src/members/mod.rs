@@ -54,12 +54,12 @@ use crate::stacks::{
     embedded_teamchaos, send_brain, Geometry, MilanBrain, Stack, CHAOS_KEEPER, CHAOS_PLAYER,
 };
 use mrt_blackboard::{Blackboard, Proxy};
-use mrt_core::{Point2, Pose2};
+use mrt_core::Pose2;
 use mrt_dcdt::{Activation, Agora, Context, Member, MemberError, Message, RequestType, RunReport};
 use mrt_msgs::robot::{lps, Lpo};
 use mrt_msgs::{
     BehaviorStatus, BookingReport, CameraFrame, GameInfo, GameState, MateReport, MemberFault,
-    MotorCommand, Odometry, Percepts, RobotCommand, Sonar, SonarScan, WorldSnapshot,
+    MotorCommand, Odometry, Percepts, RobotCommand, SonarScan, WorldSnapshot,
 };
 use mrt_msgs::{PlanRequest, PlannedPath, Target};
 use mrt_perception::vision::agent::VisionAgent;

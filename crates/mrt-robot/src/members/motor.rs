@@ -23,12 +23,12 @@ impl Member for Motor {
     fn do_your_job(&mut self, ctx: &mut Context<'_>) -> Result<(), MemberError> {
         let mut last = None;
         while let Some(m) = ctx.receive_msg() {
-            last = Some(m.get::<MotorCommand>()?.0.clone());
+            last = Some(*m.get::<MotorCommand>()?);
         }
         if let Some(cmd) = last {
             let mut devices = lock(&self.devices)?;
-            devices.set_duty(&self.base.duties(&cmd))?;
-            if cmd.kick.is_some() {
+            devices.set_duty(&self.base.duties(&cmd.twist))?;
+            if cmd.kick {
                 devices.kick()?;
             }
         }
