@@ -16,7 +16,7 @@
 
 #![allow(clippy::print_stdout)] // examples talk to the user
 
-use mrt_core::frames::Framed;
+use mrt_core::frames::{metres, Framed};
 use mrt_core::{normalize_angle, Pose2};
 use mrt_msgs::{
     AnchoredRobot, CameraFrame, GameInfo, GameState, Marker, RobotSighting, Sighting, WorldSnapshot,
@@ -105,9 +105,9 @@ pub fn run(print: bool) -> Result<Vec<Moment>, String> {
                     "    anchor {} {:<8} at ({:+.2}, {:+.2}) m, {:+.1} m/s north, reliability {:.2}{}",
                     r.id,
                     r.class.name(),
-                    r.x / 1000.0,
-                    r.y / 1000.0,
-                    r.vy / 1000.0,
+                    metres(r.x),
+                    metres(r.y),
+                    metres(r.vy),
                     r.reliability,
                     if r.seen_ago > 0.0 { format!(", unseen for {:.1} s", r.seen_ago) } else { String::new() }
                 );

@@ -3,6 +3,7 @@
 //! works in metres, radians and counts per metre.
 
 use anyhow::{anyhow, Context as _, Result};
+use mrt_core::frames::{metres, millimetres, MM_PER_M};
 use mrt_perception::mice_calibration::log::CalibrationLog;
 use mrt_perception::mice_calibration::{
     Estimate, MiceCalibration, MiceMounting, Mouse, MouseCalibration, MouseMounting, Procedure, CPI,
@@ -45,7 +46,7 @@ pub fn run(command: &MiceCommand) -> Result<()> {
 }
 
 fn calibrate(args: &CalibrateArgs) -> Result<()> {
-    let procedure = Procedure::new(args.length_mm / 1000.0, args.turn_deg.to_radians())
+    let procedure = Procedure::new(metres(args.length_mm), args.turn_deg.to_radians())
         .map_err(|e| anyhow!("--length-mm / --turn-deg: {e}"))?;
     let log = CalibrationLog::read(&args.log)?;
     let c = log.calibrate(&procedure).with_context(|| format!("{}", args.log.display()))?;
@@ -112,8 +113,8 @@ pub fn sim(cfg: &SimConfig, seed: u64, json: bool, log: Option<&Path>) -> Result
             100.0 * tol.resolution,
             report.read_fraction,
             tol.angle.to_degrees(),
-            tol.position * 1000.0,
-            tol.distance * 1000.0,
+            millimetres(tol.position),
+            millimetres(tol.distance),
             if check.is_ok() { "all within" } else { "NOT all within" }
         );
         let v = &report.validation;
@@ -122,11 +123,11 @@ pub fn sim(cfg: &SimConfig, seed: u64, json: bool, log: Option<&Path>) -> Result
              the calibrated mounting, {:.1} mm and {:.2}° through the simulated one, {:.1} mm and \
              {:.2}° through the calibrated one with §4.2's error reduction",
             v.path,
-            v.error_calibrated * 1000.0,
+            millimetres(v.error_calibrated),
             v.heading_error_calibrated.to_degrees(),
-            v.error_true_mounting * 1000.0,
+            millimetres(v.error_true_mounting),
             v.heading_error_true_mounting.to_degrees(),
-            v.error_reduced * 1000.0,
+            millimetres(v.error_reduced),
             v.heading_error_reduced.to_degrees()
         );
     }
@@ -155,7 +156,7 @@ fn table(c: &MiceCalibration, truth: Option<(&MiceMounting, [f64; 2])>) -> Strin
         "two-mice calibration (MRT manual §4.2): {} straight runs of {} mm, {} turns of {}° in \
          place; value ± one standard error\n",
         c.straight_runs,
-        p.length * 1000.0,
+        millimetres(p.length),
         c.turns,
         p.turn * deg
     );
@@ -169,12 +170,12 @@ fn table(c: &MiceCalibration, truth: Option<(&MiceMounting, [f64; 2])>) -> Strin
     }
     out.push('\n');
     let rows: [Row; 7] = [
-        ("resolution (counts/mm)", 1e-3, 3, |m| m.resolution, |k, _| k),
+        ("resolution (counts/mm)", 1.0 / MM_PER_M, 3, |m| m.resolution, |k, _| k),
         ("resolution (cpi)", 1.0 / CPI, 1, |m| m.resolution, |k, _| k),
         ("σ, orientation (°)", deg, 2, |m| m.sigma, |_, t| t.sigma),
-        ("x (mm)", 1e3, 2, |m| m.x, |_, t| t.x),
-        ("y (mm)", 1e3, 2, |m| m.y, |_, t| t.y),
-        ("radius (mm)", 1e3, 2, |m| m.radius, |_, t| t.x.hypot(t.y)),
+        ("x (mm)", MM_PER_M, 2, |m| m.x, |_, t| t.x),
+        ("y (mm)", MM_PER_M, 2, |m| m.y, |_, t| t.y),
+        ("radius (mm)", MM_PER_M, 2, |m| m.radius, |_, t| t.x.hypot(t.y)),
         (
             "tangent angle (°)",
             deg,
@@ -195,9 +196,9 @@ fn table(c: &MiceCalibration, truth: Option<(&MiceMounting, [f64; 2])>) -> Strin
         out.push('\n');
     }
     let pair: [PairRow; 4] = [
-        ("D (mm)", &c.distance, |m| m.distance(), 1e3),
-        ("D along x (mm)", &c.distance_x, |m| m.right.x - m.left.x, 1e3),
-        ("D along y (mm)", &c.distance_y, |m| m.right.y - m.left.y, 1e3),
+        ("D (mm)", &c.distance, |m| m.distance(), MM_PER_M),
+        ("D along x (mm)", &c.distance_x, |m| m.right.x - m.left.x, MM_PER_M),
+        ("D along y (mm)", &c.distance_y, |m| m.right.y - m.left.y, MM_PER_M),
         ("δ (°)", &c.delta, |m| m.delta(), deg),
     ];
     for (name, est, tru, scale) in pair {

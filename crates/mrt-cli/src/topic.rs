@@ -6,6 +6,7 @@
 
 use crate::interrupt;
 use anyhow::{anyhow, bail, Result};
+use mrt_core::frames::{millis, MS_PER_S};
 use mrt_core::Time;
 use mrt_dcdt::{Activation, Context, Member, MemberError, RequestType};
 use mrt_monitor::catalogue::{self, Entry};
@@ -366,11 +367,11 @@ impl Rate {
     const REAL_TIME: f64 = 0.05;
 
     fn of(times: &[(f64, f64)]) -> Rate {
-        let gaps: Vec<f64> = times.windows(2).map(|w| (w[1].0 - w[0].0) * 1000.0).collect();
+        let gaps: Vec<f64> = times.windows(2).map(|w| millis(w[1].0 - w[0].0)).collect();
         let mean = gaps.iter().sum::<f64>() / gaps.len().max(1) as f64;
         let min = gaps.iter().copied().fold(f64::INFINITY, f64::min);
         let max = gaps.iter().copied().fold(0.0, f64::max);
-        let rate = if mean > 0.0 { 1000.0 / mean } else { 0.0 };
+        let rate = if mean > 0.0 { MS_PER_S / mean } else { 0.0 };
         let (first, last) = (times.first(), times.last());
         let clock_rate = match (first, last) {
             (Some(a), Some(b)) if b.0 - a.0 > 0.0 && times.len() >= 3 => {
@@ -382,7 +383,7 @@ impl Rate {
             let offsets: Vec<f64> =
                 times.iter().map(|(arrival, created)| arrival - created).collect();
             let quickest = offsets.iter().copied().fold(f64::INFINITY, f64::min);
-            let mut delays: Vec<f64> = offsets.iter().map(|o| (o - quickest) * 1000.0).collect();
+            let mut delays: Vec<f64> = offsets.iter().map(|o| millis(o - quickest)).collect();
             delays.sort_by(f64::total_cmp);
             let mean = delays.iter().sum::<f64>() / delays.len() as f64;
             let p95 = delays[((delays.len() - 1) as f64 * 0.95).round() as usize];

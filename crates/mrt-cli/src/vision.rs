@@ -238,8 +238,11 @@ fn detect_one(
     Ok(serde_json::json!({ "image": name, "objects": objects }))
 }
 
+/// Three decimals: what `round3` keeps (a rounding, not a unit).
+const DECIMALS: f64 = 1e3;
+
 fn round3(x: f64) -> f64 {
-    (x * 1000.0).round() / 1000.0
+    (x * DECIMALS).round() / DECIMALS
 }
 
 /// `mrt vision render`.

@@ -10,9 +10,11 @@
 //!
 //! Units are SI inside (metres, radians, seconds). Two edges use others because a seed's format
 //! says so: behaviors write set-points in mm/s and degrees/s and read distances in millimetres
-//! (TeamChaos' Lua API, ThinkingCap report §3.3; Mr. BRIAN's rule files, MRT manual ch. 10).
-//! The functions here are the one place those units are converted ([`twist_from_setpoints`],
-//! [`pose_in_metres`], ...); [`MM_PER_M`] is the one conversion factor.
+//! (TeamChaos' Lua API, ThinkingCap report §3.3; Mr. BRIAN's rule files, MRT manual ch. 10),
+//! and their timers count milliseconds (TeamChaos' `getBehaviorInfo().timer`, an HFSM's time
+//! in a state). The functions here are the one place those units are converted
+//! ([`twist_from_setpoints`], [`pose_in_metres`], [`millis`], ...); [`MM_PER_M`] and
+//! [`MS_PER_S`] are the conversion factors.
 //!
 //! ```
 //! use mrt_core::frames::{Attack, Field, Framed, Robot};
@@ -44,6 +46,19 @@ pub fn metres(mm: f64) -> f64 {
 /// A length or speed (m, m/s), in millimetres (mm, mm/s) for a millimetre edge.
 pub fn millimetres(m: f64) -> f64 {
     m * MM_PER_M
+}
+
+/// Milliseconds per second: the one conversion to the behaviors' timers' unit.
+pub const MS_PER_S: f64 = 1000.0;
+
+/// A duration (s), in milliseconds (ms) for a millisecond edge.
+pub fn millis(seconds: f64) -> f64 {
+    seconds * MS_PER_S
+}
+
+/// A duration at a millisecond edge (ms), in seconds (s).
+pub fn seconds_from_millis(ms: f64) -> f64 {
+    ms / MS_PER_S
 }
 
 /// A point at a millimetre edge, in metres.
@@ -265,6 +280,14 @@ mod tests {
         assert_eq!(pose_in_millimetres(p), Pose2::new(1500.0, -250.0, 3.0));
         assert_eq!(point_in_metres(Point2::new(500.0, 0.0)), Point2::new(0.5, 0.0));
         assert_eq!(point_in_millimetres(Point2::new(0.5, 0.0)), Point2::new(500.0, 0.0));
+    }
+
+    #[test]
+    fn durations_convert_to_milliseconds_and_back() {
+        assert_eq!(millis(0.125), 125.0);
+        assert_eq!(seconds_from_millis(125.0), 0.125);
+        assert_eq!(millis(seconds_from_millis(40.0)), 40.0);
+        assert_eq!(seconds_from_millis(millis(2.5)), 2.5);
     }
 
     proptest! {

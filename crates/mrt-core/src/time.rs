@@ -18,18 +18,24 @@ use std::time::Duration;
 )]
 pub struct Time(pub u64);
 
+/// [`Time`]'s nanoseconds per millisecond.
+const NS_PER_MS: u64 = 1_000_000;
+
+/// [`Time`]'s nanoseconds per microsecond.
+const NS_PER_US: u64 = 1_000;
+
 impl Time {
     /// The clock's origin.
     pub const ZERO: Time = Time(0);
 
     /// A time `ms` milliseconds after the origin.
     pub const fn from_millis(ms: u64) -> Time {
-        Time(ms * 1_000_000)
+        Time(ms * NS_PER_MS)
     }
 
     /// A time `us` microseconds after the origin.
     pub const fn from_micros(us: u64) -> Time {
-        Time(us * 1_000)
+        Time(us * NS_PER_US)
     }
 
     /// A time `s` seconds after the origin (negative or NaN clamps to zero).

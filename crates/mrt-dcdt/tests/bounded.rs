@@ -13,6 +13,10 @@ use common::*;
 use mrt_core::SimClock;
 use mrt_dcdt::prelude::*;
 use mrt_dcdt::{DcdtError, Endpoint, MailboxBounds, MailboxReport, MemberId, RunReport};
+use std::time::Duration;
+
+/// The deaf Members' period.
+const SECOND: Duration = Duration::from_secs(1);
 
 const QUEUEING: [PolicyKind; 3] = [PolicyKind::Pmq, PolicyKind::Slwb, PolicyKind::Slwdwcv];
 
@@ -129,7 +133,7 @@ fn a_flooded_member_that_never_reads_keeps_at_most_capacity_messages() {
             .build()
             .unwrap();
         let p = a.add_member(Flood::new(10, DeliveryWarranty::None), Activation::Cyclic);
-        let d = a.add_member(Deaf { status_bounds: None }, Activation::Periodic(1000 * MS));
+        let d = a.add_member(Deaf { status_bounds: None }, Activation::Periodic(SECOND));
         a.activate_member(p).unwrap();
         a.activate_member(d).unwrap();
         exec.add_agora(a).unwrap();
@@ -184,7 +188,7 @@ fn drops_are_reported_per_member_and_subscription() {
         let p = a.add_member(flood, Activation::Cyclic);
         let d1 = a.add_member(
             Deaf { status_bounds: Some(MailboxBounds::new(2)) },
-            Activation::Periodic(1000 * MS),
+            Activation::Periodic(SECOND),
         );
         let reader = a.add_member(
             Recorder::new("reader", &[(Count::TYPE, RequestType::All)], &log()),
@@ -276,7 +280,7 @@ fn past_the_reliable_limit_messages_are_refused_and_reported() {
         let bounds = MailboxBounds::new(4).with_reliable_limit(10);
         let mut a = exec.agora_builder(1).policy(policy).mailbox_bounds(bounds).build().unwrap();
         let p = a.add_member(Flood::new(5, DeliveryWarranty::Reliable), Activation::Cyclic);
-        let d = a.add_member(Deaf { status_bounds: None }, Activation::Periodic(1000 * MS));
+        let d = a.add_member(Deaf { status_bounds: None }, Activation::Periodic(SECOND));
         a.activate_member(p).unwrap();
         a.activate_member(d).unwrap();
         exec.add_agora(a).unwrap();
@@ -315,7 +319,7 @@ fn slwsm_counts_the_messages_it_replaces_as_dropped() {
     let mut exec = SteppedExecutor::new(SimClock::new(), MS);
     let mut a = exec.agora_builder(1).policy(PolicyKind::Slwsm).build().unwrap();
     let p = a.add_member(Flood::new(3, DeliveryWarranty::None), Activation::Cyclic);
-    let d = a.add_member(Deaf { status_bounds: None }, Activation::Periodic(1000 * MS));
+    let d = a.add_member(Deaf { status_bounds: None }, Activation::Periodic(SECOND));
     a.activate_member(p).unwrap();
     a.activate_member(d).unwrap();
     exec.add_agora(a).unwrap();

@@ -5,6 +5,7 @@
 #![allow(clippy::print_stdout)]
 
 use clap::{Parser, Subcommand};
+use mrt_core::frames::millis;
 use mrt_fuzz::engine::{self, Report, RunOptions};
 use mrt_fuzz::targets::{self, Target, TARGETS};
 use mrt_fuzz::FuzzError;
@@ -98,7 +99,7 @@ fn print_report(r: &Report) {
         r.sites.len(),
         r.big_allocations,
         r.hangs,
-        r.slowest.0.as_secs_f64() * 1e3,
+        millis(r.slowest.0.as_secs_f64()),
         r.slowest.1,
         r.peak_bytes as f64 / f64::from(1 << 20),
     );

@@ -685,7 +685,7 @@ mod tests {
         assert!(ball.0.abs() < 1e-12 && (ball.1 - 2.0).abs() < 1e-12, "2 m to its left: {ball:?}");
         assert_eq!(seen.lines, vec![(1.0, -0.5)]);
         assert!(seen.landmarks.is_empty());
-        assert_eq!(t.field().unwrap().half_length, w.field.half_length / 1000.0);
+        assert_eq!(t.field().unwrap().half_length, w.field.half_length / MM_PER_M);
         t.finish();
         assert_eq!(t.end(), 2);
         assert_eq!(frame(&t, 1).truth.unwrap().score, (1, 0));

@@ -681,6 +681,7 @@ impl CameraModel {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use mrt_core::frames::metres;
     use proptest::prelude::*;
 
     /// The research notes' camera (§2): h = 450 mm, the optical axis meets the floor c = 625
@@ -704,7 +705,7 @@ mod tests {
             ((625.0, 300.0), (0.0, 155.815)),
             ((3000.0, 500.0), (205.776, 74.142)),
         ] {
-            let p = Point3::new(x / 1000.0, y / 1000.0, 0.0);
+            let p = Point3::new(metres(x), metres(y), 0.0);
             let px = cam.project(p).unwrap();
             let (pu, pv) = report_uv(&cam, px);
             assert!((pu - u).abs() < 1e-3 && (pv - v).abs() < 1e-3, "({x}, {y}): {pu} {pv}");

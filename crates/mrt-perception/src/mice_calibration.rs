@@ -52,6 +52,7 @@
 pub mod log;
 
 use crate::error::{positive, PerceptionError};
+use mrt_core::frames::MM_PER_M;
 use mrt_core::{arc_velocity, normalize_angle, sinc};
 use mrt_msgs::Displacement;
 use serde::{Deserialize, Serialize};
@@ -187,7 +188,7 @@ impl MouseMounting {
 
     /// Resolution in counts per millimetre (the log's edge unit).
     pub fn counts_per_mm(&self) -> f64 {
-        self.resolution / 1000.0
+        self.resolution / MM_PER_M
     }
 }
 
@@ -635,7 +636,7 @@ mod tests {
         let turn = [run(Counts::new(-8242.48, -4381.61), other.counts_of(0.1 * TAU, 0.0)); 2];
         let c = calibrate(&straight, &turn, &Procedure::default()).unwrap();
         // k = √(3937² + 6819²) / 500 mm = 15.7479 counts/mm, σ = atan2(3937, 6819) = 30.0003°.
-        assert!(close(c.left.resolution.value / 1000.0, 15.7479, 1e-4), "{c:?}");
+        assert!(close(c.left.resolution.value / MM_PER_M, 15.7479, 1e-4), "{c:?}");
         assert!(close(c.left.sigma.value.to_degrees(), 30.0003, 1e-4), "{c:?}");
         // p = (m̃_y, −m̃_x) / 2π = (50, 80) mm, within the rounding of the counts.
         assert!(close(c.left.x.value, 0.05, 2e-5) && close(c.left.y.value, 0.08, 2e-5), "{c:?}");
@@ -710,7 +711,9 @@ mod tests {
         let m = MiceMounting::parallel(0.2, 1000.0).unwrap();
         let mice = crate::mice::MiceOdometry::new(0.2, 1e-3).unwrap();
         let r = mice.readings_for(0.02, 0.005, 0.03);
-        let counts = |x: f64, y: f64| Counts::new(1000.0 * x, 1000.0 * y);
+        // The mice's readings (m) in counts, at the mounting's resolution (counts/m).
+        let k = m.left.resolution;
+        let counts = |x: f64, y: f64| Counts::new(k * x, k * y);
         let run = Run { left: counts(r.x_left, r.y_left), right: counts(r.x_right, r.y_right) };
         let (d, eps) = m.displacement(&run).unwrap();
         let e = mice.displacement(&r).unwrap();

@@ -13,6 +13,9 @@ use mrt_core::Point2;
 use mrt_plan::spike::{PlanMap, Shape, Spike, SpikeParams};
 use pathfinding::prelude::astar;
 
+/// The grid's cost of a step along an axis: costs are whole thousandths of a cell.
+const STRAIGHT: u64 = 1000;
+
 /// A map, its robots, the start and the goal.
 struct Scene {
     name: &'static str,
@@ -92,16 +95,16 @@ impl Grid {
     fn astar(&self, from: Point2, to: Point2) -> Option<f64> {
         let (start, goal) = (self.cell(from), self.cell(to));
         let (nx, ny) = (self.nx as i64, self.ny as i64);
-        // Costs in 1/1000 of a cell: 1000 straight, 1414 diagonal.
+        // Costs in 1/1000 of a cell: STRAIGHT (1000) along an axis, 1414 diagonal.
         let result = astar(
             &start,
             |&(i, j)| {
                 let mut next = Vec::with_capacity(8);
                 for (di, dj, cost) in [
-                    (1, 0, 1000u64),
-                    (-1, 0, 1000),
-                    (0, 1, 1000),
-                    (0, -1, 1000),
+                    (1, 0, STRAIGHT),
+                    (-1, 0, STRAIGHT),
+                    (0, 1, STRAIGHT),
+                    (0, -1, STRAIGHT),
                     (1, 1, 1414),
                     (1, -1, 1414),
                     (-1, 1, 1414),
@@ -116,11 +119,11 @@ impl Grid {
             },
             |&(i, j)| {
                 let (di, dj) = (i.abs_diff(goal.0) as f64, j.abs_diff(goal.1) as f64);
-                (1000.0 * di.hypot(dj)) as u64
+                (STRAIGHT as f64 * di.hypot(dj)) as u64
             },
             |&c| c == goal,
         )?;
-        Some(result.1 as f64 / 1000.0 * self.step)
+        Some(result.1 as f64 / STRAIGHT as f64 * self.step)
     }
 }
 

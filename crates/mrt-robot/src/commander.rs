@@ -8,6 +8,7 @@
 //! body.
 
 use crate::config::RobotConfig;
+use mrt_core::frames::millimetres;
 use mrt_msgs::WorldSnapshot;
 
 /// How a team's behaviors are adapted to the robot's body: TeamChaos' Commander Module (seed
@@ -29,7 +30,7 @@ impl Commander {
     /// fires) falls 30 mm inside the kicker's reach: a kick never fires at a ball it cannot
     /// reach and wastes the valve's recharge.
     pub fn chaos(cfg: &RobotConfig) -> Commander {
-        let reach = (cfg.radius + cfg.ball_radius + cfg.kick_reach) * 1000.0;
+        let reach = millimetres(cfg.radius + cfg.ball_radius + cfg.kick_reach);
         Commander { edge: (reach - 280.0).max(0.0) }
     }
 

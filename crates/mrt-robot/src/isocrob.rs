@@ -30,7 +30,7 @@ use crate::brain::Brain;
 use crate::stacks::{drive_to, walk_to_kickoff, Geometry};
 use mrt_blackboard::config::load_text;
 use mrt_blackboard::{Blackboard, Pattern};
-use mrt_core::frames::Framed;
+use mrt_core::frames::{metres, millimetres, pose_in_metres, seconds_from_millis, Framed};
 use mrt_core::{normalize_angle, Pose2};
 use mrt_msgs::robot::{lps, GameState, RobotCommand, Target, WorldSnapshot};
 use mrt_team::isocrob::{
@@ -48,9 +48,6 @@ pub const HEURISTIC: &str = "*.var.machine.heuristic.";
 /// `fnb()` needs the near ball within this bearing, rad: before the kicker, not beside it
 /// (except in FACE_GOAL, which goes round the ball).
 const NEAR_FRONT: f64 = 0.6;
-
-/// Millimetres in a metre: the world snapshot's unit at the edge.
-const MM: f64 = 1000.0;
 
 /// Where a robot that is not going for the ball should look (its heading, rad, team frame):
 /// at the ball when its camera saw it within `recent` seconds, else towards where the team
@@ -180,8 +177,9 @@ impl IsocrobBrain {
                 home_after: self.float("gk.home-after", d.home_after),
                 danger_time: self.float("gk.danger-time", d.danger_time),
             },
-            pulse: self.bb.get::<i64>("local.var.kicker.config.pulse").unwrap_or(125) as f64
-                / 1000.0,
+            pulse: seconds_from_millis(
+                self.bb.get::<i64>("local.var.kicker.config.pulse").unwrap_or(125) as f64,
+            ),
         }
     }
 
@@ -233,16 +231,16 @@ impl IsocrobBrain {
 
     fn field_player(&mut self, w: &WorldSnapshot, p: &Params, kicked: bool) -> RobotCommand {
         let me = w.my_pos.pose;
-        let me_m = Pose2::new(me.x / MM, me.y / MM, me.theta);
+        let me_m = pose_in_metres(me);
         let ball = w.lps[lps::BALL];
         let net = w.lps[lps::NET1];
         let ffb = ball.reliability > 0.0 && ball.seen_ago <= p.seen_ball;
         let ffog = net.theta.abs() <= p.facing && net.rho > 0.0;
         // Near, and before the kicker; while going round the ball (FACE_GOAL) near is enough.
-        let near = ffb && ball.rho / MM <= p.near_ball;
+        let near = ffb && metres(ball.rho) <= p.near_ball;
         let fnb = near
             && (ball.theta.abs() < NEAR_FRONT || self.attacker.state() == AttackerState::FaceGoal);
-        let h = heuristic(ffb.then_some(ball.rho / MM), ffog, p.k1);
+        let h = heuristic(ffb.then_some(metres(ball.rho)), ffog, p.k1);
         self.post(&format!("{HEURISTIC}{}", self.id), h);
         let slg = should_i_go(self.id, h, &self.heard(p.heard));
         self.post("local.var.machine.slg", slg);
@@ -251,10 +249,10 @@ impl IsocrobBrain {
         let lane = side * p.home_spread * (self.index / 2 + 1) as f64 / 2.0;
         let mut home = (p.home_x, lane);
         // Home postures that follow the ball the team believes in (MAP's team ball):
-        let hl = w.field.half_length / MM;
+        let hl = metres(w.field.half_length);
         let team_ball = w.global_ball;
-        let ball_m =
-            (team_ball.quality > 0.0).then_some((team_ball.pose.x / MM, team_ball.pose.y / MM));
+        let ball_m = (team_ball.quality > 0.0)
+            .then_some((metres(team_ball.pose.x), metres(team_ball.pose.y)));
         match (self.role, ball_m) {
             // an attacker with `att.support`: that far ahead of the ball (behind it when
             // negative), in its lane, to take up what comes loose;
@@ -320,9 +318,9 @@ impl IsocrobBrain {
             // With `orbit` 0: straight to the posture, facing the goal, stepping round the
             // ball when on its wrong side.
             AttackerState::FaceGoal => {
-                let behind = field.behind_ball(ball_at, p.behind * MM);
+                let behind = field.behind_ball(ball_at, millimetres(p.behind));
                 let (to, face) = if p.orbit > 0.0 {
-                    (Geometry::orbit(me, ball_at, behind, p.orbit * MM), towards_ball)
+                    (Geometry::orbit(me, ball_at, behind, millimetres(p.orbit)), towards_ball)
                 } else {
                     (Geometry::step_round(me, ball_at, behind), behind.theta)
                 };
@@ -331,16 +329,16 @@ impl IsocrobBrain {
             // push_ball(): through the ball towards the goal; kick_ball() when the goal is
             // near enough and the ball lies before the kicker.
             AttackerState::RunAndKick => {
-                let shot = field.behind_ball(ball_at, p.behind * MM).theta;
+                let shot = field.behind_ball(ball_at, millimetres(p.behind)).theta;
                 let through = (ball_at.0 + 200.0 * shot.cos(), ball_at.1 + 200.0 * shot.sin());
                 go(me, through, shot, &mut c);
-                let goal = (field.half_length - me.x).hypot(me.y) / MM;
+                let goal = metres((field.half_length - me.x).hypot(me.y));
                 let lined_up = normalize_angle(me.theta - shot).abs() < p.facing;
                 // One request a kick: none while the valve is open.
                 let idle = self.pulse_from.is_none();
                 // The kicker reaches the ball only when it touches the robot's front: a pulse
                 // fired at a ball farther away misses it, and the solenoid then recharges.
-                let reach = ball.rho / MM <= p.kick_reach;
+                let reach = metres(ball.rho) <= p.kick_reach;
                 if idle && goal <= p.kick_distance && reach && ball.theta.abs() < 0.3 && lined_up {
                     self.post("local.var.kicker.kick", true);
                 }
@@ -359,12 +357,12 @@ impl IsocrobBrain {
     fn goalkeeper(&mut self, w: &WorldSnapshot, p: &Params) -> RobotCommand {
         let ball = w.lps[lps::BALL];
         let me = w.my_pos.pose;
-        let hl = w.field.half_length / MM;
+        let hl = metres(w.field.half_length);
         let seen = (ball.reliability > 0.0).then(|| {
             let (x, y) = Geometry::ball_at(me, &ball);
             KeeperBall {
-                at: (x / MM, y / MM),
-                velocity: (w.ball_vel.x / MM, w.ball_vel.y / MM),
+                at: (metres(x), metres(y)),
+                velocity: (metres(w.ball_vel.x), metres(w.ball_vel.y)),
                 seen_ago: ball.seen_ago,
             }
         });

@@ -14,7 +14,7 @@
 use crate::runtime::LuaRuntime;
 use crate::script::ScriptError;
 use mlua::{Lua, LuaString, Table, Value};
-use mrt_core::frames::{metres, pose_in_metres, Framed};
+use mrt_core::frames::{metres, millis, pose_in_metres, Framed};
 use mrt_core::Time;
 use mrt_msgs::robot::{lps, RobotCommand, WorldSnapshot};
 use std::cell::RefCell;
@@ -502,7 +502,7 @@ fn install_inner(lua: &Lua, io: Rc<RefCell<RobotIo>>, memory_limit: usize) -> ml
         let t = lua.create_table_with_capacity(0, 2)?;
         // The innermost behavior running: a `use`d one, or the top behavior.
         let (since, is_new) = io.using.last().copied().unwrap_or((io.behavior_since, io.is_new));
-        t.set("timer", (io.world.time - since).as_secs_f64() * 1000.0)?;
+        t.set("timer", millis((io.world.time - since).as_secs_f64()))?;
         t.set("isNew", i64::from(is_new))?;
         Ok(t)
     });

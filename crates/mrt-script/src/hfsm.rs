@@ -47,6 +47,7 @@ use crate::runtime::LuaRuntime;
 use crate::script::{mtime, ScriptError};
 use mlua::chunk::ChunkMode;
 use mlua::{Function, Lua, Table, Value};
+use mrt_core::frames::millis;
 use mrt_core::Time;
 use std::cell::RefCell;
 use std::collections::HashMap;
@@ -217,7 +218,7 @@ impl Hfsm {
 
     /// Milliseconds spent in the active leaf state at `now`.
     pub fn time_in_state(&self, now: Time) -> f64 {
-        (now - self.status.borrow().since).as_secs_f64() * 1000.0
+        millis((now - self.status.borrow().since).as_secs_f64())
     }
 
     /// Runs one cycle at the world time of the robot io: check transitions (enclosing
@@ -909,7 +910,7 @@ fn install_status(
     t.set(
         "time",
         lua.create_function(move |_, ()| {
-            Ok((io.borrow().world.time - s.borrow().since).as_secs_f64() * 1000.0)
+            Ok(millis((io.borrow().world.time - s.borrow().since).as_secs_f64()))
         })?,
     )?;
     lua.globals().set("hfsm", t)

@@ -14,6 +14,7 @@
 //! ```
 
 use crate::cap::Cycle;
+use mrt_core::frames::seconds_from_millis;
 use mrt_core::Time;
 use mrt_msgs::robot::WorldSnapshot;
 
@@ -70,16 +71,19 @@ pub fn world_at(worlds: &[WorldSnapshot], k: u64, period_ms: u64) -> WorldSnapsh
     let i = usize::try_from(k).unwrap_or(usize::MAX).min(worlds.len().saturating_sub(1));
     let mut w = worlds.get(i).cloned().unwrap_or_default();
     if w.time == Time::ZERO {
-        w.time = Time::from_secs_f64(k as f64 * period_ms as f64 / 1000.0);
+        w.time = Time::from_secs_f64(seconds_from_millis(k as f64 * period_ms as f64));
     }
     w
 }
+
+/// Microseconds per millisecond: `time_ms` is rounded to the microsecond, then given in ms.
+const US_PER_MS: f64 = 1e3;
 
 /// The JSON line `mrt behave` prints for cycle `k` run at `time`.
 pub fn cycle_line(k: u64, time: Time, c: &Cycle) -> String {
     serde_json::json!({
         "cycle": k,
-        "time_ms": (time.as_secs_f64() * 1e6).round() / 1e3,
+        "time_ms": (time.as_secs_f64() * 1e6).round() / US_PER_MS,
         "path": c.path,
         "behavior": c.behavior,
         "transition": c.taken.as_ref().map(|t| &t.name),

@@ -11,7 +11,7 @@ use crate::referee::{Call, Referee, Team};
 use crate::render::{CameraState, Renderer, Scene};
 use crate::sensor::{self, sonar_ring, Odometer};
 use crate::world::World;
-use mrt_core::frames::MM_PER_M;
+use mrt_core::frames::{millimetres, MM_PER_M};
 use mrt_core::Twist;
 use mrt_core::{normalize_angle, Pose2};
 use mrt_msgs::robot::GameState;
@@ -289,7 +289,7 @@ fn fnv(hash: u64, value: i64) -> u64 {
 
 /// Millimetres, for hashing.
 fn mm(x: f64) -> i64 {
-    (x * 1000.0).round() as i64
+    millimetres(x).round() as i64
 }
 
 impl Pitch {

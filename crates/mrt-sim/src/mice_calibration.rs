@@ -350,6 +350,7 @@ fn drive(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use mrt_core::frames::millimetres;
 
     /// The rig recovers the simulated mounting within the stated tolerances, with the
     /// simulator's default mouse errors (0.5 % noise per reading and axis, 2 % of readings
@@ -447,12 +448,12 @@ mod tests {
                 let t = truth.mouse(which);
                 let k = (e.resolution.value / r.expected_resolution(which) - 1.0).abs();
                 let sigma = normalize_angle(e.sigma.value - t.sigma).abs().to_degrees();
-                let p = (e.x.value - t.x).abs().max((e.y.value - t.y).abs()) * 1000.0;
+                let p = millimetres((e.x.value - t.x).abs().max((e.y.value - t.y).abs()));
                 worst[0] = worst[0].max(k);
                 worst[1] = worst[1].max(sigma);
                 worst[2] = worst[2].max(p);
             }
-            worst[3] = worst[3].max((c.distance.value - truth.distance()).abs() * 1000.0);
+            worst[3] = worst[3].max(millimetres((c.distance.value - truth.distance()).abs()));
             let delta = normalize_angle(c.delta.value - truth.delta()).abs().to_degrees();
             worst[4] = worst[4].max(delta);
         }
@@ -468,11 +469,11 @@ mod tests {
         eprintln!(
             "test drive: mean end error {:.1} mm calibrated, {:.1} mm through the simulated \
              mounting, {:.1} mm calibrated with §4.2's reduction",
-            drive[0] * 1000.0,
-            drive[1] * 1000.0,
-            drive[2] * 1000.0
+            millimetres(drive[0]),
+            millimetres(drive[1]),
+            millimetres(drive[2])
         );
         let tol = Tolerances::default();
-        assert!(worst[0] < tol.resolution && worst[2] < tol.position * 1000.0);
+        assert!(worst[0] < tol.resolution && worst[2] < millimetres(tol.position));
     }
 }

@@ -303,6 +303,7 @@ impl Odometer {
 mod tests {
     use super::*;
     use crate::config::SimConfig;
+    use mrt_core::frames::millimetres;
     use mrt_msgs::GameState;
     use rand::SeedableRng;
     use rand_chacha::ChaCha8Rng;
@@ -485,7 +486,7 @@ mod tests {
                 .filter_map(|_| {
                     look(&w, 1, 0.0, &cfg, |_| Marker::Cyan, &mut rng).sightings[sighting::BALL]
                 })
-                .map(|s| s.distance * 1000.0)
+                .map(|s| millimetres(s.distance))
                 .collect::<Vec<_>>()
         };
         assert_eq!(sample(7), sample(7), "same seed, same noise");

@@ -9,6 +9,7 @@
 //! half-way line. This table exists once: the simulator computes what a camera
 //! sees from it, and the world model corrects its pose with it.
 
+use mrt_core::frames::millimetres;
 use mrt_core::{Point2, Vec2};
 use mrt_msgs::sighting::{
     EAST_NET, NE_CORNER, NORTH_HALFWAY, NW_CORNER, SE_CORNER, SOUTH_HALFWAY, SW_CORNER, WEST_NET,
@@ -212,7 +213,7 @@ impl FieldMap {
             half_length: self.length * 500.0,
             half_width: self.width * 500.0,
             goal_half_width: self.goal_width * 500.0,
-            penalty_area_depth: self.penalty_area_depth * 1000.0,
+            penalty_area_depth: millimetres(self.penalty_area_depth),
         }
     }
 }

@@ -1400,7 +1400,7 @@ mod tests {
         assert!((w.lps[lps::NET1].theta - PI / 2.0).abs() < 1e-9);
         let sw = w.lps[lps::LANDMARK0];
         let (dx, dy) = (-9.0 - at.x, -6.0 - at.y);
-        assert!((sw.rho - dx.hypot(dy) * 1000.0).abs() < 0.01, "{sw:?}");
+        assert!((sw.rho - dx.hypot(dy) * MM_PER_M).abs() < 0.01, "{sw:?}");
         assert!((w.my_pos.pose.x - 2000.0).abs() < 1e-6, "{:?}", w.my_pos);
         assert!((w.my_pos.pose.theta + PI / 2.0).abs() < 1e-9, "north is the team's −y");
         assert!((w.global_ball.pose.y + 2000.0).abs() < 1e-6);
@@ -1410,7 +1410,7 @@ mod tests {
         let w = m.camera(&frame(at, 1.1, &[]));
         let ball = w.lps[lps::BALL];
         assert!((ball.reliability - DECAY).abs() < 1e-12);
-        assert!((ball.rho - 5f64.sqrt() * 1000.0).abs() < 0.01, "{ball:?}");
+        assert!((ball.rho - 5f64.sqrt() * MM_PER_M).abs() < 0.01, "{ball:?}");
         assert!((ball.seen_ago - 0.1).abs() < 1e-9);
     }
 

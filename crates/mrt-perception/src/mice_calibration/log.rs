@@ -27,6 +27,7 @@
 //! Errors name the file, the line and the column ([`CalibrationError::Syntax`]).
 
 use super::{calibrate, CalibrationError, Counts, MiceCalibration, Mouse, Procedure, Run, RunKind};
+use mrt_core::frames::millimetres;
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
 use std::path::Path;
@@ -182,7 +183,7 @@ impl CalibrationLog {
     pub fn to_text(&self, procedure: &Procedure) -> String {
         let mut out = format!(
             "# two-mice calibration (MRT manual §4.2): {} mm straight runs, {}° turns in place\n{HEADER}\n",
-            procedure.length * 1000.0,
+            millimetres(procedure.length),
             procedure.turn.to_degrees()
         );
         for (kind, runs) in [(RunKind::Straight, &self.straight), (RunKind::Turn, &self.turns)] {

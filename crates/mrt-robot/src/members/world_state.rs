@@ -1,6 +1,7 @@
 //! The world-state Member: the robot's beliefs, its teammates' reports, roles and SCARE.
 
 use super::*;
+use mrt_core::frames::millimetres;
 
 /// A team ball of at least this quality is known to the role allocation (the Lua players'
 /// `ballKnown`).
@@ -78,7 +79,7 @@ impl Member for WorldState {
         };
         let id = u32::try_from(self.robot).unwrap_or(u32::MAX);
         // The ball's uncertainty in mm, as the reports and the team ball count it.
-        let ball_sigma = self.model.ball_sigma().map(|s| s * 1000.0);
+        let ball_sigma = self.model.ball_sigma().map(millimetres);
         let mut report =
             MateReport::of(id, self.keeper, &w).with_ball_sigma(ball_sigma.unwrap_or(0.0));
         // The ball booking on this frame's clock: the news, the behaviors' wish, the report.
