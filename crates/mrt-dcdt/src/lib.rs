@@ -91,6 +91,7 @@ pub mod describe;
 mod endpoint;
 mod error;
 mod executor;
+mod inputs;
 mod member;
 mod msg;
 pub mod outlet;
@@ -106,6 +107,7 @@ pub use config::PolicyKind;
 pub use endpoint::{Context, Endpoint, MsgBuilder};
 pub use error::DcdtError;
 pub use executor::{ExitReason, RunReport, SteppedExecutor, ThreadedExecutor};
+pub use inputs::Inputs;
 pub use member::{
     Activation, Member, MemberError, MemberReport, MemberState, BASE_BACKOFF, MAX_BACKOFF,
 };

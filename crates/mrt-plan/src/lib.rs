@@ -37,7 +37,7 @@
 //! | arc of circumference per sampling period (manual §4.1) | [`kinematics::integrate`] |
 //! | velocity mode, halted by the sonars (ISocRob §3.2.3) | [`guidance::VelocityGuard`], [`guidance::Sonar`] |
 //! | position mode | [`guidance::PositionMode`] |
-//! | the Guidance µAgent: the mode a command asks for, sonar echoes, ball echoes told apart | [`guide::Guidance`] |
+//! | the Guidance µAgent: the mode a command asks for, sonar echoes, ball echoes told apart | [`guidance::Guidance`] |
 //! | SPIKE, multi-resolution path planning with doors and moving objects (manual ch. 9) | [`spike::Spike`], [`spike::PlanMap`], [`spike::Plan`] |
 //! | potential field mode, ball as a repelling obstacle | [`guidance::PotentialField`], [`guidance::Obstacle`], [`guidance::behind_ball`], [`guidance::sonar_obstacles`] |
 //!
@@ -46,7 +46,6 @@
 
 mod error;
 pub mod guidance;
-pub mod guide;
 pub mod kinematics;
 pub mod spike;
 

@@ -2,7 +2,7 @@
 //! behavior stack: Lua HFSM and HBM, Mr. BRIAN, hand-written Rust), and [`BrainMember`], which
 //! puts any `Send` brain on the bus.
 
-use mrt_dcdt::{Context, Member, MemberError, RequestType};
+use mrt_dcdt::{Context, Inputs, Member, MemberError, RequestType};
 use mrt_msgs::{BehaviorStatus, RobotCommand, WorldSnapshot};
 
 /// What drives one robot: a behavior stack (Lua HFSM and HBM, Mr. BRIAN, ...).
@@ -28,25 +28,26 @@ pub trait Brain {
 pub struct BrainMember {
     brain: Box<dyn Brain + Send>,
     world: Option<WorldSnapshot>,
+    inputs: Inputs<BrainMember>,
 }
 
 impl BrainMember {
     /// A Member around `brain`.
     pub fn new(brain: Box<dyn Brain + Send>) -> Self {
-        Self { brain, world: None }
+        let inputs = Inputs::new()
+            .on::<WorldSnapshot>(RequestType::Local, |b: &mut Self, w| b.world = Some(w.clone()));
+        Self { brain, world: None, inputs }
     }
 }
 
 impl Member for BrainMember {
     fn init(&mut self, ctx: &mut Context<'_>) -> Result<(), MemberError> {
-        ctx.subscribe_to::<WorldSnapshot>(RequestType::Local);
+        self.inputs.subscribe(ctx);
         Ok(())
     }
 
     fn do_your_job(&mut self, ctx: &mut Context<'_>) -> Result<(), MemberError> {
-        while let Some(m) = ctx.receive_msg() {
-            self.world = Some(m.get::<WorldSnapshot>()?.clone());
-        }
+        self.inputs.clone().drain(self, ctx)?;
         if let Some(w) = &self.world {
             ctx.publish(self.brain.cycle(w));
         }

@@ -9,7 +9,7 @@ use mrt_perception::camera::{CameraFile, Omni, OmniFile, Pinhole};
 use mrt_perception::mice::MiceOdometry;
 use mrt_perception::vision::colors::ColorTable;
 use mrt_perception::vision::posts::PostShape;
-use mrt_plan::guide::Guidance;
+use mrt_plan::guidance::Guidance;
 use mrt_world::gaze::{GazeConfig, PanJoint};
 pub use mrt_world::relocalize::Localizer;
 use mrt_world::{FieldMap, WorldModel};

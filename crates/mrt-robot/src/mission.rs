@@ -51,7 +51,7 @@ use crate::devices::SharedDevices;
 use crate::members::{Driver, Motor};
 use crate::planner::carrot_at;
 use mrt_core::{FileError, Point2, Pose2};
-use mrt_dcdt::{Activation, Agora, Context, Member, MemberError, RequestType};
+use mrt_dcdt::{Activation, Agora, Context, Inputs, Member, MemberError, RequestType};
 use mrt_msgs::{MotorCommand, Odometry, SonarScan};
 use mrt_perception::mice::{update_pose, MiceOdometry};
 use mrt_plan::guidance::{PositionMode, PositionParams, Sonar, VelocityGuard};
@@ -607,13 +607,20 @@ impl Roby {
 pub struct RobyMember {
     robot: usize,
     roby: Arc<Mutex<Roby>>,
+    /// This cycle's odometry and sonar scan, as they come.
+    odometry: Option<Odometry>,
+    scan: Option<SonarScan>,
+    inputs: Inputs<RobyMember>,
 }
 
 impl RobyMember {
     /// The Member of robot `robot`, sharing `roby` with whoever watches it (a monitor, the
     /// simulator's report).
     pub fn new(robot: usize, roby: Arc<Mutex<Roby>>) -> RobyMember {
-        RobyMember { robot, roby }
+        let inputs = Inputs::<Self>::new()
+            .on::<Odometry>(RequestType::Local, |r, o| r.odometry = Some(*o))
+            .on::<SonarScan>(RequestType::Local, |r, s| r.scan = Some(s.clone()));
+        RobyMember { robot, roby, odometry: None, scan: None, inputs }
     }
 }
 
@@ -623,21 +630,15 @@ impl Member for RobyMember {
     }
 
     fn init(&mut self, ctx: &mut Context<'_>) -> Result<(), MemberError> {
-        ctx.subscribe_to::<Odometry>(RequestType::Local);
-        ctx.subscribe_to::<SonarScan>(RequestType::Local);
+        self.inputs.subscribe(ctx);
         Ok(())
     }
 
     fn do_your_job(&mut self, ctx: &mut Context<'_>) -> Result<(), MemberError> {
-        let (mut odometry, mut scan) = (None, None);
-        while let Some(m) = ctx.receive_msg() {
-            if let Ok(o) = m.get::<Odometry>() {
-                odometry = Some(*o);
-            } else if let Ok(s) = m.get::<SonarScan>() {
-                scan = Some(s.clone());
-            }
-        }
-        let (Some(odometry), Some(scan)) = (odometry, scan) else { return Ok(()) };
+        self.inputs.clone().drain(self, ctx)?;
+        let (Some(odometry), Some(scan)) = (self.odometry.take(), self.scan.take()) else {
+            return Ok(());
+        };
         let now = ctx.now().as_secs_f64();
         let twist = self
             .roby
@@ -670,7 +671,7 @@ pub fn add_roby(
         agora.add_member(odometry, every),
         agora.add_member(sonars, every),
         agora.add_member(RobyMember::new(robot, roby), every),
-        agora.add_member(Motor { devices, robot, base }, Activation::OnMessage),
+        agora.add_member(Motor::new(devices, robot, base), Activation::OnMessage),
     ];
     for m in ids {
         agora.activate_member(m).map_err(|e| e.to_string())?;

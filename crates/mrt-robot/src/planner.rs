@@ -14,7 +14,7 @@
 
 use mrt_core::frames::{metres, point_in_metres, pose_in_metres, Framed, Team};
 use mrt_core::{Point2, Pose2};
-use mrt_dcdt::{Context, Member, MemberError, MsgRef, RequestType};
+use mrt_dcdt::{Context, Inputs, Member, MemberError, MsgRef, RequestType};
 use mrt_msgs::{PlanRequest, PlannedPath, WorldSnapshot};
 use mrt_plan::spike::{PlanMap, Shape, Spike, SpikeParams};
 
@@ -36,13 +36,19 @@ pub(crate) struct Planner {
     world: Option<MsgRef>,
     /// SPIKE on the field last planned on: its size between the lines, m.
     spike: Option<((f64, f64), Spike)>,
+    /// The latest request, not yet answered.
+    request: Option<PlanRequest>,
+    inputs: Inputs<Planner>,
 }
 
 impl Planner {
     /// The planner of robot `robot`, whose footprint has radius `radius` (m).
     pub(crate) fn new(robot: usize, radius: f64) -> Planner {
         let params = SpikeParams { robot_radius: radius, ..SpikeParams::default() };
-        Planner { robot, params, world: None, spike: None }
+        let inputs = Inputs::new()
+            .on::<PlanRequest>(RequestType::Local, |p: &mut Planner, r| p.request = Some(*r))
+            .on_msg::<WorldSnapshot>(RequestType::Local, |p, m| p.world = Some(m.clone()));
+        Planner { robot, params, world: None, spike: None, request: None, inputs }
     }
 
     /// SPIKE on the field the world snapshot names (made again when the field changes).
@@ -90,21 +96,13 @@ impl Member for Planner {
     }
 
     fn init(&mut self, ctx: &mut Context<'_>) -> Result<(), MemberError> {
-        ctx.subscribe_to::<PlanRequest>(RequestType::Local);
-        ctx.subscribe_to::<WorldSnapshot>(RequestType::Local);
+        self.inputs.subscribe(ctx);
         Ok(())
     }
 
     fn do_your_job(&mut self, ctx: &mut Context<'_>) -> Result<(), MemberError> {
-        let mut request = None;
-        while let Some(m) = ctx.receive_msg() {
-            if m.is::<WorldSnapshot>() {
-                self.world = Some(m);
-            } else {
-                request = Some(*m.get::<PlanRequest>()?);
-            }
-        }
-        if let Some(r) = request {
+        self.inputs.clone().drain(self, ctx)?;
+        if let Some(r) = self.request.take() {
             let latest = self.world.clone();
             let w = latest.as_ref().map(|m| m.get::<WorldSnapshot>()).transpose()?;
             let path = self.plan(w.unwrap_or(&WorldSnapshot::default()), r.to);

@@ -24,7 +24,7 @@ use crate::cap::ThinkingCap;
 use crate::push::Pusher;
 use crate::runtime::Sandbox;
 use crate::watchdog::{Watchdog, DEFAULT_DEADLINE, SIMULATED_DEADLINE};
-use mrt_dcdt::{Context, Member, MemberError, Message, RequestType};
+use mrt_dcdt::{Context, Inputs, Member, MemberError, RequestType};
 use mrt_msgs::robot::WorldSnapshot;
 use std::path::PathBuf;
 use std::time::Duration;
@@ -55,6 +55,11 @@ pub struct BehaviorMember {
     world: WorldSnapshot,
     blackboard: Option<mrt_blackboard::Blackboard>,
     pusher: Option<Pusher>,
+    /// A reload was asked for since the last cycle.
+    reload: bool,
+    /// Pushed behaviors received since the last cycle.
+    pushes: Vec<BehaviorPush>,
+    inputs: Inputs<BehaviorMember>,
 }
 
 impl BehaviorMember {
@@ -84,7 +89,22 @@ impl BehaviorMember {
             world: WorldSnapshot::default(),
             blackboard: None,
             pusher: None,
+            reload: false,
+            pushes: Vec::new(),
+            inputs: Self::inputs(),
         }
+    }
+
+    /// What the behaviors read: only this robot's own world (an Agora may share a link with
+    /// teammates); reload requests and pushed behaviors from anywhere.
+    fn inputs() -> Inputs<BehaviorMember> {
+        Inputs::<Self>::new()
+            .on::<WorldSnapshot>(RequestType::Local, |b, w| b.world.clone_from(w))
+            .on::<ReloadRequest>(RequestType::All, |b, _| b.reload = true)
+            .on_msg::<BehaviorPush>(RequestType::All, |b, m| match m.get::<BehaviorPush>() {
+                Ok(push) => b.pushes.push(push.clone()),
+                Err(e) => tracing::warn!(member = %b.name, "dropped a malformed push: {e}"),
+            })
     }
 
     /// Sets the sandbox limits.
@@ -139,33 +159,25 @@ impl Member for BehaviorMember {
     }
 
     fn init(&mut self, ctx: &mut Context<'_>) -> Result<(), MemberError> {
-        // Only this robot's own world (an Agora may share a link with teammates).
-        ctx.subscribe_to::<WorldSnapshot>(RequestType::Local);
-        ctx.subscribe_to::<ReloadRequest>(RequestType::All);
-        ctx.subscribe_to::<BehaviorPush>(RequestType::All);
+        self.inputs.subscribe(ctx);
         self.pusher = Some(Pusher::new(ctx.agora_id().0, self.dir.clone()));
         self.worker = Some(self.spawn(ctx.clock_is_simulated())?);
         Ok(())
     }
 
     fn do_your_job(&mut self, ctx: &mut Context<'_>) -> Result<(), MemberError> {
+        self.inputs.clone().drain(self, ctx)?;
         let (Some(worker), Some(pusher)) = (&mut self.worker, &mut self.pusher) else {
             return Err("not initialized".into());
         };
         let (mut early, mut replies) = (Vec::new(), Vec::new());
-        while let Some(m) = ctx.receive_msg() {
-            if m.msg_type() == WorldSnapshot::TYPE {
-                self.world = m.get::<WorldSnapshot>()?.clone();
-            } else if m.msg_type() == ReloadRequest::TYPE {
-                if let Err(e) = worker.reload_requested() {
-                    early.push(e.to_string());
-                }
-            } else if m.msg_type() == BehaviorPush::TYPE {
-                match m.get::<BehaviorPush>() {
-                    Ok(push) => replies.extend(pusher.receive(push)),
-                    Err(e) => tracing::warn!(member = %self.name, "dropped a malformed push: {e}"),
-                }
+        if std::mem::take(&mut self.reload) {
+            if let Err(e) = worker.reload_requested() {
+                early.push(e.to_string());
             }
+        }
+        for push in std::mem::take(&mut self.pushes) {
+            replies.extend(pusher.receive(&push));
         }
         // Pushes compiled since the last cycle are swapped in at this boundary.
         for ready in pusher.ready() {

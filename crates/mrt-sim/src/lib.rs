@@ -6,7 +6,7 @@
 //! what a camera would detect, feel their motion through optical mice and wheel encoders and
 //! hear through a sonar ring ([`sensor`]); each robot's world state fuses odometry and sightings
 //! into its own pose estimate (`mrt-world`'s [`WorldModel`](mrt_world::WorldModel)); between their
-//! behaviors and their motors sits guidance ([`mrt_plan::guide::Guidance`], see [`bus`]).
+//! behaviors and their motors sits guidance ([`mrt_plan::guidance::Guidance`], see [`bus`]).
 //!
 //! ```
 //! use mrt_sim::config::SimConfig;

@@ -7,6 +7,20 @@ use super::*;
 pub(super) struct FaultBook {
     pub(super) devices: SharedDevices,
     pub(super) robot: usize,
+    /// Script errors received, not yet booked (the first of each status).
+    pub(super) errors: Vec<String>,
+    pub(super) inputs: Inputs<FaultBook>,
+}
+
+impl FaultBook {
+    /// The fault book of robot `robot` on `devices`.
+    pub(super) fn new(devices: SharedDevices, robot: usize) -> FaultBook {
+        let inputs =
+            Inputs::new().on::<BehaviorStatus>(RequestType::Local, |f: &mut FaultBook, s| {
+                f.errors.extend(s.errors.first().cloned());
+            });
+        FaultBook { devices, robot, errors: Vec::new(), inputs }
+    }
 }
 
 impl Member for FaultBook {
@@ -15,15 +29,14 @@ impl Member for FaultBook {
     }
 
     fn init(&mut self, ctx: &mut Context<'_>) -> Result<(), MemberError> {
-        ctx.subscribe_to::<BehaviorStatus>(RequestType::Local);
+        self.inputs.subscribe(ctx);
         Ok(())
     }
 
     fn do_your_job(&mut self, ctx: &mut Context<'_>) -> Result<(), MemberError> {
-        while let Some(m) = ctx.receive_msg() {
-            if let Some(e) = m.get::<BehaviorStatus>()?.errors.first() {
-                lock(&self.devices)?.fault(e)?;
-            }
+        self.inputs.clone().drain(self, ctx)?;
+        for e in std::mem::take(&mut self.errors) {
+            lock(&self.devices)?.fault(&e)?;
         }
         Ok(())
     }

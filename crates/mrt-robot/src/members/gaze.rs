@@ -16,6 +16,19 @@ pub(super) struct GazeControl {
     pub(super) track_landmarks: bool,
     pub(super) lps: Vec<Lpo>,
     pub(super) refused: u64,
+    pub(super) inputs: Inputs<GazeControl>,
+}
+
+impl GazeControl {
+    /// What the gaze reads: the behaviors' needs, the LPS.
+    pub(super) fn inputs() -> Inputs<GazeControl> {
+        Inputs::<Self>::new()
+            .on::<RobotCommand>(RequestType::Local, |g, c| {
+                g.needs.clone_from(&c.needs);
+                g.track_landmarks = c.track_landmarks;
+            })
+            .on::<WorldSnapshot>(RequestType::Local, |g, w| g.lps.clone_from(&w.lps))
+    }
 }
 
 impl Member for GazeControl {
@@ -24,20 +37,12 @@ impl Member for GazeControl {
     }
 
     fn init(&mut self, ctx: &mut Context<'_>) -> Result<(), MemberError> {
-        ctx.subscribe_to::<RobotCommand>(RequestType::Local);
-        ctx.subscribe_to::<WorldSnapshot>(RequestType::Local);
+        self.inputs.subscribe(ctx);
         Ok(())
     }
 
     fn do_your_job(&mut self, ctx: &mut Context<'_>) -> Result<(), MemberError> {
-        while let Some(m) = ctx.receive_msg() {
-            if let Ok(c) = m.get::<RobotCommand>() {
-                self.needs.clone_from(&c.needs);
-                self.track_landmarks = c.track_landmarks;
-            } else {
-                self.lps.clone_from(&m.get::<WorldSnapshot>()?.lps);
-            }
-        }
+        self.inputs.clone().drain(self, ctx)?;
         // The behaviors' needs stand until their next command; `trackLandMarks` adds one
         // landmark, the least recently seen, as needed as what they need most (this cycle).
         let mut needs = self.needs.clone();

@@ -19,9 +19,24 @@ pub(super) struct GuidanceMember {
     /// Turning to look for landmarks when the world model needs to localize, on a robot
     /// whose camera cannot pan (`None` with a pan joint: the gaze looks instead).
     pub(super) look: Option<LookAround>,
+    /// The behaviors' latest command, not yet guided.
+    pub(super) command: Option<RobotCommand>,
+    pub(super) inputs: Inputs<GuidanceMember>,
 }
 
 impl GuidanceMember {
+    /// What guidance reads: the behaviors' command, the world state, the sonars, the
+    /// planner's paths.
+    pub(super) fn inputs() -> Inputs<GuidanceMember> {
+        Inputs::<Self>::new()
+            .on::<RobotCommand>(RequestType::Local, |g, c| g.command = Some(c.clone()))
+            .on::<WorldSnapshot>(RequestType::Local, |g, w| g.world.clone_from(w))
+            .on::<SonarScan>(RequestType::Local, |g, s| g.scan.clone_from(s))
+            .on::<PlannedPath>(RequestType::Local, |g, p| {
+                g.path = Some((p.clone(), g.world.time.as_secs_f64()));
+            })
+    }
+
     /// A target to reach along a planned path (`plan`): the planner is asked when its path
     /// is for another goal or a second old; meanwhile the command drives to the path's
     /// carrot in position mode, or, before any path, as the target says without planning.
@@ -52,27 +67,13 @@ impl Member for GuidanceMember {
     }
 
     fn init(&mut self, ctx: &mut Context<'_>) -> Result<(), MemberError> {
-        ctx.subscribe_to::<RobotCommand>(RequestType::Local);
-        ctx.subscribe_to::<WorldSnapshot>(RequestType::Local);
-        ctx.subscribe_to::<SonarScan>(RequestType::Local);
-        ctx.subscribe_to::<PlannedPath>(RequestType::Local);
+        self.inputs.subscribe(ctx);
         Ok(())
     }
 
     fn do_your_job(&mut self, ctx: &mut Context<'_>) -> Result<(), MemberError> {
-        let mut last = None;
-        while let Some(m) = ctx.receive_msg() {
-            if let Ok(c) = m.get::<RobotCommand>() {
-                last = Some(c.clone());
-            } else if let Ok(w) = m.get::<WorldSnapshot>() {
-                self.world.clone_from(w);
-            } else if let Ok(p) = m.get::<PlannedPath>() {
-                self.path = Some((p.clone(), self.world.time.as_secs_f64()));
-            } else {
-                self.scan.clone_from(m.get::<SonarScan>()?);
-            }
-        }
-        if let Some(mut cmd) = last {
+        self.inputs.clone().drain(self, ctx)?;
+        if let Some(mut cmd) = self.command.take() {
             let now = self.world.time.as_secs_f64();
             let (needs, played) =
                 (self.world.needs_localization, self.world.game_state == GameState::Playing);

@@ -27,7 +27,7 @@
 //! 4. **`planner-<n>`** (SPIKE, MRT manual ch. 9, on message): plans a path for each
 //!    [`PlanRequest`] round the robots the world model anchored ([`crate::planner`]);
 //! 4. **`guide-<n>`** (`GuidanceMember`; guidance, ISocRob §3.2.3, on message): turns the behaviors'
-//!    [`RobotCommand`] into a [`MotorCommand`] with [`mrt_plan::guide::Guidance`]: velocity
+//!    [`RobotCommand`] into a [`MotorCommand`] with [`mrt_plan::guidance::Guidance`]: velocity
 //!    mode halted by the sonars, or position and potential-field modes to a target posture,
 //!    or, for a target with `plan`, position mode along the planner's path, halted by the
 //!    sonars; on a robot whose camera cannot pan, it turns the robot in place while the world
@@ -55,7 +55,10 @@ use crate::stacks::{
 };
 use mrt_blackboard::{Blackboard, Proxy};
 use mrt_core::Pose2;
-use mrt_dcdt::{Activation, Agora, Context, Member, MemberError, Message, RequestType, RunReport};
+use mrt_dcdt::{
+    Activation, Agora, Context, Inputs, Member, MemberError, Message, MsgRef, RequestType,
+    RunReport,
+};
 use mrt_msgs::robot::{lps, Lpo};
 use mrt_msgs::{
     BehaviorStatus, BookingReport, CameraFrame, GameInfo, GameState, MateReport, MemberFault,
@@ -63,7 +66,7 @@ use mrt_msgs::{
 };
 use mrt_msgs::{PlanRequest, PlannedPath, Target};
 use mrt_perception::vision::agent::VisionAgent;
-use mrt_plan::guide::Guidance;
+use mrt_plan::guidance::Guidance;
 use mrt_script::member::BehaviorMember;
 use mrt_team::booking::{BallBooking, BookingParams};
 use mrt_team::isocrob::Role as IsocrobRole;
@@ -247,6 +250,8 @@ fn add_cycle(
         book: None,
         role: if keeper { Role::Goalkeeper } else { Role::Defender },
         scare: scare.then(|| Coordinator::new(u32::try_from(robot).unwrap_or(u32::MAX))),
+        frame: None,
+        inputs: WorldState::inputs(),
     };
     let guide = GuidanceMember {
         robot,
@@ -256,6 +261,8 @@ fn add_cycle(
         path: None,
         asked: None,
         look: cfg.gaze.is_none().then(LookAround::default),
+        command: None,
+        inputs: GuidanceMember::inputs(),
     };
     let mut ids = vec![agora.add_member(odometry, every), agora.add_member(camera, every)];
     if let Some(v) = &cfg.vision {
@@ -265,7 +272,7 @@ fn add_cycle(
         if let Some(up) = v.up_camera {
             agent = agent.up_camera(up);
         }
-        ids.push(agora.add_member(Vision { robot, agent, refused: 0 }, every));
+        ids.push(agora.add_member(Vision::new(robot, agent), every));
     }
     ids.extend([
         agora.add_member(game, every),
@@ -286,14 +293,15 @@ fn add_cycle(
             track_landmarks: false,
             lps: Vec::new(),
             refused: 0,
+            inputs: GazeControl::inputs(),
         };
         ids.push(agora.add_member(gaze, every));
     }
     ids.extend([
         agora.add_member(Planner::new(robot, cfg.radius), Activation::OnMessage),
         agora.add_member(guide, Activation::OnMessage),
-        agora.add_member(Motor { devices: dev(), robot, base: cfg.base }, Activation::OnMessage),
-        agora.add_member(FaultBook { devices, robot }, Activation::OnMessage),
+        agora.add_member(Motor::new(dev(), robot, cfg.base), Activation::OnMessage),
+        agora.add_member(FaultBook::new(devices, robot), Activation::OnMessage),
     ]);
     for m in ids {
         agora.activate_member(m).map_err(|e| e.to_string())?;

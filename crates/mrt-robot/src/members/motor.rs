@@ -8,6 +8,18 @@ pub(crate) struct Motor {
     pub(crate) devices: SharedDevices,
     pub(crate) robot: usize,
     pub(crate) base: Base,
+    /// The latest command, not yet applied.
+    pub(crate) command: Option<MotorCommand>,
+    pub(crate) inputs: Inputs<Motor>,
+}
+
+impl Motor {
+    /// The motor driver of robot `robot` on `devices`, driving `base`.
+    pub(crate) fn new(devices: SharedDevices, robot: usize, base: Base) -> Motor {
+        let inputs = Inputs::new()
+            .on::<MotorCommand>(RequestType::Local, |m: &mut Motor, c| m.command = Some(*c));
+        Motor { devices, robot, base, command: None, inputs }
+    }
 }
 
 impl Member for Motor {
@@ -16,16 +28,13 @@ impl Member for Motor {
     }
 
     fn init(&mut self, ctx: &mut Context<'_>) -> Result<(), MemberError> {
-        ctx.subscribe_to::<MotorCommand>(RequestType::Local);
+        self.inputs.subscribe(ctx);
         Ok(())
     }
 
     fn do_your_job(&mut self, ctx: &mut Context<'_>) -> Result<(), MemberError> {
-        let mut last = None;
-        while let Some(m) = ctx.receive_msg() {
-            last = Some(*m.get::<MotorCommand>()?);
-        }
-        if let Some(cmd) = last {
+        self.inputs.clone().drain(self, ctx)?;
+        if let Some(cmd) = self.command.take() {
             let mut devices = lock(&self.devices)?;
             devices.set_duty(&self.base.duties(&cmd.twist))?;
             if cmd.kick {

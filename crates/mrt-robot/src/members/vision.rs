@@ -9,6 +9,22 @@ pub(super) struct Vision {
     pub(super) robot: usize,
     pub(super) agent: VisionAgent,
     pub(super) refused: u64,
+    /// The latest frame with an image, not yet seen.
+    pub(super) latest: Option<MsgRef>,
+    pub(super) inputs: Inputs<Vision>,
+}
+
+impl Vision {
+    /// The vision µAgent of robot `robot`.
+    pub(super) fn new(robot: usize, agent: VisionAgent) -> Vision {
+        let inputs =
+            Inputs::new().on_msg::<CameraFrame>(RequestType::Local, |v: &mut Vision, m| {
+                if m.get::<CameraFrame>().is_ok_and(|f| f.image.is_some()) {
+                    v.latest = Some(m.clone());
+                }
+            });
+        Vision { robot, agent, refused: 0, latest: None, inputs }
+    }
 }
 
 impl Member for Vision {
@@ -17,18 +33,13 @@ impl Member for Vision {
     }
 
     fn init(&mut self, ctx: &mut Context<'_>) -> Result<(), MemberError> {
-        ctx.subscribe_to::<CameraFrame>(RequestType::Local);
+        self.inputs.subscribe(ctx);
         Ok(())
     }
 
     fn do_your_job(&mut self, ctx: &mut Context<'_>) -> Result<(), MemberError> {
-        let mut latest = None;
-        while let Some(m) = ctx.receive_msg() {
-            if m.get::<CameraFrame>().is_ok_and(|f| f.image.is_some()) {
-                latest = Some(m);
-            }
-        }
-        let Some(m) = latest else { return Ok(()) };
+        self.inputs.clone().drain(self, ctx)?;
+        let Some(m) = self.latest.take() else { return Ok(()) };
         let frame = m.get::<CameraFrame>()?;
         let Some(image) = &frame.image else { return Ok(()) };
         // Where the pan joint was when the frame was taken (the gaze control turns it), or,

@@ -29,6 +29,32 @@ pub(super) struct WorldState {
     /// robot, its sub-task and goal, into the snapshot's `job` for Team Milan's parametric
     /// behaviors (Team Milan only).
     pub(super) scare: Option<Coordinator>,
+    /// The latest frame to read this cycle: percepts, or a camera frame without an image.
+    pub(super) frame: Option<MsgRef>,
+    pub(super) inputs: Inputs<WorldState>,
+}
+
+impl WorldState {
+    /// What the world state reads, and what it does with each.
+    pub(super) fn inputs() -> Inputs<WorldState> {
+        Inputs::<Self>::new()
+            .on::<Odometry>(RequestType::Local, |s, o| s.model.odometry(o))
+            .on_msg::<CameraFrame>(RequestType::Local, |s, m| {
+                // A frame with an image is the vision µAgent's to read; its percepts follow.
+                if m.get::<CameraFrame>().is_ok_and(|f| f.image.is_none()) {
+                    s.frame = Some(m.clone());
+                }
+            })
+            .on_msg::<Percepts>(RequestType::Local, |s, m| s.frame = Some(m.clone()))
+            .on::<GameInfo>(RequestType::Local, |s, g| s.model.game(*g))
+            // Read with the next frame (MAP's merger: echoes of robots out of view).
+            .on::<SonarScan>(RequestType::Local, |s, scan| s.model.sonars(scan))
+            .on::<RobotCommand>(RequestType::Local, |s, c| s.book = c.book_ball.or(s.book))
+            .on::<MateReport>(RequestType::Remote, |s, r| {
+                s.booking_news.push((r.id, r.booking.clone()));
+                s.mates.insert(r.id, r.clone());
+            })
+    }
 }
 
 impl Member for WorldState {
@@ -37,42 +63,13 @@ impl Member for WorldState {
     }
 
     fn init(&mut self, ctx: &mut Context<'_>) -> Result<(), MemberError> {
-        ctx.subscribe_to::<Odometry>(RequestType::Local);
-        ctx.subscribe_to::<CameraFrame>(RequestType::Local);
-        ctx.subscribe_to::<Percepts>(RequestType::Local);
-        ctx.subscribe_to::<GameInfo>(RequestType::Local);
-        ctx.subscribe_to::<SonarScan>(RequestType::Local);
-        ctx.subscribe_to::<MateReport>(RequestType::Remote);
-        ctx.subscribe_to::<RobotCommand>(RequestType::Local);
+        self.inputs.subscribe(ctx);
         Ok(())
     }
 
     fn do_your_job(&mut self, ctx: &mut Context<'_>) -> Result<(), MemberError> {
-        let mut frame = None;
-        while let Some(m) = ctx.receive_msg() {
-            if let Ok(o) = m.get::<Odometry>() {
-                self.model.odometry(o);
-            } else if let Ok(f) = m.get::<CameraFrame>() {
-                // A frame with an image is the vision µAgent's to read; its percepts follow.
-                if f.image.is_none() {
-                    frame = Some(m);
-                }
-            } else if m.is::<Percepts>() {
-                frame = Some(m);
-            } else if let Ok(g) = m.get::<GameInfo>() {
-                self.model.game(*g);
-            } else if let Ok(scan) = m.get::<SonarScan>() {
-                // Read with the next frame (MAP's merger: echoes of robots out of view).
-                self.model.sonars(scan);
-            } else if let Ok(c) = m.get::<RobotCommand>() {
-                self.book = c.book_ball.or(self.book);
-            } else {
-                let r = m.get::<MateReport>()?;
-                self.booking_news.push((r.id, r.booking.clone()));
-                self.mates.insert(r.id, r.clone());
-            }
-        }
-        let Some(frame) = frame else { return Ok(()) };
+        self.inputs.clone().drain(self, ctx)?;
+        let Some(frame) = self.frame.take() else { return Ok(()) };
         let mut w = match frame.get::<Percepts>() {
             Ok(p) => self.model.percepts(p),
             Err(_) => self.model.camera(frame.get::<CameraFrame>()?),

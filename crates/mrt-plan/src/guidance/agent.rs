@@ -19,8 +19,7 @@
 //! use mrt_core::frames::Framed;
 //! use mrt_core::{Point2, Pose2, Twist};
 //! use mrt_msgs::robot::{RobotCommand, Target};
-//! use mrt_plan::guidance::Sonar;
-//! use mrt_plan::guide::{Guidance, Mode};
+//! use mrt_plan::guidance::{Guidance, Mode, Sonar};
 //!
 //! let guidance = Guidance::default();
 //! let me = Framed::new(Pose2::new(0.0, 0.0, 0.0));
@@ -42,9 +41,7 @@
 //! assert!((g.twist.vx - 1.2).abs() < 1e-9 && g.twist.vy.abs() < 1e-9);
 //! ```
 
-use crate::guidance::{
-    GuidanceCommand, Obstacle, PositionMode, PotentialField, Sonar, VelocityGuard,
-};
+use super::{GuidanceCommand, Obstacle, PositionMode, PotentialField, Sonar, VelocityGuard};
 use mrt_core::frames::{Framed, Team};
 use mrt_core::{Point2, Pose2, Twist};
 use mrt_msgs::robot::{RobotCommand, Target};

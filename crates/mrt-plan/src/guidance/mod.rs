@@ -1,5 +1,6 @@
-//! Guidance: the three motion modes of the ISocRob Guidance µAgent (seed `003`, §3.2.3, lines
-//! ~422–436), on top of [`crate::kinematics`].
+//! Guidance: the ISocRob Guidance µAgent (ISocRob-2000 report §3.2.3) on top of
+//! [`crate::kinematics`]. [`Guidance`] is the µAgent as one call per control cycle: it runs
+//! the mode a behavior's command asks for. Its three motion modes:
 //!
 //! - **Velocity mode** ([`VelocityGuard`]): a velocity reference goes to the motors "unless an
 //!   obstacle is found by the sonars. If this is the case, the robot movement is simply halted".
@@ -26,7 +27,10 @@ use mrt_core::{angle_diff, Point2, Pose2, Vec2};
 use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
 
+pub use agent::{echo_obstacles, Guidance, Guided, Mode};
 pub use mrt_msgs::Sonar;
+
+mod agent;
 
 /// What a guidance mode asks of the base.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
