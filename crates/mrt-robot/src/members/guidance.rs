@@ -1,5 +1,5 @@
-//! The guidance Member (`guide-<n>`): the behaviors' command through guidance each cycle
-//! ([`guided_command`]).
+//! The guidance Member (`guide-<n>`): the behaviors' command through the Guidance µAgent
+//! once a cycle, into the motor driver's command.
 
 use super::*;
 use mrt_core::frames::{point_in_metres, pose_in_metres, Framed, Team};
@@ -39,7 +39,7 @@ impl GuidanceMember {
 
     /// A target to reach along a planned path (`plan`): the planner is asked when its path
     /// is for another goal or a second old; meanwhile the command drives to the path's
-    /// carrot in position mode, or, before any path, as the target says without planning.
+    /// carrot in path mode, or, before any path, as the target says without planning.
     fn follow(&mut self, cmd: &mut RobotCommand, me: Framed<Team, Pose2>, ctx: &mut Context<'_>) {
         let Some(target) = cmd.target.filter(|t| t.plan) else { return };
         let now = self.world.time.as_secs_f64();
