@@ -39,7 +39,7 @@ WHEEL_RADIUS = 0.05  # m
 TRACK = 0.40  # m between the wheels
 TOP_WHEEL_SPEED = 24.0  # rad/s
 TOP_WHEEL_ACCEL = 60.0  # rad/s^2
-ROBOT_MASS = 30.0  # kg (configs/sim/default.toml [robot] mass)
+ROBOT_MASS = 30.0  # kg (configs/sim/default.toml [body] mass)
 GRIP = 0.8 * ROBOT_MASS * 9.81  # N: the most the wheels can push (or hold sideways)
 SERVO_TIME = 0.02  # s: how fast the body follows its wheels (velocity servo gain m / this)
 STALL_SLIP = 2.0  # rad/s: the most a wheel's speed runs ahead of the body's motion (a blocked
@@ -58,7 +58,7 @@ SONAR_HEIGHT = 0.2  # m above the floor
 SONAR_RANGE = 3.0  # m from the robot's centre; farther: no echo
 
 # --- the ball on the carpet -------------------------------------------------------------------
-BALL_DAMPING = 0.4  # 1/s ([localization] ball_damping): a ball rolled at v stops after ~v/0.4 m
+BALL_DAMPING = 0.4  # 1/s ([ball] rolling_damping): a ball rolled at v stops after ~v/0.4 m
 BALL_STOP_DECEL = 0.02  # m/s^2: the carpet's dry friction, which stops a slow ball
 
 CARPET_BITS = 2  # contype/conaffinity of the carpet; the ball has 1|2, robots and walls 1

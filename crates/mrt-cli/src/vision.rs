@@ -249,11 +249,11 @@ fn round3(x: f64) -> f64 {
 #[derive(clap::Args)]
 pub struct RenderArgs {
     /// The world: a simulator configuration (TOML; see configs/sim/default.toml), for the
-    /// field, its camera (`[camera]`) and what is drawn (`[render]`). Default: the built-in
+    /// field, its camera (`[vision.camera]`) and what is drawn (`[render]`). Default: the built-in
     /// world.
     #[arg(long)]
     pub world: Option<PathBuf>,
-    /// A camera file instead of the world's `[camera]` (see configs/vision/camera.toml).
+    /// A camera file instead of the world's `[vision.camera]` (see configs/vision/camera.toml).
     #[arg(long)]
     pub camera: Option<PathBuf>,
     /// Where the viewing robot stands: `X,Y,HEADING_DEG` (field frame: m from the centre spot,
@@ -324,16 +324,19 @@ pub fn render(args: &RenderArgs) -> Result<()> {
     };
     let camera = match &args.camera {
         Some(path) => CameraModel::from_file(path).map_err(|e| anyhow!("{e}"))?,
-        None => CameraModel::Pinhole(cfg.camera.camera().map_err(|e| anyhow!("camera: {e}"))?),
+        None => CameraModel::Pinhole(
+            cfg.vision.camera.camera().map_err(|e| anyhow!("vision.camera: {e}"))?,
+        ),
     };
     if let (Some(path), CameraModel::Pinhole(_)) = (&args.camera, camera) {
         // The world's robots carry this camera (its file keeps the pan and the mount).
-        cfg.camera = CameraFile::from_file(path).map_err(|e| anyhow!("{e}"))?;
+        cfg.vision.camera = CameraFile::from_file(path).map_err(|e| anyhow!("{e}"))?;
     }
     if !(args.pan.is_finite() && args.pan.abs() <= 180.0) {
         bail!("--pan must be -180 to 180 degrees, not {}", args.pan);
     }
-    let renderer = Renderer::with_camera(&cfg, camera).map_err(|e| anyhow!("camera: {e}"))?;
+    let renderer =
+        Renderer::with_camera(&cfg, camera).map_err(|e| anyhow!("vision.camera: {e}"))?;
     let (x, y, heading) = args.at;
     let scene = Scene {
         ball: args.ball,

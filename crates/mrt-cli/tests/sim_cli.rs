@@ -259,11 +259,11 @@ fn match_counts_and_seeds_are_range_checked() {
     assert!(out.contains("seeds 18446744073709551613..=18446744073709551615"), "{out}");
     // A robot radius that used to pass validation and panic in the referee.
     let cfg = std::env::temp_dir().join(format!("mrt-sim-radius-{}.toml", std::process::id()));
-    std::fs::write(&cfg, "[robot]\nradius = 0.6\n").unwrap();
+    std::fs::write(&cfg, "[body]\nradius = 0.6\n").unwrap();
     let (ok, _, err) = run(&["--config", cfg.to_str().unwrap()]);
     std::fs::remove_file(&cfg).unwrap();
     assert!(
-        !ok && err.contains("robot.radius must be at most 0.575 m") && !err.contains("panicked"),
+        !ok && err.contains("body.radius must be at most 0.575 m") && !err.contains("panicked"),
         "{err}"
     );
 }

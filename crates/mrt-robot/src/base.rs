@@ -56,7 +56,7 @@ impl Base {
         match name {
             "differential" => Ok(Base::Differential(DiffDrive::ianus3())),
             "omni" => Ok(Base::Omni(Omni3::triskar())),
-            other => Err(format!("robot.base must be differential or omni, not {other}")),
+            other => Err(format!("base must be differential or omni, not {other}")),
         }
     }
 

@@ -52,7 +52,7 @@ pub struct RobotConfig {
     pub gaze: Option<GazeConfig>,
     /// Which estimator keeps the robot's pose ([`mrt_world::relocalize`]).
     pub localizer: Localizer,
-    /// The ball's rolling friction as its tracker assumes it, 1/s.
+    /// The ball's rolling friction as its tracker assumes it, 1/s ([`BallSection`]).
     pub ball_damping: f64,
     /// Whether MUREA searches on goal corners too ([`LocalizationSection::goal_corners`]).
     pub goal_corners: bool,
@@ -136,35 +136,84 @@ impl Default for RobotSection {
     }
 }
 
-/// `[body]`: the base and the body's size, speed and kicker.
+/// `[body]`: the base and the body's size, speed, mass and kicker. The robot program reads its
+/// base, radius, kick reach and top speeds; a simulated world reads all of it (the body's
+/// physics: mass, acceleration, the kicker's strength and recharge).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct BodySection {
-    /// `omni` (three omni wheels, the manual's Triskar) or `differential` (IANUS3).
+    /// `omni` (three omni wheels, the manual's Triskar) or `differential` (two central wheels,
+    /// the manual's IANUS3: no sideways motion).
     pub base: String,
     /// Radius of the round footprint, m.
     pub radius: f64,
-    /// How far in front of the robot's edge the kicker reaches, m.
-    pub kick_reach: f64,
+    /// Mass, kg.
+    pub mass: f64,
     /// Top linear speed, m/s (guidance's position mode).
     pub max_speed: f64,
+    /// Top acceleration, m/s².
+    pub max_accel: f64,
     /// Top turning rate, rad/s.
     pub max_turn_rate: f64,
+    /// Speed the kicker gives the ball, m/s.
+    pub kick_speed: f64,
+    /// How far in front of the robot's edge the ball may be for a kick to reach it, m.
+    pub kick_reach: f64,
+    /// Half-width of the kicker's cone, rad.
+    pub kick_half_angle: f64,
+    /// Time between two kicks (the pneumatic tank recharges), s.
+    pub kick_recharge: f64,
 }
 
 impl Default for BodySection {
+    /// A round 50 cm base on three omni wheels, like the manual's Triskar, up to 1.2 m/s as
+    /// its IANUS3, with a pneumatic kicker.
     fn default() -> Self {
         BodySection {
             base: "omni".into(),
             radius: 0.25,
-            kick_reach: 0.12,
+            mass: 30.0,
             max_speed: 1.2,
+            max_accel: 2.0,
             max_turn_rate: 4.0,
+            kick_speed: 6.0,
+            kick_reach: 0.12,
+            kick_half_angle: 0.5,
+            kick_recharge: 1.0,
         }
     }
 }
 
-/// `[sensors]`: the mice's mounting and the camera's noise.
+/// `[ball]`: the ball played with (FIFA size 5 by default). The robot program reads its radius
+/// (the vision's distances, guidance) and its rolling friction (MAP's ball tracker); a
+/// simulated world rolls it with all of these.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct BallSection {
+    /// Radius, m.
+    pub radius: f64,
+    /// Mass, kg.
+    pub mass: f64,
+    /// Bounce off walls and robots, 0 to 1.
+    pub restitution: f64,
+    /// The carpet's rolling friction as linear damping of the ball's velocity, 1/s: a ball
+    /// rolled at `v` stops after about `v / rolling_damping` metres. Measure it on your carpet.
+    pub rolling_damping: f64,
+}
+
+impl Default for BallSection {
+    fn default() -> Self {
+        BallSection {
+            radius: 0.11,
+            mass: 0.43,
+            restitution: 0.6,
+            rolling_damping: mrt_world::model::BALL_DAMPING,
+        }
+    }
+}
+
+/// `[sensors]`: the mice's mounting and the camera's noise (a simulated world's object sensor
+/// applies the same noise).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct SensorsSection {
@@ -176,8 +225,6 @@ pub struct SensorsSection {
     pub camera_distance_noise: f64,
     /// The camera's bearing error, rad.
     pub camera_bearing_noise: f64,
-    /// Radius of the ball, m.
-    pub ball_radius: f64,
 }
 
 impl Default for SensorsSection {
@@ -187,7 +234,6 @@ impl Default for SensorsSection {
             mice_tolerance: 0.003,
             camera_distance_noise: 0.03,
             camera_bearing_noise: 0.02,
-            ball_radius: 0.11,
         }
     }
 }
@@ -312,31 +358,18 @@ impl GazeSection {
 
 /// `[localization]`: how the robot knows where it is (MRT manual ch. 7,
 /// [`mrt_world::relocalize`]) and how it follows the ball.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct LocalizationSection {
     /// `murea` (the default: the EKF tracks, MUREA finds the robot again when it is lost or
     /// was carried), `gm` (ThinkingCap's fuzzy grid does) or `ekf` (the EKF alone).
     pub localizer: Localizer,
-    /// The carpet's rolling friction as the ball's tracker assumes it: linear damping of the
-    /// ball's velocity, 1/s (MAP's Kalman tracker, [`mrt_world::track`]). Measure it on your
-    /// carpet: a ball rolled at `v` stops after about `v / ball_damping` metres.
-    pub ball_damping: f64,
     /// Whether MUREA also searches on the corner of a goal cut by the image's side (the
     /// vision's `goal_corners`). Off by default: it finds some kidnapped robots sooner and
     /// puts good trackers elsewhere more often (docs/localization.md, "Goal corners").
     pub goal_corners: bool,
 }
 
-impl Default for LocalizationSection {
-    fn default() -> Self {
-        LocalizationSection {
-            localizer: Localizer::default(),
-            ball_damping: mrt_world::model::BALL_DAMPING,
-            goal_corners: false,
-        }
-    }
-}
 
 /// `[devices]`: what the robot's drivers talk to.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -384,6 +417,8 @@ pub struct RobotFile {
     pub body: BodySection,
     /// Its sensors.
     pub sensors: SensorsSection,
+    /// The ball it plays with.
+    pub ball: BallSection,
     /// The field it plays on (metres).
     pub field: FieldMap,
     /// Its guidance.
@@ -461,7 +496,7 @@ impl RobotFile {
             ("field.penalty_area_depth", f.penalty_area_depth),
             ("field.penalty_area_width", f.penalty_area_width),
             ("field.centre_circle_radius", f.centre_circle_radius),
-            ("sensors.ball_radius", s.ball_radius),
+            ("ball.radius", self.ball.radius),
         ] {
             positive(name, v)?;
         }
@@ -507,22 +542,19 @@ impl RobotFile {
             base,
             radius,
             kick_reach: non_negative("body.kick_reach", b.kick_reach)?,
-            ball_radius: s.ball_radius,
+            ball_radius: self.ball.radius,
             field: self.field,
             mice,
             camera: CameraNoise {
                 distance: non_negative("sensors.camera_distance_noise", s.camera_distance_noise)?,
                 bearing: non_negative("sensors.camera_bearing_noise", s.camera_bearing_noise)?,
             },
-            guidance: Guidance::new(guard, field, s.ball_radius),
+            guidance: Guidance::new(guard, field, self.ball.radius),
             team_size: r.team_size,
             gaze: self.gaze.config(vision.as_ref().map(|v| &v.camera))?,
             vision,
             localizer: self.localization.localizer,
-            ball_damping: non_negative(
-                "localization.ball_damping",
-                self.localization.ball_damping,
-            )?,
+            ball_damping: non_negative("ball.rolling_damping", self.ball.rolling_damping)?,
             goal_corners: self.localization.goal_corners,
         })
     }
@@ -585,14 +617,15 @@ mod tests {
         let c = read("").unwrap();
         assert_eq!(c.ball_damping, mrt_world::model::BALL_DAMPING);
         assert_eq!(c.world_model().ball_damping(), 0.4);
-        let c = read("[localization]\nball_damping = 0.9\nlocalizer = \"gm\"\n").unwrap();
+        let c =
+            read("[ball]\nrolling_damping = 0.9\n[localization]\nlocalizer = \"gm\"\n").unwrap();
         assert_eq!(c.world_model().ball_damping(), 0.9);
         assert_eq!(c.world_model().localizer(), Localizer::Gm);
         assert!(!c.goal_corners, "goal corners are off unless asked for");
         let c = read("[localization]\ngoal_corners = true\n").unwrap();
         assert!(c.goal_corners);
-        let e = read("[localization]\nball_damping = -0.1\n").unwrap_err().to_string();
-        assert_eq!(e, "r.toml: localization.ball_damping must be a finite number >= 0, not -0.1");
+        let e = read("[ball]\nrolling_damping = -0.1\n").unwrap_err().to_string();
+        assert_eq!(e, "r.toml: ball.rolling_damping must be a finite number >= 0, not -0.1");
     }
 
     proptest! {

@@ -274,7 +274,7 @@ impl BusMatch {
             let truth = truth_of(&p);
             rec.record("/truth", time, &truth).map_err(|e| e.to_string())?;
             let c = p.config();
-            let bodies = Bodies { robot_radius: c.robot.radius, ball_radius: c.ball.radius };
+            let bodies = Bodies { robot_radius: c.body.radius, ball_radius: c.ball.radius };
             let scene = SceneUpdate::of_truth(&truth, &bodies, time);
             rec.record_rounded("/scene", time, &scene, VIEW_PRECISION)
                 .map_err(|e| e.to_string())?;

@@ -1,131 +1,17 @@
-//! The simulator's configuration: field, ball, robots and match rules, read from TOML. Every
-//! field has a documented default (Middle Size League proportions, a robot base of the MRT
-//! manual's size and speed), so a file only needs what it changes; `configs/sim/default.toml` lists them all.
+//! The simulator's configuration, read from TOML: a robot file's sections for every robot
+//! (`[field]`, `[ball]`, `[body]`, `[sensors]`, `[guidance]`, `[vision]`, `[gaze]`,
+//! `[localization]`, the robot program's own types from [`mrt_robot::config`], so each robot
+//! parameter has one definition and one default), and the world's own: the rules, the object
+//! sensor, the sonars, how the odometry errs, what the cameras draw. What a robot knows of the
+//! world is what the world is: the field map is the field, the camera noise the object
+//! sensor's. Every value has a documented default (Middle Size League proportions, a robot
+//! base of the MRT manual's size and speed), so a file only needs what it changes;
+//! `configs/sim/default.toml` lists them all.
 //!
 //! Units: metres, seconds, kilograms, radians.
 
 use serde::{Deserialize, Serialize};
 use std::path::Path;
-
-/// The field (Middle Size League proportions).
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(default, deny_unknown_fields)]
-pub struct FieldConfig {
-    /// Length between the goal lines.
-    pub length: f64,
-    /// Width between the side lines.
-    pub width: f64,
-    /// Free space between the lines and the surrounding walls.
-    pub border: f64,
-    /// Inner width of a goal.
-    pub goal_width: f64,
-    /// Depth of a goal behind its line.
-    pub goal_depth: f64,
-    /// Radius of the centre circle.
-    pub centre_circle_radius: f64,
-    /// Depth of the penalty area from the goal line.
-    pub penalty_area_depth: f64,
-    /// Width of the penalty area.
-    pub penalty_area_width: f64,
-}
-
-impl FieldConfig {
-    /// The field's map (`mrt-world`): lines, goals and landmarks, what both the simulated
-    /// camera and the robots' world models read.
-    pub fn map(&self) -> mrt_world::FieldMap {
-        mrt_world::FieldMap {
-            length: self.length,
-            width: self.width,
-            goal_width: self.goal_width,
-            goal_depth: self.goal_depth,
-            penalty_area_depth: self.penalty_area_depth,
-            penalty_area_width: self.penalty_area_width,
-            centre_circle_radius: self.centre_circle_radius,
-            ..mrt_world::FieldMap::default()
-        }
-    }
-}
-
-impl Default for FieldConfig {
-    fn default() -> Self {
-        Self {
-            length: 18.0,
-            width: 12.0,
-            border: 1.0,
-            goal_width: 2.0,
-            goal_depth: 0.6,
-            centre_circle_radius: 2.0,
-            penalty_area_depth: 2.25,
-            penalty_area_width: 6.5,
-        }
-    }
-}
-
-/// The ball (FIFA size 5).
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(default, deny_unknown_fields)]
-pub struct BallConfig {
-    /// Radius.
-    pub radius: f64,
-    /// Mass.
-    pub mass: f64,
-    /// Bounce off walls and robots, 0 to 1.
-    pub restitution: f64,
-    /// Rolling friction as linear damping (1/s): a free ball loses this fraction of its speed
-    /// per second, roughly.
-    pub rolling_damping: f64,
-}
-
-impl Default for BallConfig {
-    fn default() -> Self {
-        Self { radius: 0.11, mass: 0.43, restitution: 0.6, rolling_damping: 0.4 }
-    }
-}
-
-/// A robot base (defaults: a round 50 cm base on three omni wheels, like the manual's Triskar,
-/// up to 1.2 m/s as its IANUS3, with a pneumatic kicker).
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(default, deny_unknown_fields)]
-pub struct BodyConfig {
-    /// The wheels: `omni` (three omni wheels, the manual's Triskar) or `differential` (two
-    /// central wheels, the manual's IANUS3: no sideways motion).
-    pub base: String,
-    /// Radius of the round footprint.
-    pub radius: f64,
-    /// Mass.
-    pub mass: f64,
-    /// Top linear speed.
-    pub max_speed: f64,
-    /// Top acceleration.
-    pub max_accel: f64,
-    /// Top turning rate.
-    pub max_turn_rate: f64,
-    /// Speed given to the ball by a kick.
-    pub kick_speed: f64,
-    /// How far in front of the robot's edge the ball may be for a kick to reach it.
-    pub kick_reach: f64,
-    /// Half-width of the kicker's cone, radians.
-    pub kick_half_angle: f64,
-    /// Time between two kicks (the tank recharges).
-    pub kick_recharge: f64,
-}
-
-impl Default for BodyConfig {
-    fn default() -> Self {
-        Self {
-            base: "omni".into(),
-            radius: 0.25,
-            mass: 30.0,
-            max_speed: 1.2,
-            max_accel: 2.0,
-            max_turn_rate: 4.0,
-            kick_speed: 6.0,
-            kick_reach: 0.12,
-            kick_half_angle: 0.5,
-            kick_recharge: 1.0,
-        }
-    }
-}
 
 /// The rules and the clock.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -169,7 +55,8 @@ impl Default for MatchConfig {
     }
 }
 
-/// The object sensor: what a camera would detect.
+/// The object sensor: what a camera would detect, with the camera's noise (`[sensors]
+/// camera_distance_noise`, `camera_bearing_noise`).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct SensorConfig {
@@ -180,10 +67,6 @@ pub struct SensorConfig {
     /// Farthest distance at which the nets and the landmarks (large, brightly coloured) are
     /// detected.
     pub landmark_range: f64,
-    /// Standard deviation of the distance error, as a fraction of the distance.
-    pub distance_noise: f64,
-    /// Standard deviation of the bearing error, radians.
-    pub bearing_noise: f64,
     /// Probability of missing a visible object in one frame.
     pub miss_probability: f64,
     /// Where the robots' percepts come from.
@@ -211,8 +94,6 @@ impl Default for SensorConfig {
             half_fov: std::f64::consts::PI,
             range: 9.0,
             landmark_range: 20.0,
-            distance_noise: 0.03,
-            bearing_noise: 0.02,
             miss_probability: 0.05,
             percepts: PerceptSource::default(),
         }
@@ -220,7 +101,8 @@ impl Default for SensorConfig {
 }
 
 /// What the simulated cameras draw (the `render` module): the heights of the things that the
-/// 2-D physics has no use for, and the image effects, all off by default.
+/// 2-D physics has no use for, and the image effects, all off by default. The landmark posts
+/// are the robots' `[vision] post_radius` and `post_height`.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct RenderConfig {
@@ -232,10 +114,6 @@ pub struct RenderConfig {
     pub wall_height: f64,
     /// Height of a robot's dark cylinder, m (its team marker is a band near the top).
     pub robot_height: f64,
-    /// Radius of a landmark post (the corners, the ends of the half-way line), m.
-    pub post_radius: f64,
-    /// Height of a landmark post, m.
-    pub post_height: f64,
     /// Image noise: standard deviation per channel, in levels of 0–255.
     pub noise: f64,
     /// Lighting variation: each frame's brightness is scaled by a factor drawn uniformly
@@ -252,8 +130,6 @@ impl Default for RenderConfig {
             goal_height: 1.0,
             wall_height: 0.5,
             robot_height: 0.6,
-            post_radius: 0.1,
-            post_height: 0.8,
             noise: 0.0,
             lighting: 0.0,
             motion_blur: 0.0,
@@ -268,8 +144,6 @@ impl RenderConfig {
             ("render.goal_height", self.goal_height),
             ("render.wall_height", self.wall_height),
             ("render.robot_height", self.robot_height),
-            ("render.post_radius", self.post_radius),
-            ("render.post_height", self.post_height),
         ];
         for (name, v) in positive {
             if !(v.is_finite() && v > 0.0 && v <= 10.0) {
@@ -313,23 +187,17 @@ impl Default for SonarConfig {
     }
 }
 
-/// The odometry sensors: two optical mice underneath (MRT manual ch. 4) and the wheel
-/// encoders. These numbers describe the *simulated* sensors; the world-state Member's filter
-/// assumes its own (see [`mrt_world::model`]).
+/// The odometry sensors' errors: two optical mice underneath (MRT manual ch. 4) and the wheel
+/// encoders. The mice's mounting is the robot's (`[sensors] mice_distance`); these numbers
+/// are how the *simulated* sensors err, which the robots do not know.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct OdometryConfig {
-    /// Distance between the two mice (`D` of the manual's §4.1), m.
-    pub mice_distance: f64,
     /// Standard deviation of each mouse reading, as a fraction of the distance it moved.
     pub mice_noise: f64,
     /// Probability that a mouse under-reads in one cycle (it lifts, or the floor is too
     /// uniform): its reading is then 50–100 % of the true one, in the true direction (§4.2).
     pub mice_miss_probability: f64,
-    /// Largest difference of the two mice's `x̄` accepted as consistent, m per cycle (the
-    /// manual's error detection); larger differences are reduced (§4.2) or, failing that,
-    /// the cycle uses the wheels.
-    pub mice_tolerance: f64,
     /// Standard deviation of the wheel odometry, as a fraction of the motion. The wheels also
     /// count motion that did not happen when the robot is blocked (they slip).
     pub wheel_noise: f64,
@@ -337,33 +205,16 @@ pub struct OdometryConfig {
 
 impl Default for OdometryConfig {
     fn default() -> Self {
-        Self {
-            mice_distance: 0.2,
-            mice_noise: 0.005,
-            mice_miss_probability: 0.02,
-            mice_tolerance: 0.003,
-            wheel_noise: 0.05,
-        }
-    }
-}
-
-impl OdometryConfig {
-    /// The two-mice sensor these settings describe.
-    pub fn mice(&self) -> Result<mrt_perception::mice::MiceOdometry, String> {
-        mrt_perception::mice::MiceOdometry::new(self.mice_distance, self.mice_tolerance)
-            .map_err(|e| format!("odometry: {e}"))
+        Self { mice_noise: 0.005, mice_miss_probability: 0.02, wheel_noise: 0.05 }
     }
 }
 
 impl SimConfig {
-    /// Robot `id`'s robot file in this world: its base, size, kicker reach, mice, camera noise,
-    /// guidance and the field it plays on, from this world's sections, with `stack` driving it
-    /// (what `mrt sim --distributed` gives each robot process).
+    /// Robot `id`'s robot file in this world, with `stack` driving it (what `mrt sim
+    /// --distributed` gives each robot process): this world's robot sections as they are,
+    /// its rules' team size and control period, and vision on when the world renders images.
     pub fn robot_file(&self, id: usize, stack: &str) -> mrt_robot::config::RobotFile {
-        use mrt_robot::config::{
-            BodySection, DevicesSection, GazeSection, RobotFile, RobotSection, SensorsSection,
-            VisionSection,
-        };
+        use mrt_robot::config::{DevicesSection, GazeSection, RobotFile, RobotSection};
         RobotFile {
             robot: RobotSection {
                 id,
@@ -372,30 +223,15 @@ impl SimConfig {
                 behaviors: None,
                 control_period: self.rules.control_period,
             },
-            body: BodySection {
-                base: self.robot.base.clone(),
-                radius: self.robot.radius,
-                kick_reach: self.robot.kick_reach,
-                max_speed: self.robot.max_speed,
-                max_turn_rate: self.robot.max_turn_rate,
-            },
-            sensors: SensorsSection {
-                mice_distance: self.odometry.mice_distance,
-                mice_tolerance: self.odometry.mice_tolerance,
-                camera_distance_noise: self.sensor.distance_noise,
-                camera_bearing_noise: self.sensor.bearing_noise,
-                ball_radius: self.ball.radius,
-            },
-            field: self.field.map(),
+            body: self.body.clone(),
+            sensors: self.sensors.clone(),
+            ball: self.ball.clone(),
+            field: self.field,
             guidance: self.guidance.clone(),
             devices: DevicesSection::default(),
-            vision: VisionSection {
+            vision: mrt_robot::config::VisionSection {
                 enabled: self.sensor.percepts == PerceptSource::Vision,
-                camera: self.camera.clone(),
-                colors: mrt_perception::vision::colors::ColorTable::shipped(),
-                post_radius: self.render.post_radius,
-                post_height: self.render.post_height,
-                up_camera: self.up_camera.clone(),
+                ..self.vision.clone()
             },
             gaze: GazeSection {
                 half_fov: self.gaze.half_fov.or(match self.sensor.percepts {
@@ -413,37 +249,43 @@ impl SimConfig {
     pub fn robot(&self) -> Result<mrt_robot::config::RobotConfig, String> {
         self.robot_file(0, "chaser").config()
     }
+
+    /// The two-mice sensor of the robots' `[sensors]` mounting.
+    pub fn mice(&self) -> Result<mrt_perception::mice::MiceOdometry, String> {
+        mrt_perception::mice::MiceOdometry::new(
+            self.sensors.mice_distance,
+            self.sensors.mice_tolerance,
+        )
+        .map_err(|e| format!("sensors: {e}"))
+    }
 }
 
 /// The whole configuration.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct SimConfig {
-    /// The field.
-    pub field: FieldConfig,
-    /// The ball.
-    pub ball: BallConfig,
-    /// The robots (both teams).
-    pub robot: BodyConfig,
+    /// The field (a robot file's `[field]`: the robots' map is the field they play on).
+    pub field: mrt_world::FieldMap,
+    /// The ball (a robot file's `[ball]`).
+    pub ball: mrt_robot::config::BallSection,
+    /// Every robot's body, both teams (a robot file's `[body]`).
+    pub body: mrt_robot::config::BodySection,
+    /// Every robot's mice mounting and camera noise (a robot file's `[sensors]`).
+    pub sensors: mrt_robot::config::SensorsSection,
     /// The rules.
     pub rules: MatchConfig,
-    /// The object sensor.
+    /// The object sensor and where the robots' percepts come from.
     pub sensor: SensorConfig,
     /// The sonar ring.
     pub sonar: SonarConfig,
-    /// Guidance: the robot file's `[guidance]` section, for every robot.
+    /// Every robot's guidance (a robot file's `[guidance]`).
     pub guidance: mrt_robot::config::GuidanceSection,
-    /// The odometry sensors.
+    /// How the simulated odometry errs.
     pub odometry: OdometryConfig,
-    /// Every robot's camera: a camera file's keys (`mrt_perception::camera::CameraFile`;
-    /// all of them when the table is given, the shipped `configs/vision/camera.toml` when not).
-    pub camera: mrt_perception::camera::CameraFile,
-    /// Every robot's omnidirectional up camera, when the robots carry one (`[up_camera]`, an
-    /// omni camera file's keys, `configs/vision/omni.toml`; none by default): with vision
-    /// percepts, the simulator renders its image too and the robots' vision finds the ball
-    /// all around in it (ISocRob seed `003` §2.2, §3.2.1).
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub up_camera: Option<mrt_perception::camera::OmniFile>,
+    /// Every robot's cameras, colour classes and the landmark posts' shape (a robot file's
+    /// `[vision]`: `[vision.camera]`, `[vision.up_camera]`, `[vision.colors.*]`); the
+    /// simulator renders what these cameras see. `enabled` is set by `[sensor] percepts`.
+    pub vision: mrt_robot::config::VisionSection,
     /// What the cameras draw.
     pub render: RenderConfig,
     /// Every robot's camera pan joint and gaze control (a robot file's `[gaze]`; off by
@@ -498,11 +340,11 @@ impl SimConfig {
             ("field.goal_depth", self.field.goal_depth),
             ("ball.radius", self.ball.radius),
             ("ball.mass", self.ball.mass),
-            ("robot.radius", self.robot.radius),
-            ("robot.mass", self.robot.mass),
-            ("robot.max_speed", self.robot.max_speed),
-            ("robot.max_accel", self.robot.max_accel),
-            ("robot.max_turn_rate", self.robot.max_turn_rate),
+            ("body.radius", self.body.radius),
+            ("body.mass", self.body.mass),
+            ("body.max_speed", self.body.max_speed),
+            ("body.max_accel", self.body.max_accel),
+            ("body.max_turn_rate", self.body.max_turn_rate),
             ("rules.half_duration", self.rules.half_duration),
             ("rules.physics_step", self.rules.physics_step),
             ("rules.control_period", self.rules.control_period),
@@ -521,8 +363,8 @@ impl SimConfig {
             ("rules.stuck_time", self.rules.stuck_time, 0.1),
             ("rules.stuck_distance", self.rules.stuck_distance, 0.001),
             ("sensor.half_fov", self.sensor.half_fov, 0.01),
-            ("robot.kick_half_angle", self.robot.kick_half_angle, 0.0),
-            ("robot.kick_reach", self.robot.kick_reach, 0.0),
+            ("body.kick_half_angle", self.body.kick_half_angle, 0.0),
+            ("body.kick_reach", self.body.kick_reach, 0.0),
             ("field.centre_circle_radius", self.field.centre_circle_radius, 0.0),
             ("field.penalty_area_depth", self.field.penalty_area_depth, 0.0),
             ("field.penalty_area_width", self.field.penalty_area_width, 0.0),
@@ -536,9 +378,9 @@ impl SimConfig {
             return Err(format!("rules.kidnaps must be at most 100, not {}", self.rules.kidnaps));
         }
         if self.sensor.half_fov > std::f64::consts::PI
-            || self.robot.kick_half_angle > std::f64::consts::PI
+            || self.body.kick_half_angle > std::f64::consts::PI
         {
-            return Err("sensor.half_fov and robot.kick_half_angle must be at most π".into());
+            return Err("sensor.half_fov and body.kick_half_angle must be at most π".into());
         }
         // Physical bounds: a field no hall holds, or a time step that would take a match years
         // to simulate, is a typo.
@@ -562,11 +404,9 @@ impl SimConfig {
         let non_negative = [
             ("field.border", self.field.border),
             ("ball.rolling_damping", self.ball.rolling_damping),
-            ("robot.kick_speed", self.robot.kick_speed),
-            ("robot.kick_recharge", self.robot.kick_recharge),
+            ("body.kick_speed", self.body.kick_speed),
+            ("body.kick_recharge", self.body.kick_recharge),
             ("rules.set_duration", self.rules.set_duration),
-            ("sensor.distance_noise", self.sensor.distance_noise),
-            ("sensor.bearing_noise", self.sensor.bearing_noise),
             ("rules.ready_duration", self.rules.ready_duration),
             ("sonar.noise", self.sonar.noise),
             ("sonar.half_beam", self.sonar.half_beam),
@@ -588,7 +428,12 @@ impl SimConfig {
                 return Err(format!("{name} must be between 0 and 1, not {v}"));
             }
         }
-        mrt_robot::base::Base::parse(&self.robot.base)?;
+        mrt_robot::base::Base::parse(&self.body.base).map_err(|e| format!("body.{e}"))?;
+        if self.vision.enabled {
+            return Err("vision.enabled is not for a simulator file: the robots run their \
+                        vision when sensor.percepts is \"vision\""
+                .into());
+        }
         if self.field.goal_width >= self.field.width {
             return Err("field.goal_width must be smaller than field.width".into());
         }
@@ -605,30 +450,25 @@ impl SimConfig {
             ));
         }
         self.render.validate()?;
-        self.camera.camera().map_err(|e| format!("camera: {e}"))?;
-        if let Some(up) = &self.up_camera {
-            up.camera().map_err(|e| format!("up_camera: {e}"))?;
-        }
         self.check_derived()?;
-        self.odometry.mice()?;
         self.robot()?;
         Ok(())
     }
 
-    /// The quantities the simulator derives from several values (without them `[robot]
+    /// The quantities the simulator derives from several values (without them `[body]
     /// radius = 0.6` would pass validation, then the referee panicked on a `clamp` whose minimum exceeded
     /// its maximum). Each error names the field to change.
     fn check_derived(&self) -> Result<(), String> {
-        let (f, r, b) = (&self.field, self.robot.radius, self.ball.radius);
+        let (f, r, b) = (&self.field, self.body.radius, self.ball.radius);
         let (hl, hw) = (f.length / 2.0, f.width / 2.0);
         // Physics: bodies of these sizes and masses must have a density an f32 holds.
         if !(MIN_BODY_RADIUS..=1.0).contains(&r) || !(MIN_BODY_RADIUS..=1.0).contains(&b) {
             return Err(format!(
-                "robot.radius and ball.radius must be {MIN_BODY_RADIUS} to 1 m, not {r} and {b}"
+                "body.radius and ball.radius must be {MIN_BODY_RADIUS} to 1 m, not {r} and {b}"
             ));
         }
-        if self.robot.mass > MAX_MASS || self.ball.mass > MAX_MASS {
-            return Err(format!("robot.mass and ball.mass must be at most {MAX_MASS} kg"));
+        if self.body.mass > MAX_MASS || self.ball.mass > MAX_MASS {
+            return Err(format!("body.mass and ball.mass must be at most {MAX_MASS} kg"));
         }
         if self.rules.half_duration > MAX_HALF_DURATION {
             return Err(format!(
@@ -640,7 +480,7 @@ impl SimConfig {
         // most ENTRY_SPACING apart.
         if 2.0 * r + 0.05 > ENTRY_SPACING {
             return Err(format!(
-                "robot.radius must be at most {} m (robots enter the field 2 × radius + 0.05 m \
+                "body.radius must be at most {} m (robots enter the field 2 × radius + 0.05 m \
                  apart, at most {ENTRY_SPACING} m), not {r}",
                 (ENTRY_SPACING - 0.05) / 2.0
             ));
@@ -650,10 +490,10 @@ impl SimConfig {
         let farthest = hl - r - 0.1;
         if 2.0 * r + b > farthest {
             return Err(format!(
-                "field.length must be at least {:.3} m for robots of robot.radius {r} m: at \
-                 kickoff the kicker stands 2 × robot.radius + ball.radius = {:.3} m from the \
+                "field.length must be at least {:.3} m for robots of body.radius {r} m: at \
+                 kickoff the kicker stands 2 × body.radius + ball.radius = {:.3} m from the \
                  centre spot, and no robot may stand farther than field.length / 2 − \
-                 robot.radius − 0.1 m = {farthest:.3} m from it",
+                 body.radius − 0.1 m = {farthest:.3} m from it",
                 2.0 * (3.0 * r + b + 0.1),
                 2.0 * r + b
             ));
@@ -665,7 +505,7 @@ impl SimConfig {
             return Err(format!(
                 "rules.team_size {} does not fit across field.width {} m: the {lanes} field \
                  players of a team line up {lane_width:.3} m apart at kickoff, less than a \
-                 robot's width (2 × robot.radius = {} m)",
+                 robot's width (2 × body.radius = {} m)",
                 self.rules.team_size,
                 f.width,
                 2.0 * r
@@ -730,7 +570,7 @@ mod tests {
     fn an_empty_file_gives_the_documented_defaults() {
         let cfg = SimConfig::from_toml("", "empty.toml").unwrap();
         assert_eq!(cfg, SimConfig::default());
-        assert_eq!((cfg.field.length, cfg.field.width, cfg.robot.max_speed), (18.0, 12.0, 1.2));
+        assert_eq!((cfg.field.length, cfg.field.width, cfg.body.max_speed), (18.0, 12.0, 1.2));
     }
 
     #[test]
@@ -760,11 +600,11 @@ mod tests {
             ("[rules]\ncontrol_period = 1e30\n", "control_period"),
             ("[sensor]\nhalf_fov = 7.0\n", "half_fov"),
             ("[field]\npenalty_area_depth = 12.0\n", "penalty area"),
-            ("[robot]\nbase = \"legs\"\n", "robot.base must be differential or omni"),
+            ("[body]\nbase = \"legs\"\n", "body.base must be differential or omni"),
             ("[rules]\nphysics_step = 1e-9\n", "rules.physics_step must be between 0.0001 and 1"),
             ("[field]\nlength = 1e6\n", "field.length must be between 2 and 200"),
             ("[field]\nwidth = 1e6\n", "field.width must be between 2 and 200"),
-            ("[odometry]\nmice_distance = 1e-300\n", "between 0.01 and 2 m"),
+            ("[sensors]\nmice_distance = 1e-300\n", "between 0.01 and 2 m"),
             ("[rules]\nhalf_duration = 1e12\n", "rules.half_duration must be at most 86400 s"),
         ] {
             let e = SimConfig::from_toml(text, "bad.toml").unwrap_err().to_string();

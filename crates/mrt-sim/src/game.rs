@@ -225,7 +225,7 @@ impl Eyes {
         let stream = |i: u64, salt: u64| {
             CameraState::new(seed.wrapping_mul(0x2545_F491_4F6C_DD1D) ^ i ^ salt)
         };
-        let up = match &cfg.up_camera {
+        let up = match &cfg.vision.up_camera {
             Some(f) => Some(Renderer::with_camera(cfg, CameraModel::Omni(f.camera()?))?),
             None => None,
         };
@@ -313,10 +313,10 @@ impl Pitch {
                 ChaCha8Rng::seed_from_u64(seed.wrapping_mul(0x9E37_79B9_7F4A_7C15).wrapping_add(i))
             })
             .collect();
-        let mice = cfg.odometry.mice()?;
+        let mice = cfg.mice()?;
         let mut kidnap_rng = ChaCha8Rng::seed_from_u64(seed ^ 0x6B69_646E_6170_0001);
         let kidnap_plan = Self::plan_kidnaps(cfg, robots, &mut kidnap_rng);
-        let base = Base::parse(&cfg.robot.base)?;
+        let base = Base::parse(&cfg.body.base)?;
         Ok(Pitch {
             cfg: cfg.clone(),
             base,
@@ -342,7 +342,7 @@ impl Pitch {
                 PerceptSource::Oracle => None,
                 PerceptSource::Vision => Some(Eyes::new(cfg, robots, seed)?),
             },
-            pans: vec![cfg.camera.camera().map_or(0.0, |c| c.pan); robots],
+            pans: vec![cfg.vision.camera.camera().map_or(0.0, |c| c.pan); robots],
             kidnap_plan,
             kidnap_rng,
             kidnaps: Vec::new(),

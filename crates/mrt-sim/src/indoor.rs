@@ -264,7 +264,7 @@ impl IndoorWorld {
                 (*p, body)
             })
             .collect();
-        let r = &cfg.robot;
+        let r = &cfg.body;
         let area = std::f64::consts::PI * r.radius * r.radius;
         let (robot, _) = physics.insert(
             RigidBodyBuilder::dynamic().pose(Pose::new(v(start.x, start.y), start.theta as f32)),
@@ -288,7 +288,7 @@ impl IndoorWorld {
 
     /// Sets the robot's velocity set-point, within its top speeds.
     pub fn drive(&mut self, drive: Twist) {
-        let r = &self.cfg.robot;
+        let r = &self.cfg.body;
         let clamp = |x: f64, m: f64| if x.is_finite() { x.clamp(-m, m) } else { 0.0 };
         self.drive = Twist::new(
             clamp(drive.vx, r.max_speed),
@@ -325,7 +325,7 @@ impl IndoorWorld {
                 b.set_next_kinematic_translation(v(at.x, at.y));
             }
         }
-        let r = &self.cfg.robot;
+        let r = &self.cfg.body;
         let (max_dv, max_dw) = (r.max_accel * dt, 4.0 * r.max_turn_rate * dt);
         if let Some(body) = self.physics.bodies.get_mut(self.robot) {
             accelerate(body, self.drive, max_dv, max_dw);
@@ -351,11 +351,11 @@ impl Bodies for IndoorWorld {
         self.drive
     }
     fn robot_radius(&self) -> f64 {
-        self.cfg.robot.radius
+        self.cfg.body.radius
     }
     fn sonar(&self, i: usize, count: usize, half_beam: f64, range: f64) -> Vec<f64> {
         let Some(pose) = Bodies::robot(self, i) else { return Vec::new() };
-        let ring = SonarRing { count, half_beam, range, radius: self.cfg.robot.radius };
+        let ring = SonarRing { count, half_beam, range, radius: self.cfg.body.radius };
         ring.cast(&self.physics, self.robot, pose)
     }
 }
@@ -494,13 +494,13 @@ pub fn run_mission(
     (map, mission, events): (&PlanMap, &Mission, &IndoorEvents),
     mut progress: impl FnMut(f64),
 ) -> Result<IndoorReport, String> {
-    let mice = cfg.odometry.mice()?;
+    let mice = cfg.mice()?;
     let robot = cfg.robot()?;
     let mut body = RobyBody::new(mice);
-    body.guard = mrt_plan::guidance::VelocityGuard::new(cfg.robot.radius + 0.1, 0.35)
+    body.guard = mrt_plan::guidance::VelocityGuard::new(cfg.body.radius + 0.1, 0.35)
         .map_err(|e| e.to_string())?;
-    body.radius = cfg.robot.radius;
-    body.position.max_speed = body.position.max_speed.min(cfg.robot.max_speed);
+    body.radius = cfg.body.radius;
+    body.position.max_speed = body.position.max_speed.min(cfg.body.max_speed);
     body.position.steering = robot.base.steering();
     body.half_beam = cfg.sonar.half_beam;
     let roby = Arc::new(Mutex::new(

@@ -157,11 +157,11 @@ impl Referee {
         // `validate` keeps 2r + 0.05 ≤ ENTRY_SPACING; max/min (not clamp) cannot panic even so.
         let step = ((hl - 1.0) / n as f64)
             .min(crate::config::ENTRY_SPACING)
-            .max(2.0 * cfg.robot.radius + 0.05);
+            .max(2.0 * cfg.body.radius + 0.05);
         for i in 0..world.robot_count() {
             let t = self.team_of(i);
             let k = if t == Team::Home { i } else { i - self.team_size };
-            let x = (hl - 0.5 - step * k as f64).max(cfg.robot.radius);
+            let x = (hl - 0.5 - step * k as f64).max(cfg.body.radius);
             let x = -self.attack_direction(t) * x;
             world.place_robot(i, Pose2::new(x, -hw, std::f64::consts::FRAC_PI_2));
         }
@@ -173,7 +173,7 @@ impl Referee {
     /// the ball, the others spread over their own half) for at most `rules.ready_duration`.
     pub fn kickoff(&mut self, world: &mut World, team: Team) {
         let cfg = world.config().clone();
-        let (hl, r) = (cfg.field.length / 2.0, cfg.robot.radius);
+        let (hl, r) = (cfg.field.length / 2.0, cfg.body.radius);
         world.place_ball(0.0, 0.0);
         self.formation = (0..world.robot_count())
             .map(|i| {

@@ -148,7 +148,7 @@ impl PitchWorld {
             return Err(format!("a match has one or two teams, not {teams}"));
         }
         let pitch = Pitch::new(cfg, seed, n, if teams == 2 { n } else { 0 })?;
-        let base = Base::parse(&cfg.robot.base)?;
+        let base = Base::parse(&cfg.body.base)?;
         let robots = n * teams;
         let names: Vec<String> = (0..robots).map(|i| robot_name(i, n)).collect();
         let answers = Answers::new(WORLD, run, &names, base.wheels()).map_err(|e| e.to_string())?;

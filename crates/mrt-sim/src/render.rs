@@ -176,16 +176,16 @@ pub struct Renderer {
 }
 
 impl Renderer {
-    /// The renderer of `cfg`'s world, with its camera (`[camera]`) and settings (`[render]`).
+    /// The renderer of `cfg`'s world, with its camera (`[vision.camera]`) and settings (`[render]`).
     pub fn new(cfg: &SimConfig) -> Result<Renderer, String> {
-        Renderer::with_camera(cfg, CameraModel::Pinhole(cfg.camera.camera()?))
+        Renderer::with_camera(cfg, CameraModel::Pinhole(cfg.vision.camera.camera()?))
     }
 
     /// The renderer of `cfg`'s world for `camera`: a pinhole camera (drawn at pan 0 and turned
     /// by [`Renderer::render`]'s `pan`), or an omnidirectional one (its mirror needs a finite
     /// viewpoint).
     pub fn with_camera(cfg: &SimConfig, camera: CameraModel) -> Result<Renderer, String> {
-        let map = cfg.field.map();
+        let map = cfg.field;
         let wall = (map.half_length() + cfg.field.border, map.half_width() + cfg.field.border);
         let floor = FloorPaint::new(&map, wall, cfg.render.line_width);
         let (camera, rays) = match camera {
@@ -198,7 +198,7 @@ impl Renderer {
         Ok(Renderer {
             camera,
             cfg: cfg.render.clone(),
-            robot_radius: cfg.robot.radius,
+            robot_radius: cfg.body.radius,
             ball_radius: cfg.ball.radius,
             floor,
             rays,
@@ -634,7 +634,7 @@ fn fixed_things(map: &FieldMap, cfg: &SimConfig) -> Vec<Thing> {
         cuboid(x(hl, hl + gd + t), -gw - t, -gw, 0.0); // south side
         cuboid(x(hl, hl + t), -gw, gw, gh - t); // crossbar
     }
-    let (r, top) = (cfg.render.post_radius, cfg.render.post_height);
+    let (r, top) = (cfg.vision.post_radius, cfg.vision.post_height);
     for k in mrt_msgs::sighting::LANDMARK0..mrt_msgs::FIELD_OBJECTS {
         let Some(p) = map.object(k) else { continue };
         let (outer, inner) = if map.east_pattern(k) == Some(true) {

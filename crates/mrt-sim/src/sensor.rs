@@ -51,7 +51,7 @@ impl Bodies for World {
         World::drive_setpoint(self, i)
     }
     fn robot_radius(&self) -> f64 {
-        self.config().robot.radius
+        self.config().body.radius
     }
     fn sonar(&self, i: usize, count: usize, half_beam: f64, range: f64) -> Vec<f64> {
         World::sonar(self, i, count, half_beam, range)
@@ -93,7 +93,7 @@ pub(crate) fn gauss(rng: &mut dyn RngCore) -> f64 {
 /// then the field map's nets and landmarks ([`mrt_world::field`]). The camera tells them apart
 /// by colour, not by team: the world model maps them onto the team's LPS slots.
 fn targets(world: &World) -> [(f64, f64); FIELD_OBJECTS] {
-    let map = world.config().field.map();
+    let map = world.config().field;
     let mut at = [world.ball(); FIELD_OBJECTS];
     for (k, slot) in at.iter_mut().enumerate().skip(1) {
         if let Some(p) = map.object(k) {
@@ -144,15 +144,16 @@ pub fn look(
     rng: &mut dyn RngCore,
 ) -> CameraFrame {
     let me = world.robot(robot).unwrap_or_default();
-    let r_robot = world.config().robot.radius;
+    let r_robot = world.config().body.radius;
     let robots: Vec<(usize, (f64, f64))> = (0..world.robot_count())
         .filter(|&i| i != robot)
         .filter_map(|i| world.robot(i).map(|p| (i, (p.x, p.y))))
         .collect();
     let mut frame = CameraFrame { time: world.time(), ..Default::default() };
+    let noise = &world.config().sensors;
     let noisy = |dist: f64, bearing: f64, rng: &mut dyn RngCore| Sighting {
-        distance: (dist * (1.0 + cfg.distance_noise * gauss(rng))).max(0.0),
-        bearing: normalize_angle(bearing + cfg.bearing_noise * gauss(rng)),
+        distance: (dist * (1.0 + noise.camera_distance_noise * gauss(rng))).max(0.0),
+        bearing: normalize_angle(bearing + noise.camera_bearing_noise * gauss(rng)),
     };
     let in_view = |bearing: f64| normalize_angle(bearing - pan).abs() <= cfg.half_fov;
     let miss = cfg.miss_probability.clamp(0.0, 1.0);
@@ -309,16 +310,18 @@ mod tests {
     use rand_chacha::ChaCha8Rng;
 
     fn exact() -> SensorConfig {
-        SensorConfig {
-            distance_noise: 0.0,
-            bearing_noise: 0.0,
-            miss_probability: 0.0,
-            ..Default::default()
-        }
+        SensorConfig { miss_probability: 0.0, ..Default::default() }
     }
 
+    /// The default world, its cameras without noise.
     fn setup() -> (World, Referee) {
-        let mut w = World::new(&SimConfig::default(), 8);
+        let mut cfg = SimConfig::default();
+        (cfg.sensors.camera_distance_noise, cfg.sensors.camera_bearing_noise) = (0.0, 0.0);
+        setup_with(&cfg)
+    }
+
+    fn setup_with(cfg: &SimConfig) -> (World, Referee) {
+        let mut w = World::new(cfg, 8);
         let mut r = Referee::new(4);
         r.start(&mut w);
         (w, r)
@@ -398,13 +401,9 @@ mod tests {
     fn the_mice_read_the_body_motion_and_the_wheels_the_set_point() {
         let (mut w, _) = setup();
         let mut rng = ChaCha8Rng::seed_from_u64(4);
-        let exact = OdometryConfig {
-            mice_noise: 0.0,
-            mice_miss_probability: 0.0,
-            wheel_noise: 0.0,
-            ..Default::default()
-        };
-        let mice = exact.mice().unwrap();
+        let exact =
+            OdometryConfig { mice_noise: 0.0, mice_miss_probability: 0.0, wheel_noise: 0.0 };
+        let mice = SimConfig::default().mice().unwrap();
         let mut odo = Odometer::new(2, mice, Base::parse("omni").unwrap());
         // The first reading tells where the robot was put down (start of the match).
         let first = odo.read(&w, &exact, 0.1, &mut rng);
@@ -444,7 +443,7 @@ mod tests {
     fn a_mouse_sometimes_under_reads_and_noise_is_proportional() {
         let (mut w, _) = setup();
         let cfg = OdometryConfig { mice_miss_probability: 0.5, ..Default::default() };
-        let mice = cfg.mice().unwrap();
+        let mice = SimConfig::default().mice().unwrap();
         let mut rng = ChaCha8Rng::seed_from_u64(5);
         let mut odo = Odometer::new(1, mice, Base::parse("omni").unwrap());
         w.place_robot(1, Pose2::new(0.0, 0.0, 0.0));
@@ -475,7 +474,7 @@ mod tests {
 
     #[test]
     fn noise_is_seeded_and_proportional_to_distance() {
-        let (mut w, _) = setup();
+        let (mut w, _) = setup_with(&SimConfig::default());
         // Off the kickoff lanes (y = 0, ±3), so nobody stands in the line of sight.
         w.place_robot(1, Pose2::new(-6.0, 1.5, 0.0));
         w.place_ball(0.0, 1.5);

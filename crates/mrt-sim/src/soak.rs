@@ -73,7 +73,7 @@ pub fn random_config(rng: &mut impl Rng, half: f64) -> SimConfig {
         b.radius = rng.random_range(0.03..0.15);
         b.mass = rng.random_range(0.05..0.6);
         b.restitution = rng.random_range(0.2..0.9);
-        let r = &mut c.robot;
+        let r = &mut c.body;
         r.base = if rng.random_bool(0.5) { "omni" } else { "differential" }.into();
         r.radius = rng.random_range(0.1..0.4);
         r.mass = rng.random_range(2.0..60.0);

@@ -220,14 +220,14 @@ fn range(kind: &str) -> f64 {
 /// Surveys `scenes` random scenes of the world `cfg` (module doc).
 pub fn survey(cfg: &SimConfig, seed: u64, scenes: usize) -> Result<SurveyReport, String> {
     let renderer = Renderer::new(cfg)?;
-    let map = cfg.field.map();
-    let camera = cfg.camera.camera()?.panned(0.0);
-    let shape = PostShape { radius: cfg.render.post_radius, height: cfg.render.post_height };
+    let map = cfg.field;
+    let camera = cfg.vision.camera.camera()?.panned(0.0);
+    let shape = PostShape { radius: cfg.vision.post_radius, height: cfg.vision.post_height };
     let mut agent = VisionAgent::new(camera, &ColorTable::shipped(), cfg.ball.radius)
         .post_shape(shape)
         .goal_width(map.goal_width);
     let (hl, hw) = (map.half_length(), map.half_width());
-    let r = cfg.robot.radius;
+    let r = cfg.body.radius;
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let mut state = CameraState::new(seed);
     let (mut ball_t, mut net_t, mut post_t, mut corner_t, mut obstacle_t) =

@@ -83,7 +83,7 @@ impl World {
                 .restitution(b.restitution as f32)
                 .friction(0.3),
         );
-        let r = &cfg.robot;
+        let r = &cfg.body;
         let robot_area = std::f64::consts::PI * r.radius * r.radius;
         let robots = (0..robots)
             .map(|i| {
@@ -192,7 +192,7 @@ impl World {
 
     /// Sets a robot's velocity set-point (limited to the robot's top speeds).
     pub fn drive(&mut self, i: usize, drive: Twist) {
-        let r = &self.cfg.robot;
+        let r = &self.cfg.body;
         let finite = |x: f64| if x.is_finite() { x } else { 0.0 };
         let (mut fw, mut left) = (finite(drive.vx), finite(drive.vy));
         let speed = fw.hypot(left);
@@ -211,7 +211,7 @@ impl World {
     /// whether the ball was kicked.
     pub fn kick(&mut self, i: usize) -> bool {
         let Some(pose) = self.robot(i) else { return false };
-        let rc = &self.cfg.robot;
+        let rc = &self.cfg.body;
         let Some(robot) = self.robots.get_mut(i) else { return false };
         if self.time < robot.kick_ready_at {
             return false;
@@ -239,7 +239,7 @@ impl World {
         let (Some(pose), Some(robot)) = (self.robot(i), self.robots.get(i)) else {
             return Vec::new();
         };
-        let ring = SonarRing { count, half_beam, range, radius: self.cfg.robot.radius };
+        let ring = SonarRing { count, half_beam, range, radius: self.cfg.body.radius };
         ring.cast(&self.physics, robot.body, pose)
     }
 
@@ -247,8 +247,8 @@ impl World {
     /// (within the acceleration limit), then rapier moves everything.
     pub fn step(&mut self) {
         let dt = self.cfg.rules.physics_step;
-        let max_dv = self.cfg.robot.max_accel * dt;
-        let max_dw = 4.0 * self.cfg.robot.max_turn_rate * dt;
+        let max_dv = self.cfg.body.max_accel * dt;
+        let max_dw = 4.0 * self.cfg.body.max_turn_rate * dt;
         for r in &self.robots {
             accelerate(&mut self.physics.bodies[r.body], r.drive, max_dv, max_dw);
         }

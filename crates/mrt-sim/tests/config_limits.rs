@@ -1,6 +1,6 @@
 //! A simulator configuration that passes validation must not panic later.
 //!
-//! `[robot] radius = 0.6` passed `SimConfig::validate`, then the referee panicked at kickoff:
+//! `[body] radius = 0.6` passed `SimConfig::validate`, then the referee panicked at kickoff:
 //! robots enter on their side line `2 × radius + 0.05` m apart but at most 1.2 m apart, and
 //! `f64::clamp` panics when its minimum (1.25) exceeds its maximum. The same kind of derived
 //! quantity hid behind other clamps: the kickoff line (`field.length / 2 − radius − 0.1`), the
@@ -31,9 +31,9 @@ fn plays(cfg: &mut SimConfig, half: f64) {
 
 #[test]
 fn a_robot_radius_of_0_6_is_refused_not_a_panic() {
-    refused("[robot]\nradius = 0.6\n", "robot.radius must be at most 0.575 m");
+    refused("[body]\nradius = 0.6\n", "body.radius must be at most 0.575 m");
     // The largest radius allowed plays.
-    let mut cfg = SimConfig::from_toml("[robot]\nradius = 0.575\n", "ok.toml").unwrap();
+    let mut cfg = SimConfig::from_toml("[body]\nradius = 0.575\n", "ok.toml").unwrap();
     plays(&mut cfg, 1.0);
 }
 
@@ -41,8 +41,8 @@ fn a_robot_radius_of_0_6_is_refused_not_a_panic() {
 fn a_field_too_short_for_the_kickoff_is_refused() {
     refused(
         "[field]\nlength = 2.0\npenalty_area_depth = 0.5\ncentre_circle_radius = 0.5\n\
-         [robot]\nradius = 0.3\n",
-        "field.length must be at least 2.220 m for robots of robot.radius 0.3 m",
+         [body]\nradius = 0.3\n",
+        "field.length must be at least 2.220 m for robots of body.radius 0.3 m",
     );
     let mut cfg = SimConfig::from_toml(
         "[field]\nlength = 2.0\npenalty_area_depth = 0.5\ncentre_circle_radius = 0.5\n",
@@ -56,7 +56,7 @@ fn a_field_too_short_for_the_kickoff_is_refused() {
 fn a_team_too_large_for_the_field_width_is_refused() {
     refused(
         "[rules]\nteam_size = 11\n[field]\nwidth = 4.0\npenalty_area_width = 3.0\n\
-         centre_circle_radius = 1.0\n[robot]\nradius = 0.2\n",
+         centre_circle_radius = 1.0\n[body]\nradius = 0.2\n",
         "rules.team_size 11 does not fit across field.width 4 m",
     );
 }
@@ -88,9 +88,9 @@ fn a_centre_circle_larger_than_the_field_is_refused() {
 
 #[test]
 fn bodies_the_physics_cannot_hold_and_endless_halves_are_refused() {
-    refused("[robot]\nradius = 0.001\n", "robot.radius and ball.radius must be 0.01 to 1 m");
-    refused("[ball]\nradius = 1e-30\n", "robot.radius and ball.radius must be 0.01 to 1 m");
-    refused("[robot]\nmass = 1e30\n", "robot.mass and ball.mass must be at most");
+    refused("[body]\nradius = 0.001\n", "body.radius and ball.radius must be 0.01 to 1 m");
+    refused("[ball]\nradius = 1e-30\n", "body.radius and ball.radius must be 0.01 to 1 m");
+    refused("[body]\nmass = 1e30\n", "body.mass and ball.mass must be at most");
     refused("[rules]\nhalf_duration = 1e12\n", "rules.half_duration must be at most 86400 s");
 }
 
@@ -123,9 +123,9 @@ prop_compose! {
         c.field.penalty_area_depth = pa_depth * length / 2.0;
         c.field.penalty_area_width = (pa_width * c.field.goal_width).min(width);
         (c.ball.radius, c.ball.mass, c.ball.restitution) = (ball_radius, ball_mass, restitution);
-        (c.robot.radius, c.robot.mass, c.robot.max_speed, c.robot.max_accel, c.robot.max_turn_rate) =
+        (c.body.radius, c.body.mass, c.body.max_speed, c.body.max_accel, c.body.max_turn_rate) =
             (radius, mass, speed, accel, turn);
-        (c.robot.kick_speed, c.robot.kick_reach, c.robot.kick_half_angle, c.robot.kick_recharge) =
+        (c.body.kick_speed, c.body.kick_reach, c.body.kick_half_angle, c.body.kick_recharge) =
             (kick_speed, reach, cone, recharge);
         (c.rules.team_size, c.rules.physics_step, c.rules.control_period, c.rules.ready_duration, c.rules.set_duration) =
             (team, step, period, ready, set);

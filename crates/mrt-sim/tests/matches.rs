@@ -50,7 +50,7 @@ fn guidance_halts_a_robot_before_the_wall_and_without_it_the_robot_hits() {
     cfg.rules.team_size = 2;
     let start = mrt_core::Pose2::new(3.0, 5.75, std::f64::consts::FRAC_PI_2);
     let go = RobotCommand { twist: Twist::new(0.4, 0.0, 0.0), ..RobotCommand::default() };
-    let edge = |p: &Pitch| 7.0 - p.world().robot(1).unwrap().y - cfg.robot.radius;
+    let edge = |p: &Pitch| 7.0 - p.world().robot(1).unwrap().y - cfg.body.radius;
     // Guided: the robot's own cycle, on the bus.
     let stand = || Box::new(Always(RobotCommand::default())) as Box<dyn Brain + Send>;
     let home = vec![stand(), Box::new(Always(go.clone())) as Box<dyn Brain + Send>];
@@ -266,19 +266,20 @@ fn a_chaser_plays_through_vision_and_roughly_knows_where_it_is() {
     assert!(median < 1.0, "pose error median {median:.3} m");
 }
 
-/// Robots that carry ISocRob's up camera too (`[up_camera]` in a simulator file): the
+/// Robots that carry ISocRob's up camera too (`[vision.up_camera]` in a simulator file): the
 /// simulator renders both images each cycle and the robots' vision reads both; a match plays
 /// through them without a fault, and a robot knows where the ball is more often than with
 /// the front camera alone (the up camera sees it all around).
 #[test]
 fn robots_with_an_up_camera_see_the_ball_more_often() {
-    let text = "[rules]\nhalf_duration = 20.0\nteam_size = 1\n\n[up_camera]\nmodel = \"omni\"\n\
+    let text =
+        "[rules]\nhalf_duration = 20.0\nteam_size = 1\n\n[vision.up_camera]\nmodel = \"omni\"\n\
                 width = 480\nheight = 480\ncx = 240.0\ncy = 240.0\nscale_px_per_m = 50.0\n";
     let with_up = SimConfig::from_toml(text, "up.toml").unwrap();
-    assert!(with_up.up_camera.is_some());
+    assert!(with_up.vision.up_camera.is_some());
     assert_eq!(SimConfig::from_toml(&with_up.to_toml().unwrap(), "again.toml").unwrap(), with_up);
     let mut front_only = with_up.clone();
-    front_only.up_camera = None;
+    front_only.vision.up_camera = None;
     let seen = |cfg: &SimConfig| {
         let m = BusMatch::with_brains(
             cfg,

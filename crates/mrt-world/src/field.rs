@@ -52,6 +52,8 @@ pub struct FieldMap {
     pub length: f64,
     /// Width between the side lines.
     pub width: f64,
+    /// Free space between the lines and the walls around the field.
+    pub border: f64,
     /// Inner width of a goal.
     pub goal_width: f64,
     /// Depth of a goal behind its goal line, to the inner face of its back.
@@ -68,12 +70,14 @@ pub struct FieldMap {
 }
 
 impl Default for FieldMap {
-    /// The Middle Size League field of the seeds' time: 18 m × 12 m, goals 2 m wide and
-    /// 0.6 m deep with 5 cm sides, penalty areas 2.25 m × 6.5 m, centre circle of 2 m.
+    /// The Middle Size League field of the seeds' time: 18 m × 12 m inside walls 1 m beyond
+    /// the lines, goals 2 m wide and 0.6 m deep with 5 cm sides, penalty areas 2.25 m × 6.5 m,
+    /// centre circle of 2 m.
     fn default() -> Self {
         FieldMap {
             length: 18.0,
             width: 12.0,
+            border: 1.0,
             goal_width: 2.0,
             goal_depth: 0.6,
             goal_wall: 0.05,

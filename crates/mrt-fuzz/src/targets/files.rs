@@ -102,7 +102,7 @@ impl Harness for BrianFiles {
 pub(super) const SIM_CONFIG: Target = Target {
     name: "sim-config",
     about: "the simulator's TOML configuration: SimConfig::from_toml (parse + validate), the derived objects, and to_toml read back",
-    keywords: &["[field]", "[ball]", "[robot]", "[match]", "[sensor]", "[sonar]", "[odometry]", "[guidance]", "=", "true", "false", "\"\"", "[]", "{}", "nan", "inf", "-inf", "1e400"],
+    keywords: &["[field]", "[ball]", "[body]", "[sensors]", "[rules]", "[sensor]", "[sonar]", "[odometry]", "[guidance]", "[vision]", "[vision.camera]", "=", "true", "false", "\"\"", "[]", "{}", "nan", "inf", "-inf", "1e400"],
     structured: Some(crate::mutate::mutate_toml),
     seeds: |root| files_under(&root.join("configs/sim"), |s| s.ends_with(".toml")),
     harness: |_| Ok(Box::new(SimToml)),
@@ -115,8 +115,7 @@ impl Harness for SimToml {
         // `SimConfig::from_file` reads the file as UTF-8 text.
         let Ok(text) = std::str::from_utf8(input) else { return false };
         let Ok(cfg) = SimConfig::from_toml(text, "fuzz.toml") else { return false };
-        let _ = cfg.field.map();
-        let _ = cfg.odometry.mice();
+        let _ = cfg.mice();
         let _ = cfg.robot();
         let _ = cfg.robot_file(0, "chaos").to_toml();
         // Documented: to_toml gives a file from_toml reads back.
@@ -235,7 +234,7 @@ impl Harness for MiceLog {
 pub(super) const ROBOT_FILE: Target = Target {
     name: "robot-file",
     about: "a robot file (mrt robot --config): RobotFile::from_toml (parse + config + spec), and to_toml read back",
-    keywords: &["[robot]", "[body]", "[sensors]", "[field]", "[guidance]", "[devices]", "id", "team_size", "stack", "=", "\"chaos\"", "\"linked\"", "nan", "inf", "-inf", "1e400", "-1"],
+    keywords: &["[robot]", "[body]", "[sensors]", "[ball]", "[field]", "[guidance]", "[devices]", "id", "team_size", "stack", "=", "\"chaos\"", "\"linked\"", "nan", "inf", "-inf", "1e400", "-1"],
     structured: Some(crate::mutate::mutate_toml),
     seeds: |root| files_under(&root.join("configs/robot"), |s| s.ends_with(".toml")),
     harness: |_| Ok(Box::new(RobotToml)),
