@@ -446,7 +446,6 @@ impl Samples for Percepts {
             PostSighting { sighting: sighting(), sigma: (0.1, 0.02), east: true, pixels: 40 };
         filled.posts = vec![post];
         filled.goal_corners = vec![post];
-        filled.open_space = [Some(0.1), None];
         filled.pan = Some(0.0);
         let at = |kind, x, y, w, h| ImageDetection { kind, x, y, w, h };
         filled.detections = Some(ImageDetections {

@@ -293,11 +293,6 @@ pub struct Percepts {
     /// obliquely; which one, the world model tells). `east`: a corner of the east goal.
     #[serde(default)]
     pub goal_corners: Vec<PostSighting>,
-    /// Where to shoot into each goal: the bearing (rad, robot frame) of its open space, the
-    /// widest stretch of its mouth that no keeper hides (ISocRob seed `003` eq. 18), for the
-    /// east and the west goal, when the whole goal is in view.
-    #[serde(default)]
-    pub open_space: [Option<f64>; 2],
     /// The camera's pan joint when the image was taken, rad (`None`: not known): where the
     /// camera looked, so that the world model knows what it should have seen.
     #[serde(default)]

@@ -14,7 +14,7 @@
 use super::balance::BalancedLut;
 use super::blobs::{find_ball, BallPercept};
 use super::colors::{ColorClass, ColorTable, Lut};
-use super::goals::{find_goal, goal_columns, open_space, GoalPercept};
+use super::goals::{find_goal, goal_columns, GoalPercept};
 use super::lines::line_points;
 use super::posts::{find_posts_in, PostPercept, PostShape};
 use super::up::UpMode;
@@ -78,8 +78,6 @@ struct Net {
     foot: Pixel,
     /// The goal's pixel count.
     pixels: u32,
-    /// The bearing of its open space (eq. 18), rad.
-    open_bearing: Option<f64>,
     /// Its box in the image: from its first to its last column, from its feet up by its
     /// columns' mean height.
     shown: ImageDetection,
@@ -281,17 +279,14 @@ impl VisionAgent {
         let [yellow, blue] = columns;
         let (east_count, west_count) =
             if self.east_goal == ColorClass::GoalYellow { (yellow, blue) } else { (blue, yellow) };
-        for (side, (k, class, count)) in
+        for (k, class, count) in
             [(EAST_NET, self.east_goal, east_count), (WEST_NET, west, west_count)]
-                .into_iter()
-                .enumerate()
         {
             let count = without_posts(count, &posts, w as usize);
             if let Some(net) = self.net(class, &count) {
                 p.sightings[k] = Some(sighting(net.at));
                 p.sigmas[k] = self.sigma(net.foot, 1.0);
                 p.pixels[k] = net.pixels;
-                p.open_space[side] = net.open_bearing;
                 shown.push(net.shown);
             } else if let Some((px, at)) = self.cut_goal_corner(class, &count) {
                 if let Some(sigma) = self.sigma(px, 1.0) {
@@ -414,14 +409,6 @@ impl VisionAgent {
         if !(0.5 * self.goal_width..=1.5 * self.goal_width).contains(&apart) {
             return None;
         }
-        // Eq. 18 on the goal's columns between its feet, with a half window of an eighth of
-        // them (as `find_goal`'s default); its bearing on the floor between the feet.
-        let (c0, c1) = (pl.x as usize, (pr.x as usize + 1).min(w));
-        let open_bearing = open_space(&count[c0..c1], ((c1 - c0) / 8).max(1)).and_then(|c| {
-            let px = Pixel::new((c0 + c) as f64 + 0.5, 0.5 * (pl.y + pr.y));
-            let at = self.camera.unproject(px)?;
-            Some(at.y.atan2(at.x))
-        });
         // Its box: its first to last column, up from its lower foot by its mean column height.
         let first = count.iter().position(|&c| c > 0).unwrap_or(0);
         let last = count.iter().rposition(|&c| c > 0).unwrap_or(w - 1);
@@ -432,7 +419,7 @@ impl VisionAgent {
         let centre = Pixel::new(first as f64 + 0.5 * width, bottom - 0.5 * tall);
         let shown = detection(DetectionKind::Net, centre, width, tall);
         let at = Point2::from((l.coords + r.coords) / 2.0);
-        Some(Net { at, foot: pl, pixels, open_bearing, shown })
+        Some(Net { at, foot: pl, pixels, shown })
     }
 
     /// The goal of `class` cut by one side of the image: the outermost foot on the other side
