@@ -246,7 +246,7 @@ fn filled_snapshot() -> WorldSnapshot {
     w.role = "attacker".to_owned();
     w.ball_booked = true;
     w.game_state = GameState::Playing;
-    w.kickoff_pose = Some(Pose2::new(-500.0, 0.0, 0.0));
+    w.kickoff_pose = Some(Framed::new(Pose2::new(-0.5, 0.0, 0.0)));
     w.needs_localization = true;
     w.job = Some(ScareJob {
         activity: "BringBall".to_owned(),

@@ -209,9 +209,10 @@ pub struct WorldSnapshot {
     pub game_state: GameState,
     /// The field (`getField`).
     pub field: Field,
-    /// In `READY`: where the referee's kickoff formation wants this robot (team frame, mm,
-    /// heading in radians; `getKickoffPose`). `None` in the other states.
-    pub kickoff_pose: Option<Pose2>,
+    /// In `READY`: where the referee's kickoff formation wants this robot (team frame,
+    /// metres, heading in radians; `getKickoffPose` gives it in mm). `None` in the other
+    /// states.
+    pub kickoff_pose: Option<Framed<Team, Pose2>>,
     /// Whether the world model needs to localize the robot: the landmarks it sees have
     /// disagreed with its pose for a while (ThinkingCap seed `001` §2.1: a perceptual need for
     /// landmarks; `mrt_world::WorldModel::needs_localization`).

@@ -370,7 +370,6 @@ pub struct LocalizationSection {
     pub goal_corners: bool,
 }
 
-
 /// `[devices]`: what the robot's drivers talk to.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]

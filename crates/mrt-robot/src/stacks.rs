@@ -17,7 +17,7 @@
 use crate::brain::Brain;
 use crate::config::RobotConfig;
 use crate::files::FilesDir;
-use mrt_core::frames::{millimetres, pose_in_metres, twist_from_setpoints, Framed};
+use mrt_core::frames::{millimetres, twist_from_setpoints};
 use mrt_core::{Point2, Pose2};
 use mrt_fuzzy::brian::Brian;
 use mrt_msgs::robot::{lps, Field, GameState, Lpo, RobotCommand, Target, WorldSnapshot};
@@ -478,7 +478,7 @@ impl Chaser {
 pub fn walk_to_kickoff(w: &WorldSnapshot) -> Option<RobotCommand> {
     let pose = w.kickoff_pose.filter(|_| w.game_state == GameState::Ready)?;
     Some(RobotCommand {
-        target: Some(Target { pose: Framed::new(pose_in_metres(pose)), avoid: true, plan: false }),
+        target: Some(Target { pose, avoid: true, plan: false }),
         needs: vec![(lps::BALL, 1.0)],
         ..RobotCommand::default()
     })

@@ -14,7 +14,7 @@
 use crate::runtime::LuaRuntime;
 use crate::script::ScriptError;
 use mlua::{Lua, LuaString, Table, Value};
-use mrt_core::frames::{metres, millis, pose_in_metres, Framed};
+use mrt_core::frames::{metres, millis, pose_in_metres, pose_in_millimetres, Framed};
 use mrt_core::Time;
 use mrt_msgs::robot::{lps, RobotCommand, WorldSnapshot};
 use std::cell::RefCell;
@@ -401,6 +401,7 @@ fn install_inner(lua: &Lua, io: Rc<RefCell<RobotIo>>, memory_limit: usize) -> ml
     let k = keys.clone();
     func!("getKickoffPose", io, |lua, (): ()| {
         let Some(p) = io.borrow().world.kickoff_pose else { return Ok(Value::Nil) };
+        let p = pose_in_millimetres(p.inner);
         let t = lua.create_table_with_capacity(0, 3)?;
         k.fill_pose(&t, p.x, p.y, Some(p.theta), None)?;
         Ok(Value::Table(t))

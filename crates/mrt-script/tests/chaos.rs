@@ -209,7 +209,7 @@ fn kickoff_pose_and_targets() {
     let go = "local p = chaos.getKickoffPose() if p then chaos.setTarget(p.x, p.y, p.theta) end";
     let ready = WorldSnapshot {
         game_state: GameState::Ready,
-        kickoff_pose: Some(Pose2::new(-4000.0, 1500.0, 0.5)),
+        kickoff_pose: Some(Framed::new(Pose2::new(-4.0, 1.5, 0.5))),
         ..Default::default()
     };
     let (r, target) = run(ready, go);

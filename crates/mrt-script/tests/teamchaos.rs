@@ -1052,13 +1052,12 @@ fn the_behaviors_play_on_the_field_the_world_model_describes() {
 /// they stand.
 #[test]
 fn in_ready_the_players_and_the_goalkeeper_walk_to_their_kickoff_places() {
-    let place = mrt_core::Pose2::new(-3000.0, 1200.0, 0.0);
+    let pose = mrt_core::frames::Framed::new(mrt_core::Pose2::new(-3.0, 1.2, 0.0));
     let ready = |mut w: World| {
         w.0.game_state = GameState::Ready;
-        w.0.kickoff_pose = Some(place);
+        w.0.kickoff_pose = Some(pose);
         w
     };
-    let pose = mrt_core::frames::Framed::new(mrt_core::Pose2::new(-3.0, 1.2, 0.0));
     let want = Some(mrt_msgs::robot::Target { pose, avoid: true, plan: false });
     let mut player =
         ThinkingCap::with_hfsm(dir(), dir().join("player.hfsm.lua"), Sandbox::default()).unwrap();

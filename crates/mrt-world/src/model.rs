@@ -956,7 +956,7 @@ impl WorldModel {
         }
         w.my_pos = Estimate { pose: mm_pose(me.to_team(attack)), quality: self.quality() };
         w.needs_localization = self.needs_localization();
-        w.kickoff_pose = self.game.kickoff_pose.map(|p| mm_pose(p.to_team(attack)));
+        w.kickoff_pose = self.game.kickoff_pose.map(|p| p.to_team(attack));
         if let Some(Memory { at, reliability, .. }) = self.memory[lps::BALL] {
             let (x, y) = mm(at.to_team(attack));
             w.global_ball = Estimate { pose: Pose2::new(x, y, 0.0), quality: reliability };

@@ -172,7 +172,7 @@ fn sample_world(cycle: u32) -> WorldSnapshot {
         time: Time::from_secs_f64(0.1 * f64::from(cycle)),
         game_state: GameState::Playing,
         role: "attacker".to_string(),
-        kickoff_pose: Some(Pose2::new(-1000.0, 0.0, 0.0)),
+        kickoff_pose: Some(mrt_core::frames::Framed::new(Pose2::new(-1.0, 0.0, 0.0))),
         ..WorldSnapshot::default()
     };
     w.lps[lps::BALL] = Lpo { rho: 900.0, theta: 0.3, reliability: 0.9, seen_ago: 0.0 };
