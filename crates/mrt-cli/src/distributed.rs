@@ -221,8 +221,8 @@ fn monitor_net_file(port: u16, discovery: u16, ports: &[u16]) -> String {
 struct Post(RawPort);
 
 impl WorldPort for Post {
-    fn put(&self, key: &str, bytes: Vec<u8>) -> Result<(), String> {
-        self.0.put(key, bytes).map_err(|e| e.to_string())
+    fn put(&self, key: &str, bytes: Vec<u8>) -> Result<(), mrt_robot::RobotError> {
+        self.0.put(key, bytes).map_err(|e| mrt_robot::RobotError::World(e.to_string()))
     }
 }
 

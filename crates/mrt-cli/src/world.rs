@@ -35,8 +35,8 @@ const SCOUTING: &str = "224.0.0.224:7446";
 struct Port(RawPort);
 
 impl WorldPort for Port {
-    fn put(&self, key: &str, bytes: Vec<u8>) -> Result<(), String> {
-        self.0.put(key, bytes).map_err(|e| e.to_string())
+    fn put(&self, key: &str, bytes: Vec<u8>) -> Result<(), mrt_robot::RobotError> {
+        self.0.put(key, bytes).map_err(|e| mrt_robot::RobotError::World(e.to_string()))
     }
 }
 
@@ -47,8 +47,8 @@ pub fn robot(args: &RobotArgs, file: &RobotFile, started: Instant) -> Result<()>
     let path = args.config.as_path();
     let here = path.parent().unwrap_or(Path::new("."));
     let at = |e: String| anyhow!("{}: {e}", path.display());
-    let cfg = file.config().map_err(at)?;
-    let spec = file.spec().map_err(at)?;
+    let cfg = file.config().map_err(|e| at(e.to_string()))?;
+    let spec = file.spec().map_err(|e| at(e.to_string()))?;
     let d = &file.devices;
     let world = d.world.as_deref().ok_or_else(|| at("devices.world is missing".into()))?;
     let name = d.name.clone().unwrap_or_else(|| format!("robot-{}", file.robot.id));

@@ -12,6 +12,7 @@
 //! a sideways request turns the base while it drives the part of the request along its
 //! heading, and the behavior, which sees the robot turn, closes the loop.
 
+use crate::error::RobotError;
 use mrt_core::Pose2;
 use mrt_msgs::Displacement;
 use mrt_plan::kinematics::{
@@ -52,11 +53,11 @@ pub enum Base {
 
 impl Base {
     /// Parses `differential` (IANUS3) or `omni` (Triskar).
-    pub fn parse(name: &str) -> Result<Base, String> {
+    pub fn parse(name: &str) -> Result<Base, RobotError> {
         match name {
             "differential" => Ok(Base::Differential(DiffDrive::ianus3())),
             "omni" => Ok(Base::Omni(Omni3::triskar())),
-            other => Err(format!("base must be differential or omni, not {other}")),
+            other => Err(RobotError::UnknownBase(other.to_string())),
         }
     }
 

@@ -5,6 +5,7 @@
 //! file from its world configuration (`mrt_sim::config::SimConfig::robot_file`).
 
 use crate::base::Base;
+use crate::error::RobotError;
 use mrt_perception::camera::{CameraFile, Omni, OmniFile, Pinhole};
 use mrt_perception::mice::MiceOdometry;
 use mrt_perception::vision::colors::ColorTable;
@@ -439,8 +440,8 @@ impl RobotFile {
             RobotFileError::parse(file, text, e.span().map(|s| s.start), e.message())
         })?;
         let invalid = |message| RobotFileError::Invalid { file: file.to_string(), message };
-        parsed.config().map_err(invalid)?;
-        parsed.spec().map_err(invalid)?;
+        parsed.checked_config().map_err(invalid)?;
+        parsed.checked_spec().map_err(invalid)?;
         Ok(parsed)
     }
 
@@ -451,12 +452,21 @@ impl RobotFile {
     }
 
     /// The file as TOML that [`RobotFile::from_toml`] reads back.
-    pub fn to_toml(&self) -> Result<String, String> {
-        toml::to_string(self).map_err(|e| e.to_string())
+    pub fn to_toml(&self) -> Result<String, RobotError> {
+        Ok(toml::to_string(self)?)
     }
 
     /// Which robot and which stack ([`crate::members::RobotSpec`]).
-    pub fn spec(&self) -> Result<crate::members::RobotSpec, String> {
+    pub fn spec(&self) -> Result<crate::members::RobotSpec, RobotError> {
+        self.checked_spec().map_err(RobotError::Config)
+    }
+
+    /// The robot's configuration, every value checked.
+    pub fn config(&self) -> Result<RobotConfig, RobotError> {
+        self.checked_config().map_err(RobotError::Config)
+    }
+
+    fn checked_spec(&self) -> Result<crate::members::RobotSpec, String> {
         let r = &self.robot;
         let stack =
             crate::stacks::Stack::parse(&r.stack).map_err(|e| format!("robot.stack: {e}"))?;
@@ -470,8 +480,7 @@ impl RobotFile {
         Ok(crate::members::RobotSpec { robot: r.id, keeper: r.id % n == 0, mate: r.id % n, stack })
     }
 
-    /// The robot's configuration, every value checked.
-    pub fn config(&self) -> Result<RobotConfig, String> {
+    fn checked_config(&self) -> Result<RobotConfig, String> {
         use mrt_plan::guidance::{PositionParams, PotentialField, PotentialParams, VelocityGuard};
         let (r, b, s) = (&self.robot, &self.body, &self.sensors);
         let positive = |name: &str, v: f64| {

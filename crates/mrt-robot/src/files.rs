@@ -7,6 +7,7 @@
 //! leaves its directory; the next process to write one removes those of processes no
 //! longer running.
 
+use crate::error::RobotError;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{Arc, Mutex, PoisonError, Weak};
@@ -61,7 +62,7 @@ static LIVE: Mutex<Vec<(&'static str, Weak<Written>)>> = Mutex::new(Vec::new());
 static COUNT: AtomicU64 = AtomicU64::new(0);
 
 /// The compiled-in `files` as a directory (written now unless a live handle already has it).
-pub(crate) fn embedded(name: &'static str, files: &[(&str, &str)]) -> Result<FilesDir, String> {
+pub(crate) fn embedded(name: &'static str, files: &[(&str, &str)]) -> Result<FilesDir, RobotError> {
     let mut live = LIVE.lock().unwrap_or_else(PoisonError::into_inner);
     live.retain(|(_, w)| w.strong_count() > 0);
     if let Some(w) = live.iter().find(|(n, _)| *n == name).and_then(|(_, w)| w.upgrade()) {
@@ -72,15 +73,18 @@ pub(crate) fn embedded(name: &'static str, files: &[(&str, &str)]) -> Result<Fil
     let dir = std::env::temp_dir().join(format!("mrt-{name}-{}-{n}", std::process::id()));
     // A directory left by an earlier process with the same id must not add stale files.
     if dir.exists() {
-        std::fs::remove_dir_all(&dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+        std::fs::remove_dir_all(&dir)
+            .map_err(|source| RobotError::Io { path: dir.clone(), source })?;
     }
     let written = Arc::new(Written(dir.clone()));
     for (file, text) in files {
         let path = dir.join(file);
         if let Some(parent) = path.parent() {
-            std::fs::create_dir_all(parent).map_err(|e| format!("{}: {e}", parent.display()))?;
+            std::fs::create_dir_all(parent)
+                .map_err(|source| RobotError::Io { path: parent.to_path_buf(), source })?;
         }
-        std::fs::write(&path, text).map_err(|e| format!("{}: {e}", path.display()))?;
+        std::fs::write(&path, text)
+            .map_err(|source| RobotError::Io { path: path.clone(), source })?;
     }
     live.push((name, Arc::downgrade(&written)));
     Ok(FilesDir { path: dir, _written: Some(written) })

@@ -27,6 +27,7 @@
 //! lanes, the defender `def.guard` of the way out from its goal towards it.
 
 use crate::brain::Brain;
+use crate::error::RobotError;
 use crate::stacks::{drive_to, walk_to_kickoff, Geometry};
 use mrt_blackboard::config::load_text;
 use mrt_blackboard::{Blackboard, Pattern};
@@ -124,10 +125,14 @@ struct Params {
 impl IsocrobBrain {
     /// Robot `id` (its number on the blackboard) of the team, playing `role`; `index` orders
     /// the field players. Loads the team's configuration onto `bb`.
-    pub fn new(id: u32, role: Role, index: usize, bb: Blackboard) -> Result<IsocrobBrain, String> {
-        load_text(&bb, CONFIG, Path::new("configs/isocrob/config.dat"))
-            .map_err(|e| e.to_string())?;
-        bb.set("local.var.machine.role", role.name()).map_err(|e| e.to_string())?;
+    pub fn new(
+        id: u32,
+        role: Role,
+        index: usize,
+        bb: Blackboard,
+    ) -> Result<IsocrobBrain, RobotError> {
+        load_text(&bb, CONFIG, Path::new("configs/isocrob/config.dat"))?;
+        bb.set("local.var.machine.role", role.name())?;
         Ok(IsocrobBrain {
             id,
             role,
@@ -137,7 +142,7 @@ impl IsocrobBrain {
             search: None,
             pulse_from: None,
             kicked: false,
-            shared: Pattern::parse("*.var.machine.heuristic.*").map_err(|e| e.to_string())?,
+            shared: Pattern::parse("*.var.machine.heuristic.*")?,
             faults: Vec::new(),
         })
     }

@@ -41,6 +41,7 @@ pub mod brain;
 pub mod commander;
 pub mod config;
 pub mod devices;
+pub mod error;
 pub mod files;
 pub mod isocrob;
 pub mod look_around;
@@ -51,3 +52,5 @@ pub mod remote;
 pub mod rerun;
 pub mod stacks;
 pub mod world;
+
+pub use error::RobotError;

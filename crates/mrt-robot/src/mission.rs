@@ -48,6 +48,7 @@
 
 use crate::base::Base;
 use crate::devices::SharedDevices;
+use crate::error::RobotError;
 use crate::members::{Driver, Motor};
 use crate::planner::carrot_at;
 use mrt_core::{FileError, Point2, Pose2};
@@ -657,7 +658,7 @@ pub fn add_roby(
     (robot, period, base): (usize, Duration, Base),
     roby: Arc<Mutex<Roby>>,
     devices: SharedDevices,
-) -> Result<(), String> {
+) -> Result<(), RobotError> {
     let every = Activation::Periodic(period);
     let odometry: Driver<Odometry> =
         Driver { kind: "odometry", robot, devices: devices.clone(), read: |d| d.odometry() };
@@ -674,7 +675,7 @@ pub fn add_roby(
         agora.add_member(Motor::new(devices, robot, base), Activation::OnMessage),
     ];
     for m in ids {
-        agora.activate_member(m).map_err(|e| e.to_string())?;
+        agora.activate_member(m)?;
     }
     Ok(())
 }

@@ -17,6 +17,7 @@ use mrt_core::{Point2, Pose2};
 use mrt_dcdt::{Context, Inputs, Member, MemberError, MsgRef, RequestType};
 use mrt_msgs::{PlanRequest, PlannedPath, WorldSnapshot};
 use mrt_plan::spike::{PlanMap, Shape, Spike, SpikeParams};
+use mrt_plan::PlanError;
 
 /// Anchored robots at least this reliable are planned round.
 pub const PLAN_RELIABILITY: f64 = 0.3;
@@ -52,15 +53,14 @@ impl Planner {
     }
 
     /// SPIKE on the field the world snapshot names (made again when the field changes).
-    fn spike(&mut self, field: &mrt_msgs::Field) -> Result<&Spike, String> {
+    fn spike(&mut self, field: &mrt_msgs::Field) -> Result<&Spike, PlanError> {
         // The world snapshot's millimetres (what behaviors read) to SI.
         let size = (metres(2.0 * field.half_length), metres(2.0 * field.half_width));
-        if self.spike.as_ref().is_none_or(|(s, _)| *s != size) {
-            let map = PlanMap::soccer_field(size.0, size.1).map_err(|e| e.to_string())?;
-            let spike = Spike::new(map, self.params).map_err(|e| e.to_string())?;
-            self.spike = Some((size, spike));
-        }
-        self.spike.as_ref().map(|(_, s)| s).ok_or_else(|| "no planner".to_string())
+        let current = match self.spike.take() {
+            Some((s, spike)) if s == size => (s, spike),
+            _ => (size, Spike::new(PlanMap::soccer_field(size.0, size.1)?, self.params)?),
+        };
+        Ok(&self.spike.insert(current).1)
     }
 
     /// The answer to a request for `to`, from world snapshot `w`.
@@ -73,9 +73,8 @@ impl Planner {
             .map(|r| Shape::Disc { centre: point_in_metres(Point2::new(r.x, r.y)), radius })
             .collect();
         let from = pose_in_metres(w.my_pos.pose).position();
-        let planned = self.spike(&w.field).and_then(|s| {
-            s.plan_among(from, to.inner.position(), &moving).map_err(|e| e.to_string())
-        });
+        let planned =
+            self.spike(&w.field).and_then(|s| s.plan_among(from, to.inner.position(), &moving));
         match planned {
             Ok(plan) => {
                 let mut poses: Vec<Framed<Team, Pose2>> =
@@ -85,7 +84,7 @@ impl Planner {
                 }
                 PlannedPath { to, poses, length: plan.length, error: String::new() }
             }
-            Err(error) => PlannedPath { to, error, ..PlannedPath::default() },
+            Err(e) => PlannedPath { to, error: e.to_string(), ..PlannedPath::default() },
         }
     }
 }

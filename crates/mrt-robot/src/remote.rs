@@ -12,6 +12,7 @@
 
 use crate::config::RobotConfig;
 use crate::devices::{Actuation, LinkedDevices, Loaded};
+use crate::error::RobotError;
 use crate::members::{add_robot, member_faults, RobotSpec};
 use mrt_core::{SimClock, Time};
 use mrt_dcdt::config::AgoraConfig;
@@ -76,7 +77,7 @@ impl RemoteRobot {
         spec: RobotSpec,
         behaviors: &Path,
         net: Option<AgoraConfig>,
-    ) -> Result<RemoteRobot, String> {
+    ) -> Result<RemoteRobot, RobotError> {
         RemoteRobot::with_members(cfg, spec, behaviors, net, Vec::new())
     }
 
@@ -88,7 +89,7 @@ impl RemoteRobot {
         behaviors: &Path,
         net: Option<AgoraConfig>,
         extra: Vec<Box<dyn Member>>,
-    ) -> Result<RemoteRobot, String> {
+    ) -> Result<RemoteRobot, RobotError> {
         let period = cfg.period();
         let mut exec = SteppedExecutor::new(SimClock::new(), period);
         let community = InnerLinkManager::new();
@@ -96,20 +97,16 @@ impl RemoteRobot {
         if let Some(net) = net {
             builder = builder.config(net);
         }
-        let mut agora = builder.build().map_err(|e| e.to_string())?;
+        let mut agora = builder.build()?;
         let devices = Arc::new(Mutex::new(LinkedDevices::default()));
         add_robot(&mut agora, cfg, &spec, behaviors, devices.clone())?;
         for member in extra {
             let id = agora.add_boxed_member(member, Activation::OnMessage);
-            agora.activate_member(id).map_err(|e| e.to_string())?;
+            agora.activate_member(id)?;
         }
-        exec.add_agora(agora).map_err(|e| e.to_string())?;
+        exec.add_agora(agora)?;
         let runner_id = 1000 + spec.agora_id()?;
-        let mut runner = exec
-            .agora_builder(runner_id)
-            .inner_link(&community)
-            .build()
-            .map_err(|e| e.to_string())?;
+        let mut runner = exec.agora_builder(runner_id).inner_link(&community).build()?;
         let inbox = runner.endpoint();
         inbox.subscribe_to::<MateReport>(RequestType::Remote);
         exec.start();
@@ -194,7 +191,7 @@ impl RemoteRobot {
 
     /// Runs one control cycle on `input`'s readings at its time, after the teammates'
     /// reports due then (module doc), and says what the drivers did.
-    pub fn cycle(&mut self, input: Cycle, run: &mut RobotRun) -> Result<Actuation, String> {
+    pub fn cycle(&mut self, input: Cycle, run: &mut RobotRun) -> Result<Actuation, RobotError> {
         if input.at > self.exec.now() {
             self.exec.clock().set(input.at);
         }
@@ -205,9 +202,9 @@ impl RemoteRobot {
         if !late_joiner && !self.wait_for_mates(now) {
             run.late_mates += 1;
         }
-        self.devices.lock().map_err(|_| "the devices lock is poisoned")?.load(input.readings);
+        self.devices.lock().map_err(|_| RobotError::Poisoned("devices"))?.load(input.readings);
         self.exec.run_for(self.period);
-        let act = self.devices.lock().map_err(|_| "the devices lock is poisoned")?.take();
+        let act = self.devices.lock().map_err(|_| RobotError::Poisoned("devices"))?.take();
         self.ran = true;
         run.cycles += 1;
         Ok(act)
@@ -250,12 +247,12 @@ impl RemoteRobot {
 
     /// The match is over: the Members close; their faults (failed to start, failed jobs,
     /// panics, lost mail).
-    pub fn finish(self) -> Result<Vec<MemberFault>, String> {
+    pub fn finish(self) -> Result<Vec<MemberFault>, RobotError> {
         finish(&self.spec, self.exec)
     }
 }
 
-fn finish(spec: &RobotSpec, exec: SteppedExecutor) -> Result<Vec<MemberFault>, String> {
+fn finish(spec: &RobotSpec, exec: SteppedExecutor) -> Result<Vec<MemberFault>, RobotError> {
     let id = spec.agora_id()?;
     let reports = exec.finish();
     Ok(reports.iter().filter(|r| r.agora.0 == id).flat_map(member_faults).collect())

@@ -4,6 +4,7 @@
 //! simulated clock, exactly as the robot's world state fed it, and its commands are kept to
 //! compare with the recorded ones.
 
+use crate::error::RobotError;
 use crate::members::behavior_member;
 use crate::stacks::Stack;
 use mrt_core::SimClock;
@@ -87,10 +88,10 @@ pub fn rerun(
     behaviors: Option<&Path>,
     period: Duration,
     snapshots: Vec<WorldSnapshot>,
-) -> Result<RerunReport, String> {
+) -> Result<RerunReport, RobotError> {
     let cycles = snapshots.len();
     let mut exec = SteppedExecutor::new(SimClock::new(), period);
-    let mut agora = exec.agora_builder(1).build().map_err(|e| e.to_string())?;
+    let mut agora = exec.agora_builder(1).build()?;
     let every = Activation::Periodic(period);
     let seen = Arc::new(Mutex::new(Rerun::default()));
     let ids = [
@@ -99,13 +100,13 @@ pub fn rerun(
         agora.add_member(Collect(seen.clone()), Activation::OnMessage),
     ];
     for id in ids {
-        agora.activate_member(id).map_err(|e| e.to_string())?;
+        agora.activate_member(id)?;
     }
-    exec.add_agora(agora).map_err(|e| e.to_string())?;
+    exec.add_agora(agora)?;
     let mut out = Vec::with_capacity(cycles);
     for _ in 0..cycles {
         exec.run_for(period);
-        let mut cycle = seen.lock().map_err(|_| "the re-run's lock is poisoned")?;
+        let mut cycle = seen.lock().map_err(|_| RobotError::Poisoned("re-run's"))?;
         out.push(std::mem::take(&mut *cycle));
     }
     let fault = exec.finish().iter().flat_map(|r| &r.members).find_map(|m| m.last_error.clone());
@@ -151,6 +152,9 @@ mod tests {
     #[test]
     fn an_isocrob_robot_is_refused() {
         let e = rerun(Stack::Isocrob, false, None, Duration::from_millis(100), vec![]).unwrap_err();
-        assert!(e.contains("blackboard"), "{e}");
+        assert!(
+            matches!(e, crate::RobotError::StackWiring(_)) && e.to_string().contains("blackboard"),
+            "{e}"
+        );
     }
 }

@@ -16,6 +16,7 @@
 
 use crate::brain::Brain;
 use crate::config::RobotConfig;
+use crate::error::RobotError;
 use crate::files::FilesDir;
 use mrt_core::frames::{millimetres, twist_from_setpoints};
 use mrt_core::{Point2, Pose2};
@@ -40,13 +41,13 @@ pub enum Stack {
 
 impl Stack {
     /// Parses `chaos`, `milan` or `chaser`.
-    pub fn parse(s: &str) -> Result<Stack, String> {
+    pub fn parse(s: &str) -> Result<Stack, RobotError> {
         match s {
             "chaos" => Ok(Stack::Chaos),
             "milan" => Ok(Stack::Milan),
             "chaser" => Ok(Stack::Chaser),
             "isocrob" => Ok(Stack::Isocrob),
-            other => Err(format!("unknown team stack '{other}' (chaos, milan, isocrob, chaser)")),
+            other => Err(RobotError::UnknownStack(other.to_string())),
         }
     }
 
@@ -215,12 +216,12 @@ impl Geometry {
 }
 
 /// The compiled-in TeamChaos files, as a directory while the handle (or a clone) lives.
-pub fn embedded_teamchaos() -> Result<FilesDir, String> {
+pub fn embedded_teamchaos() -> Result<FilesDir, RobotError> {
     crate::files::embedded("teamchaos", TEAMCHAOS)
 }
 
 /// The compiled-in Team Milan configuration, as a directory while the handle lives.
-pub fn embedded_milan() -> Result<FilesDir, String> {
+pub fn embedded_milan() -> Result<FilesDir, RobotError> {
     crate::files::embedded("milan", MILAN)
 }
 
@@ -261,12 +262,8 @@ fn deg360(a: f64) -> f64 {
 
 impl MilanBrain {
     /// The goalkeeper or a field player, on the configuration of `dir`.
-    pub fn new(dir: &Path, keeper: bool) -> Result<MilanBrain, String> {
-        Ok(MilanBrain {
-            brian: Brian::from_dir(dir).map_err(|e| e.to_string())?,
-            keeper,
-            ball_seen_at: None,
-        })
+    pub fn new(dir: &Path, keeper: bool) -> Result<MilanBrain, RobotError> {
+        Ok(MilanBrain { brian: Brian::from_dir(dir)?, keeper, ball_seen_at: None })
     }
 
     /// The Parser: crisp inputs from the world snapshot (team frame, mm, degrees).
@@ -422,21 +419,21 @@ impl Brain for MilanBrain {
 /// The brains of one team of `size` robots (robot 0 keeps goal) of a stack that runs as a
 /// brain (Milan, the Chaser). TeamChaos and ISocRob run as Members of their own
 /// (`members::add_robot`).
-pub fn team(stack: Stack, cfg: &RobotConfig) -> Result<Vec<Box<dyn Brain + Send>>, String> {
+pub fn team(stack: Stack, cfg: &RobotConfig) -> Result<Vec<Box<dyn Brain + Send>>, RobotError> {
     (0..cfg.team_size).map(|i| send_brain(stack, i == 0)).collect()
 }
 
 /// The brain of a Milan or baseline robot (the goalkeeper when `keeper`).
-pub fn send_brain(stack: Stack, keeper: bool) -> Result<Box<dyn Brain + Send>, String> {
+pub fn send_brain(stack: Stack, keeper: bool) -> Result<Box<dyn Brain + Send>, RobotError> {
     match stack {
         Stack::Milan => Ok(Box::new(MilanBrain::new(&embedded_milan()?, keeper)?)),
         Stack::Chaser => Ok(Box::new(Chaser { keeper })),
-        Stack::Chaos => {
-            Err("the Chaos stack runs as its behavior Member (members::add_robot)".into())
-        }
-        Stack::Isocrob => {
-            Err("an ISocRob robot needs its blackboard and Proxy (members::add_robot)".into())
-        }
+        Stack::Chaos => Err(RobotError::StackWiring(
+            "the Chaos stack runs as its behavior Member (members::add_robot)",
+        )),
+        Stack::Isocrob => Err(RobotError::StackWiring(
+            "an ISocRob robot needs its blackboard and Proxy (members::add_robot)",
+        )),
     }
 }
 

@@ -9,6 +9,7 @@
 
 use crate::base::Base;
 use crate::devices::Loaded;
+use crate::error::RobotError;
 use crate::remote::{Cycle, RemoteRobot, RobotRun};
 use mrt_core::Time;
 use mrt_devices::messages::Fault;
@@ -20,7 +21,7 @@ use std::time::{Duration, Instant};
 /// Where a world robot's answers go (`put` on a zenoh key, in `mrt robot`).
 pub trait WorldPort {
     /// Sends `bytes` on `key`.
-    fn put(&self, key: &str, bytes: Vec<u8>) -> Result<(), String>;
+    fn put(&self, key: &str, bytes: Vec<u8>) -> Result<(), RobotError>;
 }
 
 /// What reaches a world robot.
@@ -78,7 +79,7 @@ impl WorldRobot {
         mail: &Receiver<WorldMail>,
         port: &dyn WorldPort,
         silence: Duration,
-    ) -> Result<WorldRun, String> {
+    ) -> Result<WorldRun, RobotError> {
         let mut run = RobotRun::default();
         let mut heard = Instant::now();
         loop {
@@ -86,11 +87,10 @@ impl WorldRobot {
             let m = match mail.recv_timeout(left) {
                 Ok(m) => m,
                 Err(RecvTimeoutError::Timeout) => {
-                    return Err(format!("no step from world {} for {silence:?}", self.keys.world()))
+                    let world = self.keys.world().to_string();
+                    return Err(RobotError::WorldSilent { world, silence });
                 }
-                Err(RecvTimeoutError::Disconnected) => {
-                    return Err("the link to the world closed".into())
-                }
+                Err(RecvTimeoutError::Disconnected) => return Err(RobotError::LinkClosed),
             };
             match m {
                 WorldMail::Sense(bytes) => match self.gate.admit(&bytes, Instant::now()) {
@@ -99,7 +99,7 @@ impl WorldRobot {
                         run.first_frame.get_or_insert(heard);
                         let (step, time) = (readings.step, readings.time);
                         let act = self.step(*readings, &mut run)?;
-                        let bytes = serde_json::to_vec(&act).map_err(|e| e.to_string())?;
+                        let bytes = serde_json::to_vec(&act)?;
                         port.put(&self.keys.act(), bytes.clone())?;
                         self.gate.answered(step, time, bytes);
                         run.first_answer.get_or_insert_with(Instant::now);
@@ -115,10 +115,7 @@ impl WorldRobot {
                     Err(refusal) => self.log(&refusal),
                 },
                 WorldMail::Gone => {
-                    return Err(format!(
-                        "world {} went away without ending the match",
-                        self.keys.world()
-                    ))
+                    return Err(RobotError::WorldGone(self.keys.world().to_string()))
                 }
             }
         }
@@ -146,9 +143,9 @@ impl WorldRobot {
     }
 
     /// One cycle on a step's readings, and the answer.
-    fn step(&mut self, r: Readings, run: &mut RobotRun) -> Result<Act, String> {
+    fn step(&mut self, r: Readings, run: &mut RobotRun) -> Result<Act, RobotError> {
         let wheels = match &r.wheel_turns {
-            Some(turns) => self.base.motion(turns).map_err(|e| e.to_string())?,
+            Some(turns) => self.base.motion(turns)?,
             None => Displacement::default(),
         };
         let odometry = r.odometry.then_some(Odometry { mice: r.mice, wheels, placed: r.placed });
@@ -160,8 +157,8 @@ impl WorldRobot {
         let did = self.robot.cycle(cycle, run)?;
         let (wheels, twist) = match &did.duty {
             Some(duty) => {
-                let speeds = self.base.wheel_speeds(duty).map_err(|e| e.to_string())?;
-                let t = self.base.twist_for(duty).map_err(|e| e.to_string())?;
+                let speeds = self.base.wheel_speeds(duty)?;
+                let t = self.base.twist_for(duty)?;
                 (Some(speeds), Some(t))
             }
             None => (None, None),
@@ -180,7 +177,7 @@ impl WorldRobot {
         })
     }
 
-    fn end(self, robot: RobotRun, port: &dyn WorldPort) -> Result<WorldRun, String> {
+    fn end(self, robot: RobotRun, port: &dyn WorldPort) -> Result<WorldRun, RobotError> {
         let bye = Bye {
             protocol: PROTOCOL,
             world: self.keys.world().into(),
@@ -200,7 +197,7 @@ impl WorldRobot {
                 .collect(),
             dropped: self.gate.dropped(),
         };
-        let bytes = serde_json::to_vec(&bye).map_err(|e| e.to_string())?;
+        let bytes = serde_json::to_vec(&bye)?;
         port.put(&self.keys.bye(), bytes)?;
         Ok(WorldRun { robot, bye })
     }

@@ -22,8 +22,9 @@ use std::time::Duration;
 struct Port(Mutex<Sender<(String, Vec<u8>)>>);
 
 impl WorldPort for Port {
-    fn put(&self, key: &str, bytes: Vec<u8>) -> Result<(), String> {
-        self.0.lock().unwrap().send((key.to_string(), bytes)).map_err(|e| e.to_string())
+    fn put(&self, key: &str, bytes: Vec<u8>) -> Result<(), mrt_robot::RobotError> {
+        let sent = self.0.lock().unwrap().send((key.to_string(), bytes));
+        sent.map_err(|e| mrt_robot::RobotError::World(e.to_string()))
     }
 }
 

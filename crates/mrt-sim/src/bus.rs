@@ -136,7 +136,7 @@ impl BusMatch {
     ) -> Result<BusMatch, String> {
         let n = cfg.rules.team_size;
         let stacks: Vec<Stack> = [Some(home), away].into_iter().flatten().collect();
-        let dir = behaviors_dir(&stacks, behaviors)?;
+        let dir = behaviors_dir(&stacks, behaviors).map_err(|e| e.to_string())?;
         let files = dir.clone();
         let teams = (n, if away.is_some() { n } else { 0 });
         if let Some(rec) = &recorder {
@@ -167,7 +167,7 @@ impl BusMatch {
         }
         BusMatch::build(cfg, seed, teams, files, recorder, |agora, robot_cfg, robot, devices| {
             let spec = RobotSpec::of(robot, n, (home, away.unwrap_or(home)));
-            add_robot(agora, robot_cfg, &spec, &dir, devices)
+            add_robot(agora, robot_cfg, &spec, &dir, devices).map_err(|e| e.to_string())
         })
     }
 
@@ -187,6 +187,7 @@ impl BusMatch {
         BusMatch::build(cfg, seed, teams, files, None, |agora, robot_cfg, robot, devices| {
             let brain = brains.next().ok_or("more robots than brains")?;
             add_robot_with_brain(agora, robot_cfg, (robot, robot % n == 0), brain, devices)
+                .map_err(|e| e.to_string())
         })
     }
 

@@ -247,7 +247,7 @@ impl SimConfig {
     /// What each robot of this world is configured with (the robot program's
     /// [`RobotConfig`](mrt_robot::config::RobotConfig)), from [`SimConfig::robot_file`].
     pub fn robot(&self) -> Result<mrt_robot::config::RobotConfig, String> {
-        self.robot_file(0, "chaser").config()
+        self.robot_file(0, "chaser").config().map_err(|e| e.to_string())
     }
 
     /// The two-mice sensor of the robots' `[sensors]` mounting.

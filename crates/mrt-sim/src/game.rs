@@ -316,7 +316,7 @@ impl Pitch {
         let mice = cfg.mice()?;
         let mut kidnap_rng = ChaCha8Rng::seed_from_u64(seed ^ 0x6B69_646E_6170_0001);
         let kidnap_plan = Self::plan_kidnaps(cfg, robots, &mut kidnap_rng);
-        let base = Base::parse(&cfg.body.base)?;
+        let base = Base::parse(&cfg.body.base).map_err(|e| e.to_string())?;
         Ok(Pitch {
             cfg: cfg.clone(),
             base,

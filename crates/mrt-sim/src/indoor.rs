@@ -518,7 +518,8 @@ pub fn run_mission(
     let mut exec = SteppedExecutor::new(SimClock::new(), period);
     let mut agora = exec.agora_builder(1u32).build().map_err(|e| e.to_string())?;
     let devices: SharedDevices = Arc::new(Mutex::new(IndoorDevices(building.clone())));
-    add_roby(&mut agora, (0, period, robot.base), roby.clone(), devices)?;
+    add_roby(&mut agora, (0, period, robot.base), roby.clone(), devices)
+        .map_err(|e| e.to_string())?;
     exec.add_agora(agora).map_err(|e| e.to_string())?;
     let steps = (cfg.rules.control_period / cfg.rules.physics_step).round().max(1.0) as usize;
     let (mut trajectory, mut samples) = (Vec::new(), Vec::new());

@@ -148,7 +148,7 @@ impl PitchWorld {
             return Err(format!("a match has one or two teams, not {teams}"));
         }
         let pitch = Pitch::new(cfg, seed, n, if teams == 2 { n } else { 0 })?;
-        let base = Base::parse(&cfg.body.base)?;
+        let base = Base::parse(&cfg.body.base).map_err(|e| e.to_string())?;
         let robots = n * teams;
         let names: Vec<String> = (0..robots).map(|i| robot_name(i, n)).collect();
         let answers = Answers::new(WORLD, run, &names, base.wheels()).map_err(|e| e.to_string())?;
@@ -229,7 +229,7 @@ impl PitchWorld {
 
     fn put_sense(&self, i: usize, bytes: &[u8]) -> Result<(), String> {
         let key = self.answers.keys(i).map(Keys::sense).ok_or_else(|| format!("no robot {i}"))?;
-        self.post.put(&key, bytes.to_vec())
+        self.post.put(&key, bytes.to_vec()).map_err(|e| e.to_string())
     }
 
     /// One control cycle: every robot's sense out, every robot's answer in (or its silence
@@ -344,7 +344,8 @@ impl PitchWorld {
             steps: self.cycle,
         };
         if let Some(key) = self.answers.keys(0).map(Keys::end) {
-            self.post.put(&key, serde_json::to_vec(&end).map_err(|e| e.to_string())?)?;
+            let bytes = serde_json::to_vec(&end).map_err(|e| e.to_string())?;
+            self.post.put(&key, bytes).map_err(|e| e.to_string())?;
         }
         let mut byes: BTreeMap<usize, Bye> = BTreeMap::new();
         let start = Instant::now();
@@ -401,6 +402,7 @@ mod tests {
     use mrt_robot::remote::RemoteRobot;
     use mrt_robot::stacks::Stack;
     use mrt_robot::world::{WorldMail, WorldRobot, WorldRun};
+    use mrt_robot::RobotError;
     use std::path::Path;
     use std::sync::mpsc::{channel, Sender};
     use std::sync::Mutex;
@@ -446,7 +448,7 @@ mod tests {
     type Robot = (Keys, Sender<WorldMail>);
 
     impl WorldPort for Hub {
-        fn put(&self, key: &str, bytes: Vec<u8>) -> Result<(), String> {
+        fn put(&self, key: &str, bytes: Vec<u8>) -> Result<(), RobotError> {
             for (keys, tx) in self.0.lock().unwrap().iter() {
                 if keys.sense() == key {
                     let _ = tx.send(WorldMail::Sense(bytes.clone()));
@@ -462,8 +464,8 @@ mod tests {
     struct ToWorld(Sender<(String, Vec<u8>)>);
 
     impl WorldPort for ToWorld {
-        fn put(&self, key: &str, bytes: Vec<u8>) -> Result<(), String> {
-            self.0.send((key.to_string(), bytes)).map_err(|e| e.to_string())
+        fn put(&self, key: &str, bytes: Vec<u8>) -> Result<(), RobotError> {
+            self.0.send((key.to_string(), bytes)).map_err(|e| RobotError::World(e.to_string()))
         }
     }
 
@@ -490,7 +492,7 @@ mod tests {
         spec: RobotSpec,
         behaviors: &Path,
         silence: Duration,
-    ) -> std::thread::JoinHandle<Result<WorldRun, String>> {
+    ) -> std::thread::JoinHandle<Result<WorldRun, RobotError>> {
         let n = cfg.rules.team_size;
         let team = spec.robot / n.max(1);
         let robot_cfg = cfg.robot().unwrap();

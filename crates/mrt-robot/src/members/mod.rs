@@ -46,6 +46,7 @@ use crate::brain::BrainMember;
 use crate::commander::Commander;
 use crate::config::RobotConfig;
 use crate::devices::{DeviceError, Devices, SharedDevices};
+use crate::error::RobotError;
 use crate::files::FilesDir;
 use crate::isocrob::IsocrobBrain;
 use crate::look_around::LookAround;
@@ -127,8 +128,8 @@ impl RobotSpec {
     }
 
     /// The id of the robot's Agora.
-    pub fn agora_id(&self) -> Result<u32, String> {
-        u32::try_from(self.robot + 1).map_err(|e| e.to_string())
+    pub fn agora_id(&self) -> Result<u32, RobotError> {
+        u32::try_from(self.robot + 1).map_err(|_| RobotError::RobotNumber(self.robot))
     }
 }
 
@@ -143,7 +144,7 @@ pub fn add_robot(
     spec: &RobotSpec,
     behaviors: &Path,
     devices: SharedDevices,
-) -> Result<(), String> {
+) -> Result<(), RobotError> {
     let RobotSpec { robot, keeper, mate, stack } = *spec;
     let (behavior, commander): (Box<dyn Member>, _) = match stack {
         Stack::Isocrob => {
@@ -159,10 +160,10 @@ pub fn add_robot(
             // A team's own `config.dat` and `config-<robot>.dat` beside the built-in one (the
             // seed's way to configure robot by robot), when the behaviors directory has them.
             if !behaviors.as_os_str().is_empty() {
-                mrt_blackboard::config::load_dir(&bb, behaviors).map_err(|e| e.to_string())?;
+                mrt_blackboard::config::load_dir(&bb, behaviors)?;
             }
             let proxy = agora.add_member(Proxy::new(bb), Activation::Periodic(cfg.period()));
-            agora.activate_member(proxy).map_err(|e| e.to_string())?;
+            agora.activate_member(proxy)?;
             (Box::new(BrainMember::new(Box::new(brain))) as Box<dyn Member>, Commander::PLAIN)
         }
         Stack::Chaos => (behavior_member(stack, keeper, Some(behaviors))?, Commander::chaos(cfg)),
@@ -184,11 +185,13 @@ pub fn behavior_member(
     stack: Stack,
     keeper: bool,
     behaviors: Option<&Path>,
-) -> Result<Box<dyn Member>, String> {
+) -> Result<Box<dyn Member>, RobotError> {
     Ok(match (stack, behaviors) {
         (Stack::Chaos, Some(dir)) if keeper => Box::new(BehaviorMember::hbm(dir, CHAOS_KEEPER)),
         (Stack::Chaos, Some(dir)) => Box::new(BehaviorMember::hfsm(dir, dir.join(CHAOS_PLAYER))),
-        (Stack::Chaos, None) => return Err("a Chaos robot needs its TeamChaos files".into()),
+        (Stack::Chaos, None) => {
+            return Err(RobotError::StackWiring("a Chaos robot needs its TeamChaos files"))
+        }
         (Stack::Milan, Some(dir)) => {
             Box::new(BrainMember::new(Box::new(MilanBrain::new(dir, keeper)?)))
         }
@@ -205,7 +208,7 @@ pub fn add_robot_with_brain(
     (robot, keeper): (usize, bool),
     brain: Box<dyn crate::brain::Brain + Send>,
     devices: SharedDevices,
-) -> Result<(), String> {
+) -> Result<(), RobotError> {
     let behavior = Box::new(BrainMember::new(brain));
     add_cycle(agora, cfg, (robot, keeper, false), behavior, Commander::PLAIN, devices)
 }
@@ -221,7 +224,7 @@ fn add_cycle(
     behavior: Box<dyn Member>,
     commander: Commander,
     devices: SharedDevices,
-) -> Result<(), String> {
+) -> Result<(), RobotError> {
     let every = Activation::Periodic(cfg.period());
     let dev = || devices.clone();
     let odometry: Driver<Odometry> =
@@ -304,7 +307,7 @@ fn add_cycle(
         agora.add_member(FaultBook::new(devices, robot), Activation::OnMessage),
     ]);
     for m in ids {
-        agora.activate_member(m).map_err(|e| e.to_string())?;
+        agora.activate_member(m)?;
     }
     Ok(())
 }
@@ -312,7 +315,7 @@ fn add_cycle(
 /// The TeamChaos files robots of `stacks` run: `behaviors`, or the compiled-in ones when the
 /// Chaos stack plays (nothing otherwise).
 /// Keep the handle while the robots may read them: compiled-in files are removed with it.
-pub fn behaviors_dir(stacks: &[Stack], behaviors: Option<&Path>) -> Result<FilesDir, String> {
+pub fn behaviors_dir(stacks: &[Stack], behaviors: Option<&Path>) -> Result<FilesDir, RobotError> {
     match behaviors {
         Some(d) => Ok(FilesDir::user(d)),
         None if stacks.contains(&Stack::Chaos) => embedded_teamchaos(),
