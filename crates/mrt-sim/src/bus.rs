@@ -9,6 +9,7 @@
 
 use crate::config::SimConfig;
 use crate::devices::PitchDevices;
+use crate::error::SimError;
 use crate::game::{MatchReport, Pitch};
 use crate::referee::Call;
 use mrt_core::SimClock;
@@ -31,8 +32,8 @@ use std::time::Duration;
 
 type Shared = Arc<Mutex<Pitch>>;
 
-fn lock_pitch(p: &Shared) -> Result<MutexGuard<'_, Pitch>, String> {
-    p.lock().map_err(|_| "the pitch lock is poisoned".to_string())
+fn lock_pitch(p: &Shared) -> Result<MutexGuard<'_, Pitch>, SimError> {
+    p.lock().map_err(|_| SimError::Poisoned("pitch"))
 }
 
 /// Books a Member's fault against robot `robot`.
@@ -116,7 +117,7 @@ impl BusMatch {
         home: Stack,
         away: Option<Stack>,
         behaviors: Option<&Path>,
-    ) -> Result<BusMatch, String> {
+    ) -> Result<BusMatch, SimError> {
         BusMatch::recorded(cfg, seed, home, away, behaviors, None)
     }
 
@@ -133,10 +134,10 @@ impl BusMatch {
         away: Option<Stack>,
         behaviors: Option<&Path>,
         recorder: Option<SharedRecorder>,
-    ) -> Result<BusMatch, String> {
+    ) -> Result<BusMatch, SimError> {
         let n = cfg.rules.team_size;
         let stacks: Vec<Stack> = [Some(home), away].into_iter().flatten().collect();
-        let dir = behaviors_dir(&stacks, behaviors).map_err(|e| e.to_string())?;
+        let dir = behaviors_dir(&stacks, behaviors)?;
         let files = dir.clone();
         let teams = (n, if away.is_some() { n } else { 0 });
         if let Some(rec) = &recorder {
@@ -148,9 +149,9 @@ impl BusMatch {
                 period: cfg.robot()?.period().as_secs_f64(),
                 profile: RecordProfile::Full,
             };
-            let mut rec = rec.lock().map_err(|_| "the recorder's lock is poisoned".to_string())?;
+            let mut rec = rec.lock().map_err(|_| SimError::Poisoned("recorder's"))?;
             let info = MatchInfo { profile: rec.profile(), ..info };
-            rec.record("/match", mrt_core::Time::ZERO, &info).map_err(|e| e.to_string())?;
+            rec.record("/match", mrt_core::Time::ZERO, &info)?;
             let f = &cfg.field;
             let lines = FieldLines {
                 half_length: f.length / 2.0,
@@ -162,12 +163,11 @@ impl BusMatch {
                 centre_circle_radius: f.centre_circle_radius,
             };
             let field = SceneUpdate::field(&lines, mrt_core::Time::ZERO);
-            rec.record_rounded("/field", mrt_core::Time::ZERO, &field, VIEW_PRECISION)
-                .map_err(|e| e.to_string())?;
+            rec.record_rounded("/field", mrt_core::Time::ZERO, &field, VIEW_PRECISION)?;
         }
         BusMatch::build(cfg, seed, teams, files, recorder, |agora, robot_cfg, robot, devices| {
             let spec = RobotSpec::of(robot, n, (home, away.unwrap_or(home)));
-            add_robot(agora, robot_cfg, &spec, &dir, devices).map_err(|e| e.to_string())
+            Ok(add_robot(agora, robot_cfg, &spec, &dir, devices)?)
         })
     }
 
@@ -179,15 +179,15 @@ impl BusMatch {
         seed: u64,
         home: Vec<Box<dyn Brain + Send>>,
         away: Vec<Box<dyn Brain + Send>>,
-    ) -> Result<BusMatch, String> {
+    ) -> Result<BusMatch, SimError> {
         let teams = (home.len(), away.len());
         let n = cfg.rules.team_size.max(1);
         let mut brains = home.into_iter().chain(away);
         let files = FilesDir::user(std::path::PathBuf::new());
         BusMatch::build(cfg, seed, teams, files, None, |agora, robot_cfg, robot, devices| {
-            let brain = brains.next().ok_or("more robots than brains")?;
-            add_robot_with_brain(agora, robot_cfg, (robot, robot % n == 0), brain, devices)
-                .map_err(|e| e.to_string())
+            let brain =
+                brains.next().ok_or_else(|| SimError::Match("more robots than brains".into()))?;
+            Ok(add_robot_with_brain(agora, robot_cfg, (robot, robot % n == 0), brain, devices)?)
         })
     }
 
@@ -204,8 +204,8 @@ impl BusMatch {
             &RobotConfig,
             usize,
             SharedDevices,
-        ) -> Result<(), String>,
-    ) -> Result<BusMatch, String> {
+        ) -> Result<(), SimError>,
+    ) -> Result<BusMatch, SimError> {
         let robot_cfg = cfg.robot()?;
         let pitch = Arc::new(Mutex::new(Pitch::new(cfg, seed, home, away)?));
         let period = robot_cfg.period();
@@ -216,32 +216,29 @@ impl BusMatch {
             links.push(team_link.clone());
             for _ in 0..size {
                 let robot = exec.agoras().count();
-                let id = u32::try_from(robot + 1).map_err(|e| e.to_string())?;
-                let mut agora = exec
-                    .agora_builder(id)
-                    .inner_link(&team_link)
-                    .build()
-                    .map_err(|e| e.to_string())?;
+                let id = u32::try_from(robot + 1)
+                    .map_err(|_| SimError::Match(format!("robot {robot} has no Agora id")))?;
+                let mut agora = exec.agora_builder(id).inner_link(&team_link).build()?;
                 let devices = Arc::new(Mutex::new(PitchDevices::new(pitch.clone(), robot)?));
                 add(&mut agora, &robot_cfg, robot, devices)?;
                 let watch = EstimateWatch { pitch: pitch.clone(), robot };
                 let watch = agora.add_member(watch, mrt_dcdt::Activation::OnMessage);
-                agora.activate_member(watch).map_err(|e| e.to_string())?;
+                agora.activate_member(watch)?;
                 if let Some(rec) = &recorder {
                     let (team, k) =
                         if robot < home { ("home", robot) } else { ("away", robot - home) };
                     let tap = Tap::new(format!("{team}/{k}"), rec.clone());
                     let tap = agora.add_member(tap, mrt_dcdt::Activation::OnMessage);
-                    agora.activate_member(tap).map_err(|e| e.to_string())?;
+                    agora.activate_member(tap)?;
                 }
-                exec.add_agora(agora).map_err(|e| e.to_string())?;
+                exec.add_agora(agora)?;
             }
         }
         Ok(BusMatch { pitch, exec, period, links, _files: files, recorder })
     }
 
     /// The pitch (the world, the referee, the book), between cycles.
-    pub fn pitch(&self) -> Result<MutexGuard<'_, Pitch>, String> {
+    pub fn pitch(&self) -> Result<MutexGuard<'_, Pitch>, SimError> {
         lock_pitch(&self.pitch)
     }
 
@@ -267,26 +264,25 @@ impl BusMatch {
     ///
     /// When recording, the truth is recorded first, at the time the robots' messages of this
     /// cycle carry: what was so when they looked.
-    pub fn cycle(&mut self) -> Result<Vec<Call>, String> {
+    pub fn cycle(&mut self) -> Result<Vec<Call>, SimError> {
         if let Some(rec) = &self.recorder {
             let p = lock_pitch(&self.pitch)?;
             let time = mrt_core::Time::from_secs_f64(p.world().time());
-            let mut rec = rec.lock().map_err(|_| "the recorder's lock is poisoned".to_string())?;
+            let mut rec = rec.lock().map_err(|_| SimError::Poisoned("recorder's"))?;
             let truth = truth_of(&p);
-            rec.record("/truth", time, &truth).map_err(|e| e.to_string())?;
+            rec.record("/truth", time, &truth)?;
             let c = p.config();
             let bodies = Bodies { robot_radius: c.body.radius, ball_radius: c.ball.radius };
             let scene = SceneUpdate::of_truth(&truth, &bodies, time);
-            rec.record_rounded("/scene", time, &scene, VIEW_PRECISION)
-                .map_err(|e| e.to_string())?;
+            rec.record_rounded("/scene", time, &scene, VIEW_PRECISION)?;
         }
         self.exec.run_for(self.period);
-        let mut p = self.pitch.lock().map_err(|_| "the pitch lock is poisoned".to_string())?;
+        let mut p = self.pitch.lock().map_err(|_| SimError::Poisoned("pitch"))?;
         Ok(p.advance())
     }
 
     /// Plays until the end, calling `progress` with the simulated time after each cycle.
-    pub fn play(self, progress: impl FnMut(f64)) -> Result<MatchReport, String> {
+    pub fn play(self, progress: impl FnMut(f64)) -> Result<MatchReport, SimError> {
         self.play_until(f64::INFINITY, progress)
     }
 
@@ -296,7 +292,7 @@ impl BusMatch {
         self,
         max_seconds: f64,
         mut progress: impl FnMut(f64),
-    ) -> Result<MatchReport, String> {
+    ) -> Result<MatchReport, SimError> {
         self.play_while(|t| {
             progress(t);
             t < max_seconds
@@ -306,7 +302,10 @@ impl BusMatch {
     /// Plays until the end, or until `go_on` (called with the simulated time after each
     /// cycle, and once before the first) says `false`: an interrupted match reports what was
     /// played.
-    pub fn play_while(mut self, mut go_on: impl FnMut(f64) -> bool) -> Result<MatchReport, String> {
+    pub fn play_while(
+        mut self,
+        mut go_on: impl FnMut(f64) -> bool,
+    ) -> Result<MatchReport, SimError> {
         let mut time = lock_pitch(&self.pitch)?.world().time();
         while go_on(time) && !lock_pitch(&self.pitch)?.finished() {
             self.cycle()?;
@@ -324,9 +323,9 @@ impl BusMatch {
                 }
             }
         }
-        let pitch =
-            Arc::try_unwrap(self.pitch).map_err(|_| "the pitch is still shared".to_string())?;
-        Ok(pitch.into_inner().map_err(|_| "the pitch lock is poisoned".to_string())?.report())
+        let pitch = Arc::try_unwrap(self.pitch)
+            .map_err(|_| SimError::Match("the pitch is still shared".into()))?;
+        Ok(pitch.into_inner().map_err(|_| SimError::Poisoned("pitch"))?.report())
     }
 }
 

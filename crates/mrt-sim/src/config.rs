@@ -10,6 +10,7 @@
 //!
 //! Units: metres, seconds, kilograms, radians.
 
+use crate::error::SimError;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 
@@ -246,17 +247,17 @@ impl SimConfig {
 
     /// What each robot of this world is configured with (the robot program's
     /// [`RobotConfig`](mrt_robot::config::RobotConfig)), from [`SimConfig::robot_file`].
-    pub fn robot(&self) -> Result<mrt_robot::config::RobotConfig, String> {
-        self.robot_file(0, "chaser").config().map_err(|e| e.to_string())
+    pub fn robot(&self) -> Result<mrt_robot::config::RobotConfig, SimError> {
+        Ok(self.robot_file(0, "chaser").config()?)
     }
 
     /// The two-mice sensor of the robots' `[sensors]` mounting.
-    pub fn mice(&self) -> Result<mrt_perception::mice::MiceOdometry, String> {
+    pub fn mice(&self) -> Result<mrt_perception::mice::MiceOdometry, SimError> {
         mrt_perception::mice::MiceOdometry::new(
             self.sensors.mice_distance,
             self.sensors.mice_tolerance,
         )
-        .map_err(|e| format!("sensors: {e}"))
+        .map_err(|e| SimError::Config(format!("sensors: {e}")))
     }
 }
 
@@ -314,7 +315,7 @@ impl SimConfig {
     pub fn from_toml(text: &str, file: &str) -> Result<SimConfig, ConfigError> {
         let cfg: SimConfig = toml::from_str(text)
             .map_err(|e| ConfigError::parse(file, text, e.span().map(|s| s.start), e.message()))?;
-        cfg.validate()
+        cfg.checked()
             .map_err(|message| ConfigError::Invalid { file: file.to_string(), message })?;
         Ok(cfg)
     }
@@ -327,12 +328,16 @@ impl SimConfig {
 
     /// The configuration as a TOML file that [`SimConfig::from_toml`] reads back (what the
     /// robots of a distributed match are given).
-    pub fn to_toml(&self) -> Result<String, String> {
-        toml::to_string(self).map_err(|e| e.to_string())
+    pub fn to_toml(&self) -> Result<String, SimError> {
+        Ok(toml::to_string(self)?)
     }
 
     /// Checks that every value makes sense.
-    pub fn validate(&self) -> Result<(), String> {
+    pub fn validate(&self) -> Result<(), SimError> {
+        self.checked().map_err(SimError::Config)
+    }
+
+    fn checked(&self) -> Result<(), String> {
         let positive = [
             ("field.length", self.field.length),
             ("field.width", self.field.width),
@@ -451,7 +456,7 @@ impl SimConfig {
         }
         self.render.validate()?;
         self.check_derived()?;
-        self.robot()?;
+        self.robot().map_err(|e| e.to_string())?;
         Ok(())
     }
 

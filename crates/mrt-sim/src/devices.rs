@@ -4,6 +4,7 @@
 //! referee's assistant).
 
 use crate::drivers::SimulatedAirboard;
+use crate::error::SimError;
 use crate::game::Pitch;
 use mrt_msgs::{CameraFrame, GameInfo, Odometry, Sonar};
 use mrt_robot::base::MotorDriver;
@@ -19,8 +20,8 @@ pub struct PitchDevices {
 
 impl PitchDevices {
     /// Robot `robot`'s devices on `pitch`.
-    pub fn new(pitch: Arc<Mutex<Pitch>>, robot: usize) -> Result<PitchDevices, String> {
-        let base = pitch.lock().map_err(|_| "the pitch lock is poisoned".to_string())?.base();
+    pub fn new(pitch: Arc<Mutex<Pitch>>, robot: usize) -> Result<PitchDevices, SimError> {
+        let base = pitch.lock().map_err(|_| SimError::Poisoned("pitch"))?.base();
         let airboard = SimulatedAirboard::new(pitch.clone(), robot, base);
         Ok(PitchDevices { pitch, robot, airboard })
     }
@@ -57,7 +58,7 @@ impl Devices for PitchDevices {
     }
 
     fn set_pan(&mut self, pan: f64) -> Result<(), DeviceError> {
-        self.with(|p, i| p.set_pan(i, pan))?.map_err(DeviceError::Refused)
+        self.with(|p, i| p.set_pan(i, pan))?.map_err(|e| DeviceError::Refused(e.to_string()))
     }
 
     fn fault(&mut self, message: &str) -> Result<(), DeviceError> {

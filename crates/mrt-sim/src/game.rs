@@ -7,6 +7,7 @@
 //! watching every step.
 
 use crate::config::{PerceptSource, SimConfig};
+use crate::error::SimError;
 use crate::referee::{Call, Referee, Team};
 use crate::render::{CameraState, Renderer, Scene};
 use crate::sensor::{self, sonar_ring, Odometer};
@@ -221,12 +222,16 @@ struct Eyes {
 }
 
 impl Eyes {
-    fn new(cfg: &SimConfig, robots: usize, seed: u64) -> Result<Eyes, String> {
+    fn new(cfg: &SimConfig, robots: usize, seed: u64) -> Result<Eyes, SimError> {
         let stream = |i: u64, salt: u64| {
             CameraState::new(seed.wrapping_mul(0x2545_F491_4F6C_DD1D) ^ i ^ salt)
         };
         let up = match &cfg.vision.up_camera {
-            Some(f) => Some(Renderer::with_camera(cfg, CameraModel::Omni(f.camera()?))?),
+            Some(f) => {
+                let omni =
+                    f.camera().map_err(|e| SimError::Config(format!("vision.up_camera: {e}")))?;
+                Some(Renderer::with_camera(cfg, CameraModel::Omni(omni))?)
+            }
             None => None,
         };
         let up_states = match up {
@@ -295,13 +300,13 @@ fn mm(x: f64) -> i64 {
 impl Pitch {
     /// A pitch with `home` and `away` robots (`away` is `cfg.rules.team_size` or 0: home alone
     /// on the field), kickoff done, all randomness drawn from `seed`.
-    pub fn new(cfg: &SimConfig, seed: u64, home: usize, away: usize) -> Result<Pitch, String> {
+    pub fn new(cfg: &SimConfig, seed: u64, home: usize, away: usize) -> Result<Pitch, SimError> {
         let n = cfg.rules.team_size;
         if home != n || (away != n && away != 0) {
-            return Err(format!(
+            return Err(SimError::Match(format!(
                 "each team needs {n} robots (home has {home}, away {away}; an empty away team \
                  plays alone on the field)"
-            ));
+            )));
         }
         cfg.validate()?;
         let robots = home + away;
@@ -316,7 +321,7 @@ impl Pitch {
         let mice = cfg.mice()?;
         let mut kidnap_rng = ChaCha8Rng::seed_from_u64(seed ^ 0x6B69_646E_6170_0001);
         let kidnap_plan = Self::plan_kidnaps(cfg, robots, &mut kidnap_rng);
-        let base = Base::parse(&cfg.body.base).map_err(|e| e.to_string())?;
+        let base = Base::parse(&cfg.body.base)?;
         Ok(Pitch {
             cfg: cfg.clone(),
             base,
@@ -493,11 +498,11 @@ impl Pitch {
     /// Turns robot `i`'s camera pan joint to `pan` (rad from straight ahead, counter-clockwise;
     /// the joint turns within one cycle: its range and speed are the robot's gaze control's
     /// to keep). A pan that is not a finite number is refused.
-    pub fn set_pan(&mut self, i: usize, pan: f64) -> Result<(), String> {
+    pub fn set_pan(&mut self, i: usize, pan: f64) -> Result<(), SimError> {
         if !pan.is_finite() {
-            return Err(format!("camera pan joint: {pan} rad is not an angle"));
+            return Err(SimError::Match(format!("camera pan joint: {pan} rad is not an angle")));
         }
-        let slot = self.pans.get_mut(i).ok_or_else(|| format!("no robot {i}"))?;
+        let slot = self.pans.get_mut(i).ok_or_else(|| SimError::Match(format!("no robot {i}")))?;
         *slot = mrt_core::normalize_angle(pan);
         Ok(())
     }

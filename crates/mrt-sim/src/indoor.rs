@@ -20,10 +20,11 @@
 //! let (map, mission, events) = mrt_sim::indoor::embedded()?;
 //! assert_eq!(mission.points.len(), 4);
 //! assert!(!map.doors.is_empty() && !events.door_closes.is_empty());
-//! # Ok::<(), String>(())
+//! # Ok::<(), mrt_sim::SimError>(())
 //! ```
 
 use crate::config::SimConfig;
+use crate::error::SimError;
 use crate::sensor::{sonar_ring, Bodies, Odometer};
 use crate::world::{accelerate, v, SonarRing};
 use mrt_core::SimClock;
@@ -185,13 +186,10 @@ impl IndoorEvents {
 ///
 /// # Errors
 /// A message naming the embedded file that does not read (a build from a broken checkout).
-pub fn embedded() -> Result<(PlanMap, Mission, IndoorEvents), String> {
-    let map =
-        PlanMap::from_toml(MAP, "configs/worlds/indoor/map.toml").map_err(|e| e.to_string())?;
-    let mission = Mission::from_toml(MISSION, "configs/worlds/indoor/mission.toml")
-        .map_err(|e| e.to_string())?;
-    let events = IndoorEvents::from_toml(EVENTS, "configs/worlds/indoor/world.toml")
-        .map_err(|e| e.to_string())?;
+pub fn embedded() -> Result<(PlanMap, Mission, IndoorEvents), SimError> {
+    let map = PlanMap::from_toml(MAP, "configs/worlds/indoor/map.toml")?;
+    let mission = Mission::from_toml(MISSION, "configs/worlds/indoor/mission.toml")?;
+    let events = IndoorEvents::from_toml(EVENTS, "configs/worlds/indoor/world.toml")?;
     Ok((map, mission, events))
 }
 
@@ -476,8 +474,8 @@ impl Devices for IndoorDevices {
     }
 }
 
-fn lock<T>(m: &Mutex<T>) -> Result<std::sync::MutexGuard<'_, T>, String> {
-    m.lock().map_err(|_| "a lock is poisoned".to_string())
+fn lock<T>(m: &Mutex<T>) -> Result<std::sync::MutexGuard<'_, T>, SimError> {
+    m.lock().map_err(|_| SimError::Poisoned("indoor world's"))
 }
 
 /// Runs `mission` in the building `map` with `events` until it ends or the events' duration
@@ -493,19 +491,16 @@ pub fn run_mission(
     seed: u64,
     (map, mission, events): (&PlanMap, &Mission, &IndoorEvents),
     mut progress: impl FnMut(f64),
-) -> Result<IndoorReport, String> {
+) -> Result<IndoorReport, SimError> {
     let mice = cfg.mice()?;
     let robot = cfg.robot()?;
     let mut body = RobyBody::new(mice);
-    body.guard = mrt_plan::guidance::VelocityGuard::new(cfg.body.radius + 0.1, 0.35)
-        .map_err(|e| e.to_string())?;
+    body.guard = mrt_plan::guidance::VelocityGuard::new(cfg.body.radius + 0.1, 0.35)?;
     body.radius = cfg.body.radius;
     body.position.max_speed = body.position.max_speed.min(cfg.body.max_speed);
     body.position.steering = robot.base.steering();
     body.half_beam = cfg.sonar.half_beam;
-    let roby = Arc::new(Mutex::new(
-        Roby::new(map.clone(), mission.clone(), body).map_err(|e| e.to_string())?,
-    ));
+    let roby = Arc::new(Mutex::new(Roby::new(map.clone(), mission.clone(), body)?));
     let building = Arc::new(Mutex::new(Building {
         world: IndoorWorld::new(map, events, mission.start, cfg),
         odometer: Odometer::new(0, mice, robot.base),
@@ -516,11 +511,10 @@ pub fn run_mission(
     }));
     let period = robot.period();
     let mut exec = SteppedExecutor::new(SimClock::new(), period);
-    let mut agora = exec.agora_builder(1u32).build().map_err(|e| e.to_string())?;
+    let mut agora = exec.agora_builder(1u32).build()?;
     let devices: SharedDevices = Arc::new(Mutex::new(IndoorDevices(building.clone())));
-    add_roby(&mut agora, (0, period, robot.base), roby.clone(), devices)
-        .map_err(|e| e.to_string())?;
-    exec.add_agora(agora).map_err(|e| e.to_string())?;
+    add_roby(&mut agora, (0, period, robot.base), roby.clone(), devices)?;
+    exec.add_agora(agora)?;
     let steps = (cfg.rules.control_period / cfg.rules.physics_step).round().max(1.0) as usize;
     let (mut trajectory, mut samples) = (Vec::new(), Vec::new());
     let mut next_sample = 0.0;

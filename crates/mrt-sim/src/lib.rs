@@ -27,6 +27,7 @@ pub mod bus;
 pub mod config;
 pub mod devices;
 pub mod drivers;
+pub mod error;
 pub mod game;
 pub mod indoor;
 pub mod metrics;
@@ -39,6 +40,8 @@ pub mod sensor;
 pub mod soak;
 pub mod survey;
 pub mod world;
+
+pub use error::SimError;
 
 use mrt_robot::stacks::Stack;
 use std::path::Path;
@@ -54,7 +57,7 @@ pub fn play(
     behaviors: Option<&Path>,
     record: bool,
     mut progress: impl FnMut(f64),
-) -> Result<game::MatchReport, String> {
+) -> Result<game::MatchReport, SimError> {
     let go_on = |t| {
         progress(t);
         true
@@ -74,7 +77,7 @@ pub fn play_recorded(
     record: bool,
     recorder: Option<mrt_monitor::SharedRecorder>,
     go_on: impl FnMut(f64) -> bool,
-) -> Result<game::MatchReport, String> {
+) -> Result<game::MatchReport, SimError> {
     let mut m = bus::BusMatch::recorded(cfg, seed, home, Some(away), behaviors, recorder)?;
     m.record_frames(record);
     m.play_while(go_on)

@@ -18,6 +18,7 @@
 //! loss divides out).
 
 use crate::config::SimConfig;
+use crate::error::SimError;
 use crate::sensor::mouse_errors;
 use crate::world::World;
 use mrt_core::Twist;
@@ -176,7 +177,7 @@ const RUN_LIMIT: f64 = 60.0;
 
 /// One robot on the field of `cfg`, driven through the manual's procedure (10 straight runs,
 /// 5 turns) with mice mounted as `truth`, the randomness of their errors from `seed`.
-pub fn run(cfg: &SimConfig, truth: &MiceMounting, seed: u64) -> Result<RigReport, String> {
+pub fn run(cfg: &SimConfig, truth: &MiceMounting, seed: u64) -> Result<RigReport, SimError> {
     let procedure = Procedure::default();
     let mut world = World::new(cfg, 1);
     // Out of the ball's way, with room for the runs, near the origin where `f32` is finest.
@@ -191,14 +192,14 @@ pub fn run(cfg: &SimConfig, truth: &MiceMounting, seed: u64) -> Result<RigReport
         };
         for i in 0..n {
             let r = drive(&mut world, start, kind, goal, truth, &mut rng)
-                .map_err(|e| format!("{} run {}: {e}", kind.name(), i + 1))?;
+                .map_err(|e| SimError::Match(format!("{} run {}: {e}", kind.name(), i + 1)))?;
             match kind {
                 RunKind::Straight => log.straight.push(r),
                 RunKind::Turn => log.turns.push(r),
             }
         }
     }
-    let calibration = log.calibrate(&procedure).map_err(|e| e.to_string())?;
+    let calibration = log.calibrate(&procedure)?;
     let validation = validate(&mut world, start, truth, &calibration.mounting(), &mut rng)?;
     let p = cfg.odometry.mice_miss_probability.clamp(0.0, 1.0);
     Ok(RigReport {
@@ -220,7 +221,7 @@ fn validate(
     truth: &MiceMounting,
     estimate: &MiceMounting,
     rng: &mut ChaCha8Rng,
-) -> Result<Validation, String> {
+) -> Result<Validation, SimError> {
     let cfg = world.config().clone();
     let per_read = (cfg.rules.control_period / cfg.rules.physics_step).round().max(1.0) as u64;
     // (forward m/s, turn rad/s, seconds): left and right arcs, a straight, a turn, to rest.
@@ -236,7 +237,7 @@ fn validate(
             if step % per_read != 0 {
                 continue;
             }
-            let now = world.robot(0).ok_or("the robot is gone")?;
+            let now = world.robot(0).ok_or_else(|| SimError::Match("the robot is gone".into()))?;
             let d = now.relative_to(&last);
             path += d.x.hypot(d.y);
             last = now;
@@ -291,7 +292,7 @@ fn drive(
     goal: f64,
     truth: &MiceMounting,
     rng: &mut ChaCha8Rng,
-) -> Result<Run, String> {
+) -> Result<Run, SimError> {
     let cfg = world.config().clone();
     let per_read = (cfg.rules.control_period / cfg.rules.physics_step).round().max(1.0) as u64;
     let steps = (RUN_LIMIT / cfg.rules.physics_step).ceil() as u64;
@@ -310,7 +311,7 @@ fn drive(
         *from = now;
     };
     for step in 1..=steps {
-        let now = world.robot(0).ok_or("the robot is gone")?;
+        let now = world.robot(0).ok_or_else(|| SimError::Match("the robot is gone".into()))?;
         turned += normalize_angle(now.theta - prev.theta);
         let moved = now.relative_to(&prev);
         let at_rest = moved.x.hypot(moved.y) < 1e-6 && moved.theta.abs() < 1e-6;
@@ -340,11 +341,11 @@ fn drive(
         world.drive(0, drive);
         world.step();
         if step % per_read == 0 {
-            let now = world.robot(0).ok_or("the robot is gone")?;
+            let now = world.robot(0).ok_or_else(|| SimError::Match("the robot is gone".into()))?;
             read(&mut last_read, now, &mut total);
         }
     }
-    Err(format!("not done after {RUN_LIMIT} simulated seconds"))
+    Err(SimError::Match(format!("not done after {RUN_LIMIT} simulated seconds")))
 }
 
 #[cfg(test)]

@@ -29,6 +29,7 @@
 
 use crate::bus::book_fault;
 use crate::config::SimConfig;
+use crate::error::SimError;
 use crate::game::{MatchReport, Pitch};
 use crate::referee::Call;
 use mrt_core::Twist;
@@ -142,16 +143,16 @@ impl PitchWorld {
         post: Box<dyn WorldPort + Send>,
         mail: Receiver<(String, Vec<u8>)>,
         patience: Patience,
-    ) -> Result<PitchWorld, String> {
+    ) -> Result<PitchWorld, SimError> {
         let n = cfg.rules.team_size;
         if !(1..=2).contains(&teams) {
-            return Err(format!("a match has one or two teams, not {teams}"));
+            return Err(SimError::Match(format!("a match has one or two teams, not {teams}")));
         }
         let pitch = Pitch::new(cfg, seed, n, if teams == 2 { n } else { 0 })?;
-        let base = Base::parse(&cfg.body.base).map_err(|e| e.to_string())?;
+        let base = Base::parse(&cfg.body.base)?;
         let robots = n * teams;
         let names: Vec<String> = (0..robots).map(|i| robot_name(i, n)).collect();
-        let answers = Answers::new(WORLD, run, &names, base.wheels()).map_err(|e| e.to_string())?;
+        let answers = Answers::new(WORLD, run, &names, base.wheels())?;
         let period_ns = (cfg.rules.control_period * 1e9).round() as u64;
         Ok(PitchWorld {
             pitch,
@@ -200,12 +201,12 @@ impl PitchWorld {
     }
 
     /// Robot `i`'s `sense` of this cycle, read from the pitch as its drivers would read it.
-    fn sense(&mut self, i: usize, time: f64) -> Result<Vec<u8>, String> {
+    fn sense(&mut self, i: usize, time: f64) -> Result<Vec<u8>, SimError> {
         let counts = self.pitch.odometry_counts(i);
         let (camera, up_camera) = wire::camera(&self.pitch.camera(i));
         let game = wire::game(&self.pitch.game_info(i));
         let sonars = wire::sonars(&self.pitch.sonar(i));
-        let keys = self.answers.keys(i).ok_or_else(|| format!("no robot {i}"))?;
+        let keys = self.answers.keys(i).ok_or_else(|| SimError::Match(format!("no robot {i}")))?;
         let placed = counts.placed.map(|p| p.inner);
         let sense = Sense {
             protocol: PROTOCOL,
@@ -220,22 +221,26 @@ impl PitchWorld {
             sonars: Some(sonars),
             game,
         };
-        serde_json::to_vec(&sense).map_err(|e| e.to_string())
+        Ok(serde_json::to_vec(&sense)?)
     }
 
     fn run(&self) -> &str {
         self.answers.run()
     }
 
-    fn put_sense(&self, i: usize, bytes: &[u8]) -> Result<(), String> {
-        let key = self.answers.keys(i).map(Keys::sense).ok_or_else(|| format!("no robot {i}"))?;
-        self.post.put(&key, bytes.to_vec()).map_err(|e| e.to_string())
+    fn put_sense(&self, i: usize, bytes: &[u8]) -> Result<(), SimError> {
+        let key = self
+            .answers
+            .keys(i)
+            .map(Keys::sense)
+            .ok_or_else(|| SimError::Match(format!("no robot {i}")))?;
+        Ok(self.post.put(&key, bytes.to_vec())?)
     }
 
     /// One control cycle: every robot's sense out, every robot's answer in (or its silence
     /// booked), the answers applied in robot order, the physics up to the next cycle. Returns
     /// the referee's calls.
-    pub fn cycle(&mut self) -> Result<Vec<Call>, String> {
+    pub fn cycle(&mut self) -> Result<Vec<Call>, SimError> {
         let k = self.cycle;
         // The clock of step k, as the robot's clock reads it back (to the nanosecond).
         let time = k.saturating_mul(self.period_ns) as f64 / 1e9;
@@ -285,7 +290,7 @@ impl PitchWorld {
         }
         if let Some(pan) = act.pan {
             if let Err(e) = self.pitch.set_pan(i, pan) {
-                self.pitch.fault(i, 1, &e);
+                self.pitch.fault(i, 1, &e.to_string());
             }
         }
         for f in &act.faults {
@@ -295,7 +300,7 @@ impl PitchWorld {
 
     /// Every robot's answer to step `k`, waiting as [`Patience`] says (and putting a sense
     /// again after [`Patience::resend`]).
-    fn gather(&mut self, k: u64, senses: &[Vec<u8>]) -> Result<Vec<Option<Act>>, String> {
+    fn gather(&mut self, k: u64, senses: &[Vec<u8>]) -> Result<Vec<Option<Act>>, SimError> {
         let mut acts: Vec<Option<Act>> = vec![None; senses.len()];
         let start = Instant::now();
         let mut resent = vec![start; senses.len()];
@@ -330,13 +335,15 @@ impl PitchWorld {
                     }
                 }
                 Err(RecvTimeoutError::Timeout) => {}
-                Err(RecvTimeoutError::Disconnected) => return Err("the robots' mail closed".into()),
+                Err(RecvTimeoutError::Disconnected) => {
+                    return Err(SimError::Match("the robots' mail closed".into()))
+                }
             }
         }
     }
 
     /// Ends the match, gathers the robots' last words and returns the report.
-    pub fn finish(mut self) -> Result<MatchReport, String> {
+    pub fn finish(mut self) -> Result<MatchReport, SimError> {
         let end = End {
             protocol: PROTOCOL,
             world: WORLD.into(),
@@ -344,8 +351,8 @@ impl PitchWorld {
             steps: self.cycle,
         };
         if let Some(key) = self.answers.keys(0).map(Keys::end) {
-            let bytes = serde_json::to_vec(&end).map_err(|e| e.to_string())?;
-            self.post.put(&key, bytes).map_err(|e| e.to_string())?;
+            let bytes = serde_json::to_vec(&end)?;
+            self.post.put(&key, bytes)?;
         }
         let mut byes: BTreeMap<usize, Bye> = BTreeMap::new();
         let start = Instant::now();
@@ -383,7 +390,7 @@ impl PitchWorld {
     }
 
     /// Plays until the end, calling `progress` with the simulated time after each cycle.
-    pub fn play(mut self, mut progress: impl FnMut(f64)) -> Result<MatchReport, String> {
+    pub fn play(mut self, mut progress: impl FnMut(f64)) -> Result<MatchReport, SimError> {
         while !self.finished() {
             self.cycle()?;
             progress(self.time());

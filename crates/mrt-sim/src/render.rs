@@ -37,10 +37,11 @@
 //! // The ball is 1 m straight ahead: the middle column shows its orange (shaded).
 //! let orange = |p: [u8; 3]| p[0] > 150 && p[1] > 60 && p[1] < 120 && p[2] < 30;
 //! assert!((0..240).filter_map(|row| image.pixel(160, row)).any(orange));
-//! # Ok::<(), String>(())
+//! # Ok::<(), mrt_sim::SimError>(())
 //! ```
 
 use crate::config::{RenderConfig, SimConfig};
+use crate::error::SimError;
 use mrt_core::Pose2;
 use mrt_msgs::Image;
 use mrt_perception::camera::{Camera, CameraModel, Omni, Pinhole, Pixel};
@@ -177,14 +178,19 @@ pub struct Renderer {
 
 impl Renderer {
     /// The renderer of `cfg`'s world, with its camera (`[vision.camera]`) and settings (`[render]`).
-    pub fn new(cfg: &SimConfig) -> Result<Renderer, String> {
-        Renderer::with_camera(cfg, CameraModel::Pinhole(cfg.vision.camera.camera()?))
+    pub fn new(cfg: &SimConfig) -> Result<Renderer, SimError> {
+        let camera = cfg
+            .vision
+            .camera
+            .camera()
+            .map_err(|e| SimError::Config(format!("vision.camera: {e}")))?;
+        Renderer::with_camera(cfg, CameraModel::Pinhole(camera))
     }
 
     /// The renderer of `cfg`'s world for `camera`: a pinhole camera (drawn at pan 0 and turned
     /// by [`Renderer::render`]'s `pan`), or an omnidirectional one (its mirror needs a finite
     /// viewpoint).
-    pub fn with_camera(cfg: &SimConfig, camera: CameraModel) -> Result<Renderer, String> {
+    pub fn with_camera(cfg: &SimConfig, camera: CameraModel) -> Result<Renderer, SimError> {
         let map = cfg.field;
         let wall = (map.half_length() + cfg.field.border, map.half_width() + cfg.field.border);
         let floor = FloorPaint::new(&map, wall, cfg.render.line_width);
@@ -582,19 +588,19 @@ fn pinhole_rays(camera: &Pinhole, floor: &FloorPaint) -> Rays {
 
 /// The rays of an omnidirectional camera: from the mirror's viewpoint to the floor point each
 /// pixel images (an affine map: a row of pixels is an evenly stepped line of the floor).
-fn omni_rays(omni: &Omni) -> Result<Vec<RowRays>, String> {
+fn omni_rays(omni: &Omni) -> Result<Vec<RowRays>, SimError> {
     if !(omni.viewpoint.is_finite() && omni.viewpoint > 0.0) {
-        return Err(format!(
+        return Err(SimError::Config(format!(
             "the mirror's viewpoint must be finite and > 0, not {}",
             omni.viewpoint
-        ));
+        )));
     }
     let (_, h) = omni.size();
     let floor = |col: f64, row: u32| omni.floor_of(Pixel::new(col + 0.5, f64::from(row) + 0.5));
     (0..h)
         .map(|row| {
             let (Some(a), Some(b)) = (floor(0.0, row), floor(1.0, row)) else {
-                return Err("the camera's affine map has no inverse".to_string());
+                return Err(SimError::Config("the camera's affine map has no inverse".into()));
             };
             Ok(RowRays { start: [a.x, a.y, -omni.viewpoint], step: [b.x - a.x, b.y - a.y, 0.0] })
         })

@@ -7,6 +7,7 @@
 //! are faults the match reports, not crashes.
 
 use crate::config::SimConfig;
+use crate::error::SimError;
 use mrt_robot::stacks::Stack;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -36,14 +37,16 @@ impl SoakMatch {
     }
 
     /// Plays it; `Err` for a crash (a panic, with its message, or the simulator's error).
-    pub fn play(&self) -> Result<crate::game::MatchReport, String> {
+    pub fn play(&self) -> Result<crate::game::MatchReport, SimError> {
         let (home, away) = self.stacks;
         let run = || {
             crate::bus::BusMatch::new(&self.cfg, self.seed, home, Some(away), None)?.play(|_| {})
         };
         match std::panic::catch_unwind(AssertUnwindSafe(run)) {
             Ok(r) => r,
-            Err(payload) => Err(format!("panic: {}", panic_message(payload.as_ref()))),
+            Err(payload) => {
+                Err(SimError::Match(format!("panic: {}", panic_message(payload.as_ref()))))
+            }
         }
     }
 }

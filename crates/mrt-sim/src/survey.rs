@@ -26,10 +26,11 @@
 //! let report = survey(&SimConfig::default(), 7, 20)?;
 //! let ball = report.kind("ball").expect("the ball is surveyed");
 //! assert!(ball.in_view > 0 && ball.found <= ball.in_view);
-//! # Ok::<(), String>(())
+//! # Ok::<(), mrt_sim::SimError>(())
 //! ```
 
 use crate::config::SimConfig;
+use crate::error::SimError;
 use crate::render::{CameraState, Renderer, Scene};
 use mrt_core::{normalize_angle, Pose2};
 use mrt_msgs::{Percepts, Sighting};
@@ -218,10 +219,15 @@ fn range(kind: &str) -> f64 {
 }
 
 /// Surveys `scenes` random scenes of the world `cfg` (module doc).
-pub fn survey(cfg: &SimConfig, seed: u64, scenes: usize) -> Result<SurveyReport, String> {
+pub fn survey(cfg: &SimConfig, seed: u64, scenes: usize) -> Result<SurveyReport, SimError> {
     let renderer = Renderer::new(cfg)?;
     let map = cfg.field;
-    let camera = cfg.vision.camera.camera()?.panned(0.0);
+    let camera = cfg
+        .vision
+        .camera
+        .camera()
+        .map_err(|e| SimError::Config(format!("vision.camera: {e}")))?
+        .panned(0.0);
     let shape = PostShape { radius: cfg.vision.post_radius, height: cfg.vision.post_height };
     let mut agent = VisionAgent::new(camera, &ColorTable::shipped(), cfg.ball.radius)
         .post_shape(shape)
@@ -237,7 +243,7 @@ pub fn survey(cfg: &SimConfig, seed: u64, scenes: usize) -> Result<SurveyReport,
         let viewer = robots[0].0;
         let scene = Scene { ball: Some(ball), robots: robots.clone() };
         let image = renderer.render(&scene, viewer, 0.0, Some(0), &mut state);
-        let p: Percepts = agent.see(&image, scene_no as f64, 0.0).map_err(|e| e.to_string())?;
+        let p: Percepts = agent.see(&image, scene_no as f64, 0.0)?;
         let visible = |kind: &str, x: f64, y: f64, z: f64| {
             let s = sight(viewer, x, y);
             s.distance <= range(kind)
