@@ -2,9 +2,9 @@
 //!
 //! The processing side of the MRT manual's sensing modules (§2.1: drivers apart from
 //! processing): readings come in as the standard messages of `mrt-msgs` (from a real robot's
-//! drivers or from the simulator's), and what they mean comes out. Today: the dead-reckoning
+//! drivers or from the simulator's), and what they mean comes out: the dead-reckoning
 //! sensor made of two optical mice (manual ch. 4), with the manual's formula typos fixed and
-//! its error detection and reduction (§4.2), and the camera models colour vision will use
+//! its error detection and reduction (§4.2), the camera models
 //! ([`camera`]: a pinhole camera on a pan joint with radial distortion, ISocRob's
 //! omnidirectional mirror, the ball's floor point and apparent size, with the report's typos
 //! fixed), colour vision on camera images ([`vision`]: ISocRob seed `003` §3.2.1's lookup table,

@@ -1,7 +1,7 @@
 //! The object sensor: what a robot's camera would detect, as distance and bearing with
 //! range-dependent noise, a field of view, occlusion by other robots and random misses. It is
-//! the documented stand-in for camera images and colour vision (a later issue), and stays as
-//! the fast mode.
+//! the fast stand-in for rendered images and the robots' colour vision (`[sensor] percepts =
+//! "oracle"`).
 //!
 //! The odometry sensors ([`Odometer`]) are two optical mice (MRT manual ch. 4) and the wheel
 //! encoders. Both drivers report raw readings ([`CameraFrame`], [`Odometry`]); the robot's

@@ -9,8 +9,7 @@
 //! they go unseen; the PAM's camera control, [`gaze::Gaze`], which turns the camera's pan joint
 //! to the object the behaviors need most (seed `001` §2.1); and the team side,
 //! [`team::merge_team`]. It reads the standard messages of `mrt-msgs` only (never a
-//! simulator), so the same world model runs on a real robot. MAP and MUREA come here
-//!.
+//! simulator), so the same world model runs on a real robot.
 //!
 //! ```
 //! use mrt_core::frames::Framed;

@@ -1,5 +1,4 @@
-//! An HFSM drawn as SVG, with a layout of our own that stays linear in the machine's size
-//!.
+//! An HFSM drawn as SVG, with a layout of our own that stays linear in the machine's size.
 //!
 //! Each machine is a panel, the root first; inside it the states stand in columns by their
 //! distance (in transitions) from the initial state, read left to right as the dot drawing
