@@ -1,24 +1,43 @@
 //! The simulator's files import each other in one direction: config → world →
 //! referee → sensor → game → metrics, sensor → indoor, drivers → devices → bus → remote, plot,
-//! soak, survey. A file that names `crate::x` depends on `x`; this test fails on any import
-//! circle, with the circle.
+//! soak, survey. A module (`src/x.rs` and the files under `src/x/`) that names `crate::y`
+//! depends on `y`; this test fails on any import circle, with the circle.
 #![allow(missing_docs, clippy::unwrap_used, clippy::expect_used)]
 
 use std::collections::BTreeMap;
 use std::path::Path;
 
+/// Each top-level module's files: `src/x.rs` and everything under `src/x/`.
+fn module_texts(src: &Path) -> BTreeMap<String, String> {
+    let mut texts: BTreeMap<String, String> = BTreeMap::new();
+    let mut dirs = vec![src.to_path_buf()];
+    while let Some(dir) = dirs.pop() {
+        for entry in std::fs::read_dir(&dir).unwrap() {
+            let path = entry.unwrap().path();
+            if path.is_dir() {
+                dirs.push(path);
+                continue;
+            }
+            if path.extension().is_none_or(|e| e != "rs") {
+                continue;
+            }
+            let relative = path.strip_prefix(src).unwrap();
+            let top = relative.components().next().unwrap().as_os_str().to_string_lossy();
+            let name = top.trim_end_matches(".rs").to_string();
+            if name == "lib" {
+                continue;
+            }
+            let text = std::fs::read_to_string(&path).unwrap();
+            texts.entry(name).or_default().push_str(&text);
+        }
+    }
+    texts
+}
+
 fn imports() -> BTreeMap<String, Vec<String>> {
     let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
     let mut graph = BTreeMap::new();
-    for entry in std::fs::read_dir(&src).unwrap() {
-        let path = entry.unwrap().path();
-        let Some(name) = path.file_stem().and_then(|s| s.to_str()).map(str::to_string) else {
-            continue;
-        };
-        if name == "lib" || path.extension().is_none_or(|e| e != "rs") {
-            continue;
-        }
-        let text = std::fs::read_to_string(&path).unwrap();
+    for (name, text) in module_texts(&src) {
         let mut deps: Vec<String> = text
             .match_indices("crate::")
             .map(|(i, _)| {
