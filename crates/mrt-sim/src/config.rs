@@ -250,15 +250,6 @@ impl SimConfig {
     pub fn robot(&self) -> Result<mrt_robot::config::RobotConfig, SimError> {
         Ok(self.robot_file(0, "chaser").config()?)
     }
-
-    /// The two-mice sensor of the robots' `[sensors]` mounting.
-    pub fn mice(&self) -> Result<mrt_perception::mice::MiceOdometry, SimError> {
-        mrt_perception::mice::MiceOdometry::new(
-            self.sensors.mice_distance,
-            self.sensors.mice_tolerance,
-        )
-        .map_err(|e| SimError::Config(format!("sensors: {e}")))
-    }
 }
 
 /// The whole configuration.

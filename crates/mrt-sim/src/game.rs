@@ -141,10 +141,11 @@ impl Pitch {
                 ChaCha8Rng::seed_from_u64(seed.wrapping_mul(0x9E37_79B9_7F4A_7C15).wrapping_add(i))
             })
             .collect();
-        let mice = cfg.mice()?;
+        // The robots' own mice and base, as their robot file describes them.
+        let robot = cfg.robot()?;
+        let (mice, base) = (robot.mice, robot.base);
         let mut kidnap_rng = ChaCha8Rng::seed_from_u64(seed ^ 0x6B69_646E_6170_0001);
         let kidnap_plan = Self::plan_kidnaps(cfg, robots, &mut kidnap_rng);
-        let base = Base::parse(&cfg.body.base)?;
         Ok(Pitch {
             cfg: cfg.clone(),
             base,

@@ -492,9 +492,8 @@ pub fn run_mission(
     (map, mission, events): (&PlanMap, &Mission, &IndoorEvents),
     mut progress: impl FnMut(f64),
 ) -> Result<IndoorReport, SimError> {
-    let mice = cfg.mice()?;
     let robot = cfg.robot()?;
-    let mut body = RobyBody::new(mice);
+    let mut body = RobyBody::new(robot.mice);
     body.guard = mrt_plan::guidance::VelocityGuard::new(cfg.body.radius + 0.1, 0.35)?;
     body.radius = cfg.body.radius;
     body.position.max_speed = body.position.max_speed.min(cfg.body.max_speed);
@@ -503,7 +502,7 @@ pub fn run_mission(
     let roby = Arc::new(Mutex::new(Roby::new(map.clone(), mission.clone(), body)?));
     let building = Arc::new(Mutex::new(Building {
         world: IndoorWorld::new(map, events, mission.start, cfg),
-        odometer: Odometer::new(0, mice, robot.base),
+        odometer: Odometer::new(0, robot.mice, robot.base),
         rng: ChaCha8Rng::seed_from_u64(seed),
         cfg: cfg.clone(),
         base: robot.base,

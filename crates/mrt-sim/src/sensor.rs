@@ -403,7 +403,7 @@ mod tests {
         let mut rng = ChaCha8Rng::seed_from_u64(4);
         let exact =
             OdometryConfig { mice_noise: 0.0, mice_miss_probability: 0.0, wheel_noise: 0.0 };
-        let mice = SimConfig::default().mice().unwrap();
+        let mice = SimConfig::default().robot().unwrap().mice;
         let mut odo = Odometer::new(2, mice, Base::parse("omni").unwrap());
         // The first reading tells where the robot was put down (start of the match).
         let first = odo.read(&w, &exact, 0.1, &mut rng);
@@ -443,7 +443,7 @@ mod tests {
     fn a_mouse_sometimes_under_reads_and_noise_is_proportional() {
         let (mut w, _) = setup();
         let cfg = OdometryConfig { mice_miss_probability: 0.5, ..Default::default() };
-        let mice = SimConfig::default().mice().unwrap();
+        let mice = SimConfig::default().robot().unwrap().mice;
         let mut rng = ChaCha8Rng::seed_from_u64(5);
         let mut odo = Odometer::new(1, mice, Base::parse("omni").unwrap());
         w.place_robot(1, Pose2::new(0.0, 0.0, 0.0));

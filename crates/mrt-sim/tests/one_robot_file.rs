@@ -53,7 +53,7 @@ fn a_value_changed_in_a_simulator_file_reaches_the_robots_and_the_world_alike() 
     // The robot program's view ...
     assert_eq!((robot.radius, robot.ball_radius, robot.ball_damping), (0.3, 0.12, 0.6));
     assert_eq!((robot.field.length, robot.camera.bearing), (16.0, 0.01));
-    assert_eq!(robot.mice, sim.mice().unwrap());
+    assert_eq!(robot.mice, mrt_perception::mice::MiceOdometry::new(0.15, 0.003).unwrap());
     // ... is the one definition the world simulates.
     assert_eq!((sim.body.radius, sim.body.mass, sim.ball.radius), (0.3, 25.0, 0.12));
     assert_eq!(sim.field.length, 16.0);

@@ -115,7 +115,6 @@ impl Harness for SimToml {
         // `SimConfig::from_file` reads the file as UTF-8 text.
         let Ok(text) = std::str::from_utf8(input) else { return false };
         let Ok(cfg) = SimConfig::from_toml(text, "fuzz.toml") else { return false };
-        let _ = cfg.mice();
         let _ = cfg.robot();
         let _ = cfg.robot_file(0, "chaos").to_toml();
         // Documented: to_toml gives a file from_toml reads back.
