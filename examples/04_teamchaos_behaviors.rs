@@ -19,8 +19,8 @@
 #![allow(clippy::print_stdout)] // examples talk to the user
 
 use anyhow::{Context as _, Result};
-use mrt_core::frames::{pose_in_millimetres, setpoints_of};
-use mrt_core::{Pose2, Time};
+use mrt_core::frames::{setpoints_of, Framed};
+use mrt_core::{Pose2, Time, Twist};
 use mrt_msgs::robot::{lps, Estimate, Lpo, WorldSnapshot};
 use mrt_script::{Sandbox, ThinkingCap};
 use std::path::{Path, PathBuf};
@@ -69,7 +69,7 @@ pub struct KeeperMove {
     pub vlat: f64,
     /// Whether it looks for landmarks.
     pub track_landmarks: bool,
-    /// The posture it asked guidance for, if any (team frame: mm, mm, rad).
+    /// The posture it asked guidance for, if any (team frame: m, m, rad).
     pub target: Option<Pose2>,
 }
 
@@ -89,27 +89,26 @@ impl Field {
             Lpo { rho: dx.hypot(dy), theta, reliability: 0.9, seen_ago: 0.0 }
         };
         w.lps[lps::BALL] = seen(self.ball.0, self.ball.1);
-        w.lps[lps::NET1] = seen(self.ball.0 + 4500.0, self.ball.1);
-        w.my_pos = Estimate { pose: self.robot, quality: 0.9 };
+        w.lps[lps::NET1] = seen(self.ball.0 + 4.5, self.ball.1);
+        w.my_pos = Estimate { pose: Framed::new(self.robot), quality: 0.9 };
         w
     }
 
     /// Moves the robot as commanded for `dt` seconds (forward, sideways to the left, turning),
     /// at most at a Middle Size base's top speeds (1.2 m/s, 4 rad/s), as guidance would; a
     /// kick sends the ball 5 m on.
-    fn advance(&mut self, vlin: f64, vlat: f64, vrot_deg: f64, kick: Option<i64>, dt: f64) {
-        let (top, top_turn) = (1200.0, 4f64.to_degrees());
-        let speed = vlin.hypot(vlat);
+    fn advance(&mut self, twist: Twist, kick: Option<i64>, dt: f64) {
+        let (top, top_turn) = (1.2, 4.0);
+        let speed = twist.vx.hypot(twist.vy);
         let slow = if speed > top { top / speed } else { 1.0 };
-        let (vlin, vlat, vrot_deg) =
-            (vlin * slow, vlat * slow, vrot_deg.clamp(-top_turn, top_turn));
-        let theta = self.robot.theta + vrot_deg.to_radians() * dt;
+        let (vx, vy, omega) =
+            (twist.vx * slow, twist.vy * slow, twist.omega.clamp(-top_turn, top_turn));
+        let theta = self.robot.theta + omega * dt;
         let (c, s) = (theta.cos(), theta.sin());
-        let (x, y) =
-            (self.robot.x + (vlin * c - vlat * s) * dt, self.robot.y + (vlin * s + vlat * c) * dt);
+        let (x, y) = (self.robot.x + (vx * c - vy * s) * dt, self.robot.y + (vx * s + vy * c) * dt);
         self.robot = Pose2::new(x, y, theta);
         if kick.is_some() {
-            self.ball.0 += 5000.0;
+            self.ball.0 += 5.0;
         }
     }
 }
@@ -132,7 +131,7 @@ pub fn run(scratch: &Path, verbose: bool) -> Result<Outcome> {
     let sandbox = Sandbox::default();
     let mut attacker = ThinkingCap::with_hfsm(scratch, scratch.join("attacker.hfsm.lua"), sandbox)
         .map_err(|e| anyhow::anyhow!("{e}"))?;
-    let mut field = Field { robot: Pose2::new(0.0, 0.0, 0.0), ball: (3200.0, 2400.0) };
+    let mut field = Field { robot: Pose2::new(0.0, 0.0, 0.0), ball: (3.2, 2.4) };
     let go2ball = scratch.join("go2ball.lua");
     let original = std::fs::read_to_string(&go2ball)?;
     let mut steps = Vec::new();
@@ -166,7 +165,7 @@ pub fn run(scratch: &Path, verbose: bool) -> Result<Outcome> {
         let cmd = &c.command;
         // The set-points in the behaviors' own units, as the script wrote them.
         let (vlin, vlat, vrot) = setpoints_of(cmd.twist);
-        field.advance(vlin, vlat, vrot, cmd.kick, 0.1);
+        field.advance(cmd.twist, cmd.kick, 0.1);
         let step = Step {
             path: c.path.clone(),
             behavior: c.behavior.clone().unwrap_or_default(),
@@ -219,18 +218,19 @@ fn bump_mtime(path: &Path, k: u64) -> Result<()> {
 fn run_goalkeeper(dir: &Path, verbose: bool) -> Result<Vec<KeeperMove>> {
     let mut gk = ThinkingCap::with_behavior(dir, "goalkeeper", Sandbox::default())
         .map_err(|e| anyhow::anyhow!("{e}"))?;
-    let home = Estimate { pose: Pose2::new(-8700.0, 0.0, 0.0), quality: 0.9 };
+    let at = |x: f64, y: f64| Framed::new(Pose2::new(x, y, 0.0));
+    let home = Estimate { pose: at(-8.7, 0.0), quality: 0.9 };
     let lost = WorldSnapshot { my_pos: home, ..Default::default() };
     let mut in_net = lost.clone();
-    in_net.my_pos.pose = Pose2::new(-9200.0, 0.0, 0.0);
-    in_net.lps[lps::BALL] = Lpo { rho: 3000.0, theta: 0.0, reliability: 0.9, seen_ago: 0.0 };
-    // The ball 2.9 m out at y = 300, the keeper 600 mm to its left on its line (400 mm out of
-    // the goal line): it asks guidance for the spot level with the ball, (−8600, 300).
+    in_net.my_pos.pose = at(-9.2, 0.0);
+    in_net.lps[lps::BALL] = Lpo { rho: 3.0, theta: 0.0, reliability: 0.9, seen_ago: 0.0 };
+    // The ball 2.9 m out at y = 0.3, the keeper 0.6 m to its left on its line (0.4 m out of
+    // the goal line): it asks guidance for the spot level with the ball, (−8.6, 0.3).
     let mut cut = lost.clone();
-    let theta = (-600.0f64).atan2(2900.0);
-    cut.lps[lps::BALL] = Lpo { rho: 2961.0, theta, reliability: 0.9, seen_ago: 0.0 };
-    cut.global_ball = Estimate { pose: Pose2::new(-5700.0, 300.0, 0.0), quality: 0.9 };
-    cut.my_pos.pose = Pose2::new(-8600.0, 900.0, 0.0);
+    let theta = (-0.6f64).atan2(2.9);
+    cut.lps[lps::BALL] = Lpo { rho: 2.961, theta, reliability: 0.9, seen_ago: 0.0 };
+    cut.global_ball = Estimate { pose: at(-5.7, 0.3), quality: 0.9 };
+    cut.my_pos.pose = at(-8.6, 0.9);
     let mut out = Vec::new();
     if verbose {
         println!("\nGoalkeeper (goalkeeper.lua and its 11 sub-behaviors):\n");
@@ -246,10 +246,10 @@ fn run_goalkeeper(dir: &Path, verbose: bool) -> Result<Vec<KeeperMove>> {
         }
         let m = &c.command;
         let (vlin, vlat, vrot) = setpoints_of(m.twist);
-        let target = m.target.map(|t| pose_in_millimetres(t.pose.inner));
+        let target = m.target.map(|t| t.pose.inner);
         if verbose {
             let to = target.map_or(String::new(), |t| {
-                format!("  to ({:.0}, {:.0}) facing {:.2} rad", t.x, t.y, t.theta)
+                format!("  to ({:.2}, {:.2}) m facing {:.2} rad", t.x, t.y, t.theta)
             });
             println!(
                 "  {name:<34} vlin {vlin:>6.1}  vrot {vrot:>6.1}  vlat {vlat:>6.1}  landmarks {}{to}",

@@ -2,7 +2,7 @@
 //!
 //! What you learn: how a robot's world model (`mrt_world::WorldModel`) turns the camera's robot
 //! percepts into anchored robots that behaviors read (MRT manual ch. 8, MAP; TeamChaos'
-//! perceptual anchoring, seed 001 §2.1). The marker band a percept shows makes it a teammate or
+//! perceptual anchoring, ThinkingCap report §2.1). The marker band a percept shows makes it a teammate or
 //! an opponent. Association keeps each robot's identity when two robots cross. An anchor
 //! predicted through an occlusion keeps its identity and fades while unseen. The snapshot then
 //! answers a behavior's questions: the nearest opponent and a free direction to the net.
@@ -16,7 +16,7 @@
 
 #![allow(clippy::print_stdout)] // examples talk to the user
 
-use mrt_core::frames::{metres, Framed};
+use mrt_core::frames::Framed;
 use mrt_core::{normalize_angle, Pose2};
 use mrt_msgs::{
     AnchoredRobot, CameraFrame, GameInfo, GameState, Marker, RobotSighting, Sighting, WorldSnapshot,
@@ -105,9 +105,9 @@ pub fn run(print: bool) -> Result<Vec<Moment>, String> {
                     "    anchor {} {:<8} at ({:+.2}, {:+.2}) m, {:+.1} m/s north, reliability {:.2}{}",
                     r.id,
                     r.class.name(),
-                    metres(r.x),
-                    metres(r.y),
-                    metres(r.vy),
+                    r.at.inner.x,
+                    r.at.inner.y,
+                    r.velocity.inner.y,
                     r.reliability,
                     if r.seen_ago > 0.0 { format!(", unseen for {:.1} s", r.seen_ago) } else { String::new() }
                 );

@@ -20,11 +20,10 @@
 use mrt_msgs::ScareReport;
 use mrt_team::scare::soccer::{Coordinator, Situation};
 
-/// Where the four robots stand (team frame, mm; robot 1 keeps goal).
-pub const ROBOTS: [(f64, f64); 4] =
-    [(-8500.0, 0.0), (-1500.0, 0.0), (2500.0, 2000.0), (-5000.0, -1500.0)];
+/// Where the four robots stand (team frame, m; robot 1 keeps goal).
+pub const ROBOTS: [(f64, f64); 4] = [(-8.5, 0.0), (-1.5, 0.0), (2.5, 2.0), (-5.0, -1.5)];
 /// The ball.
-pub const BALL: (f64, f64) = (-1000.0, 0.0);
+pub const BALL: (f64, f64) = (-1.0, 0.0);
 
 /// What robot `i` believes: the same ball and opponents for all, its teammates where they are.
 fn situation(i: usize, opponents: &[(f64, f64)]) -> Situation {
@@ -37,8 +36,8 @@ fn situation(i: usize, opponents: &[(f64, f64)]) -> Situation {
             .map(|j| (j as u32 + 1, ROBOTS[j], j == 0))
             .collect(),
         opponents: opponents.to_vec(),
-        half_length: 9000.0,
-        goal_half_width: 1000.0,
+        half_length: 9.0,
+        goal_half_width: 1.0,
     }
 }
 
@@ -93,7 +92,7 @@ pub fn run(opponents: &[(f64, f64)], print: bool) -> (Vec<Vec<(u32, String)>>, S
 /// Runs the example: with the opponent blocking the ball, then without it.
 pub fn main() {
     println!("An opponent stands in front of the ball, robot 3 is free far ahead:");
-    run(&[(-200.0, 0.0)], true);
+    run(&[(-0.2, 0.0)], true);
     println!("\nThe opponent has gone:");
     run(&[], true);
 }

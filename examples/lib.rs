@@ -27,7 +27,7 @@ mod tests {
     #[test]
     fn coordinating_with_scare_gives_every_robot_the_same_allocation() {
         use super::coordinating_with_scare::run;
-        let (views, job) = run(&[(-200.0, 0.0)], false);
+        let (views, job) = run(&[(-0.2, 0.0)], false);
         assert!(views.windows(2).all(|w| w[0] == w[1]), "{views:?}");
         let expect =
             |v: &[(u32, &str)]| v.iter().map(|(r, a)| (*r, a.to_string())).collect::<Vec<_>>();
@@ -104,11 +104,12 @@ mod tests {
         // near where it is (x −0.1, y 0 m).
         let hidden = at(2.0).robots.iter().find(|r| r.class == RobotClass::Opponent).unwrap();
         assert!((hidden.reliability - 0.5f64.powf(0.6)).abs() < 1e-6, "{hidden:?}");
-        assert!((hidden.x + 100.0).abs() < 150.0 && hidden.y.abs() < 300.0, "{hidden:?}");
+        let hidden_at = hidden.at.inner;
+        assert!((hidden_at.x + 0.1).abs() < 0.15 && hidden_at.y.abs() < 0.3, "{hidden:?}");
         // At the end the teammate is 2 m north, the opponent 2 m south, both seen.
         let end = &at(4.0).robots;
         let mate = end.iter().find(|r| r.class == RobotClass::Teammate).unwrap();
-        assert!((mate.y - 2000.0).abs() < 100.0 && mate.reliability == 1.0);
+        assert!((mate.at.inner.y - 2.0).abs() < 0.1 && mate.reliability == 1.0);
         // Straight ahead is blocked while they cross, and free at the start and the end.
         assert_eq!(at(0.0).free_direction, Some(0.0));
         assert_ne!(at(2.0).free_direction, Some(0.0));
@@ -176,7 +177,7 @@ mod tests {
         assert!(gk[0].vrot != 0.0 && gk[0].track_landmarks, "ball lost: turns to look for it");
         assert!(gk[1].vlin > 0.0, "inside its net: moves out");
         let spot = gk[2].target.expect("off the line: it asks guidance for its spot");
-        assert!((spot.x + 8600.0).abs() < 1e-9 && (spot.y - 300.0).abs() < 1e-9, "{spot:?}");
+        assert!((spot.x + 8.6).abs() < 1e-9 && (spot.y - 0.3).abs() < 1e-9, "{spot:?}");
     }
 
     #[test]

@@ -88,7 +88,7 @@ def main():
     if ball is not None:
         x = ball.find("attribute[@name='x']")
         reliability = None if x is None else float(x.get("reliability"))
-    # Time in nanoseconds of the robot's clock; the pose in the robot's team frame, mm and rad.
+    # Time in nanoseconds of the robot's clock; the pose in the robot's team frame, m and rad.
     pose = (last.get("my_pos") or {}).get("pose") or {}
 
     request = int(time.time() * 1000) & 0xFFFFFFFF

@@ -30,7 +30,7 @@
 //! assert!((team.inner.x - 0.0).abs() < 1e-12 && (team.inner.y + 2.0).abs() < 1e-12);
 //! ```
 
-use crate::geometry::{normalize_angle, Point2, Pose2, Twist};
+use crate::geometry::{normalize_angle, Point2, Pose2, Twist, Vec2};
 use serde::{Deserialize, Deserializer, Serialize, Serializer};
 use std::f64::consts::PI;
 use std::marker::PhantomData;
@@ -199,6 +199,20 @@ impl Framed<Team, Point2> {
     pub fn to_field(self, attack: Attack) -> Framed<Field, Point2> {
         let s = attack.sign();
         Framed::new(Point2::new(s * self.inner.x, s * self.inner.y))
+    }
+}
+
+impl Framed<Field, Vec2> {
+    /// The vector (a velocity, a displacement) in the frame of a team attacking `attack`.
+    pub fn to_team(self, attack: Attack) -> Framed<Team, Vec2> {
+        Framed::new(self.inner * attack.sign())
+    }
+}
+
+impl Framed<Team, Vec2> {
+    /// The vector in the field frame, for a team attacking `attack`.
+    pub fn to_field(self, attack: Attack) -> Framed<Field, Vec2> {
+        Framed::new(self.inner * attack.sign())
     }
 }
 

@@ -3,7 +3,7 @@
 //! source, test, benchmark or example of the workspace multiplies or divides by a literal
 //! thousand (`x * 1000.0`, `x / 1e3`, `1000.0 * x`) or declares an `f64` of `1000.0`. A
 //! thousand millimetres as a distance (`Pose2::new(1000.0, 0.0, 0.0)`) is not a conversion and
-//! is not matched; the few distances that look like one are listed in [`DISTANCES`]. A factor
+//! is not matched; a distance that looks like one would be listed in [`DISTANCES`]. A factor
 //! that is not a unit's (three decimals of a rounding) is a named constant written `1e3`.
 #![allow(missing_docs, clippy::unwrap_used, clippy::expect_used)]
 
@@ -11,16 +11,7 @@ use std::path::{Path, PathBuf};
 
 /// Lines the matcher flags that are distances in the millimetre world, not conversions:
 /// (file from the workspace root, the line's trimmed text).
-const DISTANCES: &[(&str, &str)] = &[
-    // 1 m of the behaviors' millimetre field, not a factor.
-    ("crates/mrt-robot/src/stacks.rs", "pub const CORNER_DEPTH: f64 = 1000.0;"),
-    // Players a metre apart on a millimetre field.
-    ("crates/mrt-team/benches/team.rs", "at: (f64::from(k) * 1000.0 - 4000.0, 500.0),"),
-    (
-        "crates/mrt-world/src/team.rs",
-        "pose: Estimate { pose: Pose2::new(-1000.0 * f64::from(id), 0.0, 0.0), quality: 0.9 },",
-    ),
-];
+const DISTANCES: &[(&str, &str)] = &[];
 
 /// The files that convert: the helpers themselves, and this test's own examples.
 const EXEMPT: [&str; 2] =

@@ -636,7 +636,7 @@ mod json_tests {
 
     #[test]
     fn json_mutants_stay_json_and_change() {
-        let seed = br#"{"lps": [{"rho": 3000, "theta": 1.0}], "role": "attacker", "mates": []}"#;
+        let seed = br#"{"lps": [{"rho": 3.0, "theta": 1.0}], "role": "attacker", "mates": []}"#;
         let mut rng = ChaCha8Rng::seed_from_u64(3);
         let mutants: Vec<Vec<u8>> = (0..500).filter_map(|_| mutate_json(&mut rng, seed)).collect();
         assert_eq!(mutants.len(), 500);

@@ -5,12 +5,12 @@
 //! listener (`mrt sim --serve`).
 //!
 //! Everything in a frame is in the field frame (metres from the centre spot, x towards the
-//! east goal, radians): the robots' team-frame millimetres (`WorldSnapshot`, `PlannedPath`)
-//! are turned with the direction the robot's team attacks (`GameInfo::attack`).
+//! east goal, radians): the robots' team-frame beliefs (`WorldSnapshot`, `PlannedPath`) are
+//! turned with the direction the robot's team attacks (`GameInfo::attack`).
 
 use crate::camera::CompressedImage;
 use crate::replay::{Recording, ReplayError};
-use mrt_core::frames::{Attack, Framed, Team, MM_PER_M};
+use mrt_core::frames::{Attack, Framed, Team};
 use mrt_core::{Point2, Pose2, Time};
 use mrt_msgs::{
     BehaviorStatus, GameInfo, GameState, HfsmStructure, ImageDetections, Localization, Percepts,
@@ -329,10 +329,10 @@ impl Timeline {
                     view.world(&w);
                     let f = w.field;
                     self.field.get_or_insert(FieldView {
-                        half_length: f.half_length / MM_PER_M,
-                        half_width: f.half_width / MM_PER_M,
-                        goal_half_width: f.goal_half_width / MM_PER_M,
-                        penalty_area_depth: f.penalty_area_depth / MM_PER_M,
+                        half_length: f.half_length,
+                        half_width: f.half_width,
+                        goal_half_width: f.goal_half_width,
+                        penalty_area_depth: f.penalty_area_depth,
                     });
                     true
                 }
@@ -525,9 +525,9 @@ impl RobotView {
         Attack::from_direction(self.attack)
     }
 
-    /// A team-frame point in millimetres, in the field frame in metres.
-    fn field_point(&self, x: f64, y: f64) -> (f64, f64) {
-        let p = Framed::<Team, Point2>::new(Point2::new(x, y) / MM_PER_M).to_field(self.attack());
+    /// A team-frame point, in the field frame.
+    fn field_point(&self, p: Framed<Team, Point2>) -> (f64, f64) {
+        let p = p.to_field(self.attack());
         (p.inner.x, p.inner.y)
     }
 
@@ -542,13 +542,14 @@ impl RobotView {
 
     fn world(&mut self, w: &WorldSnapshot) {
         let b = w.global_ball;
-        self.team_ball = (b.quality > 0.0).then(|| self.field_point(b.pose.x, b.pose.y));
+        self.team_ball =
+            (b.quality > 0.0).then(|| self.field_point(Framed::new(b.pose.inner.position())));
         self.team_ball_quality = b.quality;
         self.anchors = w
             .robots
             .iter()
             .map(|r| AnchorView {
-                at: self.field_point(r.x, r.y),
+                at: self.field_point(r.at),
                 class: r.class,
                 reliability: r.reliability,
             })
@@ -625,9 +626,9 @@ mod tests {
     }
 
     /// Messages of one instant make one frame; a later message closes it. An away robot that
-    /// attacks west has its team-frame millimetres turned half round into field metres: its
-    /// team ball at (1000, 500) mm is at (−1, −0.5) m on the field, the robot it anchored at
-    /// (2000, 0) mm at (−2, 0) m, its planned pose (500, −250) mm at (−0.5, 0.25) m.
+    /// attacks west has its team frame turned half round into the field's: its team ball at
+    /// (1, 0.5) is at (−1, −0.5) on the field, the robot it anchored at (2, 0) at (−2, 0), its
+    /// planned pose (0.5, −0.25) at (−0.5, 0.25).
     #[test]
     fn one_frame_per_instant_in_the_field_frame() {
         let mut t = Timeline::new();
@@ -645,9 +646,9 @@ mod tests {
         };
         t.ingest("/away/0/Localization", at(0.0), &json(&l));
         let w = WorldSnapshot {
-            global_ball: Estimate { pose: Pose2::new(1000.0, 500.0, 0.0), quality: 0.8 },
+            global_ball: Estimate { pose: Framed::new(Pose2::new(1.0, 0.5, 0.0)), quality: 0.8 },
             robots: vec![AnchoredRobot {
-                x: 2000.0,
+                at: Framed::new(Point2::new(2.0, 0.0)),
                 class: RobotClass::Opponent,
                 reliability: 0.7,
                 ..Default::default()
@@ -685,7 +686,7 @@ mod tests {
         assert!(ball.0.abs() < 1e-12 && (ball.1 - 2.0).abs() < 1e-12, "2 m to its left: {ball:?}");
         assert_eq!(seen.lines, vec![(1.0, -0.5)]);
         assert!(seen.landmarks.is_empty());
-        assert_eq!(t.field().unwrap().half_length, w.field.half_length / MM_PER_M);
+        assert_eq!(t.field().unwrap().half_length, w.field.half_length);
         t.finish();
         assert_eq!(t.end(), 2);
         assert_eq!(frame(&t, 1).truth.unwrap().score, (1, 0));

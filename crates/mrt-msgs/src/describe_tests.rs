@@ -5,7 +5,7 @@
 
 use crate::*;
 use mrt_core::frames::Framed;
-use mrt_core::{Pose2, Time, Twist, Vec2};
+use mrt_core::{Point2, Pose2, Time, Twist, Vec2};
 use mrt_dcdt::describe::{AttrValue, SelfDescribing};
 use std::collections::HashSet;
 
@@ -160,18 +160,19 @@ fn a_world_snapshot() {
     let f = form_of(&filled_snapshot());
     assert_eq!(attr(&f, "WorldSnapshot", "role"), (sym("attacker"), 0.0, 1.0));
     assert_eq!(attr(&f, "WorldSnapshot", "game_state"), (sym("Playing"), 0.0, 1.0));
-    assert_eq!(attr(&f, "WorldSnapshot", "ball_vel[1]"), (num(-50.0), 0.0, 1.0));
+    assert_eq!(attr(&f, "WorldSnapshot", "ball_vel[1]"), (num(-0.05), 0.0, 1.0));
     // The ball's LPS object: its reliability is its attributes'.
-    assert_eq!(attr(&f, "lps[0]", "rho"), (num(2400.0), 0.0, 0.9));
+    assert_eq!(attr(&f, "lps[0]", "rho"), (num(2.4), 0.0, 0.9));
     // An estimate's quality is the reliability of its pose.
-    assert_eq!(attr(&f, "my_pos.pose", "x"), (num(-1000.0), 0.0, 0.8));
-    assert_eq!(attr(&f, "mates[0].at.pose", "y"), (num(300.0), 0.0, 0.5));
+    assert_eq!(attr(&f, "my_pos.pose", "x"), (num(-1.0), 0.0, 0.8));
+    assert_eq!(attr(&f, "mates[0].at.pose", "y"), (num(0.3), 0.0, 0.5));
     assert_eq!(attr(&f, "mates[0]", "keeper"), (sym("true"), 0.0, 1.0));
-    // An anchored robot: `sigma` (of its place) is the variability of x and y only.
+    // An anchored robot: `at_sigma` (of its place) is the variability of its position only.
     assert_eq!(class(&f, "robots[0]"), "AnchoredRobot");
     assert_eq!(attr(&f, "robots[0]", "class"), (sym("opponent"), 0.0, 0.6));
-    assert_eq!(attr(&f, "robots[0]", "x"), (num(1500.0), 120.0, 0.6));
-    assert_eq!(attr(&f, "robots[0]", "y"), (num(-200.0), 120.0, 0.6));
+    assert_eq!(attr(&f, "robots[0]", "at[0]"), (num(1.5), 0.12, 0.6));
+    assert_eq!(attr(&f, "robots[0]", "at[1]"), (num(-0.2), 0.12, 0.6));
+    assert_eq!(attr(&f, "robots[0]", "velocity[0]"), (num(0.01), 0.0, 0.6));
     assert_eq!(attr(&f, "robots[0]", "theta"), (num(-0.1), 0.0, 0.6));
     assert_eq!(class(&f, "kickoff_pose"), "Pose2");
     assert_eq!(class(&f, "job"), "ScareJob");
@@ -182,12 +183,12 @@ fn a_world_snapshot() {
 #[test]
 fn a_mate_report() {
     let f = form_of(&filled_report());
-    assert_eq!(attr(&f, "MateReport", "ball_sigma"), (num(150.0), 0.0, 1.0));
+    assert_eq!(attr(&f, "MateReport", "ball_sigma"), (num(0.15), 0.0, 1.0));
     // `ball_sigma` is the variability of the ball's numbers, its quality their reliability.
-    assert_eq!(attr(&f, "ball.pose", "x"), (num(2000.0), 150.0, 0.7));
+    assert_eq!(attr(&f, "ball.pose", "x"), (num(2.0), 0.15, 0.7));
     assert_eq!(attr(&f, "ball", "quality"), (num(0.7), 0.0, 1.0));
-    assert_eq!(attr(&f, "pose.pose", "x"), (num(-1000.0), 0.0, 0.8));
-    assert_eq!(attr(&f, "robots[0]", "x"), (num(1500.0), 120.0, 1.0));
+    assert_eq!(attr(&f, "pose.pose", "x"), (num(-1.0), 0.0, 0.8));
+    assert_eq!(attr(&f, "robots[0]", "at[0]"), (num(1.5), 0.12, 1.0));
     assert_eq!(class(&f, "booking"), "BookingReport");
     assert_eq!(attr(&f, "booking", "grant[0]"), (num(2.0), 0.0, 1.0));
     assert_eq!(attr(&f, "scare", "attitudes[1]"), (num(0.25), 0.0, 1.0));
@@ -221,24 +222,22 @@ fn odometry_and_camera_frames() {
 
 fn filled_snapshot() -> WorldSnapshot {
     let mut w = WorldSnapshot { time: Time(12_500_000_000), ..WorldSnapshot::default() };
-    w.lps[lps::BALL] = Lpo { rho: 2400.0, theta: 0.1, reliability: 0.9, seen_ago: 0.0 };
-    w.my_pos = Estimate { pose: Pose2::new(-1000.0, 0.0, 0.0), quality: 0.8 };
-    w.ball_vel = Vec2::new(100.0, -50.0);
-    w.global_ball = Estimate { pose: Pose2::new(2000.0, 500.0, 0.0), quality: 0.7 };
+    w.lps[lps::BALL] = Lpo { rho: 2.4, theta: 0.1, reliability: 0.9, seen_ago: 0.0 };
+    w.my_pos = Estimate { pose: Framed::new(Pose2::new(-1.0, 0.0, 0.0)), quality: 0.8 };
+    w.ball_vel = Framed::new(Vec2::new(0.1, -0.05));
+    w.global_ball = Estimate { pose: Framed::new(Pose2::new(2.0, 0.5, 0.0)), quality: 0.7 };
     w.mates = vec![Mate {
         id: 2,
-        at: Estimate { pose: Pose2::new(0.0, 300.0, 1.0), quality: 0.5 },
+        at: Estimate { pose: Framed::new(Pose2::new(0.0, 0.3, 1.0)), quality: 0.5 },
         keeper: true,
     }];
     w.robots = vec![AnchoredRobot {
         id: 5,
         class: RobotClass::Opponent,
-        x: 1500.0,
-        y: -200.0,
-        vx: 10.0,
-        vy: 0.0,
-        sigma: 120.0,
-        rho: 2500.0,
+        at: Framed::new(Point2::new(1.5, -0.2)),
+        velocity: Framed::new(Vec2::new(0.01, 0.0)),
+        at_sigma: 0.12,
+        rho: 2.5,
         theta: -0.1,
         reliability: 0.6,
         seen_ago: 0.0,
@@ -252,7 +251,7 @@ fn filled_snapshot() -> WorldSnapshot {
         activity: "BringBall".to_owned(),
         functionality: "carrier".to_owned(),
         subtask: "ReachBall".to_owned(),
-        position: Some((1.0, -2.0)),
+        position: Some(Framed::new(Point2::new(1.0, -2.0))),
         aim: None,
         kick: true,
     });
@@ -260,7 +259,7 @@ fn filled_snapshot() -> WorldSnapshot {
 }
 
 fn filled_report() -> MateReport {
-    let mut report = MateReport::of(3, false, &filled_snapshot()).with_ball_sigma(150.0);
+    let mut report = MateReport::of(3, false, &filled_snapshot()).with_ball_sigma(0.15);
     report.booking = BookingReport {
         stamp: 12.5,
         claim: Some(12.0),

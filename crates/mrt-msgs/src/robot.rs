@@ -1,10 +1,12 @@
-//! What a robot's behaviors read and write each cycle (ThinkingCap, seed `001` §3.3): a typed
+//! What a robot's behaviors read and write each cycle (ThinkingCap report §3.3): a typed
 //! [`WorldSnapshot`] (local perceptual space, global state, team, game state) and a
 //! [`RobotCommand`] (velocities, kick, perceptual needs, behavior selection). The world model
-//! and the simulator fill the snapshot; behaviors (Lua or fuzzy) fill the command.
+//! fills the snapshot; behaviors (Lua or fuzzy) fill the command. Both are SI (m, rad, s) and
+//! every position is framed; the behaviors' millimetres and degrees are converted where the
+//! behavior APIs read and write them (`mrt_core::frames`).
 
 use mrt_core::frames::{setpoints_of, Framed, Team};
-use mrt_core::{Pose2, Time, Twist, Vec2};
+use mrt_core::{Point2, Pose2, Time, Twist, Vec2};
 use serde::{Deserialize, Serialize};
 
 /// Indices of the local perceptual space (LPS) objects (`BALL`, `NET1`, ... of chaoslib).
@@ -23,12 +25,13 @@ pub mod lps {
     pub const COUNT: usize = LANDMARK0 + LANDMARKS;
 }
 
-/// A local perceptual object (LPO): an object anchored in the robot's frame.
+/// A local perceptual object (LPO): an object anchored in the robot's frame, as a distance
+/// and a bearing.
 #[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
 pub struct Lpo {
-    /// Distance, millimetres.
+    /// Distance from the robot's centre, m.
     pub rho: f64,
     /// Bearing, radians, counter-clockwise (left) positive, 0 straight ahead.
     pub theta: f64,
@@ -38,14 +41,15 @@ pub struct Lpo {
     pub seen_ago: f64,
 }
 
-/// A global estimate: a pose on the field and its quality, 0 (unknown) to 1.
+/// A global estimate: a pose on the field, in the team frame, and its quality, 0 (unknown) to
+/// 1.
 #[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
 pub struct Estimate {
-    /// The pose in the field frame: millimetres from the centre spot, x towards the
-    /// opponent's net, heading in radians (for the ball, `theta` is unused).
-    pub pose: Pose2,
+    /// The pose in the team frame: metres from the centre spot, x towards the opponent's
+    /// net, heading in radians (for the ball, `theta` is unused).
+    pub pose: Framed<Team, Pose2>,
     /// Quality, 0 to 1.
     pub quality: f64,
 }
@@ -101,17 +105,15 @@ pub struct AnchoredRobot {
     pub id: u32,
     /// Teammate, opponent or unknown.
     pub class: RobotClass,
-    /// Its centre in the team frame, mm (x towards the opponent's net).
-    pub x: f64,
-    /// See `x`.
-    pub y: f64,
-    /// Its velocity in the team frame, mm/s.
-    pub vx: f64,
-    /// See `vx`.
-    pub vy: f64,
-    /// One standard deviation of its place, mm.
-    pub sigma: f64,
-    /// Distance from this robot's centre to its centre, mm (as an [`Lpo`]).
+    /// Its centre in the team frame, m (x towards the opponent's net).
+    #[cfg_attr(feature = "schema", schemars(with = "[f64; 2]"))]
+    pub at: Framed<Team, Point2>,
+    /// Its velocity in the team frame, m/s.
+    #[cfg_attr(feature = "schema", schemars(with = "[f64; 2]"))]
+    pub velocity: Framed<Team, Vec2>,
+    /// One standard deviation of its place, m.
+    pub at_sigma: f64,
+    /// Distance from this robot's centre to its centre, m (as an [`Lpo`]).
     pub rho: f64,
     /// Its bearing, rad, counter-clockwise positive, 0 straight ahead.
     pub theta: f64,
@@ -122,8 +124,8 @@ pub struct AnchoredRobot {
     pub seen_ago: f64,
 }
 
-/// The field as the world model's map knows it (`getField`), in millimetres: behaviors read
-/// their geometry from here instead of assuming one field size.
+/// The field as the world model's map knows it (`getField`), in metres: behaviors read their
+/// geometry from here instead of assuming one field size.
 #[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
@@ -141,12 +143,7 @@ pub struct Field {
 impl Default for Field {
     /// The Middle Size League field of the seeds' time: 18 m x 12 m, goals 2 m wide.
     fn default() -> Self {
-        Field {
-            half_length: 9000.0,
-            half_width: 6000.0,
-            goal_half_width: 1000.0,
-            penalty_area_depth: 2250.0,
-        }
+        Field { half_length: 9.0, half_width: 6.0, goal_half_width: 1.0, penalty_area_depth: 2.25 }
     }
 }
 
@@ -191,9 +188,9 @@ pub struct WorldSnapshot {
     pub lps: Vec<Lpo>,
     /// The robot's own global pose (`gsGetMyPos`).
     pub my_pos: Estimate,
-    /// The ball's velocity in the field frame, mm/s (`getBallVel`).
+    /// The ball's velocity in the team frame, m/s (`getBallVel`).
     #[cfg_attr(feature = "schema", schemars(with = "[f64; 2]"))]
-    pub ball_vel: Vec2,
+    pub ball_vel: Framed<Team, Vec2>,
     /// The ball's global position (`getGlobalBall`).
     pub global_ball: Estimate,
     /// Teammates (`getMates`).
@@ -224,7 +221,7 @@ pub struct WorldSnapshot {
 }
 
 /// A robot's SCARE activity as its behaviors read it (MRT manual ch. 11, §2.3): names, and
-/// the goal of the current sub-task in the team frame (mm).
+/// the goal of the current sub-task in the team frame (m).
 #[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
@@ -236,9 +233,11 @@ pub struct ScareJob {
     /// The current sub-task, e.g. `ReachBall`.
     pub subtask: String,
     /// Where to stand (facing the ball), for position goals.
-    pub position: Option<(f64, f64)>,
+    #[cfg_attr(feature = "schema", schemars(with = "Option<[f64; 2]>"))]
+    pub position: Option<Framed<Team, Point2>>,
     /// Where to play the ball (the net, or a mate), for ball goals.
-    pub aim: Option<(f64, f64)>,
+    #[cfg_attr(feature = "schema", schemars(with = "Option<[f64; 2]>"))]
+    pub aim: Option<Framed<Team, Point2>>,
     /// Whether the sub-task kicks the ball (a shot or a pass), not only reaches it.
     pub kick: bool,
 }
@@ -250,7 +249,7 @@ impl Default for WorldSnapshot {
             time: Time::ZERO,
             lps: vec![Lpo::default(); lps::COUNT],
             my_pos: Estimate::default(),
-            ball_vel: Vec2::zeros(),
+            ball_vel: Framed::new(Vec2::zeros()),
             global_ball: Estimate::default(),
             mates: Vec::new(),
             robots: Vec::new(),
@@ -269,11 +268,11 @@ impl WorldSnapshot {
     /// The reliability an anchored robot needs to count for the behaviors' default queries
     /// (`getNearestOpponent`, `getFreeDirection`, Team Milan's inputs): about 1.7 s unseen.
     pub const ANCHORED: f64 = 0.3;
-    /// How far ahead the behaviors' free direction looks unless told, mm.
-    pub const FREE_REACH: f64 = 2000.0;
+    /// How far ahead the behaviors' free direction looks unless told, m.
+    pub const FREE_REACH: f64 = 2.0;
     /// Half the width of the corridor the behaviors' free direction keeps free unless told,
-    /// mm: two Middle Size robots' radii.
-    pub const FREE_CLEARANCE: f64 = 500.0;
+    /// m: two Middle Size robots' radii.
+    pub const FREE_CLEARANCE: f64 = 0.5;
 
     /// The nearest robot that is not known to be a teammate, with at least `min_reliability`
     /// (`getNearestOpponent`): an opponent, or a robot of unknown team (a careful player
@@ -291,8 +290,8 @@ impl WorldSnapshot {
     }
 
     /// The free direction nearest to `desired` (rad, robot frame; `getFreeDirection`): the
-    /// bearing of a corridor `2·clearance` wide (mm: this robot's radius plus another's) and
-    /// `reach` long (mm) in which no anchored robot of at least `min_reliability` stands.
+    /// bearing of a corridor `2·clearance` wide (m: this robot's radius plus another's) and
+    /// `reach` long (m) in which no anchored robot of at least `min_reliability` stands.
     /// Bearings are tried every 5° outwards from `desired`, left before right; `None` when
     /// every one is blocked.
     pub fn free_direction(
@@ -408,43 +407,43 @@ mod tests {
         let mut w = WorldSnapshot::default();
         assert!(w.nearest_opponent(0.0).is_none());
         w.robots = vec![
-            robot(RobotClass::Teammate, 500.0, 0.0, 1.0),
-            robot(RobotClass::Opponent, 3000.0, 0.5, 1.0),
-            robot(RobotClass::Robot, 2000.0, -0.5, 0.2),
+            robot(RobotClass::Teammate, 0.5, 0.0, 1.0),
+            robot(RobotClass::Opponent, 3.0, 0.5, 1.0),
+            robot(RobotClass::Robot, 2.0, -0.5, 0.2),
         ];
-        assert_eq!(w.nearest_opponent(0.0).map(|r| r.rho), Some(2000.0), "unknown team counts");
-        assert_eq!(w.nearest_opponent(0.5).map(|r| r.rho), Some(3000.0));
+        assert_eq!(w.nearest_opponent(0.0).map(|r| r.rho), Some(2.0), "unknown team counts");
+        assert_eq!(w.nearest_opponent(0.5).map(|r| r.rho), Some(3.0));
     }
 
     #[test]
     fn the_free_direction_goes_round_a_robot_in_the_way() {
         let mut w = WorldSnapshot::default();
         // Nothing in the way: the desired bearing itself.
-        assert_eq!(w.free_direction(0.3, 2000.0, 500.0, 0.5), Some(0.3));
+        assert_eq!(w.free_direction(0.3, 2.0, 0.5, 0.5), Some(0.3));
         // A robot 1 m straight ahead, corridor half-width 0.45 m: blocked while
-        // |1000·sin(b)| < 450, i.e. |b| < 26.7°; the first free bearing on the 5° grid is 30°,
+        // |sin(b)| < 0.45, i.e. |b| < 26.7°; the first free bearing on the 5° grid is 30°,
         // left first.
-        w.robots = vec![robot(RobotClass::Opponent, 1000.0, 0.0, 1.0)];
-        let b = w.free_direction(0.0, 2000.0, 450.0, 0.5).unwrap();
+        w.robots = vec![robot(RobotClass::Opponent, 1.0, 0.0, 1.0)];
+        let b = w.free_direction(0.0, 2.0, 0.45, 0.5).unwrap();
         assert!((b - 30f64.to_radians()).abs() < 1e-9, "{b}");
-        // A second robot on the left at 35°, 1.2 m (1200·sin 5° = 105 mm off the 30° line)
+        // A second robot on the left at 35°, 1.2 m (1.2·sin 5° = 0.105 m off the 30° line)
         // pushes it to the right.
-        w.robots.push(robot(RobotClass::Robot, 1200.0, 35f64.to_radians(), 1.0));
-        let b = w.free_direction(0.0, 2000.0, 450.0, 0.5).unwrap();
+        w.robots.push(robot(RobotClass::Robot, 1.2, 35f64.to_radians(), 1.0));
+        let b = w.free_direction(0.0, 2.0, 0.45, 0.5).unwrap();
         assert!((b + 30f64.to_radians()).abs() < 1e-9, "{b}");
         // Robots behind, beyond the reach or faded do not block.
         w.robots = vec![
-            robot(RobotClass::Opponent, 1000.0, std::f64::consts::PI, 1.0),
-            robot(RobotClass::Opponent, 3000.0, 0.0, 1.0),
-            robot(RobotClass::Opponent, 1000.0, 0.0, 0.1),
+            robot(RobotClass::Opponent, 1.0, std::f64::consts::PI, 1.0),
+            robot(RobotClass::Opponent, 3.0, 0.0, 1.0),
+            robot(RobotClass::Opponent, 1.0, 0.0, 0.1),
         ];
-        assert_eq!(w.free_direction(0.0, 2000.0, 500.0, 0.5), Some(0.0));
+        assert_eq!(w.free_direction(0.0, 2.0, 0.5, 0.5), Some(0.0));
         // Surrounded: none.
         w.robots = (0..12)
             .map(|k| {
-                robot(RobotClass::Opponent, 400.0, f64::from(k) * std::f64::consts::FRAC_PI_6, 1.0)
+                robot(RobotClass::Opponent, 0.4, f64::from(k) * std::f64::consts::FRAC_PI_6, 1.0)
             })
             .collect();
-        assert_eq!(w.free_direction(0.0, 2000.0, 500.0, 0.5), None);
+        assert_eq!(w.free_direction(0.0, 2.0, 0.5, 0.5), None);
     }
 }

@@ -1,10 +1,12 @@
-//! What teammates tell each other (ISocRob seed `003` §3.1, TeamChaos seed `001` §2.3): each
+//! What teammates tell each other (ISocRob-2000 report §3.1, ThinkingCap report §2.3): each
 //! robot's own pose, ball and the robots it sees, every cycle.
 
 use crate::robot::{Estimate, RobotClass, WorldSnapshot};
+use mrt_core::frames::{Framed, Team};
+use mrt_core::Point2;
 use serde::{Deserialize, Serialize};
 
-/// What a robot tells its teammates every cycle (team frame, mm): its own pose and its own
+/// What a robot tells its teammates every cycle (team frame, m): its own pose and its own
 /// sighting of the ball (never what it heard from others, so stale news does not circulate).
 #[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -17,7 +19,7 @@ pub struct MateReport {
     pub pose: Estimate,
     /// Where it believes the ball is (quality 0 when it has no idea).
     pub ball: Estimate,
-    /// One standard deviation of `ball`'s position, mm (0: not known; the team then reads it
+    /// One standard deviation of `ball`'s position, m (0: not known; the team then reads it
     /// from the quality).
     #[serde(default)]
     pub ball_sigma: f64,
@@ -73,19 +75,18 @@ pub struct BookingReport {
     pub echo: Vec<(u32, f64)>,
 }
 
-/// A robot a teammate anchored and sees this frame (team frame, mm).
+/// A robot a teammate anchored and sees this frame (team frame, m).
 #[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
 pub struct SharedRobot {
     /// Teammate, opponent or unknown, as the teammate classified it (one team, one meaning).
     pub class: RobotClass,
-    /// Its centre, mm.
-    pub x: f64,
-    /// See `x`.
-    pub y: f64,
-    /// One standard deviation of its place, mm.
-    pub sigma: f64,
+    /// Its centre, m.
+    #[cfg_attr(feature = "schema", schemars(with = "[f64; 2]"))]
+    pub at: Framed<Team, Point2>,
+    /// One standard deviation of its place, m.
+    pub at_sigma: f64,
 }
 
 impl MateReport {
@@ -96,7 +97,7 @@ impl MateReport {
             .robots
             .iter()
             .filter(|r| r.seen_ago <= 0.0)
-            .map(|r| SharedRobot { class: r.class, x: r.x, y: r.y, sigma: r.sigma })
+            .map(|r| SharedRobot { class: r.class, at: r.at, at_sigma: r.at_sigma })
             .collect();
         MateReport {
             id,
@@ -111,7 +112,7 @@ impl MateReport {
         }
     }
 
-    /// The same report with the ball's standard deviation, mm.
+    /// The same report with the ball's standard deviation, m.
     pub fn with_ball_sigma(self, ball_sigma: f64) -> MateReport {
         MateReport { ball_sigma, ..self }
     }

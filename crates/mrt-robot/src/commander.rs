@@ -1,4 +1,4 @@
-//! The Commander (TeamChaos seed `001` §2.1: the Commander Module between the behaviors and
+//! The Commander (ThinkingCap report §2.1: the Commander Module between the behaviors and
 //! the body): how a team's behaviors are adapted to the robot they run on.
 //!
 //! TeamChaos tuned its behaviors for AIBO walking speeds (about 0.3 m/s) and the AIBO's head;
@@ -8,15 +8,15 @@
 //! body.
 
 use crate::config::RobotConfig;
-use mrt_core::frames::millimetres;
+use mrt_core::frames::metres;
 use mrt_msgs::WorldSnapshot;
 
-/// How a team's behaviors are adapted to the robot's body: TeamChaos' Commander Module (seed
-/// `001` §2.1), which turned the behaviors' set-points into a walking style for the AIBO's
+/// How a team's behaviors are adapted to the robot's body: ThinkingCap's Commander Module
+/// (report §2.1), which turned the behaviors' set-points into a walking style for the AIBO's
 /// legs. Here the world state's LPS distances are shifted ([`Commander::perceive`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Commander {
-    /// Subtracted from every LPS distance (mm).
+    /// Subtracted from every LPS distance (m).
     pub edge: f64,
 }
 
@@ -30,8 +30,9 @@ impl Commander {
     /// fires) falls 30 mm inside the kicker's reach: a kick never fires at a ball it cannot
     /// reach and wastes the valve's recharge.
     pub fn chaos(cfg: &RobotConfig) -> Commander {
-        let reach = millimetres(cfg.radius + cfg.ball_radius + cfg.kick_reach);
-        Commander { edge: (reach - 280.0).max(0.0) }
+        // 250 mm + 30 mm, where the behaviors' millimetres say it.
+        let touching = metres(280.0);
+        Commander { edge: (cfg.radius + cfg.ball_radius + cfg.kick_reach - touching).max(0.0) }
     }
 
     /// The camera driver's side: distances from the robot's edge.

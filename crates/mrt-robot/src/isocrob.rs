@@ -31,7 +31,7 @@ use crate::error::RobotError;
 use crate::stacks::{drive_to, walk_to_kickoff, Geometry};
 use mrt_blackboard::config::load_text;
 use mrt_blackboard::{Blackboard, Pattern};
-use mrt_core::frames::{metres, millimetres, pose_in_metres, seconds_from_millis, Framed};
+use mrt_core::frames::{seconds_from_millis, Framed};
 use mrt_core::{normalize_angle, Pose2};
 use mrt_msgs::robot::{lps, GameState, RobotCommand, Target, WorldSnapshot};
 use mrt_team::isocrob::{
@@ -57,7 +57,7 @@ const NEAR_FRONT: f64 = 0.6;
 /// that faced it kept whatever way it faced, and a goalkeeper looked along its goal line for
 /// seconds while the shot came (with the 40° front camera, before this).
 fn look_at_ball(w: &WorldSnapshot, recent: f64) -> f64 {
-    let me = w.my_pos.pose;
+    let me = w.my_pos.pose.inner;
     let ball = w.lps[lps::BALL];
     if ball.reliability > 0.0 && ball.seen_ago <= recent {
         me.theta + ball.theta
@@ -69,8 +69,8 @@ fn look_at_ball(w: &WorldSnapshot, recent: f64) -> f64 {
 /// The heading (rad, team frame) from the robot to where its team believes the ball is
 /// (MAP's team ball), when the team has one.
 fn team_ball_heading(w: &WorldSnapshot) -> Option<f64> {
-    let (me, ball) = (w.my_pos.pose, w.global_ball);
-    (ball.quality > 0.0).then(|| (ball.pose.y - me.y).atan2(ball.pose.x - me.x))
+    let (me, ball) = (w.my_pos.pose.inner, w.global_ball);
+    (ball.quality > 0.0).then(|| (ball.pose.inner.y - me.y).atan2(ball.pose.inner.x - me.x))
 }
 
 /// [`drive_to`] at up to 1.5 m/s.
@@ -235,17 +235,16 @@ impl IsocrobBrain {
     }
 
     fn field_player(&mut self, w: &WorldSnapshot, p: &Params, kicked: bool) -> RobotCommand {
-        let me = w.my_pos.pose;
-        let me_m = pose_in_metres(me);
+        let me = w.my_pos.pose.inner;
         let ball = w.lps[lps::BALL];
         let net = w.lps[lps::NET1];
         let ffb = ball.reliability > 0.0 && ball.seen_ago <= p.seen_ball;
         let ffog = net.theta.abs() <= p.facing && net.rho > 0.0;
         // Near, and before the kicker; while going round the ball (FACE_GOAL) near is enough.
-        let near = ffb && metres(ball.rho) <= p.near_ball;
+        let near = ffb && ball.rho <= p.near_ball;
         let fnb = near
             && (ball.theta.abs() < NEAR_FRONT || self.attacker.state() == AttackerState::FaceGoal);
-        let h = heuristic(ffb.then_some(metres(ball.rho)), ffog, p.k1);
+        let h = heuristic(ffb.then_some(ball.rho), ffog, p.k1);
         self.post(&format!("{HEURISTIC}{}", self.id), h);
         let slg = should_i_go(self.id, h, &self.heard(p.heard));
         self.post("local.var.machine.slg", slg);
@@ -254,11 +253,11 @@ impl IsocrobBrain {
         let lane = side * p.home_spread * (self.index / 2 + 1) as f64 / 2.0;
         let mut home = (p.home_x, lane);
         // Home postures that follow the ball the team believes in (MAP's team ball):
-        let hl = metres(w.field.half_length);
+        let hl = w.field.half_length;
         let team_ball = w.global_ball;
-        let ball_m = (team_ball.quality > 0.0)
-            .then_some((metres(team_ball.pose.x), metres(team_ball.pose.y)));
-        match (self.role, ball_m) {
+        let team_ball =
+            (team_ball.quality > 0.0).then_some((team_ball.pose.inner.x, team_ball.pose.inner.y));
+        match (self.role, team_ball) {
             // an attacker with `att.support`: that far ahead of the ball (behind it when
             // negative), in its lane, to take up what comes loose;
             (Role::Attacker, Some((bx, _))) if p.support != 0.0 => {
@@ -276,7 +275,7 @@ impl IsocrobBrain {
             }
             _ => {}
         }
-        let rp = (me_m.x - home.0).hypot(me_m.y - home.1) <= p.reached;
+        let rp = (me.x - home.0).hypot(me.y - home.1) <= p.reached;
         // r(360): the heading turned since the search began.
         let rotated = match (self.attacker.state(), &mut self.search) {
             (AttackerState::SearchBall, Some((last, turned))) => {
@@ -323,9 +322,9 @@ impl IsocrobBrain {
             // With `orbit` 0: straight to the posture, facing the goal, stepping round the
             // ball when on its wrong side.
             AttackerState::FaceGoal => {
-                let behind = field.behind_ball(ball_at, millimetres(p.behind));
+                let behind = field.behind_ball(ball_at, p.behind);
                 let (to, face) = if p.orbit > 0.0 {
-                    (Geometry::orbit(me, ball_at, behind, millimetres(p.orbit)), towards_ball)
+                    (Geometry::orbit(me, ball_at, behind, p.orbit), towards_ball)
                 } else {
                     (Geometry::step_round(me, ball_at, behind), behind.theta)
                 };
@@ -334,16 +333,16 @@ impl IsocrobBrain {
             // push_ball(): through the ball towards the goal; kick_ball() when the goal is
             // near enough and the ball lies before the kicker.
             AttackerState::RunAndKick => {
-                let shot = field.behind_ball(ball_at, millimetres(p.behind)).theta;
-                let through = (ball_at.0 + 200.0 * shot.cos(), ball_at.1 + 200.0 * shot.sin());
+                let shot = field.behind_ball(ball_at, p.behind).theta;
+                let through = (ball_at.0 + 0.2 * shot.cos(), ball_at.1 + 0.2 * shot.sin());
                 go(me, through, shot, &mut c);
-                let goal = metres((field.half_length - me.x).hypot(me.y));
+                let goal = (field.half_length - me.x).hypot(me.y);
                 let lined_up = normalize_angle(me.theta - shot).abs() < p.facing;
                 // One request a kick: none while the valve is open.
                 let idle = self.pulse_from.is_none();
                 // The kicker reaches the ball only when it touches the robot's front: a pulse
                 // fired at a ball farther away misses it, and the solenoid then recharges.
-                let reach = metres(ball.rho) <= p.kick_reach;
+                let reach = ball.rho <= p.kick_reach;
                 if idle && goal <= p.kick_distance && reach && ball.theta.abs() < 0.3 && lined_up {
                     self.post("local.var.kicker.kick", true);
                 }
@@ -361,15 +360,12 @@ impl IsocrobBrain {
 
     fn goalkeeper(&mut self, w: &WorldSnapshot, p: &Params) -> RobotCommand {
         let ball = w.lps[lps::BALL];
-        let me = w.my_pos.pose;
-        let hl = metres(w.field.half_length);
-        let seen = (ball.reliability > 0.0).then(|| {
-            let (x, y) = Geometry::ball_at(me, &ball);
-            KeeperBall {
-                at: (metres(x), metres(y)),
-                velocity: (metres(w.ball_vel.x), metres(w.ball_vel.y)),
-                seen_ago: ball.seen_ago,
-            }
+        let me = w.my_pos.pose.inner;
+        let hl = w.field.half_length;
+        let seen = (ball.reliability > 0.0).then(|| KeeperBall {
+            at: Geometry::ball_at(me, &ball),
+            velocity: (w.ball_vel.inner.x, w.ball_vel.inner.y),
+            seen_ago: ball.seen_ago,
         });
         let (mode, y) = keeper(seen, hl, &p.keeper);
         self.post("local.var.machine.state", mode.name());
@@ -425,14 +421,14 @@ mod tests {
     use mrt_msgs::robot::Lpo;
     use std::sync::Arc;
 
-    /// A playing robot at `me` (team frame, mm) that sees the ball at `ball` (mm), at `time`.
+    /// A playing robot at `me` (team frame, m) that sees the ball at `ball` (m), at `time`.
     fn world(time: f64, me: Pose2, ball: (f64, f64)) -> WorldSnapshot {
         let mut w = WorldSnapshot {
             game_state: GameState::Playing,
             time: Time::from_secs_f64(time),
             ..WorldSnapshot::default()
         };
-        w.my_pos.pose = me;
+        w.my_pos.pose = Framed::new(me);
         w.my_pos.quality = 0.9;
         let lpo = |(x, y): (f64, f64)| {
             let (dx, dy) = (x - me.x, y - me.y);
@@ -452,15 +448,15 @@ mod tests {
     /// team believes it is, then up the field; never at the stale, dead-reckoned LPS ball.
     #[test]
     fn a_robot_looks_at_the_ball_it_saw_then_the_team_ball_then_up_the_field() {
-        let me = Pose2::new(-8600.0, 0.0, 1.8);
-        let mut w = world(10.0, me, (-6600.0, 2000.0));
+        let me = Pose2::new(-8.6, 0.0, 1.8);
+        let mut w = world(10.0, me, (-6.6, 2.0));
         let at_ball = std::f64::consts::FRAC_PI_4; // (−6.6, 2) from (−8.6, 0): 45°
         assert!((normalize_angle(look_at_ball(&w, 0.8)) - at_ball).abs() < 1e-9);
         // Not seen for 5 s: the LPS ball turned with the robot and says "straight ahead".
-        w.lps[lps::BALL] = Lpo { rho: 1050.0, theta: -0.01, reliability: 0.01, seen_ago: 5.0 };
+        w.lps[lps::BALL] = Lpo { rho: 1.05, theta: -0.01, reliability: 0.01, seen_ago: 5.0 };
         assert_eq!(look_at_ball(&w, 0.8), 0.0, "no team ball: up the field");
         w.global_ball.quality = 0.5;
-        w.global_ball.pose = Pose2::new(-4600.0, -4000.0, 0.0);
+        w.global_ball.pose = Framed::new(Pose2::new(-4.6, -4.0, 0.0));
         let team = -std::f64::consts::FRAC_PI_4;
         assert!((look_at_ball(&w, 0.8) - team).abs() < 1e-9, "towards the team ball");
     }
@@ -479,7 +475,7 @@ mod tests {
         let (out2, out3) = (bb2.outbox(), bb3.outbox());
         let mut r2 = IsocrobBrain::new(2, Role::Attacker, 1, bb2.clone()).unwrap();
         let mut r3 = IsocrobBrain::new(3, Role::Attacker, 2, bb3.clone()).unwrap();
-        let (me2, me3) = (Pose2::new(-2000.0, 1000.0, 0.0), Pose2::new(-2000.0, -1500.0, 0.0));
+        let (me2, me3) = (Pose2::new(-2.0, 1.0, 0.0), Pose2::new(-2.0, -1.5, 0.0));
         let mut cycle = |t: f64, ball: (f64, f64)| {
             clock.set(Time::from_secs_f64(t));
             r2.cycle(&world(t, me2, ball));
@@ -491,20 +487,20 @@ mod tests {
         };
         // The ball 1.1 m before robot 2, 3.3 m from robot 3. In the first cycle each hears
         // nobody yet and goes; from the second, robot 3 knows it is the farther.
-        cycle(0.0, (-900.0, 1000.0));
-        let (s2, s3) = cycle(0.1, (-900.0, 1000.0));
+        cycle(0.0, (-0.9, 1.0));
+        let (s2, s3) = cycle(0.1, (-0.9, 1.0));
         assert_eq!((s2, s3), (AttackerState::ApproachBall, AttackerState::ShouldIGo));
         // Eq 19: 1.1 m, less k₁ = 0.5 m for facing the opponent's goal.
         let h2 = bb3.get::<f64>("*.var.machine.heuristic.2").unwrap();
         assert!((h2 - 0.6).abs() < 1e-9, "{h2}");
         assert_eq!(bb3.get::<bool>("local.var.machine.slg"), Ok(false));
         // The ball rolls to robot 3's side.
-        cycle(0.2, (-900.0, -1500.0));
-        let (s2, s3) = cycle(0.3, (-900.0, -1500.0));
+        cycle(0.2, (-0.9, -1.5));
+        let (s2, s3) = cycle(0.3, (-0.9, -1.5));
         assert_eq!((s2, s3), (AttackerState::ShouldIGo, AttackerState::ApproachBall));
         // A teammate not heard for longer than `heard` (1 s) is not a rival.
         clock.set(Time::from_secs_f64(2.0));
-        r2.cycle(&world(2.0, me2, (-900.0, -1500.0)));
+        r2.cycle(&world(2.0, me2, (-0.9, -1.5)));
         assert_eq!(r2.state(), AttackerState::ApproachBall);
     }
 
@@ -534,8 +530,8 @@ mod tests {
     fn an_attacker_lined_up_before_the_goal_kicks() {
         let clock = Arc::new(SimClock::new());
         let mut r = IsocrobBrain::new(2, Role::Attacker, 1, board(2, &clock)).unwrap();
-        let me = Pose2::new(7000.0, 0.0, 0.0);
-        let w = world(0.0, me, (7350.0, 0.0));
+        let me = Pose2::new(7.0, 0.0, 0.0);
+        let w = world(0.0, me, (7.35, 0.0));
         r.cycle(&w); // APPROACH_BALL → FACE_GOAL (near, before it)
         r.cycle(&w); // FACE_GOAL → RUN_AND_KICK (facing the goal)
         assert_eq!(r.state(), AttackerState::RunAndKick);
@@ -566,15 +562,15 @@ mod tests {
     #[test]
     fn an_attacker_kicks_only_a_ball_within_the_kickers_reach() {
         let mut r = attacker_with("kick-reach", 0.45);
-        let me = Pose2::new(7000.0, 0.0, 0.0);
-        let far = world(0.0, me, (7650.0, 0.0));
+        let me = Pose2::new(7.0, 0.0, 0.0);
+        let far = world(0.0, me, (7.65, 0.0));
         r.cycle(&far); // APPROACH_BALL → FACE_GOAL (near, before it)
         r.cycle(&far); // FACE_GOAL → RUN_AND_KICK (facing the goal)
         assert_eq!(r.state(), AttackerState::RunAndKick);
         let c = r.cycle(&far);
         assert_eq!((c.kick, r.state()), (None, AttackerState::RunAndKick), "{c:?}");
         assert!(c.twist.vx > 0.0, "pushes on: {c:?}");
-        let c = r.cycle(&world(0.1, me, (7400.0, 0.0)));
+        let c = r.cycle(&world(0.1, me, (7.4, 0.0)));
         assert_eq!(c.kick, Some(1), "within reach: {c:?}");
     }
 
@@ -586,10 +582,10 @@ mod tests {
         let mut r = attacker_with("orbit", 0.6);
         // The ball 0.6 m to the robot's left; the robot faces up the field, the goal ahead.
         let me = Pose2::new(0.0, 0.0, 0.0);
-        let w = world(0.0, me, (0.0, 600.0));
+        let w = world(0.0, me, (0.0, 0.6));
         r.cycle(&w); // APPROACH_BALL: not yet before it, so no FACE_GOAL
         let mut w = w;
-        w.my_pos.pose.theta = std::f64::consts::FRAC_PI_2;
+        w.my_pos.pose.inner.theta = std::f64::consts::FRAC_PI_2;
         w.lps[lps::BALL].theta = 0.0;
         w.lps[lps::NET1].theta -= std::f64::consts::FRAC_PI_2;
         r.cycle(&w); // facing the ball: FACE_GOAL
@@ -597,12 +593,12 @@ mod tests {
         let c = r.cycle(&w);
         assert_eq!(r.state(), AttackerState::FaceGoal);
         assert!(c.twist.omega.abs() < 1e-9, "keeps facing the ball: {c:?}");
-        // By hand: the posture is 350 mm behind the ball, at about (−349, 623) mm; the robot
-        // is at −90° about the ball and the posture at about 176°, the shorter way clockwise.
-        // The waypoint is 0.6 rad on, at −124° on the 600 mm circle: (−339, 105) mm, in the
-        // robot's frame (facing +y) 105 mm ahead and 339 mm to its left.
+        // By hand: the posture is 0.35 m behind the ball, at about (−0.349, 0.623) m; the
+        // robot is at −90° about the ball and the posture at about 176°, the shorter way
+        // clockwise. The waypoint is 0.6 rad on, at −124° on the 0.6 m circle: (−0.339,
+        // 0.105) m, in the robot's frame (facing +y) 0.105 m ahead and 0.339 m to its left.
         assert!(c.twist.vy > 0.0 && c.twist.vx > 0.0, "{c:?}");
-        assert!((c.twist.vx / c.twist.vy - 105.0 / 339.0).abs() < 0.02, "{c:?}");
+        assert!((c.twist.vx / c.twist.vy - 0.105 / 0.339).abs() < 0.02, "{c:?}");
     }
 
     /// With `ahead` 0.3 rad, FACE_GOAL hands over to RUN_AND_KICK only when the robot faces
@@ -612,7 +608,7 @@ mod tests {
     #[test]
     fn face_goal_runs_only_with_the_ball_before_the_kicker() {
         let me = Pose2::new(0.0, 0.0, 0.0);
-        let beside = (400.0 * 0.5f64.cos(), 400.0 * 0.5f64.sin());
+        let beside = (0.4 * 0.5f64.cos(), 0.4 * 0.5f64.sin());
         let mut plain = attacker_with("ahead", 0.0);
         plain.cycle(&world(0.0, me, beside)); // APPROACH_BALL → FACE_GOAL (near, within 0.6)
         plain.cycle(&world(0.1, me, beside));
@@ -621,7 +617,7 @@ mod tests {
         r.cycle(&world(0.0, me, beside));
         r.cycle(&world(0.1, me, beside));
         assert_eq!(r.state(), AttackerState::FaceGoal, "the ball beside the kicker");
-        r.cycle(&world(0.2, me, (400.0, 40.0)));
+        r.cycle(&world(0.2, me, (0.4, 0.04)));
         assert_eq!(r.state(), AttackerState::RunAndKick, "the ball before it");
     }
 
@@ -630,8 +626,8 @@ mod tests {
     fn waiting_at(role: Role, index: usize, name: &str, value: f64) -> Pose2 {
         let (mut r, bb) = robot_with(role, index, name, value);
         bb.set(&format!("{HEURISTIC}9"), -10.0).unwrap();
-        let mut w = world(0.0, Pose2::new(-1000.0, -3000.0, 0.0), (-3000.0, 3000.0));
-        w.global_ball.pose = Pose2::new(-3000.0, 3000.0, 0.0);
+        let mut w = world(0.0, Pose2::new(-1.0, -3.0, 0.0), (-3.0, 3.0));
+        w.global_ball.pose = Framed::new(Pose2::new(-3.0, 3.0, 0.0));
         w.global_ball.quality = 0.5;
         r.cycle(&w);
         let c = r.cycle(&w);
@@ -668,8 +664,8 @@ mod tests {
         let clock = Arc::new(SimClock::new());
         let bb = board(1, &clock);
         let mut r = IsocrobBrain::new(1, Role::Goalkeeper, 0, bb.clone()).unwrap();
-        let me = Pose2::new(-8600.0, 0.0, 0.0);
-        let c = r.cycle(&world(0.0, me, (-5000.0, 500.0)));
+        let me = Pose2::new(-8.6, 0.0, 0.0);
+        let c = r.cycle(&world(0.0, me, (-5.0, 0.5)));
         let t = c.target.unwrap().pose.inner;
         assert!((t.x + 8.6).abs() < 1e-9 && (t.y - 0.5).abs() < 1e-9, "{t:?}");
         assert_eq!(bb.get::<String>("local.var.machine.state").unwrap(), "FOLLOW");

@@ -12,7 +12,7 @@
 //! old. Meanwhile it drives in position mode towards a point [`LOOKAHEAD`] ahead on the path
 //! ([`carrot`]), with the sonars halting the robot as in velocity mode.
 
-use mrt_core::frames::{metres, point_in_metres, pose_in_metres, Framed, Team};
+use mrt_core::frames::{Framed, Team};
 use mrt_core::{Point2, Pose2};
 use mrt_dcdt::{Context, Inputs, Member, MemberError, MsgRef, RequestType};
 use mrt_msgs::{PlanRequest, PlannedPath, WorldSnapshot};
@@ -54,8 +54,7 @@ impl Planner {
 
     /// SPIKE on the field the world snapshot names (made again when the field changes).
     fn spike(&mut self, field: &mrt_msgs::Field) -> Result<&Spike, PlanError> {
-        // The world snapshot's millimetres (what behaviors read) to SI.
-        let size = (metres(2.0 * field.half_length), metres(2.0 * field.half_width));
+        let size = (2.0 * field.half_length, 2.0 * field.half_width);
         let current = match self.spike.take() {
             Some((s, spike)) if s == size => (s, spike),
             _ => (size, Spike::new(PlanMap::soccer_field(size.0, size.1)?, self.params)?),
@@ -70,9 +69,9 @@ impl Planner {
             .robots
             .iter()
             .filter(|r| r.reliability >= PLAN_RELIABILITY)
-            .map(|r| Shape::Disc { centre: point_in_metres(Point2::new(r.x, r.y)), radius })
+            .map(|r| Shape::Disc { centre: r.at.inner, radius })
             .collect();
-        let from = pose_in_metres(w.my_pos.pose).position();
+        let from = w.my_pos.pose.inner.position();
         let planned =
             self.spike(&w.field).and_then(|s| s.plan_among(from, to.inner.position(), &moving));
         match planned {
@@ -179,15 +178,10 @@ mod tests {
     fn the_planner_goes_round_an_anchored_robot() {
         let mut planner = Planner::new(0, 0.25);
         let mut w = WorldSnapshot::default();
-        w.field.half_length = 9000.0;
-        w.field.half_width = 6000.0;
-        w.my_pos.pose = Pose2::new(-3000.0, 0.0, 0.0);
-        w.robots.push(mrt_msgs::AnchoredRobot {
-            x: 0.0,
-            y: 0.0,
-            reliability: 0.9,
-            ..Default::default()
-        });
+        w.field.half_length = 9.0;
+        w.field.half_width = 6.0;
+        w.my_pos.pose = at(-3.0, 0.0, 0.0);
+        w.robots.push(mrt_msgs::AnchoredRobot { reliability: 0.9, ..Default::default() });
         let path = planner.plan(&w, at(3.0, 0.0, 1.0));
         assert!(path.error.is_empty(), "{path:?}");
         assert!(path.length > 6.0 && path.length < 6.5, "{}", path.length);

@@ -128,7 +128,7 @@ mod tests {
             .map(|k| {
                 let mut w = WorldSnapshot { game_state: GameState::Playing, ..Default::default() };
                 w.lps[lps::BALL] = Lpo {
-                    rho: 500.0 + 300.0 * f64::from(k),
+                    rho: 0.5 + 0.3 * f64::from(k),
                     theta: 0.2 * f64::from(k) - 0.5,
                     reliability: 1.0,
                     seen_ago: 0.0,

@@ -22,8 +22,8 @@ const DIR: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../behaviors/teamchao
 /// The ball 2 m ahead, the opponent's net far behind it: the Attacker sits in GoToBall.
 fn world() -> WorldSnapshot {
     let mut w = WorldSnapshot { time: Time::from_millis(100), ..Default::default() };
-    w.lps[lps::BALL] = Lpo { rho: 2000.0, theta: 0.05, reliability: 0.9, seen_ago: 0.0 };
-    w.lps[lps::NET1] = Lpo { rho: 6000.0, theta: 0.1, reliability: 0.8, seen_ago: 0.0 };
+    w.lps[lps::BALL] = Lpo { rho: 2.0, theta: 0.05, reliability: 0.9, seen_ago: 0.0 };
+    w.lps[lps::NET1] = Lpo { rho: 6.0, theta: 0.1, reliability: 0.8, seen_ago: 0.0 };
     w.my_pos.quality = 0.9;
     w
 }

@@ -14,7 +14,7 @@
 use crate::runtime::LuaRuntime;
 use crate::script::ScriptError;
 use mlua::{Lua, LuaString, Table, Value};
-use mrt_core::frames::{metres, millis, pose_in_metres, pose_in_millimetres, Framed};
+use mrt_core::frames::{metres, millimetres, millis, pose_in_metres, pose_in_millimetres, Framed};
 use mrt_core::Time;
 use mrt_msgs::robot::{lps, RobotCommand, WorldSnapshot};
 use std::cell::RefCell;
@@ -209,13 +209,13 @@ impl Keys {
 /// reliability, seen_ago}` (team frame mm, mm/s; robot frame mm, rad).
 fn robot_table(lua: &Lua, keys: &Keys, r: &mrt_msgs::AnchoredRobot) -> mlua::Result<Table> {
     let t = lua.create_table_with_capacity(0, 11)?;
-    keys.fill_pose(&t, r.x, r.y, None, None)?;
+    keys.fill_pose(&t, millimetres(r.at.inner.x), millimetres(r.at.inner.y), None, None)?;
     t.raw_set("id", r.id)?;
     t.raw_set("class", r.class.name())?;
-    t.raw_set("vx", r.vx)?;
-    t.raw_set("vy", r.vy)?;
-    t.raw_set("sigma", r.sigma)?;
-    t.raw_set(&keys.rho, r.rho)?;
+    t.raw_set("vx", millimetres(r.velocity.inner.x))?;
+    t.raw_set("vy", millimetres(r.velocity.inner.y))?;
+    t.raw_set("sigma", millimetres(r.at_sigma))?;
+    t.raw_set(&keys.rho, millimetres(r.rho))?;
     t.raw_set(&keys.theta, r.theta)?;
     t.raw_set(&keys.reliability, r.reliability)?;
     t.raw_set(&keys.seen_ago, r.seen_ago)?;
@@ -287,7 +287,7 @@ fn install_inner(lua: &Lua, io: Rc<RefCell<RobotIo>>, memory_limit: usize) -> ml
         let io = io.borrow();
         lpos[i].get(lua, io.generation, |t| {
             let o = io.world.lps.get(i).copied().unwrap_or_default();
-            t.raw_set(&keys.rho, o.rho)?;
+            t.raw_set(&keys.rho, millimetres(o.rho))?;
             t.raw_set(&keys.theta, o.theta)?;
             t.raw_set(&keys.reliability, o.reliability)?;
             t.raw_set(&keys.seen_ago, o.seen_ago)
@@ -298,17 +298,17 @@ fn install_inner(lua: &Lua, io: Rc<RefCell<RobotIo>>, memory_limit: usize) -> ml
     func!("gsGetMyPos", io, |lua, (): ()| {
         let keys = &k;
         let io = io.borrow();
-        let p = io.world.my_pos;
-        my_pos.get(lua, io.generation, |t| {
-            keys.fill_pose(t, p.pose.x, p.pose.y, Some(p.pose.theta), Some(p.quality))
-        })
+        let (p, quality) =
+            (pose_in_millimetres(io.world.my_pos.pose.inner), io.world.my_pos.quality);
+        my_pos
+            .get(lua, io.generation, |t| keys.fill_pose(t, p.x, p.y, Some(p.theta), Some(quality)))
     });
     let ball_vel = CycleTable::default();
     let k = keys.clone();
     func!("getBallVel", io, |lua, (): ()| {
         let keys = &k;
         let io = io.borrow();
-        let v = io.world.ball_vel;
+        let v = io.world.ball_vel.inner.map(millimetres);
         ball_vel.get(lua, io.generation, |t| keys.fill_pose(t, v.x, v.y, None, None))
     });
     let field = CycleTable::default();
@@ -316,10 +316,10 @@ fn install_inner(lua: &Lua, io: Rc<RefCell<RobotIo>>, memory_limit: usize) -> ml
         let io = io.borrow();
         let f = io.world.field;
         field.get(lua, io.generation, |t| {
-            t.raw_set("half_length", f.half_length)?;
-            t.raw_set("half_width", f.half_width)?;
-            t.raw_set("goal_half_width", f.goal_half_width)?;
-            t.raw_set("penalty_area_depth", f.penalty_area_depth)
+            t.raw_set("half_length", millimetres(f.half_length))?;
+            t.raw_set("half_width", millimetres(f.half_width))?;
+            t.raw_set("goal_half_width", millimetres(f.goal_half_width))?;
+            t.raw_set("penalty_area_depth", millimetres(f.penalty_area_depth))
         })
     });
     let global_ball = CycleTable::default();
@@ -327,10 +327,9 @@ fn install_inner(lua: &Lua, io: Rc<RefCell<RobotIo>>, memory_limit: usize) -> ml
     func!("getGlobalBall", io, |lua, (): ()| {
         let keys = &k;
         let io = io.borrow();
-        let b = io.world.global_ball;
-        global_ball.get(lua, io.generation, |t| {
-            keys.fill_pose(t, b.pose.x, b.pose.y, None, Some(b.quality))
-        })
+        let (b, quality) =
+            (pose_in_millimetres(io.world.global_ball.pose.inner), io.world.global_ball.quality);
+        global_ball.get(lua, io.generation, |t| keys.fill_pose(t, b.x, b.y, None, Some(quality)))
     });
     let k = keys.clone();
     // Role negotiation asks for the mates several times a cycle: one list per cycle.
@@ -342,13 +341,8 @@ fn install_inner(lua: &Lua, io: Rc<RefCell<RobotIo>>, memory_limit: usize) -> ml
             t.clear()?;
             for (k, m) in io.world.mates.iter().enumerate() {
                 let e = lua.create_table_with_capacity(0, 6)?;
-                keys.fill_pose(
-                    &e,
-                    m.at.pose.x,
-                    m.at.pose.y,
-                    Some(m.at.pose.theta),
-                    Some(m.at.quality),
-                )?;
+                let p = pose_in_millimetres(m.at.pose.inner);
+                keys.fill_pose(&e, p.x, p.y, Some(p.theta), Some(m.at.quality))?;
                 e.set("id", m.id)?;
                 e.set("keeper", m.keeper)?;
                 t.raw_set(k + 1, e)?;
@@ -392,9 +386,11 @@ fn install_inner(lua: &Lua, io: Rc<RefCell<RobotIo>>, memory_limit: usize) -> ml
         let net = w.lps[lps::NET1];
         let toward = if net.reliability > 0.0 { net.theta } else { 0.0 };
         let theta = finite("getFreeDirection", theta.unwrap_or(toward))?;
-        let reach = finite("getFreeDirection", reach.unwrap_or(WorldSnapshot::FREE_REACH))?;
-        let clearance =
-            finite("getFreeDirection", clearance.unwrap_or(WorldSnapshot::FREE_CLEARANCE))?;
+        // The Lua API's millimetres to the snapshot's metres.
+        let reach = reach.map(metres).unwrap_or(WorldSnapshot::FREE_REACH);
+        let clearance = clearance.map(metres).unwrap_or(WorldSnapshot::FREE_CLEARANCE);
+        let (reach, clearance) =
+            (finite("getFreeDirection", reach)?, finite("getFreeDirection", clearance)?);
         Ok(w.free_direction(theta, reach, clearance, WorldSnapshot::ANCHORED))
     });
 

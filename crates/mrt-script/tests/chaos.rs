@@ -1,4 +1,5 @@
-//! The `chaos.*` robot API (seed 001 §3.3) and the seed's `lookball` behavior (§4.3).
+//! The `chaos.*` robot API (ThinkingCap report §3.3) and the report's `lookball` behavior
+//! (§4.3). The snapshot is in metres; the scripts read millimetres.
 
 #![allow(clippy::unwrap_used)]
 
@@ -20,7 +21,7 @@ fn setup() -> (LuaRuntime, Rc<RefCell<RobotIo>>) {
 
 fn world_with_ball(theta: f64, t_ms: u64) -> WorldSnapshot {
     let mut w = WorldSnapshot { time: Time::from_millis(t_ms), ..Default::default() };
-    w.lps[lps::BALL] = Lpo { rho: 400.0, theta, reliability: 0.9, seen_ago: 0.0 };
+    w.lps[lps::BALL] = Lpo { rho: 0.4, theta, reliability: 0.9, seen_ago: 0.0 };
     w
 }
 
@@ -59,15 +60,15 @@ fn lookball_turns_towards_where_the_ball_was_and_speeds_up_after_400_ms() {
 fn every_data_access_function_reads_the_snapshot() {
     let (rt, io) = setup();
     let mut w = world_with_ball(0.25, 42);
-    w.my_pos = Estimate { pose: Pose2::new(1000.0, -500.0, 0.5), quality: 0.8 };
-    w.global_ball = Estimate { pose: Pose2::new(2000.0, 300.0, 0.0), quality: 0.6 };
-    w.ball_vel = mrt_core::Vec2::new(100.0, -20.0);
+    w.my_pos = Estimate { pose: Framed::new(Pose2::new(1.0, -0.5, 0.5)), quality: 0.8 };
+    w.global_ball = Estimate { pose: Framed::new(Pose2::new(2.0, 0.3, 0.0)), quality: 0.6 };
+    w.ball_vel = Framed::new(mrt_core::Vec2::new(0.1, -0.02));
     w.mates = vec![Mate {
         id: 3,
-        at: Estimate { pose: Pose2::new(-100.0, 50.0, 1.0), quality: 0.5 },
+        at: Estimate { pose: Framed::new(Pose2::new(-0.1, 0.05, 1.0)), quality: 0.5 },
         keeper: true,
     }];
-    w.field.half_length = 6000.0;
+    w.field.half_length = 6.0;
     w.role = "attacker".into();
     w.ball_booked = true;
     w.game_state = GameState::Playing;
@@ -99,22 +100,21 @@ fn behaviors_read_the_anchored_robots_the_nearest_opponent_and_a_free_direction(
     let mut w = world_with_ball(0.0, 100);
     // The opponent's net straight ahead; a teammate 0.8 m ahead in the way, an opponent 1.5 m
     // away on the left at 40°, and an old robot of unknown team behind.
-    w.lps[lps::NET1] = Lpo { rho: 5000.0, theta: 0.0, reliability: 1.0, seen_ago: 0.0 };
+    w.lps[lps::NET1] = Lpo { rho: 5.0, theta: 0.0, reliability: 1.0, seen_ago: 0.0 };
     let robot = |id, class, rho: f64, theta: f64, reliability| AnchoredRobot {
         id,
         class,
-        x: rho * f64::cos(theta),
-        y: rho * f64::sin(theta),
+        at: Framed::new(mrt_core::Point2::new(rho * f64::cos(theta), rho * f64::sin(theta))),
         rho,
         theta,
         reliability,
-        sigma: 80.0,
+        at_sigma: 0.08,
         ..Default::default()
     };
     w.robots = vec![
-        robot(4, RobotClass::Teammate, 800.0, 0.0, 1.0),
-        robot(7, RobotClass::Opponent, 1500.0, 40f64.to_radians(), 0.9),
-        robot(9, RobotClass::Robot, 1200.0, 3.0, 0.2),
+        robot(4, RobotClass::Teammate, 0.8, 0.0, 1.0),
+        robot(7, RobotClass::Opponent, 1.5, 40f64.to_radians(), 0.9),
+        robot(9, RobotClass::Robot, 1.2, 3.0, 0.2),
     ];
     io.borrow_mut().begin_cycle(w, "probe");
     let probe = r#"

@@ -5,6 +5,7 @@
 
 #![allow(clippy::unwrap_used)]
 
+use mrt_core::frames::metres;
 use mrt_core::Time;
 use mrt_fuzzy::hbm::Defuzzification;
 use mrt_msgs::robot::{lps, Lpo, RobotCommand, WorldSnapshot};
@@ -97,10 +98,10 @@ fn run(
     Ok(io.borrow().command.clone())
 }
 
-/// A world with the ball at `rho` mm straight ahead.
+/// A world with the ball at `rho` mm (the behaviors' unit) straight ahead.
 fn ball_at(rho: f64, t_ms: u64) -> WorldSnapshot {
     let mut w = WorldSnapshot { time: Time::from_millis(t_ms), ..Default::default() };
-    w.lps[lps::BALL] = Lpo { rho, theta: 0.0, reliability: 0.9, seen_ago: 0.0 };
+    w.lps[lps::BALL] = Lpo { rho: metres(rho), theta: 0.0, reliability: 0.9, seen_ago: 0.0 };
     w
 }
 

@@ -24,7 +24,7 @@ fn runtime() -> (LuaRuntime, Rc<RefCell<RobotIo>>) {
 
 fn world() -> WorldSnapshot {
     let mut w = WorldSnapshot::default();
-    w.lps[lps::BALL] = Lpo { rho: 900.0, theta: 0.4, reliability: 0.9, ..Lpo::default() };
+    w.lps[lps::BALL] = Lpo { rho: 0.9, theta: 0.4, reliability: 0.9, ..Lpo::default() };
     w
 }
 

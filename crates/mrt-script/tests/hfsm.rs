@@ -5,6 +5,7 @@
 
 #![allow(clippy::unwrap_used)]
 
+use mrt_core::frames::metres;
 use mrt_core::Time;
 use mrt_msgs::robot::{lps, Lpo, WorldSnapshot};
 use mrt_script::chaos::{install, GlobalValue, RobotIo};
@@ -40,7 +41,7 @@ fn load_err(source: &str) -> ScriptError {
 /// A world at `t_ms` with the ball at `rho` mm straight ahead.
 fn world(t_ms: u64, rho: f64) -> WorldSnapshot {
     let mut w = WorldSnapshot { time: Time::from_millis(t_ms), ..Default::default() };
-    w.lps[lps::BALL] = Lpo { rho, theta: 0.0, reliability: 0.9, seen_ago: 0.0 };
+    w.lps[lps::BALL] = Lpo { rho: metres(rho), theta: 0.0, reliability: 0.9, seen_ago: 0.0 };
     w
 }
 

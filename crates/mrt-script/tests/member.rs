@@ -18,7 +18,7 @@ impl Member for World {
     fn do_your_job(&mut self, ctx: &mut Context<'_>) -> Result<(), MemberError> {
         let mut w = WorldSnapshot { time: ctx.now(), ..Default::default() };
         let theta = if ctx.now().as_secs_f64() < 1.0 { 0.0 } else { 1.2 };
-        w.lps[lps::BALL] = Lpo { rho: 2000.0, theta, reliability: 0.9, seen_ago: 0.0 };
+        w.lps[lps::BALL] = Lpo { rho: 2.0, theta, reliability: 0.9, seen_ago: 0.0 };
         ctx.publish(w);
         Ok(())
     }

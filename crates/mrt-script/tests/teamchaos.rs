@@ -12,7 +12,7 @@
 
 #![allow(clippy::unwrap_used)]
 
-use mrt_core::frames::pose_in_millimetres;
+use mrt_core::frames::{metres, pose_in_metres, pose_in_millimetres, Framed};
 use mrt_core::{Pose2, Time};
 use mrt_msgs::robot::{lps, Estimate, GameState, Lpo, WorldSnapshot};
 use mrt_script::{Cycle, Sandbox, ScriptError, ThinkingCap};
@@ -33,7 +33,8 @@ fn dir() -> PathBuf {
 }
 
 /// A scripted world: by default nothing seen, the robot at the centre spot facing the
-/// opponent's net and well localized (quality 0.9).
+/// opponent's net and well localized (quality 0.9). Its builders take the behaviors' units
+/// (mm, rad), as the scripts read them, and keep the snapshot's metres.
 #[derive(Clone)]
 struct World(WorldSnapshot);
 
@@ -46,19 +47,19 @@ impl World {
 
     /// The ball seen at `rho` mm, bearing `theta` rad (left positive).
     fn ball(mut self, rho: f64, theta: f64) -> World {
-        self.0.lps[lps::BALL] = Lpo { rho, theta, reliability: 0.9, seen_ago: 0.0 };
+        self.0.lps[lps::BALL] = Lpo { rho: metres(rho), theta, reliability: 0.9, seen_ago: 0.0 };
         self
     }
 
     /// The ball not seen for `seen_ago` s, last at bearing `theta`.
     fn ball_lost(mut self, theta: f64, seen_ago: f64) -> World {
-        self.0.lps[lps::BALL] = Lpo { rho: 1500.0, theta, reliability: 0.0, seen_ago };
+        self.0.lps[lps::BALL] = Lpo { rho: 1.5, theta, reliability: 0.0, seen_ago };
         self
     }
 
     /// The opponent's net seen at `rho` mm, bearing `theta`.
     fn net1(mut self, rho: f64, theta: f64) -> World {
-        self.0.lps[lps::NET1] = Lpo { rho, theta, reliability: 0.9, seen_ago: 0.0 };
+        self.0.lps[lps::NET1] = Lpo { rho: metres(rho), theta, reliability: 0.9, seen_ago: 0.0 };
         self
     }
 
@@ -79,13 +80,13 @@ impl World {
 
     /// The robot's global pose (mm, mm, rad) and localization quality.
     fn me(mut self, x: f64, y: f64, theta: f64, quality: f64) -> World {
-        self.0.my_pos = Estimate { pose: Pose2::new(x, y, theta), quality };
+        self.0.my_pos = Estimate { pose: team_mm(x, y, theta), quality };
         self
     }
 
     /// A teammate at (x, y) (mm), facing the opponent's net.
     fn mate(mut self, id: u32, x: f64, y: f64, keeper: bool) -> World {
-        let at = Estimate { pose: Pose2::new(x, y, 0.0), quality: 0.9 };
+        let at = Estimate { pose: team_mm(x, y, 0.0), quality: 0.9 };
         self.0.mates.push(mrt_msgs::robot::Mate { id, at, keeper });
         self
     }
@@ -98,9 +99,14 @@ impl World {
 
     /// The ball's global position, quality 0.9.
     fn global_ball(mut self, x: f64, y: f64) -> World {
-        self.0.global_ball = Estimate { pose: Pose2::new(x, y, 0.0), quality: 0.9 };
+        self.0.global_ball = Estimate { pose: team_mm(x, y, 0.0), quality: 0.9 };
         self
     }
+}
+
+/// A team-frame pose given in the behaviors' millimetres.
+fn team_mm(x: f64, y: f64, theta: f64) -> Framed<mrt_core::frames::Team, Pose2> {
+    Framed::new(pose_in_metres(Pose2::new(x, y, theta)))
 }
 
 fn cap(behavior: &str) -> ThinkingCap {
@@ -343,17 +349,16 @@ fn alignbnet1_aims_at_the_side_of_the_net_away_from_its_keeper() {
     use mrt_msgs::{AnchoredRobot, RobotClass};
     let w = World::at(0).me(0.0, 0.0, 0.0, 0.9).ball(400.0, 0.0).net1(9000.0, 0.0);
     close(run("alignbnet1", w.clone()).command.vlat(), 0.0);
-    let (x, y) = (8700.0f64, 500.0f64);
+    let (x, y) = (8.7f64, 0.5f64);
     let mut guarded = w;
     guarded.0.robots.push(AnchoredRobot {
         id: 5,
         class: RobotClass::Opponent,
-        x,
-        y,
+        at: Framed::new(mrt_core::Point2::new(x, y)),
         rho: x.hypot(y),
         theta: y.atan2(x),
         reliability: 0.9,
-        sigma: 80.0,
+        at_sigma: 0.08,
         ..Default::default()
     });
     let c = run("alignbnet1", guarded);
@@ -768,7 +773,7 @@ fn an_hfsm_naming_an_unknown_behavior_keeps_the_last_good_one_running() {
 fn the_heap_stays_small_over_many_cycles() {
     let mut cap = ThinkingCap::with_behavior(dir(), "gkcutb", Sandbox::default()).unwrap();
     let mut w = WorldSnapshot { time: Time::from_millis(100), ..Default::default() };
-    w.lps[lps::BALL] = Lpo { rho: 2000.0, theta: 0.05, reliability: 0.9, seen_ago: 0.0 };
+    w.lps[lps::BALL] = Lpo { rho: 2.0, theta: 0.05, reliability: 0.9, seen_ago: 0.0 };
     let mut peak = 0;
     for _ in 0..20_000 {
         let c = cap.cycle(w.clone());
@@ -796,7 +801,7 @@ fn a_runaway_hfsm_gets_the_safe_command_for_that_cycle() {
     let sandbox = Sandbox { instruction_budget: 200_000, ..Sandbox::default() };
     let mut cap = ThinkingCap::with_hfsm(&scratch, &machine, sandbox).unwrap();
     let mut w = WorldSnapshot { game_state: GameState::Playing, ..Default::default() };
-    w.lps[lps::BALL] = Lpo { rho: 2000.0, theta: 0.0, reliability: 0.9, seen_ago: 0.0 };
+    w.lps[lps::BALL] = Lpo { rho: 2.0, theta: 0.0, reliability: 0.9, seen_ago: 0.0 };
     let walking = cap.cycle(w.clone());
     assert!(walking.errors.is_empty() && walking.command.vlin() > 200.0, "{walking:?}");
     let stuck = cap.cycle(WorldSnapshot { game_state: GameState::Finished, ..w.clone() });
@@ -1039,7 +1044,7 @@ fn the_supporter_stays_out_of_our_goal_mouth() {
 fn the_behaviors_play_on_the_field_the_world_model_describes() {
     let w = World::at(0).me(-6050.0, 0.0, 0.0, 0.9).ball(2000.0, 0.0).global_ball(-4000.0, 0.0);
     let mut small = w.clone();
-    small.0.field.half_length = 6000.0;
+    small.0.field.half_length = 6.0;
     let on_small = run("goalkeeper", small);
     let on_default = run("goalkeeper", w);
     assert!(on_small.command.vrot() > 20.0 && on_small.command.need(lps::NET1) > 0.7);

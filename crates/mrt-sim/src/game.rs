@@ -12,7 +12,7 @@ use crate::referee::{Call, Referee, Team};
 use crate::render::{CameraState, Renderer, Scene};
 use crate::sensor::{self, sonar_ring, Odometer};
 use crate::world::World;
-use mrt_core::frames::{millimetres, MM_PER_M};
+use mrt_core::frames::{millimetres, Attack};
 use mrt_core::Twist;
 use mrt_core::{normalize_angle, Pose2};
 use mrt_msgs::robot::GameState;
@@ -440,7 +440,7 @@ impl Pitch {
         }
     }
 
-    /// Books the robots robot `i`'s world snapshot anchored (team frame, mm) against where
+    /// Books the robots robot `i`'s world snapshot anchored (team frame) against where
     /// the other robots are now ([`RobotErrors`]); anchors not seen in this frame are left out.
     pub fn book_robots(&mut self, i: usize, robots: &[AnchoredRobot]) {
         let mine = self.referee.team_of(i);
@@ -459,7 +459,10 @@ impl Pitch {
             .take_while(|b| b.time >= now)
             .find(|b| b.robot == i)
             .filter(|_| self.record);
-        let field = |r: &AnchoredRobot| (attack * r.x / MM_PER_M, attack * r.y / MM_PER_M);
+        let field = |r: &AnchoredRobot| {
+            let p = r.at.to_field(Attack::from_direction(attack)).inner;
+            (p.x, p.y)
+        };
         if let Some(b) = sample {
             b.anchors =
                 robots.iter().filter(|r| r.seen_ago <= 0.0).map(|r| (field(r), r.class)).collect();

@@ -52,7 +52,7 @@ fn bench(c: &mut Criterion) {
     let players: Vec<Player> = (0..5)
         .map(|k| Player {
             id: k + 1,
-            at: (f64::from(k) * 1000.0 - 4000.0, 500.0),
+            at: (f64::from(k) - 4.0, 0.5),
             keeper: k == 0,
             said: if k == 2 { Role::Attacker } else { Role::Defender },
         })
@@ -62,16 +62,15 @@ fn bench(c: &mut Criterion) {
     });
     // SCARE: five robots of Team Milan with the ball ahead, a blocking opponent and an open
     // mate (so that the PassageToMate schema is on the agenda and covered).
-    let pos =
-        [(-8500.0, 0.0), (-1500.0, 0.0), (2000.0, 2000.0), (-4000.0, -1000.0), (-2000.0, 2500.0)];
+    let pos = [(-8.5, 0.0), (-1.5, 0.0), (2.0, 2.0), (-4.0, -1.0), (-2.0, 2.5)];
     let situation = |i: usize| Situation {
         me: (pos[i].0, pos[i].1, 0.0),
         keeper: i == 0,
-        ball: Some((-1000.0, 0.0)),
+        ball: Some((-1.0, 0.0)),
         mates: (0..5).filter(|j| *j != i).map(|j| (j as u32 + 1, pos[j], j == 0)).collect(),
-        opponents: vec![(-200.0, 0.0), (4000.0, -2500.0), (-3000.0, 3000.0)],
-        half_length: 9000.0,
-        goal_half_width: 1000.0,
+        opponents: vec![(-0.2, 0.0), (4.0, -2.5), (-3.0, 3.0)],
+        half_length: 9.0,
+        goal_half_width: 1.0,
     };
     let t = table();
     let agents: Vec<Agent> =

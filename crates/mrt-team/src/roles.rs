@@ -1,4 +1,4 @@
-//! The roles a team agrees on (TeamChaos seed `001` §3.3: `getRole`, "implemented with a
+//! The roles a team agrees on (ThinkingCap report §3.3: `getRole`, "implemented with a
 //! dynamic role allocation method", Agüero et al. 2006a, not retrieved; figure 8's roles).
 //!
 //! Every robot runs [`allocate`] on the same shared data, so every robot that heard the same
@@ -20,16 +20,16 @@
 //! use mrt_team::roles::{allocate, Player, Role};
 //!
 //! let players = [
-//!     Player { id: 1, at: (-8500.0, 0.0), keeper: true, said: Role::Goalkeeper },
-//!     Player { id: 2, at: (-1000.0, 300.0), keeper: false, said: Role::Defender },
-//!     Player { id: 3, at: (-3000.0, 0.0), keeper: false, said: Role::Attacker },
-//!     Player { id: 4, at: (-6000.0, 0.0), keeper: false, said: Role::Supporter },
+//!     Player { id: 1, at: (-8.5, 0.0), keeper: true, said: Role::Goalkeeper },
+//!     Player { id: 2, at: (-1.0, 0.3), keeper: false, said: Role::Defender },
+//!     Player { id: 3, at: (-3.0, 0.0), keeper: false, said: Role::Attacker },
+//!     Player { id: 4, at: (-6.0, 0.0), keeper: false, said: Role::Supporter },
 //! ];
-//! let roles = allocate(&players, Some((-1200.0, 0.0)));
+//! let roles = allocate(&players, Some((-1.2, 0.0)));
 //! assert_eq!(roles, vec![(1, Role::Goalkeeper), (2, Role::Attacker), (3, Role::Supporter), (4, Role::Defender)]);
 //! ```
 
-/// A role in the team (seed `001`, figure 8).
+/// A role in the team (ThinkingCap report, figure 8).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub enum Role {
     /// Keeps goal.
@@ -61,15 +61,15 @@ impl Role {
     }
 }
 
-/// How much nearer the ball the robot that says it is the attacker counts, mm.
-pub const ROLE_HOLD: f64 = 400.0;
+/// How much nearer the ball the robot that says it is the attacker counts, m.
+pub const ROLE_HOLD: f64 = 0.4;
 
 /// One robot as the allocation sees it.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Player {
     /// Its number.
     pub id: u32,
-    /// Where it is (team frame, mm).
+    /// Where it is (team frame, m).
     pub at: (f64, f64),
     /// Whether it keeps goal.
     pub keeper: bool,
@@ -127,14 +127,14 @@ mod tests {
 
     #[test]
     fn the_attacker_keeps_its_role_until_another_is_nearer_by_the_hold() {
-        // Ball at the origin; robot 2 attacks from 1000 mm, robot 3 comes to 700 mm.
-        let near = [p(2, 1000.0, 0.0, Role::Attacker), p(3, 0.0, 700.0, Role::Supporter)];
+        // Ball at the origin; robot 2 attacks from 1 m, robot 3 comes to 0.7 m.
+        let near = [p(2, 1.0, 0.0, Role::Attacker), p(3, 0.0, 0.7, Role::Supporter)];
         assert_eq!(
             allocate(&near, Some((0.0, 0.0))),
             vec![(2, Role::Attacker), (3, Role::Supporter)]
         );
-        // At 550 mm it is 450 mm nearer: more than the hold.
-        let nearer = [p(2, 1000.0, 0.0, Role::Attacker), p(3, 0.0, 550.0, Role::Supporter)];
+        // At 0.55 m it is 0.45 m nearer: more than the hold.
+        let nearer = [p(2, 1.0, 0.0, Role::Attacker), p(3, 0.0, 0.55, Role::Supporter)];
         assert_eq!(
             allocate(&nearer, Some((0.0, 0.0))),
             vec![(2, Role::Supporter), (3, Role::Attacker)]
@@ -144,10 +144,10 @@ mod tests {
     #[test]
     fn every_robot_computes_the_same_roles_whatever_order_it_lists_them_in() {
         let team = [
-            Player { id: 1, at: (-8500.0, 0.0), keeper: true, said: Role::Goalkeeper },
-            p(2, 100.0, 0.0, Role::Defender),
-            p(3, -100.0, 0.0, Role::Defender),
-            p(4, 3000.0, 0.0, Role::Defender),
+            Player { id: 1, at: (-8.5, 0.0), keeper: true, said: Role::Goalkeeper },
+            p(2, 0.1, 0.0, Role::Defender),
+            p(3, -0.1, 0.0, Role::Defender),
+            p(4, 3.0, 0.0, Role::Defender),
         ];
         let ball = Some((0.0, 0.0));
         let mut reversed = team;

@@ -17,7 +17,7 @@ use mrt_team::scare::{allocate, Agent, Params};
 use proptest::prelude::*;
 
 fn field_xy() -> impl Strategy<Value = (f64, f64)> {
-    (-9000.0..9000.0f64, -6000.0..6000.0f64)
+    (-9.0..9.0f64, -6.0..6.0f64)
 }
 
 /// Robot positions, the ball (or none), opponents.
@@ -44,8 +44,8 @@ fn situation(
         ball,
         mates: (0..pos.len()).filter(|j| *j != i).map(|j| (j as u32 + 1, pos[j], j == 0)).collect(),
         opponents: opponents.to_vec(),
-        half_length: 9000.0,
-        goal_half_width: 1000.0,
+        half_length: 9.0,
+        goal_half_width: 1.0,
     }
 }
 
@@ -98,7 +98,7 @@ proptest! {
             opportunity,
             doing,
         };
-        let sit = situation(1, &[(-8000.0, 0.0), (0.0, 0.0), (1000.0, 500.0)], Some((500.0, 0.0)), &[]);
+        let sit = situation(1, &[(-8.0, 0.0), (0.0, 0.0), (1.0, 0.5)], Some((0.5, 0.0)), &[]);
         let c = me.cycle(1.0, &sit, &[(id, &report)], 0.0);
         // This robot always gets its job.
         prop_assert!(!c.job.activity.is_empty());
@@ -110,8 +110,8 @@ proptest! {
 /// brings it; then it hears a teammate nearer the ball and hands BringBall over.
 #[test]
 fn alone_a_robot_brings_the_ball_and_hands_it_over_when_it_hears_a_nearer_mate() {
-    let pos = [(-8000.0, 0.0), (-3000.0, 0.0), (900.0, 0.0)];
-    let ball = Some((1000.0, 0.0));
+    let pos = [(-8.0, 0.0), (-3.0, 0.0), (0.9, 0.0)];
+    let ball = Some((1.0, 0.0));
     let mut two = Coordinator::new(2);
     let alone = two.cycle(0.0, &situation(1, &pos, ball, &[]), &[], 0.0);
     assert_eq!(alone.job.activity, "BringBall");
@@ -129,8 +129,8 @@ fn alone_a_robot_brings_the_ball_and_hands_it_over_when_it_hears_a_nearer_mate()
 fn a_robot_that_cannot_reach_the_ball_in_time_leaves_bringball_to_a_mate() {
     // Robot 2 is nearest, but the ball sits in front of it (it never gets behind it: the
     // robots stand still here).
-    let pos = [(-8000.0, 0.0), (2000.0, 0.0), (-4000.0, 2000.0)];
-    let ball = Some((1000.0, 0.0));
+    let pos = [(-8.0, 0.0), (2.0, 0.0), (-4.0, 2.0)];
+    let ball = Some((1.0, 0.0));
     let mut two = Coordinator::new(2);
     let mut three = Coordinator::new(3);
     let mut r3 = three.cycle(0.0, &situation(2, &pos, ball, &[]), &[], 0.0).report;
@@ -152,8 +152,8 @@ fn a_robot_that_cannot_reach_the_ball_in_time_leaves_bringball_to_a_mate() {
 /// teammates cannot take it) goes on with it at once instead of walking off to a position.
 #[test]
 fn a_robot_alone_keeps_bringball_after_a_failure() {
-    let pos = [(-8000.0, 0.0), (2000.0, 0.0)];
-    let ball = Some((1000.0, 0.0));
+    let pos = [(-8.0, 0.0), (2.0, 0.0)];
+    let ball = Some((1.0, 0.0));
     let mut two = Coordinator::new(2);
     for k in 0..300 {
         let now = f64::from(k) * 0.1;

@@ -9,7 +9,6 @@
 //! half-way line. This table exists once: the simulator computes what a camera
 //! sees from it, and the world model corrects its pose with it.
 
-use mrt_core::frames::millimetres;
 use mrt_core::{Point2, Vec2};
 use mrt_msgs::sighting::{
     EAST_NET, NE_CORNER, NORTH_HALFWAY, NW_CORNER, SE_CORNER, SOUTH_HALFWAY, SW_CORNER, WEST_NET,
@@ -210,14 +209,13 @@ impl FieldMap {
         best.filter(|b| second - b.residual.abs() >= clearance)
     }
 
-    /// The field as behaviors read it in their [`mrt_msgs::WorldSnapshot`]: half sizes in
-    /// millimetres (the unit of TeamChaos' `getField`, seed `001` §3.3).
+    /// The field as behaviors read it in their [`mrt_msgs::WorldSnapshot`]: half sizes, m.
     pub fn snapshot(&self) -> Field {
         Field {
-            half_length: self.length * 500.0,
-            half_width: self.width * 500.0,
-            goal_half_width: self.goal_width * 500.0,
-            penalty_area_depth: millimetres(self.penalty_area_depth),
+            half_length: self.length / 2.0,
+            half_width: self.width / 2.0,
+            goal_half_width: self.goal_width / 2.0,
+            penalty_area_depth: self.penalty_area_depth,
         }
     }
 }
@@ -330,11 +328,11 @@ mod tests {
     }
 
     #[test]
-    fn the_snapshot_field_is_in_millimetres() {
+    fn the_snapshot_field_is_the_maps_in_half_sizes() {
         let f = FieldMap::default().snapshot();
         assert_eq!(
             (f.half_length, f.half_width, f.goal_half_width, f.penalty_area_depth),
-            (9000.0, 6000.0, 1000.0, 2250.0)
+            (9.0, 6.0, 1.0, 2.25)
         );
         assert_eq!(f, Field::default(), "the snapshot's default field is the map's");
     }

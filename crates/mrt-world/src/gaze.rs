@@ -28,7 +28,7 @@
 //! let mut gaze = Gaze::new(GazeConfig { joint, half_fov: 0.4, dwell: 0.3 });
 //! let mut lps_now = vec![Lpo::default(); lps::COUNT];
 //! // The ball was seen 1 s ago, 0.8 rad to the left; the behaviors need it.
-//! lps_now[lps::BALL] = Lpo { rho: 2000.0, theta: 0.8, reliability: 0.5, seen_ago: 1.0 };
+//! lps_now[lps::BALL] = Lpo { rho: 2.0, theta: 0.8, reliability: 0.5, seen_ago: 1.0 };
 //! let aim = gaze.step(&[(lps::BALL, 1.0)], &lps_now, 0.1);
 //! assert_eq!(aim.object, Some(lps::BALL));
 //! assert!((aim.pan - 0.2).abs() < 1e-12, "2 rad/s for 0.1 s towards 0.8 rad");
@@ -288,7 +288,7 @@ mod tests {
             }
             for &(o, b) in &self.bearings {
                 if (b - pan).abs() <= half_fov {
-                    self.lps[o] = Lpo { rho: 2000.0, theta: b, reliability: 1.0, seen_ago: 0.0 };
+                    self.lps[o] = Lpo { rho: 2.0, theta: b, reliability: 1.0, seen_ago: 0.0 };
                 }
             }
         }
@@ -363,7 +363,7 @@ mod tests {
         let (g, mut s) = (&mut gaze(), Stand::new(&objects));
         // All were seen before, long ago (a gaze only aims at anchors it has).
         for (o, b) in objects.into_iter().skip(1) {
-            s.lps[o] = Lpo { rho: 5000.0, theta: b, reliability: 0.1, seen_ago: 9.0 };
+            s.lps[o] = Lpo { rho: 5.0, theta: b, reliability: 0.1, seen_ago: 9.0 };
         }
         let mut looks = std::collections::BTreeMap::new();
         let mut oldest = [0.0_f64; 4];
@@ -403,7 +403,7 @@ mod tests {
         let mut g = gaze();
         let mut lps_now = vec![Lpo::default(); lps::COUNT];
         // Remembered 0.5 rad to the left, but no longer there: never seen again.
-        lps_now[lps::BALL] = Lpo { rho: 1000.0, theta: 0.5, reliability: 0.6, seen_ago: 1.0 };
+        lps_now[lps::BALL] = Lpo { rho: 1.0, theta: 0.5, reliability: 0.6, seen_ago: 1.0 };
         let aims: Vec<Aim> = (0..40).map(|_| g.step(&[(lps::BALL, 1.0)], &lps_now, DT)).collect();
         let arrived = aims.iter().position(|a| (a.pan - 0.5).abs() < 1e-9).expect("turned to it");
         assert!(!aims[arrived].searching);

@@ -28,7 +28,7 @@
 //! frame.sightings[mrt_msgs::sighting::EAST_NET] = Some(Sighting { distance: 9.0, bearing: 0.0 });
 //! frame.sightings[sighting::BALL] = Some(Sighting { distance: 2.0, bearing: 0.5 });
 //! let w = model.camera(&frame);
-//! assert!((w.lps[lps::BALL].rho - 2000.0).abs() < 1e-6, "LPS distances are in mm");
+//! assert!((w.lps[lps::BALL].rho - 2.0).abs() < 1e-9, "LPS distances are in metres");
 //! assert_eq!(w.lps[lps::BALL].reliability, 1.0);
 //! assert!(w.my_pos.quality > 0.8);
 //! assert_eq!(w.game_state, GameState::Playing);

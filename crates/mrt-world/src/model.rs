@@ -36,7 +36,7 @@ use crate::relocalize::{self, CameraNoise, FrameSeen, Localizer, Relocalizer};
 use crate::track::{
     sighting_covariance, Track, TrackCounts, BALL_ACCEL, BALL_MANEUVER, BALL_TOP_SPEED,
 };
-use mrt_core::frames::{Attack, Field, Framed, Team, MM_PER_M};
+use mrt_core::frames::{Attack, Field, Framed};
 use mrt_core::{normalize_angle, Point2, Pose2, Time, Vec2};
 use mrt_msgs::robot::{lps, AnchoredRobot, Estimate, Lpo, WorldSnapshot};
 use mrt_msgs::{
@@ -930,11 +930,6 @@ impl WorldModel {
     fn snapshot(&self, frame: &CameraFrame) -> WorldSnapshot {
         let me: Framed<Field, Pose2> = Framed::new(self.pose);
         let attack = Attack::from_direction(self.game.attack);
-        // The snapshot's edge: the team frame in millimetres (TeamChaos' LPS and GS).
-        let mm = |p: Framed<Team, Point2>| (p.inner.x * MM_PER_M, p.inner.y * MM_PER_M);
-        let mm_pose = |p: Framed<Team, Pose2>| {
-            Pose2::new(p.inner.x * MM_PER_M, p.inner.y * MM_PER_M, p.inner.theta)
-        };
         let mut w = WorldSnapshot {
             time: Time::from_secs_f64(frame.time),
             game_state: self.game.state,
@@ -947,32 +942,27 @@ impl WorldModel {
                 continue;
             };
             let (range, bearing) = me.range_bearing(at);
-            *lpo = Lpo {
-                rho: range * MM_PER_M,
-                theta: bearing,
-                reliability,
-                seen_ago: frame.time - seen,
-            };
+            *lpo = Lpo { rho: range, theta: bearing, reliability, seen_ago: frame.time - seen };
         }
-        w.my_pos = Estimate { pose: mm_pose(me.to_team(attack)), quality: self.quality() };
+        w.my_pos = Estimate { pose: me.to_team(attack), quality: self.quality() };
         w.needs_localization = self.needs_localization();
         w.kickoff_pose = self.game.kickoff_pose.map(|p| p.to_team(attack));
         if let Some(Memory { at, reliability, .. }) = self.memory[lps::BALL] {
-            let (x, y) = mm(at.to_team(attack));
-            w.global_ball = Estimate { pose: Pose2::new(x, y, 0.0), quality: reliability };
+            let ball = at.to_team(attack).inner;
+            let pose = Framed::new(Pose2::new(ball.x, ball.y, 0.0));
+            w.global_ball = Estimate { pose, quality: reliability };
         }
         w.robots = self.anchored_robots(frame.time, attack);
         if let Some((vx, vy)) = self.ball_velocity {
             // The velocity turned by the estimated heading into the field frame (`observe`),
             // then into the team's.
-            let v: Framed<Field, Point2> = Framed::new(Point2::new(vx, vy));
-            let (fx, fy) = mm(v.to_team(attack));
-            w.ball_vel = Vec2::new(fx, fy);
+            let v: Framed<Field, Vec2> = Framed::new(Vec2::new(vx, vy));
+            w.ball_vel = v.to_team(attack);
         }
         w
     }
 
-    /// The anchored robots out of the find phase, in the team frame (mm), nearest first.
+    /// The anchored robots out of the find phase, in the team frame, nearest first.
     fn anchored_robots(&self, time: f64, attack: Attack) -> Vec<AnchoredRobot> {
         let me: Framed<Field, Pose2> = Framed::new(self.pose);
         let own = self.game.marker;
@@ -985,18 +975,14 @@ impl WorldModel {
                 let (x, y) = a.position(time);
                 let at: Framed<Field, Point2> = Framed::new(Point2::new(x, y));
                 let (rho, theta) = me.range_bearing(at);
-                let team = at.to_team(attack).inner;
                 let (vx, vy) = a.velocity();
-                let v = Framed::<Field, _>::new(Point2::new(vx, vy)).to_team(attack).inner;
                 AnchoredRobot {
                     id: a.id(),
                     class: a.class(own),
-                    x: team.x * MM_PER_M,
-                    y: team.y * MM_PER_M,
-                    vx: v.x * MM_PER_M,
-                    vy: v.y * MM_PER_M,
-                    sigma: a.sigma(time) * MM_PER_M,
-                    rho: rho * MM_PER_M,
+                    at: at.to_team(attack),
+                    velocity: Framed::<Field, _>::new(Vec2::new(vx, vy)).to_team(attack),
+                    at_sigma: a.sigma(time),
+                    rho,
                     theta,
                     reliability: a.reliability(time),
                     seen_ago: time - a.last_seen(),
@@ -1306,12 +1292,13 @@ mod tests {
         assert_eq!(w.robots.len(), 2, "{:?}", w.robots);
         let (mate, opponent) = (&w.robots[0], &w.robots[1]);
         assert_eq!((mate.class, opponent.class), (RobotClass::Teammate, RobotClass::Opponent));
-        // Team frame attacking west: (x, y) → (−x, −y), mm.
-        assert!((mate.x - 4000.0).abs() < 1.0 && mate.y.abs() < 1.0, "{mate:?}");
-        assert!((opponent.x - 2000.0).abs() < 1.0 && (opponent.y + 3000.0).abs() < 1.0);
-        assert!((opponent.rho - 3000.0).abs() < 1.0 && opponent.theta.abs() < 1e-6);
+        // Team frame attacking west: (x, y) → (−x, −y).
+        let (mate_at, opponent_at) = (mate.at.inner, opponent.at.inner);
+        assert!((mate_at.x - 4.0).abs() < 1e-3 && mate_at.y.abs() < 1e-3, "{mate:?}");
+        assert!((opponent_at.x - 2.0).abs() < 1e-3 && (opponent_at.y + 3.0).abs() < 1e-3);
+        assert!((opponent.rho - 3.0).abs() < 1e-3 && opponent.theta.abs() < 1e-6);
         assert_eq!((opponent.reliability, opponent.seen_ago), (1.0, 0.0));
-        assert!(opponent.sigma > 0.0 && opponent.sigma < 200.0, "{}", opponent.sigma);
+        assert!(opponent.at_sigma > 0.0 && opponent.at_sigma < 0.2, "{}", opponent.at_sigma);
         assert_eq!(w.nearest_opponent(0.5).map(|r| r.id), Some(opponent.id));
         // Unseen for a second: still there, half as reliable.
         f.time = 2.1;
@@ -1375,20 +1362,19 @@ mod tests {
         m.odometry(&Odometry::default());
         let mut objects = landmarks();
         objects.push((lps::BALL, (0.0, 2.0)));
-        // Attacking east: the team frame is the field frame (mm).
+        // Attacking east: the team frame is the field frame.
         m.game(playing(1.0));
         let w = m.camera(&frame(at, 1.0, &objects));
         assert_eq!(w.game_state, GameState::Playing, "the game controller's state");
         let ball = w.lps[lps::BALL];
-        assert!((ball.rho - 2828.427).abs() < 0.01 && (ball.theta + PI / 4.0).abs() < 1e-9);
+        assert!((ball.rho - 2.828427).abs() < 1e-5 && (ball.theta + PI / 4.0).abs() < 1e-9);
         assert_eq!((ball.reliability, ball.seen_ago), (1.0, 0.0));
         // The own net (west, (-9, 0)): 7 m on the left.
         let own = w.lps[lps::NET2];
-        assert!((own.rho - 7000.0).abs() < 0.01 && (own.theta - PI / 2.0).abs() < 1e-9);
-        assert!((w.my_pos.pose.x + 2000.0).abs() < 1e-6 && w.my_pos.pose.y.abs() < 1e-6);
-        assert!(
-            (w.global_ball.pose.x).abs() < 1e-6 && (w.global_ball.pose.y - 2000.0).abs() < 1e-6
-        );
+        assert!((own.rho - 7.0).abs() < 1e-5 && (own.theta - PI / 2.0).abs() < 1e-9);
+        let (me, ball) = (w.my_pos.pose.inner, w.global_ball.pose.inner);
+        assert!((me.x + 2.0).abs() < 1e-9 && me.y.abs() < 1e-9);
+        assert!(ball.x.abs() < 1e-9 && (ball.y - 2.0).abs() < 1e-9);
         // Attacking west: the same field turned half round; the opponent's net (NET1) is
         // the west net, 7 m on the left, and "landmark 0" (the opponent's left corner) is
         // the field's south-west corner.
@@ -1396,21 +1382,22 @@ mod tests {
         m2.place(Framed::new(at));
         m2.game(playing(-1.0));
         let w = m2.camera(&frame(at, 1.0, &objects));
-        assert!((w.lps[lps::NET1].rho - 7000.0).abs() < 0.01);
+        assert!((w.lps[lps::NET1].rho - 7.0).abs() < 1e-5);
         assert!((w.lps[lps::NET1].theta - PI / 2.0).abs() < 1e-9);
         let sw = w.lps[lps::LANDMARK0];
         let (dx, dy) = (-9.0 - at.x, -6.0 - at.y);
-        assert!((sw.rho - dx.hypot(dy) * MM_PER_M).abs() < 0.01, "{sw:?}");
-        assert!((w.my_pos.pose.x - 2000.0).abs() < 1e-6, "{:?}", w.my_pos);
-        assert!((w.my_pos.pose.theta + PI / 2.0).abs() < 1e-9, "north is the team's −y");
-        assert!((w.global_ball.pose.y + 2000.0).abs() < 1e-6);
+        assert!((sw.rho - dx.hypot(dy)).abs() < 1e-5, "{sw:?}");
+        let me = w.my_pos.pose.inner;
+        assert!((me.x - 2.0).abs() < 1e-9, "{:?}", w.my_pos);
+        assert!((me.theta + PI / 2.0).abs() < 1e-9, "north is the team's −y");
+        assert!((w.global_ball.pose.inner.y + 2.0).abs() < 1e-9);
         // Nothing seen next cycle: memories stay where they were, fading; the robot moves
         // 1 m forward (north) by the mice, so the ball, 2 m north-east, is now 2.236 m away.
         m.odometry(&exact_mice(Pose2::new(1.0, 0.0, 0.0)));
         let w = m.camera(&frame(at, 1.1, &[]));
         let ball = w.lps[lps::BALL];
         assert!((ball.reliability - DECAY).abs() < 1e-12);
-        assert!((ball.rho - 5f64.sqrt() * MM_PER_M).abs() < 0.01, "{ball:?}");
+        assert!((ball.rho - 5f64.sqrt()).abs() < 1e-5, "{ball:?}");
         assert!((ball.seen_ago - 0.1).abs() < 1e-9);
     }
 

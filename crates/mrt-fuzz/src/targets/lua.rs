@@ -175,8 +175,8 @@ fn sample_world(cycle: u32) -> WorldSnapshot {
         kickoff_pose: Some(mrt_core::frames::Framed::new(Pose2::new(-1.0, 0.0, 0.0))),
         ..WorldSnapshot::default()
     };
-    w.lps[lps::BALL] = Lpo { rho: 900.0, theta: 0.3, reliability: 0.9, seen_ago: 0.0 };
-    w.lps[lps::NET1] = Lpo { rho: 4000.0, theta: -0.2, reliability: 0.7, seen_ago: 0.5 };
+    w.lps[lps::BALL] = Lpo { rho: 0.9, theta: 0.3, reliability: 0.9, seen_ago: 0.0 };
+    w.lps[lps::NET1] = Lpo { rho: 4.0, theta: -0.2, reliability: 0.7, seen_ago: 0.5 };
     w.mates.push(Mate { id: 2, at: Estimate::default(), keeper: true });
     w
 }
@@ -312,7 +312,7 @@ impl Harness for Machines {
 pub(super) const WORLD: Target = Target {
     name: "world",
     about: "world snapshots as mrt behave reads them (JSON → WorldSnapshot, one or an array), then run through the Attacker's ThinkingCap cycles",
-    keywords: &["lps", "rho", "theta", "reliability", "seen_ago", "my_pos", "pose", "quality", "ball_vel", "global_ball", "mates", "id", "at", "keeper", "role", "ball_booked", "game_state", "field", "half_length", "half_width", "goal_half_width", "penalty_area_depth", "kickoff_pose", "time", "x", "y", "null", "true", "false", "[]", "{}", "\"PLAYING\"", "\"Playing\"", ":", ","],
+    keywords: &["lps", "rho", "theta", "reliability", "seen_ago", "my_pos", "pose", "quality", "ball_vel", "global_ball", "mates", "id", "at", "velocity", "at_sigma", "robots", "keeper", "role", "ball_booked", "game_state", "field", "half_length", "half_width", "goal_half_width", "penalty_area_depth", "kickoff_pose", "time", "x", "y", "null", "true", "false", "[]", "{}", "\"PLAYING\"", "\"Playing\"", ":", ","],
     structured: Some(crate::mutate::mutate_json),
     seeds: |root| {
         let mut seeds = files_under(&teamchaos(root).join("worlds"), |s| s.ends_with(".json"))?;

@@ -2,7 +2,7 @@
 //! once a cycle, into the motor driver's command.
 
 use super::*;
-use mrt_core::frames::{point_in_metres, pose_in_metres, Framed, Team};
+use mrt_core::frames::{Framed, Team};
 use mrt_core::Twist;
 
 /// Guidance of one robot: the behaviors' command through the Guidance µAgent with the latest
@@ -80,11 +80,9 @@ impl Member for GuidanceMember {
             if let Some(rate) = self.look.as_mut().and_then(|l| l.step(now, needs, played)) {
                 cmd = RobotCommand { twist: Twist::new(0.0, 0.0, rate), ..RobotCommand::default() };
             }
-            // The world snapshot's edge units (mm: what behaviors read) to SI, once.
-            let me = Framed::new(pose_in_metres(self.world.my_pos.pose));
+            let me = self.world.my_pos.pose;
             let ball = self.world.global_ball;
-            let ball =
-                (ball.quality >= 0.1).then(|| Framed::new(point_in_metres(ball.pose.position())));
+            let ball = (ball.quality >= 0.1).then(|| Framed::new(ball.pose.inner.position()));
             self.follow(&mut cmd, me, ctx);
             let guided = self.guidance.guide(&cmd, me, ball, &self.scan.sonars);
             ctx.publish(MotorCommand { twist: guided.twist, kick: cmd.kick.is_some() });

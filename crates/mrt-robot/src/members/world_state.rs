@@ -96,7 +96,7 @@ impl Member for WorldState {
         // booking already keeps when each was last heard) and the team ball.
         let me = Player {
             id,
-            at: (w.my_pos.pose.x, w.my_pos.pose.y),
+            at: (w.my_pos.pose.inner.x, w.my_pos.pose.inner.y),
             keeper: self.keeper,
             said: self.role,
         };
@@ -105,13 +105,13 @@ impl Member for WorldState {
         let players: Vec<Player> = std::iter::once(me)
             .chain(heard.iter().map(|r| Player {
                 id: r.id,
-                at: (r.pose.pose.x, r.pose.pose.y),
+                at: (r.pose.pose.inner.x, r.pose.pose.inner.y),
                 keeper: r.keeper,
                 said: Role::from_name(&r.role).unwrap_or(Role::Defender),
             }))
             .collect();
         let ball = (w.global_ball.quality > BALL_KNOWN)
-            .then_some((w.global_ball.pose.x, w.global_ball.pose.y));
+            .then_some((w.global_ball.pose.inner.x, w.global_ball.pose.inner.y));
         self.role = allocate(&players, ball).first().map_or(self.role, |r| r.1);
         report.role = self.role.name().to_string();
         w.role = self.role.name().to_string();
@@ -142,11 +142,17 @@ pub(super) fn situation(
     heard: &[&MateReport],
 ) -> Situation {
     Situation {
-        me: (w.my_pos.pose.x, w.my_pos.pose.y, w.my_pos.pose.theta),
+        me: (w.my_pos.pose.inner.x, w.my_pos.pose.inner.y, w.my_pos.pose.inner.theta),
         keeper,
         ball,
-        mates: heard.iter().map(|r| (r.id, (r.pose.pose.x, r.pose.pose.y), r.keeper)).collect(),
-        opponents: w.opponents(WorldSnapshot::ANCHORED).map(|r| (r.x, r.y)).collect(),
+        mates: heard
+            .iter()
+            .map(|r| (r.id, (r.pose.pose.inner.x, r.pose.pose.inner.y), r.keeper))
+            .collect(),
+        opponents: w
+            .opponents(WorldSnapshot::ANCHORED)
+            .map(|r| (r.at.inner.x, r.at.inner.y))
+            .collect(),
         half_length: w.field.half_length,
         goal_half_width: w.field.goal_half_width,
     }

@@ -4,7 +4,7 @@
 //! rates opportunities, each activity's sub-tasks, and the goal each sub-task gives Mr.
 //! BRIAN's parametric behaviors.
 //!
-//! Everything is in the team frame (mm, x towards the opponent's net at `(half_length, 0)`),
+//! Everything is in the team frame (m, x towards the opponent's net at `(half_length, 0)`),
 //! read from a [`Situation`]: what one robot believes. The numbers (distances, priorities,
 //! time limits) are design choices tuned on the simulated pitch (`docs/teams.md`).
 //!
@@ -20,6 +20,8 @@
 
 use super::sequencer::{Progress, Sequencer, SubTask, Verdict};
 use super::{allocate, Activities, Activity, Agent, Allocation, Assignment, Params};
+use mrt_core::frames::Framed;
+use mrt_core::Point2;
 use mrt_msgs::{ScareJob, ScareReport};
 
 /// Indices of Team Milan's activities in [`table`].
@@ -56,7 +58,7 @@ pub fn table() -> Activities {
     .with_default("Support")
 }
 
-/// What one robot believes, as the soccer activities read it (team frame, mm, rad).
+/// What one robot believes, as the soccer activities read it (team frame, m, rad).
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Situation {
     /// Its own pose: x, y, heading.
@@ -76,13 +78,13 @@ pub struct Situation {
 }
 
 /// An opponent this near the ball, ahead of the robot that carries it, blocks its way.
-const BLOCKED: f64 = 1200.0;
+const BLOCKED: f64 = 1.2;
 /// A receiver this far ahead of the ball, with no opponent within [`OPEN`], is worth a pass.
-const AHEAD: f64 = 1500.0;
+const AHEAD: f64 = 1.5;
 /// No opponent within this of a receiver.
-const OPEN: f64 = 1500.0;
-/// Attitudes fall to a half at this cost, mm.
-const HALF_AT: f64 = 3000.0;
+const OPEN: f64 = 1.5;
+/// Attitudes fall to a half at this cost, m.
+const HALF_AT: f64 = 3.0;
 
 fn dist(a: (f64, f64), b: (f64, f64)) -> f64 {
     (a.0 - b.0).hypot(a.1 - b.1)
@@ -107,7 +109,7 @@ impl Situation {
     /// the ball.
     fn ball_cost(&self, p: (f64, f64), ball: (f64, f64)) -> f64 {
         let ahead = (p.0 - ball.0).max(0.0);
-        dist(p, ball) + ahead.min(1000.0)
+        dist(p, ball) + ahead.min(1.0)
     }
 
     /// The robot of the team (itself or a mate) nearest the ball by [`ball_cost`], by
@@ -142,9 +144,9 @@ impl Situation {
     pub fn defense_spot(&self, ball: (f64, f64)) -> (f64, f64) {
         let goal = (-self.half_length, 0.0);
         let d = dist(ball, goal);
-        let out = (d / 3.0).max(1500.0).min(d);
-        if d < 1.0 {
-            return (goal.0 + 1500.0, 0.0);
+        let out = (d / 3.0).max(1.5).min(d);
+        if d < 1e-3 {
+            return (goal.0 + 1.5, 0.0);
         }
         (goal.0 + (ball.0 - goal.0) * out / d, (ball.1 - goal.1) * out / d)
     }
@@ -152,8 +154,8 @@ impl Situation {
     /// Where DefensiveDoubling's `block` stands: 1 m from the ball towards the own goal.
     pub fn block_spot(&self, ball: (f64, f64)) -> (f64, f64) {
         let goal = (-self.half_length, 0.0);
-        let d = dist(ball, goal).max(1.0);
-        let k = (1000.0 / d).min(1.0);
+        let d = dist(ball, goal).max(1e-3);
+        let k = (1.0 / d).min(1.0);
         (ball.0 + (goal.0 - ball.0) * k, ball.1 + (goal.1 - ball.1) * k)
     }
 
@@ -161,7 +163,7 @@ impl Situation {
     /// side of it, within the posts.
     pub fn cover_spot(&self, ball: (f64, f64)) -> (f64, f64) {
         let y = ball.1.clamp(-self.goal_half_width, self.goal_half_width) / 2.0;
-        (-self.half_length + 1200.0, y)
+        (-self.half_length + 1.2, y)
     }
 
     /// Where Support stands: 2 m ahead of the ball (at most 2 m short of the opponent's goal
@@ -170,15 +172,15 @@ impl Situation {
     /// team scored 34 : 25 against the Chaser over seeds 201–260; ahead, 66 : 39 with 2 m to
     /// the side and 63 : 36 over 201–250 with 1 m; docs/teams.md.)
     pub fn support_spot(&self, ball: (f64, f64)) -> (f64, f64) {
-        let side = if ball.1 > 0.0 { -1000.0 } else { 1000.0 };
-        ((ball.0 + 2000.0).min(self.half_length - 2000.0), ball.1 + side)
+        let side = if ball.1 > 0.0 { -1.0 } else { 1.0 };
+        ((ball.0 + 2.0).min(self.half_length - 2.0), ball.1 + side)
     }
 
     /// Where a receiver goes: its own position moved forward to 2 m ahead of the ball when
     /// it is not that far ahead, away from the touch lines.
     pub fn receive_spot(&self, ball: (f64, f64)) -> (f64, f64) {
         let (x, y) = self.pos();
-        (x.max(ball.0 + 2000.0).min(self.half_length - 1000.0), y.clamp(-2500.0, 2500.0))
+        (x.max(ball.0 + 2.0).min(self.half_length - 1.0), y.clamp(-2.5, 2.5))
     }
 
     /// The opportunity of each activity of [`table`], as robot `me` rates it.
@@ -201,7 +203,7 @@ impl Situation {
             .iter()
             .any(|op| dist(*op, ball) < BLOCKED && op.0 > ball.0 && op.0 > at.0);
         let open = self.field_players(me).any(|(id, p)| id != carrier && self.open_ahead(p, ball));
-        if blocked && open && ball.0 < self.half_length - 2000.0 {
+        if blocked && open && ball.0 < self.half_length - 2.0 {
             o[ids::PASSAGE] = 1.0;
         }
         o
@@ -269,7 +271,7 @@ pub enum Goal {
 impl Situation {
     /// The goal of sub-task `step` of assignment `a` for this robot; `mates` locate the
     /// receiver of a pass (`receiver`: its number). `shot` is where along the opponent's
-    /// goal line to shoot (mm from its centre).
+    /// goal line to shoot (m from its centre).
     pub fn goal(&self, a: Assignment, step: usize, receiver: Option<u32>, shot: f64) -> Goal {
         let Some(ball) = self.ball else {
             return if a.activity == ids::GOALIE { Goal::Keep } else { Goal::Search };
@@ -363,7 +365,7 @@ impl Coordinator {
 
     /// One cycle at `now` (s): `sit` is what this robot believes, `heard` the SCARE reports
     /// of the teammates heard lately (a robot that hears nobody allocates for itself alone),
-    /// `shot` where along the opponent's goal line to shoot (mm from its centre).
+    /// `shot` where along the opponent's goal line to shoot (m from its centre).
     pub fn cycle(
         &mut self,
         now: f64,
@@ -467,12 +469,13 @@ fn job_of(table: &Activities, a: Assignment, seq: &Sequencer, goal: Goal) -> Sca
         subtask: seq.current().map(|t| t.name.clone()).unwrap_or_default(),
         ..ScareJob::default()
     };
+    let point = |(x, y): (f64, f64)| Framed::new(Point2::new(x, y));
     match goal {
         Goal::PlayBall { aim, kick } => {
-            job.aim = Some(aim);
+            job.aim = Some(point(aim));
             job.kick = kick;
         }
-        Goal::Position { at } => job.position = Some(at),
+        Goal::Position { at } => job.position = Some(point(at)),
         Goal::Keep | Goal::Search => {}
     }
     job
@@ -496,16 +499,16 @@ fn judge(sit: &Situation, subtask: &str, goal: Goal) -> Verdict {
                 ((ball.1 - me.1).atan2(ball.0 - me.0), (aim.1 - ball.1).atan2(aim.0 - ball.0));
             let off = (to_ball - to_aim + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU)
                 - std::f64::consts::PI;
-            if dist(me, ball) < 700.0 && off.abs() < 25f64.to_radians() {
+            if dist(me, ball) < 0.7 && off.abs() < 25f64.to_radians() {
                 Verdict::Success
             } else {
                 Verdict::Running
             }
         }
         // The ball is off: kicked, or lost to someone.
-        ("Shoot" | "Pass", _) if dist(me, ball) > 1200.0 => Verdict::Success,
-        ("GetOpen", Goal::Position { at }) if dist(me, at) < 400.0 => Verdict::Success,
-        ("Receive", _) if dist(me, ball) < 700.0 => Verdict::Success,
+        ("Shoot" | "Pass", _) if dist(me, ball) > 1.2 => Verdict::Success,
+        ("GetOpen", Goal::Position { at }) if dist(me, at) < 0.4 => Verdict::Success,
+        ("Receive", _) if dist(me, ball) < 0.7 => Verdict::Success,
         _ => Verdict::Running,
     }
 }
@@ -516,15 +519,15 @@ mod tests {
     use super::*;
 
     fn field() -> Situation {
-        Situation { half_length: 9000.0, goal_half_width: 1000.0, ..Situation::default() }
+        Situation { half_length: 9.0, goal_half_width: 1.0, ..Situation::default() }
     }
 
     /// Four robots, each rating its own attitudes from the same beliefs, allocate: keeper,
     /// the nearest to the ball brings it, the others defend and support.
     #[test]
     fn a_team_of_four_allocates_goalie_bringball_defense_support() {
-        let ball = Some((1000.0, 500.0));
-        let pos = [(-8500.0, 0.0), (0.0, 0.0), (-4000.0, -1000.0), (3000.0, 2000.0)];
+        let ball = Some((1.0, 0.5));
+        let pos = [(-8.5, 0.0), (0.0, 0.0), (-4.0, -1.0), (3.0, 2.0)];
         let sit = |i: usize| {
             let mut s = field();
             s.me = (pos[i].0, pos[i].1, 0.0);
@@ -547,27 +550,27 @@ mod tests {
         // Robot 2 is on the ball's own side: its goal is to play it to the net and, in its
         // second sub-task, to kick.
         let g = sit(1).goal(a.of(2).unwrap(), 1, None, 0.0);
-        assert_eq!(g, Goal::PlayBall { aim: (9000.0, 0.0), kick: true });
+        assert_eq!(g, Goal::PlayBall { aim: (9.0, 0.0), kick: true });
         // Defense stands on the ball–goal line, a third of the way out.
         let Goal::Position { at } = sit(2).goal(a.of(3).unwrap(), 0, None, 0.0) else { panic!() };
-        let (bx, by): (f64, f64) = (1000.0 + 9000.0, 500.0);
+        let (bx, by): (f64, f64) = (1.0 + 9.0, 0.5);
         let k = (bx.hypot(by) / 3.0) / bx.hypot(by);
-        assert!((at.0 - (-9000.0 + bx * k)).abs() < 1e-6 && (at.1 - by * k).abs() < 1e-6, "{at:?}");
+        assert!((at.0 - (-9.0 + bx * k)).abs() < 1e-6 && (at.1 - by * k).abs() < 1e-6, "{at:?}");
     }
 
     #[test]
     fn a_blocked_carrier_with_an_open_mate_makes_a_passage() {
         let mut s = field();
-        s.me = (-1500.0, 0.0, 0.0);
-        s.ball = Some((-1000.0, 0.0));
-        s.mates = vec![(3, (2000.0, 2000.0), false)];
-        s.opponents = vec![(-200.0, 0.0), (4000.0, -2500.0)];
+        s.me = (-1.5, 0.0, 0.0);
+        s.ball = Some((-1.0, 0.0));
+        s.mates = vec![(3, (2.0, 2.0), false)];
+        s.opponents = vec![(-0.2, 0.0), (4.0, -2.5)];
         let o = s.opportunity(2);
         assert_eq!(o[ids::PASSAGE], 1.0, "{o:?}");
         // Robot 3 rates itself as receiver (open, ahead); robot 2 as passer.
         let mut r = s.clone();
-        r.me = (2000.0, 2000.0, 0.0);
-        r.mates = vec![(2, (-1500.0, 0.0), false)];
+        r.me = (2.0, 2.0, 0.0);
+        r.mates = vec![(2, (-1.5, 0.0), false)];
         let agents = [Agent::new(2, s.attitudes()), Agent::new(3, r.attitudes())];
         let t = table();
         let a = allocate(&t, &o, &agents, &Params::default());
@@ -575,7 +578,7 @@ mod tests {
         assert_eq!(a.of(3), Some(Assignment { activity: ids::PASSAGE, functionality: 1 }));
         // The passer aims at its receiver.
         let g = s.goal(a.of(2).unwrap(), 0, Some(3), 0.0);
-        assert_eq!(g, Goal::PlayBall { aim: (2000.0, 2000.0), kick: false });
+        assert_eq!(g, Goal::PlayBall { aim: (2.0, 2.0), kick: false });
         // Without the blocking opponent there is no passage: robot 2 brings the ball.
         s.opponents.remove(0);
         assert_eq!(s.opportunity(2)[ids::PASSAGE], 0.0);
@@ -590,11 +593,11 @@ mod tests {
             s.goal(Assignment { activity: ids::SUPPORT, functionality: 0 }, 0, None, 0.0),
             Goal::Search
         );
-        s.ball = Some((-6000.0, 1000.0));
+        s.ball = Some((-6.0, 1.0));
         assert_eq!(s.opportunity(1)[ids::DOUBLING], 1.0);
         // The block stands 1 m from the ball towards the own goal.
-        let b = s.block_spot((-6000.0, 1000.0));
-        assert!((dist(b, (-6000.0, 1000.0)) - 1000.0).abs() < 1e-6);
-        assert!(b.0 < -6000.0);
+        let b = s.block_spot((-6.0, 1.0));
+        assert!((dist(b, (-6.0, 1.0)) - 1.0).abs() < 1e-6);
+        assert!(b.0 < -6.0);
     }
 }
