@@ -553,4 +553,48 @@ mod tests {
         assert_eq!(ids, [0, 1], "the home robots' reports, not the away team's (2, 3)");
         assert!(alone.lock().unwrap().is_empty(), "not on any team's link");
     }
+
+    /// What teammates tell each other is in the world model's SI units: every pose a report
+    /// carries lies on the field (metres: within 12 m of the centre spot), and the ball's
+    /// uncertainty, once a robot has seen the ball, is a few decimetres, not hundreds.
+    #[test]
+    fn team_reports_are_in_metres() {
+        struct Listen(Arc<Mutex<Vec<MateReport>>>);
+        impl Member for Listen {
+            fn init(&mut self, ctx: &mut Context<'_>) -> Result<(), MemberError> {
+                ctx.subscribe_to::<MateReport>(RequestType::Remote);
+                Ok(())
+            }
+            fn do_your_job(&mut self, ctx: &mut Context<'_>) -> Result<(), MemberError> {
+                while let Some(m) = ctx.receive_msg() {
+                    let r = m.get::<MateReport>()?.clone();
+                    self.0.lock().map_err(|_| "poisoned")?.push(r);
+                }
+                Ok(())
+            }
+        }
+        let cfg = short(5.0, 2);
+        let mut m = BusMatch::new(&cfg, 1, Stack::Chaser, Some(Stack::Chaser), None).unwrap();
+        let period = m.period;
+        let heard: Arc<Mutex<Vec<MateReport>>> = Arc::default();
+        let link = m.team_link(0).cloned().unwrap();
+        let mut agora = m.executor().agora_builder(98).inner_link(&link).build().unwrap();
+        let member = agora.add_member(Listen(Arc::clone(&heard)), Activation::Periodic(period));
+        agora.activate_member(member).unwrap();
+        m.executor().add_agora(agora).unwrap();
+        for _ in 0..40 {
+            m.cycle().unwrap();
+        }
+        let reports = heard.lock().unwrap();
+        assert!(!reports.is_empty());
+        for r in reports.iter() {
+            let p = r.pose.pose.inner;
+            assert!(p.x.hypot(p.y) < 12.0, "a pose off the field: {r:?}");
+            assert!((0.0..2.0).contains(&r.ball_sigma), "ball sigma {} m: {r:?}", r.ball_sigma);
+            for s in &r.robots {
+                assert!(s.at.inner.x.hypot(s.at.inner.y) < 12.0 && s.at_sigma < 2.0, "{s:?}");
+            }
+        }
+        assert!(reports.iter().any(|r| r.ball_sigma > 0.0), "nobody saw the ball in 4 s");
+    }
 }

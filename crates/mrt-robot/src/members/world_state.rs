@@ -1,7 +1,6 @@
 //! The world-state Member: the robot's beliefs, its teammates' reports, roles and SCARE.
 
 use super::*;
-use mrt_core::frames::millimetres;
 
 /// A team ball of at least this quality is known to the role allocation (the Lua players'
 /// `ballKnown`).
@@ -75,8 +74,8 @@ impl Member for WorldState {
             Err(_) => self.model.camera(frame.get::<CameraFrame>()?),
         };
         let id = u32::try_from(self.robot).unwrap_or(u32::MAX);
-        // The ball's uncertainty in mm, as the reports and the team ball count it.
-        let ball_sigma = self.model.ball_sigma().map(millimetres);
+        // The ball's uncertainty (m), as the reports and the team ball count it.
+        let ball_sigma = self.model.ball_sigma();
         let mut report =
             MateReport::of(id, self.keeper, &w).with_ball_sigma(ball_sigma.unwrap_or(0.0));
         // The ball booking on this frame's clock: the news, the behaviors' wish, the report.
