@@ -1,4 +1,4 @@
-//! The robot API `chaos.*` of ThinkingCap's chaoslib (seed 001 §3.3), so a TeamChaos behavior
+//! The robot API `chaos.*` of ThinkingCap's chaoslib (ThinkingCap report §3.3), so a TeamChaos
 //! ports with minimal change. Reads a [`WorldSnapshot`], writes a [`RobotCommand`].
 //!
 //! | group | functions |
@@ -254,8 +254,30 @@ pub fn install(rt: &LuaRuntime, io: Rc<RefCell<RobotIo>>) -> Result<(), ScriptEr
     install_inner(&rt.lua, io, rt.sandbox().memory_limit).map_err(ScriptError::setup)
 }
 
+/// The `chaos` table being filled: each function sees the robot's [`RobotIo`].
+struct Api<'a> {
+    lua: &'a Lua,
+    chaos: Table,
+    io: Rc<RefCell<RobotIo>>,
+}
+
+impl Api<'_> {
+    /// Declares `chaos.<name>`, a function of the Lua state, the robot and its arguments.
+    fn func<A, R>(
+        &self,
+        name: &str,
+        f: impl Fn(&Lua, &RefCell<RobotIo>, A) -> mlua::Result<R> + 'static,
+    ) -> mlua::Result<()>
+    where
+        A: mlua::FromLuaMulti,
+        R: mlua::IntoLuaMulti,
+    {
+        let io = self.io.clone();
+        self.chaos.set(name, self.lua.create_function(move |lua, args: A| f(lua, &io, args))?)
+    }
+}
+
 fn install_inner(lua: &Lua, io: Rc<RefCell<RobotIo>>, memory_limit: usize) -> mlua::Result<()> {
-    let chaos = lua.create_table()?;
     let g = lua.globals();
     for (name, v) in [("BALL", lps::BALL), ("NET1", lps::NET1), ("NET2", lps::NET2)] {
         g.set(name, v)?;
@@ -266,22 +288,25 @@ fn install_inner(lua: &Lua, io: Rc<RefCell<RobotIo>>, memory_limit: usize) -> ml
     g.set("INTEGER", INTEGER)?;
     g.set("FLOAT", FLOAT)?;
     g.set("STRING", STRING)?;
+    let api = Api { lua, chaos: lua.create_table()?, io };
+    let keys = Rc::new(Keys::new(lua)?);
+    install_data(&api, &keys)?;
+    install_anchors(&api, &keys)?;
+    install_control(&api)?;
+    install_coordination(&api)?;
+    install_persistence(&api, memory_limit)?;
+    g.set("chaos", api.chaos)
+}
 
-    macro_rules! func {
-        ($name:literal, $io:ident, |$lua:ident, $args:tt : $ty:ty| $body:expr) => {{
-            let $io = io.clone();
-            chaos.set($name, lua.create_function(move |$lua, $args: $ty| $body)?)?;
-        }};
-    }
-
+/// Data access: the world snapshot, in the Lua API's units.
+fn install_data(api: &Api<'_>, keys: &Rc<Keys>) -> mlua::Result<()> {
     // Data access.
     // Data tables are filled at most once per cycle and handed out again on later calls of
     // the same cycle: behaviors and predicates ask for the ball many times a cycle. Treat them
     // as read-only, as the seed's copies were.
     let lpos: Vec<CycleTable> = (0..lps::COUNT).map(|_| CycleTable::default()).collect();
-    let keys = Rc::new(Keys::new(lua)?);
     let k = keys.clone();
-    func!("lps_getLpo", io, |lua, i: i64| {
+    api.func("lps_getLpo", move |lua, io, i: i64| {
         let keys = &k;
         let i = check_index("lps_getLpo", i)?;
         let io = io.borrow();
@@ -292,27 +317,27 @@ fn install_inner(lua: &Lua, io: Rc<RefCell<RobotIo>>, memory_limit: usize) -> ml
             t.raw_set(&keys.reliability, o.reliability)?;
             t.raw_set(&keys.seen_ago, o.seen_ago)
         })
-    });
+    })?;
     let my_pos = CycleTable::default();
     let k = keys.clone();
-    func!("gsGetMyPos", io, |lua, (): ()| {
+    api.func("gsGetMyPos", move |lua, io, (): ()| {
         let keys = &k;
         let io = io.borrow();
         let (p, quality) =
             (pose_in_millimetres(io.world.my_pos.pose.inner), io.world.my_pos.quality);
         my_pos
             .get(lua, io.generation, |t| keys.fill_pose(t, p.x, p.y, Some(p.theta), Some(quality)))
-    });
+    })?;
     let ball_vel = CycleTable::default();
     let k = keys.clone();
-    func!("getBallVel", io, |lua, (): ()| {
+    api.func("getBallVel", move |lua, io, (): ()| {
         let keys = &k;
         let io = io.borrow();
         let v = io.world.ball_vel.inner.map(millimetres);
         ball_vel.get(lua, io.generation, |t| keys.fill_pose(t, v.x, v.y, None, None))
-    });
+    })?;
     let field = CycleTable::default();
-    func!("getField", io, |lua, (): ()| {
+    api.func("getField", move |lua, io, (): ()| {
         let io = io.borrow();
         let f = io.world.field;
         field.get(lua, io.generation, |t| {
@@ -321,20 +346,20 @@ fn install_inner(lua: &Lua, io: Rc<RefCell<RobotIo>>, memory_limit: usize) -> ml
             t.raw_set("goal_half_width", millimetres(f.goal_half_width))?;
             t.raw_set("penalty_area_depth", millimetres(f.penalty_area_depth))
         })
-    });
+    })?;
     let global_ball = CycleTable::default();
     let k = keys.clone();
-    func!("getGlobalBall", io, |lua, (): ()| {
+    api.func("getGlobalBall", move |lua, io, (): ()| {
         let keys = &k;
         let io = io.borrow();
         let (b, quality) =
             (pose_in_millimetres(io.world.global_ball.pose.inner), io.world.global_ball.quality);
         global_ball.get(lua, io.generation, |t| keys.fill_pose(t, b.x, b.y, None, Some(quality)))
-    });
+    })?;
     let k = keys.clone();
     // Role negotiation asks for the mates several times a cycle: one list per cycle.
     let mates = CycleTable::default();
-    func!("getMates", io, |lua, (): ()| {
+    api.func("getMates", move |lua, io, (): ()| {
         let keys = &k;
         let io = io.borrow();
         mates.get(lua, io.generation, |t| {
@@ -349,12 +374,17 @@ fn install_inner(lua: &Lua, io: Rc<RefCell<RobotIo>>, memory_limit: usize) -> ml
             }
             Ok(())
         })
-    });
+    })?;
 
+    Ok(())
+}
+
+/// The other robots MAP anchored, and the kickoff pose.
+fn install_anchors(api: &Api<'_>, keys: &Rc<Keys>) -> mlua::Result<()> {
     // The other robots MAP anchored (MRT manual ch. 8), nearest first.
     let k = keys.clone();
     let robots = CycleTable::default();
-    func!("getRobots", io, |lua, (): ()| {
+    api.func("getRobots", move |lua, io, (): ()| {
         let keys = &k;
         let io = io.borrow();
         robots.get(lua, io.generation, |t| {
@@ -364,48 +394,50 @@ fn install_inner(lua: &Lua, io: Rc<RefCell<RobotIo>>, memory_limit: usize) -> ml
             }
             Ok(())
         })
-    });
+    })?;
     let k = keys.clone();
-    func!("getNearestOpponent", io, |lua, min: Option<f64>| {
+    api.func("getNearestOpponent", move |lua, io, min: Option<f64>| {
         let min = finite("getNearestOpponent", min.unwrap_or(WorldSnapshot::ANCHORED))?;
         let io = io.borrow();
         match io.world.nearest_opponent(min) {
             Some(r) => Ok(Value::Table(robot_table(lua, &k, r)?)),
             None => Ok(Value::Nil),
         }
-    });
-    func!("getFreeDirection", io, |_lua,
-                                   (theta, reach, clearance): (
-        Option<f64>,
-        Option<f64>,
-        Option<f64>
-    )| {
-        let io = io.borrow();
-        let w = &io.world;
-        // Towards the opponent's net when known, else straight ahead.
-        let net = w.lps[lps::NET1];
-        let toward = if net.reliability > 0.0 { net.theta } else { 0.0 };
-        let theta = finite("getFreeDirection", theta.unwrap_or(toward))?;
-        // The Lua API's millimetres to the snapshot's metres.
-        let reach = reach.map(metres).unwrap_or(WorldSnapshot::FREE_REACH);
-        let clearance = clearance.map(metres).unwrap_or(WorldSnapshot::FREE_CLEARANCE);
-        let (reach, clearance) =
-            (finite("getFreeDirection", reach)?, finite("getFreeDirection", clearance)?);
-        Ok(w.free_direction(theta, reach, clearance, WorldSnapshot::ANCHORED))
-    });
+    })?;
+    api.func(
+        "getFreeDirection",
+        move |_lua, io, (theta, reach, clearance): (Option<f64>, Option<f64>, Option<f64>)| {
+            let io = io.borrow();
+            let w = &io.world;
+            // Towards the opponent's net when known, else straight ahead.
+            let net = w.lps[lps::NET1];
+            let toward = if net.reliability > 0.0 { net.theta } else { 0.0 };
+            let theta = finite("getFreeDirection", theta.unwrap_or(toward))?;
+            // The Lua API's millimetres to the snapshot's metres.
+            let reach = reach.map(metres).unwrap_or(WorldSnapshot::FREE_REACH);
+            let clearance = clearance.map(metres).unwrap_or(WorldSnapshot::FREE_CLEARANCE);
+            let (reach, clearance) =
+                (finite("getFreeDirection", reach)?, finite("getFreeDirection", clearance)?);
+            Ok(w.free_direction(theta, reach, clearance, WorldSnapshot::ANCHORED))
+        },
+    )?;
 
     let k = keys.clone();
-    func!("getKickoffPose", io, |lua, (): ()| {
+    api.func("getKickoffPose", move |lua, io, (): ()| {
         let Some(p) = io.borrow().world.kickoff_pose else { return Ok(Value::Nil) };
         let p = pose_in_millimetres(p.inner);
         let t = lua.create_table_with_capacity(0, 3)?;
         k.fill_pose(&t, p.x, p.y, Some(p.theta), None)?;
         Ok(Value::Table(t))
-    });
+    })?;
 
-    // Control actions.
+    Ok(())
+}
+
+/// Control actions: the command being built.
+fn install_control(api: &Api<'_>) -> mlua::Result<()> {
     type TargetArgs = (f64, f64, f64, Option<bool>, Option<bool>);
-    func!("setTarget", io, |_lua, (x, y, theta, avoid, plan): TargetArgs| {
+    api.func("setTarget", move |_lua, io, (x, y, theta, avoid, plan): TargetArgs| {
         if !(x.abs() <= MAX_TARGET && y.abs() <= MAX_TARGET && theta.is_finite()) {
             return Err(mlua::Error::runtime(format!(
                 "bad argument: setTarget needs finite numbers, x and y within ±{MAX_TARGET:e} mm, \
@@ -420,28 +452,28 @@ fn install_inner(lua: &Lua, io: Rc<RefCell<RobotIo>>, memory_limit: usize) -> ml
             plan: plan.unwrap_or(false),
         });
         Ok(())
-    });
+    })?;
     // A set-point that is not a finite number is the script's fault, reported as one: NaN
     // would silently stop the robot and infinity saturate it. A huge finite one is taken as
     // MAX_SETPOINT, far beyond any base's top speed, like any other too fast. The Lua API's
     // mm/s and degrees/s become the command's m/s and rad/s here.
-    func!("setVlin", io, |_lua, v: f64| {
+    api.func("setVlin", move |_lua, io, v: f64| {
         io.borrow_mut().command.twist.vx = metres(setpoint("setVlin", v)?);
         Ok(())
-    });
-    func!("setVrot", io, |_lua, v: f64| {
+    })?;
+    api.func("setVrot", move |_lua, io, v: f64| {
         io.borrow_mut().command.twist.omega = setpoint("setVrot", v)?.to_radians();
         Ok(())
-    });
-    func!("setVlat", io, |_lua, v: f64| {
+    })?;
+    api.func("setVlat", move |_lua, io, v: f64| {
         io.borrow_mut().command.twist.vy = metres(setpoint("setVlat", v)?);
         Ok(())
-    });
-    func!("setKick", io, |_lua, id: i64| {
+    })?;
+    api.func("setKick", move |_lua, io, id: i64| {
         io.borrow_mut().command.kick = Some(id);
         Ok(())
-    });
-    func!("setNeeded", io, |_lua, (i, v): (i64, f64)| {
+    })?;
+    api.func("setNeeded", move |_lua, io, (i, v): (i64, f64)| {
         let i = check_index("setNeeded", i)?;
         let v = finite("setNeeded", v)?.clamp(0.0, 1.0);
         // The largest need per object wins: keep one entry per object, not one per call.
@@ -451,12 +483,12 @@ fn install_inner(lua: &Lua, io: Rc<RefCell<RobotIo>>, memory_limit: usize) -> ml
             None => needs.push((i, v)),
         }
         Ok(())
-    });
-    func!("trackLandMarks", io, |_lua, (): ()| {
+    })?;
+    api.func("trackLandMarks", move |_lua, io, (): ()| {
         io.borrow_mut().command.track_landmarks = true;
         Ok(())
-    });
-    func!("setBehavior", io, |_lua, name: mlua::LuaString| {
+    })?;
+    api.func("setBehavior", move |_lua, io, name: mlua::LuaString| {
         let name = name.to_str()?;
         let name: &str = &name;
         let mut io = io.borrow_mut();
@@ -471,30 +503,38 @@ fn install_inner(lua: &Lua, io: Rc<RefCell<RobotIo>>, memory_limit: usize) -> ml
         }
         io.command.behavior = Some(name.to_string());
         Ok(())
-    });
+    })?;
 
-    // Coordination.
-    func!("getRole", io, |lua, (): ()| {
+    Ok(())
+}
+
+/// Coordination: role and ball booking.
+fn install_coordination(api: &Api<'_>) -> mlua::Result<()> {
+    api.func("getRole", move |lua, io, (): ()| {
         let t = lua.create_table_with_capacity(0, 1)?;
         t.set("name", io.borrow().world.role.clone())?;
         Ok(t)
-    });
-    func!("haveBookedBall", io, |lua, (): ()| {
+    })?;
+    api.func("haveBookedBall", move |lua, io, (): ()| {
         let t = lua.create_table_with_capacity(0, 1)?;
         t.set("booked", io.borrow().world.ball_booked)?;
         Ok(t)
-    });
-    func!("bookBall", io, |_lua, (): ()| {
+    })?;
+    api.func("bookBall", move |_lua, io, (): ()| {
         io.borrow_mut().command.book_ball = Some(true);
         Ok(())
-    });
-    func!("releaseBookedBall", io, |_lua, (): ()| {
+    })?;
+    api.func("releaseBookedBall", move |_lua, io, (): ()| {
         io.borrow_mut().command.book_ball = Some(false);
         Ok(())
-    });
+    })?;
 
-    // Persistence.
-    func!("getBehaviorInfo", io, |lua, (): ()| {
+    Ok(())
+}
+
+/// Persistence: behavior info, the global hash table, the game state.
+fn install_persistence(api: &Api<'_>, memory_limit: usize) -> mlua::Result<()> {
+    api.func("getBehaviorInfo", move |lua, io, (): ()| {
         let io = io.borrow();
         let t = lua.create_table_with_capacity(0, 2)?;
         // The innermost behavior running: a `use`d one, or the top behavior.
@@ -502,8 +542,8 @@ fn install_inner(lua: &Lua, io: Rc<RefCell<RobotIo>>, memory_limit: usize) -> ml
         t.set("timer", millis((io.world.time - since).as_secs_f64()))?;
         t.set("isNew", i64::from(is_new))?;
         Ok(t)
-    });
-    func!("setGlobal", io, |lua, (key, ty, value): (String, i64, Value)| {
+    })?;
+    api.func("setGlobal", move |lua, io, (key, ty, value): (String, i64, Value)| {
         let v = match (ty, &value) {
             (INTEGER, Value::Integer(i)) => GlobalValue::Integer(*i),
             (INTEGER, Value::Number(n)) if n.fract() == 0.0 && n.is_finite() => GlobalValue::Integer(*n as i64),
@@ -531,17 +571,16 @@ fn install_inner(lua: &Lua, io: Rc<RefCell<RobotIo>>, memory_limit: usize) -> ml
         io.globals_bytes = total;
         io.globals.insert(key, v);
         Ok(())
-    });
-    func!("getGlobal", io, |lua, key: String| {
+    })?;
+    api.func("getGlobal", move |lua, io, key: String| {
         Ok(match io.borrow().globals.get(&key) {
             Some(GlobalValue::Integer(i)) => Value::Integer(*i),
             Some(GlobalValue::Float(f)) => Value::Number(*f),
             Some(GlobalValue::String(s)) => Value::String(lua.create_string(s)?),
             None => Value::Nil,
         })
-    });
-    func!("getCurrentState", io, |_lua, (): ()| Ok(io.borrow().world.game_state.name()));
+    })?;
+    api.func("getCurrentState", move |_lua, io, (): ()| Ok(io.borrow().world.game_state.name()))?;
 
-    g.set("chaos", chaos)?;
     Ok(())
 }
