@@ -513,29 +513,32 @@ mod tests {
         assert!(first.is_some_and(|(t, _)| *t <= 120.0), "{:?}", report.calls);
     }
 
+    /// A Member that keeps every `MateReport` its Agora's links bring (Remote subscription).
+    struct Listen(Arc<Mutex<Vec<MateReport>>>);
+
+    impl Member for Listen {
+        fn init(&mut self, ctx: &mut Context<'_>) -> Result<(), MemberError> {
+            ctx.subscribe_to::<MateReport>(RequestType::Remote);
+            Ok(())
+        }
+        fn do_your_job(&mut self, ctx: &mut Context<'_>) -> Result<(), MemberError> {
+            while let Some(m) = ctx.receive_msg() {
+                let r = m.get::<MateReport>()?.clone();
+                self.0.lock().map_err(|_| "poisoned")?.push(r);
+            }
+            Ok(())
+        }
+    }
+
     /// Teammates know each other only through the bus: a MateReport crosses the team's
     /// InnerLinkManager (Remote subscription), never to the other team, and never to an Agora
     /// on no link.
     #[test]
     fn teammates_hear_each_other_over_the_bus() {
-        struct Listen(Arc<Mutex<std::collections::BTreeSet<u32>>>);
-        impl Member for Listen {
-            fn init(&mut self, ctx: &mut Context<'_>) -> Result<(), MemberError> {
-                ctx.subscribe_to::<MateReport>(RequestType::Remote);
-                Ok(())
-            }
-            fn do_your_job(&mut self, ctx: &mut Context<'_>) -> Result<(), MemberError> {
-                while let Some(m) = ctx.receive_msg() {
-                    let id = m.get::<MateReport>()?.id;
-                    self.0.lock().map_err(|_| "poisoned")?.insert(id);
-                }
-                Ok(())
-            }
-        }
         let cfg = short(5.0, 2);
         let mut m = BusMatch::new(&cfg, 1, Stack::Chaser, Some(Stack::Chaser), None).unwrap();
         let period = m.period;
-        let (on_home, alone) = (Arc::default(), Arc::default());
+        let (on_home, alone): (Arc<Mutex<Vec<MateReport>>>, _) = (Arc::default(), Arc::default());
         for (id, link, heard) in [(98, m.team_link(0).cloned(), &on_home), (99, None, &alone)] {
             let mut b = m.executor().agora_builder(id);
             if let Some(l) = &link {
@@ -549,7 +552,9 @@ mod tests {
         for _ in 0..5 {
             m.cycle().unwrap();
         }
-        let ids: Vec<u32> = on_home.lock().unwrap().iter().copied().collect();
+        let heard: std::collections::BTreeSet<u32> =
+            on_home.lock().unwrap().iter().map(|r| r.id).collect();
+        let ids: Vec<u32> = heard.into_iter().collect();
         assert_eq!(ids, [0, 1], "the home robots' reports, not the away team's (2, 3)");
         assert!(alone.lock().unwrap().is_empty(), "not on any team's link");
     }
@@ -559,20 +564,6 @@ mod tests {
     /// uncertainty, once a robot has seen the ball, is a few decimetres, not hundreds.
     #[test]
     fn team_reports_are_in_metres() {
-        struct Listen(Arc<Mutex<Vec<MateReport>>>);
-        impl Member for Listen {
-            fn init(&mut self, ctx: &mut Context<'_>) -> Result<(), MemberError> {
-                ctx.subscribe_to::<MateReport>(RequestType::Remote);
-                Ok(())
-            }
-            fn do_your_job(&mut self, ctx: &mut Context<'_>) -> Result<(), MemberError> {
-                while let Some(m) = ctx.receive_msg() {
-                    let r = m.get::<MateReport>()?.clone();
-                    self.0.lock().map_err(|_| "poisoned")?.push(r);
-                }
-                Ok(())
-            }
-        }
         let cfg = short(5.0, 2);
         let mut m = BusMatch::new(&cfg, 1, Stack::Chaser, Some(Stack::Chaser), None).unwrap();
         let period = m.period;
