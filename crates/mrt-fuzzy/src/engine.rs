@@ -33,7 +33,7 @@
 //! # Ok::<(), mrt_fuzzy::BrianError>(())
 //! ```
 
-use crate::brian::{Composer, Composition, Semantics, WeightComposer};
+use crate::compose::{Composer, Composition, Semantics, WeightComposer};
 use crate::lexer::Span;
 use crate::BrianError;
 use std::path::Path;

@@ -49,6 +49,7 @@
 #![deny(missing_docs)]
 
 pub mod brian;
+mod compose;
 pub mod engine;
 mod error;
 pub mod expr;
