@@ -1,6 +1,6 @@
 //! The error type of `mrt-fuzzy`.
 
-use crate::lexer::Span;
+use crate::span::Span;
 use std::path::{Path, PathBuf};
 
 /// What can go wrong when loading Mr. BRIAN files.

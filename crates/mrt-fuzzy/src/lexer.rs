@@ -2,16 +2,8 @@
 //! with `#` comments to the end of the line and 1-based line/column positions.
 
 use crate::error::BrianError;
+pub use crate::span::Span;
 use std::path::Path;
-
-/// Where a token starts: 1-based line and column (in characters).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
-pub struct Span {
-    /// Line, from 1.
-    pub line: usize,
-    /// Column, from 1, in characters.
-    pub column: usize,
-}
 
 /// A token of a Mr. BRIAN file.
 #[derive(Clone, Debug, PartialEq)]

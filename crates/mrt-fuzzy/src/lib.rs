@@ -59,6 +59,7 @@ pub mod lexer;
 pub mod member;
 mod set;
 pub mod shapes;
+mod span;
 
 pub use error::BrianError;
 pub use set::{FuzzySet, FuzzyValue};
