@@ -4,15 +4,15 @@
 use crate::config::{AgoraConfig, PolicyKind};
 use crate::endpoint::Endpoint;
 use crate::error::DcdtError;
-use crate::executor::{RunReport, ThreadedExecutor};
 use crate::member::{Activation, Member, MemberState, Runner, SharedState};
+use crate::outlet::AgoraPort;
 use crate::policy::MailboxBounds;
 use crate::postoffice::{InnerLinkManager, PostOffice, Route};
+use crate::shared::AgoraShared;
 use crate::waker::Waker;
 use mrt_core::{AgoraId, MemberId, SharedClock, WallClock};
 use std::path::Path;
-use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::{Arc, RwLock};
+use std::sync::Arc;
 
 /// How the Agora was instantiated (§3.3).
 #[derive(Clone, Debug, PartialEq)]
@@ -21,40 +21,6 @@ pub enum AgoraMode {
     Standalone,
     /// From a configuration file: the network half (links, bridges, Finder) uses it.
     Network(Box<AgoraConfig>),
-}
-
-/// What an Agora shares with its Members' endpoints and its executor.
-pub(crate) struct AgoraShared {
-    pub(crate) id: AgoraId,
-    pub(crate) clock: SharedClock,
-    pub(crate) post_office: Arc<PostOffice>,
-    pub(crate) route: Route,
-    pub(crate) outlet: crate::outlet::OutletSlot,
-    shutdown: AtomicBool,
-    wakers: RwLock<Vec<Arc<Waker>>>,
-}
-
-impl AgoraShared {
-    pub(crate) fn waker(&self, member: MemberId) -> Option<Arc<Waker>> {
-        self.wakers.read().unwrap_or_else(|e| e.into_inner()).get(member.0 as usize).cloned()
-    }
-
-    pub(crate) fn is_shutting_down(&self) -> bool {
-        self.shutdown.load(Ordering::Acquire)
-    }
-
-    pub(crate) fn request_shutdown(&self, by: Option<MemberId>) {
-        if !self.shutdown.swap(true, Ordering::AcqRel) {
-            match by {
-                Some(m) => tracing::info!(agora = %self.id, "shutdown requested by {m}"),
-                None => tracing::info!(agora = %self.id, "shutdown requested"),
-            }
-        }
-        for w in self.wakers.read().unwrap_or_else(|e| e.into_inner()).iter() {
-            w.force_wake();
-        }
-        self.post_office.policy.stop_dispatcher();
-    }
 }
 
 /// Builds an [`Agora`]: id, clock, PostOffice policy, in-process community.
@@ -118,15 +84,8 @@ impl AgoraBuilder {
     }
 
     fn assemble(self, post_office: Arc<PostOffice>, route: Route) -> Agora {
-        let shared = Arc::new(AgoraShared {
-            id: self.id,
-            clock: self.clock.unwrap_or_else(|| Arc::new(WallClock::new())),
-            post_office,
-            route,
-            outlet: crate::outlet::OutletSlot::default(),
-            shutdown: AtomicBool::new(false),
-            wakers: RwLock::new(Vec::new()),
-        });
+        let clock = self.clock.unwrap_or_else(|| Arc::new(WallClock::new()));
+        let shared = Arc::new(AgoraShared::new(self.id, clock, post_office, route));
         let mode = match self.config {
             Some(c) => AgoraMode::Network(Box::new(c)),
             None => AgoraMode::Standalone,
@@ -221,8 +180,8 @@ impl Agora {
 
     /// The handle a network layer uses to send this Agora's messages out and deliver the ones
     /// it receives ([`crate::outlet`]).
-    pub fn port(&self) -> crate::outlet::AgoraPort {
-        crate::outlet::AgoraPort { shared: self.shared.clone() }
+    pub fn port(&self) -> AgoraPort {
+        AgoraPort { shared: self.shared.clone() }
     }
 
     fn new_member_id(&mut self) -> MemberId {
@@ -230,11 +189,7 @@ impl Agora {
         self.next_member += 1;
         let waker = Arc::new(Waker::default());
         self.shared.post_office.register(id, waker.clone());
-        let mut wakers = self.shared.wakers.write().unwrap_or_else(|e| e.into_inner());
-        if wakers.len() <= id.0 as usize {
-            wakers.resize_with(id.0 as usize + 1, Default::default);
-        }
-        wakers[id.0 as usize] = waker;
+        self.shared.set_waker(id, waker);
         id
     }
 
@@ -295,12 +250,6 @@ impl Agora {
     /// A handle that shuts the Agora down from any thread (like a Member calling `shutdown`).
     pub fn shutdown_handle(&self) -> ShutdownHandle {
         ShutdownHandle(self.shared.clone())
-    }
-
-    /// Runs every activated Member, each on its own thread, until every Member terminated or
-    /// one called `shutdown` (`LetsWork()`). Needs a real-time clock.
-    pub fn lets_work(self) -> Result<RunReport, DcdtError> {
-        ThreadedExecutor::new().run(self)
     }
 
     /// Takes the activated Members' runners out, for an executor.

@@ -4,12 +4,12 @@
 //! Method names follow the manual (§3.3.2): `subscribe` (`SubscribeMsgType`), `unsubscribe`,
 //! `unsubscribe_all`, `create_msg`, `share_msg`, `receive_msg`, `remove_curr_msg`.
 
-use crate::agora::AgoraShared;
 use crate::error::DcdtError;
 use crate::msg::{DeliveryWarranty, Message, Msg, MsgHeader, MsgRef, RawPayload};
 use crate::parcel::{InlineMsg, Make, Parcel};
 use crate::policy::{MailboxBounds, MailboxRef, RequestType};
 use crate::pool::MsgPool;
+use crate::shared::AgoraShared;
 use mrt_core::{AgoraId, MemberId, MsgType, Time};
 use std::ops::{Deref, DerefMut};
 use std::sync::Arc;

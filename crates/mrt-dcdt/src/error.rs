@@ -69,7 +69,7 @@ pub enum DcdtError {
     Config(#[from] crate::config::ConfigError),
     /// A network frame is malformed.
     #[error(transparent)]
-    Wire(#[from] crate::wire::WireError),
+    Wire(#[from] crate::frame::WireError),
     /// A thread could not be started.
     #[error("cannot start the thread of {what}: {source}")]
     Spawn {

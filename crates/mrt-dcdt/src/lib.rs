@@ -88,9 +88,11 @@ mod agora;
 pub mod config;
 #[cfg(feature = "describe")]
 pub mod describe;
+mod egress;
 mod endpoint;
 mod error;
 mod executor;
+mod frame;
 mod inputs;
 mod member;
 mod msg;
@@ -99,6 +101,7 @@ mod parcel;
 mod policy;
 mod pool;
 mod postoffice;
+mod shared;
 mod waker;
 pub mod wire;
 

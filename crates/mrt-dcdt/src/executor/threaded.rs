@@ -2,13 +2,24 @@
 //! Member corresponds to a particular thread").
 
 use super::{ExitReason, RunReport};
-use crate::agora::{Agora, AgoraShared};
+use crate::agora::Agora;
 use crate::error::DcdtError;
 use crate::member::{Activation, MemberReport, Runner, Step};
+use crate::shared::AgoraShared;
 use mrt_core::Time;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Condvar, Mutex};
 use std::thread;
+
+// `Agora::lets_work` lives with the executor it hands the Agora to: executors know the Agora,
+// the Agora knows no executor.
+impl Agora {
+    /// Runs every activated Member, each on its own thread, until every Member terminated or
+    /// one called `shutdown` (`LetsWork()`). Needs a real-time clock.
+    pub fn lets_work(self) -> Result<RunReport, DcdtError> {
+        ThreadedExecutor::new().run(self)
+    }
+}
 
 /// Runs each activated Member of one Agora on its own thread until every Member terminated or
 /// shutdown was called. All Members run `init` before any runs its first job, so a producer's
