@@ -29,6 +29,10 @@
 
 use nalgebra::{Matrix2, Point2, Point3, Rotation3, Vector2, Vector3};
 
+/// The largest image side the vision accepts (larger frames are refused, not processed), and
+/// so the largest a camera file may describe.
+pub const MAX_SIDE: u32 = 16_384;
+
 /// A pixel position `(col, row)`, sub-pixel, top-left origin, rows downwards.
 pub type Pixel = Point2<f64>;
 
@@ -454,7 +458,7 @@ impl CameraFile {
         if self.model != "pinhole" {
             return Err(format!("model = \"{}\": the models are \"pinhole\"", self.model));
         }
-        let max = crate::vision::blobs::MAX_SIDE;
+        let max = MAX_SIDE;
         if !(1..=max).contains(&self.width) || !(1..=max).contains(&self.height) {
             return Err(format!("width and height must be 1 to {max} pixels"));
         }
@@ -590,7 +594,7 @@ impl OmniFile {
                 self.model
             ));
         }
-        let max = crate::vision::blobs::MAX_SIDE;
+        let max = MAX_SIDE;
         if !(1..=max).contains(&self.width) || !(1..=max).contains(&self.height) {
             return Err(format!("width and height must be 1 to {max} pixels"));
         }

@@ -18,7 +18,7 @@
 //! # Ok::<(), mrt_perception::source::SourceError>(())
 //! ```
 
-use crate::vision::blobs::MAX_SIDE;
+use crate::camera::MAX_SIDE;
 use mrt_msgs::Image;
 use std::path::{Path, PathBuf};
 

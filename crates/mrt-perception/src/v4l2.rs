@@ -20,8 +20,8 @@
 //! # Ok::<(), mrt_perception::source::SourceError>(())
 //! ```
 
+use crate::camera::MAX_SIDE;
 use crate::source::{ImageSource, SourceError};
-use crate::vision::blobs::MAX_SIDE;
 use linuxvideo::format::{PixFormat, PixelFormat};
 use linuxvideo::stream::ReadStream;
 use linuxvideo::{BufType, Device};

@@ -15,8 +15,9 @@ use image::{GrayImage, Luma};
 use imageproc::region_labelling::{connected_components, Connectivity};
 use nalgebra::{Point2, Point3};
 
-/// The largest image side the vision accepts (larger frames are refused, not processed).
-pub const MAX_SIDE: u32 = 16_384;
+// The largest image side the vision accepts, defined with the camera models (whose files may
+// not describe a larger image).
+pub use crate::camera::MAX_SIDE;
 
 /// One connected region of a class.
 #[derive(Clone, Copy, Debug, PartialEq)]
