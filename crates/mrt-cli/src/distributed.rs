@@ -11,9 +11,7 @@
 
 use crate::world::{FIRST_ANSWER, PHASES};
 use anyhow::{anyhow, bail, Context as _, Result};
-use mrt_monitor::{Recorder, SharedRecorder, Tap};
 use mrt_net::{NetConfig, RawPort};
-use mrt_robot::config::RobotFile;
 use mrt_robot::stacks::Stack;
 use mrt_sim::config::SimConfig;
 use mrt_sim::game::MatchReport;
@@ -26,53 +24,6 @@ use std::time::{Duration, Instant};
 
 /// How long robots may take to start (load behaviors, join the network).
 const START: Duration = Duration::from_secs(120);
-
-/// `mrt robot --config FILE`: one robot's Agora on its configured devices.
-#[derive(clap::Args)]
-pub struct RobotArgs {
-    /// The robot file (TOML; see configs/robot/robot.toml): which robot, its stack, body,
-    /// sensors, field, guidance and devices.
-    #[arg(long)]
-    pub config: PathBuf,
-    /// Record every message of the robot's Agora into this MCAP file (topics
-    /// `/<prefix>/<type>`, the robot's clock), finished when the robot ends.
-    #[arg(long, value_name = "FILE.mcap")]
-    pub record: Option<PathBuf>,
-    /// With --record: the topics' prefix, e.g. `home/1` (default: the robot's name in its
-    /// devices, else `robot-<id>`). `home/k` and `away/k` are what the web monitor matches
-    /// with the truth's robots.
-    #[arg(long, value_name = "PREFIX", requires = "record")]
-    pub record_as: Option<String>,
-}
-
-/// A Member added to a robot's Agora beside its own (`RemoteRobot::with_members`).
-type Extra = Box<dyn mrt_dcdt::Member>;
-
-impl RobotArgs {
-    /// The recorder of `--record` (none without it) and the Members to add to the robot's
-    /// Agora for it: its tap, recording under `--record-as` or `default`.
-    pub(crate) fn recording(&self, default: &str) -> Result<(Option<SharedRecorder>, Vec<Extra>)> {
-        let Some(path) = &self.record else { return Ok((None, Vec::new())) };
-        let rec = Recorder::create(path)?.shared();
-        let prefix = self.record_as.clone().unwrap_or_else(|| default.to_string());
-        let tap: Extra = Box::new(Tap::new(prefix, rec.clone()));
-        Ok((Some(rec), vec![tap]))
-    }
-}
-
-/// Finishes the recording of `mrt robot --record`, and says what it holds.
-pub(crate) fn finish_recording(rec: Option<SharedRecorder>, path: Option<&Path>) -> Result<()> {
-    if let (Some(rec), Some(path)) = (rec, path) {
-        let s = Recorder::finish_shared(rec)?;
-        eprintln!(
-            "recorded {} messages on {} topics into {}",
-            s.messages,
-            s.channels,
-            path.display()
-        );
-    }
-    Ok(())
-}
 
 /// Picks the loopback ports of one match: free now, distinct, and outside the system's
 /// ephemeral range. A port the system handed out for `:0` could be handed out again, to an
@@ -492,23 +443,6 @@ pub struct Rejoined {
     pub after: Option<Duration>,
     /// Where the time went, as the robot wrote it (`behaviors loaded and linked 0.2 s, ready 0.4 s after start`).
     pub phases: String,
-}
-
-/// `mrt robot --config FILE`: one robot's Agora on the devices its file names, until its
-/// world ends the match.
-pub fn robot(args: &RobotArgs) -> Result<()> {
-    let started = Instant::now();
-    let file = RobotFile::from_file(&args.config).map_err(|e| anyhow!("{e}"))?;
-    if file.devices.kind != "world" {
-        bail!(
-            "{}: devices.kind = \"{}\": this mrt drives worlds of the device protocol \
-             (kind = \"world\", docs/devices.md); a robot with its own hardware implements \
-             mrt_robot::devices::Devices (see ARCHITECTURE.md)",
-            args.config.display(),
-            file.devices.kind.escape_debug()
-        );
-    }
-    crate::world::robot(args, &file, started)
 }
 
 #[cfg(test)]

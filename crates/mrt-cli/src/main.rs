@@ -100,7 +100,7 @@ enum Command {
     /// Run one robot: its Agora on the devices its robot file names (configs/robot/; `mrt sim
     /// --distributed` starts each of its robots with this command).
     #[cfg(feature = "net")]
-    Robot(distributed::RobotArgs),
+    Robot(world::RobotArgs),
     /// Play in a world nobody here wrote: `mrt world mujoco` starts the MuJoCo world
     /// (worlds/mujoco/, Python) and one `mrt robot` per robot on its devices (docs/devices.md).
     #[cfg(feature = "net")]
@@ -355,7 +355,7 @@ fn run(command: Command) -> Result<()> {
         Command::Soak { command } => soak::run(&command)?,
         Command::Mice { command } => mice::run(&command)?,
         #[cfg(feature = "net")]
-        Command::Robot(args) => distributed::robot(&args)?,
+        Command::Robot(args) => world::robot(&args)?,
         #[cfg(feature = "net")]
         Command::World { command: WorldCommand::Mujoco(args) } => mujoco::play(&args)?,
         Command::Bb { command } => bb::run(command)?,

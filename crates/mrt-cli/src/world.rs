@@ -1,23 +1,90 @@
 //! `mrt robot --config FILE` with `[devices] kind = "world"`: the robot program on the
-//! devices of a world that speaks the device protocol over zenoh (docs/devices.md).
+//! devices of a world that speaks the device protocol over zenoh (docs/devices.md): the
+//! command's arguments ([`RobotArgs`]), its recording, and the robot's run. `mrt sim
+//! --distributed` (`distributed`) starts such robots and reads what they write to their logs
+//! ([`PHASES`], [`FIRST_ANSWER`]).
 
-use crate::distributed::RobotArgs;
 use anyhow::{anyhow, bail, Context as _, Result};
 use mrt_core::AgoraId;
 use mrt_dcdt::config::AgoraConfig;
 use mrt_dcdt::Message as _;
 use mrt_devices::Keys;
+use mrt_monitor::{Recorder, SharedRecorder, Tap};
 use mrt_msgs::MateReport;
 use mrt_net::{NetConfig, RawPort};
 use mrt_robot::config::RobotFile;
 use mrt_robot::members::behaviors_dir;
 use mrt_robot::remote::RemoteRobot;
 use mrt_robot::world::{WorldMail, WorldPort, WorldRobot};
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc::{sync_channel, TrySendError};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
+
+/// `mrt robot --config FILE`: one robot's Agora on its configured devices.
+#[derive(clap::Args)]
+pub struct RobotArgs {
+    /// The robot file (TOML; see configs/robot/robot.toml): which robot, its stack, body,
+    /// sensors, field, guidance and devices.
+    #[arg(long)]
+    pub config: PathBuf,
+    /// Record every message of the robot's Agora into this MCAP file (topics
+    /// `/<prefix>/<type>`, the robot's clock), finished when the robot ends.
+    #[arg(long, value_name = "FILE.mcap")]
+    pub record: Option<PathBuf>,
+    /// With --record: the topics' prefix, e.g. `home/1` (default: the robot's name in its
+    /// devices, else `robot-<id>`). `home/k` and `away/k` are what the web monitor matches
+    /// with the truth's robots.
+    #[arg(long, value_name = "PREFIX", requires = "record")]
+    pub record_as: Option<String>,
+}
+
+/// A Member added to a robot's Agora beside its own (`RemoteRobot::with_members`).
+type Extra = Box<dyn mrt_dcdt::Member>;
+
+impl RobotArgs {
+    /// The recorder of `--record` (none without it) and the Members to add to the robot's
+    /// Agora for it: its tap, recording under `--record-as` or `default`.
+    pub(crate) fn recording(&self, default: &str) -> Result<(Option<SharedRecorder>, Vec<Extra>)> {
+        let Some(path) = &self.record else { return Ok((None, Vec::new())) };
+        let rec = Recorder::create(path)?.shared();
+        let prefix = self.record_as.clone().unwrap_or_else(|| default.to_string());
+        let tap: Extra = Box::new(Tap::new(prefix, rec.clone()));
+        Ok((Some(rec), vec![tap]))
+    }
+}
+
+/// Finishes the recording of `mrt robot --record`, and says what it holds.
+pub(crate) fn finish_recording(rec: Option<SharedRecorder>, path: Option<&Path>) -> Result<()> {
+    if let (Some(rec), Some(path)) = (rec, path) {
+        let s = Recorder::finish_shared(rec)?;
+        eprintln!(
+            "recorded {} messages on {} topics into {}",
+            s.messages,
+            s.channels,
+            path.display()
+        );
+    }
+    Ok(())
+}
+
+/// `mrt robot --config FILE`: one robot's Agora on the devices its file names, until its
+/// world ends the match.
+pub fn robot(args: &RobotArgs) -> Result<()> {
+    let started = Instant::now();
+    let file = RobotFile::from_file(&args.config).map_err(|e| anyhow!("{e}"))?;
+    if file.devices.kind != "world" {
+        bail!(
+            "{}: devices.kind = \"{}\": this mrt drives worlds of the device protocol \
+             (kind = \"world\", docs/devices.md); a robot with its own hardware implements \
+             mrt_robot::devices::Devices (see ARCHITECTURE.md)",
+            args.config.display(),
+            file.devices.kind.escape_debug()
+        );
+    }
+    on_world(args, &file, started)
+}
 
 /// A robot that hears nothing from its world for this long gives up.
 const SILENCE: Duration = Duration::from_secs(30);
@@ -43,7 +110,7 @@ impl WorldPort for Port {
 /// Runs the robot of `file` (read from `path`) on its world until the world's end. The vision
 /// µAgent runs when `[vision] enabled` says so (a world that sends images needs it; one that
 /// sends an object sensor's frames does not).
-pub fn robot(args: &RobotArgs, file: &RobotFile, started: Instant) -> Result<()> {
+fn on_world(args: &RobotArgs, file: &RobotFile, started: Instant) -> Result<()> {
     let path = args.config.as_path();
     let here = path.parent().unwrap_or(Path::new("."));
     let at = |e: String| anyhow!("{}: {e}", path.display());
@@ -149,5 +216,5 @@ pub fn robot(args: &RobotArgs, file: &RobotFile, started: Instant) -> Result<()>
     for f in &run.bye.faults {
         eprintln!("robot {name}: {} ×{}: {}", f.name, f.count, f.error.escape_debug());
     }
-    crate::distributed::finish_recording(rec, args.record.as_deref())
+    finish_recording(rec, args.record.as_deref())
 }
