@@ -23,8 +23,9 @@ use mrt_msgs::{
 use mrt_plan::kinematics::integrate;
 use mrt_robot::config::{RobotConfig, RobotFile};
 use mrt_robot::devices::{DeviceError, Devices};
-use mrt_robot::members::{add_robot, RobotSpec};
-use mrt_robot::stacks::Stack;
+use mrt_robot::members::add_robot;
+use mrt_robot::spec::RobotSpec;
+use mrt_robot::spec::Stack;
 use std::sync::{Arc, Mutex};
 
 /// The toy robot's hardware: where it truly is, where the ball is, what its motors were told.

@@ -12,7 +12,7 @@
 use crate::world::{FIRST_ANSWER, PHASES};
 use anyhow::{anyhow, bail, Context as _, Result};
 use mrt_net::{NetConfig, RawPort};
-use mrt_robot::stacks::Stack;
+use mrt_robot::spec::Stack;
 use mrt_sim::config::SimConfig;
 use mrt_sim::game::MatchReport;
 use mrt_sim::remote::{robot_name, Patience, PitchWorld, WorldPort, WORLD};

@@ -11,7 +11,7 @@ use mrt_monitor::{MatchInfo, RecordProfile, RecordSummary, Recorder, Recording, 
 use mrt_msgs::GameState;
 use mrt_perception::camera::OmniFile;
 use mrt_robot::config::RobotFile;
-use mrt_robot::stacks::Stack;
+use mrt_robot::spec::Stack;
 use mrt_sim::game::TeamStats;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};

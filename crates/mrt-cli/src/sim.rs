@@ -4,7 +4,7 @@ use anyhow::{anyhow, Context as _, Result};
 use indicatif::{ProgressBar, ProgressStyle};
 use mrt_monitor::serve::Server;
 use mrt_monitor::{RecordProfile, Recorder, SharedRecorder, SharedTimeline, Timeline};
-use mrt_robot::stacks::Stack;
+use mrt_robot::spec::Stack;
 use mrt_sim::config::SimConfig;
 use mrt_sim::game::{MatchReport, TeamStats};
 use mrt_sim::metrics::MetricsBook;

@@ -8,7 +8,7 @@
 
 use anyhow::{anyhow, bail, Result};
 use indicatif::{ProgressBar, ProgressStyle};
-use mrt_robot::stacks::Stack;
+use mrt_robot::spec::Stack;
 use mrt_sim::bus::BusMatch;
 use mrt_sim::config::SimConfig;
 use mrt_sim::soak::{resident_bytes, slope, SoakMatch};

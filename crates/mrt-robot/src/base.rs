@@ -12,27 +12,13 @@
 //! a sideways request turns the base while it drives the part of the request along its
 //! heading, and the behavior, which sees the robot turn, closes the loop.
 
-use crate::error::RobotError;
+use crate::error::{DriverError, RobotError};
 use mrt_core::Pose2;
 use mrt_msgs::Displacement;
 use mrt_plan::kinematics::{
     duty_cycle, integrate, nearer_end, DiffDrive, Kinematics, Omni3, OmniWheels, Steering, Twist,
     WheelSpeeds,
 };
-
-/// What a motor driver refuses.
-#[derive(Debug, thiserror::Error, PartialEq)]
-#[non_exhaustive]
-pub enum DriverError {
-    /// Not one duty cycle per wheel.
-    #[error("{got} duty cycles for {wheels} wheels")]
-    WheelCount {
-        /// Wheels of the base.
-        wheels: usize,
-        /// Duty cycles given.
-        got: usize,
-    },
-}
 
 /// The driver side of the AIRBoard: one PWM duty cycle in `[-1, 1]` per wheel.
 pub trait MotorDriver: Send {

@@ -6,6 +6,7 @@
 
 use crate::base::Base;
 use crate::error::RobotError;
+use crate::spec::{RobotSpec, Stack};
 use mrt_perception::camera::{CameraFile, Omni, OmniFile, Pinhole};
 use mrt_perception::mice::MiceOdometry;
 use mrt_perception::vision::colors::ColorTable;
@@ -456,8 +457,8 @@ impl RobotFile {
         Ok(toml::to_string(self)?)
     }
 
-    /// Which robot and which stack ([`crate::members::RobotSpec`]).
-    pub fn spec(&self) -> Result<crate::members::RobotSpec, RobotError> {
+    /// Which robot and which stack ([`RobotSpec`]).
+    pub fn spec(&self) -> Result<RobotSpec, RobotError> {
         self.checked_spec().map_err(RobotError::Config)
     }
 
@@ -466,10 +467,9 @@ impl RobotFile {
         self.checked_config().map_err(RobotError::Config)
     }
 
-    fn checked_spec(&self) -> Result<crate::members::RobotSpec, String> {
+    fn checked_spec(&self) -> Result<RobotSpec, String> {
         let r = &self.robot;
-        let stack =
-            crate::stacks::Stack::parse(&r.stack).map_err(|e| format!("robot.stack: {e}"))?;
+        let stack = Stack::parse(&r.stack).map_err(|e| format!("robot.stack: {e}"))?;
         let n = r.team_size;
         if !(1..=11).contains(&n) {
             return Err(format!("robot.team_size must be 1 to 11, not {n}"));
@@ -477,7 +477,7 @@ impl RobotFile {
         if r.id >= 2 * n {
             return Err(format!("robot.id must be below 2 × team_size = {}, not {}", 2 * n, r.id));
         }
-        Ok(crate::members::RobotSpec { robot: r.id, keeper: r.id % n == 0, mate: r.id % n, stack })
+        Ok(RobotSpec { robot: r.id, keeper: r.id % n == 0, mate: r.id % n, stack })
     }
 
     fn checked_config(&self) -> Result<RobotConfig, String> {

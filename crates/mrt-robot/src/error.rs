@@ -1,6 +1,7 @@
 //! What can go wrong setting up or running the robot program: [`RobotError`]. Each variant
 //! says where the trouble is (the robot file, the bus, a stack's behaviors, the wheels, the
-//! world's link) and keeps the error it came from as its source.
+//! world's link) and keeps the error it came from as its source; and what a motor driver
+//! refuses: [`DriverError`].
 
 use std::path::PathBuf;
 
@@ -41,7 +42,7 @@ pub enum RobotError {
     Plan(#[from] mrt_plan::PlanError),
     /// The wheels' driver refused a command or a reading.
     #[error(transparent)]
-    Driver(#[from] crate::base::DriverError),
+    Driver(#[from] DriverError),
     /// A message to or from the world could not be encoded.
     #[error(transparent)]
     Json(#[from] serde_json::Error),
@@ -79,4 +80,18 @@ pub enum RobotError {
     /// A robot number too large for an Agora id.
     #[error("robot {0} has no Agora id (at most u32::MAX - 1)")]
     RobotNumber(usize),
+}
+
+/// What a motor driver refuses.
+#[derive(Debug, thiserror::Error, PartialEq)]
+#[non_exhaustive]
+pub enum DriverError {
+    /// Not one duty cycle per wheel.
+    #[error("{got} duty cycles for {wheels} wheels")]
+    WheelCount {
+        /// Wheels of the base.
+        wheels: usize,
+        /// Duty cycles given.
+        got: usize,
+    },
 }

@@ -30,7 +30,7 @@
 //! // The baseline player sees the ball 1 m straight ahead: it goes for it.
 //! let mut w = WorldSnapshot::default();
 //! w.game_state = mrt_msgs::GameState::Playing;
-//! w.lps[lps::BALL] = Lpo { rho: 1000.0, theta: 0.0, reliability: 1.0, seen_ago: 0.0 };
+//! w.lps[lps::BALL] = Lpo { rho: 1.0, theta: 0.0, reliability: 1.0, seen_ago: 0.0 };
 //! let cmd = Chaser::default().cycle(&w);
 //! assert!(cmd.twist.vx > 0.0, "{cmd:?}");
 //! ```
@@ -50,6 +50,7 @@ pub mod mission;
 pub mod planner;
 pub mod remote;
 pub mod rerun;
+pub mod spec;
 pub mod stacks;
 pub mod world;
 

@@ -13,7 +13,8 @@
 use crate::config::RobotConfig;
 use crate::devices::{Actuation, LinkedDevices, Loaded};
 use crate::error::RobotError;
-use crate::members::{add_robot, member_faults, RobotSpec};
+use crate::members::{add_robot, member_faults};
+use crate::spec::RobotSpec;
 use mrt_core::{SimClock, Time};
 use mrt_dcdt::config::AgoraConfig;
 use mrt_dcdt::{

@@ -6,7 +6,7 @@
 
 use crate::error::RobotError;
 use crate::members::behavior_member;
-use crate::stacks::Stack;
+use crate::spec::Stack;
 use mrt_core::SimClock;
 use mrt_dcdt::{Activation, Context, Member, MemberError, RequestType, SteppedExecutor};
 use mrt_msgs::{BehaviorStatus, RobotCommand, WorldSnapshot};

@@ -18,49 +18,13 @@ use crate::brain::Brain;
 use crate::config::RobotConfig;
 use crate::error::RobotError;
 use crate::files::FilesDir;
+use crate::spec::Stack;
 use mrt_core::frames::{millimetres, twist_from_setpoints};
 use mrt_core::{Point2, Pose2, Twist};
 use mrt_fuzzy::brian::Brian;
 use mrt_msgs::robot::{lps, Field, GameState, Lpo, RobotCommand, Target, WorldSnapshot};
 use mrt_plan::guidance::behind_ball;
 use std::path::Path;
-
-/// A behavior stack.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Stack {
-    /// TeamChaos: Lua HFSM and fuzzy HBM behaviors.
-    Chaos,
-    /// Team Milan: Mr. BRIAN fuzzy behaviors (`configs/brian/milan`).
-    Milan,
-    /// The hand-written baseline.
-    Chaser,
-    /// Team ISocRob: the Machine µAgent's role state machines on a shared blackboard
-    /// ([`crate::isocrob`]).
-    Isocrob,
-}
-
-impl Stack {
-    /// Parses `chaos`, `milan` or `chaser`.
-    pub fn parse(s: &str) -> Result<Stack, RobotError> {
-        match s {
-            "chaos" => Ok(Stack::Chaos),
-            "milan" => Ok(Stack::Milan),
-            "chaser" => Ok(Stack::Chaser),
-            "isocrob" => Ok(Stack::Isocrob),
-            other => Err(RobotError::UnknownStack(other.to_string())),
-        }
-    }
-
-    /// The name.
-    pub fn name(self) -> &'static str {
-        match self {
-            Stack::Chaos => "chaos",
-            Stack::Milan => "milan",
-            Stack::Chaser => "chaser",
-            Stack::Isocrob => "isocrob",
-        }
-    }
-}
 
 /// The TeamChaos behavior files, compiled in.
 const TEAMCHAOS: &[(&str, &str)] = &[

@@ -3,7 +3,8 @@
 
 #![allow(clippy::unwrap_used)]
 
-use mrt_robot::stacks::{send_brain, Stack};
+use mrt_robot::spec::Stack;
+use mrt_robot::stacks::send_brain;
 use mrt_robot::RobotError;
 
 #[test]

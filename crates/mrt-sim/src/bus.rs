@@ -22,10 +22,8 @@ use mrt_robot::brain::Brain;
 use mrt_robot::config::RobotConfig;
 use mrt_robot::devices::SharedDevices;
 use mrt_robot::files::FilesDir;
-use mrt_robot::members::{
-    add_robot, add_robot_with_brain, behaviors_dir, member_faults, RobotSpec,
-};
-use mrt_robot::stacks::Stack;
+use mrt_robot::members::{add_robot, add_robot_with_brain, behaviors_dir, member_faults};
+use mrt_robot::spec::{RobotSpec, Stack};
 use std::path::Path;
 use std::sync::{Arc, Mutex, MutexGuard};
 use std::time::Duration;

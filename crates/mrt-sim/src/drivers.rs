@@ -5,7 +5,8 @@
 //! motion exactly as on a real base (a differential drive cannot move sideways; a command
 //! beyond a wheel's top speed is scaled down as a whole, keeping its direction).
 
-use mrt_robot::base::{Base, DriverError, MotorDriver};
+use mrt_robot::base::{Base, MotorDriver};
+use mrt_robot::error::DriverError;
 
 /// The simulated AIRBoard of one robot: duty cycles in, the robot's wheels turn in the world.
 pub struct SimulatedAirboard {

@@ -25,7 +25,7 @@ pub enum SimError {
     Json(#[from] serde_json::Error),
     /// A base's wheels refused a command or a reading.
     #[error(transparent)]
-    Driver(#[from] mrt_robot::base::DriverError),
+    Driver(#[from] mrt_robot::error::DriverError),
     /// The planner, guidance or the indoor robot's mission refused its map or parameters.
     #[error(transparent)]
     Plan(#[from] mrt_plan::PlanError),

@@ -43,7 +43,7 @@ pub mod world;
 
 pub use error::SimError;
 
-use mrt_robot::stacks::Stack;
+use mrt_robot::spec::Stack;
 use std::path::Path;
 
 /// Plays one match between two stacks (`home`, `away`), `cfg.rules.team_size` robots each,

@@ -405,9 +405,9 @@ mod tests {
     use crate::bus::BusMatch;
     use crate::config::short;
     use mrt_dcdt::{Agora, AgoraPort, MsgRef, MsgType, Outlet};
-    use mrt_robot::members::RobotSpec;
     use mrt_robot::remote::RemoteRobot;
-    use mrt_robot::stacks::Stack;
+    use mrt_robot::spec::RobotSpec;
+    use mrt_robot::spec::Stack;
     use mrt_robot::world::{WorldMail, WorldRobot, WorldRun};
     use mrt_robot::RobotError;
     use std::path::Path;

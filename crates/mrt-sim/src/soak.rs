@@ -8,7 +8,7 @@
 
 use crate::config::SimConfig;
 use crate::error::SimError;
-use mrt_robot::stacks::Stack;
+use mrt_robot::spec::Stack;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use std::panic::AssertUnwindSafe;

@@ -8,7 +8,7 @@
 
 #![allow(clippy::unwrap_used)]
 
-use mrt_robot::stacks::Stack;
+use mrt_robot::spec::Stack;
 use mrt_sim::config::SimConfig;
 use mrt_sim::game::MatchReport;
 use mrt_sim::play;

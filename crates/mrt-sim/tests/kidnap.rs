@@ -3,7 +3,7 @@
 #![allow(missing_docs, clippy::unwrap_used, clippy::expect_used)]
 
 use mrt_robot::config::Localizer;
-use mrt_robot::stacks::Stack;
+use mrt_robot::spec::Stack;
 use mrt_sim::config::SimConfig;
 use mrt_sim::game::Pitch;
 use mrt_sim::metrics::MetricsBook;

@@ -14,7 +14,8 @@ use mrt_dcdt::{Activation, Context, Member, MemberError, RequestType};
 use mrt_msgs::Localization;
 use mrt_msgs::WorldSnapshot;
 use mrt_robot::brain::Brain;
-use mrt_robot::stacks::{team, Chaser, Stack};
+use mrt_robot::spec::Stack;
+use mrt_robot::stacks::{team, Chaser};
 use std::sync::{Arc, Mutex};
 
 fn chasers(n: usize) -> Vec<Box<dyn Brain + Send>> {

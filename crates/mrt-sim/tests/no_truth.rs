@@ -11,7 +11,7 @@
 
 use mrt_dcdt::{Activation, Context, Member, MemberError, RequestType};
 use mrt_msgs::{CameraFrame, Percepts, WorldSnapshot};
-use mrt_robot::stacks::Stack;
+use mrt_robot::spec::Stack;
 use mrt_sim::bus::BusMatch;
 use mrt_sim::config::{PerceptSource, SimConfig};
 use std::path::Path;

@@ -51,8 +51,9 @@ use crate::files::FilesDir;
 use crate::isocrob::IsocrobBrain;
 use crate::look_around::LookAround;
 use crate::planner::{carrot, plans_for, same_goal, Planner, REPLAN};
+use crate::spec::{RobotSpec, Stack};
 use crate::stacks::{
-    embedded_teamchaos, send_brain, Geometry, MilanBrain, Stack, CHAOS_KEEPER, CHAOS_PLAYER,
+    embedded_teamchaos, send_brain, Geometry, MilanBrain, CHAOS_KEEPER, CHAOS_PLAYER,
 };
 use mrt_blackboard::{Blackboard, Proxy};
 use mrt_core::Pose2;
@@ -99,39 +100,6 @@ use guidance::GuidanceMember;
 pub(crate) use motor::Motor;
 use vision::Vision;
 use world_state::WorldState;
-
-/// One robot of a match: which robot it is (0 .. 2 × team size: home, then away), whether it
-/// keeps goal and which behavior stack drives it. Its Agora's id is `robot + 1`.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct RobotSpec {
-    /// The robot.
-    pub robot: usize,
-    /// Keeps goal (robot 0 of each team).
-    pub keeper: bool,
-    /// Its number within its team (0: the goalkeeper).
-    pub mate: usize,
-    /// What drives it.
-    pub stack: Stack,
-}
-
-impl RobotSpec {
-    /// Robot `robot` of a match with `team_size` robots a side, the home team playing `home`
-    /// and the away team `away`.
-    pub fn of(robot: usize, team_size: usize, (home, away): (Stack, Stack)) -> RobotSpec {
-        let n = team_size.max(1);
-        RobotSpec {
-            robot,
-            keeper: robot % n == 0,
-            mate: robot % n,
-            stack: if robot < n { home } else { away },
-        }
-    }
-
-    /// The id of the robot's Agora.
-    pub fn agora_id(&self) -> Result<u32, RobotError> {
-        u32::try_from(self.robot + 1).map_err(|_| RobotError::RobotNumber(self.robot))
-    }
-}
 
 /// Puts one robot's Members into `agora`, activated: the drivers of its `devices`, its world
 /// state, its behaviors (the stack of `spec`: the TeamChaos files of `behaviors` for the Chaos
