@@ -10,9 +10,6 @@
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 
-/// Crates whose circles are tolerated for now: their modules are being reorganized.
-const PENDING: &[&str] = &["mrt-script"];
-
 /// Top-level module → the modules it names.
 type Graph = BTreeMap<String, BTreeSet<String>>;
 
@@ -144,24 +141,12 @@ fn no_module_imports_a_module_that_imports_it_back() {
     let imports: usize = graphs.values().flat_map(|g| g.values()).map(BTreeSet::len).sum();
     assert!(imports > 100, "the scanner found only {imports} imports: {graphs:?}");
     let mut found = Vec::new();
-    for (name, graph) in graphs.iter().filter(|(name, _)| !PENDING.contains(&name.as_str())) {
+    for (name, graph) in &graphs {
         for circle in circles(graph) {
             found.push(format!("{name}: {}", circle.join(" → ")));
         }
     }
     assert!(found.is_empty(), "import circles:\n{}", found.join("\n"));
-}
-
-#[test]
-fn every_pending_crate_still_has_a_circle() {
-    let crates = crates();
-    for name in PENDING {
-        let src = crates.get(*name).unwrap_or_else(|| panic!("{name} is not a workspace crate"));
-        assert!(
-            !circles(&graph(src)).is_empty(),
-            "{name} has no import circle any more: remove it from PENDING"
-        );
-    }
 }
 
 #[test]

@@ -17,10 +17,10 @@
 //! from its files after a back-off.
 
 use crate::chaos::{self, RobotIo};
+use crate::error::ScriptError;
 use crate::hbm::Hbm;
 use crate::hfsm::{Hfsm, Taken};
 use crate::runtime::{LuaRuntime, Sandbox};
-use crate::script::ScriptError;
 use crate::watch::ScriptWatcher;
 use mrt_blackboard::Blackboard;
 use mrt_msgs::robot::{RobotCommand, WorldSnapshot};

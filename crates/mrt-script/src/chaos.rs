@@ -11,8 +11,8 @@
 //! Globals `BALL`, `NET1`, `NET2`, `LANDMARK0`.. and `INTEGER`, `FLOAT`, `STRING` are defined.
 //! A wrong argument type is a Lua error in the calling script, never a panic.
 
+use crate::error::ScriptError;
 use crate::runtime::LuaRuntime;
-use crate::script::ScriptError;
 use mlua::{Lua, LuaString, Table, Value};
 use mrt_core::frames::{metres, millimetres, millis, pose_in_metres, pose_in_millimetres, Framed};
 use mrt_core::Time;
@@ -565,7 +565,7 @@ fn install_persistence(api: &Api<'_>, memory_limit: usize) -> mlua::Result<()> {
             return Err(mlua::Error::runtime(format!(
                 "chaos.setGlobal(\"{}\"): not enough memory: the globals would take {total} bytes \
                  of the {memory_limit}-byte memory limit",
-                crate::runtime::clip(&key, 80)
+                crate::error::clip(&key, 80)
             )));
         }
         io.globals_bytes = total;

@@ -29,8 +29,9 @@
 //! too.
 
 use crate::chaos::RobotIo;
+use crate::error::ScriptError;
 use crate::runtime::LuaRuntime;
-use crate::script::{LoadStrategy, Script, ScriptError};
+use crate::script::{LoadStrategy, Script};
 use crate::watch::Change;
 use mlua::{Lua, LuaString, MetaMethod, Table, Value, Variadic};
 use mrt_core::frames::metres;

@@ -43,8 +43,9 @@
 //!   load.
 
 use crate::chaos::RobotIo;
+use crate::error::ScriptError;
 use crate::runtime::LuaRuntime;
-use crate::script::{mtime, ScriptError};
+use crate::script::mtime;
 use mlua::chunk::ChunkMode;
 use mlua::{Function, Lua, Table, Value};
 use mrt_core::frames::millis;

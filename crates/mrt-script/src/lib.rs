@@ -39,12 +39,10 @@
 //! The user guide is `docs/behaviors.md`; the seed's behaviors ship in `behaviors/teamchaos/`.
 #![deny(missing_docs)]
 
-// The one module of the workspace with `unsafe`: a C allocator around Lua's.
-#[allow(unsafe_code)]
-mod alloc;
 pub mod blackboard;
 mod cap;
 pub mod chaos;
+mod error;
 pub mod hbm;
 pub mod hfsm;
 pub mod member;
@@ -56,8 +54,9 @@ mod watch;
 mod watchdog;
 
 pub use cap::{Cycle, ThinkingCap, FAULT_LIMIT, RUNAWAY_LIMIT};
-pub use runtime::{Interrupt, LuaRuntime, Sandbox, MAX_TEXT, PRINT_LINES_PER_CALL, STEP_BYTES};
-pub use script::{LoadStrategy, Script, ScriptError};
+pub use error::{ScriptError, MAX_TEXT};
+pub use runtime::{Interrupt, LuaRuntime, Sandbox, PRINT_LINES_PER_CALL, STEP_BYTES};
+pub use script::{LoadStrategy, Script};
 pub use watch::{compile_source, Change, Compiled, ScriptWatcher};
 pub use watchdog::{
     Watchdog, DEFAULT_DEADLINE, HEALTHY_CYCLES, LOAD_DEADLINE, MAX_BACKOFF, MAX_RESTARTS,

@@ -14,7 +14,7 @@
 //! does not have) is taken back off the disk: the directory keeps holding what runs, so a
 //! robot that restarts starts with it.
 
-use crate::script::ScriptError;
+use crate::error::ScriptError;
 use crate::watch::{compile_source, Change};
 use mrt_msgs::{BehaviorPush, BehaviorPushReply};
 use std::path::{Path, PathBuf};

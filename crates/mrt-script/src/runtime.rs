@@ -28,8 +28,11 @@
 //! blame another script). What none of this sees (a Rust function that blocks) is the
 //! [`Watchdog`](crate::Watchdog)'s.
 
-use crate::alloc;
-use crate::script::ScriptError;
+// The one module of the workspace with `unsafe`: a C allocator around Lua's.
+#[allow(unsafe_code)]
+mod alloc;
+
+use crate::error::{clip, ScriptError, MAX_TEXT};
 use mlua::{HookTriggers, Lua, LuaOptions, MultiValue, StdLib, Value, VmState};
 use std::sync::atomic::{AtomicBool, AtomicU64, AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex, PoisonError};
@@ -61,10 +64,6 @@ const CHECK_EVERY: u32 = 1000;
 
 /// Lines `print` writes to the log in one call; more are counted and dropped.
 pub const PRINT_LINES_PER_CALL: usize = 20;
-
-/// Longest text (bytes) of one `print` line, an error message or a traceback; longer ones
-/// are clipped with a note of how much was cut.
-pub const MAX_TEXT: usize = 1024;
 
 /// Bytes of a C function's output (or of text it scans) that cost one instruction of the
 /// budget.
@@ -661,18 +660,6 @@ fn set_end(p: &[u8], start: usize) -> usize {
     p.len()
 }
 
-/// `text` cut to at most `max` bytes (on a character boundary), saying how much was cut.
-pub(crate) fn clip(text: &str, max: usize) -> String {
-    if text.len() <= max {
-        return text.to_string();
-    }
-    let mut end = max;
-    while !text.is_char_boundary(end) {
-        end -= 1;
-    }
-    format!("{}… [{} more bytes]", &text[..end], text.len() - end)
-}
-
 /// The chunk name of the sandbox's own Lua, as errors and tracebacks show it.
 pub(crate) const PRELUDE_NAME: &str = "sandbox";
 
@@ -713,13 +700,5 @@ mod tests {
         assert_eq!(find_bytes(b"hi", b"hello", 1), None);
         assert_eq!(find_bytes(b"abc", b"c", i64::MAX), None);
         assert_eq!(find_bytes(b"abc", b"a", i64::MIN), Some((1, 1)));
-    }
-
-    #[test]
-    fn clip_keeps_short_texts_and_cuts_long_ones_on_a_boundary() {
-        assert_eq!(clip("short", 10), "short");
-        let long = "é".repeat(10); // 20 bytes
-        let c = clip(&long, 5);
-        assert!(c.starts_with("éé…") && c.ends_with("[16 more bytes]"), "{c}");
     }
 }

@@ -1,6 +1,7 @@
 //! A behavior script: loading strategies, calls with budgets, hot reload with fallback.
 
-use crate::runtime::{clip, LuaRuntime, MAX_TEXT};
+use crate::error::{clip, split_position, ScriptError, MAX_TEXT};
+use crate::runtime::LuaRuntime;
 use crate::watch::Compiled;
 use mlua::chunk::ChunkMode;
 use mlua::{FromLuaMulti, Function};
@@ -8,126 +9,9 @@ use std::cell::RefCell;
 use std::path::{Path, PathBuf};
 use std::time::SystemTime;
 
-/// What went wrong with a script. The robot keeps its last good behavior in every case.
-#[derive(Debug, thiserror::Error)]
-#[non_exhaustive]
-pub enum ScriptError {
-    /// The script does not compile.
-    #[error("{file}:{line}: {message}")]
-    Syntax {
-        /// The script.
-        file: String,
-        /// Line of the error (0 when Lua did not say).
-        line: usize,
-        /// Lua's explanation.
-        message: String,
-    },
-    /// The script raised an error while running (including a chaos API called with wrong
-    /// arguments).
-    #[error("{file}:{line}: runtime error: {message}")]
-    Runtime {
-        /// The script where it happened (the innermost script frame; a behavior `use`d by
-        /// another names its own file).
-        file: String,
-        /// The line (0 when Lua did not say).
-        line: usize,
-        /// Lua's explanation, with the API function that refused its arguments.
-        message: String,
-        /// Lua's stack traceback.
-        traceback: String,
-    },
-    /// The call ran past its instruction budget (an endless loop?).
-    #[error("{file}:{line}: aborted after {budget} instructions (instruction budget exceeded)")]
-    Budget {
-        /// The script that was running when the budget ran out (a behavior `use`d by another
-        /// names its own file).
-        file: String,
-        /// The line it was running (0 when unknown).
-        line: usize,
-        /// The budget.
-        budget: u64,
-    },
-    /// The watchdog stopped the behavior: its cycle did not end within the deadline (a C
-    /// function or an API call that blocks, or anything else the budget does not see).
-    #[error("{file}: stopped by the watchdog: the cycle did not end within {deadline_ms} ms")]
-    Watchdog {
-        /// The script (or the behavior Member) that was running.
-        file: String,
-        /// The deadline.
-        deadline_ms: u64,
-    },
-    /// The robot was stopped: its behaviors ran away (budget or memory) or failed this many
-    /// cycles in a row. It stands still, running no Lua, until its behaviors restart from
-    /// their files (the [`Watchdog`](crate::Watchdog)'s back-off) or a file is reloaded.
-    #[error("{file}: stopped after {cycles} cycles in a row {why}; the robot stands still until its behaviors restart from their files")]
-    Stopped {
-        /// The HFSM file or the behavior at the top.
-        file: String,
-        /// Failing cycles in a row.
-        cycles: u32,
-        /// How they failed: `running away` or `with errors`.
-        why: &'static str,
-    },
-    /// The Lua state ran out of its memory limit.
-    #[error("{file}: aborted: memory limit of {limit} bytes exceeded")]
-    Memory {
-        /// The script.
-        file: String,
-        /// The limit.
-        limit: usize,
-    },
-    /// The script compiled but what it defines is wrong (an HFSM with an unknown state, a
-    /// meta-state containing itself...).
-    #[error("{file}:{line}: {message}")]
-    Invalid {
-        /// The script.
-        file: String,
-        /// The line of the definition (0 when unknown).
-        line: usize,
-        /// What is wrong.
-        message: String,
-    },
-    /// The script file could not be read.
-    #[error("{file}: {source}")]
-    Io {
-        /// The script.
-        file: String,
-        /// The OS error.
-        #[source]
-        source: std::io::Error,
-    },
-    /// The Lua state could not be prepared.
-    #[error("cannot prepare the Lua runtime: {0}")]
-    Setup(String),
-}
-
 impl ScriptError {
-    /// The line the error names, when it names one.
-    pub fn line(&self) -> Option<usize> {
-        match self {
-            ScriptError::Syntax { line, .. }
-            | ScriptError::Runtime { line, .. }
-            | ScriptError::Budget { line, .. }
-            | ScriptError::Invalid { line, .. } => Some(*line).filter(|&l| l > 0),
-            _ => None,
-        }
-    }
-
-    pub(crate) fn setup(e: mlua::Error) -> ScriptError {
-        ScriptError::Setup(e.to_string())
-    }
-
-    /// A compile error: `Syntax` with Lua's line when it is one.
-    pub(crate) fn syntax(file: &str, e: &mlua::Error) -> ScriptError {
-        match e {
-            mlua::Error::SyntaxError { message, .. } => {
-                let (line, msg) = split_position(message);
-                ScriptError::Syntax { file: file.into(), line, message: clip(&msg, MAX_TEXT) }
-            }
-            other => ScriptError::Setup(clip(&format!("{file}: {other}"), MAX_TEXT)),
-        }
-    }
-
+    /// A Lua error of a call into `file` on `rt`: the runtime's meter tells an overrun, an
+    /// interruption and a memory error from the script's own errors.
     pub(crate) fn from_lua(file: &str, rt: &LuaRuntime, e: mlua::Error) -> ScriptError {
         if let mlua::Error::SyntaxError { message, .. } = &e {
             // Lua says `[string "name"]:LINE: message` or `name:LINE: message`.
@@ -204,15 +88,6 @@ fn script_position(s: &str) -> Option<(&str, usize, &str)> {
     // `sandbox` is the runtime's own wrappers (`string.find`...): the script is further out.
     (!name.is_empty() && !name.starts_with('[') && name != crate::runtime::PRELUDE_NAME)
         .then_some((name, line, rest))
-}
-
-fn split_position(message: &str) -> (usize, String) {
-    let mut parts = message.splitn(3, ':');
-    let (_, line, rest) = (parts.next(), parts.next(), parts.next());
-    match (line.and_then(|l| l.trim().parse().ok()), rest) {
-        (Some(l), Some(r)) => (l, r.trim().to_string()),
-        _ => (0, message.to_string()),
-    }
 }
 
 /// How a script is kept between calls (ThinkingCap §3.2; the seed measured 40 / 17 / 7 ms per

@@ -12,7 +12,7 @@
 //! On Linux a file counts as written when it is closed after writing (or created, or renamed
 //! into place), so a half-written file is not compiled; elsewhere every modification counts.
 
-use crate::script::ScriptError;
+use crate::error::ScriptError;
 use mlua::chunk::ChunkMode;
 use notify::event::{AccessKind, AccessMode, CreateKind, ModifyKind, RenameMode};
 use notify::{Event, EventKind, RecommendedWatcher, RecursiveMode, Watcher};

@@ -40,8 +40,8 @@
 //! ```
 
 use crate::cap::{Cycle, ThinkingCap};
+use crate::error::ScriptError;
 use crate::runtime::Interrupt;
-use crate::script::ScriptError;
 use crate::watch::Change;
 use mrt_msgs::robot::{RobotCommand, WorldSnapshot};
 use std::sync::mpsc::{channel, Receiver, RecvTimeoutError, Sender};

@@ -11,7 +11,7 @@
 //! The allocator wraps the one mlua installed (which keeps the memory limit and its counts);
 //! it is taken out again before the runtime is dropped.
 
-use crate::runtime::{Meter, STEP_BYTES};
+use super::{Meter, STEP_BYTES};
 use mlua::{ffi, Lua};
 use std::os::raw::c_void;
 use std::ptr;
