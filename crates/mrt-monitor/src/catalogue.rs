@@ -69,12 +69,11 @@ fn camera_frame_json(m: &Msg) -> Encoded {
     if f.image.is_none() && f.up_image.is_none() {
         return Some(serde_json::to_vec(f));
     }
-    let CameraFrame { time, sightings, robots, ball_velocity, image: _, pan, up_image: _ } = f;
+    let CameraFrame { time, sightings, robots, image: _, pan, up_image: _ } = f;
     let bare = CameraFrame {
         time: *time,
         sightings: *sightings,
         robots: robots.clone(),
-        ball_velocity: *ball_velocity,
         image: None,
         pan: *pan,
         up_image: None,

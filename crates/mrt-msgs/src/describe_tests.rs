@@ -300,7 +300,6 @@ fn filled_camera() -> CameraFrame {
         time: 3.25,
         sightings,
         robots: vec![robot_sighting()],
-        ball_velocity: Some((0.5, 0.0)),
         image: Some(Image::new(640, 480)),
         pan: Some(0.2),
         up_image: Some(Image::new(2, 2)),

@@ -245,10 +245,6 @@ pub struct CameraFrame {
     /// Other robots in view.
     #[serde(default)]
     pub robots: Vec<RobotSighting>,
-    /// The ball's velocity in the robot's frame (m/s). No camera measures one: MRT's devices
-    /// leave it `None`, and the world model's ball tracker (MAP) fills it in the frame it
-    /// reads.
-    pub ball_velocity: Option<(f64, f64)>,
     /// The camera's image, when the camera renders or grabs one (the vision µAgent's input,
     /// ISocRob seed `003` §3.2.1); `None` from the object sensor alone.
     #[serde(default)]

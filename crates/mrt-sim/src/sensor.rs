@@ -358,9 +358,7 @@ mod tests {
         assert_eq!(game_info(&r, 5).attack, -1.0);
         assert_eq!(g.kickoff_pose.map(|p| p.inner), r.kickoff_pose(1));
         assert_eq!(f.time, w.time());
-        // No velocity, though the ball is seen: a camera does not measure one.
         assert!(f.sightings[sighting::BALL].is_some());
-        assert_eq!(f.ball_velocity, None);
     }
 
     #[test]
@@ -373,7 +371,7 @@ mod tests {
             .is_some());
         w.place_robot(6, Pose2::new(-1.5, 0.05, 0.0)); // in the line of sight
         let hidden = look(&w, 1, 0.0, &exact(), |_| Marker::Cyan, &mut rng);
-        assert_eq!((hidden.sightings[sighting::BALL], hidden.ball_velocity), (None, None));
+        assert_eq!(hidden.sightings[sighting::BALL], None);
         assert!(hidden.sightings[WEST_NET].is_some(), "landmarks stand above the robots");
     }
 

@@ -44,7 +44,7 @@ use mrt_msgs::{
     RobotSighting, Sighting, Sonar, SonarScan, FIELD_OBJECTS,
 };
 use mrt_perception::mice::{Displacement, MiceOdometry};
-use nalgebra::{Matrix2, Matrix2x3, Matrix3, Vector2, Vector3};
+use nalgebra::{Matrix2, Matrix2x3, Matrix3, Rotation2, Vector2, Vector3};
 use std::f64::consts::PI;
 
 /// A post is named only when the next best landmark of its pattern fits this many times
@@ -173,8 +173,8 @@ pub struct WorldModel {
     doubted: Option<f64>,
     /// One standard deviation of the ball's place when it was last seen, m.
     ball_seen_sigma: f64,
-    /// The ball's velocity in the field frame (m/s) when the last frame gave one.
-    ball_velocity: Option<(f64, f64)>,
+    /// The ball's velocity (m/s) when the last frame saw the ball.
+    ball_velocity: Option<Framed<Field, Vec2>>,
     /// MAP's anchors of the other robots.
     robots: Anchors,
     /// The radius this model gives the other robots, m (their centre is this far beyond the
@@ -386,7 +386,10 @@ impl WorldModel {
         let (sigma_xy, sigma_theta) = self.sigma();
         let ball = self.memory[lps::BALL].map(|m| BallBelief {
             at: (m.at.inner.x, m.at.inner.y),
-            velocity: self.ball_velocity.filter(|_| m.seen == self.now),
+            velocity: self
+                .ball_velocity
+                .filter(|_| m.seen == self.now)
+                .map(|v| (v.inner.x, v.inner.y)),
             seen_ago: self.now - m.seen,
         });
         Localization {
@@ -446,9 +449,8 @@ impl WorldModel {
     }
 
     /// One camera frame: the nets and landmarks correct the pose, every sighting refreshes the
-    /// LPS memory, the ball's tracker gives its velocity (a velocity in the frame is not read:
-    /// no camera measures one), and the snapshot is built. Call after this cycle's
-    /// [`WorldModel::odometry`].
+    /// LPS memory, the ball's tracker gives its velocity, and the snapshot is built. Call after
+    /// this cycle's [`WorldModel::odometry`].
     pub fn camera(&mut self, frame: &CameraFrame) -> WorldSnapshot {
         let none = [None; FIELD_OBJECTS];
         let perceived = self.global().then(|| {
@@ -456,19 +458,13 @@ impl WorldModel {
         });
         let velocity =
             frame.sightings[sighting::BALL].map(|z| self.track_ball(frame.time, &z, None));
-        let robots = &frame.robots;
-        let frame_pan = frame.pan;
-        let frame = CameraFrame {
-            time: frame.time,
-            sightings: frame.sightings,
-            ball_velocity: velocity,
-            ..Default::default()
-        };
-        self.observe(&frame, &none, robots, frame_pan, perceived, &[])
+        self.observe(frame, &none, &frame.robots, frame.pan, perceived, &[], velocity)
     }
 
-    /// [`WorldModel::camera`] with each sighting's own standard deviations, where known, and
-    /// the frame's perceptions for the relocalizer.
+    /// [`WorldModel::camera`] with each sighting's own standard deviations, where known, the
+    /// frame's perceptions for the relocalizer and the ball tracker's velocity (odometry frame,
+    /// [`WorldModel::track_ball`]).
+    #[allow(clippy::too_many_arguments)]
     fn observe(
         &mut self,
         frame: &CameraFrame,
@@ -477,6 +473,7 @@ impl WorldModel {
         pan: Option<f64>,
         mut perceived: Option<Vec<Perception>>,
         line_points: &[(f64, f64)],
+        ball_velocity: Option<Vec2>,
     ) -> WorldSnapshot {
         let relocalized = self.counts.relocalized;
         // MUREA first checks the odometry's prediction against what the robot sees.
@@ -535,10 +532,10 @@ impl WorldModel {
         }
         let me: Framed<Field, Pose2> = Framed::new(self.pose);
         self.now = frame.time;
-        self.ball_velocity = frame.ball_velocity.map(|(vx, vy)| {
-            let (s, c) = self.pose.theta.sin_cos();
-            (c * vx - s * vy, s * vx + c * vy)
-        });
+        // From the odometry's frame into the field's: turned by the corrected heading's
+        // difference from the odometry's.
+        let turn = Rotation2::new(self.pose.theta - self.odom.theta);
+        self.ball_velocity = ball_velocity.map(|v| Framed::new(turn * v));
         if let Some(z) = frame.sightings[sighting::BALL] {
             // How sure the ball's place is: the sighting's error and the corrected pose's.
             let sd = self.noise.sigma(z.distance, sigmas[sighting::BALL]);
@@ -669,19 +666,19 @@ impl WorldModel {
                 self.counts.posts_named += 1;
             }
         }
-        frame.ball_velocity = p.sightings[sighting::BALL]
+        let velocity = p.sightings[sighting::BALL]
             .map(|z| self.track_ball(p.time, &z, p.sigmas[sighting::BALL]));
-        self.observe(&frame, &sigmas, &p.robots, p.pan, perceived, &p.line_points)
+        self.observe(&frame, &sigmas, &p.robots, p.pan, perceived, &p.line_points, velocity)
     }
 
     /// MAP's tracker fed with one sighting of the ball; returns the ball's velocity in the
-    /// robot's frame. The track lies in the odometry's frame ([`WorldModel::odom`]), not the
+    /// odometry's frame. The track lies in the odometry's frame ([`WorldModel::odom`]), not the
     /// field's: there a correction of the pose (a few centimetres, a degree, every frame that
     /// sees a landmark) would move every sighting after it and read as the ball's motion. The
     /// sighting's covariance is the camera's alone; odometry over a few frames errs far less.
     /// The place stays the sighting's in the field frame (the track lags behind kicks and a
     /// relocalized pose: 0.33 m mean error against 0.20 m).
-    fn track_ball(&mut self, time: f64, z: &Sighting, sigma: Option<(f64, f64)>) -> (f64, f64) {
+    fn track_ball(&mut self, time: f64, z: &Sighting, sigma: Option<(f64, f64)>) -> Vec2 {
         let sd = self.noise.sigma(z.distance, sigma);
         let o = self.odom;
         let a = o.theta + z.bearing;
@@ -693,8 +690,7 @@ impl WorldModel {
             // Gated out (a false sighting, or the first after a kick): the prediction.
             self.ball_track.predicted(time).map_or((0.0, 0.0), |(_, _, vx, vy)| (vx, vy))
         };
-        let (s, c) = o.theta.sin_cos();
-        (c * vx + s * vy, -s * vx + c * vy)
+        Vec2::new(vx, vy)
     }
 
     /// Where an object seen at `range` (m) and `bearing` (rad, robot frame) with standard

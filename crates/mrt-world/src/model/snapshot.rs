@@ -30,10 +30,7 @@ impl WorldModel {
             w.global_ball = Estimate { pose, quality: reliability };
         }
         w.robots = self.anchored_robots(frame.time, attack);
-        if let Some((vx, vy)) = self.ball_velocity {
-            // The velocity turned by the estimated heading into the field frame (`observe`),
-            // then into the team's.
-            let v: Framed<Field, Vec2> = Framed::new(Vec2::new(vx, vy));
+        if let Some(v) = self.ball_velocity {
             w.ball_vel = v.to_team(attack);
         }
         w
