@@ -1,7 +1,6 @@
 //! Camera models: where a point of the world appears in the image, and which floor point a
-//! pixel sees (ISocRob seed `003` §2.2 and §3.2.1; the research notes
-//! `shared/research/ISOCROB_VISION.md` §2–3 write the report's equations 7–11 out, with their
-//! typos and approximations fixed).
+//! pixel sees (ISocRob-2000 report §2.2 and §3.2.1: its equations 7–11, with their typos and
+//! approximations fixed).
 //!
 //! Two models behind one trait, [`Camera`]:
 //! - [`Pinhole`]: a perspective camera mounted on the robot at a height, tilted down, on a
@@ -426,18 +425,95 @@ impl Default for CameraFile {
     }
 }
 
+/// A camera file's value that no camera can have; each names the key at fault.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum CameraFileError {
+    /// `model` is not the file's model.
+    #[error("model = {found:?}: {expected}")]
+    Model {
+        /// The file's `model`.
+        found: String,
+        /// What it may be.
+        expected: &'static str,
+    },
+    /// The file names no model.
+    #[error("no model: say model = \"pinhole\" or \"omni\"")]
+    NoModel,
+    /// `width` or `height` is 0 or larger than [`MAX_SIDE`].
+    #[error("width and height must be 1 to {max} pixels")]
+    Size {
+        /// [`MAX_SIDE`].
+        max: u32,
+    },
+    /// A value that must be a finite number is not.
+    #[error("{key} must be a finite number, not {value}")]
+    NotFinite {
+        /// The key.
+        key: &'static str,
+        /// Its value.
+        value: f64,
+    },
+    /// A value that must be a finite number > 0 is not.
+    #[error("{key} must be a finite number > 0, not {value}")]
+    NotPositive {
+        /// The key.
+        key: &'static str,
+        /// Its value.
+        value: f64,
+    },
+    /// Two values out of their ranges or order.
+    #[error("{rule} (got {} and {})", got.0, got.1)]
+    Range {
+        /// What the two keys must be.
+        rule: &'static str,
+        /// Their values.
+        got: (f64, f64),
+    },
+}
+
+impl CameraFileError {
+    /// Checks that each `(key, value)` is finite.
+    fn finite(values: &[(&'static str, f64)]) -> Result<(), CameraFileError> {
+        match values.iter().find(|(_, v)| !v.is_finite()) {
+            Some(&(key, value)) => Err(CameraFileError::NotFinite { key, value }),
+            None => Ok(()),
+        }
+    }
+
+    /// Checks that each `(key, value)` is finite and > 0.
+    fn positive(values: &[(&'static str, f64)]) -> Result<(), CameraFileError> {
+        match values.iter().find(|(_, v)| !(v.is_finite() && *v > 0.0)) {
+            Some(&(key, value)) => Err(CameraFileError::NotPositive { key, value }),
+            None => Ok(()),
+        }
+    }
+
+    /// Checks that an image is 1 to [`MAX_SIDE`] pixels each way.
+    fn size(width: u32, height: u32) -> Result<(), CameraFileError> {
+        let sides = 1..=MAX_SIDE;
+        if sides.contains(&width) && sides.contains(&height) {
+            Ok(())
+        } else {
+            Err(CameraFileError::Size { max: MAX_SIDE })
+        }
+    }
+}
+
 /// A camera file of type `F` parsed from `text` and checked by `check`; `file` names it in
 /// errors (line and column for syntax).
 fn checked_file<F: serde::de::DeserializeOwned, C>(
     text: &str,
     file: &str,
-    check: impl Fn(&F) -> Result<C, String>,
+    check: impl Fn(&F) -> Result<C, CameraFileError>,
 ) -> Result<F, mrt_core::FileError> {
     let parsed: F = toml::from_str(text).map_err(|e| {
         mrt_core::FileError::parse(file, text, e.span().map(|s| s.start), e.message())
     })?;
-    check(&parsed)
-        .map_err(|message| mrt_core::FileError::Invalid { file: file.to_string(), message })?;
+    check(&parsed).map_err(|e| mrt_core::FileError::Invalid {
+        file: file.to_string(),
+        message: e.to_string(),
+    })?;
     Ok(parsed)
 }
 
@@ -454,37 +530,30 @@ impl CameraFile {
     }
 
     /// The camera it describes, every value checked.
-    pub fn camera(&self) -> Result<Pinhole, String> {
+    pub fn camera(&self) -> Result<Pinhole, CameraFileError> {
         if self.model != "pinhole" {
-            return Err(format!("model = \"{}\": the models are \"pinhole\"", self.model));
+            let expected = "the models are \"pinhole\"";
+            return Err(CameraFileError::Model { found: self.model.clone(), expected });
         }
-        let max = MAX_SIDE;
-        if !(1..=max).contains(&self.width) || !(1..=max).contains(&self.height) {
-            return Err(format!("width and height must be 1 to {max} pixels"));
-        }
-        let finite = [
+        CameraFileError::size(self.width, self.height)?;
+        CameraFileError::finite(&[
             ("cx", self.cx),
             ("cy", self.cy),
             ("k1", self.k1),
             ("k2", self.k2),
             ("mount_x_m", self.mount_x_m),
             ("mount_y_m", self.mount_y_m),
-        ];
-        for (name, v) in finite {
-            if !v.is_finite() {
-                return Err(format!("{name} must be a finite number, not {v}"));
-            }
-        }
-        for (name, v) in [("fx", self.fx), ("fy", self.fy), ("height_m", self.height_m)] {
-            if !(v.is_finite() && v > 0.0) {
-                return Err(format!("{name} must be a finite number > 0, not {v}"));
-            }
-        }
+        ])?;
+        CameraFileError::positive(&[
+            ("fx", self.fx),
+            ("fy", self.fy),
+            ("height_m", self.height_m),
+        ])?;
         if !(-90.0..=90.0).contains(&self.tilt_deg) || !(-180.0..=180.0).contains(&self.pan_deg) {
-            return Err(format!(
-                "tilt_deg must be -90 to 90 and pan_deg -180 to 180 (got {} and {})",
-                self.tilt_deg, self.pan_deg
-            ));
+            return Err(CameraFileError::Range {
+                rule: "tilt_deg must be -90 to 90 and pan_deg -180 to 180",
+                got: (self.tilt_deg, self.pan_deg),
+            });
         }
         let intrinsics = Intrinsics {
             fx: self.fx,
@@ -587,36 +656,28 @@ impl OmniFile {
     }
 
     /// The camera it describes, every value checked.
-    pub fn camera(&self) -> Result<Omni, String> {
+    pub fn camera(&self) -> Result<Omni, CameraFileError> {
         if self.model != "omni" {
-            return Err(format!(
-                "model = \"{}\": an omnidirectional camera file says \"omni\"",
-                self.model
-            ));
+            let expected = "an omnidirectional camera file says \"omni\"";
+            return Err(CameraFileError::Model { found: self.model.clone(), expected });
         }
-        let max = MAX_SIDE;
-        if !(1..=max).contains(&self.width) || !(1..=max).contains(&self.height) {
-            return Err(format!("width and height must be 1 to {max} pixels"));
-        }
-        for (name, v) in [("cx", self.cx), ("cy", self.cy), ("rotation_deg", self.rotation_deg)] {
-            if !v.is_finite() {
-                return Err(format!("{name} must be a finite number, not {v}"));
-            }
-        }
-        for (name, v) in
-            [("scale_px_per_m", self.scale_px_per_m), ("viewpoint_m", self.viewpoint_m)]
-        {
-            if !(v.is_finite() && v > 0.0) {
-                return Err(format!("{name} must be a finite number > 0, not {v}"));
-            }
-        }
+        CameraFileError::size(self.width, self.height)?;
+        CameraFileError::finite(&[
+            ("cx", self.cx),
+            ("cy", self.cy),
+            ("rotation_deg", self.rotation_deg),
+        ])?;
+        CameraFileError::positive(&[
+            ("scale_px_per_m", self.scale_px_per_m),
+            ("viewpoint_m", self.viewpoint_m),
+        ])?;
         if !(self.blind_m.is_finite() && self.blind_m >= 0.0 && self.range_m.is_finite())
             || self.range_m <= self.blind_m
         {
-            return Err(format!(
-                "blind_m must be ≥ 0 and less than range_m (got {} and {})",
-                self.blind_m, self.range_m
-            ));
+            return Err(CameraFileError::Range {
+                rule: "blind_m must be ≥ 0 and less than range_m",
+                got: (self.blind_m, self.range_m),
+            });
         }
         let centre = Pixel::new(self.cx, self.cy);
         let mut cam = Omni::upright(self.width, self.height, self.scale_px_per_m, centre);
@@ -647,8 +708,10 @@ impl CameraModel {
             mrt_core::FileError::parse(file, text, e.span().map(|s| s.start), e.message())
         };
         let table: toml::Table = toml::from_str(text).map_err(parse)?;
-        let invalid =
-            |message: String| mrt_core::FileError::Invalid { file: file.to_string(), message };
+        let invalid = |e: CameraFileError| mrt_core::FileError::Invalid {
+            file: file.to_string(),
+            message: e.to_string(),
+        };
         match table.get("model").and_then(|m| m.as_str()) {
             Some("omni") => {
                 let f: OmniFile = toml::from_str(text).map_err(parse)?;
@@ -658,10 +721,11 @@ impl CameraModel {
                 let f: CameraFile = toml::from_str(text).map_err(parse)?;
                 f.camera().map(CameraModel::Pinhole).map_err(invalid)
             }
-            Some(other) => Err(invalid(format!(
-                "model = \"{other}\": the models are \"pinhole\" and \"omni\""
-            ))),
-            None => Err(invalid("no model: say model = \"pinhole\" or \"omni\"".to_string())),
+            Some(other) => Err(invalid(CameraFileError::Model {
+                found: other.to_string(),
+                expected: "the models are \"pinhole\" and \"omni\"",
+            })),
+            None => Err(invalid(CameraFileError::NoModel)),
         }
     }
 
@@ -867,6 +931,28 @@ mod tests {
         assert!(e.to_string().starts_with("c.toml:10:1: unknown field `roll_deg`"), "{e}");
         let e = CameraFile::from_toml(&text.replace("pinhole", "fisheye"), "c.toml").unwrap_err();
         assert!(e.to_string().contains("the models are \"pinhole\""), "{e}");
+    }
+
+    #[test]
+    fn a_camera_file_s_errors_name_the_key_and_escape_the_model() {
+        let bad = |f: CameraFile| f.camera().unwrap_err();
+        let e = bad(CameraFile { model: "pin\u{1b}[2Jhole".into(), ..CameraFile::default() });
+        assert!(matches!(e, CameraFileError::Model { .. }) && !e.to_string().contains('\u{1b}'));
+        assert_eq!(
+            bad(CameraFile { width: 0, ..CameraFile::default() }),
+            CameraFileError::Size { max: MAX_SIDE }
+        );
+        let e = bad(CameraFile { k1: f64::INFINITY, ..CameraFile::default() });
+        assert!(matches!(e, CameraFileError::NotFinite { key: "k1", .. }), "{e}");
+        let e = bad(CameraFile { height_m: 0.0, ..CameraFile::default() });
+        assert!(matches!(e, CameraFileError::NotPositive { key: "height_m", .. }), "{e}");
+        let e = bad(CameraFile { tilt_deg: 95.0, ..CameraFile::default() });
+        assert_eq!(
+            e.to_string(),
+            "tilt_deg must be -90 to 90 and pan_deg -180 to 180 (got 95 and 0)"
+        );
+        let e = OmniFile { viewpoint_m: f64::NAN, ..OmniFile::default() }.camera().unwrap_err();
+        assert!(matches!(e, CameraFileError::NotPositive { key: "viewpoint_m", .. }), "{e}");
     }
 
     proptest! {

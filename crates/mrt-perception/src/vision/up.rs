@@ -33,7 +33,7 @@
 //! let ball = find_ball_up(&classes, &omni, 0.11).unwrap();
 //! assert!((ball.distance - 5f64.sqrt()).abs() < 0.02, "{ball:?}");
 //! assert!((ball.bearing - 0.5f64.atan()).abs() < 0.01, "{ball:?}");
-//! # Ok::<(), String>(())
+//! # Ok::<(), mrt_perception::camera::CameraFileError>(())
 //! ```
 
 use super::agent::{check_size, VisionError};
