@@ -9,8 +9,10 @@ use mrt_sim::config::SimConfig;
 use mrt_sim::game::{MatchReport, TeamStats};
 use mrt_sim::metrics::MetricsBook;
 use mrt_sim::play_recorded;
-use mrt_sim::referee::{Call, Team};
 use std::path::PathBuf;
+
+mod report;
+pub(crate) use report::team_lines;
 
 /// What `mrt sim` was asked (its command-line options).
 #[derive(clap::Args)]
@@ -385,6 +387,11 @@ pub fn run(args: &SimArgs) -> Result<()> {
         }
         return series(args, &cfg, stacks);
     }
+    one_match(args, &cfg, stacks)
+}
+
+/// One match with a progress bar (and the monitor, with `--serve`), then its report.
+fn one_match(args: &SimArgs, cfg: &SimConfig, stacks: (Stack, Stack)) -> Result<()> {
     let robots = 2 * cfg.rules.team_size;
     if let Some(n) = args.belief.filter(|&n| n >= robots) {
         anyhow::bail!("--belief {n}: the match has robots 0 to {}", robots - 1);
@@ -410,7 +417,7 @@ pub fn run(args: &SimArgs) -> Result<()> {
     let started = std::time::Instant::now();
     let realtime = args.realtime;
     let plot = args.plot.is_some();
-    let (report, notes) = play_one(&cfg, args.seed, stacks, args, plot, timeline.as_ref(), |t| {
+    let (report, notes) = play_one(cfg, args.seed, stacks, args, plot, timeline.as_ref(), |t| {
         bar.set_position(t as u64);
         if realtime {
             let ahead = t - started.elapsed().as_secs_f64();
@@ -420,120 +427,13 @@ pub fn run(args: &SimArgs) -> Result<()> {
         }
     })?;
     bar.finish_and_clear();
-    let (h, a) = (stacks.0.name(), stacks.1.name());
-    outln!("{h} (home) {} : {} {a} (away)   seed {}", report.score.0, report.score.1, report.seed);
-    for line in team_lines(&[h, a], &report.stats) {
-        outln!("{line}");
-    }
-    for (i, name) in [(0, h), (1, a)] {
-        let s = &report.stats[i];
-        if s.booked_cycles > 0 {
-            outln!(
-                "  {name:<8} ball booked in {} robot cycles, by two robots at once in {}",
-                s.booked_cycles,
-                s.booking_conflicts
-            );
-        }
-        // What the robots believed is watched in one process only (not with --distributed).
-        if s.attacker_cycles > 0 {
-            outln!(
-                "  {name:<8} attacker (getRole) in {} robot cycles, two at once in {}",
-                s.attacker_cycles,
-                s.attacker_conflicts
-            );
-        }
-        if s.ball_job_cycles > 0 {
-            outln!(
-                "  {name:<8} SCARE job on the ball in {} robot cycles, two at once in {}",
-                s.ball_job_cycles,
-                s.ball_job_conflicts
-            );
-        }
-    }
-    for (t, call) in &report.calls {
-        if let Call::Goal(team) = call {
-            let who = if *team == Team::Home { h } else { a };
-            outln!("  goal {who:<8} at {:>3}:{:02}", (*t as u64) / 60, (*t as u64) % 60);
-        }
-    }
+    let names = (stacks.0.name(), stacks.1.name());
+    report::score(&report, names);
     let mut book = MetricsBook::default();
     book.add(&report);
-    let m = book.metrics();
-    let l = &m.localization;
-    if let (Some(pm), Some(p95), Some(hm), Some(h95)) =
-        (l.median_m, l.p95_m, l.heading_median_deg, l.heading_p95_deg)
-    {
-        outln!(
-            "  localization error (the robots' own estimates against the truth): position {pm:.2} m median, {p95:.2} m p95; heading {hm:.1}° median, {h95:.1}° p95"
-        );
-    }
-    if let (Some(mean), Some(p95)) = (m.ball.mean_m, m.ball.p95_m) {
-        let velocity = m
-            .ball
-            .velocity_mean_mps
-            .map_or(String::new(), |v| format!("; velocity {v:.2} m/s mean"));
-        outln!("  ball error while seen: {mean:.2} m mean, {p95:.2} m p95{velocity}");
-    }
-    let r = &m.robots;
-    if let (Some(median), Some(p95)) = (r.median_m, r.p95_m) {
-        outln!(
-            "  other robots anchored while seen: {median:.2} m median, {p95:.2} m p95; team right {}, wrong {}, unknown {}; {} phantoms",
-            r.class_right,
-            r.class_wrong,
-            r.class_unknown,
-            r.phantoms
-        );
-    }
-    if let (Some(median), Some(p95)) = (r.remembered_median_m, r.remembered_p95_m) {
-        outln!(
-            "  other robots remembered unseen (reliability ≥ 0.3): {median:.2} m median, {p95:.2} m p95; {} phantoms of {}",
-            r.remembered_phantoms,
-            r.remembered_samples
-        );
-    }
-    if m.localization.relocalized > 0 {
-        outln!(
-            "  relocalized {} times, {} of them falsely (> 1 m from the truth)",
-            m.localization.relocalized,
-            m.localization.falsely_relocalized
-        );
-    }
-    if m.kidnap.count > 0 {
-        outln!(
-            "  kidnapped {} times, found again {} times{}",
-            m.kidnap.count,
-            m.kidnap.recovered,
-            m.kidnap
-                .median_recovery_s
-                .map_or(String::new(), |t| format!(" (median {t:.1} s after the carry)"))
-        );
-    }
+    report::estimates(&book.metrics());
     write_metrics(args, &book)?;
-    let n = cfg.rules.team_size;
-    let clock = |t: f64| format!("{}:{:04.1}", (t / 60.0).floor() as u64, t % 60.0);
-    for k in report.kidnaps.iter().filter(|k| k.recovered_after.is_none()) {
-        let (team, i) = if k.robot < n { (h, k.robot) } else { (a, k.robot - n) };
-        outln!(
-            "  robot {} ({team} #{i}) carried at {} to ({:.2}, {:.2}) m facing {:.0}°: not found again",
-            k.robot,
-            clock(k.at),
-            k.to.x,
-            k.to.y,
-            k.to.theta.to_degrees()
-        );
-    }
-    for f in &report.faults {
-        let (team, k) = if f.robot < n { (h, f.robot) } else { (a, f.robot - n) };
-        let from = f
-            .first_at
-            .map_or(String::new(), |t| format!(" from {}:{:02}", (t as u64) / 60, (t as u64) % 60));
-        outln!(
-            "  robot {} ({team} #{k}) faulted {} times{from} (stood still meanwhile): {}",
-            f.robot,
-            f.count,
-            mrt_core::printable(&f.message)
-        );
-    }
+    report::incidents(&report, cfg.rules.team_size, names);
     let seeing = match cfg.sensor.percepts {
         mrt_sim::config::PerceptSource::Vision => "seeing through its camera images",
         mrt_sim::config::PerceptSource::Oracle => "seeing through the object sensor",
@@ -550,8 +450,8 @@ pub fn run(args: &SimArgs) -> Result<()> {
     }
     if let Some(p) = &args.plot {
         let svg = match args.belief {
-            Some(n) => report.belief_svg(&cfg, n, args.window.unwrap_or((0.0, f64::INFINITY))),
-            None => report.to_svg(&cfg, (h, a)),
+            Some(n) => report.belief_svg(cfg, n, args.window.unwrap_or((0.0, f64::INFINITY))),
+            None => report.to_svg(cfg, names),
         };
         std::fs::write(p, svg).with_context(|| format!("cannot write {}", p.display()))?;
         outln!("  drawing: {}", p.display());
@@ -611,26 +511,6 @@ fn bench(args: &SimArgs, cfg: &SimConfig, stacks: (Stack, Stack)) -> Result<()> 
         if median >= 100.0 { "met" } else { "not met" }
     );
     Ok(())
-}
-
-/// A match's line for each team named (home's, then away's, if it played): goals, shots (on
-/// target) and the team's share of the cycles in which one of its robots was the closest to
-/// the ball.
-pub(crate) fn team_lines(names: &[&str], stats: &[TeamStats; 2]) -> Vec<String> {
-    let total = (stats[0].possession_cycles + stats[1].possession_cycles).max(1) as f64;
-    names
-        .iter()
-        .zip(stats)
-        .map(|(name, s)| {
-            format!(
-                "  {name:<8} goals {:>2}  shots {:>3} ({:>3} on target)  possession {:>5.1} %",
-                s.goals,
-                s.shots,
-                s.shots_on_target,
-                100.0 * s.possession_cycles as f64 / total
-            )
-        })
-        .collect()
 }
 
 /// Wilson score interval (95 %) of `k` successes in `n` trials, in percent.
