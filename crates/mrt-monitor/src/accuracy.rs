@@ -99,10 +99,11 @@ pub fn accuracy(recording: &Recording) -> Result<Vec<Accuracy>, ReplayError> {
             errors[0].push(off);
             errors[1].push(normalize_angle(p.theta - real.theta).abs());
             if let Some(ball) = l.ball.filter(|b| b.seen_ago <= 0.0) {
-                errors[2].push((ball.at.0 - truth.ball.0).hypot(ball.at.1 - truth.ball.1));
-                if let Some((vx, vy)) = ball.velocity {
+                let at = ball.at.inner;
+                errors[2].push((at.x - truth.ball.0).hypot(at.y - truth.ball.1));
+                if let Some(v) = ball.velocity {
                     let (tx, ty) = truth.ball_velocity;
-                    errors[3].push((vx - tx).hypot(vy - ty));
+                    errors[3].push((v.inner.x - tx).hypot(v.inner.y - ty));
                 }
             }
         }
@@ -137,7 +138,7 @@ mod tests {
     use super::*;
     use crate::Recorder;
     use mrt_core::frames::Framed;
-    use mrt_core::Pose2;
+    use mrt_core::{Point2, Pose2, Vec2};
     use mrt_msgs::{BallBelief, GameState};
 
     #[test]
@@ -162,8 +163,8 @@ mod tests {
             let home = Localization {
                 pose: Framed::new(Pose2::new(x + 0.3, 0.0, 0.1)),
                 ball: Some(BallBelief {
-                    at: (2.0, 1.5),
-                    velocity: Some((0.0, 0.0)),
+                    at: Framed::new(Point2::new(2.0, 1.5)),
+                    velocity: Some(Framed::new(Vec2::zeros())),
                     seen_ago: if seen { 0.0 } else { 0.1 },
                 }),
                 ..Default::default()

@@ -536,7 +536,7 @@ impl RobotView {
         self.sigma_xy = l.sigma_xy;
         self.sigma_theta = l.sigma_theta;
         self.quality = l.quality;
-        self.ball = l.ball.map(|b| b.at);
+        self.ball = l.ball.map(|b| (b.at.inner.x, b.at.inner.y));
         self.ball_seen_ago = l.ball.map_or(f64::INFINITY, |b| b.seen_ago);
     }
 
@@ -641,7 +641,11 @@ mod tests {
         let l = Localization {
             pose: Framed::new(Pose2::new(3.0, 0.1, 3.0)),
             sigma_xy: 0.05,
-            ball: Some(BallBelief { at: (1.1, 2.0), velocity: None, seen_ago: 0.0 }),
+            ball: Some(BallBelief {
+                at: Framed::new(Point2::new(1.1, 2.0)),
+                velocity: None,
+                seen_ago: 0.0,
+            }),
             ..Default::default()
         };
         t.ingest("/away/0/Localization", at(0.0), &json(&l));

@@ -426,7 +426,11 @@ impl Samples for Localization {
             sigma_theta: 0.05,
             quality: 0.9,
             counts: FilterCounts { mice: 100, corrections: 7, ..FilterCounts::default() },
-            ball: Some(BallBelief { at: (2.0, 0.5), velocity: None, seen_ago: 0.2 }),
+            ball: Some(BallBelief {
+                at: Framed::new(Point2::new(2.0, 0.5)),
+                velocity: None,
+                seen_ago: 0.2,
+            }),
         };
         vec![Localization::default(), filled]
     }

@@ -3,7 +3,7 @@
 //! with its uncertainty and what the filter used and refused, and its belief about the ball.
 
 use mrt_core::frames::{Field, Framed};
-use mrt_core::Pose2;
+use mrt_core::{Point2, Pose2, Vec2};
 use serde::{Deserialize, Serialize};
 
 /// What a pose filter used and refused, counted since it started.
@@ -67,9 +67,11 @@ pub struct Localization {
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct BallBelief {
     /// Where it is.
-    pub at: (f64, f64),
-    /// How fast it moves (`None`: the sensor gives no velocity).
-    pub velocity: Option<(f64, f64)>,
+    #[cfg_attr(feature = "schema", schemars(with = "[f64; 2]"))]
+    pub at: Framed<Field, Point2>,
+    /// How fast it moves (`None`: not seen in this frame).
+    #[cfg_attr(feature = "schema", schemars(with = "Option<[f64; 2]>"))]
+    pub velocity: Option<Framed<Field, Vec2>>,
     /// How long ago it was last seen, s (0: in this frame).
     pub seen_ago: f64,
 }

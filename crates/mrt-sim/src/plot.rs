@@ -202,15 +202,17 @@ impl MatchReport {
         );
         let mut next_arrow = f64::NEG_INFINITY;
         for b in &mine {
-            let Some(BallBelief { at: (x, y), velocity, .. }) = b.ball else { continue };
+            let Some(BallBelief { at, velocity, .. }) = b.ball else { continue };
+            let (x, y) = (at.inner.x, at.inner.y);
             let _ = writeln!(
                 s,
                 r##"<circle cx="{:.1}" cy="{:.1}" r="1.8" fill="#ff9800"/>"##,
                 c.px(x),
                 c.py(y)
             );
-            if let Some((vx, vy)) = velocity.filter(|_| b.time >= next_arrow) {
+            if let Some(v) = velocity.filter(|_| b.time >= next_arrow) {
                 next_arrow = b.time + 1.0;
+                let (vx, vy) = (v.inner.x, v.inner.y);
                 let (tx, ty) = (x + vx * ARROW_SECONDS, y + vy * ARROW_SECONDS);
                 let _ = writeln!(
                     s,

@@ -37,10 +37,10 @@ impl Pitch {
         l.heading.push(normalize_angle(p.theta - truth.theta).abs());
         if let Some(ball) = seen {
             let (bx, by) = self.world.ball();
-            l.ball.push((ball.at.0 - bx).hypot(ball.at.1 - by));
-            if let Some((vx, vy)) = ball.velocity {
+            l.ball.push((ball.at.inner.x - bx).hypot(ball.at.inner.y - by));
+            if let Some(v) = ball.velocity {
                 let (tx, ty) = self.world.ball_velocity();
-                l.ball_velocity.push((vx - tx).hypot(vy - ty));
+                l.ball_velocity.push((v.inner.x - tx).hypot(v.inner.y - ty));
             }
         }
         if l.seen_relocalized.len() <= i {

@@ -385,11 +385,8 @@ impl WorldModel {
     pub fn localization(&self) -> Localization {
         let (sigma_xy, sigma_theta) = self.sigma();
         let ball = self.memory[lps::BALL].map(|m| BallBelief {
-            at: (m.at.inner.x, m.at.inner.y),
-            velocity: self
-                .ball_velocity
-                .filter(|_| m.seen == self.now)
-                .map(|v| (v.inner.x, v.inner.y)),
+            at: m.at,
+            velocity: self.ball_velocity.filter(|_| m.seen == self.now),
             seen_ago: self.now - m.seen,
         });
         Localization {

@@ -453,7 +453,7 @@ fn a_rolling_ball_seen_by_vision_has_the_tracker_s_velocity() {
         m.percepts(&p);
     }
     let b = m.localization().ball.unwrap_or_default();
-    let (vx, vy) = b.velocity.unwrap_or_default();
+    let (vx, vy) = b.velocity.map_or((0.0, 0.0), |v| (v.inner.x, v.inner.y));
     assert!((vx - ball(1.0).2).abs() < 0.15 && vy.abs() < 0.15, "({vx}, {vy})");
     assert_eq!(m.ball_track_counts().restarts, 1);
     // Kicked back west at 4 m/s from where it was at 1.05 s.
@@ -465,7 +465,8 @@ fn a_rolling_ball_seen_by_vision_has_the_tracker_s_velocity() {
     }
     // The manoeuvre model took the kick without a restart (the quiet model alone gated
     // it out twice and restarted): three frames later the velocity is the kick's.
-    let (vx, vy) = m.localization().ball.and_then(|b| b.velocity).unwrap_or_default();
+    let v = m.localization().ball.and_then(|b| b.velocity).unwrap_or_default().inner;
+    let (vx, vy) = (v.x, v.y);
     assert!((vx + 4.0).abs() < 0.5 && vy.abs() < 0.3, "({vx}, {vy})");
     let restarts = m.ball_track_counts().restarts;
     assert!(restarts <= 2, "{:?}", m.ball_track_counts());
@@ -493,8 +494,8 @@ fn a_pose_correction_does_not_move_the_ball_s_track() {
     for t in 0..10 {
         m.odometry(&exact_mice(Pose2::default()));
         m.camera(&frame(truth, f64::from(t) * 0.1, &objects));
-        if let Some((vx, vy)) = m.localization().ball.and_then(|b| b.velocity) {
-            fastest = fastest.max(vx.hypot(vy));
+        if let Some(v) = m.localization().ball.and_then(|b| b.velocity) {
+            fastest = fastest.max(v.inner.norm());
         }
     }
     let p = m.pose().inner;
