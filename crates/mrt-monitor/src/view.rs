@@ -161,7 +161,7 @@ impl SeenView {
             landmarks: sightings.flatten().map(at).collect(),
             posts: p.posts.iter().map(|q| at(&q.sighting)).collect(),
             robots: p.robots.iter().map(|r| at(&r.sighting)).collect(),
-            lines: p.line_points.clone(),
+            lines: p.line_points.iter().map(|q| (q.inner.x, q.inner.y)).collect(),
         }
     }
 }
@@ -664,7 +664,10 @@ mod tests {
         let pose = Framed::new(Pose2::new(0.5, -0.25, 0.0));
         let path = PlannedPath { poses: vec![pose], ..Default::default() };
         t.ingest("/away/0/PlannedPath", at(0.0), &json(&path));
-        let mut seen = Percepts { line_points: vec![(1.0, -0.5)], ..Default::default() };
+        let mut seen = Percepts {
+            line_points: vec![Framed::new(mrt_core::Point2::new(1.0, -0.5))],
+            ..Default::default()
+        };
         seen.sightings[mrt_msgs::sighting::BALL] =
             Some(Sighting { distance: 2.0, bearing: std::f64::consts::FRAC_PI_2 });
         t.ingest("/away/0/Percepts", at(0.0), &json(&seen));

@@ -442,7 +442,8 @@ impl Samples for Percepts {
         filled.sightings[sighting::BALL] = Some(sighting());
         filled.sigmas[sighting::BALL] = Some((0.02, 0.01));
         filled.pixels[sighting::BALL] = 120;
-        filled.line_points = vec![(1.0, 0.5), (1.2, 0.5)];
+        filled.line_points =
+            vec![Framed::new(Point2::new(1.0, 0.5)), Framed::new(Point2::new(1.2, 0.5))];
         filled.robots = vec![robot_sighting()];
         let post =
             PostSighting { sighting: sighting(), sigma: (0.1, 0.02), east: true, pixels: 40 };

@@ -4,8 +4,8 @@
 //! ([`GameInfo`]).
 
 use crate::robot::{lps, GameState};
-use mrt_core::frames::{Field, Framed};
-use mrt_core::Pose2;
+use mrt_core::frames::{Field, Framed, Robot};
+use mrt_core::{Point2, Pose2};
 use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
 
@@ -274,8 +274,9 @@ pub struct Percepts {
     pub sigmas: [Option<(f64, f64)>; FIELD_OBJECTS],
     /// How many pixels each sighting rests on.
     pub pixels: [u32; FIELD_OBJECTS],
-    /// Points of the white field lines on the floor (robot frame, m).
-    pub line_points: Vec<(f64, f64)>,
+    /// Points of the white field lines on the floor (m).
+    #[cfg_attr(feature = "schema", schemars(with = "Vec<[f64; 2]>"))]
+    pub line_points: Vec<Framed<Robot, Point2>>,
     /// Other robots: the nearest point of each, from the robot's centre, with its marker
     /// when the image shows it.
     #[serde(default)]

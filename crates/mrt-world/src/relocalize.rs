@@ -58,6 +58,7 @@
 use crate::field::FieldMap;
 use crate::hough::{hough_lines, self_localize, HoughParams};
 use crate::murea::{Fix, Kind, Map, Murea, Perception};
+use mrt_core::frames::{Framed, Robot};
 use mrt_core::{normalize_angle, Point2, Pose2};
 use mrt_msgs::{PostSighting, Sighting, FIELD_OBJECTS};
 use serde::{Deserialize, Serialize};
@@ -186,7 +187,7 @@ pub struct FrameSeen<'a> {
     /// Corners of goals cut by the image's side, by their goal's colour.
     pub goal_corners: &'a [PostSighting],
     /// Field-line points, robot frame (m).
-    pub line_points: &'a [(f64, f64)],
+    pub line_points: &'a [Framed<Robot, Point2>],
 }
 
 impl<'a> FrameSeen<'a> {
@@ -221,7 +222,7 @@ pub fn perceptions(field: &FieldMap, noise: CameraNoise, seen: FrameSeen<'_>) ->
         out.push(point(Kind::goal_corner(corner.east, true), &corner.sighting, Some(corner.sigma)));
     }
     let step = line_points.len().div_ceil(LINE_POINTS).max(1);
-    for &(x, y) in line_points.iter().step_by(step) {
+    for (x, y) in line_points.iter().step_by(step).map(|p| (p.inner.x, p.inner.y)) {
         let z = Sighting { distance: x.hypot(y), bearing: y.atan2(x) };
         out.push(point(Kind::LINE, &z, None).weighted(LINE_WEIGHT));
     }
@@ -319,10 +320,10 @@ impl Relocalizer {
 
     /// This frame's field-line points (robot frame, m), for the self mode; call before
     /// [`Relocalizer::frame`].
-    pub fn lines(&mut self, points: &[(f64, f64)]) {
+    pub fn lines(&mut self, points: &[Framed<Robot, Point2>]) {
         if let Some((_, lines)) = &mut self.self_mode {
             lines.clear();
-            lines.extend(points.iter().map(|&(x, y)| Point2::new(x, y)));
+            lines.extend(points.iter().map(|p| p.inner));
         }
     }
 
@@ -602,7 +603,8 @@ mod tests {
             east: false,
             pixels: 40,
         }];
-        let lines: Vec<(f64, f64)> = (0..40).map(|i| (1.0 + 0.1 * f64::from(i), 0.5)).collect();
+        let lines: Vec<Framed<Robot, Point2>> =
+            (0..40).map(|i| Framed::new(Point2::new(1.0 + 0.1 * f64::from(i), 0.5))).collect();
         let p = perceptions(
             &f,
             NOISE,
@@ -620,7 +622,7 @@ mod tests {
 
     /// The field-line points within 4 m of `pose`, every 10 cm, robot frame (an up camera's
     /// view, less its noise).
-    fn lines_around(pose: Pose2) -> Vec<(f64, f64)> {
+    fn lines_around(pose: Pose2) -> Vec<Framed<Robot, Point2>> {
         let mut out = Vec::new();
         for seg in field().lines() {
             let n = (seg.length() / 0.1) as usize;
@@ -628,7 +630,7 @@ mod tests {
                 let p = seg.a + (seg.b - seg.a) * (k as f64 / n as f64);
                 let q = pose.inverse_transform_point(p);
                 if q.coords.norm() <= 4.0 {
-                    out.push((q.x, q.y));
+                    out.push(Framed::new(q));
                 }
             }
         }
@@ -641,7 +643,7 @@ mod tests {
         r: &mut Relocalizer,
         frames: u32,
         (sightings, corners): (&[Option<Sighting>; FIELD_OBJECTS], &[PostSighting]),
-        lines: &[(f64, f64)],
+        lines: &[Framed<Robot, Point2>],
         wrong: Pose2,
     ) -> Fix {
         let f = field();
@@ -702,9 +704,9 @@ mod tests {
         let bearing = one[5].map_or(1.0, |s: Sighting| s.bearing);
         assert!(bearing.abs() < 20f64.to_radians(), "the post in view: {bearing}");
         // The line points in a 40° field of view ahead, up to 4 m.
-        let lines: Vec<(f64, f64)> = lines_around(truth)
+        let lines: Vec<Framed<Robot, Point2>> = lines_around(truth)
             .into_iter()
-            .filter(|&(x, y)| x > 0.3 && y.atan2(x).abs() < 20f64.to_radians())
+            .filter(|p| p.inner.x > 0.3 && p.inner.y.atan2(p.inner.x).abs() < 20f64.to_radians())
             .collect();
         assert!(lines.len() >= ONE_MARK_LINES, "{} line points in view", lines.len());
         let fix = first_fix(&mut Relocalizer::new(&f), 10, (&one, &[]), &lines, wrong);
@@ -712,8 +714,8 @@ mod tests {
         assert!(err < 0.2 && normalize_angle(fix.pose.theta - truth.theta).abs() < 0.05, "{fix:?}");
     }
 
-    /// A keeper carried 2.8 m out in front of its own goal and facing it (a match of session
-    /// 39: 165 s lost) sees no net, the goal being cut by the image's side, and no post: one
+    /// A keeper carried 2.8 m out in front of its own goal and facing it (a match once lost
+    /// it for 165 s) sees no net, the goal being cut by the image's side, and no post: one
     /// corner of the goal and the lines before it find it again.
     #[test]
     fn a_goal_corner_and_the_lines_find_a_keeper_carried_before_its_goal() {
@@ -729,9 +731,9 @@ mod tests {
             east: true,
             pixels: 5000,
         };
-        let lines: Vec<(f64, f64)> = lines_around(truth)
+        let lines: Vec<Framed<Robot, Point2>> = lines_around(truth)
             .into_iter()
-            .filter(|&(x, y)| x > 0.3 && y.atan2(x).abs() < 30f64.to_radians())
+            .filter(|p| p.inner.x > 0.3 && p.inner.y.atan2(p.inner.x).abs() < 30f64.to_radians())
             .collect();
         assert!(lines.len() >= ONE_MARK_LINES, "{} line points in view", lines.len());
         let none = [None; FIELD_OBJECTS];
@@ -750,8 +752,8 @@ mod tests {
         let mark = (1..FIELD_OBJECTS).find(|&k| seen[k].is_some()).unwrap_or(0);
         let mut one = [None; FIELD_OBJECTS];
         one[mark] = seen[mark];
-        let lines: Vec<(f64, f64)> =
-            lines_around(truth).into_iter().filter(|&(x, _)| x > 0.3).collect();
+        let lines: Vec<Framed<Robot, Point2>> =
+            lines_around(truth).into_iter().filter(|p| p.inner.x > 0.3).collect();
         let mut r = Relocalizer::new(&f);
         r.one_mark.budget.cells = 10; // every search runs out
         let wrong = Pose2::new(2.0, -2.0, 0.5);

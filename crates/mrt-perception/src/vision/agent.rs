@@ -19,6 +19,7 @@ use super::lines::line_points;
 use super::posts::{find_posts_in, PostPercept, PostShape};
 use super::up::UpMode;
 use crate::camera::{Camera, Omni, Pinhole, Pixel};
+use mrt_core::frames::Framed;
 use mrt_msgs::sighting::{BALL, EAST_NET, WEST_NET};
 use mrt_msgs::{
     DetectionKind, Image, ImageDetection, ImageDetections, Marker, Percepts, PostSighting,
@@ -175,7 +176,7 @@ impl VisionAgent {
         let (Some(image), Some(up)) = (up, self.up.as_mut()) else { return Ok(p) };
         up.classify(&self.lut, image)?;
         // The self mode's input: the field lines all around.
-        p.line_points.extend(up.lines().into_iter().map(|l| (l.at.x, l.at.y)));
+        p.line_points.extend(up.lines().into_iter().map(|l| Framed::new(l.at)));
         if p.sightings[BALL].is_some() {
             return Ok(p);
         }
@@ -303,7 +304,7 @@ impl VisionAgent {
             }
         }
         let lines = line_points(&self.classes, &self.camera, LINE_STEP, LINE_MAX_RUN);
-        p.line_points = lines.iter().map(|l| (l.at.x, l.at.y)).collect();
+        p.line_points = lines.iter().map(|l| Framed::new(l.at)).collect();
         p.robots = self.robots(&mut shown);
         p.posts = posts
             .iter()

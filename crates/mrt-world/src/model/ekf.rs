@@ -181,10 +181,10 @@ impl WorldModel {
     /// This is how ISocRob's "self" localization used the lines (seed `003` §3.2.1), as an
     /// EKF update instead of a Hough match: the lines are in nearly every frame, the goals and
     /// posts far and few.
-    pub(super) fn correct_lines(&mut self, line_points: &[(f64, f64)]) {
+    pub(super) fn correct_lines(&mut self, line_points: &[Framed<Robot, Point2>]) {
         let mut near: Vec<(f64, f64, f64)> = line_points
             .iter()
-            .map(|&(x, y)| (x.hypot(y), x, y))
+            .map(|p| (p.inner.coords.norm(), p.inner.x, p.inner.y))
             .filter(|&(d, _, _)| d.is_finite() && (LINE_MIN_RANGE..=LINE_RANGE).contains(&d))
             .collect();
         near.sort_by(|a, b| a.0.total_cmp(&b.0));

@@ -36,7 +36,7 @@ use crate::relocalize::{self, CameraNoise, FrameSeen, Localizer, Relocalizer};
 use crate::track::{
     sighting_covariance, Track, TrackCounts, BALL_ACCEL, BALL_MANEUVER, BALL_TOP_SPEED,
 };
-use mrt_core::frames::{Attack, Field, Framed};
+use mrt_core::frames::{Attack, Field, Framed, Robot};
 use mrt_core::{normalize_angle, Point2, Pose2, Time, Vec2};
 use mrt_msgs::robot::{lps, AnchoredRobot, Estimate, Lpo, WorldSnapshot};
 use mrt_msgs::{
@@ -469,7 +469,7 @@ impl WorldModel {
         robots: &[RobotSighting],
         pan: Option<f64>,
         mut perceived: Option<Vec<Perception>>,
-        line_points: &[(f64, f64)],
+        line_points: &[Framed<Robot, Point2>],
         ball_velocity: Option<Vec2>,
     ) -> WorldSnapshot {
         let relocalized = self.counts.relocalized;

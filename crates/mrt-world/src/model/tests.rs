@@ -506,13 +506,13 @@ fn a_pose_correction_does_not_move_the_ball_s_track() {
 
 /// Field-line points seen from `truth`, in the robot frame: `n` points from `a` to `b`
 /// (field frame, m).
-fn line(truth: Pose2, a: (f64, f64), b: (f64, f64), n: usize) -> Vec<(f64, f64)> {
+fn line(truth: Pose2, a: (f64, f64), b: (f64, f64), n: usize) -> Vec<Framed<Robot, Point2>> {
     let (s, c) = truth.theta.sin_cos();
     (0..n)
         .map(|i| {
             let f = i as f64 / (n - 1) as f64;
             let (x, y) = (a.0 + f * (b.0 - a.0) - truth.x, a.1 + f * (b.1 - a.1) - truth.y);
-            (c * x + s * y, -s * x + c * y)
+            Framed::new(Point2::new(c * x + s * y, -s * x + c * y))
         })
         .collect()
 }
@@ -540,7 +540,7 @@ fn field_lines_correct_the_pose_across_them_and_a_corner_fixes_it() {
     // Both lines: both coordinates.
     let mut m = model();
     m.place(Framed::new(Pose2::new(truth.x + 0.06, truth.y - 0.09, truth.theta)));
-    let corner: Vec<(f64, f64)> = touch.iter().chain(&goal).copied().collect();
+    let corner: Vec<Framed<Robot, Point2>> = touch.iter().chain(&goal).copied().collect();
     for time in [0.1, 0.2] {
         m.percepts(&Percepts { time, line_points: corner.clone(), ..Default::default() });
     }
@@ -601,7 +601,7 @@ fn a_correction_that_is_not_finite_is_refused_and_counted() {
 fn line_points_at_the_robot_s_own_foot_leave_the_pose_and_its_sigma_finite() {
     let mut m = model();
     m.place(Framed::new(Pose2::new(-1.924532815054719, 0.49055413021987215, 0.0)));
-    let points = vec![(-4.0e-151, 0.0), (0.0, 0.0)];
+    let points = vec![Framed::new(Point2::new(-4.0e-151, 0.0)), Framed::new(Point2::origin())];
     m.percepts(&Percepts { time: 0.1, line_points: points, ..Default::default() });
     let e = m.pose().inner;
     assert!(e.x.is_finite() && e.y.is_finite() && e.theta.is_finite(), "{e:?}");
@@ -624,7 +624,8 @@ proptest::proptest! {
     ) {
         let mut m = model();
         m.place(Framed::new(Pose2::new(x, y, theta)));
-        m.percepts(&Percepts { time: 0.1, line_points: points, ..Default::default() });
+        let line_points = points.into_iter().map(|(x, y)| Framed::new(Point2::new(x, y))).collect();
+        m.percepts(&Percepts { time: 0.1, line_points, ..Default::default() });
         let e = m.pose().inner;
         proptest::prop_assert!(e.x.is_finite() && e.y.is_finite() && e.theta.is_finite());
         let (sxy, st) = m.sigma();
