@@ -1,11 +1,11 @@
 //! The pitch's book of what the robots believed, against the truth: their own poses and the
-//! ball's ([`LocalizationErrors`](super::LocalizationErrors)), the other robots they anchored
-//! ([`RobotErrors`](super::RobotErrors)) and the team beliefs two robots should not hold at
-//! once ([`TeamStats`](super::TeamStats): the ball booking, the attacker, SCARE's job on the
-//! ball). The robots never read it; the match report does.
+//! ball's ([`LocalizationErrors`]), the other robots they anchored ([`RobotErrors`]) and the
+//! team beliefs two robots should not hold at once ([`TeamStats`]: the ball booking, the
+//! attacker, SCARE's job on the ball). The robots never read it; the match report does.
 
-use super::BeliefSample;
-use super::{Pitch, FALSELY_RELOCALIZED, PHANTOM, RECOVERED};
+use super::{BeliefSample, Pitch, FALSELY_RELOCALIZED, PHANTOM, RECOVERED};
+#[cfg(doc)]
+use super::{LocalizationErrors, RobotErrors, TeamStats};
 use crate::referee::Team;
 use mrt_core::frames::Attack;
 use mrt_core::normalize_angle;
