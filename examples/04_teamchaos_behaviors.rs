@@ -1,6 +1,6 @@
 //! # 04 — TeamChaos behaviors: the Attacker HFSM, the goalkeeper, and a hot reload
 //!
-//! What you learn: how ThinkingCap (TeamChaos, seed 001) runs a robot's behaviors written in
+//! What you learn: how ThinkingCap (TeamChaos, ThinkingCap/TeamChaos report) runs a robot's behaviors written in
 //! Lua: a hierarchical state machine (`behaviors/teamchaos/attacker.hfsm.lua`) chooses a
 //! low-level behavior each cycle with `chaos.setBehavior`, and fuzzy rules (`go2ball.lua`,
 //! `dokick.lua`, ...) blended by context give the velocities, the kick and the perceptual

@@ -1,5 +1,5 @@
 -- alignbnet1: move until the robot, the ball and the opponent's net (NET1) are aligned
--- (seed 001 §4.3). Strafing right makes the near ball drift left in view faster than the far
+-- (ThinkingCap/TeamChaos report §4.3). Strafing right makes the near ball drift left in view faster than the far
 -- net, so a net seen left of the ball calls for a step to the right, and the other way round;
 -- meanwhile the robot keeps facing the ball.
 rule(netLeftOfBall(), "strafe", "RIGHT")

@@ -1,10 +1,10 @@
--- The Attacker HFSM (seed 001 §5.2, figures 10 and 11), as one Lua file like the seed's HFSM
+-- The Attacker HFSM (ThinkingCap/TeamChaos report §5.2, figures 10 and 11), as one Lua file like the seed's HFSM
 -- editor generated. It expects the ball in direct view (a higher machine takes care of that).
 -- Each state calls one low-level behavior of this directory; transitions test the LPS.
 
 local function ball() return chaos.lps_getLpo(BALL) end
 
--- The attacker keeps the ball booked while it attacks (seed 001 §3.3: a teammate that also
+-- The attacker keeps the ball booked while it attacks (ThinkingCap/TeamChaos report §3.3: a teammate that also
 -- goes for the ball waits for the booking); a booking not asked for again lapses in 5 s.
 local function attack(behavior)
   chaos.bookBall()

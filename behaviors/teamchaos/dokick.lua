@@ -1,4 +1,4 @@
--- dokick: move towards the ball and kick it (seed 001 §4.3).
+-- dokick: move towards the ball and kick it (ThinkingCap/TeamChaos report §4.3).
 rule(headedLeft(), "turn", "RIGHT")
 rule(headedAhead(), "turn", "NONE")
 rule(headedRight(), "turn", "LEFT")

@@ -1,4 +1,4 @@
--- faceball: turn on the spot until the ball is straight ahead (seed 001 §4.3, §5.2).
+-- faceball: turn on the spot until the ball is straight ahead (ThinkingCap/TeamChaos report §4.3, §5.2).
 rule(headedLeft(), "turn", "RIGHT")
 rule(headedAhead(), "turn", "NONE")
 rule(headedRight(), "turn", "LEFT")

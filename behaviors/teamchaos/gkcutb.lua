@@ -1,4 +1,4 @@
--- gkcutb (seed 001 §4.1): keep the goalkeeper between the ball and our net: on a line 400 mm
+-- gkcutb (ThinkingCap/TeamChaos report §4.1): keep the goalkeeper between the ball and our net: on a line 400 mm
 -- out of the goal line, level with the ball (within the posts), facing the ball; clear with a
 -- front kick when the ball is close and the robot points to a safe area. The spot is a posture
 -- for guidance (position mode: straight there at the base's speed, turning to the ball). With

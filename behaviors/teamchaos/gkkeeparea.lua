@@ -1,4 +1,4 @@
--- gkkeeparea (seed 001 §4.3): face forward, then move back into the goal area.
+-- gkkeeparea (ThinkingCap/TeamChaos report §4.3): face forward, then move back into the goal area.
 local p = chaos.gsGetMyPos()
 local facingForward = TRI(-0.3, 0, 0.3)(p.theta)
 local homeX = -field().half_length + GOAL_AREA_DEPTH / 2

@@ -1,4 +1,4 @@
--- gkkeepbarea (seed 001 §4.3): face backwards (towards our net), then move to just below the
+-- gkkeepbarea (ThinkingCap/TeamChaos report §4.3): face backwards (towards our net), then move to just below the
 -- penalty area line.
 local p = chaos.gsGetMyPos()
 local back = math.abs(p.theta)                         -- pi when facing our net

@@ -1,4 +1,4 @@
--- gkkeepout (seed 001 §4.3): turn slowly while moving until the robot is out of its net; needs
+-- gkkeepout (ThinkingCap/TeamChaos report §4.3): turn slowly while moving until the robot is out of its net; needs
 -- the most probably visible landmarks, the opponent's net included.
 always("turn", "LEFT")
 always("go", "SLOW")

@@ -1,4 +1,4 @@
--- gklocalize (seed 001 §4.3): stand still and look for the closest landmarks and the nets
+-- gklocalize (ThinkingCap/TeamChaos report §4.3): stand still and look for the closest landmarks and the nets
 -- for a better position estimate.
 always("go", "STAY")
 always("turn", "NONE")

@@ -1,4 +1,4 @@
--- go2ball: move to the ball location (seed 001 §4.3): turn towards it, go fast when it is far
+-- go2ball: move to the ball location (ThinkingCap/TeamChaos report §4.3): turn towards it, go fast when it is far
 -- and ahead, slow when it is close, and wait for the turn when it is off to the side.
 rule(headedLeft(), "turn", "RIGHT")
 rule(headedAhead(), "turn", "NONE")

@@ -1,4 +1,4 @@
--- goalkeeper (seed 001 §4.3, figure 7): the top of the goalkeeper hierarchy. Meta-rules choose
+-- goalkeeper (ThinkingCap/TeamChaos report §4.3, figure 7): the top of the goalkeeper hierarchy. Meta-rules choose
 -- and blend the sub-behaviors by context: get out of the net, scan for a lost ball, localize
 -- when lost, clear a ball in the penalty area within reach (1.5 m: farther, an opponent gets
 -- there first and shoots at an empty net), otherwise hold the spot on the goal line that cuts

@@ -1,4 +1,4 @@
--- Shared definitions of the TeamChaos behaviors (seed 001 §4): field geometry and the fuzzy
+-- Shared definitions of the TeamChaos behaviors (ThinkingCap/TeamChaos report §4): field geometry and the fuzzy
 -- predicates the rules use. Run once when the directory is loaded (and again when edited).
 -- Units: LPS distances in mm and bearings in radians (left positive); the global frame has its
 -- origin at the centre spot, x towards the opponent's net (NET1), our net (NET2) at
@@ -137,7 +137,7 @@ function offsetFromBallToNet()
   return p.y - yline
 end
 
--- Team play: roles (seed 001 §5.1, figure 8: attacker, supporter, defender). Every field
+-- Team play: roles (ThinkingCap/TeamChaos report §5.1, figure 8: attacker, supporter, defender). Every field
 -- player ranks itself by its distance to the global ball (its own sighting or a teammate's)
 -- among the field players it hears from; the goalkeeper stays out of the ranking.
 function ballKnown() return chaos.getGlobalBall().quality > 0.2 end

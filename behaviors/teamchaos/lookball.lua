@@ -1,4 +1,4 @@
--- lookball (ThinkingCap, seed 001 §4.3): turn on the spot until the ball is seen, towards
+-- lookball (ThinkingCap, ThinkingCap/TeamChaos report §4.3): turn on the spot until the ball is seen, towards
 -- where it was last seen; slowly for the first 400 ms (the ball may be close), then faster.
 -- As printed in the seed, which lays the first lines out garbled; the code is unchanged.
 -- One guard added: when ball.theta is 0 the seed divides 0 by 0 (NaN); we keep the sign 1.

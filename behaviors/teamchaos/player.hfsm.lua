@@ -1,9 +1,9 @@
--- A field player for a whole match (seed 001 §5.1, figure 8): wait while the game is stopped
+-- A field player for a whole match (ThinkingCap/TeamChaos report §5.1, figure 8): wait while the game is stopped
 -- (walking to the kickoff position in READY), then play one of three roles, renegotiated every cycle from the shared world state:
 -- the field player closest to the ball is the Attacker (the seed's Attacker of §5.2, reused
 -- from its own file, not copied), the next one the Supporter, the others Defenders. A player
 -- that has lost the ball goes to where its teammates see it, or looks around for it. The
--- attacker books the ball (seed 001 §3.3): two players that both think themselves closest
+-- attacker books the ball (ThinkingCap/TeamChaos report §3.3): two players that both think themselves closest
 -- do not both attack it.
 
 include "attacker.hfsm.lua"
@@ -15,7 +15,7 @@ local function ballSeenNow() return chaos.lps_getLpo(BALL).reliability > 0.5 end
 -- Keep a role for 400 mm of advantage before handing it over.
 local HOLD = 400
 
--- Roles that do not go for the ball give the ball booking back (seed 001 §3.3).
+-- Roles that do not go for the ball give the ball booking back (ThinkingCap/TeamChaos report §3.3).
 local function release() chaos.releaseBookedBall() end
 local function booked() return chaos.haveBookedBall().booked end
 

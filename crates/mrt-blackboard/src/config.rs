@@ -1,4 +1,4 @@
-//! Initial values from `config.dat` and `config-<id>.dat` (ISocRob `003` §3.1: "a set of
+//! Initial values from `config.dat` and `config-<id>.dat` (ISocRob-2000 report §3.1: "a set of
 //! blackboard variables initial values (configuration parameters) from the files `config.dat`
 //! and `config-n.dat`, by this order, where `n` is the robot's ID").
 //!

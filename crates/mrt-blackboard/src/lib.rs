@@ -1,6 +1,6 @@
 //! # mrt-blackboard: the ISocRob blackboard
 //!
-//! A robot's blackboard (seed `003` §3.1) is a set of symbol/value bindings that its modules
+//! A robot's blackboard (ISocRob-2000 report §3.1) is a set of symbol/value bindings that its modules
 //! share, and that robots share with each other. Symbols are dotted ASCII names whose first
 //! level is the scope — `local` (this robot), `*` (all robots) or a robot's ID — and whose
 //! second is the kind: `var` (the latest value) or `talk` (a FIFO queue) ([`symbol`]). Values

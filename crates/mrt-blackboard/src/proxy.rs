@@ -1,4 +1,4 @@
-//! The Proxy (ISocRob `003` §3.2.5): the Member of a robot's Agora that carries the shared
+//! The Proxy (ISocRob-2000 report §3.2.5): the Member of a robot's Agora that carries the shared
 //! (`*` and `n`) blackboard changes between robots. It publishes each local change as a
 //! [`BbUpdate`] and applies every [`BbUpdate`] it receives from another Agora (a `Remote`
 //! subscription: a robot never hears itself). On the bus the changes travel wherever DCDT

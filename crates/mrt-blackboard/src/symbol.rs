@@ -1,4 +1,4 @@
-//! Blackboard symbols (ISocRob `003` §3.1): dotted ASCII names whose first two levels have a
+//! Blackboard symbols (ISocRob-2000 report §3.1): dotted ASCII names whose first two levels have a
 //! built-in meaning.
 //!
 //! - level 1, the **scope**: `local` (this robot only), `*` (shared with all robots) or `n`,

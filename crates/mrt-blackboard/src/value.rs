@@ -1,4 +1,4 @@
-//! Blackboard values (ISocRob `003` §3.1): `Int`, `Float`, `Bool` and `String`, and their one
+//! Blackboard values (ISocRob-2000 report §3.1): `Int`, `Float`, `Bool` and `String`, and their one
 //! text form, shared by the configuration files and the relay: the type's name, a space, the
 //! literal — `Int -3`, `Float 0.8`, `Bool true`, `String "a \"quoted\" word"`.
 //!

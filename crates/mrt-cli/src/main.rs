@@ -243,7 +243,7 @@ struct BehaveArgs {
 
 #[derive(Subcommand)]
 enum BehaveCommand {
-    /// Send an edited behavior file to a running robot (seed 001 §3.2): checked for syntax
+    /// Send an edited behavior file to a running robot (ThinkingCap/TeamChaos report §3.2): checked for syntax
     /// errors here first, then compiled by the robot off its control path and swapped in at
     /// a cycle boundary, or refused with the error and its line while the old version keeps
     /// running (docs/behaviors.md, "Sending a behavior to a running robot").

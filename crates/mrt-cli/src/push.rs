@@ -1,5 +1,5 @@
 //! `mrt behave push FILE --robot ID --net CONFIG`: an edited behavior sent to a running robot
-//! (seed `001` §3.2: the HBM editor checked a behavior for syntax errors and "if the edited
+//! (ThinkingCap/TeamChaos report §3.2: the HBM editor checked a behavior for syntax errors and "if the edited
 //! behavior contains no syntax errors, it can be sent to the robot at any time, without the
 //! need of stopping or rebooting it").
 //!

@@ -1,5 +1,5 @@
 //! The fuzzy core of ThinkingCap's Hierarchical Behavior Module (HBM) and its Context-Dependent
-//! Blending (CDB), seed 001 §4.1.
+//! Blending (CDB), ThinkingCap/TeamChaos report §4.1.
 //!
 //! A low-level behavior is a set of rules `if <predicate> then <action> <LABEL>`: each firing
 //! rule asserts the label of a control variable (`go`, `turn`, `strafe`, `kick`...) at the
@@ -44,7 +44,7 @@ use crate::shapes::defuzzify;
 /// How a control variable's blended labels become one crisp value.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum Defuzzification {
-    /// Mamdani: the centroid of the union of the clipped label sets (seed 001 §4.1).
+    /// Mamdani: the centroid of the union of the clipped label sets (ThinkingCap/TeamChaos report §4.1).
     #[default]
     Centroid,
     /// Weighted mean of the labels' core centres.
@@ -369,7 +369,7 @@ mod tests {
         assert_eq!(v.defuzzify(&[0.0]), None);
     }
 
-    /// The gkcutb strafe example (seed 001 §4.1) in both modes, by hand: posLeft 0.6 → RIGHT,
+    /// The gkcutb strafe example (ThinkingCap/TeamChaos report §4.1) in both modes, by hand: posLeft 0.6 → RIGHT,
     /// posAhead 0.4 → NONE. Labels RIGHT = TRI(-300 -200 -100), NONE = TRI(-100 0 100),
     /// LEFT = TRI(100 200 300). Singleton: (0.6·-200 + 0.4·0) / 1.0 = -120. Centroid: two
     /// disjoint symmetric trapezia; RIGHT clipped at 0.6 has area 200·0.6·(1 − 0.6/2) = 84 at

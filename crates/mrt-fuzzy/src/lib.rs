@@ -44,7 +44,7 @@
 //! | `weight_composer` (mult, max, min) / `float_composer` (max, average, min) | [`brian::WeightComposer`], [`brian::Composer`], `engine.txt` ([`engine`]) |
 //! | `threshold_filter` (0.49) | [`brian::Brian::set_threshold`], `engine.txt` ([`engine`]) |
 //! | Parser and Messenger (§10.3.10) on the bus | [`member::BrianMember`], [`member::BrianInputs`], [`member::BrianCommands`] (feature `member`) |
-//! | ThinkingCap HBM rules and Context-Dependent Blending (seed 001 §4.1) | [`hbm::Blender`], [`hbm::ControlVariable`], Mamdani [`hbm::centroid`] |
+//! | ThinkingCap HBM rules and Context-Dependent Blending (ThinkingCap/TeamChaos report §4.1) | [`hbm::Blender`], [`hbm::ControlVariable`], Mamdani [`hbm::centroid`] |
 //! | the checker of §10.4.7 | `mrt brian check DIR` (errors: [`BrianError`]) |
 #![deny(missing_docs)]
 

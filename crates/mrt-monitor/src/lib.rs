@@ -1,7 +1,7 @@
 //! # mrt-monitor: seeing what the robots think
 //!
-//! The seeds' teams looked into their robots with monitors (ThinkingCap's HBM monitor, seed
-//! `001` §4.1 and §5.1; ISocRob's Monitor, seed `003` §3.2.7). This crate is MRT's: it listens
+//! The seeds' teams looked into their robots with monitors (ThinkingCap's HBM monitor, ThinkingCap/TeamChaos
+//! report §4.1 and §5.1; ISocRob's Monitor, ISocRob-2000 report §3.2.7). This crate is MRT's: it listens
 //! on the bus like any Member and never reaches into an engine's internals.
 //!
 //! - [`record`]: a [`Recorder`] writes messages into an [MCAP](https://mcap.dev) file, one

@@ -11,10 +11,10 @@
 //!   before frame `i`, when the recording has images (`mrt sim --images`);
 //! - `GET /seen/{team}/{k}/{i}`: what robot `team/k`'s vision found in that same image, where
 //!   in it (a [`SeenImage`](crate::view::SeenImage): time, image size, boxes in pixels), when
-//!   its percepts said (ISocRob seed `003` §3.2.7);
+//!   its percepts said (ISocRob-2000 report §3.2.7);
 //! - `GET /hfsm/{team}/{k}/{i}`: the shape of robot `team/k`'s HFSM in force at frame `i` (an
 //!   `HfsmStructure`: machines, states, transitions), when its behavior Member told it
-//!   (ThinkingCap seed `001` §4.1, §5.1);
+//!   (ThinkingCap/TeamChaos report §4.1, §5.1);
 //! - `GET /ws`: a WebSocket; each text message `{"frame": i}` (or `"latest"`) is answered
 //!   with what `/frame/{i}` answers. The page plays, pauses, steps and scrubs by asking.
 

@@ -243,7 +243,7 @@ struct Shot {
 }
 
 /// What a robot's vision found in one camera image, where in the image
-/// (`Percepts::detections`): what the page draws over the picture (ISocRob seed `003` §3.2.7,
+/// (`Percepts::detections`): what the page draws over the picture (ISocRob-2000 report §3.2.7,
 /// the Monitor's window per vision channel).
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct SeenImage {
@@ -421,7 +421,7 @@ impl Timeline {
     }
 
     /// The shape of robot `name`'s HFSM in force at frame `index` ([`HfsmStructure`] as
-    /// JSON): the last told at or before it (ThinkingCap seed `001` §4.1, §5.1).
+    /// JSON): the last told at or before it (ThinkingCap/TeamChaos report §4.1, §5.1).
     pub fn hfsm(&self, name: &str, index: usize) -> Option<Arc<str>> {
         let known = self.structures.get(name)?;
         let k = known.partition_point(|(i, _)| *i <= index);

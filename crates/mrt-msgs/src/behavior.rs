@@ -1,4 +1,4 @@
-//! What the behavior Members say and hear besides the command (ThinkingCap, seed `001` §3.2:
+//! What the behavior Members say and hear besides the command (ThinkingCap, ThinkingCap/TeamChaos report §3.2:
 //! behaviors changed while the robot runs).
 
 use serde::{Deserialize, Serialize};
@@ -27,7 +27,7 @@ pub struct BehaviorStatus {
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct ReloadRequest;
 
-/// An edited behavior file sent to a running robot (seed `001` §3.2: a behavior with no syntax
+/// An edited behavior file sent to a running robot (ThinkingCap/TeamChaos report §3.2: a behavior with no syntax
 /// errors "can be sent to the robot at any time, without the need of stopping or rebooting
 /// it"). The robot whose Agora is `robot` compiles it off its control path, writes it into its
 /// behavior directory and swaps it in at a cycle boundary, or keeps its running version, and
@@ -67,7 +67,7 @@ pub struct BehaviorPushReply {
     pub line: Option<u32>,
 }
 
-/// The shape of a behavior Member's HFSM, for monitors that draw it (ThinkingCap seed `001`
+/// The shape of a behavior Member's HFSM, for monitors that draw it (ThinkingCap/TeamChaos report
 /// §4.1 and §5.1: the HFSM editor's and monitor's view of the machines): its machines, each
 /// with its states and labelled transitions. Published when the machine is loaded or
 /// reloaded, and again now and then for monitors that join late; never each cycle. Together

@@ -50,7 +50,7 @@ pub const PERCEPTS: MsgType = reserved(0x4B);
 pub const PLAN_REQUEST: MsgType = reserved(0x4C);
 /// [`crate::PlannedPath`]: planner → guidance, monitors.
 pub const PLANNED_PATH: MsgType = reserved(0x4D);
-/// The blackboard's `BbUpdate` (ISocRob seed `003` §3.1; `mrt_blackboard::proxy`).
+/// The blackboard's `BbUpdate` (ISocRob-2000 report §3.1; `mrt_blackboard::proxy`).
 pub const BB_UPDATE: MsgType = reserved(0x50);
 /// `mrt-net`'s probe: a ping (for `mrt-net-node` and the network tests).
 pub const NET_PING: MsgType = MsgType(0x4E45_5401);

@@ -10,17 +10,17 @@
 //! | message | from → to | seed |
 //! |---|---|---|
 //! | [`Odometry`] (mice readings, wheels, placement) | odometry driver → world model | manual ch. 4 |
-//! | [`CameraFrame`] (sightings of ball, nets, landmarks) | camera driver → world model | ISocRob `003` §3.2.1 |
-//! | [`SonarScan`] of [`Sonar`]s | sonar driver → guidance | ISocRob `003` §2, §3.2.3 |
-//! | [`GameInfo`] | game controller → world model | TeamChaos `001` §3.3 (`getCurrentState`) |
-//! | [`MateReport`] | world model → teammates' world models | ISocRob `003` §3.1 |
-//! | [`Localization`] (pose, uncertainty, [`FilterCounts`]) | world model → monitors, recorders | TeamChaos `001` §4.1 |
-//! | [`WorldSnapshot`] | world model → behaviors, guidance | TeamChaos `001` §3.3 (LPS, GS) |
-//! | [`RobotCommand`] | behaviors → guidance | TeamChaos `001` §3.3 |
-//! | [`MotorCommand`] | guidance → motor and kicker driver | ISocRob `003` §3.2.3 |
+//! | [`CameraFrame`] (sightings of ball, nets, landmarks) | camera driver → world model | ISocRob-2000 report §3.2.1 |
+//! | [`SonarScan`] of [`Sonar`]s | sonar driver → guidance | ISocRob-2000 report §2, §3.2.3 |
+//! | [`GameInfo`] | game controller → world model | ThinkingCap/TeamChaos report §3.3 (`getCurrentState`) |
+//! | [`MateReport`] | world model → teammates' world models | ISocRob-2000 report §3.1 |
+//! | [`Localization`] (pose, uncertainty, [`FilterCounts`]) | world model → monitors, recorders | ThinkingCap/TeamChaos report §4.1 |
+//! | [`WorldSnapshot`] | world model → behaviors, guidance | ThinkingCap/TeamChaos report §3.3 (LPS, GS) |
+//! | [`RobotCommand`] | behaviors → guidance | ThinkingCap/TeamChaos report §3.3 |
+//! | [`MotorCommand`] | guidance → motor and kicker driver | ISocRob-2000 report §3.2.3 |
 //! | [`PlanRequest`], [`PlannedPath`] | guidance (or SCARE) ↔ planner | manual ch. 9 (SPIKE) |
-//! | [`BehaviorStatus`], [`ReloadRequest`], [`BehaviorPush`], [`BehaviorPushReply`] | behavior Member ↔ monitors, editors | TeamChaos `001` §3.2 |
-//! | [`HfsmStructure`] (the machine's states and transitions) | HFSM Member → monitors | ThinkingCap `001` §4.1, §5.1 |
+//! | [`BehaviorStatus`], [`ReloadRequest`], [`BehaviorPush`], [`BehaviorPushReply`] | behavior Member ↔ monitors, editors | ThinkingCap/TeamChaos report §3.2 |
+//! | [`HfsmStructure`] (the machine's states and transitions) | HFSM Member → monitors | ThinkingCap/TeamChaos report §4.1, §5.1 |
 //!
 //! Three standard messages live with their engine and take their id from [`ids`] too: the
 //! blackboard's `BbUpdate` (`mrt-blackboard`), the bus's XML `SelfDescribing` message

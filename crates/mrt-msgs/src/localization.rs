@@ -1,5 +1,5 @@
 //! What the world model says about its own pose, for monitors, recorders and tests (ThinkingCap
-//! seed `001` §4.1: the monitor shows the pose's uncertainty): the estimate in the field frame
+//! ThinkingCap/TeamChaos report §4.1: the monitor shows the pose's uncertainty): the estimate in the field frame
 //! with its uncertainty and what the filter used and refused, and its belief about the ball.
 
 use mrt_core::frames::{Field, Framed};

@@ -95,7 +95,7 @@ impl RobotClass {
 }
 
 /// Another robot anchored by the world model (MAP's anchors, MRT manual ch. 8; TeamChaos'
-/// perceptual anchoring, seed `001` §2.1): a track with an identity that lasts while the robot
+/// perceptual anchoring, ThinkingCap/TeamChaos report §2.1): a track with an identity that lasts while the robot
 /// is seen, is predicted while it is not, and fades.
 #[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
@@ -211,7 +211,7 @@ pub struct WorldSnapshot {
     /// states.
     pub kickoff_pose: Option<Framed<Team, Pose2>>,
     /// Whether the world model needs to localize the robot: the landmarks it sees have
-    /// disagreed with its pose for a while (ThinkingCap seed `001` §2.1: a perceptual need for
+    /// disagreed with its pose for a while (ThinkingCap/TeamChaos report §2.1: a perceptual need for
     /// landmarks; `mrt_world::WorldModel::needs_localization`).
     pub needs_localization: bool,
     /// The SCARE activity this robot was given, its current sub-task and the goal the

@@ -1,6 +1,6 @@
 //! What the sensor drivers publish (MRT manual §2.1: sensing modules): the optical mice and
 //! wheels ([`Odometry`], manual ch. 4), the camera's object detections ([`CameraFrame`]), the
-//! sonar ring ([`SonarScan`], ISocRob seed `003` §2), and the game controller's news
+//! sonar ring ([`SonarScan`], ISocRob-2000 report §2), and the game controller's news
 //! ([`GameInfo`]).
 
 use crate::robot::{lps, GameState};
@@ -9,7 +9,7 @@ use mrt_core::{Point2, Pose2};
 use serde::{Deserialize, Serialize};
 use std::f64::consts::PI;
 
-/// One sonar reading: where the sonar looks and how far the echo is (ISocRob seed `003` §2,
+/// One sonar reading: where the sonar looks and how far the echo is (ISocRob-2000 report §2,
 /// §3.2.3).
 #[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
@@ -40,7 +40,7 @@ impl Sonar {
     }
 
     /// The bearing of sonar `i` of `n` equally spaced around the body, sonar 0 forward (the
-    /// ISocRob robots have sixteen, seed `003` §2).
+    /// ISocRob robots have sixteen, ISocRob-2000 report §2).
     pub fn ring_bearing(i: usize, n: usize) -> f64 {
         if n == 0 {
             return 0.0;
@@ -214,7 +214,7 @@ pub struct RobotSighting {
 }
 
 /// What the game controller tells every robot each cycle (field frame, m): the referee's
-/// state of TeamChaos' `getCurrentState()` (seed `001` §3.3) and the robot's place in the
+/// state of TeamChaos' `getCurrentState()` (ThinkingCap/TeamChaos report §3.3) and the robot's place in the
 /// kickoff formation. Its own message, published by the game controller's driver (a radio
 /// listening to the referee box on a real field), not part of any camera frame.
 #[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
@@ -233,7 +233,7 @@ pub struct GameInfo {
 }
 
 /// One frame of the object sensor, published by the camera driver: distance and bearing of the
-/// ball, the nets and the landmarks, told apart by colour (ISocRob seed `003` §3.2.1).
+/// ball, the nets and the landmarks, told apart by colour (ISocRob-2000 report §3.2.1).
 #[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct CameraFrame {
@@ -246,7 +246,7 @@ pub struct CameraFrame {
     #[serde(default)]
     pub robots: Vec<RobotSighting>,
     /// The camera's image, when the camera renders or grabs one (the vision µAgent's input,
-    /// ISocRob seed `003` §3.2.1); `None` from the object sensor alone.
+    /// ISocRob-2000 report §3.2.1); `None` from the object sensor alone.
     #[serde(default)]
     pub image: Option<Image>,
     /// The camera's pan joint when the frame was taken, rad (`None`: the camera has no joint
@@ -254,12 +254,12 @@ pub struct CameraFrame {
     #[serde(default)]
     pub pan: Option<f64>,
     /// The omnidirectional up camera's image taken at the same time, when the robot has one
-    /// (ISocRob seed `003` §2.2: a camera under a mirror on the robot's top).
+    /// (ISocRob-2000 report §2.2: a camera under a mirror on the robot's top).
     #[serde(default)]
     pub up_image: Option<Image>,
 }
 
-/// What the vision µAgent found in one camera image (ISocRob seed `003` §3.2.1), robot frame:
+/// What the vision µAgent found in one camera image (ISocRob-2000 report §3.2.1), robot frame:
 /// the objects in the object sensor's form (so the world model reads both alike), their
 /// uncertainty and pixel evidence, the field-line points and the obstacles.
 #[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
@@ -295,14 +295,14 @@ pub struct Percepts {
     #[serde(default)]
     pub pan: Option<f64>,
     /// Where in the image the objects above were found (pixels), for monitors that draw them
-    /// over the camera's picture (ISocRob seed `003` §3.2.7, the Monitor's vision window).
+    /// over the camera's picture (ISocRob-2000 report §3.2.7, the Monitor's vision window).
     /// `None` from a vision that does not say; nothing reads it to decide anything.
     #[serde(default)]
     pub detections: Option<ImageDetections>,
 }
 
 /// What the vision found where in one camera image (pixels from the image's top-left corner,
-/// x to the right, y down): what a monitor draws over the picture (ISocRob seed `003` §3.2.7).
+/// x to the right, y down): what a monitor draws over the picture (ISocRob-2000 report §3.2.7).
 #[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct ImageDetections {
@@ -355,7 +355,7 @@ pub enum DetectionKind {
     Line,
 }
 
-/// A landmark post in a camera image (ISocRob seed `003` §3.2.1: landmarks told apart by
+/// A landmark post in a camera image (ISocRob-2000 report §3.2.1: landmarks told apart by
 /// colour): its outer bands wear the colour of the goal of its half, so the image tells the
 /// half, not which of the half's posts it is.
 #[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
@@ -373,7 +373,7 @@ pub struct PostSighting {
 }
 
 /// An RGB image, 8 bits per channel, row by row from the top-left corner (`3·width` bytes a
-/// row): what a camera driver grabs or the simulator renders (ISocRob seed `003` §3.2.1).
+/// row): what a camera driver grabs or the simulator renders (ISocRob-2000 report §3.2.1).
 #[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[derive(Clone, Default, PartialEq, Eq, Serialize, Deserialize)]
 pub struct Image {

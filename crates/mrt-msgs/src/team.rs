@@ -27,8 +27,8 @@ pub struct MateReport {
     /// whose anchors the others fuse, MRT manual ch. 8).
     #[serde(default)]
     pub robots: Vec<SharedRobot>,
-    /// Its part in the team's ball booking (TeamChaos' distributed mutual exclusion, seed
-    /// `001` §3.3; `mrt_team::booking`).
+    /// Its part in the team's ball booking (TeamChaos' distributed mutual exclusion, ThinkingCap/TeamChaos
+    /// report §3.3; `mrt_team::booking`).
     #[serde(default)]
     pub booking: BookingReport,
     /// The role it plays (`getRole`: `goalkeeper`, `attacker`, `supporter`, `defender`;

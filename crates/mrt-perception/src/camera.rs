@@ -4,11 +4,11 @@
 //!
 //! Two models behind one trait, [`Camera`]:
 //! - [`Pinhole`]: a perspective camera mounted on the robot at a height, tilted down, on a
-//!   **pan joint** the robot can turn (TeamChaos' head, seed `001` §2.1; ISocRob's front camera
+//!   **pan joint** the robot can turn (TeamChaos' head, ThinkingCap/TeamChaos report §2.1; ISocRob's front camera
 //!   is the pan-0 case), with intrinsics `(fx, fy, cx, cy)` and optional radial distortion
 //!   `(k1, k2)`;
 //! - [`Omni`]: ISocRob's omnidirectional "up" camera, whose mirror images the floor
-//!   orthographically up to an affine map (seed `003` §2.2): a floor point `(x, y)` of the
+//!   orthographically up to an affine map (ISocRob-2000 report §2.2): a floor point `(x, y)` of the
 //!   robot frame appears at pixel `A·(x, y) + b`; a point above the floor appears where the
 //!   line from the mirror's viewpoint through it meets the floor.
 //!
@@ -242,7 +242,7 @@ impl Camera for Pinhole {
 /// where its line from the viewpoint meets the floor, `viewpoint / (viewpoint − z)` times
 /// farther out than the point itself (with `viewpoint = ∞`, every point above a floor point
 /// appears at that floor point). The robot's own body hides the floor within `blind` of its
-/// centre, and the mirror's rim everything beyond `range` (ISocRob: about 4.5 m, seed `003`
+/// centre, and the mirror's rim everything beyond `range` (ISocRob: about 4.5 m, ISocRob-2000 report
 /// §3.2.1 "up").
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Omni {

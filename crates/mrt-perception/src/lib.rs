@@ -7,7 +7,7 @@
 //! its error detection and reduction (§4.2), the camera models
 //! ([`camera`]: a pinhole camera on a pan joint with radial distortion, ISocRob's
 //! omnidirectional mirror, the ball's floor point and apparent size, with the report's typos
-//! fixed), colour vision on camera images ([`vision`]: ISocRob seed `003` §3.2.1's lookup table,
+//! fixed), colour vision on camera images ([`vision`]: ISocRob-2000 report §3.2.1's lookup table,
 //! ball, goals, lines and obstacles, and the vision µAgent that turns an image into percepts),
 //! and where images come from ([`source`]: the camera driver trait and a player of image
 //! files). A plain library: no bus, no simulator.
@@ -33,11 +33,11 @@
 //! | eq. (4.3)–(4.5) | [`mice::update_pose`] |
 //! | `x̄_r = x̄_l` error detection, error reduction (manual §4.2) | [`mice::MiceOdometry::check`], [`mice::MiceOdometry::reduce`] |
 //! | calibration: `D`, `σ_r`, `σ_l`, `δ`, resolutions, positions (manual §4.2), general mounting | [`mice_calibration::calibrate`], [`mice_calibration::MiceMounting`], its log [`mice_calibration::log`] |
-//! | front camera, inverse projection eqs (7)–(9) (ISocRob `003` §3.2.1) | [`camera::Pinhole`] (with a pan joint) |
-//! | "up" camera, mirror (ISocRob `003` §2.2) | [`camera::Omni`], its file [`camera::OmniFile`]; either model's file [`camera::CameraModel`] |
-//! | the µAgent's "up" mode: the ball all around (ISocRob `003` §3.2.1) | [`vision::up::find_ball_up`] |
+//! | front camera, inverse projection eqs (7)–(9) (ISocRob-2000 report §3.2.1) | [`camera::Pinhole`] (with a pan joint) |
+//! | "up" camera, mirror (ISocRob-2000 report §2.2) | [`camera::Omni`], its file [`camera::OmniFile`]; either model's file [`camera::CameraModel`] |
+//! | the µAgent's "up" mode: the ball all around (ISocRob-2000 report §3.2.1) | [`vision::up::find_ball_up`] |
 //! | ball correction and expected size, eqs (10)–(11) | [`camera::ball_floor_point`], [`camera::ball_diameter_px`] |
-//! | the vision µAgent (ISocRob `003` §3.2.1) | [`vision::agent::VisionAgent`] |
+//! | the vision µAgent (ISocRob-2000 report §3.2.1) | [`vision::agent::VisionAgent`] |
 //! | a camera driver (manual ch. 12, ISocRob §2.2) | [`source::ImageSource`], [`source::ImageSequence`] |
 //!
 //! The manual's mice equations have typos; [`mice`] lists each one with the corrected formula,

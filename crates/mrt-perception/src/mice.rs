@@ -1,4 +1,4 @@
-//! Dead reckoning with two optical mice (MRT manual ch. 4, seed `000` lines ~566–668).
+//! Dead reckoning with two optical mice (MRT manual ch. 4).
 //!
 //! # Geometry (the manual's "initial hypothesis", §4.1)
 //!

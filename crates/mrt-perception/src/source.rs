@@ -68,7 +68,7 @@ pub enum SourceError {
     },
 }
 
-/// A camera driver: hands out the next image (seed `003` §3.2.1: the vision µAgent's input;
+/// A camera driver: hands out the next image (ISocRob-2000 report §3.2.1: the vision µAgent's input;
 /// MRT manual ch. 12: the robots' cameras). `Ok(None)` means the source has ended (a file
 /// sequence that does not loop); a live camera never ends.
 pub trait ImageSource: Send {

@@ -1,6 +1,6 @@
 //! A USB camera on Linux (Video4Linux2), as an [`ImageSource`]:
-//! the robot's own camera for the vision µAgent (ISocRob's robots carried USB cameras, seed
-//! `003` §2.2). Behind the `v4l2` cargo feature, on Linux only.
+//! the robot's own camera for the vision µAgent (ISocRob's robots carried USB cameras, ISocRob-2000
+//! report §2.2). Behind the `v4l2` cargo feature, on Linux only.
 //!
 //! The camera is asked for the camera file's size in RGB24, YUYV (4:2:2, the format nearly
 //! every webcam offers) or Motion-JPEG, in that order of preference. YUYV is converted with

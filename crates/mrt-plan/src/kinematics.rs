@@ -1,9 +1,9 @@
 //! Robot kinematics: twists, wheel speeds, the two MRT bases, and exact pose integration.
 //!
 //! - [`DiffDrive`]: the bi-directional IANUS3 base, "two independent, central, traction wheels",
-//!   "can run up to 1.2 m/s" (MRT manual ch. 12.5, seed `000` line ~2015).
+//!   "can run up to 1.2 m/s" (MRT manual §12.5).
 //! - [`Omni3`]: the holonomic Triskar base, "three independent, traction, omnidirectional wheels
-//!   [...] placed at 120 degrees from each other" (ch. 12.6, line ~2033).
+//!   [...] placed at 120 degrees from each other" (MRT manual §12.6).
 //!
 //! Both implement [`Kinematics`]: wheel speeds from a [`Twist`] and back, a [`Kinematics::limit`]
 //! that scales a twist so no wheel exceeds its top speed, and a [`Kinematics::ramp`] that bounds

@@ -3,7 +3,7 @@
 //! The acting end of an MRT robot as a plain library (no bus, no Lua): SPIKE, the path planner
 //! of the MRT manual's ch. 9 ([`spike`], docs/planning.md), and from a wanted velocity
 //! to wheel speeds for the two MRT bases (MRT manual ch. 12: IANUS3, Triskar; the AIRBoard of
-//! ch. 5 takes one set point per motor), and the three guidance modes of the ISocRob Guidance µAgent (seed `003`
+//! ch. 5 takes one set point per motor), and the three guidance modes of the ISocRob Guidance µAgent (ISocRob-2000 report
 //! §3.2.3): velocity with a sonar stop, go-to-posture, and potential fields around obstacles,
 //! including "behind the ball" targets.
 //!

@@ -41,7 +41,7 @@ pub struct RobotConfig {
     pub mice: MiceOdometry,
     /// The camera's noise.
     pub camera: CameraNoise,
-    /// Guidance between the behaviors and the motors (ISocRob seed `003` §3.2.3).
+    /// Guidance between the behaviors and the motors (ISocRob-2000 report §3.2.3).
     pub guidance: Guidance,
     /// Robots per team (robot 0 of each keeps goal).
     pub team_size: usize,
@@ -49,7 +49,7 @@ pub struct RobotConfig {
     /// (`None`: the camera driver's frames carry percepts already, as the simulator's object
     /// sensor does).
     pub vision: Option<VisionSetup>,
-    /// The PAM's gaze control of the camera's pan joint (TeamChaos seed `001` §2.1), when the
+    /// The PAM's gaze control of the camera's pan joint (ThinkingCap/TeamChaos report §2.1), when the
     /// camera has one (`None`: the camera stays where its file puts it).
     pub gaze: Option<GazeConfig>,
     /// Which estimator keeps the robot's pose ([`mrt_world::relocalize`]).
@@ -60,7 +60,7 @@ pub struct RobotConfig {
     pub goal_corners: bool,
 }
 
-/// What the vision µAgent needs (ISocRob seed `003` §3.2.1).
+/// What the vision µAgent needs (ISocRob-2000 report §3.2.1).
 #[derive(Clone, Debug, PartialEq)]
 pub struct VisionSetup {
     /// The camera's geometry, pan joint at rest.
@@ -240,7 +240,7 @@ impl Default for SensorsSection {
     }
 }
 
-/// `[guidance]` (ISocRob seed `003` §3.2.3).
+/// `[guidance]` (ISocRob-2000 report §3.2.3).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct GuidanceSection {
@@ -296,7 +296,7 @@ impl Default for VisionSection {
 }
 
 /// `[gaze]`: the camera's pan joint and the PAM's gaze control that turns it to the object the
-/// behaviors need most (TeamChaos seed `001` §2.1, [`mrt_world::gaze`]).
+/// behaviors need most (ThinkingCap/TeamChaos report §2.1, [`mrt_world::gaze`]).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct GazeSection {

@@ -1,4 +1,4 @@
-//! Team ISocRob (seed `003` §3.2): robots whose Machine µAgent ([`mrt_team::isocrob`]) reads
+//! Team ISocRob (ISocRob-2000 report §3.2): robots whose Machine µAgent ([`mrt_team::isocrob`]) reads
 //! its parameters from the blackboard (`configs/isocrob/config.dat`, compiled in), talks to its
 //! teammates only through the blackboard (each posts its `should_I_go` heuristic as
 //! `*.var.machine.heuristic.<robot>`, carried by the [`Proxy`](mrt_blackboard::Proxy) Member),
@@ -213,7 +213,7 @@ impl IsocrobBrain {
             .collect()
     }
 
-    /// The Kicker µAgent (seed `003` §3.2.4): when `local.var.kicker.kick` is set it opens
+    /// The Kicker µAgent (ISocRob-2000 report §3.2.4): when `local.var.kicker.kick` is set it opens
     /// the valve for the configured pulse (the kick command held that long) and clears the
     /// variable. Returns whether the pulse ended in this cycle (`kb()`).
     fn kicker(&mut self, now: f64, pulse: f64, cmd: &mut RobotCommand) -> bool {

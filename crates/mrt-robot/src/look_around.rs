@@ -1,7 +1,7 @@
 //! Looking around with the body: what a robot whose camera cannot pan does when its world
 //! model needs to localize ([`WorldSnapshot::needs_localization`](mrt_msgs::WorldSnapshot)).
 //!
-//! ThinkingCap's behaviors state a perceptual need for landmarks (`trackLandMarks`, seed `001`
+//! ThinkingCap's behaviors state a perceptual need for landmarks (`trackLandMarks`, ThinkingCap/TeamChaos report
 //! §2.1) and the PAM turns the head to satisfy it ([`mrt_world::gaze`]). A robot with a fixed
 //! camera has only its body to turn. When the world model doubts its pose (the goals and posts
 //! it sees disagree with it: a robot carried by hand, the kidnapped robot of every RoboCup

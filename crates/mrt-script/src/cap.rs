@@ -1,4 +1,4 @@
-//! One robot's behavioral layer as ThinkingCap runs it (seed 001 §2.1, §3.2): each cycle the
+//! One robot's behavioral layer as ThinkingCap runs it (ThinkingCap/TeamChaos report §2.1, §3.2): each cycle the
 //! high-level HFSM chooses a low-level behavior (`chaos.setBehavior`), and the HBM runs it,
 //! giving the robot command. Scripts edited on disk are reloaded at the next cycle boundary.
 //!
@@ -51,7 +51,7 @@ pub struct Cycle {
     pub reloaded: Vec<String>,
     /// What went wrong (the robot went on regardless).
     pub errors: Vec<ScriptError>,
-    /// The HFSM's shape, for monitors (ThinkingCap seed `001` §4.1, §5.1): in the first
+    /// The HFSM's shape, for monitors (ThinkingCap/TeamChaos report §4.1, §5.1): in the first
     /// cycle, after the machine was reloaded, and every `STRUCTURE_EVERY` (100) cycles for
     /// monitors that join late; `None` otherwise and without an HFSM.
     pub structure: Option<mrt_msgs::HfsmStructure>,

@@ -1,4 +1,4 @@
-//! Fuzzy HBM behaviors written in Lua and blended by context rules (ThinkingCap, seed 001 §4.1),
+//! Fuzzy HBM behaviors written in Lua and blended by context rules (ThinkingCap, ThinkingCap/TeamChaos report §4.1),
 //! on the fuzzy core of `mrt-fuzzy` ([`mrt_fuzzy::hbm::Blender`]).
 //!
 //! A behavior directory holds one Lua file per behavior, named after it (`gkcutb.lua` is the

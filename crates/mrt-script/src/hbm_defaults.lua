@@ -1,4 +1,4 @@
--- Default HBM control variables (seed 001 §4.1): what the rules `rule(truth, VARIABLE, LABEL)`
+-- Default HBM control variables (ThinkingCap/TeamChaos report §4.1): what the rules `rule(truth, VARIABLE, LABEL)`
 -- can assert, and which robot command each one drives. A behavior directory's `hbm.lua` may
 -- redefine any of them (same name) or add new ones.
 --

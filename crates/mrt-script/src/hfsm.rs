@@ -1,4 +1,4 @@
-//! Hierarchical finite state machines for high-level behaviors (ThinkingCap, seed 001 §5.1).
+//! Hierarchical finite state machines for high-level behaviors (ThinkingCap, ThinkingCap/TeamChaos report §5.1).
 //!
 //! A machine is defined in one Lua file, as the seed's HFSM editor generated:
 //!
@@ -482,7 +482,7 @@ impl Hfsm {
         out
     }
 
-    /// The machines' shape for monitors (ThinkingCap seed `001` §4.1, §5.1: the HFSM view),
+    /// The machines' shape for monitors (ThinkingCap/TeamChaos report §4.1, §5.1: the HFSM view),
     /// the root first: what [`Hfsm::to_dot`] and [`Hfsm::to_svg`] draw, as a bus message. A
     /// meta-state `runs` the machine whose states are its children; the active path
     /// ([`Hfsm::path`]) is the root's name, then one state name per level.

@@ -1,6 +1,6 @@
 //! # mrt-script: Lua behaviors for MRT robots
 //!
-//! ThinkingCap (TeamChaos, seed 001 §3) writes behaviors as Lua scripts so a team can change a
+//! ThinkingCap (the ThinkingCap/TeamChaos report §3) writes behaviors as Lua scripts so a team can change a
 //! running robot's behavior in seconds. This crate holds the runtime they run in (on `mlua` with
 //! a vendored Lua 5.4, no system Lua needed):
 //!

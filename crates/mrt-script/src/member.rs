@@ -1,11 +1,11 @@
-//! The behavior Members: ThinkingCap's HFSM and HBM on the DCDT bus (seed 001 §2.1).
+//! The behavior Members: ThinkingCap's HFSM and HBM on the DCDT bus (ThinkingCap/TeamChaos report §2.1).
 //!
 //! A [`BehaviorMember`] reads the latest [`WorldSnapshot`] from the bus, runs one cycle of an
 //! HFSM (the "HFSM Member") or of one HBM behavior (the "HBM Member") per activation (every
 //! 100 ms by default, as in the seed: [`DEFAULT_PERIOD`]), and publishes the [`RobotCommand`](mrt_msgs::robot::RobotCommand)
 //! and a [`BehaviorStatus`] (active path, behavior, errors) for monitors, with the HFSM's
 //! shape as an [`HfsmStructure`](mrt_msgs::HfsmStructure) when it is loaded or reloaded and
-//! every 100 cycles (`STRUCTURE_EVERY`) (seed 001 §4.1, §5.1). A
+//! every 100 cycles (`STRUCTURE_EVERY`) (ThinkingCap/TeamChaos report §4.1, §5.1). A
 //! [`ReloadRequest`] on the bus reloads the edited scripts at the next cycle boundary; a
 //! [`BehaviorPush`] for this robot's Agora brings the edited file itself, like the seed's
 //! editor sending a behavior to a running robot ([`crate::push`]): it is compiled off the

@@ -1,4 +1,4 @@
-//! Behaviors sent to a running robot (seed `001` §3.2: "if the edited behavior contains no
+//! Behaviors sent to a running robot (ThinkingCap/TeamChaos report §3.2: "if the edited behavior contains no
 //! syntax errors, it can be sent to the robot at any time, without the need of stopping or
 //! rebooting it"; `mrt behave push`).
 //!

@@ -1,4 +1,4 @@
-//! The HBM rule language (seed 001 §4.1) on temporary behavior directories: fuzzy sets and
+//! The HBM rule language (ThinkingCap/TeamChaos report §4.1) on temporary behavior directories: fuzzy sets and
 //! connectives, rules and control variables checked by hand (singleton variables), CDB blending
 //! of sub-behaviors, perceptual needs, behaviors using themselves, errors with file and line,
 //! hot reload with fallback, and runaway or hostile behaviors that must not stop the robot.

@@ -1,4 +1,4 @@
-//! Hierarchical finite state machines (seed 001 §5.1) with small inline machines: entering
+//! Hierarchical finite state machines (ThinkingCap/TeamChaos report §5.1) with small inline machines: entering
 //! through nested meta-states, transition priorities (meta-states first), enter/exit hooks,
 //! string and function tests with fuzzy results, `hfsm.*` seen by scripts, reuse of a
 //! meta-state, load-time and runtime errors, reload, and Graphviz output.

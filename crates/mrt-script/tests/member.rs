@@ -114,7 +114,7 @@ impl Member for Shapes {
     }
 }
 
-/// The HFSM Member tells its machine's shape for monitors (seed 001 §4.1, §5.1) in its first
+/// The HFSM Member tells its machine's shape for monitors (ThinkingCap/TeamChaos report §4.1, §5.1) in its first
 /// cycle and then every `STRUCTURE_EVERY` cycles, not every cycle.
 #[test]
 fn the_hfsm_member_tells_its_shape_rarely() {

@@ -1,4 +1,4 @@
-//! The Lua runtime of ThinkingCap behaviors (seed 001 §3): sandbox, budgets, loading strategies
+//! The Lua runtime of ThinkingCap behaviors (ThinkingCap/TeamChaos report §3): sandbox, budgets, loading strategies
 //! and hot reload with fallback.
 
 #![allow(clippy::unwrap_used)]

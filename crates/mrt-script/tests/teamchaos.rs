@@ -1,4 +1,4 @@
-//! The shipped TeamChaos behaviors (`behaviors/teamchaos`, seed 001 §4 and §5) driven with
+//! The shipped TeamChaos behaviors (`behaviors/teamchaos`, ThinkingCap/TeamChaos report §4 and §5) driven with
 //! scripted world snapshots: the seed's trackbnet1 example, the basic behaviors, the
 //! goalkeeper hierarchy and the Attacker HFSM, with the expected commands worked out by hand
 //! from the predicates of `hbm.lua` and the default control variables (Mamdani centroid).
@@ -872,7 +872,7 @@ fn role_scene(t_ms: u64) -> World {
         .mate(0, -8500.0, 0.0, true)
 }
 
-/// The field player's roles (seed 001 §5.1, figure 8). The robot stands at (−2000, 0) facing
+/// The field player's roles (ThinkingCap/TeamChaos report §5.1, figure 8). The robot stands at (−2000, 0) facing
 /// the opponent's net; the ball is 800 mm ahead, at (−1200, 0). The goalkeeper at (−8500, 0)
 /// is always left out of the ranking. The first cycle enters Wait, the second starts the game
 /// (Search); from the third the role is played, and `gotopos` drives towards its spot:
@@ -899,7 +899,7 @@ fn field_players_share_the_roles_by_their_distance_to_the_ball() {
             })
             .collect::<Vec<_>>()
     };
-    // Behind the ball, the attacker-to-be waits for the ball booking (seed 001 §3.3): it
+    // Behind the ball, the attacker-to-be waits for the ball booking (ThinkingCap/TeamChaos report §3.3): it
     // asks for it, and attacks once its world snapshot says it holds it.
     let unbooked = run4(&|w| w);
     let paths: Vec<&str> = unbooked.iter().map(|c| c.path.as_str()).collect();

@@ -1,5 +1,5 @@
 //! Camera images: what each robot's camera sees, drawn from the simulator's world
-//! (the input of the ISocRob vision µAgent, seed `003` §3.2.1).
+//! (the input of the ISocRob vision µAgent, ISocRob-2000 report §3.2.1).
 //!
 //! The world is "3-D enough": the physics is 2-D, and the renderer gives every thing a height
 //! ([`RenderConfig`]). It draws, for a [`Pinhole`] camera on a robot:

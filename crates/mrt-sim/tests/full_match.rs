@@ -45,7 +45,7 @@ fn a_full_match_finishes_and_reproduces_its_trajectory_hash() {
     for s in &a.stats {
         assert!(s.shots_on_target > 0 && s.shots_on_target < s.shots, "{s:?}");
     }
-    // Chaos' attackers book the ball (TeamChaos seed 001 §3.3) through the team's reports on
+    // Chaos' attackers book the ball (ThinkingCap/TeamChaos report §3.3) through the team's reports on
     // the bus: often, and never two at once. Milan does not book.
     assert!(a.stats[1].booked_cycles > 1000, "{:?}", a.stats[1]);
     assert_eq!(a.stats[1].booking_conflicts, 0);
@@ -68,7 +68,7 @@ fn a_full_match_finishes_and_reproduces_its_trajectory_hash() {
     assert!(a.faults.is_empty(), "{:?}", a.faults);
 }
 
-/// Team ISocRob (seed `003` §3.2.2) plays a whole match against the baseline: its robots talk
+/// Team ISocRob (ISocRob-2000 report §3.2.2) plays a whole match against the baseline: its robots talk
 /// only through their blackboards (the heuristics of `should_I_go` carried by the Proxy), no
 /// Member of theirs fails, they shoot on target and score (seed 5, oracle: 4 : 0; the series
 /// are in docs/teams.md), and the same seed gives the same match.

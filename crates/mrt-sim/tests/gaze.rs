@@ -1,4 +1,4 @@
-//! Perceptual needs steer the camera (TeamChaos seed `001` §2.1): a robot on
+//! Perceptual needs steer the camera (ThinkingCap/TeamChaos report §2.1): a robot on
 //! the simulated pitch whose behaviors need the ball and a landmark alike, with a narrow
 //! camera on a pan joint, looks at them in turn as their anchors decay; with no joint it
 //! never turns its camera.

@@ -383,7 +383,7 @@ fn a_goal_cut_by_the_image_side_gives_the_corner_in_view() {
     assert!(p.sightings[EAST_NET].is_some() && p.goal_corners.is_empty(), "{p:?}");
 }
 
-/// The open space (seed `003` eq. 18) on a rendered frame: an empty goal's is in its mouth;
+/// The open space (ISocRob-2000 report eq. 18) on a rendered frame: an empty goal's is in its mouth;
 /// with a keeper on its left half, it lies right of the keeper. `look` reports the
 /// same goals by their nearest points.
 /// The vision tells the teams apart by the marker band round each robot's top (MAP's
@@ -573,7 +573,7 @@ fn the_up_camera_sees_the_ball_all_around() {
     assert!(floor == palette::CARPET || floor == palette::LINE, "{floor:?}");
 }
 
-/// The µAgent's front and up modes multiplexed (seed `003` §3.2.1): with the ball behind the
+/// The µAgent's front and up modes multiplexed (ISocRob-2000 report §3.2.1): with the ball behind the
 /// robot the front camera sees no ball, and the up camera's image gives it, within 5 % of its
 /// distance and 1.5° of its bearing; in front, the front camera's ball is kept.
 #[test]

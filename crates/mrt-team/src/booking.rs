@@ -1,4 +1,4 @@
-//! The ball booking of TeamChaos (seed `001` §3.3): `bookBall` asks the teammates to book the
+//! The ball booking of TeamChaos (ThinkingCap/TeamChaos report §3.3): `bookBall` asks the teammates to book the
 //! ball for this robot, `releaseBookedBall` gives it back, `haveBookedBall` says whether it is
 //! booked. The seed implements it with a distributed mutual exclusion (Agüero et al., 2006b,
 //! not retrieved); this is one built for robots that talk over a lossy, delaying network and

@@ -1,4 +1,4 @@
-//! ISocRob's Machine µAgent (seed `003` §3.2.2): the team's organizational mode, the robots'
+//! ISocRob's Machine µAgent (ISocRob-2000 report §3.2.2): the team's organizational mode, the robots'
 //! roles, the attacker's state machine with its predicates, the goalkeeper's three modes, and
 //! `should_I_go`, the heuristic that lets one robot only go for the ball.
 //!
@@ -28,7 +28,7 @@
 //! assert!(!should_i_go(4, h4, &[]), "not seeing the ball never wins, even alone");
 //! ```
 
-/// The organizational mode of the team (seed `003` §3.2.2): what the whole team is doing.
+/// The organizational mode of the team (ISocRob-2000 report §3.2.2): what the whole team is doing.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Mode {
     /// Idle: waiting for an organizational change (the program just started).
@@ -56,7 +56,7 @@ impl Mode {
     }
 }
 
-/// A robot's role in the play mode (seed `003` §3.2.2).
+/// A robot's role in the play mode (ISocRob-2000 report §3.2.2).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Role {
     /// Moves across its goal to stand in front of the ball ([`keeper()`]).
@@ -117,7 +117,7 @@ pub fn should_i_go(me: u32, mine: f64, others: &[(u32, f64)]) -> bool {
         .all(|&(id, h)| mine < h || (mine == h && me < id))
 }
 
-/// The attacker's predicates for one cycle (seed `003` §3.2.2, the names of figure 7).
+/// The attacker's predicates for one cycle (ISocRob-2000 report §3.2.2, the names of figure 7).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Predicates {
     /// `ffb()`, `front_found_ball()`: the front camera sees the ball.
@@ -136,7 +136,7 @@ pub struct Predicates {
     pub slg: bool,
 }
 
-/// The states of the attacker's machine (seed `003` figure 7), each with the function it runs.
+/// The states of the attacker's machine (ISocRob-2000 report figure 7), each with the function it runs.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum AttackerState {
     /// `ET_go_home()`: to the home posture, watching for the ball.
@@ -167,7 +167,7 @@ impl AttackerState {
     }
 }
 
-/// The attacker role's state machine (seed `003` figure 7). The figure itself is not in the
+/// The attacker role's state machine (ISocRob-2000 report figure 7). The figure itself is not in the
 /// seed's text; these transitions follow the states' and predicates' descriptions there, and
 /// a state stays as it is when no condition holds (as the figure's caption says):
 ///
@@ -231,7 +231,7 @@ impl Attacker {
     }
 }
 
-/// The goalkeeper's modes (seed `003` §3.2.2).
+/// The goalkeeper's modes (ISocRob-2000 report §3.2.2).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum KeeperMode {
     /// Follows the ball's position along its movement axis.
@@ -284,7 +284,7 @@ pub struct KeeperBall {
     pub seen_ago: f64,
 }
 
-/// The goalkeeper's decision (seed `003` §3.2.2): HOME when the ball is in the opponent's half
+/// The goalkeeper's decision (ISocRob-2000 report §3.2.2): HOME when the ball is in the opponent's half
 /// or unseen for longer than [`KeeperParams::home_after`]; otherwise INTERCEPT when the ball
 /// rolls towards the goal and reaches the movement axis within
 /// [`KeeperParams::danger_time`] between the goal's ends, FOLLOW when not. Returns the mode

@@ -5,13 +5,13 @@
 //!
 //! | seed name | Rust |
 //! |---|---|
-//! | TeamChaos' ball booking, a distributed mutual exclusion: `bookBall`, `releaseBookedBall`, `haveBookedBall` (seed `001` §3.3) | [`booking::BallBooking`] |
-//! | the role the team agreed on: `getRole` (seed `001` §3.3, figure 8's roles) | [`roles::allocate`], [`roles::Role`] |
+//! | TeamChaos' ball booking, a distributed mutual exclusion: `bookBall`, `releaseBookedBall`, `haveBookedBall` (ThinkingCap/TeamChaos report §3.3) | [`booking::BallBooking`] |
+//! | the role the team agreed on: `getRole` (ThinkingCap/TeamChaos report §3.3, figure 8's roles) | [`roles::allocate`], [`roles::Role`] |
 //!
 //! | SCARE (MRT manual ch. 11): jobs and schemata, attitude and opportunity, the agenda, the allocation | [`scare::allocate`], [`scare::Activities`] |
 //! | SCARE's sequencer and monitor | [`scare::sequencer::Sequencer`] |
 //! | Team Milan's activities (BringBall, PassageToMate, Defense, ...) | [`scare::soccer`] |
-//! | ISocRob's Machine µAgent: modes, roles, the attacker's state machine, the goalkeeper's modes, `should_I_go` (seed `003` §3.2.2) | [`isocrob`] |
+//! | ISocRob's Machine µAgent: modes, roles, the attacker's state machine, the goalkeeper's modes, `should_I_go` (ISocRob-2000 report §3.2.2) | [`isocrob`] |
 //!
 //! ```
 //! use mrt_team::booking::{BallBooking, BookingParams};

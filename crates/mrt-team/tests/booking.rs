@@ -1,4 +1,4 @@
-//! The ball booking (TeamChaos seed `001` §3.3) over a simulated network that loses, delays
+//! The ball booking (ThinkingCap/TeamChaos report §3.3) over a simulated network that loses, delays
 //! and reorders reports, with robots that fall silent: two robots that hear each other never
 //! hold the booking at once, a released or silent holder's booking passes on, and a claim
 //! that is not affirmed lapses.

@@ -1,4 +1,4 @@
-//! `should_I_go()` (ISocRob seed `003` §3.2.2): on any values the teammates post, at most one
+//! `should_I_go()` (ISocRob-2000 report §3.2.2): on any values the teammates post, at most one
 //! robot of the team goes for the ball, and exactly one when any of them sees it.
 
 use mrt_team::isocrob::{heuristic, should_i_go};

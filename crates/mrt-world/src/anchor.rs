@@ -1,5 +1,5 @@
-//! MAP's anchors of the other robots (MRT manual ch. 8; TeamChaos' perceptual anchoring, seed
-//! `001` §2.1; research note MODULES.md §3): every robot the camera sees becomes an anchor, a
+//! MAP's anchors of the other robots (MRT manual ch. 8; TeamChaos' perceptual anchoring, ThinkingCap/TeamChaos
+//! report §2.1; research note MODULES.md §3): every robot the camera sees becomes an anchor, a
 //! symbol with an identity that lasts, whose place and velocity a Kalman [`Track`] estimates.
 //!
 //! Each frame, in MAP's three steps:
@@ -101,7 +101,7 @@ pub struct RobotPercept {
     pub marker: Option<Marker>,
 }
 
-/// An anchor's phase in the anchoring process (seed `001` §2.1; research note §3: find,
+/// An anchor's phase in the anchoring process (ThinkingCap/TeamChaos report §2.1; research note §3: find,
 /// track, reacquire).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Phase {

@@ -2,7 +2,7 @@
 //! the robot's localization read (lines, goals, landmarks), in the field frame: metres from the
 //! centre spot, x towards the east goal, y to the north side line.
 //!
-//! The landmarks are the objects the camera tells apart by colour (ISocRob seed `003`
+//! The landmarks are the objects the camera tells apart by colour (ISocRob-2000 report
 //! §3.2.1: the two goals, the corner posts, the posts at the ends of the half-way line), in the
 //! order of the camera's sightings ([`mrt_msgs::sighting`]): after the ball, the east and the
 //! west net, then the four corners (NE, SE, NW, SW) and the north and south ends of the
@@ -131,7 +131,7 @@ impl FieldMap {
     }
 
     /// Whether landmark post `k` wears the east goal's colour in its outer bands and the west
-    /// goal's in the middle one (ISocRob seed `003` §3.2.1: the landmarks are told apart by
+    /// goal's in the middle one (ISocRob-2000 report §3.2.1: the landmarks are told apart by
     /// colour). The posts of the east half do, and, a choice of this map, those at the ends
     /// of the half-way line; the west half's wear the colours the other way round. A camera
     /// tells the pattern, not which post of its pattern it sees. `None` for the ball, the

@@ -1,4 +1,4 @@
-//! The PAM's camera control (TeamChaos seed `001` §2.1, after Saffiotti & LeBlanc 2000):
+//! The PAM's camera control (ThinkingCap/TeamChaos report §2.1, after Saffiotti & LeBlanc 2000):
 //! the behaviors state *perceptual needs*, one necessity in [0, 1] per LPS object
 //! (`chaos.setNeeded`, Mr. BRIAN's `need` rules), and each cycle [`Gaze`] picks the object to
 //! look at and turns the camera's pan joint towards it.
@@ -164,7 +164,7 @@ impl Gaze {
         Aim { object: Some(object), pan: self.pan, searching }
     }
 
-    /// `trackLandMarks` (seed `001` §3 and §4: "sets necessities for the most relevant
+    /// `trackLandMarks` (ThinkingCap/TeamChaos report §3 and §4: "sets necessities for the most relevant
     /// landmarks or nets"; `gktracklms` "selects the least recently seen landmark"): the need
     /// `(slot, need)` for the landmark of `slots` to look at next. That is the fixated one
     /// while it is held, else the least recently seen whose anchor is within the camera's
@@ -336,7 +336,7 @@ mod tests {
     #[test]
     fn the_highest_need_wins_and_the_other_object_is_not_looked_at() {
         let (g, mut s) = (&mut gaze(), Stand::new(&[(lps::BALL, 1.0), (lps::NET1, -1.0)]));
-        // `trackbnet1` with the ball 400 mm away: BALL 1.0, NET1 0.7 (seed 001 §3).
+        // `trackbnet1` with the ball 400 mm away: BALL 1.0, NET1 0.7 (ThinkingCap/TeamChaos report §3).
         let aims = run(g, &mut s, &[(lps::BALL, 1.0), (lps::NET1, 0.7)], 200);
         assert!(aims.iter().all(|a| a.object == Some(lps::BALL)));
         assert!((aims[199].pan - 1.0).abs() < 1e-9, "resting on the ball");

@@ -1,4 +1,4 @@
-//! GM, ThinkingCap's fuzzy grid self-localization (seed `001` §2.1: "Self-localization in the
+//! GM, ThinkingCap's fuzzy grid self-localization (ThinkingCap/TeamChaos report §2.1: "Self-localization in the
 //! GM is based on fuzzy logic (Buschka et al., 2000), (Herrero-Pérez et al., 2004)").
 //!
 //! The seed names the method only; the research notes recall it (`MODULES.md` §6, recalled

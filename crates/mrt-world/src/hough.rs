@@ -1,4 +1,4 @@
-//! ISocRob's self-localization from the field lines (seed `003` §3.2.1, the vision µAgent's
+//! ISocRob's self-localization from the field lines (ISocRob-2000 report §3.2.1, the vision µAgent's
 //! "self" mode; the research notes `MODULES.md` §7 write the steps out): the white points a
 //! camera found on the floor (robot frame) vote in a **Hough** transform for straight lines,
 //! `ρ = x·cos φ + y·sin φ`; the strongest lines are matched **combinatorially** to the field
@@ -232,7 +232,7 @@ impl HoughPose {
     /// How well the pose agrees with seeing the east (yellow) goal's centre at `bearing`
     /// (robot frame, rad): the cosine of the angle between where it is seen and where that
     /// pose would see it, 1 at best. Of a pose and its half-turn twin, the one facing the
-    /// goal seen is the right one (seed `003` §3.2.1: goal colour breaks the symmetry).
+    /// goal seen is the right one (ISocRob-2000 report §3.2.1: goal colour breaks the symmetry).
     pub fn facing(&self, map: &FieldMap, bearing: f64) -> f64 {
         let p = self.pose;
         let expected = (0.0 - p.y).atan2(map.half_length() - p.x) - p.theta;

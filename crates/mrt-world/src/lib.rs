@@ -1,13 +1,13 @@
 //! # mrt-world: what a robot knows about the world
 //!
 //! The reasoning side of an MRT robot that turns percepts into knowledge (MRT manual §2.1;
-//! TeamChaos seed `001` §2.1, perceptual anchoring; ISocRob seed `003` §3.1, the world
+//! ThinkingCap/TeamChaos report §2.1, perceptual anchoring; ISocRob-2000 report §3.1, the world
 //! state): one [`field::FieldMap`] (lines, goals, landmarks) that the simulator's truth and
 //! the robot's localization both read; the [`model::WorldModel`], an extended Kalman filter on
 //! the robot's pose predicted by the two-mice odometry and corrected by the landmarks the
 //! camera saw, with the local perceptual space (LPS) of anchors whose reliability decays when
 //! they go unseen; the PAM's camera control, [`gaze::Gaze`], which turns the camera's pan joint
-//! to the object the behaviors need most (seed `001` §2.1); and the team side,
+//! to the object the behaviors need most (ThinkingCap/TeamChaos report §2.1); and the team side,
 //! [`team::merge_team`]. It reads the standard messages of `mrt-msgs` only (never a
 //! simulator), so the same world model runs on a real robot.
 //!

@@ -11,7 +11,7 @@
 //!    into a short **window** (the last [`Relocalizer::window`] seconds), each glimpse
 //!    kept in the field frame of the tracker's pose when it was seen and carried to the
 //!    robot's frame now by the tracker's motion since, so that a robot whose camera sees one
-//!    thing at a time (a pan joint sweeping, seed `001` §2.1) still gathers enough to
+//!    thing at a time (a pan joint sweeping, ThinkingCap/TeamChaos report §2.1) still gathers enough to
 //!    localize. (The tracker's motion, not the odometry's alone: a mouse that under-reads
 //!    turns the dead reckoning by tenths of a radian, which the tracker's corrections undo.)
 //!    Older glimpses weigh less (halved every [`HALF_LIFE`] s) and their tolerances grow
@@ -42,7 +42,7 @@
 //!    [`ONE_MARK_BACKOFF`] s.
 //!
 //! 4. In ISocRob's **self mode** ([`Relocalizer::with_self_mode`], for a robot whose up
-//!    camera sees the field lines all around it, seed `003` §3.2.1), a frame with
+//!    camera sees the field lines all around it, ISocRob-2000 report §3.2.1), a frame with
 //!    [`SELF_POINTS`] line points or more is searched even without two goals or posts: the
 //!    Hough transform of its lines ([`crate::hough`]) gives the pose up to the field's
 //!    half-turn symmetry, MUREA refines both twins on the window, and the fix is taken, on
@@ -306,7 +306,7 @@ impl Relocalizer {
         }
     }
 
-    /// The same relocalizer in ISocRob's self mode too (module doc, 4.; seed `003` §3.2.1):
+    /// The same relocalizer in ISocRob's self mode too (module doc, 4.; ISocRob-2000 report §3.2.1):
     /// for a robot whose camera sees the field lines all around (the up camera).
     pub fn with_self_mode(mut self, field: &FieldMap) -> Relocalizer {
         self.self_mode = Some((*field, Vec::new()));
@@ -661,7 +661,7 @@ mod tests {
         panic!("not found: {:?}", r.counts())
     }
 
-    /// Seed `003` §3.2.1's self mode: a robot carried to a place where it sees one net only
+    /// The ISocRob-2000 report's self mode (§3.2.1): a robot carried to a place where it sees one net only
     /// (the search on goals and posts needs two) is found again from the field lines all
     /// around it, the net telling the half-turn twins apart: with the self mode from the
     /// Hough lines of one frame, without it by MUREA's search on the net and the window's

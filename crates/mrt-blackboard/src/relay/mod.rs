@@ -1,4 +1,4 @@
-//! The Relay (ISocRob `003` §3.2.6): a TCP server that lets a person watch and set a robot's
+//! The Relay (ISocRob-2000 report §3.2.6): a TCP server that lets a person watch and set a robot's
 //! blackboard variables, one text line per request and one line per reply. The grammar and
 //! the replies are in `docs/relay-protocol.md`; [`parse_request`] is its parser.
 //!

@@ -1,4 +1,4 @@
-//! The vision µAgent (ISocRob seed `003` §3.2.1): one camera image in, [`Percepts`] out. The
+//! The vision µAgent (ISocRob-2000 report §3.2.1): one camera image in, [`Percepts`] out. The
 //! pieces of this module put together: the colour lookup table, the ball (size test and centre
 //! correction), the goals, the field-line points, other robots with their team markers.
 //!
@@ -147,7 +147,7 @@ impl VisionAgent {
         }
     }
 
-    /// The robot's omnidirectional up camera too (ISocRob seed `003` §2.2): its images give
+    /// The robot's omnidirectional up camera too (ISocRob-2000 report §2.2): its images give
     /// the ball all around the robot ([`VisionAgent::see_with_up`]).
     pub fn up_camera(mut self, omni: Omni) -> VisionAgent {
         self.up = Some(UpMode::new(omni));
@@ -160,7 +160,7 @@ impl VisionAgent {
     }
 
     /// [`VisionAgent::see`] on the front camera's image, multiplexed with the up camera's
-    /// (seed `003` §3.2.1: the µAgent's front, up and self modes): the up camera's field-line
+    /// (ISocRob-2000 report §3.2.1: the µAgent's front, up and self modes): the up camera's field-line
     /// points all around join the front camera's ([`crate::vision::up::line_points_up`]), and
     /// when the front camera does not see the ball and the up camera does
     /// ([`crate::vision::up::find_ball_up`]), the ball is the up camera's, with one pixel of
@@ -260,7 +260,7 @@ impl VisionAgent {
         self.classes.resize(w as usize * h as usize, 0);
         self.balanced.classify(&self.lut, &image.rgb, w as usize, &mut self.classes);
         let mut p = Percepts { time, pan: Some(pan), ..Default::default() };
-        // Where in the image each object was found, for monitors (ISocRob seed `003` §3.2.7).
+        // Where in the image each object was found, for monitors (ISocRob-2000 report §3.2.7).
         let mut shown = Vec::with_capacity(8 + ImageDetections::MAX_LINE_POINTS);
         let ball = find_ball(&self.classes, &self.camera, self.ball_radius);
         if let Some(ball) = ball {

@@ -1,6 +1,6 @@
 //! White balance: each image's colours corrected so that its carpet shows the colour the colour
 //! classes were set for, before the lookup table classifies them (MRT's addition to ISocRob's
-//! vision, seed `003` §3.2.1, whose thresholds hold for one light only).
+//! vision, ISocRob-2000 report §3.2.1, whose thresholds hold for one light only).
 //!
 //! A light half as bright, a warm lamp or a camera's own gain moves every colour of the image
 //! the same way, channel by channel. The carpet, most of what a field camera sees, is a

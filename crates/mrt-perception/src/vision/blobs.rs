@@ -1,4 +1,4 @@
-//! Blobs of one colour class and the ball percept (ISocRob seed `003` §3.2.1: the windowed
+//! Blobs of one colour class and the ball percept (ISocRob-2000 report §3.2.1: the windowed
 //! blob of the ball's pixels, its distance-dependent size test and its centre correction, eqs
 //! 10–11 as fixed in the research notes §3).
 //!

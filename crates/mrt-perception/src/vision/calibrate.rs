@@ -4,7 +4,7 @@
 //! well: a class whose colour shows up there is too narrow.
 //!
 //! HSV is computed the way the lookup table computes it (from the pixel's RGB15 value, eq. 13
-//! of seed `003`), so the histograms show exactly what the thresholds are compared with.
+//! of the ISocRob-2000 report), so the histograms show exactly what the thresholds are compared with.
 //!
 //! ```
 //! use mrt_perception::vision::calibrate::Histograms;

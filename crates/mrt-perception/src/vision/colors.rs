@@ -1,4 +1,4 @@
-//! Colour classes and the lookup table (ISocRob seed `003` §3.2.1, eqs 12–15; research notes
+//! Colour classes and the lookup table (ISocRob-2000 report §3.2.1, eqs 12–15; research notes
 //! `ISOCROB_VISION.md` §4).
 //!
 //! A class is a box in HSV space, `⟨H_min, H_max, S_min, V_min⟩` as in the report, with hue in

@@ -1,4 +1,4 @@
-//! Goals: their nearest point and the open space for a shot (ISocRob seed `003` §3.2.1,
+//! Goals: their nearest point and the open space for a shot (ISocRob-2000 report §3.2.1,
 //! eqs 16–18; research notes §5).
 //!
 //! With `u(i, j) = 1` where pixel (column i, row j) has the goal's colour: the column counts

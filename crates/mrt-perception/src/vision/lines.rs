@@ -1,4 +1,4 @@
-//! Field-line points for localization (ISocRob seed `003` §3.2.1, the "self" mode: green/white
+//! Field-line points for localization (ISocRob-2000 report §3.2.1, the "self" mode: green/white
 //! transitions found by sampling the image, fed to a line extraction; research notes §7).
 //!
 //! Scan lines: every `step`-th column, from the bottom of the image up (near to far), looking

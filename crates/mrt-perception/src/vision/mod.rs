@@ -1,4 +1,4 @@
-//! Colour vision (ISocRob seed `003` §3.2.1, the vision µAgent): pixels classified by a colour
+//! Colour vision (ISocRob-2000 report §3.2.1, the vision µAgent): pixels classified by a colour
 //! lookup table built from HSV thresholds ([`colors`]), each image white-balanced to the
 //! carpet first ([`balance`]); blobs and the ball ([`blobs`]), goals
 //! with their nearest point and open space ([`goals`]), field-line points ([`lines`]) and the

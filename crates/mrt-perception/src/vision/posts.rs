@@ -1,4 +1,4 @@
-//! Landmark posts (ISocRob seed `003` §3.2.1: the camera tells the field's landmarks apart by
+//! Landmark posts (ISocRob-2000 report §3.2.1: the camera tells the field's landmarks apart by
 //! colour): cylinders beside the field painted in three bands of the goal colours, the outer
 //! bands the colour of the goal of their half and the middle band the other one (yellow,
 //! blue, yellow on the yellow goal's half).

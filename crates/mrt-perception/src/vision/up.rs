@@ -1,4 +1,4 @@
-//! The vision µAgent's **up** mode (ISocRob seed `003` §3.2.1): the omnidirectional camera
+//! The vision µAgent's **up** mode (ISocRob-2000 report §3.2.1): the omnidirectional camera
 //! finds the ball all around the robot, within the mirror's reach and outside the floor the
 //! robot's body hides. "Because of the mirror geometry (hardware unwrapping) it is trivial to
 //! obtain floor objects positions": a pixel is a floor point through the camera's affine map
@@ -223,7 +223,7 @@ pub fn find_ball_up(classes: &[u8], omni: &Omni, radius: f64) -> Option<BallPerc
 }
 
 /// The field-line points an omnidirectional camera's class map shows (the µAgent's "self"
-/// mode, seed `003` §3.2.1; research notes §7 step 1): `rays` radial scan lines from the
+/// mode, ISocRob-2000 report §3.2.1; research notes §7 step 1): `rays` radial scan lines from the
 /// robot's blind disc out to the mirror's reach, evenly spread round the robot, each looking
 /// (like [`super::lines::line_points`] in a front image) for runs of at most `max_run` line
 /// pixels between carpet; each run's middle is a floor point, robot frame, through the

@@ -2,7 +2,7 @@
 
 use super::*;
 
-/// The PAM's gaze control of one robot (TeamChaos seed `001` §2.1, [`mrt_world::gaze`]): each
+/// The PAM's gaze control of one robot (ThinkingCap/TeamChaos report §2.1, [`mrt_world::gaze`]): each
 /// cycle, the behaviors' latest perceptual needs (with `trackLandMarks`, the least recently seen
 /// landmark or net) and the latest LPS choose the object to look at, and the camera's pan joint
 /// is turned towards it. A joint that refuses is counted and

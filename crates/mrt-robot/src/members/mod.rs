@@ -9,7 +9,7 @@
 //!    sensor's percepts), `game-controller-<n>` the referee's news ([`GameInfo`]),
 //!    `sonars-<n>` the sonar ring ([`SonarScan`]);
 //! 1. **`vision-<n>`** (periodic, when the robot's configuration has
-//!    [`vision`](RobotConfig::vision)): the vision µAgent (ISocRob seed `003` §3.2.1) turns
+//!    [`vision`](RobotConfig::vision)): the vision µAgent (ISocRob-2000 report §3.2.1) turns
 //!    the camera's latest image into [`Percepts`];
 //! 2. **`WorldState`** (periodic): fuses odometry, camera percepts, sonar echoes and game
 //!    controller into the robot's own pose, LPS and anchored robots ([`WorldModel`]), takes
@@ -22,7 +22,7 @@
 //!    Chaos stack, or a [`BrainMember`] around any `Send` [`Brain`](crate::brain::Brain)
 //!    (Milan, the baseline);
 //! 4. **`gaze-<n>`** (periodic, when the robot's configuration has
-//!    [`gaze`](RobotConfig::gaze)): the PAM's camera control (seed `001` §2.1) turns the
+//!    [`gaze`](RobotConfig::gaze)): the PAM's camera control (ThinkingCap/TeamChaos report §2.1) turns the
 //!    camera's pan joint to the object the behaviors need most ([`Devices::set_pan`]);
 //! 4. **`planner-<n>`** (SPIKE, MRT manual ch. 9, on message): plans a path for each
 //!    [`PlanRequest`] round the robots the world model anchored ([`crate::planner`]);

@@ -2,7 +2,7 @@
 
 use super::*;
 
-/// The vision µAgent of one robot (ISocRob seed `003` §3.2.1): the camera's latest image into
+/// The vision µAgent of one robot (ISocRob-2000 report §3.2.1): the camera's latest image into
 /// [`Percepts`]. An image the camera's geometry does not fit is counted, logged once, and
 /// dropped.
 pub(super) struct Vision {

@@ -15,7 +15,7 @@ pub(super) struct WorldState {
     pub(super) body: Commander,
     pub(super) model: WorldModel,
     pub(super) mates: BTreeMap<u32, MateReport>,
-    /// The team's ball booking (TeamChaos seed `001` §3.3, [`mrt_team::booking`]): fed by the
+    /// The team's ball booking (ThinkingCap/TeamChaos report §3.3, [`mrt_team::booking`]): fed by the
     /// behaviors' `bookBall`/`releaseBookedBall` and the teammates' reports.
     pub(super) booking: BallBooking,
     /// Teammates' booking reports received since the last frame.

@@ -33,7 +33,7 @@ pub struct TeamStats {
     /// Control cycles in which this team had the robot closest to the ball (within 1 m).
     pub possession_cycles: u64,
     /// Robot cycles in which one of its robots believed it held the ball booking (TeamChaos
-    /// seed `001` §3.3, `mrt_team::booking`).
+    /// ThinkingCap/TeamChaos report §3.3, `mrt_team::booking`).
     pub booked_cycles: u64,
     /// Robot cycles in which a robot believed it held the booking while a teammate did too
     /// in the same cycle (the booking's promise: never).

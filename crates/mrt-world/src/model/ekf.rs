@@ -178,7 +178,7 @@ impl WorldModel {
     /// scalar EKF update whose Jacobian is the line's normal `n` for the position and
     /// `n · ∂p/∂θ` for the heading. A point tells nothing along its line, so a frame of one
     /// line corrects the pose across it only, and the corner of two lines fixes the position.
-    /// This is how ISocRob's "self" localization used the lines (seed `003` §3.2.1), as an
+    /// This is how ISocRob's "self" localization used the lines (ISocRob-2000 report §3.2.1), as an
     /// EKF update instead of a Hough match: the lines are in nearly every frame, the goals and
     /// posts far and few.
     pub(super) fn correct_lines(&mut self, line_points: &[Framed<Robot, Point2>]) {

@@ -14,7 +14,7 @@
 //!   sightings again. (With the default sensors this happens a few times a match per robot,
 //!   mostly after a mouse under-read while the robot drove straight: its `x̄` is then 0 on
 //!   both mice, so the manual's check cannot see the error, and the heading jumps.)
-//! - **LPS** (seed `001` §3, the perceptual anchors): each object keeps the field position
+//! - **LPS** (ThinkingCap/TeamChaos report §3, the perceptual anchors): each object keeps the field position
 //!   where it was last seen, computed from the pose estimate; an object not seen in a frame
 //!   keeps it, so its robot-relative position moves with the robot's own estimated motion,
 //!   and its reliability decays by [`DECAY`] per cycle.
@@ -270,7 +270,7 @@ impl WorldModel {
         self
     }
 
-    /// The sonar ring's reading (ISocRob seed `003` §2): kept for the next frame's anchoring,
+    /// The sonar ring's reading (ISocRob-2000 report §2): kept for the next frame's anchoring,
     /// where an echo keeps a robot the camera does not see in track ([`Anchors::observe`]).
     pub fn sonars(&mut self, scan: &SonarScan) {
         self.sonars.clone_from(&scan.sonars);
@@ -363,7 +363,7 @@ impl WorldModel {
     /// Whether the robot needs to localize: the goals and posts it sees (or MUREA's window)
     /// have disagreed with its pose for [`DOUBTED`] s, none agreeing (it was carried, or its
     /// pose went wrong), and no relocalization has settled it. This is the perceptual need that
-    /// ThinkingCap's behaviors state with `trackLandMarks` (seed `001` §2.1), stated by the
+    /// ThinkingCap's behaviors state with `trackLandMarks` (ThinkingCap/TeamChaos report §2.1), stated by the
     /// world model itself: with a pan joint the gaze looks for landmarks, without one the
     /// robot turns ([`WorldSnapshot::needs_localization`]).
     pub fn needs_localization(&self) -> bool {
