@@ -23,8 +23,8 @@
 //! The report's inverse projection (eq. 8) is exact for the forward distance; its lateral one
 //! (`y = (v/f)·√(h² + x²)`) divides by the slant range instead of the depth along the optical
 //! axis and over-estimates `|y|` by `1/cos δ` off the axis. [`Pinhole`] intersects the pixel's
-//! ray with the floor, which is the exact form; a test checks the research vectors and the
-//! report's error.
+//! ray with the floor, which is the exact form; tests check it on worked vectors (computed
+//! from the exact forms) and measure the report's error.
 
 use nalgebra::{Matrix2, Point2, Point3, Rotation3, Vector2, Vector3};
 
@@ -336,11 +336,11 @@ impl Camera for Omni {
     }
 }
 
-/// The report's ball correction (eqs 10–11, research §3): the centroid of a ball's pixels
-/// images its centre, at height `radius`; where that ray meets the floor is `floor_hit`, at
-/// horizontal run `r` from the camera's foot. The ball's own floor point lies on the same
-/// line at `r·(1 − radius/h)` (`h`: the camera's height). **The report corrects x only; the
-/// same factor applies to y** (research §3, flag): both are scalings of the ray's run.
+/// The report's ball correction (eqs 10–11): the centroid of a ball's pixels images its
+/// centre, at height `radius`; where that ray meets the floor is `floor_hit`, at horizontal
+/// run `r` from the camera's foot. The ball's own floor point lies on the same line at
+/// `r·(1 − radius/h)` (`h`: the camera's height). **The report corrects x only; the same
+/// factor applies to y**: both are scalings of the ray's run.
 pub fn ball_floor_point(
     camera_foot: Point2<f64>,
     height: f64,
@@ -351,9 +351,9 @@ pub fn ball_floor_point(
 }
 
 /// The apparent diameter (pixels) of a ball of `radius` (m) whose centre is at `range` (m)
-/// from the optical centre, for focal length `f` (pixels): `w = 2·radius·f / range` (research
-/// §3: the report's eq. 11b divides by the range to the *floor* point, which under-estimates
-/// `w` by exactly `1 − D/(2h)`, and names the diameter a radius).
+/// from the optical centre, for focal length `f` (pixels): `w = 2·radius·f / range` (the
+/// report's eq. 11b divides by the range to the *floor* point, which under-estimates `w` by
+/// exactly `1 − D/(2h)`, and names the diameter a radius).
 pub fn ball_diameter_px(radius: f64, f: f64, range: f64) -> f64 {
     2.0 * radius * f / range
 }
@@ -752,8 +752,9 @@ mod tests {
     use mrt_core::frames::metres;
     use proptest::prelude::*;
 
-    /// The research notes' camera (§2): h = 450 mm, the optical axis meets the floor c = 625
-    /// mm ahead, f = 400 px. In metres here.
+    /// A worked example of the report's front camera: h = 450 mm and f = 400 px (example
+    /// values: the report does not give them), the optical axis meets the floor c = 625 mm
+    /// ahead (the report's value). In metres here.
     fn isocrob_front() -> Pinhole {
         let (h, c) = (0.45, 0.625);
         Pinhole::new(Intrinsics::centred(640, 480, 400.0), h, (h / c).atan())
@@ -765,9 +766,9 @@ mod tests {
     }
 
     #[test]
-    fn the_research_vectors_project_and_come_back() {
+    fn the_worked_vectors_project_and_come_back() {
         let cam = isocrob_front();
-        // floor (x, y) mm → (u, v) px, from research §2.
+        // floor (x, y) mm → (u, v) px, computed from the exact forward model.
         for ((x, y), (u, v)) in [
             ((1000.0, 200.0), (81.571, 74.455)),
             ((625.0, 300.0), (0.0, 155.815)),
@@ -783,7 +784,7 @@ mod tests {
     }
 
     /// The report's lateral inverse (eq. 8's y = (v/f)·√(h² + x²)) is not the pinhole one: at
-    /// (3000, 500) mm it gives 562.283 mm (research §2); the model gives 500.
+    /// (3000, 500) mm it gives 562.283 mm; the model gives 500.
     #[test]
     fn the_reports_lateral_formula_overestimates_off_axis() {
         let cam = isocrob_front();
@@ -809,11 +810,11 @@ mod tests {
         assert!(level.project(Point3::new(-1.0, 0.0, 0.0)).is_none());
     }
 
-    /// The research vector of §3: camera at h = 0.45 m, ball of diameter 0.22 m centred at
+    /// A worked test vector: camera at h = 0.45 m, ball of diameter 0.22 m centred at
     /// 1.5 m: its centre's ray meets the floor at 1.985294 m, the correction gives 1.5 back;
     /// the exact apparent diameter is 57.215 px (the report's formula: 43.229).
     #[test]
-    fn ball_correction_and_size_by_the_research_vector() {
+    fn ball_correction_and_size_by_the_worked_vector() {
         let (h, f, radius) = (0.45, 400.0, 0.11);
         let cam = Pinhole::new(Intrinsics::centred(640, 480, f), h, 0.0);
         let centre = Point3::new(1.5, 0.0, radius);
@@ -830,7 +831,8 @@ mod tests {
         assert!((report - 43.229).abs() < 1e-3, "{report}");
     }
 
-    /// The lateral correction applies to y too (research §3, flag): a ball off to the side.
+    /// The lateral correction applies to y too (the report corrects x only): a ball off to the
+    /// side.
     #[test]
     fn the_ball_correction_scales_y_as_well() {
         let cam = isocrob_front();

@@ -232,7 +232,7 @@ impl MiceMounting {
     }
 
     /// The robot's motion over one sampling period from both mice's counts, for this mounting
-    /// (the manual's §4.1 in its general form, research notes `MODULES.md` §1.1), and the
+    /// (the manual's §4.1 in its general form: the mice anywhere, turned any way), and the
     /// residual `ε` of the §4.1 constraint: the two mice's motions along their joining line,
     /// which a rigid body makes equal, differ by `ε` metres (0 for consistent counts).
     ///
@@ -618,9 +618,9 @@ mod tests {
         (a - b).abs() <= tol
     }
 
-    /// The research notes' vector T5 (`MODULES.md` §1.5), in the manual's mouse axes: a mouse
-    /// at (50, 80) mm turned by σ = 30°, at 400 cpi (15.748 counts/mm). 500 mm straight ahead
-    /// it counts x̄ = kL sin σ = 3937.0, ȳ = kL cos σ = 6819.1; a 2π turn moves it by
+    /// A worked test vector (T5), in the manual's mouse axes: a mouse at (50, 80) mm turned
+    /// by σ = 30°, at 400 cpi (15.748 counts/mm). 500 mm straight ahead it counts
+    /// x̄ = kL sin σ = 3937.0, ȳ = kL cos σ = 6819.1; a 2π turn moves it by
     /// 2π J p = (−502.655, 314.159) mm, which it counts as x̄ = −8242.48, ȳ = −4381.61.
     #[test]
     fn t5_recovers_the_mouse() {

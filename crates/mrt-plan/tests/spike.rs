@@ -1,7 +1,7 @@
-//! SPIKE (MRT manual ch. 9) against the research notes' tests (`MODULES.md` §4): an empty
-//! room, a door just wide enough and one too narrow, a passage narrower than the coarse
-//! cells, paths that keep their clearance, an obstacle dropped on the path, and lengths
-//! against an independent shortest path (a visibility graph on the grown discs).
+//! SPIKE (MRT manual ch. 9) tested on: an empty room, a door just wide enough and one too
+//! narrow, a passage narrower than the coarse cells, paths that keep their clearance, an
+//! obstacle dropped on the path, and lengths against an independent shortest path (a
+//! visibility graph on the grown discs).
 #![allow(clippy::unwrap_used, clippy::expect_used)]
 
 use mrt_core::Point2;
@@ -107,9 +107,9 @@ fn round_a_pillar_the_path_keeps_its_clearance_and_is_nearly_the_shortest() {
     assert!(plan.length <= 1.05 * best, "{} vs {best}", plan.length);
 }
 
-/// Research notes §4: a wall with a 0.9 m door, robot radius 0.3 m, safety 0.1 m: the path
-/// goes through the door, keeps 0.3 m everywhere and 0.4 m outside the door's region; a
-/// 0.5 m door lets nothing through. A 0.7 m gap is passable only as a door.
+/// A wall with a 0.9 m door, robot radius 0.3 m, safety 0.1 m: the path goes through the
+/// door, keeps 0.3 m everywhere and 0.4 m outside the door's region; a 0.5 m door lets
+/// nothing through. A 0.7 m gap is passable only as a door.
 #[test]
 fn a_door_just_wide_enough_is_passed_and_one_too_narrow_is_not() {
     let params = SpikeParams { robot_radius: 0.3, safety: 0.1, ..SpikeParams::default() };
@@ -152,8 +152,8 @@ fn a_door_just_wide_enough_is_passed_and_one_too_narrow_is_not() {
     }
 }
 
-/// Research notes §4: a passage narrower than the coarse cells is found (the
-/// multi-resolution check): 0.7 m between two walls, 0.6 m needed.
+/// A passage narrower than the coarse cells is found (the multi-resolution check): 0.7 m
+/// between two walls, 0.6 m needed.
 #[test]
 fn a_passage_narrower_than_the_coarse_cells_is_found() {
     let map = PlanMap::new(p(-8.0, -8.0), p(8.0, 8.0))

@@ -1,4 +1,4 @@
-//! SCARE's promises, on random teams (MODULES.md §5's tests as properties):
+//! SCARE's promises, as properties on random teams:
 //!
 //! - every robot that heard the same reports computes the same allocation, whatever order it
 //!   heard them in;

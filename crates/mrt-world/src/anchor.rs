@@ -1,6 +1,6 @@
-//! MAP's anchors of the other robots (MRT manual ch. 8; TeamChaos' perceptual anchoring, ThinkingCap/TeamChaos
-//! report §2.1; research note MODULES.md §3): every robot the camera sees becomes an anchor, a
-//! symbol with an identity that lasts, whose place and velocity a Kalman [`Track`] estimates.
+//! MAP's anchors of the other robots (MRT manual ch. 8; TeamChaos' perceptual anchoring,
+//! ThinkingCap/TeamChaos report §2.1): every robot the camera sees becomes an anchor, a symbol
+//! with an identity that lasts, whose place and velocity a Kalman [`Track`] estimates.
 //!
 //! Each frame, in MAP's three steps:
 //! 1. **Classification.** A robot percept is a Robot; the colour of its marker band, when the
@@ -48,17 +48,16 @@ use nalgebra::Matrix2;
 use pathfinding::kuhn_munkres::kuhn_munkres_min;
 use pathfinding::matrix::Matrix;
 
-/// Random acceleration of a robot, m/s² (research note MODULES.md §3: ~1 m/s², a design
-/// choice).
+/// Random acceleration of a robot, m/s² (~1 m/s², a design choice).
 pub const ROBOT_ACCEL: f64 = 1.0;
 /// An unseen robot's predicted velocity fades at this rate, 1/s: robots stop and turn, and a
 /// constant-velocity prediction over seconds would carry the anchor far from any robot.
 pub const ROBOT_DAMPING: f64 = 0.5;
-/// An unseen anchor's reliability is multiplied by this every second (λ of the research note).
+/// An unseen anchor's reliability is multiplied by this every second (a design choice).
 pub const FADE: f64 = 0.5;
 /// An anchor's reliability is multiplied by this every second the camera looks where it is
-/// predicted and does not see it (the research note: fading faster when the object should have
-/// been visible): a robot gone from in front of the camera is forgotten within a second
+/// predicted and does not see it (a design choice: fading faster when the object should
+/// have been visible): a robot gone from in front of the camera is forgotten within a second
 /// instead of three.
 pub const MISSED: f64 = 0.05;
 /// Below this reliability an anchor is forgotten (≈ 3.3 s unseen).
@@ -101,8 +100,8 @@ pub struct RobotPercept {
     pub marker: Option<Marker>,
 }
 
-/// An anchor's phase in the anchoring process (ThinkingCap/TeamChaos report §2.1; research note §3: find,
-/// track, reacquire).
+/// An anchor's phase in the anchoring process (ThinkingCap/TeamChaos report §2.1; anchoring's
+/// usual three phases: find, track, reacquire).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Phase {
     /// New: seen fewer than [`CONFIRM`] times.
@@ -577,8 +576,8 @@ mod tests {
         assert_eq!(anchors.anchors().len(), 1);
     }
 
-    /// "Faster if the object should have been visible" (research note §3): where the camera
-    /// looks and does not see an anchor, it fades at MISSED a second; elsewhere at FADE.
+    /// Fading faster when the object should have been visible: where the camera looks and
+    /// does not see an anchor, it fades at MISSED a second; elsewhere at FADE.
     #[test]
     fn an_anchor_the_camera_should_see_and_does_not_fades_fast() {
         let mut anchors = Anchors::default();

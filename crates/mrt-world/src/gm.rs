@@ -1,8 +1,8 @@
 //! GM, ThinkingCap's fuzzy grid self-localization (ThinkingCap/TeamChaos report §2.1: "Self-localization in the
 //! GM is based on fuzzy logic (Buschka et al., 2000), (Herrero-Pérez et al., 2004)").
 //!
-//! The seed names the method only; the research notes recall it (`MODULES.md` §6, recalled
-//! literature) and the details below marked *design* are this module's choices.
+//! The report names the method only; the method below is recalled from those papers, not
+//! checked against their text, and the details marked *design* are this module's choices.
 //!
 //! - **State**: a 2½-D possibility grid. Each `(x, y)` cell of [`GmParams::cell`] metres holds a
 //!   fuzzy set over the heading, sampled in [`GmParams::headings`] bins: how possible it is that

@@ -1,18 +1,19 @@
-//! ISocRob's self-localization from the field lines (ISocRob-2000 report §3.2.1, the vision µAgent's
-//! "self" mode; the research notes `MODULES.md` §7 write the steps out): the white points a
-//! camera found on the floor (robot frame) vote in a **Hough** transform for straight lines,
-//! `ρ = x·cos φ + y·sin φ`; the strongest lines are matched **combinatorially** to the field
-//! model, whose lines all run along the field's axes: a detected line's direction gives the
-//! heading up to a quarter turn, and its distance, put against each model line of its family,
-//! one coordinate of the robot. Every combination is scored by how many of the points fall on
-//! the field's lines (the centre circle included) from that pose.
+//! ISocRob's self-localization from the field lines (ISocRob-2000 report §3.2.1, the vision
+//! µAgent's "self" mode, whose steps the report names without their details): the white
+//! points a camera found on the floor (robot frame) vote in a **Hough** transform for
+//! straight lines, `ρ = x·cos φ + y·sin φ`; the strongest lines are matched
+//! **combinatorially** to the field model, whose lines all run along the field's axes: a
+//! detected line's direction gives the heading up to a quarter turn, and its distance, put
+//! against each model line of its family, one coordinate of the robot. Every combination is
+//! scored by how many of the points fall on the field's lines (the centre circle included)
+//! from that pose.
 //!
 //! The field is symmetric under a half turn about the centre spot: a pose and its twin
 //! (`(−x, −y, θ + π)`) explain the same lines, and both are returned with the same score.
 //! The goal colour breaks the tie ([`HoughPose::facing`]: which goal the robot sees where),
 //! or the pose the robot believed ([`nearest`]).
 //!
-//! Design choices (the research notes' \[DES\] tags): 1° × 5 cm cells; after a line is taken,
+//! Design choices, where the report is silent: 1° × 5 cm cells; after a line is taken,
 //! its points leave the vote, so a second line is not the first one's neighbour cell; a line
 //! needs [`HoughParams::min_votes`] points; a point is on a line within
 //! [`HoughParams::tolerance`].
@@ -394,9 +395,9 @@ mod tests {
         Pose2::new(-p.x, -p.y, (p.theta + PI).rem_euclid(TAU))
     }
 
-    /// Research §7's test: field-line points from known poses, with noise and 30 % outliers,
-    /// give the pose up to the half-turn symmetry (the truth and its twin, both best), and
-    /// the goal seen (or the pose believed) picks the truth.
+    /// Field-line points from known poses, with noise and 30 % outliers, give the pose up to
+    /// the half-turn symmetry (the truth and its twin, both best), and the goal seen (or the
+    /// pose believed) picks the truth.
     #[test]
     fn the_pose_is_found_up_to_the_symmetry_and_the_goal_picks_it() {
         let map = FieldMap::default();

@@ -3,8 +3,8 @@
 //!
 //! The manual gives MUREA's parameters (a map, the accuracy required, a timeout), its input
 //! (sensor-agnostic *perceptions*) and its answer: the pose that accumulates the most
-//! evidence. The search below is the research notes' rendering (`MODULES.md` §2), a best-first
-//! branch and bound:
+//! evidence. How MUREA searches is not written there; the search below is a design choice,
+//! a best-first branch and bound:
 //!
 //! - **Evidence** of a pose: each perception whose residual `d` (range and bearing to the
 //!   nearest map element of its [`Kind`], in tolerances) is below 1 counts its weight times

@@ -5,10 +5,9 @@
 //! The state is `(x, y, vx, vy)` (m, m/s). Between sightings the object rolls on, slowing by a
 //! linear damping `c` (1/s: the ball's rolling friction; 0 for a constant-velocity model):
 //! `v(t + dt) = v·e^(−c·dt)`, `p(t + dt) = p + v·(1 − e^(−c·dt))/c`. The process noise is a
-//! random acceleration of [`Track::accel`] m/s² ([`BALL_ACCEL`] for a ball; research note
-//! MODULES.md §3 suggests 2 m/s², a design choice). A sighting is a position with its covariance
-//! ([`sighting_covariance`]: the camera's range and bearing error and the robot's own pose
-//! uncertainty).
+//! random acceleration of [`Track::accel`] m/s² ([`BALL_ACCEL`] for a ball, a design
+//! choice). A sighting is a position with its covariance ([`sighting_covariance`]: the
+//! camera's range and bearing error and the robot's own pose uncertainty).
 //!
 //! A sighting whose Mahalanobis distance from the prediction exceeds the χ² gate
 //! ([`GATE`], 99 % with two degrees of freedom) is not that object where the track expects it.
@@ -54,9 +53,10 @@ pub const GATE: f64 = 9.21;
 /// The random acceleration of a rolling ball, m/s²: what its rolling friction model leaves
 /// out (bumps, spin). Pushes, kicks and collisions are the manoeuvre model's
 /// ([`BALL_MANEUVER`]) or, beyond it, the gate's, which restarts the track. A design choice,
-/// measured with the quiet model alone, `mrt sim --seed S --metrics m.json`, seeds 1 and 2: the velocity error with the object sensor is 0.39 and 0.35 m/s at
-/// 0.5 m/s², 0.56 and 0.51 at 2 (the research note's value); with vision it is 0.30 and 0.33
-/// at 0.5, 0.27 and 0.30 at 2. The exact sensor's loss is the larger.
+/// measured with the quiet model alone, `mrt sim --seed S --metrics m.json`, seeds 1 and 2:
+/// the velocity error with the object sensor is 0.39 and 0.35 m/s at 0.5 m/s², 0.56 and 0.51
+/// at 2; with vision it is 0.30 and 0.33 at 0.5, 0.27 and 0.30 at 2. The exact sensor's loss
+/// is the larger.
 pub const BALL_ACCEL: f64 = 0.5;
 /// After this many gated-out sightings in a row, the track restarts from the last.
 pub const RESTART_AFTER: u32 = 2;
@@ -506,9 +506,9 @@ mod tests {
         ((f64::from(k) * 12.9898).sin() * 43_758.545_3).rem_euclid(1.0) * 2.0 - 1.0
     }
 
-    /// The research note's test (MODULES.md §3): a ball at 1 m/s seen at 10 Hz has its
-    /// velocity within 10 % after about 10 updates (here with up to 1 cm of noise per
-    /// sighting, and the ball's random acceleration, [`BALL_ACCEL`]).
+    /// A ball at 1 m/s seen at 10 Hz has its velocity within 10 % after about 10 updates (here
+    /// with up to 1 cm of noise per sighting, and the ball's random acceleration,
+    /// [`BALL_ACCEL`]).
     #[test]
     fn the_predicted_place_gives_the_update_s_distance() {
         let mut t = Track::new(0.5, 1.0);

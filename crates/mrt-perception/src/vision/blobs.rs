@@ -1,6 +1,7 @@
 //! Blobs of one colour class and the ball percept (ISocRob-2000 report §3.2.1: the windowed
 //! blob of the ball's pixels, its distance-dependent size test and its centre correction, eqs
-//! 10–11 as fixed in the research notes §3).
+//! 10–11, fixed: the correction scales y as well as x, and the expected size divides by the
+//! range to the ball's centre, not to the floor point).
 //!
 //! Connected components are `imageproc`'s (8-connected); this module only gathers each
 //! component's pixel count, centre of mass and bounding box, and turns the best ball blob into
@@ -184,9 +185,9 @@ pub struct BallPercept {
     pub pixels: u32,
 }
 
-/// The size test's bounds on a blob's area against the expected one, π(w/2)² (research §3,
-/// a design choice: partial segmentation and occlusion on the low side, merged noise on the
-/// high side).
+/// The size test's bounds on a blob's area against the expected one, π(w/2)² (a design
+/// choice: partial segmentation and occlusion on the low side, merged noise on the high
+/// side).
 pub const BALL_AREA_RANGE: (f64, f64) = (0.3, 3.0);
 
 /// Of a ball blob, this share of its pixels at least must be of the ball's own class (its lit

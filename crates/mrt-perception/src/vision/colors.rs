@@ -1,5 +1,4 @@
-//! Colour classes and the lookup table (ISocRob-2000 report §3.2.1, eqs 12–15; research notes
-//! `ISOCROB_VISION.md` §4).
+//! Colour classes and the lookup table (ISocRob-2000 report §3.2.1, eqs 12–15).
 //!
 //! A class is a box in HSV space, `⟨H_min, H_max, S_min, V_min⟩` as in the report, with hue in
 //! degrees (the report's sextant units × 60) and saturation and value in `[0, 1]`. Fixed from

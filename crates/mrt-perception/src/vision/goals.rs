@@ -1,12 +1,12 @@
 //! Goals: their nearest point and the open space for a shot (ISocRob-2000 report §3.2.1,
-//! eqs 16–18; research notes §5).
+//! eqs 16–18).
 //!
 //! With `u(i, j) = 1` where pixel (column i, row j) has the goal's colour: the column counts
 //! `p_h(i) = Σ_j u(i, j)` (eq. 16) and the row counts `p_v(j) = Σ_i u(i, j)` (eq. 17).
 //! - **Nearest point.** The report prints `y_n = argmin_y {p_v(y) | p_v(y) > T_p}`, which taken
-//!   literally picks the row with the *fewest* goal pixels; what is meant (research §5, flag)
-//!   is the extreme row: the goal row closest to the bottom of the image, the last row whose
-//!   count passes the noise threshold `T_p`.
+//!   literally picks the row with the *fewest* goal pixels; what is meant is the extreme
+//!   row: the goal row closest to the bottom of the image, the last row whose count passes
+//!   the noise threshold `T_p`.
 //! - **Open space** (eq. 18): `x_o = argmax_x Σ_k p_h(k)·h(x − k)` with `h(n) = 1` for
 //!   `|n| ≤ T_o`: a box filter of width `2T_o + 1` over the column counts (prefix sums,
 //!   columns outside the image count 0), its argmax the window where most goal is visible,
@@ -153,8 +153,6 @@ mod tests {
     use crate::camera::Intrinsics;
     use nalgebra::Point3;
 
-    /// The research notes' vector (§5): p_h = [0,0,3,5,5,0,0,4,6,6,6,2], T_o = 1: windowed sums
-    /// [0,3,8,13,10,5,4,10,16,18,14,8], x_o = 9.
     #[test]
     fn both_goal_colours_are_counted_in_one_pass_as_each_alone() {
         let (w, h) = (7u32, 5u32);
@@ -166,8 +164,10 @@ mod tests {
         assert!(goal_columns(&map, w, h + 1).iter().all(Vec::is_empty));
     }
 
+    /// A worked test vector of eq. 18: p_h = [0,0,3,5,5,0,0,4,6,6,6,2], T_o = 1: windowed sums
+    /// [0,3,8,13,10,5,4,10,16,18,14,8], x_o = 9.
     #[test]
-    fn open_space_by_the_research_vector() {
+    fn open_space_by_the_worked_vector() {
         let p_h = [0, 0, 3, 5, 5, 0, 0, 4, 6, 6, 6, 2];
         assert_eq!(open_space(&p_h, 1), Some(9));
         assert_eq!(open_space(&[0, 0, 0], 1), None);

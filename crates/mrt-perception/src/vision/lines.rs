@@ -1,5 +1,5 @@
 //! Field-line points for localization (ISocRob-2000 report §3.2.1, the "self" mode: green/white
-//! transitions found by sampling the image, fed to a line extraction; research notes §7).
+//! transitions found by sampling the image, fed to a line extraction).
 //!
 //! Scan lines: every `step`-th column, from the bottom of the image up (near to far), looking
 //! for a run of line pixels between carpet pixels: green, then white for at most `max_run`

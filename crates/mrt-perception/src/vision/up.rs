@@ -223,11 +223,12 @@ pub fn find_ball_up(classes: &[u8], omni: &Omni, radius: f64) -> Option<BallPerc
 }
 
 /// The field-line points an omnidirectional camera's class map shows (the µAgent's "self"
-/// mode, ISocRob-2000 report §3.2.1; research notes §7 step 1): `rays` radial scan lines from the
-/// robot's blind disc out to the mirror's reach, evenly spread round the robot, each looking
-/// (like [`super::lines::line_points`] in a front image) for runs of at most `max_run` line
-/// pixels between carpet; each run's middle is a floor point, robot frame, through the
-/// mirror's affine map (exact for the floor).
+/// mode, ISocRob-2000 report §3.2.1, its first step: green/white transitions found by
+/// sampling the image): `rays` radial scan lines from the robot's blind disc out to the
+/// mirror's reach, evenly spread round the robot, each looking (like
+/// [`super::lines::line_points`] in a front image) for runs of at most `max_run` line pixels
+/// between carpet; each run's middle is a floor point, robot frame, through the mirror's
+/// affine map (exact for the floor).
 pub fn line_points_up(
     classes: &[u8],
     omni: &Omni,

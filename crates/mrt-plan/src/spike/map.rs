@@ -144,10 +144,11 @@ fn segments_distance(a: Point2, b: Point2, p: Point2, q: Point2) -> f64 {
         .min(segment_distance(q, a, b))
 }
 
-/// A door (research notes §4 step 4): the gap between two jambs `a` and `b`. Within its
-/// region (closer to the gap than the robot's radius plus the safety) the safety distance
-/// shrinks to what the door's width leaves, so a door is passable when it is wider than the
-/// robot by a few times the accuracy, and not when it is narrower.
+/// A door (the manual: doors small with respect to the grid are handled; how is a design
+/// choice): the gap between two jambs `a` and `b`. Within its region (closer to the gap than
+/// the robot's radius plus the safety) the safety distance shrinks to what the door's width
+/// leaves, so a door is passable when it is wider than the robot by a few times the
+/// accuracy, and not when it is narrower.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Door {
     /// One jamb.

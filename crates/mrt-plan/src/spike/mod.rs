@@ -5,9 +5,9 @@
 //! and a goal in, a trajectory (a sequence of poses) out, with the robot's size, the required
 //! accuracy, a safety distance and the plan's resolution as options; doors and passages small
 //! with respect to the grid are handled, and moving objects when the robot detects them. How
-//! it does it is not written down; this is the research notes' reconstruction (`MODULES.md`
-//! §4, design choices tagged \[DES\] there) on the classical multi-resolution cell
-//! decomposition (Kambhampati and Davis, 1986):
+//! it does it is not written down; what follows is a reconstruction, its details design
+//! choices, on the classical multi-resolution cell decomposition (Kambhampati and Davis,
+//! 1986):
 //!
 //! 1. **Configuration space.** The robot is a disc: its centre must keep `robot_radius +
 //!    safety` from every obstacle and from the map's edge. In a [`Door`]'s region the safety

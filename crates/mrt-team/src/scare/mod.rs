@@ -2,9 +2,9 @@
 //! which activity, decided by every robot identically from data the team shares, then each
 //! robot's activity decomposed into sub-tasks and watched.
 //!
-//! The manual gives the parts and their names; `../shared/research/MODULES.md` §5 spells
-//! out what the manual only sketches, with tags saying what is the manual's and what is a
-//! design choice. This module is the coordination sub-module:
+//! The manual gives the parts and their names and only sketches how they work; what it
+//! leaves open (how the agenda is ordered, how robots are given activities, the settings)
+//! is this module's design. This module is the coordination sub-module:
 //!
 //! - **Activities** ([`Activity`]): a *job* is done by one robot or several
 //!   ([`Activity::job`], with a cardinality `card_min..=card_max`); a *schema* is done by
@@ -226,7 +226,7 @@ impl Agent {
     }
 }
 
-/// The allocation's settings (MODULES.md §5, design choices).
+/// The allocation's settings (design choices).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Params {
     /// An activity whose opportunity is below this is not on the agenda (the manual's
@@ -410,7 +410,7 @@ fn cover_schema(
 mod tests {
     use super::*;
 
-    /// MODULES.md §5's test table: Goalie (1..1, only the keeper can), BringBall (1..1),
+    /// A test table of three jobs: Goalie (1..1, only the keeper can), BringBall (1..1),
     /// Defense (0..2).
     fn three() -> Activities {
         Activities::new(vec![
