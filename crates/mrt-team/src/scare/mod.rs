@@ -16,7 +16,7 @@
 //!   those of one robot (the caller's choice: Team Milan takes the lowest-numbered robot
 //!   heard), so that all allocate from the same numbers.
 //! - **The agenda** ([`agenda`]): the activities whose opportunity reaches
-//!   [`Params::admit`] (the manual's precondition, a fuzzy truth ≥ 0.5), by priority, then
+//!   [`Params::admit`] (a fuzzy truth ≥ 0.5, a design choice), by priority, then
 //!   opportunity, then their order in the table. *Design choice*: the manual says
 //!   "multi-objective analysis" without a method; a fixed priority with the opportunity as
 //!   the second key is what a team can read and tune.
@@ -229,8 +229,8 @@ impl Agent {
 /// The allocation's settings (design choices).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Params {
-    /// An activity whose opportunity is below this is not on the agenda (the manual's
-    /// precondition: a fuzzy truth of at least 0.5).
+    /// An activity whose opportunity is below this is not on the agenda (0.5: the
+    /// opportunity is more true than false).
     pub admit: f64,
     /// How much more a robot's current activity counts.
     pub hysteresis: f64,
