@@ -1,4 +1,4 @@
-//! Colour vision's hot path on the synthetic 640×480 frame: green field, 3 px white
+//! Colour vision's hot path on a synthetic 640×480 frame: green field, 3 px white
 //! lines and centre circle, a yellow and a blue goal, an orange ball of radius 10 px, five black
 //! robots of radius 22 px, Gaussian noise σ = 8 per channel. Measured: building the lookup table
 //! (once per colour file), classifying the frame through it, and that plus the ball's blob;

@@ -819,7 +819,7 @@ fn a_used_behavior_has_its_own_behavior_info() {
 
 #[test]
 fn a_behavior_that_keeps_failing_is_stopped_until_a_file_is_reloaded() {
-    // The issue's `error(string.rep("E", 4e6))`: every cycle pays for 4 MB of error text.
+    // A hostile `error(string.rep("E", 4e6))`: every cycle pays for 4 MB of error text.
     let dir = Dir::new("failing");
     dir.write("hbm.lua", SINGLETON_HBM);
     dir.write("shout.lua", r#"always("go", "FAST") error(string.rep("E", 4e5))"#);
