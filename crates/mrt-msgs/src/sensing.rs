@@ -232,8 +232,9 @@ pub struct GameInfo {
     pub marker: Option<Marker>,
 }
 
-/// One frame of the object sensor, published by the camera driver: distance and bearing of the
-/// ball, the nets and the landmarks, told apart by colour (ISocRob-2000 report §3.2.1).
+/// One camera frame, published by the camera driver: the image the camera took (the vision's
+/// input), or, from an object sensor, the distance and bearing of the ball, the nets and the
+/// landmarks, told apart by colour (ISocRob-2000 report §3.2.1).
 #[cfg_attr(feature = "schema", derive(schemars::JsonSchema))]
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct CameraFrame {

@@ -2,9 +2,11 @@
 //!
 //! A simulated Middle Size League soccer match in which every robot runs the real MRT stack.
 //! The physics is `rapier2d` seen from above ([`world`]); the rules are a referee
-//! ([`referee`]: READY, SET, PLAYING, ...); robots see through an object sensor that reports
-//! what a camera would detect, feel their motion through optical mice and wheel encoders and
-//! hear through a sonar ring ([`sensor`]); each robot's world state fuses odometry and sightings
+//! ([`referee`]: READY, SET, PLAYING, ...); robots see through camera images the simulator
+//! renders ([`render`], read by the robot's vision), or through an object sensor that reports
+//! what a camera would detect (`--percepts oracle`, the fast mode); they feel their motion
+//! through optical mice and wheel encoders and hear through a sonar ring ([`sensor`]); each
+//! robot's world state fuses odometry and sightings
 //! into its own pose estimate (`mrt-world`'s [`WorldModel`](mrt_world::WorldModel)); between their
 //! behaviors and their motors sits guidance ([`mrt_plan::guidance::Guidance`], see [`bus`]).
 //!
