@@ -99,8 +99,10 @@ pub(super) fn estimates(m: &Metrics) {
     }
 }
 
-/// The kidnapped robots not found again and the robots that faulted, each with its team.
-pub(super) fn incidents(report: &MatchReport, n: usize, (h, a): (&str, &str)) {
+/// The kidnapped robots not found again and the robots that faulted, each with its team
+/// (robots `0 .. team_size` are home's).
+pub(super) fn incidents(report: &MatchReport, team_size: usize, (h, a): (&str, &str)) {
+    let n = team_size;
     let clock = |t: f64| format!("{}:{:04.1}", (t / 60.0).floor() as u64, t % 60.0);
     for k in report.kidnaps.iter().filter(|k| k.recovered_after.is_none()) {
         let (team, i) = if k.robot < n { (h, k.robot) } else { (a, k.robot - n) };
