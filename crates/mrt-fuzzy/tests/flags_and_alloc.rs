@@ -18,10 +18,10 @@ fn config(test: &str) -> PathBuf {
         ("Cando.ini", "Patrol = (P Auto);\nManualMove = (NOT (P Auto));"),
         ("want.txt", "Patrol = (P Auto);\nManualMove = (NOT (P Auto));"),
         ("behavior.txt", "(level 1 ManualMove b/ManualMove.rul)\n(level 1 Patrol b/Patrol.rul)"),
-        ("b/ManualMove.rul", "(Pushed) => (Speed FAST);\n(NOT (Pushed)) => (Speed STOP);"),
+        ("b/ManualMove.rul", "(Pushed) => (Speed FAST);\n(NOT (Pushed)) => (Speed HALT);"),
         // Patrol arms the flag once the joystick was pushed, and drives slowly once armed.
         ("b/Patrol.rul", "(Pushed) => (Armed TRUE);\n(Armed) => (Speed SLOW) (Armed TRUE);"),
-        ("s_shape.txt", "(SPEED (SNG (STOP 0)) (SNG (SLOW 20)) (SNG (FAST 100)))\n(FLAG (SNG (TRUE 1.0)))"),
+        ("s_shape.txt", "(SPEED (SNG (HALT 0)) (SNG (SLOW 20)) (SNG (FAST 100)))\n(FLAG (SNG (TRUE 1.0)))"),
         ("s_ftoc.txt", "(Speed SPEED)\n(Armed FLAG)"),
     ] {
         std::fs::write(d.join(f), t).unwrap();
