@@ -3,7 +3,7 @@
 -- front kick when the ball is close and the robot points to a safe area. The spot is a posture
 -- for guidance (position mode: straight there at the base's speed, turning to the ball). With
 -- gotopos' fuzzy labels the keeper strafed along the line at 0.4 m/s, a third of the base's
--- top speed, and fell behind the ball's moves (docs/teams.md, Chaos with vision).
+-- top speed, and fell behind the ball's moves.
 -- A posture outranks the velocities of a blend: while goalkeeper's meta-rules also give
 -- gkclearb a part, the keeper holds this spot rather than going for the ball.
 local b, f, p = chaos.getGlobalBall(), field(), chaos.gsGetMyPos()

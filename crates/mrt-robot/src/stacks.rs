@@ -141,7 +141,7 @@ impl Geometry {
     /// ahead of the robot's own angle about the ball, and straight to the posture once the
     /// robot is within [`ORBIT_STEP`] of it. A robot that faces the ball on the way keeps it
     /// before its camera and never sweeps it along with its front (ISocRob's FACE_GOAL with a
-    /// 63° front camera: docs/teams.md).
+    /// 63° front camera).
     pub fn orbit(me: Pose2, ball: (f64, f64), behind: Pose2, radius: f64) -> (f64, f64) {
         let mine = (me.y - ball.1).atan2(me.x - ball.0);
         let goal = (behind.y - ball.1).atan2(behind.x - ball.0);
@@ -163,8 +163,7 @@ impl Geometry {
     /// Where along the opponent's goal line to shoot (m from its centre): the open side,
     /// away from the robot the world model anchored nearest the goal's centre (within 1.5 m,
     /// not a teammate: the goalkeeper), two thirds of the way to the post; the centre when no
-    /// such robot is known. Measured on the pitch, `--percepts oracle`, Milan against the
-    /// Chaser: docs/performance.md, "Teams".
+    /// such robot is known.
     pub fn open_side(&self, w: &WorldSnapshot) -> f64 {
         let keeper = w
             .opponents(WorldSnapshot::ANCHORED)

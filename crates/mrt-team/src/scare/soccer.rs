@@ -168,9 +168,8 @@ impl Situation {
 
     /// Where Support stands: 2 m ahead of the ball (at most 2 m short of the opponent's goal
     /// line), 1 m to the side of it towards the middle of the field: ready for a pass or a
-    /// loose ball upfield. (Tuned on the pitch: standing 2 m *behind* the ball instead, the
-    /// team scored 34 : 25 against the Chaser over seeds 201–260; ahead, 66 : 39 with 2 m to
-    /// the side and 63 : 36 over 201–250 with 1 m; docs/teams.md.)
+    /// loose ball upfield (ahead of the ball rather than behind it: tuned on the pitch against
+    /// the Chaser).
     pub fn support_spot(&self, ball: (f64, f64)) -> (f64, f64) {
         let side = if ball.1 > 0.0 { -1.0 } else { 1.0 };
         ((ball.0 + 2.0).min(self.half_length - 2.0), ball.1 + side)
