@@ -54,7 +54,8 @@ fn recording(name: &str) -> Recorded {
     let args = ["--half", "40", "--seed", "61", "--percepts", "oracle"];
     let (path, stdout) =
         record(name, &[&args[..], &["--home", "chaser", "--away", "chaos"]].concat());
-    // "chaser (home) 1 : 0 chaos (away)   seed 61", then "  goal chaser   at   0:36" lines.
+    // The report's first line is "chaser (home) H : A chaos (away)   seed S", and each goal
+    // has a line "goal TEAM at M:SS".
     let head: Vec<&str> = stdout.lines().next().unwrap_or_default().split_whitespace().collect();
     assert!(head.len() > 4 && head[..2] == ["chaser", "(home)"] && head[3] == ":", "{stdout}");
     let score = (head[2].parse().unwrap(), head[4].parse().unwrap());

@@ -287,8 +287,7 @@ impl Referee {
         // Out: the whole ball over a line (and not in a goal). Put back 0.5 m inside.
         if bx.abs() > hl + r || by.abs() > hw + r {
             let (mx, my) = ((hl - 0.5).max(0.0), (hw - 0.5).max(0.0));
-            let x = bx.clamp(-mx, mx);
-            let y = by.clamp(-my, my);
+            let (x, y) = free_spot(world, (bx.clamp(-mx, mx), by.clamp(-my, my)), (mx, my));
             world.place_ball(x, y);
             self.anchor = ((x, y), now);
             return Some(Call::Out { at: (bx, by) });
@@ -315,12 +314,41 @@ impl Referee {
                     da.total_cmp(&db)
                 })
                 .unwrap_or((0.0, 0.0));
+            let at = free_spot(world, at, (hl, hw));
             world.place_ball(at.0, at.1);
             self.anchor = (at, now);
             return Some(Call::Dropped { at });
         }
         None
     }
+}
+
+/// Where the referee puts the ball down near `at`: `at` itself when no robot's body is within
+/// a ball's width of it, else the nearest free point on rings of 0.1 m steps around it (within
+/// `half` of the centre each way); `at` when the field is too crowded for any.
+fn free_spot(world: &World, at: (f64, f64), half: (f64, f64)) -> (f64, f64) {
+    let cfg = world.config();
+    let clear = cfg.body.radius + 2.0 * cfg.ball.radius;
+    let free = |(x, y): (f64, f64)| {
+        x.abs() <= half.0
+            && y.abs() <= half.1
+            && (0..world.robot_count())
+                .filter_map(|i| world.robot(i))
+                .all(|p| (p.x - x).hypot(p.y - y) >= clear)
+    };
+    if free(at) {
+        return at;
+    }
+    (1..=40)
+        .flat_map(|ring| {
+            let d = 0.1 * f64::from(ring);
+            (0..16).map(move |k| {
+                let a = f64::from(k) * PI / 8.0;
+                (at.0 + d * a.cos(), at.1 + d * a.sin())
+            })
+        })
+        .find(|&p| free(p))
+        .unwrap_or(at)
 }
 
 #[cfg(test)]
@@ -467,12 +495,36 @@ mod tests {
     }
 
     #[test]
+    fn the_ball_is_never_put_down_inside_a_robot() {
+        let (mut w, mut r) = setup();
+        run(&mut w, &mut r, 1.0);
+        // A robot stands where the ball would go back after crossing the side line.
+        w.place_robot(0, Pose2::new(3.0, 5.5, 0.0));
+        w.place_ball(3.0, 6.3);
+        let calls = run(&mut w, &mut r, 0.2);
+        assert!(calls.iter().any(|c| matches!(c, Call::Out { .. })), "{calls:?}");
+        let (bx, by) = w.ball();
+        let me = w.robot(0).unwrap();
+        let clear = w.config().body.radius + w.config().ball.radius;
+        assert!((me.x - bx).hypot(me.y - by) > clear, "ball at ({bx}, {by}), robot at {me:?}");
+        // Put down near where it would have gone, inside the lines.
+        assert!((bx - 3.0).hypot(by - 5.5) < 1.0 && by <= 5.5 + 1e-9, "({bx}, {by})");
+    }
+
+    #[test]
     fn a_stuck_ball_is_dropped_at_a_neutral_point() {
         let (mut w, mut r) = setup();
         run(&mut w, &mut r, 1.0);
         w.place_ball(4.0, 2.0);
         let calls = run(&mut w, &mut r, 10.5);
-        assert_eq!(calls, [Call::Dropped { at: (4.5, 3.0) }]);
+        // The nearest neutral point, (4.5, 3.0), or beside it when a robot stands there.
+        let [Call::Dropped { at }] = calls.as_slice() else { panic!("{calls:?}") };
+        assert!((at.0 - 4.5).hypot(at.1 - 3.0) < 0.5, "{at:?}");
+        let clear = w.config().body.radius + 2.0 * w.config().ball.radius - 1e-9;
+        for i in 0..w.robot_count() {
+            let p = w.robot(i).unwrap();
+            assert!((p.x - at.0).hypot(p.y - at.1) >= clear, "robot {i} at {p:?}, ball at {at:?}");
+        }
     }
 
     #[test]
