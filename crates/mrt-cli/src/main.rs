@@ -16,7 +16,7 @@
 //!   prints each in canonical form, or the first error with file, line and column.
 //!
 //! Logging goes through `tracing`; set `RUST_LOG` (e.g. `RUST_LOG=mrt_dcdt=debug`) for more.
-#![allow(clippy::print_stdout)]
+#![deny(clippy::print_stdout)]
 
 /// `println!` for results: ends the program quietly when standard output has been closed
 /// (`mrt sim | head -3`), where `println!` would panic on the broken pipe.

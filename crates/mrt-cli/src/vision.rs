@@ -415,7 +415,7 @@ pub fn calibrate(args: &CalibrateArgs) -> Result<()> {
         .collect();
     let report =
         serde_json::json!({ "images": images.len(), "pixels": hist.pixels(), "classes": classes });
-    println!("{report}");
+    outln!("{report}");
     if let Some(dir) = &args.out {
         let svg = dir.join("histograms.svg");
         std::fs::write(&svg, histogram_svg(&hist, &colors))

@@ -142,7 +142,7 @@ use quick_xml::escape::EscapeError;
 use quick_xml::events::attributes::{AttrError, Attribute as XmlAttr};
 use quick_xml::events::{BytesEnd, BytesStart, Event};
 use quick_xml::name::QName;
-use quick_xml::{Reader, Writer};
+use quick_xml::{Reader, Writer, XmlVersion};
 use serde::{Deserialize, Serialize};
 use std::borrow::Cow;
 use std::fmt::Write as _;

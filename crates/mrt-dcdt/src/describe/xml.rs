@@ -165,9 +165,16 @@ impl<'a> Parser<'a> {
                 SyntaxError::InvalidBangMarkup => {
                     "expected a comment, cdata section or doctype after `<!`".to_owned()
                 }
-                SyntaxError::UnclosedPIOrXmlDecl => {
+                SyntaxError::UnclosedPI => {
                     "expected `?>` to close the processing instruction, found end of input"
                         .to_owned()
+                }
+                SyntaxError::UnclosedXmlDecl => {
+                    "expected `?>` to close the xml declaration, found end of input".to_owned()
+                }
+                SyntaxError::UnclosedSingleQuotedAttributeValue
+                | SyntaxError::UnclosedDoubleQuotedAttributeValue => {
+                    "expected a quote to close the attribute's value, found end of input".to_owned()
                 }
                 SyntaxError::UnclosedComment => {
                     "expected `-->` to close the comment, found end of input".to_owned()
@@ -194,6 +201,12 @@ impl<'a> Parser<'a> {
                 }
                 IllFormedError::MissingDeclVersion(_) => {
                     "expected `version` first in the xml declaration".to_owned()
+                }
+                IllFormedError::UnknownVersion => {
+                    "expected version 1.0 or 1.1 in the xml declaration".to_owned()
+                }
+                IllFormedError::UnclosedReference => {
+                    "expected `;` to end the reference, found end of input".to_owned()
                 }
                 IllFormedError::MissingDoctypeName => "expected a name in the doctype".to_owned(),
                 IllFormedError::DoubleHyphenInComment => {
@@ -223,7 +236,7 @@ impl<'a> Parser<'a> {
                 Event::Comment(_) | Event::PI(_) => continue,
                 Event::Decl(_) | Event::DocType(_) if prolog => continue,
                 Event::Text(text) if text.iter().copied().all(is_xml_space) => continue,
-                Event::Text(_) | Event::CData(_) => "text",
+                Event::Text(_) | Event::CData(_) | Event::GeneralRef(_) => "text",
                 Event::Decl(_) => "an xml declaration",
                 Event::DocType(_) => "a doctype",
             };
@@ -237,7 +250,7 @@ impl<'a> Parser<'a> {
         for attr in tag.attributes() {
             let attr = attr.map_err(|e| self.attr_error(pos, tag, what, &e))?;
             let key = lossy(attr.key.as_ref()).into_owned();
-            let value = match attr.unescape_value() {
+            let value = match attr.normalized_value(XmlVersion::Implicit1_0) {
                 Ok(value) => value.into_owned(),
                 Err(e) => {
                     let problem = match &e {
