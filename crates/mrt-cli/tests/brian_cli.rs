@@ -1,5 +1,5 @@
-//! `mrt brian check|eval|plot` on the shared brian40 configurations. Skipped, and said so, when
-//! `../shared` is absent (it is always there in CI).
+//! `mrt brian check|eval|plot` on the brian40 configurations (`configs/brian/brian40`, flat,
+//! and `brian40-hier`, with a level-2 behavior).
 
 #![allow(clippy::unwrap_used, clippy::print_stderr)]
 
@@ -24,14 +24,8 @@ fn eval(dir: &std::path::Path, trace: bool, input: &[u8]) -> std::process::Outpu
     child.wait_with_output().unwrap()
 }
 
-fn bench(name: &str) -> Option<PathBuf> {
-    let d = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/bench").join(name);
-    if d.exists() {
-        Some(d)
-    } else {
-        eprintln!("skipped: {} is absent", d.display());
-        None
-    }
+fn bench(name: &str) -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../configs/brian").join(name)
 }
 
 fn copy_dir(from: &std::path::Path, to: &std::path::Path) {
@@ -49,7 +43,7 @@ fn copy_dir(from: &std::path::Path, to: &std::path::Path) {
 
 #[test]
 fn check_is_silent_on_a_good_configuration_and_names_the_place_of_an_error() {
-    let Some(dir) = bench("brian40-hier") else { return };
+    let dir = bench("brian40-hier");
     let out = mrt().args(["brian", "check"]).arg(&dir).output().unwrap();
     assert!(out.status.success());
     assert!(out.stdout.is_empty() && out.stderr.is_empty());
@@ -75,7 +69,7 @@ fn check_is_silent_on_a_good_configuration_and_names_the_place_of_an_error() {
 
 #[test]
 fn eval_reads_json_lines_and_matches_the_expected_commands() {
-    let Some(dir) = bench("brian40") else { return };
+    let dir = bench("brian40");
     let cycles: Vec<String> = std::fs::read_to_string(dir.join("cycles.jsonl"))
         .unwrap()
         .lines()
@@ -123,7 +117,7 @@ fn eval_reads_json_lines_and_matches_the_expected_commands() {
 
 #[test]
 fn plot_draws_every_shape() {
-    let Some(dir) = bench("brian40-hier") else { return };
+    let dir = bench("brian40-hier");
     let svg = std::env::temp_dir().join(format!("mrt-brian-plot-{}.svg", std::process::id()));
     let out = mrt().args(["brian", "plot"]).arg(&dir).arg("--out").arg(&svg).output().unwrap();
     assert!(out.status.success());
@@ -196,7 +190,7 @@ fn check_eval_and_plot_work_on_the_shipped_harvester() {
 /// first token.
 #[test]
 fn check_reports_bad_utf8_at_its_place_and_refuses_foreign_rule_files() {
-    let Some(dir) = bench("brian40-hier") else { return };
+    let dir = bench("brian40-hier");
     let broken = std::env::temp_dir().join(format!("mrt-brian-issue17-{}", std::process::id()));
     copy_dir(&dir, &broken);
     let rul = broken.join("behaviors/ApproachBall.rul");

@@ -1,4 +1,4 @@
-//! Mr. BRIAN cycle time on the shared configurations (`../shared/bench`): brian40 flat (its 500
+//! Mr. BRIAN cycle time on the configurations `configs/brian/brian40*`: brian40 flat (its 500
 //! conformance cycles) and brian40-hier on `cycles-level2-active.jsonl` (the level-2 behavior
 //! runs every cycle). One iteration = one full cycle: set the inputs, fuzzify, predicates,
 //! behaviors, composition, defuzzification.
@@ -16,7 +16,7 @@ type Cycle = Vec<(usize, f64, f64)>;
 
 /// Loads a configuration and its cycles.
 fn load(dir: &str, cycles: &str) -> Option<(Brian, Vec<Cycle>)> {
-    let d = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/bench").join(dir);
+    let d = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../configs/brian").join(dir);
     if !d.exists() {
         eprintln!("skipped: {} is absent", d.display());
         return None;

@@ -522,12 +522,8 @@ mod tests {
     }
 
     #[test]
-    fn shared_bench_shapes_parse_when_present() {
-        let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/bench/brian40");
-        if !dir.exists() {
-            eprintln!("skipped: ../shared/bench/brian40 is absent (it is always there in CI)");
-            return;
-        }
+    fn the_brian40_shapes_parse() {
+        let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../configs/brian/brian40");
         for (shapes, assoc) in [("shape_ctof.txt", "ctof.txt"), ("s_shape.txt", "s_ftoc.txt")] {
             let sp = dir.join(shapes);
             let ap = dir.join(assoc);

@@ -1,7 +1,6 @@
-//! Conformance on the shared Mr. BRIAN configurations `../shared/bench/brian40` (flat) and
+//! Conformance on the Mr. BRIAN configurations `configs/brian/brian40` (flat) and
 //! `brian40-hier` (with a level-2 behavior): every cycle of `cycles.jsonl`, in order, must give
-//! the commands of `expected.jsonl` (1e-3, angles modulo 360). Skipped, and said so, when
-//! `../shared` is absent (it is always there in CI).
+//! the commands of `expected.jsonl` (1e-3, angles modulo 360).
 
 #![allow(clippy::unwrap_used, clippy::print_stderr)]
 
@@ -9,17 +8,8 @@ use mrt_fuzzy::brian::Brian;
 use serde_json::{Map, Value};
 use std::path::PathBuf;
 
-fn bench_dir(name: &str) -> Option<PathBuf> {
-    let d = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/bench").join(name);
-    if d.exists() {
-        Some(d)
-    } else {
-        eprintln!(
-            "skipped: {} is absent (the shared bench data is always there in CI)",
-            d.display()
-        );
-        None
-    }
+fn bench_dir(name: &str) -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../configs/brian").join(name)
 }
 
 fn lines(path: PathBuf) -> Vec<Map<String, Value>> {
@@ -44,7 +34,7 @@ fn inputs(cycle: &Map<String, Value>) -> Vec<(String, f64, f64)> {
 }
 
 fn conformance(name: &str) {
-    let Some(dir) = bench_dir(name) else { return };
+    let dir = bench_dir(name);
     let mut brian = Brian::from_dir(&dir).unwrap();
     let cycles = lines(dir.join("cycles.jsonl"));
     let expected = lines(dir.join("expected.jsonl"));
@@ -74,7 +64,7 @@ fn conformance(name: &str) {
         }
     }
     let n = cycles.len();
-    assert_eq!(n, 500, "{name}: the shared data has 500 cycles");
+    assert_eq!(n, 500, "{name}: the data has 500 cycles");
     assert!(
         failures.is_empty(),
         "{name}: {}/{n} cycles differ; first ones:\n{}",
