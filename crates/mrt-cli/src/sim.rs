@@ -101,8 +101,8 @@ pub struct SimArgs {
     /// or Lichtblick, or read it with any `mcap` library. One in-process match.
     #[arg(long)]
     pub record: Option<PathBuf>,
-    /// With --record: a file a user can mail (the default match in 16.4 MB instead of
-    /// 105.5): every topic, but the world snapshots, percepts, mate reports, localization,
+    /// With --record: a file a user can mail (the default match in 16.0 MB instead of
+    /// 106.5): every topic, but the world snapshots, percepts, mate reports, localization,
     /// sonars and odometry at 2 Hz of the simulated clock and the scene at 5 Hz, and every
     /// float with 4 decimals (0.1 mm in metres). Enough for the web monitor and Foxglove;
     /// `mrt replay --robot` cannot re-run behaviors on it exactly (docs/monitor.md).
@@ -368,6 +368,15 @@ pub fn run(args: &SimArgs) -> Result<()> {
         Stack::parse(&args.home).map_err(|e| anyhow!("--home: {e}"))?,
         Stack::parse(&args.away).map_err(|e| anyhow!("--away: {e}"))?,
     );
+    let reads_behaviors = |s: Stack| matches!(s, Stack::Chaos | Stack::Isocrob);
+    if args.behaviors.is_some() && !reads_behaviors(stacks.0) && !reads_behaviors(stacks.1) {
+        anyhow::bail!(
+            "--behaviors DIR is read by the chaos and isocrob stacks, and this match has neither \
+             (--home {}, --away {}); Milan's Mr. BRIAN files are built into mrt",
+            stacks.0.name(),
+            stacks.1.name()
+        );
+    }
     if args.images > 0 && args.record.is_none() && args.serve.is_none() {
         anyhow::bail!("--images keeps camera images in a recording or the monitor: add --record FILE or --serve");
     }

@@ -129,6 +129,9 @@ fn bad_options_are_clear_errors() {
     assert!(!ok && err.contains("half_duration"), "{err}");
     let (ok, _, err) = run(&["--config", "/nonexistent.toml"]);
     assert!(!ok && err.contains("/nonexistent.toml"), "{err}");
+    // Behaviors nobody in the match would read are refused, not silently ignored.
+    let (ok, _, err) = run(&["--home", "milan", "--away", "chaser", "--behaviors", "my-milan"]);
+    assert!(!ok && err.contains("--behaviors DIR is read by the chaos and isocrob"), "{err}");
 }
 
 #[test]
