@@ -16,8 +16,8 @@ fn config(kidnaps: u32, localizer: Localizer) -> SimConfig {
     cfg
 }
 
-/// Every robot is carried twice a match (once a half); with MUREA each is found again within
-/// a few seconds, and the pooled metrics say so.
+/// Every robot is carried twice a match (once a half); with MUREA each is found again, most
+/// within a few seconds, over several seeds, and the pooled metrics say so.
 #[test]
 fn kidnapped_robots_find_themselves_again() {
     kidnapped_robots_find_themselves_again_with(Localizer::Murea);
@@ -29,31 +29,45 @@ fn kidnapped_robots_find_themselves_again_with_the_fuzzy_grid() {
     kidnapped_robots_find_themselves_again_with(Localizer::Gm);
 }
 
+/// The seeds of the kidnap matches.
+const SEEDS: [u64; 2] = [2, 3];
+
+/// A carry must be recovered from within this long (s); one carried less than this before
+/// the final whistle is not judged.
+const RECOVERY: f64 = 20.0;
+
 fn kidnapped_robots_find_themselves_again_with(localizer: Localizer) {
     let cfg = config(1, localizer);
-    // A robot carried less than the 10 s a recovery may take before the final whistle may
-    // not be found before it: such a carry is not judged.
-    let r = mrt_sim::play(&cfg, 2, (Stack::Milan, Stack::Chaos), None, false, |_| {}).unwrap();
     let robots = 2 * cfg.rules.team_size;
-    assert!(r.kidnaps.len() >= robots * 2 - 1, "{} kidnaps", r.kidnaps.len());
-    let judged = |k: &&mrt_sim::game::Kidnap| k.at + 10.0 <= r.duration;
-    let late = r.kidnaps.iter().filter(|k| !judged(k)).count();
-    assert!(
-        r.kidnaps.len() - late >= robots,
-        "{late} of {} carries in the last 10 s",
-        r.kidnaps.len()
-    );
-    for k in r.kidnaps.iter().filter(judged) {
-        let after = k.recovered_after.unwrap_or_else(|| panic!("never found again: {k:?}"));
-        // A robot carried to where it sees few landmarks takes several seconds (`mrt sim
-        // --percepts oracle --kidnap 1 --half 40 --metrics`); the median stays under 2 s.
-        assert!(after < 10.0, "{k:?}");
-    }
     let mut book = MetricsBook::default();
-    book.add(&r);
+    let (mut carries, mut late, mut quick) = (0, 0, 0);
+    for seed in SEEDS {
+        let r =
+            mrt_sim::play(&cfg, seed, (Stack::Milan, Stack::Chaos), None, false, |_| {}).unwrap();
+        assert!(r.kidnaps.len() >= robots * 2 - 1, "seed {seed}: {} kidnaps", r.kidnaps.len());
+        for k in &r.kidnaps {
+            if k.at + RECOVERY > r.duration {
+                late += 1;
+                continue;
+            }
+            // A robot carried to where it sees few landmarks takes several seconds (`mrt sim
+            // --percepts oracle --kidnap 1 --half 40 --metrics`), never the whole bound.
+            let after = k
+                .recovered_after
+                .unwrap_or_else(|| panic!("seed {seed}: never found again: {k:?}"));
+            assert!(after < RECOVERY, "seed {seed}: {k:?}");
+            quick += usize::from(after < 10.0);
+        }
+        carries += r.kidnaps.len();
+        book.add(&r);
+    }
+    // Most are found within 10 s, and the median within 2 s.
+    let judged = carries - late;
+    assert!(judged >= robots * SEEDS.len(), "{late} of {carries} carries in the last {RECOVERY} s");
+    assert!(quick * 10 >= judged * 9, "{quick} of {judged} carries found within 10 s");
     let m = book.metrics();
-    assert_eq!(m.kidnap.count as usize, r.kidnaps.len());
-    assert!(m.kidnap.recovered as usize + late >= r.kidnaps.len(), "{m:?}");
+    assert_eq!(m.kidnap.count as usize, carries);
+    assert!(m.kidnap.recovered as usize + late >= carries, "{m:?}");
     assert!(m.kidnap.median_recovery_s.is_some_and(|t| t < 2.0), "{m:?}");
     // The global localizer found some of them (the EKF, matching named landmarks, the others),
     // never wrongly.

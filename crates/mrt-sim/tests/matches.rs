@@ -164,24 +164,26 @@ fn a_match_with_the_same_seed_is_the_same_match() {
     assert!(a.calls.iter().any(|(_, c)| *c == Call::HalfTime));
 }
 
+/// A chaser against a lone keeper shoots in every match and scores within two minutes in at
+/// least half of them (seeds 1–6; the keeper saves some, and some shots go wide).
 #[test]
-fn a_chaser_alone_scores_within_two_minutes() {
+fn a_chaser_against_a_keeper_scores_within_two_minutes_in_half_the_matches() {
     let cfg = short(2.0, 1);
-    let m = BusMatch::with_brains(
-        &cfg,
-        1,
-        vec![Box::new(Chaser { keeper: false })],
-        vec![Box::new(Chaser { keeper: true })],
-    )
-    .unwrap();
-    let report = m.play_until(120.0, |_| {}).unwrap();
-    assert!(report.stats[0].shots > 0, "{:?}", report.stats);
-    assert!(
-        report.score.0 >= 1,
-        "home scored within two minutes: {:?} {:?}",
-        report.score,
-        report.calls
-    );
+    let mut scored = Vec::new();
+    for seed in 1..=6 {
+        let m = BusMatch::with_brains(
+            &cfg,
+            seed,
+            vec![Box::new(Chaser { keeper: false })],
+            vec![Box::new(Chaser { keeper: true })],
+        )
+        .unwrap();
+        let report = m.play_until(120.0, |_| {}).unwrap();
+        assert!(report.stats[0].shots > 0, "seed {seed}: {:?}", report.stats);
+        scored.push(report.score.0);
+    }
+    let matches_won = scored.iter().filter(|&&g| g >= 1).count();
+    assert!(matches_won >= 3, "home scored in {matches_won} of 6 matches: {scored:?}");
 }
 
 /// Milan alone scores within two minutes (TeamChaos: `bus.rs`'s own test).
