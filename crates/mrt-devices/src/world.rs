@@ -172,7 +172,8 @@ impl Answers {
         &self.robots
     }
 
-    /// The key expression of every message the world's robots send (`act` and `bye`).
+    /// The key expression of every message the world's robots send (`act` and `bye`); it
+    /// matches the world's own `sense` messages too, which [`Answers::take`] passes over.
     pub fn subscription(&self) -> String {
         format!("mrt/devices/{PROTOCOL}/{}/*/*", self.world)
     }
@@ -183,8 +184,13 @@ impl Answers {
     }
 
     /// Takes the message `bytes` put on `key`, answering step `step` (`None`: no step is
-    /// asked, acts are late). `None`: dropped and counted.
+    /// asked, acts are late). `None`: dropped and counted, or the world's own `sense` to one
+    /// of its robots, which its subscription ([`Answers::subscription`]) hears too and which
+    /// is no drop.
     pub fn take(&mut self, key: &str, bytes: &[u8], step: Option<u64>) -> Option<Answer> {
+        if key.ends_with("/sense") && self.robots.iter().any(|k| k.sense() == key) {
+            return None;
+        }
         match self.admit(key, bytes, step) {
             Ok(a) => Some(a),
             Err(refusal) => {
@@ -359,6 +365,10 @@ mod tests {
         assert_eq!(a.take(&key, &other, Some(4)), None);
         assert_eq!(a.take("mrt/devices/1/sim/nobody/act", &bytes, Some(4)), None);
         assert_eq!(a.dropped().stranger, 3);
+        // The world's own readings to its robots come back on its subscription: not a drop.
+        let sense = a.keys(1).unwrap().sense();
+        assert_eq!(a.take(&sense, b"{}", Some(4)), None);
+        assert_eq!(a.dropped().total(), 5);
         // Wrong wheels, not a number, not JSON, another protocol.
         let two = serde_json::to_vec(&Act { wheels: Some(vec![1.0, 2.0]), ..act("away-0", 4) });
         assert_eq!(a.take(&key, &two.unwrap(), Some(4)), None);
