@@ -239,12 +239,19 @@ pub fn play(
     )
     .map_err(|e| anyhow!("{e}"))?;
     world.record_frames(record);
-    let tx = Mutex::new(tx);
-    let _mail = port.subscribe(&world.subscription(), move |key, bytes| {
-        if let Ok(tx) = tx.lock() {
-            let _ = tx.send((key.to_string(), bytes));
-        }
-    })?;
+    let _mail = world
+        .subscriptions()
+        .iter()
+        .map(|keys| {
+            let tx = Mutex::new(tx.clone());
+            port.subscribe(keys, move |key, bytes| {
+                if let Ok(tx) = tx.lock() {
+                    let _ = tx.send((key.to_string(), bytes));
+                }
+            })
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    drop(tx);
     // The robots on the network now, by their liveliness tokens; one whose token went away
     // (its process ended) is not waited for.
     let alive_keys: Vec<String> = world.robots().iter().map(|k| k.alive()).collect();

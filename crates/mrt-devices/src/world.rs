@@ -172,10 +172,11 @@ impl Answers {
         &self.robots
     }
 
-    /// The key expression of every message the world's robots send (`act` and `bye`); it
-    /// matches the world's own `sense` messages too, which [`Answers::take`] passes over.
-    pub fn subscription(&self) -> String {
-        format!("mrt/devices/{PROTOCOL}/{}/*/*", self.world)
+    /// The key expressions of every message the world's robots send, `act` and `bye` (and
+    /// not the world's own `sense`, which lies beside them).
+    pub fn subscriptions(&self) -> [String; 2] {
+        let robots = format!("mrt/devices/{PROTOCOL}/{}/*", self.world);
+        [format!("{robots}/act"), format!("{robots}/bye")]
     }
 
     /// What the world's drops were, by reason (`out_of_order`: an answer to another step).
@@ -184,13 +185,8 @@ impl Answers {
     }
 
     /// Takes the message `bytes` put on `key`, answering step `step` (`None`: no step is
-    /// asked, acts are late). `None`: dropped and counted, or the world's own `sense` to one
-    /// of its robots, which its subscription ([`Answers::subscription`]) hears too and which
-    /// is no drop.
+    /// asked, acts are late). `None`: dropped and counted.
     pub fn take(&mut self, key: &str, bytes: &[u8], step: Option<u64>) -> Option<Answer> {
-        if key.ends_with("/sense") && self.robots.iter().any(|k| k.sense() == key) {
-            return None;
-        }
         match self.admit(key, bytes, step) {
             Ok(a) => Some(a),
             Err(refusal) => {
@@ -365,10 +361,12 @@ mod tests {
         assert_eq!(a.take(&key, &other, Some(4)), None);
         assert_eq!(a.take("mrt/devices/1/sim/nobody/act", &bytes, Some(4)), None);
         assert_eq!(a.dropped().stranger, 3);
-        // The world's own readings to its robots come back on its subscription: not a drop.
-        let sense = a.keys(1).unwrap().sense();
-        assert_eq!(a.take(&sense, b"{}", Some(4)), None);
-        assert_eq!(a.dropped().total(), 5);
+        // The world subscribes to its robots' acts and byes, not to its own readings.
+        let [acts, byes] = a.subscriptions();
+        assert_eq!(
+            (acts.as_str(), byes.as_str()),
+            ("mrt/devices/1/sim/*/act", "mrt/devices/1/sim/*/bye")
+        );
         // Wrong wheels, not a number, not JSON, another protocol.
         let two = serde_json::to_vec(&Act { wheels: Some(vec![1.0, 2.0]), ..act("away-0", 4) });
         assert_eq!(a.take(&key, &two.unwrap(), Some(4)), None);

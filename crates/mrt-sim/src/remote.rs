@@ -169,9 +169,9 @@ impl PitchWorld {
         })
     }
 
-    /// The key expression of everything the robots send (their `act`s and `bye`s).
-    pub fn subscription(&self) -> String {
-        self.answers.subscription()
+    /// The key expressions of everything the robots send (their `act`s and `bye`s).
+    pub fn subscriptions(&self) -> [String; 2] {
+        self.answers.subscriptions()
     }
 
     /// The robots' keys, in robot order.
