@@ -15,6 +15,7 @@
 use mrt_robot::spec::Stack;
 use mrt_sim::bus::BusMatch;
 use mrt_sim::config::SimConfig;
+use mrt_sim::metrics::MetricsBook;
 
 /// The seeds: a few, so that a property is not one match's accident.
 const SEEDS: [u64; 4] = [11, 23, 37, 41];
@@ -82,14 +83,6 @@ fn play_checked(
     report
 }
 
-/// The median and the 95th percentile of `v`.
-fn median_and_p95(v: &[f64]) -> (f64, f64) {
-    let mut v = v.to_vec();
-    v.sort_by(f64::total_cmp);
-    let at = |q: f64| v[((v.len() - 1) as f64 * q).round() as usize];
-    (at(0.5), at(0.95))
-}
-
 fn holds_for(home: Stack, away: Stack) {
     let cfg = config();
     for seed in SEEDS {
@@ -97,8 +90,11 @@ fn holds_for(home: Stack, away: Stack) {
         assert!(rep.faults.is_empty(), "seed {seed}: {:?}", rep.faults);
         // Each robot knows where it is: half of its estimates within 25 cm, 95 % within 1 m
         // (the object sensor's noise, the mice's drift, the placements at each kickoff).
-        let (median, p95) = median_and_p95(&rep.localization.position);
-        assert!(rep.localization.position.len() > 1000, "seed {seed}: few estimates");
+        let mut book = MetricsBook::default();
+        book.add(&rep);
+        let l = book.metrics().localization;
+        let (median, p95) = (l.median_m.unwrap_or(f64::NAN), l.p95_m.unwrap_or(f64::NAN));
+        assert!(l.samples > 1000, "seed {seed}: few estimates");
         assert!(
             median < 0.25 && p95 < 1.0,
             "seed {seed}: pose error median {median:.2} m, p95 {p95:.2} m"
