@@ -134,7 +134,7 @@ impl PitchWorld {
     /// A match from `seed` (`teams`: 2, or 1 for the home team alone on the field) in run
     /// `run` (an id of 1–64 of `a–z 0–9 - _`): senses go out through `post`, the robots'
     /// messages come in on `mail` as `(key, bytes)` (subscribe it to
-    /// [`PitchWorld::subscription`]).
+    /// [`PitchWorld::subscriptions`]).
     pub fn new(
         cfg: &SimConfig,
         seed: u64,
